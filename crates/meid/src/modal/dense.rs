@@ -1,0 +1,1 @@
+//! Dense generalised symmetric eigen-solver (to be written).

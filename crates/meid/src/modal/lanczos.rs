@@ -1,0 +1,1 @@
+//! Sparse shift-invert block Lanczos (to be written).

@@ -1,0 +1,123 @@
+//! Modal analysis and the reduced modal model (paper Eq. 9).
+//!
+//! The impact engine never sees a finite-element mesh: it sees a [`ModalModel`],
+//! the structure reduced to `n` mass-normalised modes,
+//!
+//! ```text
+//! q̈_i + Σ_j D_ij q̇_j + ω_i² q_i = Ψ_i · f      (paper Eq. 9; D = diag(2 ζ_i ω_i) for modal damping)
+//! ```
+//!
+//! together with the mode-shape values `Ψ_i(P)` at the named points the impact system
+//! needs (bed contact O_b, floating-base point O_f, measurement point B) and the force
+//! to the floor as a linear function of the modal coordinates. A lumped model, a
+//! finite-element model and a user's table of measured or imported modes all end here.
+//!
+//! Submodules: [`dense`] (dense generalised symmetric eigen-solver), [`lanczos`]
+//! (sparse shift-invert block Lanczos for large models).
+
+pub mod dense;
+pub mod lanczos;
+
+use std::collections::BTreeMap;
+
+use crate::{Error, Result};
+
+/// The force to the floor as a linear function of the modal state:
+/// `F_floor = Σ_i stiffness[i] q_i + Σ_i damping[i] q̇_i` (N), positive when it pushes
+/// the floor in +z (the direction the slider moves).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FloorForce {
+    /// Per mode, N per unit modal coordinate (N / (m·kg^½)).
+    pub stiffness: Vec<f64>,
+    /// Per mode, N per unit modal velocity.
+    pub damping: Vec<f64>,
+}
+
+/// A structure reduced to its modes. All vectors have one entry per retained mode.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModalModel {
+    /// Natural circular frequencies ω_i (rad/s), ascending. Rigid-body modes are exactly 0.
+    pub omega_rad_per_s: Vec<f64>,
+    /// Modal damping matrix D (1/s), row-major `n × n`. For modal damping ratios it is
+    /// `diag(2 ζ_i ω_i)`; discrete dashpots of a lumped model add `Φᵀ C Φ`.
+    pub damping: Vec<f64>,
+    /// Mass-normalised mode-shape values in z at named points (m per unit modal coordinate).
+    pub points: BTreeMap<String, Vec<f64>>,
+    /// Force to the floor, if the structure rests on the floor through something.
+    pub floor_force: Option<FloorForce>,
+    /// A label per mode for tables and plots, e.g. "mode 6".
+    pub labels: Vec<String>,
+}
+
+impl ModalModel {
+    /// Builds a model with modal damping ratios ζ_i: `D = diag(2 ζ_i ω_i)`.
+    pub fn with_damping_ratios(omega_rad_per_s: Vec<f64>, zeta: &[f64]) -> Result<Self> {
+        let n = omega_rad_per_s.len();
+        if zeta.len() != n {
+            return Err(Error::invalid(
+                "damping ratios",
+                format!("{} ratios given for {} modes", zeta.len(), n),
+            ));
+        }
+        let mut damping = vec![0.0; n * n];
+        for i in 0..n {
+            damping[i * n + i] = 2.0 * zeta[i] * omega_rad_per_s[i];
+        }
+        let labels = (1..=n).map(|i| format!("mode {i}")).collect();
+        Ok(Self { omega_rad_per_s, damping, points: BTreeMap::new(), floor_force: None, labels })
+    }
+
+    /// Number of retained modes.
+    pub fn len(&self) -> usize {
+        self.omega_rad_per_s.len()
+    }
+
+    /// True when no mode is retained.
+    pub fn is_empty(&self) -> bool {
+        self.omega_rad_per_s.is_empty()
+    }
+
+    /// Mode-shape values at a named point.
+    pub fn point(&self, name: &str) -> Result<&[f64]> {
+        self.points.get(name).map(|v| v.as_slice()).ok_or_else(|| {
+            let known: Vec<&str> = self.points.keys().map(|s| s.as_str()).collect();
+            Error::invalid("point", format!("no point named '{name}'; known points: {}", known.join(", ")))
+        })
+    }
+
+    /// Checks dimensions and finiteness.
+    pub fn validate(&self) -> Result<()> {
+        let n = self.len();
+        if n == 0 {
+            return Err(Error::invalid("modes", "the modal model has no modes"));
+        }
+        if self.damping.len() != n * n {
+            return Err(Error::invalid("damping", format!("expected {}x{} matrix", n, n)));
+        }
+        for (i, w) in self.omega_rad_per_s.iter().enumerate() {
+            if !w.is_finite() || *w < 0.0 {
+                return Err(Error::invalid(
+                    format!("mode {} frequency", i + 1),
+                    format!("must be finite and >= 0 rad/s (got {w})"),
+                ));
+            }
+        }
+        if self.damping.iter().any(|d| !d.is_finite()) {
+            return Err(Error::invalid("damping", "modal damping matrix has a non-finite entry"));
+        }
+        for (name, v) in &self.points {
+            if v.len() != n || v.iter().any(|x| !x.is_finite()) {
+                return Err(Error::invalid(
+                    format!("point {name}"),
+                    format!("needs {n} finite mode-shape values (got {})", v.len()),
+                ));
+            }
+        }
+        if let Some(f) = &self.floor_force {
+            if f.stiffness.len() != n || f.damping.len() != n {
+                return Err(Error::invalid("floor force", format!("needs {n} coefficients per kind")));
+            }
+        }
+        Ok(())
+    }
+}
