@@ -30,14 +30,23 @@ pub enum Error {
 impl Error {
     /// Shorthand for [`Error::InvalidValue`].
     pub fn invalid(field: impl Into<String>, message: impl Into<String>) -> Self {
-        Error::InvalidValue { field: field.into(), message: message.into() }
+        Error::InvalidValue {
+            field: field.into(),
+            message: message.into(),
+        }
     }
     /// Shorthand for [`Error::Numerical`].
     pub fn numerical(context: impl Into<String>, message: impl Into<String>) -> Self {
-        Error::Numerical { context: context.into(), message: message.into() }
+        Error::Numerical {
+            context: context.into(),
+            message: message.into(),
+        }
     }
     /// Shorthand for [`Error::Io`].
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
-        Error::Io { path: path.into(), source }
+        Error::Io {
+            path: path.into(),
+            source,
+        }
     }
 }

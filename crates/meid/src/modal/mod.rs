@@ -64,7 +64,13 @@ impl ModalModel {
             damping[i * n + i] = 2.0 * zeta[i] * omega_rad_per_s[i];
         }
         let labels = (1..=n).map(|i| format!("mode {i}")).collect();
-        Ok(Self { omega_rad_per_s, damping, points: BTreeMap::new(), floor_force: None, labels })
+        Ok(Self {
+            omega_rad_per_s,
+            damping,
+            points: BTreeMap::new(),
+            floor_force: None,
+            labels,
+        })
     }
 
     /// Number of retained modes.
@@ -81,7 +87,13 @@ impl ModalModel {
     pub fn point(&self, name: &str) -> Result<&[f64]> {
         self.points.get(name).map(|v| v.as_slice()).ok_or_else(|| {
             let known: Vec<&str> = self.points.keys().map(|s| s.as_str()).collect();
-            Error::invalid("point", format!("no point named '{name}'; known points: {}", known.join(", ")))
+            Error::invalid(
+                "point",
+                format!(
+                    "no point named '{name}'; known points: {}",
+                    known.join(", ")
+                ),
+            )
         })
     }
 
@@ -92,7 +104,10 @@ impl ModalModel {
             return Err(Error::invalid("modes", "the modal model has no modes"));
         }
         if self.damping.len() != n * n {
-            return Err(Error::invalid("damping", format!("expected {}x{} matrix", n, n)));
+            return Err(Error::invalid(
+                "damping",
+                format!("expected {}x{} matrix", n, n),
+            ));
         }
         for (i, w) in self.omega_rad_per_s.iter().enumerate() {
             if !w.is_finite() || *w < 0.0 {
@@ -103,7 +118,10 @@ impl ModalModel {
             }
         }
         if self.damping.iter().any(|d| !d.is_finite()) {
-            return Err(Error::invalid("damping", "modal damping matrix has a non-finite entry"));
+            return Err(Error::invalid(
+                "damping",
+                "modal damping matrix has a non-finite entry",
+            ));
         }
         for (name, v) in &self.points {
             if v.len() != n || v.iter().any(|x| !x.is_finite()) {
@@ -115,7 +133,10 @@ impl ModalModel {
         }
         if let Some(f) = &self.floor_force {
             if f.stiffness.len() != n || f.damping.len() != n {
-                return Err(Error::invalid("floor force", format!("needs {n} coefficients per kind")));
+                return Err(Error::invalid(
+                    "floor force",
+                    format!("needs {n} coefficients per kind"),
+                ));
             }
         }
         Ok(())
