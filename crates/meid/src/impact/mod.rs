@@ -1,1 +1,666 @@
-//! (module under construction)
+//! The impact system of the paper (Eqs. 1-9): slider, bed (a modal structure), impact damper.
+//!
+//! # Coordinates and sign convention
+//! All displacements are along one axis `z`, **positive in the direction the slider moves when
+//! it strikes** (downwards on a press). Generalised coordinates, in this order:
+//!
+//! ```text
+//! x = [q_1 … q_n,  z_s,  z_d]      (z_d only when there is an impact damper)
+//! ```
+//!
+//! `q_i` are the modal coordinates of the structure (mass-normalised modes, paper Eq. 9),
+//! `u_P = Σ_i Ψ_i(P) q_i` the displacement of structure point `P`. All start at rest at 0,
+//! with the slider touching the bed (`z_s = u_b = 0`) at `v_s`, and the damper touching the bed
+//! from the other side (`u_b = z_d = 0`) without preload (gravity and static preloads are
+//! equilibrium offsets and drop out of the linear dynamics).
+//!
+//! Forces (paper Eqs. 5-8), each a spring-dashpot acting on a relative displacement `δ = aᵀx`:
+//!
+//! | element | `δ` | force | acts |
+//! |---|---|---|---|
+//! | slider-bed contact (K_s, C_s) | `z_s − u_b` (overlap) | `f_bs = K_s δ + C_s δ̇` while closed | `−f_bs` on the slider, `+f_bs` on the bed at O_b |
+//! | bed-damper contact (K_d, C_d) | `u_b − z_d` (overlap) | `f_bd = K_d δ + C_d δ̇` while closed | `−f_bd` on the bed, `+f_bd` on the damper |
+//! | damper spring + dashpot (k_d, c_d) | `z_d − u_f` | `f_fd = k_d δ + c_d δ̇` | `−f_fd` on the damper, `+f_fd` on the base at O_f |
+//!
+//! so that `M ẍ + C_σ ẋ + K_σ x = 0`, with `M = diag(1,…,1, m_s, m_d)` and `K_σ`, `C_σ`
+//! depending on the *mode* `σ`: which contacts are closed and whether the one-way dashpot acts.
+//!
+//! # Switching rules
+//! * A contact is **closed** while its overlap `δ > 0`. With [`Release::Force`] (the default) it
+//!   also needs a compressive force `f > 0`, so a damped contact never pulls: it releases when the
+//!   force returns to zero, slightly before the overlap does. [`Release::Overlap`] is Eq. (5)/(8)
+//!   literally: the contact holds until `δ = 0` and may pull (`C δ̇ < 0`) just before release.
+//!   With `C = 0` the two rules coincide.
+//! * The damper dashpot is **one-way** (Eq. 7): `c_d` acts only while `ż_d − u̇_f < 0`,
+//!   i.e. while the damper moves back towards the bed; the damper moves away from the bed freely.
+//!   [`DashpotKind::TwoWay`] makes it act always.
+//!
+//! Between switches the system is linear and time invariant (for [`ContactLaw::Linear`]);
+//! [`crate::integrate`] propagates it exactly. Hertz and Hunt-Crossley laws need `dopri5`.
+
+use faer::Mat;
+
+use crate::modal::{FloorForce, ModalModel};
+use crate::{Error, Result};
+
+/// Force law of a unilateral contact as a function of overlap `δ > 0` and its rate `δ̇`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ContactLaw {
+    /// `f = K δ + C δ̇` (K in N/m, C in N·s/m): paper Eqs. (5) and (8).
+    Linear { stiffness: f64, damping: f64 },
+    /// `f = K δ^{3/2}` (K in N/m^1.5): Hertz contact of curved surfaces.
+    Hertz { stiffness: f64 },
+    /// Hunt-Crossley: `f = K δ^n (1 + 3/2 α δ̇)` (K in N/m^n, α in s/m); `n = 1.5` for Hertzian
+    /// geometry. The coefficient of restitution is about `1 − α v₀` for small `α v₀`.
+    HuntCrossley {
+        stiffness: f64,
+        exponent: f64,
+        alpha: f64,
+    },
+}
+
+impl ContactLaw {
+    /// True for the piecewise-linear law the exact propagator handles.
+    pub fn is_linear(&self) -> bool {
+        matches!(self, ContactLaw::Linear { .. })
+    }
+
+    /// Contact force (N) for overlap `δ` (m) and rate `δ̇` (m/s); the raw law, no clamping.
+    #[inline]
+    pub fn force(&self, delta: f64, rate: f64) -> f64 {
+        match *self {
+            ContactLaw::Linear { stiffness, damping } => stiffness * delta + damping * rate,
+            ContactLaw::Hertz { stiffness } => stiffness * delta.max(0.0).powf(1.5),
+            ContactLaw::HuntCrossley {
+                stiffness,
+                exponent,
+                alpha,
+            } => stiffness * delta.max(0.0).powf(exponent) * (1.0 + 1.5 * alpha * rate),
+        }
+    }
+
+    /// A function whose sign is the sign of the force while `δ > 0` (used for the
+    /// force-release rule). Linear: `K δ + C δ̇`; Hunt-Crossley: `1 + 3/2 α δ̇`; Hertz: `δ`.
+    #[inline]
+    pub fn force_sign_function(&self, delta: f64, rate: f64) -> f64 {
+        match *self {
+            ContactLaw::Linear { stiffness, damping } => stiffness * delta + damping * rate,
+            ContactLaw::Hertz { .. } => delta,
+            ContactLaw::HuntCrossley { alpha, .. } => 1.0 + 1.5 * alpha * rate,
+        }
+    }
+
+    /// Stiffness coefficient K of the law.
+    pub fn stiffness(&self) -> f64 {
+        match *self {
+            ContactLaw::Linear { stiffness, .. }
+            | ContactLaw::Hertz { stiffness }
+            | ContactLaw::HuntCrossley { stiffness, .. } => stiffness,
+        }
+    }
+
+    /// True when the law has a rate-dependent (dissipative) part.
+    pub fn is_damped(&self) -> bool {
+        match *self {
+            ContactLaw::Linear { damping, .. } => damping != 0.0,
+            ContactLaw::Hertz { .. } => false,
+            ContactLaw::HuntCrossley { alpha, .. } => alpha != 0.0,
+        }
+    }
+
+    /// Stored elastic energy (J) at overlap `δ > 0`: `K δ²/2` (linear) or `K δ^{n+1}/(n+1)`.
+    pub fn potential_energy(&self, delta: f64) -> f64 {
+        if delta <= 0.0 {
+            return 0.0;
+        }
+        match *self {
+            ContactLaw::Linear { stiffness, .. } => 0.5 * stiffness * delta * delta,
+            ContactLaw::Hertz { stiffness } => stiffness * delta.powf(2.5) / 2.5,
+            ContactLaw::HuntCrossley {
+                stiffness,
+                exponent,
+                ..
+            } => stiffness * delta.powf(exponent + 1.0) / (exponent + 1.0),
+        }
+    }
+}
+
+/// When a damped contact lets go. See the module documentation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Release {
+    /// Release when the contact force returns to zero: a contact never pulls (default).
+    #[default]
+    Force,
+    /// Release when the overlap returns to zero (paper Eqs. 5 and 8 literally).
+    Overlap,
+}
+
+/// A unilateral contact: a force law and a release rule.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Contact {
+    pub law: ContactLaw,
+    pub release: Release,
+}
+
+/// The striking slider (rigid body).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Slider {
+    /// m_s (kg).
+    pub mass: f64,
+    /// v_s (m/s), speed at first contact, positive towards the bed.
+    pub velocity: f64,
+}
+
+/// Whether the damper dashpot acts both ways or only while the damper returns (Eq. 7).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DashpotKind {
+    /// `c_d` acts only while `ż_d − u̇_f < 0` (paper Eq. 7).
+    #[default]
+    OneWay,
+    /// `c_d` always acts.
+    TwoWay,
+}
+
+/// The impact-damper mass on its spring and dashpot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Damper {
+    /// m_d (kg).
+    pub mass: f64,
+    /// k_d (N/m).
+    pub stiffness: f64,
+    /// c_d (N·s/m).
+    pub damping: f64,
+    pub dashpot: DashpotKind,
+}
+
+/// Which structure points the impact system uses: mode-shape values per retained mode.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Points {
+    /// O_b: where the slider strikes and the damper touches the bed.
+    pub bed_contact: Vec<f64>,
+    /// O_f: where the damper spring is anchored; `None` anchors it to the ground.
+    pub damper_anchor: Option<Vec<f64>>,
+    /// B: where the bed acceleration is measured.
+    pub measurement: Vec<f64>,
+}
+
+/// A switch of the piecewise system: a contact or the one-way dashpot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Switch {
+    SliderBed,
+    BedDamper,
+    Dashpot,
+}
+
+/// The discrete state: bit 0 slider-bed closed, bit 1 bed-damper closed, bit 2 dashpot acting.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, PartialOrd, Ord)]
+pub struct Mode(pub u8);
+
+impl Mode {
+    pub const SLIDER_BED: u8 = 1;
+    pub const BED_DAMPER: u8 = 2;
+    pub const DASHPOT: u8 = 4;
+    /// Is this switch on (contact closed, dashpot acting)?
+    #[inline]
+    pub fn on(self, s: Switch) -> bool {
+        self.0 & Self::bit(s) != 0
+    }
+    #[inline]
+    pub fn bit(s: Switch) -> u8 {
+        match s {
+            Switch::SliderBed => Self::SLIDER_BED,
+            Switch::BedDamper => Self::BED_DAMPER,
+            Switch::Dashpot => Self::DASHPOT,
+        }
+    }
+    /// This mode with switch `s` set to `on`.
+    #[inline]
+    pub fn with(self, s: Switch, on: bool) -> Mode {
+        if on {
+            Mode(self.0 | Self::bit(s))
+        } else {
+            Mode(self.0 & !Self::bit(s))
+        }
+    }
+}
+
+/// One of the scalar functions whose sign decides a switch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Indicator {
+    /// Overlap `δ` of a contact.
+    Overlap(Switch),
+    /// The force-sign function of a contact (force-release rule only).
+    Force(Switch),
+    /// Relative velocity `ż_d − u̇_f` of the damper dashpot (one-way dashpot only).
+    DashpotVelocity,
+}
+
+/// The complete impact system: a modal structure, the slider, an optional damper and contacts.
+#[derive(Debug, Clone)]
+pub struct ImpactSystem {
+    /// The structure (already including an added mass, if that is the case studied).
+    pub structure: ModalModel,
+    pub points: Points,
+    pub slider: Slider,
+    pub damper: Option<Damper>,
+    pub slider_bed: Contact,
+    /// Present exactly when `damper` is.
+    pub bed_damper: Option<Contact>,
+    /// Added mass fixed to the bed (kg), for reports; already in `structure`.
+    pub added_mass: f64,
+    floor: FloorForce,
+    has_floor: bool,
+}
+
+/// What (if anything) is attached to the bed to reduce the blow's effect.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Absorber {
+    /// Nothing: the bare machine.
+    None,
+    /// A momentum-exchange impact damper with its bed-damper contact.
+    Damper(Damper, Contact),
+    /// A rigid mass (kg) fixed to the bed at O_b.
+    AddedMass(f64),
+}
+
+impl ImpactSystem {
+    /// Assembles the system. `bed_contact`, `damper_anchor` (`None` = ground) and `measurement`
+    /// name points of `structure`.
+    pub fn new(
+        structure: &ModalModel,
+        bed_contact: &str,
+        damper_anchor: Option<&str>,
+        measurement: &str,
+        slider: Slider,
+        slider_bed: Contact,
+        absorber: Absorber,
+    ) -> Result<Self> {
+        structure.validate()?;
+        check_positive("slider.mass", slider.mass, "kg")?;
+        if !(slider.velocity.is_finite() && slider.velocity > 0.0) {
+            return Err(Error::invalid(
+                "slider.velocity",
+                format!("must be > 0 m/s towards the bed (got {})", slider.velocity),
+            ));
+        }
+        check_contact("contact.slider_bed", &slider_bed)?;
+        let (structure, damper, bed_damper, added_mass) = match absorber {
+            Absorber::None => (structure.clone(), None, None, 0.0),
+            Absorber::Damper(d, c) => {
+                check_positive("damper.mass", d.mass, "kg")?;
+                check_non_negative("damper.stiffness", d.stiffness, "N/m")?;
+                check_non_negative("damper.damping", d.damping, "N·s/m")?;
+                check_contact("contact.bed_damper", &c)?;
+                (structure.clone(), Some(d), Some(c), 0.0)
+            }
+            Absorber::AddedMass(m) => {
+                check_positive("added_mass.mass", m, "kg")?;
+                (structure.with_point_mass(bed_contact, m)?, None, None, m)
+            }
+        };
+        let points = Points {
+            bed_contact: structure.point(bed_contact)?.to_vec(),
+            damper_anchor: match damper_anchor {
+                Some(p) => Some(structure.point(p)?.to_vec()),
+                None => None,
+            },
+            measurement: structure.point(measurement)?.to_vec(),
+        };
+        let n = structure.len();
+        let (floor, has_floor) = match &structure.floor_force {
+            Some(f) => (f.clone(), true),
+            None => (
+                FloorForce {
+                    stiffness: vec![0.0; n],
+                    damping: vec![0.0; n],
+                },
+                false,
+            ),
+        };
+        Ok(Self {
+            structure,
+            points,
+            slider,
+            damper,
+            slider_bed,
+            bed_damper,
+            added_mass,
+            floor,
+            has_floor,
+        })
+    }
+
+    /// Number of structural modes n.
+    #[inline]
+    pub fn n_modes(&self) -> usize {
+        self.structure.len()
+    }
+    /// Number of second-order coordinates: n + 1 (+1 with a damper).
+    #[inline]
+    pub fn dofs(&self) -> usize {
+        self.n_modes() + 1 + usize::from(self.damper.is_some())
+    }
+    /// Index of z_s.
+    #[inline]
+    pub fn slider_index(&self) -> usize {
+        self.n_modes()
+    }
+    /// Index of z_d (only meaningful with a damper).
+    #[inline]
+    pub fn damper_index(&self) -> usize {
+        self.n_modes() + 1
+    }
+    /// True when the structure has a force path to the floor (or the damper is anchored to it).
+    pub fn has_floor_force(&self) -> bool {
+        self.has_floor || (self.damper.is_some() && self.points.damper_anchor.is_none())
+    }
+
+    /// The switches present in this system, in a fixed order.
+    pub fn switches(&self) -> Vec<Switch> {
+        let mut s = vec![Switch::SliderBed];
+        if let Some(d) = &self.damper {
+            s.push(Switch::BedDamper);
+            if d.dashpot == DashpotKind::OneWay && d.damping > 0.0 {
+                s.push(Switch::Dashpot);
+            }
+        }
+        s
+    }
+
+    /// The indicators whose signs decide the switches.
+    pub fn indicators(&self) -> Vec<Indicator> {
+        let mut out = Vec::new();
+        for s in self.switches() {
+            match s {
+                Switch::Dashpot => out.push(Indicator::DashpotVelocity),
+                c => {
+                    out.push(Indicator::Overlap(c));
+                    let contact = self.contact(c);
+                    if contact.release == Release::Force && contact.law.is_damped() {
+                        out.push(Indicator::Force(c));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The contact behind a contact switch.
+    pub fn contact(&self, s: Switch) -> &Contact {
+        match s {
+            Switch::BedDamper => self.bed_damper.as_ref().unwrap_or(&self.slider_bed),
+            _ => &self.slider_bed,
+        }
+    }
+
+    /// Masses of the second-order coordinates: `[1, …, 1, m_s, m_d]`.
+    pub fn mass_diag(&self) -> Vec<f64> {
+        let mut m = vec![1.0; self.dofs()];
+        m[self.slider_index()] = self.slider.mass;
+        if let Some(d) = &self.damper {
+            m[self.damper_index()] = d.mass;
+        }
+        m
+    }
+
+    /// The vector `a` with `δ = aᵀx` for a switch (overlap for contacts, `z_d − u_f` for the dashpot).
+    pub fn relative_vector(&self, s: Switch) -> Vec<f64> {
+        let n = self.n_modes();
+        let mut a = vec![0.0; self.dofs()];
+        match s {
+            Switch::SliderBed => {
+                for i in 0..n {
+                    a[i] = -self.points.bed_contact[i];
+                }
+                a[self.slider_index()] = 1.0;
+            }
+            Switch::BedDamper => {
+                a[..n].copy_from_slice(&self.points.bed_contact);
+                a[self.damper_index()] = -1.0;
+            }
+            Switch::Dashpot => {
+                if let Some(f) = &self.points.damper_anchor {
+                    for i in 0..n {
+                        a[i] = -f[i];
+                    }
+                }
+                a[self.damper_index()] = 1.0;
+            }
+        }
+        a
+    }
+
+    /// Second-order stiffness and damping matrices `K_σ`, `C_σ` (`dofs × dofs`) of a mode,
+    /// for linear contact laws (a non-linear law contributes its linear part, none for Hertz).
+    pub fn matrices(&self, mode: Mode) -> (Mat<f64>, Mat<f64>) {
+        let n = self.n_modes();
+        let nd = self.dofs();
+        let mut k = Mat::<f64>::zeros(nd, nd);
+        let mut c = Mat::<f64>::zeros(nd, nd);
+        for i in 0..n {
+            k[(i, i)] = self.structure.omega_rad_per_s[i].powi(2);
+            for j in 0..n {
+                c[(i, j)] = self.structure.damping[i * n + j];
+            }
+        }
+        let mut add = |a: &[f64], kk: f64, cc: f64| {
+            for i in 0..nd {
+                if a[i] == 0.0 {
+                    continue;
+                }
+                for j in 0..nd {
+                    k[(i, j)] += kk * a[i] * a[j];
+                    c[(i, j)] += cc * a[i] * a[j];
+                }
+            }
+        };
+        for s in [Switch::SliderBed, Switch::BedDamper] {
+            if s == Switch::BedDamper && self.damper.is_none() {
+                continue;
+            }
+            if mode.on(s) {
+                if let ContactLaw::Linear { stiffness, damping } = self.contact(s).law {
+                    add(&self.relative_vector(s), stiffness, damping);
+                }
+            }
+        }
+        if let Some(d) = &self.damper {
+            let dashpot_on = match d.dashpot {
+                DashpotKind::TwoWay => true,
+                DashpotKind::OneWay => mode.on(Switch::Dashpot),
+            };
+            add(
+                &self.relative_vector(Switch::Dashpot),
+                d.stiffness,
+                if dashpot_on { d.damping } else { 0.0 },
+            );
+        }
+        (k, c)
+    }
+
+    /// First-order matrix `A_σ = [[0, I], [−M⁻¹K_σ, −M⁻¹C_σ]]` for the state `X = [x; ẋ]`.
+    pub fn first_order(&self, mode: Mode) -> Mat<f64> {
+        let nd = self.dofs();
+        let (k, c) = self.matrices(mode);
+        let m = self.mass_diag();
+        let mut a = Mat::<f64>::zeros(2 * nd, 2 * nd);
+        for i in 0..nd {
+            a[(i, nd + i)] = 1.0;
+            for j in 0..nd {
+                a[(nd + i, j)] = -k[(i, j)] / m[i];
+                a[(nd + i, nd + j)] = -c[(i, j)] / m[i];
+            }
+        }
+        a
+    }
+
+    /// The initial state: everything at rest at 0, the slider moving at `v_s`.
+    pub fn initial_state(&self) -> Vec<f64> {
+        let nd = self.dofs();
+        let mut x = vec![0.0; 2 * nd];
+        x[nd + self.slider_index()] = self.slider.velocity;
+        x
+    }
+
+    /// Row vector `ℓ` with `value = ℓᵀX` for an indicator (linear laws; for Hunt-Crossley's
+    /// force indicator this is the rate part only and [`Self::indicator_value`] adds the constant).
+    pub fn indicator_vector(&self, ind: Indicator) -> Vec<f64> {
+        let nd = self.dofs();
+        let mut l = vec![0.0; 2 * nd];
+        match ind {
+            Indicator::Overlap(s) => {
+                l[..nd].copy_from_slice(&self.relative_vector(s));
+            }
+            Indicator::DashpotVelocity => {
+                l[nd..].copy_from_slice(&self.relative_vector(Switch::Dashpot));
+            }
+            Indicator::Force(s) => {
+                let a = self.relative_vector(s);
+                match self.contact(s).law {
+                    ContactLaw::Linear { stiffness, damping } => {
+                        for i in 0..nd {
+                            l[i] = stiffness * a[i];
+                            l[nd + i] = damping * a[i];
+                        }
+                    }
+                    ContactLaw::Hertz { .. } => l[..nd].copy_from_slice(&a),
+                    ContactLaw::HuntCrossley { alpha, .. } => {
+                        for i in 0..nd {
+                            l[nd + i] = 1.5 * alpha * a[i];
+                        }
+                    }
+                }
+            }
+        }
+        l
+    }
+
+    /// Value of an indicator at state `X`.
+    pub fn indicator_value(&self, ind: Indicator, x: &[f64]) -> f64 {
+        let nd = self.dofs();
+        let (s, is_force) = match ind {
+            Indicator::Overlap(s) => (s, false),
+            Indicator::Force(s) => (s, true),
+            Indicator::DashpotVelocity => {
+                return dot(&self.relative_vector(Switch::Dashpot), &x[nd..])
+            }
+        };
+        let a = self.relative_vector(s);
+        let d = dot(&a, &x[..nd]);
+        if !is_force {
+            return d;
+        }
+        let r = dot(&a, &x[nd..]);
+        self.contact(s).law.force_sign_function(d, r)
+    }
+
+    /// The switch state implied by indicator signs (`+1`, `−1`): contacts closed while the
+    /// overlap (and, with force release, the force) is positive; dashpot on while returning.
+    pub fn switch_on(&self, s: Switch, sign_of: &dyn Fn(Indicator) -> f64) -> bool {
+        match s {
+            Switch::Dashpot => sign_of(Indicator::DashpotVelocity) < 0.0,
+            c => {
+                let contact = self.contact(c);
+                let overlap = sign_of(Indicator::Overlap(c)) > 0.0;
+                if contact.release == Release::Force && contact.law.is_damped() {
+                    overlap && sign_of(Indicator::Force(c)) > 0.0
+                } else {
+                    overlap
+                }
+            }
+        }
+    }
+
+    /// Generalised contact and damper forces at state `X` in mode `mode`, for any law:
+    /// returns `(f_bs, f_bd, f_fd)` (N).
+    pub fn element_forces(&self, mode: Mode, x: &[f64]) -> (f64, f64, f64) {
+        let nd = self.dofs();
+        let f = |s: Switch| {
+            if !mode.on(s) {
+                return 0.0;
+            }
+            let a = self.relative_vector(s);
+            self.contact(s)
+                .law
+                .force(dot(&a, &x[..nd]), dot(&a, &x[nd..]))
+        };
+        let fbs = f(Switch::SliderBed);
+        let (fbd, ffd) = match &self.damper {
+            Some(d) => {
+                let a = self.relative_vector(Switch::Dashpot);
+                let (del, rate) = (dot(&a, &x[..nd]), dot(&a, &x[nd..]));
+                let c_on = match d.dashpot {
+                    DashpotKind::TwoWay => true,
+                    DashpotKind::OneWay => mode.on(Switch::Dashpot),
+                };
+                (
+                    f(Switch::BedDamper),
+                    d.stiffness * del + if c_on { d.damping * rate } else { 0.0 },
+                )
+            }
+            None => (0.0, 0.0),
+        };
+        (fbs, fbd, ffd)
+    }
+
+    /// Force to the floor (N) at state `X`: the structure's ground reactions plus the damper
+    /// spring/dashpot force when the damper is anchored to the ground.
+    pub fn floor_force(&self, mode: Mode, x: &[f64]) -> f64 {
+        let n = self.n_modes();
+        let nd = self.dofs();
+        let mut f = dot(&self.floor.stiffness, &x[..n]) + dot(&self.floor.damping, &x[nd..nd + n]);
+        if self.damper.is_some() && self.points.damper_anchor.is_none() {
+            f += self.element_forces(mode, x).2;
+        }
+        f
+    }
+}
+
+/// `Σ a_i b_i`.
+#[inline]
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn check_positive(field: &str, v: f64, unit: &str) -> Result<()> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            field,
+            format!("must be a finite number > 0 {unit} (got {v})"),
+        ))
+    }
+}
+
+fn check_non_negative(field: &str, v: f64, unit: &str) -> Result<()> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            field,
+            format!("must be a finite number >= 0 {unit} (got {v})"),
+        ))
+    }
+}
+
+fn check_contact(field: &str, c: &Contact) -> Result<()> {
+    match c.law {
+        ContactLaw::Linear { stiffness, damping } => {
+            check_positive(&format!("{field}.stiffness"), stiffness, "N/m")?;
+            check_non_negative(&format!("{field}.damping"), damping, "N·s/m")
+        }
+        ContactLaw::Hertz { stiffness } => {
+            check_positive(&format!("{field}.stiffness"), stiffness, "N/m^1.5")
+        }
+        ContactLaw::HuntCrossley {
+            stiffness,
+            exponent,
+            alpha,
+        } => {
+            check_positive(&format!("{field}.stiffness"), stiffness, "N/m^n")?;
+            check_positive(&format!("{field}.exponent"), exponent, "")?;
+            check_non_negative(&format!("{field}.alpha"), alpha, "s/m")
+        }
+    }
+}

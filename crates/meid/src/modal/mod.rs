@@ -97,6 +97,63 @@ impl ModalModel {
         })
     }
 
+    /// The same structure with a rigid point mass `mass_kg` fixed at point `point`, by
+    /// Rayleigh-Ritz on the retained modes (exact when all modes of the structure are retained,
+    /// e.g. a lumped model):
+    ///
+    /// ```text
+    /// (I + m ψ ψᵀ) q̈ + D q̇ + Ω² q = 0,   ψ = Ψ(point);   solve Ω² y = λ (I + m ψ ψᵀ) y,
+    /// q = Y q',  Ω'² = Yᵀ Ω² Y,  D' = Yᵀ D Y,  Ψ'(P) = Yᵀ Ψ(P).
+    /// ```
+    pub fn with_point_mass(&self, point: &str, mass_kg: f64) -> Result<ModalModel> {
+        use faer::Mat;
+        let n = self.len();
+        let psi = self.point(point)?.to_vec();
+        let mut k = Mat::<f64>::zeros(n, n);
+        let mut m = Mat::<f64>::zeros(n, n);
+        for i in 0..n {
+            k[(i, i)] = self.omega_rad_per_s[i].powi(2);
+            for j in 0..n {
+                m[(i, j)] = mass_kg * psi[i] * psi[j] + if i == j { 1.0 } else { 0.0 };
+            }
+        }
+        let modes = dense::solve(k.as_ref(), m.as_ref())?;
+        let y = &modes.shapes;
+        let project = |v: &[f64]| -> Vec<f64> {
+            (0..n)
+                .map(|j| (0..n).map(|i| y[(i, j)] * v[i]).sum())
+                .collect()
+        };
+        let mut damping = vec![0.0; n * n];
+        for a in 0..n {
+            for b in 0..n {
+                let mut s = 0.0;
+                for i in 0..n {
+                    for j in 0..n {
+                        s += y[(i, a)] * self.damping[i * n + j] * y[(j, b)];
+                    }
+                }
+                damping[a * n + b] = s;
+            }
+        }
+        let points = self
+            .points
+            .iter()
+            .map(|(k, v)| (k.clone(), project(v)))
+            .collect();
+        let floor_force = self.floor_force.as_ref().map(|f| FloorForce {
+            stiffness: project(&f.stiffness),
+            damping: project(&f.damping),
+        });
+        Ok(ModalModel {
+            omega_rad_per_s: modes.omega_rad_per_s,
+            damping,
+            points,
+            floor_force,
+            labels: (1..=n).map(|i| format!("mode {i}")).collect(),
+        })
+    }
+
     /// Checks dimensions and finiteness.
     pub fn validate(&self) -> Result<()> {
         let n = self.len();

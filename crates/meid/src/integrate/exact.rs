@@ -1,0 +1,339 @@
+//! Exact event-driven propagation of the piecewise-linear impact system.
+//!
+//! Each mode's closed-form [`Propagator`] is built the first time the mode is entered and kept
+//! for the run. A stretch in one mode is handled as follows:
+//!
+//! 1. the side of every indicator at the stretch start ([`super::switching::lex_sign`]);
+//! 2. the first sign change of any indicator on the closed-form solution ([`super::roots`]),
+//!    capped by the end of the run;
+//! 3. output samples inside the stretch: the first evaluated in closed form, the next ones by
+//!    the real transition matrix `E = exp(A Δt)` (one mat-vec per sample), re-seeded from the
+//!    closed form every 64 samples;
+//! 4. exact contact-force maxima (roots of the force's derivative), closed-contact times, and
+//!    the dissipated energy `∫ ẋᵀ C_σ ẋ dt` integrated in closed form;
+//! 5. the new mode at the switch ([`super::switching::select_mode`]).
+
+use std::collections::HashMap;
+
+use faer::{c64, Mat};
+
+use super::propagator::{Functional, Propagator, Segment};
+use super::roots::{all_crossings, first_crossing, SearchOptions};
+use super::switching::{lex_sign, select_mode};
+use super::{CollisionEnd, Event, Grid, Observer, Options, Solution, Totals};
+use crate::impact::{ImpactSystem, Indicator, Mode, Switch};
+use crate::{Error, Result};
+
+struct ModeData {
+    prop: Propagator,
+    c: Mat<f64>,
+    /// Transition matrix for the output step.
+    step: Option<Mat<f64>>,
+}
+
+/// Runs the exact propagator. See the module documentation.
+pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Result<Solution> {
+    for s in [Switch::SliderBed, Switch::BedDamper] {
+        if (s == Switch::SliderBed || sys.damper.is_some()) && !sys.contact(s).law.is_linear() {
+            return Err(Error::invalid(
+                "simulation.method",
+                "method 'exact' needs linear contact laws; use 'dopri5' for hertz or hunt-crossley",
+            ));
+        }
+    }
+    let nd = sys.dofs();
+    let n = 2 * nd;
+    let masses = sys.mass_diag();
+    let inds = sys.indicators();
+    let ind_vecs: Vec<Vec<f64>> = inds.iter().map(|&i| sys.indicator_vector(i)).collect();
+    let mut cache: HashMap<Mode, ModeData> = HashMap::new();
+    let mut grid = Grid::new(opts.sample_rate);
+    let t_end = opts.duration;
+
+    let build = |mode: Mode| -> Result<ModeData> {
+        let (k, c) = sys.matrices(mode);
+        let a = sys.first_order(mode);
+        let prop = Propagator::new(&k, &c, &masses, a)?;
+        Ok(ModeData {
+            prop,
+            c,
+            step: None,
+        })
+    };
+
+    let mut x = sys.initial_state();
+    let mut t = 0.0;
+    let (mut mode, _) = select_mode(sys, &x, Mode(0), &mut |m| sys.first_order(m));
+    let mut events = Vec::new();
+    let mut totals = Totals::default();
+    let mut collision_end: Option<CollisionEnd> = None;
+    let mut segments = 0usize;
+    let mut zero_length = 0usize;
+    let mut buf = vec![0.0; n];
+    let mut buf2 = vec![0.0; n];
+
+    loop {
+        if !cache.contains_key(&mode) {
+            let md = build(mode)?;
+            cache.insert(mode, md);
+        }
+        let md = cache
+            .get_mut(&mode)
+            .ok_or_else(|| Error::numerical("exact", "mode cache"))?;
+        if let (Some(g), None) = (&grid, &md.step) {
+            md.step = Some(md.prop.transition(g.dt));
+        }
+        let md = &*md;
+        let prop = &md.prop;
+        let seg = prop.segment(&x);
+        let period = prop.period();
+        let search = SearchOptions::default();
+        segments += 1;
+
+        // 1-2: the first switch.
+        let mut s_end = t_end - t;
+        let mut switched = false;
+        for l in &ind_vecs {
+            let sign0 = lex_sign(l, &prop.a, &x);
+            if sign0 == 0.0 {
+                continue; // identically zero: never crosses
+            }
+            let f = seg.functional(l);
+            if let Some(s) = first_crossing(&f, s_end, sign0, search) {
+                if s < s_end {
+                    s_end = s;
+                    switched = true;
+                }
+            }
+        }
+        if s_end < 0.0 {
+            s_end = 0.0;
+        }
+
+        // 3: output samples in [t, t + s_end) (and at t_end on the last stretch).
+        if let Some(g) = grid.as_mut() {
+            let last = !switched;
+            let mut j = g.next;
+            let mut k = 0usize;
+            let step = md.step.as_ref();
+            loop {
+                let tj = g.time(j);
+                let inside = if last {
+                    tj <= t + s_end * (1.0 + 1e-15) + 1e-15 * t_end
+                } else {
+                    tj < t + s_end
+                };
+                if !inside || tj > t_end * (1.0 + 1e-12) {
+                    break;
+                }
+                if k % 64 == 0 || step.is_none() {
+                    seg.state(tj - t, &mut buf);
+                } else if let Some(e) = step {
+                    for i in 0..n {
+                        buf2[i] = (0..n).map(|c| e[(i, c)] * buf[c]).sum();
+                    }
+                    std::mem::swap(&mut buf, &mut buf2);
+                }
+                obs.sample(tj, &buf, mode);
+                j += 1;
+                k += 1;
+            }
+            g.next = j;
+        }
+
+        // 4: peaks, contact times, dissipation.
+        for (ci, s) in [Switch::SliderBed, Switch::BedDamper]
+            .into_iter()
+            .enumerate()
+        {
+            if mode.on(s) && (ci == 0 || sys.damper.is_some()) {
+                totals.closed_time[ci] += s_end;
+                let lf = contact_force_vector(sys, s);
+                let peak = max_on_segment(&seg, &lf, &prop.a, s_end, period);
+                totals.peak_force[ci] = totals.peak_force[ci].max(peak);
+            }
+        }
+        totals.dissipated += dissipated(&seg, &md.c, nd, s_end);
+
+        // Advance.
+        seg.state(s_end, &mut buf);
+        x.copy_from_slice(&buf);
+        t += s_end;
+        if !switched {
+            break;
+        }
+        if s_end <= 1e-14 * period.min(t_end) {
+            zero_length += 1;
+            if zero_length > 50 {
+                return Err(Error::numerical(
+                    "exact propagator",
+                    format!(
+                        "switches chatter at t = {t:.9e} s without time advancing (mode {:?})",
+                        mode
+                    ),
+                ));
+            }
+        } else {
+            zero_length = 0;
+        }
+        // 5: the new mode.
+        let mut mat = |m: Mode| -> Mat<f64> { sys.first_order(m) };
+        let (new_mode, _) = select_mode(sys, &x, mode, &mut mat);
+        if new_mode != mode {
+            events.push(Event {
+                t,
+                from: mode,
+                to: new_mode,
+            });
+            if events.len() > opts.max_events {
+                return Err(Error::numerical(
+                    "exact propagator",
+                    format!(
+                        "more than {} switching events before t = {t:.6} s",
+                        opts.max_events
+                    ),
+                ));
+            }
+        }
+        mode = new_mode;
+        if collision_end.is_none() && !mode.on(Switch::SliderBed) && !mode.on(Switch::BedDamper) {
+            collision_end = Some(CollisionEnd {
+                t,
+                x: x.clone(),
+                totals,
+            });
+            if opts.stop_at_collision_end {
+                break;
+            }
+        }
+        if t >= t_end {
+            break;
+        }
+    }
+    let fallback_modes = cache.values().filter(|m| !m.prop.is_spectral()).count();
+    Ok(Solution {
+        events,
+        collision_end,
+        t_final: t,
+        x_final: x,
+        mode_final: mode,
+        totals,
+        steps: segments,
+        rejected: 0,
+        fallback_modes,
+    })
+}
+
+/// `ℓ` with `f = ℓᵀX` for a closed linear contact's force.
+pub(crate) fn contact_force_vector(sys: &ImpactSystem, s: Switch) -> Vec<f64> {
+    sys.indicator_vector(Indicator::Force(s))
+}
+
+/// Maximum of `ℓᵀX(s)` on `[0, len]`: endpoints and the interior maxima, where the derivative
+/// `ℓᵀA X` changes sign from + to −.
+fn max_on_segment(seg: &Segment<'_>, l: &[f64], a: &Mat<f64>, len: f64, _period: f64) -> f64 {
+    let f = seg.functional(l);
+    let val = |s: f64| match &f {
+        Functional::Exp(e) => e.derivative(0, s),
+        other => super::roots::Scalar::value_slope(other, s).0,
+    };
+    let mut best = val(0.0).max(val(len));
+    let la: Vec<f64> = (0..a.ncols())
+        .map(|j| (0..a.nrows()).map(|i| l[i] * a[(i, j)]).sum())
+        .collect();
+    let df = seg.functional(&la);
+    for (s, sign_before) in all_crossings(&df, len, SearchOptions::default()) {
+        if sign_before > 0.0 {
+            best = best.max(val(s));
+        }
+    }
+    best
+}
+
+/// `∫₀^len ẋᵀ C ẋ ds` on a segment, in closed form for the spectral form
+/// (`ẋ = Re Σ β_k e^{λ_k s}`, so the integrand is a sum of exponentials), otherwise by
+/// 8-point Gauss-Legendre quadrature on sub-intervals of a quarter of the fastest period.
+fn dissipated(seg: &Segment<'_>, c: &Mat<f64>, nd: usize, len: f64) -> f64 {
+    if len <= 0.0 || c.norm_l2() == 0.0 {
+        return 0.0;
+    }
+    if let Some((beta, lam)) = seg.velocity_terms() {
+        // ẋᵀCẋ = ½ Σ_kl Re[(β_kᵀCβ_l) e^{(λ_k+λ_l)s} + (β_kᵀCβ̄_l) e^{(λ_k+λ̄_l)s}].
+        let kk = beta.len();
+        let cb: Vec<Vec<c64>> = beta
+            .iter()
+            .map(|b| {
+                (0..nd)
+                    .map(|i| (0..nd).fold(c64::new(0.0, 0.0), |acc, j| acc + b[j] * c[(i, j)]))
+                    .collect()
+            })
+            .collect();
+        let mut total = 0.0;
+        for k in 0..kk {
+            for l in 0..kk {
+                let mut p = c64::new(0.0, 0.0);
+                let mut q = c64::new(0.0, 0.0);
+                for i in 0..nd {
+                    p += beta[k][i] * cb[l][i];
+                    q += beta[k][i] * cb[l][i].conj();
+                }
+                total += 0.5 * (p * exp_integral(lam[k] + lam[l], len)).re;
+                total += 0.5 * (q * exp_integral(lam[k] + lam[l].conj(), len)).re;
+            }
+        }
+        return total;
+    }
+    // Quadrature fallback.
+    const GL_X: [f64; 4] = [
+        0.1834346424956498,
+        0.5255324099163290,
+        0.7966664774136267,
+        0.9602898564975363,
+    ];
+    const GL_W: [f64; 4] = [
+        0.3626837833783620,
+        0.3137066458778873,
+        0.2223810344533745,
+        0.1012285362903763,
+    ];
+    let pieces = ((len / (seg_period(seg) / 4.0)).ceil() as usize).clamp(1, 1_000_000);
+    let h = len / pieces as f64;
+    let mut x = vec![0.0; 2 * nd];
+    let mut total = 0.0;
+    for p in 0..pieces {
+        let mid = (p as f64 + 0.5) * h;
+        for (xi, wi) in GL_X.iter().zip(GL_W) {
+            for sgn in [-1.0, 1.0] {
+                seg.state(mid + sgn * xi * h / 2.0, &mut x);
+                let v = &x[nd..];
+                let mut e = 0.0;
+                for i in 0..nd {
+                    for j in 0..nd {
+                        e += v[i] * c[(i, j)] * v[j];
+                    }
+                }
+                total += wi * h / 2.0 * e;
+            }
+        }
+    }
+    total
+}
+
+fn seg_period(seg: &Segment<'_>) -> f64 {
+    let p = seg.propagator().period();
+    if p.is_finite() {
+        p
+    } else {
+        1.0
+    }
+}
+
+/// `∫₀^T e^{z s} ds`, stable for small `|z T|`.
+fn exp_integral(z: c64, t: f64) -> c64 {
+    let zt = z * t;
+    if zt.norm() < 1e-4 {
+        t * (1.0 + zt / 2.0 + zt * zt / 6.0 + zt * zt * zt / 24.0)
+    } else {
+        (zt.exp() - 1.0) / z
+    }
+}

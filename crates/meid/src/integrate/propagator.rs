@@ -1,0 +1,564 @@
+//! Closed-form propagation of one mode of the piecewise-linear system, `Ẋ = A_σ X`.
+//!
+//! # Spectral form with rigid-body deflation
+//! With `M = diag(m)` and symmetric `K_σ`, `C_σ`, write `x̃ = M^{½} x`, `K̃ = M^{-½}K M^{-½}`,
+//! `C̃ = M^{-½} C M^{-½}`. The common null space `R̃` of `K̃` and `C̃` (free rigid-body motion:
+//! the slider in flight, a structure without supports) gives *defective* zero eigenvalues of
+//! `A_σ` (Jordan blocks) that no eigen-decomposition represents; they are split off exactly:
+//!
+//! ```text
+//! x̃ = R̃ α + Q̃ y,   α̈ = 0  ⇒  α(s) = α₀ + α̇₀ s,
+//! ÿ + Q̃ᵀC̃Q̃ ẏ + Q̃ᵀK̃Q̃ y = 0  ⇒  Y(s) = V e^{Λ s} V⁻¹ Y₀.
+//! ```
+//!
+//! `R̃`, `Q̃` come from the symmetric eigen-decompositions of `K̃` and of `C̃` restricted to
+//! `null(K̃)`, so `R̃ ⟂ Q̃` exactly and the two parts never exchange energy. The remaining
+//! `A_r = [[0, I], [−K_r, −C_r]]` is diagonalised once per mode; conjugate pairs are kept once
+//! (weight 2), so a linear functional of the state is
+//!
+//! ```text
+//! ℓᵀX(s) = p₀ + p₁ s + Re Σ_k w_k (ℓᵀu_k) c_k e^{λ_k s},    c = V⁻¹ P⁺ X₀,
+//! ```
+//!
+//! a sum of exponentials evaluated in O(number of modes), with exact derivatives and a
+//! rigorous bound on its curvature for the event search ([`super::roots`]).
+//!
+//! # Fallback
+//! When `‖V‖‖V⁻¹‖ > 1e8` (near-critical damping, clustered non-symmetric eigenvalues) the mode
+//! falls back to the matrix exponential ([`super::expm`]), evaluated on demand.
+
+use faer::linalg::solvers::Solve;
+use faer::{c64, Mat, Side};
+
+use super::expm::expm;
+use super::roots::Scalar;
+use crate::{Error, Result};
+
+/// Relative size under which an eigenvalue of K̃ (or C̃) is taken as zero.
+const NULL_TOL: f64 = 1e-11;
+/// Largest eigenvector condition number accepted for the spectral form.
+const MAX_COND: f64 = 1e8;
+
+/// Closed-form propagator of `Ẋ = A X`, `X = [x; ẋ]` of length `2·dofs`.
+#[derive(Debug, Clone)]
+pub struct Propagator {
+    /// The first-order matrix `A`.
+    pub a: Mat<f64>,
+    dofs: usize,
+    kind: Kind,
+}
+
+#[derive(Debug, Clone)]
+enum Kind {
+    Spectral(Spectral),
+    Expm { norm_f: f64 },
+}
+
+#[derive(Debug, Clone)]
+struct Spectral {
+    /// Physical rigid patterns `M^{-½} R̃` (dofs × nr), column-major per pattern.
+    rx: Vec<Vec<f64>>,
+    /// Projections `R̃ᵀ M^{½}` (nr rows of length dofs).
+    rproj: Vec<Vec<f64>>,
+    lam: Vec<c64>,
+    weight: Vec<f64>,
+    /// `u_k`: state-space vectors (len 2·dofs) per kept eigenvalue.
+    u: Vec<Vec<c64>>,
+    /// Rows of `V⁻¹ P⁺` (len 2·dofs) per kept eigenvalue.
+    w: Vec<Vec<c64>>,
+    /// Largest |λ|, for the time scale.
+    lam_max: f64,
+}
+
+/// The motion from one state in one mode, ready for evaluation at any `s ≥ 0`.
+#[derive(Debug, Clone)]
+pub struct Segment<'p> {
+    p: &'p Propagator,
+    x0: Vec<f64>,
+    /// Rigid coordinates α₀ and α̇₀.
+    alpha0: Vec<f64>,
+    alpha_dot: Vec<f64>,
+    /// Modal coefficients c_k.
+    coef: Vec<c64>,
+}
+
+/// A linear functional of the state along a segment: `p₀ + p₁ s + Re Σ amp_k e^{λ_k s}`.
+#[derive(Debug, Clone)]
+pub struct ExpSum {
+    pub p0: f64,
+    pub p1: f64,
+    pub amp: Vec<c64>,
+    pub lam: Vec<c64>,
+    period: f64,
+}
+
+impl Propagator {
+    /// Builds the propagator of the mode with second-order matrices `k`, `c` and masses `m`.
+    pub fn new(k: &Mat<f64>, c: &Mat<f64>, m: &[f64], a: Mat<f64>) -> Result<Self> {
+        let dofs = m.len();
+        match spectral(k, c, m) {
+            Ok(s) => Ok(Self {
+                a,
+                dofs,
+                kind: Kind::Spectral(s),
+            }),
+            Err(_) => {
+                let norm_f = a.norm_l2();
+                Ok(Self {
+                    a,
+                    dofs,
+                    kind: Kind::Expm { norm_f },
+                })
+            }
+        }
+    }
+
+    /// True when this mode uses the spectral (not the matrix-exponential) form.
+    pub fn is_spectral(&self) -> bool {
+        matches!(self.kind, Kind::Spectral(_))
+    }
+
+    /// Fastest time scale of the mode: `2π / max|λ|` (s).
+    pub fn period(&self) -> f64 {
+        let lam_max = match &self.kind {
+            Kind::Spectral(s) => s.lam_max,
+            Kind::Expm { norm_f } => *norm_f,
+        };
+        if lam_max > 0.0 {
+            2.0 * std::f64::consts::PI / lam_max
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// Starts a segment at state `x0`.
+    pub fn segment(&self, x0: &[f64]) -> Segment<'_> {
+        let nd = self.dofs;
+        let (alpha0, alpha_dot, coef) = match &self.kind {
+            Kind::Spectral(s) => {
+                let alpha0 = s.rproj.iter().map(|r| dot(r, &x0[..nd])).collect();
+                let alpha_dot = s.rproj.iter().map(|r| dot(r, &x0[nd..])).collect();
+                let coef =
+                    s.w.iter()
+                        .map(|w| {
+                            w.iter()
+                                .zip(x0)
+                                .fold(c64::new(0.0, 0.0), |acc, (wi, xi)| acc + wi * xi)
+                        })
+                        .collect();
+                (alpha0, alpha_dot, coef)
+            }
+            Kind::Expm { .. } => (Vec::new(), Vec::new(), Vec::new()),
+        };
+        Segment {
+            p: self,
+            x0: x0.to_vec(),
+            alpha0,
+            alpha_dot,
+            coef,
+        }
+    }
+
+    /// Real transition matrix `E = exp(A h)`.
+    pub fn transition(&self, h: f64) -> Mat<f64> {
+        let n = 2 * self.dofs;
+        match &self.kind {
+            Kind::Expm { .. } => expm(&self.a, h),
+            Kind::Spectral(s) => {
+                let nd = self.dofs;
+                let mut e = Mat::<f64>::zeros(n, n);
+                for (rx, rp) in s.rx.iter().zip(&s.rproj) {
+                    for i in 0..nd {
+                        for j in 0..nd {
+                            let v = rx[i] * rp[j];
+                            e[(i, j)] += v;
+                            e[(i, nd + j)] += h * v;
+                            e[(nd + i, nd + j)] += v;
+                        }
+                    }
+                }
+                for k in 0..s.lam.len() {
+                    let f = (s.lam[k] * h).exp() * s.weight[k];
+                    for i in 0..n {
+                        let ui = s.u[k][i] * f;
+                        for j in 0..n {
+                            e[(i, j)] += (ui * s.w[k][j]).re;
+                        }
+                    }
+                }
+                e
+            }
+        }
+    }
+}
+
+impl<'p> Segment<'p> {
+    /// The propagator this segment runs on.
+    pub fn propagator(&self) -> &'p Propagator {
+        self.p
+    }
+
+    /// Velocity as `ẋ(s) = Re Σ β_k e^{λ_k s}` (oscillatory part only; the rigid part carries
+    /// no damping force): `(β_k, λ_k)`, or `None` for the matrix-exponential fallback.
+    pub fn velocity_terms(&self) -> Option<(Vec<Vec<c64>>, Vec<c64>)> {
+        match &self.p.kind {
+            Kind::Spectral(sp) => {
+                let nd = self.p.dofs;
+                let beta = (0..sp.lam.len())
+                    .map(|k| {
+                        sp.u[k][nd..]
+                            .iter()
+                            .map(|u| u * self.coef[k] * sp.weight[k])
+                            .collect()
+                    })
+                    .collect();
+                Some((beta, sp.lam.clone()))
+            }
+            Kind::Expm { .. } => None,
+        }
+    }
+
+    /// State at time `s` after the segment start, written into `out`.
+    pub fn state(&self, s: f64, out: &mut [f64]) {
+        let nd = self.p.dofs;
+        match &self.p.kind {
+            Kind::Expm { .. } => {
+                let e = expm(&self.p.a, s);
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = (0..2 * nd).map(|j| e[(i, j)] * self.x0[j]).sum();
+                }
+            }
+            Kind::Spectral(sp) => {
+                out.iter_mut().for_each(|o| *o = 0.0);
+                for (r, rx) in sp.rx.iter().enumerate() {
+                    let pos = self.alpha0[r] + self.alpha_dot[r] * s;
+                    for i in 0..nd {
+                        out[i] += rx[i] * pos;
+                        out[nd + i] += rx[i] * self.alpha_dot[r];
+                    }
+                }
+                for k in 0..sp.lam.len() {
+                    let f = (sp.lam[k] * s).exp() * self.coef[k] * sp.weight[k];
+                    for (o, u) in out.iter_mut().zip(&sp.u[k]) {
+                        *o += (u * f).re;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The functional `ℓᵀX(s)` along this segment.
+    pub fn functional(&self, l: &[f64]) -> Functional<'_> {
+        let nd = self.p.dofs;
+        match &self.p.kind {
+            Kind::Spectral(sp) => {
+                let mut p0 = 0.0;
+                let mut p1 = 0.0;
+                for (r, rx) in sp.rx.iter().enumerate() {
+                    let lx = dot(&l[..nd], rx);
+                    let lv = dot(&l[nd..], rx);
+                    p0 += lx * self.alpha0[r] + lv * self.alpha_dot[r];
+                    p1 += lx * self.alpha_dot[r];
+                }
+                let amp = (0..sp.lam.len())
+                    .map(|k| {
+                        let lu = sp.u[k]
+                            .iter()
+                            .zip(l)
+                            .fold(c64::new(0.0, 0.0), |acc, (u, li)| acc + u * li);
+                        lu * self.coef[k] * sp.weight[k]
+                    })
+                    .collect::<Vec<_>>();
+                // Fastest period among terms that matter.
+                let total: f64 = amp.iter().map(|a| a.norm()).sum();
+                let lam_max = amp
+                    .iter()
+                    .zip(&sp.lam)
+                    .filter(|(a, _)| a.norm() > 1e-14 * total)
+                    .map(|(_, l)| l.norm())
+                    .fold(0.0, f64::max);
+                let period = if lam_max > 0.0 {
+                    2.0 * std::f64::consts::PI / lam_max
+                } else {
+                    f64::INFINITY
+                };
+                Functional::Exp(ExpSum {
+                    p0,
+                    p1,
+                    amp,
+                    lam: sp.lam.clone(),
+                    period,
+                })
+            }
+            Kind::Expm { norm_f } => {
+                let la = row_times(l, &self.p.a);
+                let la2 = row_times(&la, &self.p.a);
+                Functional::Expm {
+                    seg: self,
+                    l: l.to_vec(),
+                    la,
+                    la2_norm: norm(&la2),
+                    norm_a: *norm_f,
+                }
+            }
+        }
+    }
+}
+
+/// A linear functional of the state along a segment, as a [`Scalar`] function of time.
+pub enum Functional<'s> {
+    Exp(ExpSum),
+    Expm {
+        seg: &'s Segment<'s>,
+        l: Vec<f64>,
+        la: Vec<f64>,
+        la2_norm: f64,
+        norm_a: f64,
+    },
+}
+
+impl ExpSum {
+    /// `j`-th derivative at `s`.
+    pub fn derivative(&self, j: u32, s: f64) -> f64 {
+        let mut v = match j {
+            0 => self.p0 + self.p1 * s,
+            1 => self.p1,
+            _ => 0.0,
+        };
+        for (a, l) in self.amp.iter().zip(&self.lam) {
+            v += (a * l.powu(j) * (l * s).exp()).re;
+        }
+        v
+    }
+}
+
+impl Scalar for ExpSum {
+    fn value_slope(&self, s: f64) -> (f64, f64) {
+        let mut g = self.p0 + self.p1 * s;
+        let mut d = self.p1;
+        for (a, l) in self.amp.iter().zip(&self.lam) {
+            let t = a * (l * s).exp();
+            g += t.re;
+            d += (t * l).re;
+        }
+        (g, d)
+    }
+    fn curvature_bound(&self, a: f64, b: f64) -> f64 {
+        self.amp
+            .iter()
+            .zip(&self.lam)
+            .map(|(amp, l)| amp.norm() * l.norm_sqr() * (l.re * a).exp().max((l.re * b).exp()))
+            .sum()
+    }
+    fn fastest_period(&self) -> f64 {
+        self.period
+    }
+}
+
+impl Scalar for Functional<'_> {
+    fn value_slope(&self, s: f64) -> (f64, f64) {
+        match self {
+            Functional::Exp(e) => e.value_slope(s),
+            Functional::Expm { seg, l, la, .. } => {
+                let mut x = vec![0.0; l.len()];
+                seg.state(s, &mut x);
+                (dot(l, &x), dot(la, &x))
+            }
+        }
+    }
+    fn curvature_bound(&self, a: f64, b: f64) -> f64 {
+        match self {
+            Functional::Exp(e) => e.curvature_bound(a, b),
+            Functional::Expm {
+                seg,
+                la2_norm,
+                norm_a,
+                l,
+                ..
+            } => {
+                let mut x = vec![0.0; l.len()];
+                seg.state(a, &mut x);
+                la2_norm * norm(&x) * (norm_a * (b - a)).exp()
+            }
+        }
+    }
+    fn fastest_period(&self) -> f64 {
+        match self {
+            Functional::Exp(e) => e.fastest_period(),
+            Functional::Expm { norm_a, .. } => {
+                if *norm_a > 0.0 {
+                    2.0 * std::f64::consts::PI / norm_a
+                } else {
+                    f64::INFINITY
+                }
+            }
+        }
+    }
+}
+
+fn spectral(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Spectral> {
+    let nd = m.len();
+    let sq: Vec<f64> = m.iter().map(|x| x.sqrt()).collect();
+    let kt = Mat::<f64>::from_fn(nd, nd, |i, j| k[(i, j)] / (sq[i] * sq[j]));
+    let ct = Mat::<f64>::from_fn(nd, nd, |i, j| c[(i, j)] / (sq[i] * sq[j]));
+    let ek = kt
+        .self_adjoint_eigen(Side::Lower)
+        .map_err(|e| Error::numerical("propagator", format!("{e:?}")))?;
+    let kmax = (0..nd).map(|i| ek.S()[i].abs()).fold(0.0, f64::max);
+    let null: Vec<usize> = (0..nd)
+        .filter(|&i| ek.S()[i].abs() <= NULL_TOL * kmax.max(f64::MIN_POSITIVE))
+        .collect();
+    let nonnull: Vec<usize> = (0..nd).filter(|i| !null.contains(i)).collect();
+    let uk = ek.U();
+    // Columns of Q̃ and R̃ in the scaled coordinates.
+    let mut q_cols: Vec<Vec<f64>> = nonnull
+        .iter()
+        .map(|&j| (0..nd).map(|i| uk[(i, j)]).collect())
+        .collect();
+    let mut r_cols: Vec<Vec<f64>> = Vec::new();
+    if !null.is_empty() {
+        let n0 = null.len();
+        let u0 = Mat::<f64>::from_fn(nd, n0, |i, j| uk[(i, null[j])]);
+        let c0 = u0.transpose() * &ct * &u0;
+        let c0 = Mat::<f64>::from_fn(n0, n0, |i, j| 0.5 * (c0[(i, j)] + c0[(j, i)]));
+        let ec = c0
+            .self_adjoint_eigen(Side::Lower)
+            .map_err(|e| Error::numerical("propagator", format!("{e:?}")))?;
+        let cmax = (0..nd).map(|i| ct[(i, i)].abs()).fold(0.0, f64::max);
+        let wv = &u0 * ec.U();
+        for j in 0..n0 {
+            let col: Vec<f64> = (0..nd).map(|i| wv[(i, j)]).collect();
+            if ec.S()[j].abs() <= NULL_TOL * cmax.max(f64::MIN_POSITIVE) {
+                r_cols.push(col);
+            } else {
+                q_cols.push(col);
+            }
+        }
+    }
+    let mr = q_cols.len();
+    let q = Mat::<f64>::from_fn(nd, mr, |i, j| q_cols[j][i]);
+    let kr = q.transpose() * &kt * &q;
+    let cr = q.transpose() * &ct * &q;
+    let n2 = 2 * mr;
+    let ar = Mat::<f64>::from_fn(n2, n2, |i, j| {
+        if i < mr {
+            if j == mr + i {
+                1.0
+            } else {
+                0.0
+            }
+        } else if j < mr {
+            -0.5 * (kr[(i - mr, j)] + kr[(j, i - mr)])
+        } else {
+            -0.5 * (cr[(i - mr, j - mr)] + cr[(j - mr, i - mr)])
+        }
+    });
+    let (lam_all, v) = if n2 > 0 {
+        let evd = ar
+            .eigen()
+            .map_err(|e| Error::numerical("propagator", format!("{e:?}")))?;
+        let lam: Vec<c64> = (0..n2).map(|i| evd.S()[i]).collect();
+        (lam, evd.U().to_owned())
+    } else {
+        (Vec::new(), Mat::<c64>::zeros(0, 0))
+    };
+    let vinv = if n2 > 0 {
+        let id = Mat::<c64>::identity(n2, n2);
+        v.partial_piv_lu().solve(&id)
+    } else {
+        Mat::<c64>::zeros(0, 0)
+    };
+    if n2 > 0 {
+        let cond = v.norm_l2() * vinv.norm_l2();
+        if !cond.is_finite() || cond > MAX_COND {
+            return Err(Error::numerical(
+                "propagator",
+                format!("eigenvector condition {cond:.2e}"),
+            ));
+        }
+    }
+    // Keep one of each conjugate pair.
+    let n_pos = lam_all.iter().filter(|l| l.im > 0.0).count();
+    let n_neg = lam_all.iter().filter(|l| l.im < 0.0).count();
+    let pair_reduce = n_pos == n_neg;
+    let mut lam = Vec::new();
+    let mut weight = Vec::new();
+    let mut u = Vec::new();
+    let mut w = Vec::new();
+    for kk in 0..n2 {
+        let l = lam_all[kk];
+        let wgt = if !pair_reduce {
+            1.0
+        } else if l.im > 0.0 {
+            2.0
+        } else if l.im < 0.0 {
+            continue;
+        } else {
+            1.0
+        };
+        // u = P_Q v: x = M^{-½} Q̃ y.
+        let mut uk_full = vec![c64::new(0.0, 0.0); 2 * nd];
+        for i in 0..nd {
+            let mut px = c64::new(0.0, 0.0);
+            let mut pv = c64::new(0.0, 0.0);
+            for j in 0..mr {
+                px += v[(j, kk)] * q[(i, j)];
+                pv += v[(mr + j, kk)] * q[(i, j)];
+            }
+            uk_full[i] = px / sq[i];
+            uk_full[nd + i] = pv / sq[i];
+        }
+        // w = row kk of V⁻¹ times P⁺ (y = Q̃ᵀ M^{½} x).
+        let mut wk_full = vec![c64::new(0.0, 0.0); 2 * nd];
+        for i in 0..nd {
+            let mut wx = c64::new(0.0, 0.0);
+            let mut wv = c64::new(0.0, 0.0);
+            for j in 0..mr {
+                wx += vinv[(kk, j)] * q[(i, j)];
+                wv += vinv[(kk, mr + j)] * q[(i, j)];
+            }
+            wk_full[i] = wx * sq[i];
+            wk_full[nd + i] = wv * sq[i];
+        }
+        lam.push(l);
+        weight.push(wgt);
+        u.push(uk_full);
+        w.push(wk_full);
+    }
+    let rx = r_cols
+        .iter()
+        .map(|r| (0..nd).map(|i| r[i] / sq[i]).collect())
+        .collect();
+    let rproj = r_cols
+        .iter()
+        .map(|r| (0..nd).map(|i| r[i] * sq[i]).collect())
+        .collect();
+    let lam_max = lam.iter().map(|l| l.norm()).fold(0.0, f64::max);
+    r_cols.clear();
+    q_cols.clear();
+    Ok(Spectral {
+        rx,
+        rproj,
+        lam,
+        weight,
+        u,
+        w,
+        lam_max,
+    })
+}
+
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn norm(a: &[f64]) -> f64 {
+    a.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// `ℓᵀ A` as a row.
+fn row_times(l: &[f64], a: &Mat<f64>) -> Vec<f64> {
+    (0..a.ncols())
+        .map(|j| (0..a.nrows()).map(|i| l[i] * a[(i, j)]).sum())
+        .collect()
+}

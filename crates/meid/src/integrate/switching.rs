@@ -1,0 +1,125 @@
+//! Choosing the mode after a switch: consistent with the state and with where it is heading.
+//!
+//! At an event some indicators are zero. The new mode must be *consistent*: with its own
+//! dynamics `A_σ`, every indicator moves to the side that implies the same mode. The side of an
+//! indicator `g = ℓᵀX` that is zero is the sign of its first non-vanishing derivative
+//! `ℓᵀA_σᵏX` (k = 0, 1, 2, …), which resolves grazing and simultaneous switches alike.
+//! Candidate modes are iterated to a fixed point; if none exists the switch rule of the last
+//! candidate is taken (and the next search starts from it).
+
+use faer::Mat;
+
+use crate::impact::{ImpactSystem, Indicator, Mode, Switch};
+
+/// Highest derivative order consulted.
+const K_MAX: usize = 8;
+
+/// Sign (+1, −1, or 0 when identically zero to order `K_MAX`) of `ℓᵀX(t)` just after `t`.
+///
+/// A derivative `ℓᵀy` (`y = Aᵏ X`) counts as zero when it is below round-off of its own terms
+/// (`1e-9 Σ|ℓᵢyᵢ|` for the value itself, which root location leaves at ~1e-13 of its terms,
+/// `1e-11` for higher orders) or below `1e-12 ‖ℓ‖‖y‖`: the latter catches quantities whose terms
+/// are all physically zero (bodies at rest, forces zero) and only carry round-off.
+pub fn lex_sign(l: &[f64], a: &Mat<f64>, x: &[f64]) -> f64 {
+    let n = x.len();
+    let l_norm = l.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let mut y = x.to_vec();
+    let mut next = vec![0.0; n];
+    for k in 0..=K_MAX {
+        let (mut val, mut scale, mut y2) = (0.0, 0.0, 0.0);
+        for i in 0..n {
+            let t = l[i] * y[i];
+            val += t;
+            scale += t.abs();
+            y2 += y[i] * y[i];
+        }
+        let tol = if k == 0 { 1e-9 } else { 1e-11 };
+        let floor = 1e-12 * l_norm * y2.sqrt();
+        if val.abs() > tol * scale && val.abs() > floor {
+            return val.signum();
+        }
+        for (i, nx) in next.iter_mut().enumerate() {
+            *nx = (0..n).map(|j| a[(i, j)] * y[j]).sum();
+        }
+        std::mem::swap(&mut y, &mut next);
+    }
+    0.0
+}
+
+/// The mode implied by indicator signs. An indicator that is identically zero (sign 0: no
+/// overlap and none coming, no relative velocity) leaves its contact open and its dashpot off:
+/// either choice exerts no force, and "open" ends a collision whose bodies merely touch.
+pub fn implied_mode(sys: &ImpactSystem, sign_of: &dyn Fn(Indicator) -> f64) -> Mode {
+    let mut mode = Mode(0);
+    for s in sys.switches() {
+        let on = match s {
+            Switch::Dashpot => sign_of(Indicator::DashpotVelocity) < 0.0,
+            _ => sys.switch_on(s, sign_of),
+        };
+        mode = mode.with(s, on);
+    }
+    mode
+}
+
+/// Selects a consistent mode at state `x`, starting the iteration from `start`.
+/// `matrix(mode)` gives `A_σ`. Returns the mode and whether it is consistent.
+pub fn select_mode(
+    sys: &ImpactSystem,
+    x: &[f64],
+    start: Mode,
+    matrix: &mut dyn FnMut(Mode) -> Mat<f64>,
+) -> (Mode, bool) {
+    let inds = sys.indicators();
+    let vecs: Vec<Vec<f64>> = inds.iter().map(|&i| sys.indicator_vector(i)).collect();
+    let mut cand = start;
+    let mut seen: Vec<Mode> = Vec::new();
+    for _ in 0..16 {
+        let a = matrix(cand);
+        let signs: Vec<f64> = vecs.iter().map(|l| lex_sign(l, &a, x)).collect();
+        let sign_of = |ind: Indicator| {
+            inds.iter()
+                .position(|&i| i == ind)
+                .map_or(0.0, |p| signs[p])
+        };
+        let next = implied_mode(sys, &sign_of);
+        if next == cand {
+            return (cand, true);
+        }
+        if seen.contains(&next) {
+            break;
+        }
+        seen.push(cand);
+        cand = next;
+    }
+    // No fixed point along the iteration: try every mode.
+    let all = 1u8 << 3;
+    for bits in 0..all {
+        let m = Mode(bits);
+        if sys
+            .switches()
+            .iter()
+            .all(|&s| m.on(s) || (m.0 & Mode::bit(s)) == 0)
+            && valid_bits(sys, m)
+        {
+            let a = matrix(m);
+            let signs: Vec<f64> = vecs.iter().map(|l| lex_sign(l, &a, x)).collect();
+            let sign_of = |ind: Indicator| {
+                inds.iter()
+                    .position(|&i| i == ind)
+                    .map_or(0.0, |p| signs[p])
+            };
+            if implied_mode(sys, &sign_of) == m {
+                return (m, true);
+            }
+        }
+    }
+    (cand, false)
+}
+
+fn valid_bits(sys: &ImpactSystem, m: Mode) -> bool {
+    let mut allowed = 0u8;
+    for s in sys.switches() {
+        allowed |= Mode::bit(s);
+    }
+    m.0 & !allowed == 0
+}
