@@ -1,1 +1,5 @@
-//! (module under construction)
+//! Studies built on the impact engine: energy accounting, spectra, sweeps, optimisation.
+
+pub mod energy;
+
+pub use energy::{simulate, EnergyTerms, History, Run, Summary};

@@ -616,6 +616,37 @@ impl ImpactSystem {
     }
 }
 
+impl ImpactSystem {
+    /// Generalised accelerations `ẍ` at state `X` in `mode` (any contact law), written to `out`
+    /// (length `dofs`): `q̈ = −Ω²q − D q̇ + ψ_b f_bs − ψ_b f_bd + ψ_f f_fd`,
+    /// `z̈_s = −f_bs/m_s`, `z̈_d = (f_bd − f_fd)/m_d`.
+    pub fn accelerations(&self, mode: Mode, x: &[f64], out: &mut [f64]) {
+        let n = self.n_modes();
+        let nd = self.dofs();
+        let (fbs, fbd, ffd) = self.element_forces(mode, x);
+        let d = &self.structure.damping;
+        for i in 0..n {
+            let mut c = 0.0;
+            for j in 0..n {
+                let dij = d[i * n + j];
+                if dij != 0.0 {
+                    c += dij * x[nd + j];
+                }
+            }
+            let mut a = -self.structure.omega_rad_per_s[i].powi(2) * x[i] - c
+                + self.points.bed_contact[i] * (fbs - fbd);
+            if let Some(f) = &self.points.damper_anchor {
+                a += f[i] * ffd;
+            }
+            out[i] = a;
+        }
+        out[self.slider_index()] = -fbs / self.slider.mass;
+        if let Some(dm) = &self.damper {
+            out[self.damper_index()] = (fbd - ffd) / dm.mass;
+        }
+    }
+}
+
 /// `Σ a_i b_i`.
 #[inline]
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {

@@ -415,6 +415,8 @@ fn spectral(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Spectral> {
         .iter()
         .map(|&j| (0..nd).map(|i| uk[(i, j)]).collect())
         .collect();
+    // Stiffness of each Q̃ column: κ for the eigenvectors of K̃, 0 for damped null directions.
+    let mut kappa: Vec<f64> = nonnull.iter().map(|&j| ek.S()[j]).collect();
     let mut r_cols: Vec<Vec<f64>> = Vec::new();
     if !null.is_empty() {
         let n0 = null.len();
@@ -432,23 +434,34 @@ fn spectral(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Spectral> {
                 r_cols.push(col);
             } else {
                 q_cols.push(col);
+                kappa.push(0.0);
             }
         }
     }
     let mr = q_cols.len();
     let q = Mat::<f64>::from_fn(nd, mr, |i, j| q_cols[j][i]);
-    let kr = q.transpose() * &kt * &q;
     let cr = q.transpose() * &ct * &q;
     let n2 = 2 * mr;
+    // Balanced first-order form: Z = [S y; ẏ] with S = diag(√κ) (1 where κ = 0), so that
+    // A_r = [[0, S], [−diag(κ/S), −C_r]] has entries of size ω rather than ω² and is
+    // skew-symmetric without damping (well-conditioned eigenvectors).
+    let scale: Vec<f64> = kappa
+        .iter()
+        .map(|&k| if k > 0.0 { k.sqrt() } else { 1.0 })
+        .collect();
     let ar = Mat::<f64>::from_fn(n2, n2, |i, j| {
         if i < mr {
             if j == mr + i {
-                1.0
+                scale[i]
             } else {
                 0.0
             }
         } else if j < mr {
-            -0.5 * (kr[(i - mr, j)] + kr[(j, i - mr)])
+            if j == i - mr {
+                -kappa[j].max(0.0) / scale[j]
+            } else {
+                0.0
+            }
         } else {
             -0.5 * (cr[(i - mr, j - mr)] + cr[(j - mr, i - mr)])
         }
@@ -502,7 +515,7 @@ fn spectral(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Spectral> {
             let mut px = c64::new(0.0, 0.0);
             let mut pv = c64::new(0.0, 0.0);
             for j in 0..mr {
-                px += v[(j, kk)] * q[(i, j)];
+                px += v[(j, kk)] / scale[j] * q[(i, j)];
                 pv += v[(mr + j, kk)] * q[(i, j)];
             }
             uk_full[i] = px / sq[i];
@@ -514,7 +527,7 @@ fn spectral(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Spectral> {
             let mut wx = c64::new(0.0, 0.0);
             let mut wv = c64::new(0.0, 0.0);
             for j in 0..mr {
-                wx += vinv[(kk, j)] * q[(i, j)];
+                wx += vinv[(kk, j)] * scale[j] * q[(i, j)];
                 wv += vinv[(kk, mr + j)] * q[(i, j)];
             }
             wk_full[i] = wx * sq[i];

@@ -1,1 +1,369 @@
-//! (module under construction)
+//! Model files: TOML in, a validated [`Model`] out.
+//!
+//! A model names a structure, the slider, an impact damper or an added mass (or neither),
+//! the two contacts and the simulation settings. See `docs/model-format.md` for the full
+//! reference and `examples/paper-lumped.toml` for a complete file.
+//!
+//! # Units (SI throughout; field names carry no suffix except `frequencies_hz`)
+//!
+//! | field | unit |
+//! |---|---|
+//! | `mass` | kg |
+//! | `velocity` | m/s |
+//! | `stiffness` (springs, linear contacts, damper spring) | N/m |
+//! | `stiffness` (hertz) / (hunt-crossley, exponent n) | N/m^1.5 / N/m^n |
+//! | `damping` (dashpots, contacts) | N·s/m |
+//! | `alpha` (hunt-crossley) | s/m |
+//! | `damping_ratios` | 1 (fraction of critical) |
+//! | `frequencies_hz` | Hz |
+//! | `shapes` (mass-normalised) | 1/√kg |
+//! | `duration` | s |
+//! | `sample_rate` | Hz |
+//!
+//! Errors name the file, line and column (or the `--set` that caused them), the field and
+//! the valid range; unknown keys get a did-you-mean.
+
+mod lumped;
+pub mod source;
+pub mod spec;
+
+use std::path::Path;
+
+use serde::Deserialize;
+
+pub use source::Source;
+pub use spec::*;
+
+use crate::impact::{
+    Absorber, Contact, ContactLaw, Damper, DashpotKind, ImpactSystem, Release, Slider,
+};
+use crate::integrate::{Method, Options};
+use crate::modal::ModalModel;
+use crate::{Error, Result};
+
+/// A validated model: the spec, the structure reduced to modes, and where it came from.
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub spec: ModelSpec,
+    /// The bare structure (no added mass), as modes.
+    pub structure: ModalModel,
+    pub source: Source,
+}
+
+/// Which absorber to build the impact system with (for comparisons).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Case {
+    /// As the model file says.
+    AsSpecified,
+    /// The bare machine.
+    NoDamper,
+    /// The impact damper of the file.
+    Damper,
+    /// The damper's mass (or the file's added mass) fixed to the bed.
+    AddedMass,
+}
+
+impl Model {
+    /// Reads and validates a model file, applying `--set PATH=VALUE` overrides in order.
+    pub fn from_file(path: &Path, overrides: &[String]) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        Self::from_text(&path.display().to_string(), text, overrides)
+    }
+
+    /// Parses and validates model text; `name` is used in error messages.
+    pub fn from_text(name: &str, text: String, overrides: &[String]) -> Result<Self> {
+        // 1. The file as written: syntax, unknown keys and types, with positions.
+        let mut table: toml::Table =
+            toml::from_str(&text).map_err(|e| source::toml_error(name, &text, &e))?;
+        let from_file: ModelSpec =
+            toml::from_str(&text).map_err(|e| source::toml_error(name, &text, &e))?;
+        let mut src = Source {
+            name: name.to_string(),
+            text,
+            overrides: Vec::new(),
+        };
+        // 2. Overrides.
+        let spec = if overrides.is_empty() {
+            from_file
+        } else {
+            for o in overrides {
+                let applied = source::apply_override(&mut table, o)?;
+                src.overrides.push(applied);
+            }
+            ModelSpec::deserialize(toml::Value::Table(table)).map_err(|e| {
+                let list: Vec<String> = src
+                    .overrides
+                    .iter()
+                    .map(|(p, v)| format!("--set {p}={v}"))
+                    .collect();
+                let mut message = e.message().trim().to_string();
+                if let Some(h) = source::did_you_mean(&message) {
+                    message.push_str(&h);
+                }
+                Error::Input {
+                    location: list.join(" "),
+                    message,
+                }
+            })?
+        };
+        // 3. Values.
+        let structure = build_structure(&spec, &src)?;
+        let model = Model {
+            spec,
+            structure,
+            source: src,
+        };
+        model.validate()?;
+        Ok(model)
+    }
+
+    /// Attaches a file position to errors about a field.
+    pub fn locate_error(&self, e: Error) -> Error {
+        match e {
+            Error::InvalidValue { field, message } => Error::Input {
+                location: self.source.locate(&field),
+                message: format!("{field}: {message}"),
+            },
+            other => other,
+        }
+    }
+
+    fn validate(&self) -> Result<()> {
+        let s = &self.spec;
+        let src = &self.source;
+        let n = self.structure.len();
+        if let Some(r) = s.structure.reference_mode {
+            if r == 0 || r > n {
+                return Err(src.error(
+                    "structure.reference_mode",
+                    format!("structure.reference_mode must be between 1 and {n} (the retained modes), got {r}"),
+                ));
+            }
+        }
+        if s.damper.is_some() && s.added_mass.is_some() {
+            return Err(src.error(
+                "added_mass",
+                "give either [damper] or [added_mass], not both",
+            ));
+        }
+        if s.damper.is_some() && s.contact.bed_damper.is_none() {
+            return Err(src.error(
+                "damper",
+                "a [damper] needs its contact: add [contact.bed_damper]",
+            ));
+        }
+        for (role, name) in [
+            ("points.bed_contact", Some(&s.points.bed_contact)),
+            ("points.measurement", Some(&s.points.measurement)),
+            ("points.damper_anchor", s.points.damper_anchor.as_ref()),
+        ] {
+            let Some(name) = name else { continue };
+            if role == "points.damper_anchor" && name == "ground" {
+                continue;
+            }
+            if !self.structure.points.contains_key(name) {
+                let known: Vec<&str> = self.structure.points.keys().map(|k| k.as_str()).collect();
+                let extra = if role == "points.damper_anchor" {
+                    ", ground"
+                } else {
+                    ""
+                };
+                return Err(src.error(
+                    role,
+                    format!(
+                        "{role}: unknown point '{name}'; valid: {}{extra}",
+                        known.join(", ")
+                    ),
+                ));
+            }
+        }
+        let sim = &s.simulation;
+        for (field, v, unit) in [
+            ("simulation.duration", sim.duration, "s"),
+            ("simulation.sample_rate", sim.sample_rate, "Hz"),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(src.error(
+                    field,
+                    format!("{field} must be a finite number > 0 {unit} (got {v})"),
+                ));
+            }
+        }
+        if !(sim.rtol > 0.0 && sim.rtol < 1.0) {
+            return Err(src.error(
+                "simulation.rtol",
+                format!("simulation.rtol must be in (0, 1) (got {})", sim.rtol),
+            ));
+        }
+        if !(sim.atol > 0.0 && sim.atol.is_finite()) {
+            return Err(src.error(
+                "simulation.atol",
+                format!("simulation.atol must be > 0 (got {})", sim.atol),
+            ));
+        }
+        // Everything the impact system checks (masses, stiffnesses, ...), with positions.
+        self.impact_system(Case::AsSpecified).map(|_| ())
+    }
+
+    /// The impact system for a case.
+    pub fn impact_system(&self, case: Case) -> Result<ImpactSystem> {
+        let s = &self.spec;
+        let slider = Slider {
+            mass: s.slider.mass,
+            velocity: s.slider.velocity,
+        };
+        let slider_bed =
+            contact(&s.contact.slider_bed).map_err(|e| self.prefix(e, "contact.slider_bed"))?;
+        let damper = match (&s.damper, &s.contact.bed_damper) {
+            (Some(d), Some(c)) => Some((
+                Damper {
+                    mass: d.mass,
+                    stiffness: d.stiffness,
+                    damping: d.damping,
+                    dashpot: match d.dashpot {
+                        DashpotKindSpec::OneWay => DashpotKind::OneWay,
+                        DashpotKindSpec::TwoWay => DashpotKind::TwoWay,
+                    },
+                },
+                contact(c).map_err(|e| self.prefix(e, "contact.bed_damper"))?,
+            )),
+            _ => None,
+        };
+        let added = s
+            .added_mass
+            .as_ref()
+            .map(|a| a.mass)
+            .or(damper.map(|d| d.0.mass));
+        let absorber = match case {
+            Case::AsSpecified => match (&damper, &s.added_mass) {
+                (Some((d, c)), _) => Absorber::Damper(*d, *c),
+                (None, Some(a)) => Absorber::AddedMass(a.mass),
+                _ => Absorber::None,
+            },
+            Case::NoDamper => Absorber::None,
+            Case::Damper => match damper {
+                Some((d, c)) => Absorber::Damper(d, c),
+                None => {
+                    return Err(Error::invalid(
+                        "damper",
+                        "the model has no [damper] to compare",
+                    ))
+                }
+            },
+            Case::AddedMass => match added {
+                Some(m) => Absorber::AddedMass(m),
+                None => {
+                    return Err(Error::invalid(
+                        "added_mass",
+                        "the model has neither [damper] nor [added_mass]",
+                    ))
+                }
+            },
+        };
+        let anchor = match s.points.damper_anchor.as_deref() {
+            None | Some("ground") => None,
+            Some(p) => Some(p),
+        };
+        ImpactSystem::new(
+            &self.structure,
+            &s.points.bed_contact,
+            anchor,
+            &s.points.measurement,
+            slider,
+            slider_bed,
+            absorber,
+        )
+        .map_err(|e| self.locate_error(e))
+    }
+
+    fn prefix(&self, e: Error, path: &str) -> Error {
+        match e {
+            Error::InvalidValue { field, message } => {
+                let full = format!("{path}.{field}");
+                Error::Input {
+                    location: self.source.locate(&full),
+                    message: format!("{full}: {message}"),
+                }
+            }
+            other => other,
+        }
+    }
+
+    /// Integration options from `[simulation]`.
+    pub fn options(&self) -> Options {
+        let s = &self.spec.simulation;
+        Options {
+            method: match s.method {
+                MethodSpec::Exact => Method::Exact,
+                MethodSpec::Dopri5 => Method::Dopri5,
+            },
+            duration: s.duration,
+            sample_rate: Some(s.sample_rate),
+            stop_at_collision_end: false,
+            rtol: s.rtol,
+            atol: s.atol,
+            ..Options::default()
+        }
+    }
+
+    /// ω_ref (rad/s): the reference mode's frequency, if the model names one.
+    pub fn reference_omega(&self) -> Option<f64> {
+        self.spec
+            .structure
+            .reference_mode
+            .map(|r| self.structure.omega_rad_per_s[r - 1])
+    }
+
+    /// Bed mass m_b (kg) for mass ratios: the lumped mass at the bed contact point, else
+    /// `1/ψ_b²` of the reference mode (its modal mass seen at O_b).
+    pub fn bed_mass(&self) -> Option<f64> {
+        if let Some(l) = &self.spec.structure.lumped {
+            return l
+                .masses
+                .iter()
+                .find(|m| m.name == self.spec.points.bed_contact)
+                .map(|m| m.mass);
+        }
+        None
+    }
+}
+
+fn contact(c: &ContactSpec) -> Result<Contact> {
+    let law = match c.law {
+        LawSpec::Linear => ContactLaw::Linear {
+            stiffness: c.stiffness,
+            damping: c.damping,
+        },
+        LawSpec::Hertz => ContactLaw::Hertz {
+            stiffness: c.stiffness,
+        },
+        LawSpec::HuntCrossley => ContactLaw::HuntCrossley {
+            stiffness: c.stiffness,
+            exponent: c.exponent.unwrap_or(1.5),
+            alpha: c.alpha,
+        },
+    };
+    if c.law != LawSpec::Linear && c.damping != 0.0 {
+        return Err(Error::invalid(
+            "damping",
+            "only the linear law takes `damping`; hunt-crossley uses `alpha`",
+        ));
+    }
+    let release = match c.release {
+        ReleaseSpec::Force => Release::Force,
+        ReleaseSpec::Overlap => Release::Overlap,
+    };
+    Ok(Contact { law, release })
+}
+
+fn build_structure(spec: &ModelSpec, src: &Source) -> Result<ModalModel> {
+    match (&spec.structure.lumped, &spec.structure.modal) {
+        (Some(l), None) => lumped::modal_model(l, src),
+        (None, Some(m)) => lumped::from_modal_spec(m, src),
+        (Some(_), Some(_)) => Err(src.error("structure", "give one of [structure.lumped] or [structure.modal], not both")),
+        (None, None) => Err(src.error(
+            "structure",
+            "the structure is missing: add [structure.lumped] (masses, springs) or [structure.modal] (frequencies_hz, shapes)",
+        )),
+    }
+}

@@ -1,0 +1,269 @@
+//! Energy accounting of a blow (paper Eqs. 10-24) and the summary of a run.
+//!
+//! At the end of the collision (see [`crate::integrate`]):
+//!
+//! ```text
+//! E_s− = ½ m_s v_s²                         (Eq. 11)
+//! E_s+ = ½ m_s ż_s+²                        (Eq. 12)
+//! E_d+ = ½ m_d ż_d+² + ½ k_d (z_d − u_f)+²   (Eq. 13)
+//! E_p+ = E_s− − E_s+ − E_d+                 (Eq. 10)   energy left in the machine
+//! ```
+//!
+//! The histories are Eqs. (16)-(22): `KE_ms = ½ m_s ż_s²`, `PE_Ks` (stored in the closed
+//! slider contact), `KE_p = ½ q̇ᵀq̇`, `PE_p = ½ qᵀΩ²q` (modal mass and stiffness),
+//! `KE_md = ½ m_d ż_d²`, `PE_kd = ½ k_d (z_d − u_f)²`, `PE_Kd` (closed damper contact), and
+//! the dissipated energy of Eq. (23), `E_s− − Σ(stored)`. Eq. (17)/(22)'s sign factors are read
+//! as "while the contact is closed" (the printed `(1 − sgn)/2` would count open contacts).
+//!
+//! Independently, the integrators integrate the dissipated power `ẋᵀC_σẋ` (exactly for
+//! `exact`); the **energy-balance residual** `|E_s− − Σ stored − ∫P dt| / E_s−` checks both.
+
+use serde::Serialize;
+
+use crate::impact::{dot, ImpactSystem, Mode, Switch};
+use crate::integrate::{self, Method, Observer, Options, Solution};
+use crate::Result;
+
+/// Stored energies at one instant (J).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct EnergyTerms {
+    pub ke_slider: f64,
+    pub pe_slider_contact: f64,
+    pub ke_machine: f64,
+    pub pe_machine: f64,
+    pub ke_damper: f64,
+    pub pe_damper_spring: f64,
+    pub pe_damper_contact: f64,
+}
+
+impl EnergyTerms {
+    /// Evaluates Eqs. (16)-(22) at state `X` in `mode`.
+    pub fn at(sys: &ImpactSystem, mode: Mode, x: &[f64]) -> Self {
+        let n = sys.n_modes();
+        let nd = sys.dofs();
+        let mut e = EnergyTerms::default();
+        let vs = x[nd + sys.slider_index()];
+        e.ke_slider = 0.5 * sys.slider.mass * vs * vs;
+        for i in 0..n {
+            let w = sys.structure.omega_rad_per_s[i];
+            e.ke_machine += 0.5 * x[nd + i] * x[nd + i];
+            e.pe_machine += 0.5 * w * w * x[i] * x[i];
+        }
+        if mode.on(Switch::SliderBed) {
+            let d = dot(&sys.relative_vector(Switch::SliderBed), &x[..nd]);
+            e.pe_slider_contact = sys.slider_bed.law.potential_energy(d);
+        }
+        if let (Some(dm), Some(c)) = (&sys.damper, &sys.bed_damper) {
+            let vd = x[nd + sys.damper_index()];
+            e.ke_damper = 0.5 * dm.mass * vd * vd;
+            let r = dot(&sys.relative_vector(Switch::Dashpot), &x[..nd]);
+            e.pe_damper_spring = 0.5 * dm.stiffness * r * r;
+            if mode.on(Switch::BedDamper) {
+                let d = dot(&sys.relative_vector(Switch::BedDamper), &x[..nd]);
+                e.pe_damper_contact = c.law.potential_energy(d);
+            }
+        }
+        e
+    }
+
+    /// Sum of all stored terms.
+    pub fn total(&self) -> f64 {
+        self.ke_slider
+            + self.pe_slider_contact
+            + self.ke_machine
+            + self.pe_machine
+            + self.ke_damper
+            + self.pe_damper_spring
+            + self.pe_damper_contact
+    }
+}
+
+/// Time histories on the output grid (one entry per sample), SI units.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct History {
+    pub time_s: Vec<f64>,
+    pub bed_displacement_m: Vec<f64>,
+    pub bed_velocity_m_per_s: Vec<f64>,
+    pub bed_acceleration_m_per_s2: Vec<f64>,
+    pub floor_force_n: Vec<f64>,
+    pub contact_force_slider_bed_n: Vec<f64>,
+    pub contact_force_bed_damper_n: Vec<f64>,
+    pub damper_force_n: Vec<f64>,
+    pub slider_displacement_m: Vec<f64>,
+    pub slider_velocity_m_per_s: Vec<f64>,
+    pub damper_displacement_m: Vec<f64>,
+    pub damper_velocity_m_per_s: Vec<f64>,
+    pub energy: Vec<EnergyTerms>,
+    /// Eq. (23): `E_s− − Σ stored` (J).
+    pub dissipated_j: Vec<f64>,
+}
+
+/// Observer that records histories (optionally) and always tracks peak levels.
+pub struct Recorder<'a> {
+    sys: &'a ImpactSystem,
+    keep: bool,
+    pub history: History,
+    pub peak_bed_acceleration: f64,
+    pub peak_floor_force: f64,
+    acc: Vec<f64>,
+    e_in: f64,
+}
+
+impl<'a> Recorder<'a> {
+    pub fn new(sys: &'a ImpactSystem, keep: bool) -> Self {
+        let e_in = 0.5 * sys.slider.mass * sys.slider.velocity.powi(2);
+        Recorder {
+            sys,
+            keep,
+            history: History::default(),
+            peak_bed_acceleration: 0.0,
+            peak_floor_force: 0.0,
+            acc: vec![0.0; sys.dofs()],
+            e_in,
+        }
+    }
+}
+
+impl Observer for Recorder<'_> {
+    fn sample(&mut self, t: f64, x: &[f64], mode: Mode) {
+        let sys = self.sys;
+        let n = sys.n_modes();
+        let nd = sys.dofs();
+        sys.accelerations(mode, x, &mut self.acc);
+        let phi_m = &sys.points.measurement;
+        let a_b = dot(phi_m, &self.acc[..n]);
+        let f_floor = sys.floor_force(mode, x);
+        self.peak_bed_acceleration = self.peak_bed_acceleration.max(a_b.abs());
+        self.peak_floor_force = self.peak_floor_force.max(f_floor.abs());
+        if !self.keep {
+            return;
+        }
+        let h = &mut self.history;
+        let (fbs, fbd, ffd) = sys.element_forces(mode, x);
+        h.time_s.push(t);
+        h.bed_displacement_m.push(dot(phi_m, &x[..n]));
+        h.bed_velocity_m_per_s.push(dot(phi_m, &x[nd..nd + n]));
+        h.bed_acceleration_m_per_s2.push(a_b);
+        h.floor_force_n.push(f_floor);
+        h.contact_force_slider_bed_n.push(fbs);
+        h.contact_force_bed_damper_n.push(fbd);
+        h.damper_force_n.push(ffd);
+        h.slider_displacement_m.push(x[sys.slider_index()]);
+        h.slider_velocity_m_per_s.push(x[nd + sys.slider_index()]);
+        let (zd, vd) = if sys.damper.is_some() {
+            (x[sys.damper_index()], x[nd + sys.damper_index()])
+        } else {
+            (0.0, 0.0)
+        };
+        h.damper_displacement_m.push(zd);
+        h.damper_velocity_m_per_s.push(vd);
+        let e = EnergyTerms::at(sys, mode, x);
+        h.dissipated_j.push(self.e_in - e.total());
+        h.energy.push(e);
+    }
+}
+
+/// The summary of a run: what happened to the blow's energy. Keys are stable (JSON output).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    pub method: &'static str,
+    /// E_p+ / E_s− (Eq. 10 over Eq. 11); `None` if the collision did not end within the run.
+    pub energy_ratio: Option<f64>,
+    pub collision_end_s: Option<f64>,
+    pub slider_energy_before_j: f64,
+    pub slider_energy_after_j: Option<f64>,
+    pub damper_energy_after_j: Option<f64>,
+    pub machine_energy_after_j: Option<f64>,
+    /// Parts of E_p+: kinetic and potential energy of the structure, and energy dissipated
+    /// (structural damping, dashpots, contact damping) up to the end of the collision.
+    pub machine_kinetic_energy_after_j: Option<f64>,
+    pub machine_potential_energy_after_j: Option<f64>,
+    pub dissipated_energy_after_j: Option<f64>,
+    /// ż_s at the end of the collision (negative: moving away from the bed).
+    pub slider_rebound_velocity_m_per_s: Option<f64>,
+    pub damper_velocity_m_per_s: Option<f64>,
+    pub contact_time_slider_bed_s: Option<f64>,
+    pub contact_time_bed_damper_s: Option<f64>,
+    /// Peak contact forces during the collision (during the run if it did not end).
+    pub peak_contact_force_slider_bed_n: f64,
+    pub peak_contact_force_bed_damper_n: f64,
+    /// Largest |bed acceleration at B| and |force to the floor| on the output grid.
+    pub peak_bed_acceleration_m_per_s2: f64,
+    pub peak_floor_force_n: f64,
+    /// |E_s− − Σ stored − ∫ P_diss dt| / E_s− at the end of the collision.
+    pub energy_balance_residual: Option<f64>,
+    /// The same at the end of the run.
+    pub energy_balance_residual_run_end: f64,
+    pub simulated_time_s: f64,
+    pub switching_events: usize,
+    pub steps: usize,
+}
+
+/// A finished run.
+#[derive(Debug, Clone)]
+pub struct Run {
+    pub summary: Summary,
+    pub history: Option<History>,
+    pub solution: Solution,
+}
+
+/// Simulates `sys`, records histories when `record` is true, and summarises.
+pub fn simulate(sys: &ImpactSystem, opts: &Options, record: bool) -> Result<Run> {
+    let mut rec = Recorder::new(sys, record);
+    let sol = integrate::solve(sys, opts, &mut rec)?;
+    let nd = sys.dofs();
+    let e_in = 0.5 * sys.slider.mass * sys.slider.velocity.powi(2);
+    let end = sol.collision_end.as_ref();
+    let at_end = end.map(|c| {
+        let mode = Mode(0); // both contacts open at the end of the collision
+        let e = EnergyTerms::at(sys, mode, &c.x);
+        let vs = c.x[nd + sys.slider_index()];
+        let vd = if sys.damper.is_some() {
+            Some(c.x[nd + sys.damper_index()])
+        } else {
+            None
+        };
+        (e, vs, vd, c)
+    });
+    let e_final = EnergyTerms::at(sys, sol.mode_final, &sol.x_final);
+    let residual_run_end = (e_in - e_final.total() - sol.totals.dissipated).abs() / e_in;
+    let summary = Summary {
+        method: match opts.method {
+            Method::Exact => "exact",
+            Method::Dopri5 => "dopri5",
+        },
+        energy_ratio: at_end
+            .map(|(e, ..)| (e_in - e.ke_slider - e.ke_damper - e.pe_damper_spring) / e_in),
+        collision_end_s: end.map(|c| c.t),
+        slider_energy_before_j: e_in,
+        slider_energy_after_j: at_end.map(|(e, ..)| e.ke_slider),
+        damper_energy_after_j: at_end.map(|(e, ..)| e.ke_damper + e.pe_damper_spring),
+        machine_energy_after_j: at_end
+            .map(|(e, ..)| e_in - e.ke_slider - e.ke_damper - e.pe_damper_spring),
+        machine_kinetic_energy_after_j: at_end.map(|(e, ..)| e.ke_machine),
+        machine_potential_energy_after_j: at_end.map(|(e, ..)| e.pe_machine),
+        dissipated_energy_after_j: at_end.map(|(.., c)| c.totals.dissipated),
+        slider_rebound_velocity_m_per_s: at_end.map(|(_, vs, ..)| vs),
+        damper_velocity_m_per_s: at_end.and_then(|(_, _, vd, _)| vd),
+        contact_time_slider_bed_s: end.map(|c| c.totals.closed_time[0]),
+        contact_time_bed_damper_s: end.map(|c| c.totals.closed_time[1]),
+        peak_contact_force_slider_bed_n: end
+            .map_or(sol.totals.peak_force[0], |c| c.totals.peak_force[0]),
+        peak_contact_force_bed_damper_n: end
+            .map_or(sol.totals.peak_force[1], |c| c.totals.peak_force[1]),
+        peak_bed_acceleration_m_per_s2: rec.peak_bed_acceleration,
+        peak_floor_force_n: rec.peak_floor_force,
+        energy_balance_residual: at_end
+            .map(|(e, .., c)| (e_in - e.total() - c.totals.dissipated).abs() / e_in),
+        energy_balance_residual_run_end: residual_run_end,
+        simulated_time_s: sol.t_final,
+        switching_events: sol.events.len(),
+        steps: sol.steps,
+    };
+    let history = if record { Some(rec.history) } else { None };
+    Ok(Run {
+        summary,
+        history,
+        solution: sol,
+    })
+}

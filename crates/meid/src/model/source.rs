@@ -1,0 +1,211 @@
+//! Where a value came from: file positions for error messages, `--set` overrides.
+
+use std::ops::Range;
+
+use toml::de::{DeTable, DeValue};
+
+use crate::{Error, Result};
+
+/// The text of a model file and the overrides applied to it.
+#[derive(Debug, Clone)]
+pub struct Source {
+    /// File name as the user gave it.
+    pub name: String,
+    pub text: String,
+    /// `(path, raw value)` from `--set PATH=VALUE`.
+    pub overrides: Vec<(String, String)>,
+}
+
+impl Source {
+    /// "file:line:col" of the value at a dotted path (`a.b[2].c`), or of the deepest table found;
+    /// `--set PATH=VALUE` when an override set it.
+    pub fn locate(&self, path: &str) -> String {
+        if let Some((p, v)) = self
+            .overrides
+            .iter()
+            .rev()
+            .find(|(p, _)| path == p || path.starts_with(&format!("{p}.")))
+        {
+            return format!("--set {p}={v}");
+        }
+        let Ok(doc) = DeTable::parse(&self.text) else {
+            return self.name.clone();
+        };
+        let mut span: Option<Range<usize>> = None;
+        let mut table: Option<&DeTable<'_>> = Some(doc.get_ref());
+        let mut value: Option<&DeValue<'_>> = None;
+        for seg in split_path(path) {
+            let (key, index) = seg;
+            let found = if let Some(t) = table {
+                t.iter()
+                    .find(|(k, _)| k.get_ref().as_ref() == key)
+                    .map(|(_, v)| v)
+            } else if let Some(DeValue::Table(t)) = value {
+                t.iter()
+                    .find(|(k, _)| k.get_ref().as_ref() == key)
+                    .map(|(_, v)| v)
+            } else {
+                None
+            };
+            let Some(v) = found else { break };
+            span = Some(v.span());
+            let mut cur = v.get_ref();
+            if let Some(i) = index {
+                if let DeValue::Array(a) = cur {
+                    if let Some(item) = a.iter().nth(i) {
+                        span = Some(item.span());
+                        cur = item.get_ref();
+                    }
+                }
+            }
+            table = None;
+            value = Some(cur);
+        }
+        match span {
+            Some(s) => {
+                let (line, col) = line_col(&self.text, s.start);
+                format!("{}:{}:{}", self.name, line, col)
+            }
+            None => self.name.clone(),
+        }
+    }
+
+    /// An input error at a path.
+    pub fn error(&self, path: &str, message: impl Into<String>) -> Error {
+        Error::Input {
+            location: self.locate(path),
+            message: message.into(),
+        }
+    }
+}
+
+/// `a.b[2].c` → [("a",None),("b",Some(2)),("c",None)].
+fn split_path(path: &str) -> Vec<(&str, Option<usize>)> {
+    path.split('.')
+        .map(|seg| match seg.find('[') {
+            Some(i) => (&seg[..i], seg[i + 1..].trim_end_matches(']').parse().ok()),
+            None => (seg, None),
+        })
+        .collect()
+}
+
+/// 1-based line and column of a byte offset.
+pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, col)
+}
+
+/// Turns a toml/serde error into a positioned message with a did-you-mean for unknown keys.
+pub fn toml_error(name: &str, text: &str, e: &toml::de::Error) -> Error {
+    let location = match e.span() {
+        Some(s) => {
+            let (l, c) = line_col(text, s.start);
+            format!("{name}:{l}:{c}")
+        }
+        None => name.to_string(),
+    };
+    let mut message = e.message().trim().to_string();
+    if let Some(hint) = did_you_mean(&message) {
+        message.push_str(&hint);
+    }
+    if let Some(s) = e.span() {
+        let (l, _) = line_col(text, s.start);
+        if let Some(line) = text.lines().nth(l - 1) {
+            message.push_str(&format!("\n  | {line}"));
+        }
+    }
+    Error::Input { location, message }
+}
+
+/// For serde's "unknown field `x`, expected one of `a`, `b`" adds "; did you mean `a`?".
+pub fn did_you_mean(message: &str) -> Option<String> {
+    let rest = message.strip_prefix("unknown field `")?;
+    let end = rest.find('`')?;
+    let bad = &rest[..end];
+    let expected: Vec<&str> = rest[end..].split('`').skip(1).step_by(2).collect();
+    let best = expected
+        .iter()
+        .map(|c| (strsim::jaro_winkler(bad, c), *c))
+        .filter(|(s, _)| *s > 0.8)
+        .max_by(|a, b| a.0.total_cmp(&b.0))?;
+    Some(format!("; did you mean `{}`?", best.1))
+}
+
+/// Applies `PATH=VALUE` to a TOML table. VALUE is parsed as a TOML value (number, string in
+/// quotes, boolean, array), falling back to a bare string.
+pub fn apply_override(table: &mut toml::Table, spec: &str) -> Result<(String, String)> {
+    let (path, raw) = spec.split_once('=').ok_or_else(|| Error::Input {
+        location: format!("--set {spec}"),
+        message: "expected PATH=VALUE, e.g. contact.bed_damper.stiffness=1.26e8".into(),
+    })?;
+    let path = path.trim();
+    let raw = raw.trim();
+    if path.is_empty() {
+        return Err(Error::Input {
+            location: format!("--set {spec}"),
+            message: "empty PATH".into(),
+        });
+    }
+    let value: toml::Value = match toml::from_str::<toml::Table>(&format!("v = {raw}")) {
+        Ok(mut t) => t
+            .remove("v")
+            .unwrap_or(toml::Value::String(raw.to_string())),
+        Err(_) => toml::Value::String(raw.to_string()),
+    };
+    let segs = split_path(path);
+    set_path(table, &segs, value, spec)?;
+    Ok((path.to_string(), raw.to_string()))
+}
+
+fn set_path(
+    table: &mut toml::Table,
+    segs: &[(&str, Option<usize>)],
+    value: toml::Value,
+    spec: &str,
+) -> Result<()> {
+    let err = |message: String| Error::Input {
+        location: format!("--set {spec}"),
+        message,
+    };
+    let Some(((key, index), rest)) = segs.split_first() else {
+        return Ok(());
+    };
+    match index {
+        None if rest.is_empty() => {
+            table.insert(key.to_string(), value);
+            Ok(())
+        }
+        None => {
+            let entry = table
+                .entry(key.to_string())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            let sub = entry
+                .as_table_mut()
+                .ok_or_else(|| err(format!("`{key}` is not a table")))?;
+            set_path(sub, rest, value, spec)
+        }
+        Some(idx) => {
+            let arr = table
+                .get_mut(*key)
+                .and_then(|v| v.as_array_mut())
+                .ok_or_else(|| err(format!("`{key}` is not an array in the model")))?;
+            let len = arr.len();
+            let item = arr.get_mut(*idx).ok_or_else(|| {
+                err(format!(
+                    "index {idx} out of range: `{key}` has {len} entries (0-based)"
+                ))
+            })?;
+            if rest.is_empty() {
+                *item = value;
+                Ok(())
+            } else {
+                let sub = item
+                    .as_table_mut()
+                    .ok_or_else(|| err(format!("`{key}[{idx}]` is not a table")))?;
+                set_path(sub, rest, value, spec)
+            }
+        }
+    }
+}

@@ -1,0 +1,265 @@
+//! The model file schema (TOML). Units: see the table in [`super`].
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+/// A whole model file.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    /// Free text shown in reports.
+    #[serde(default)]
+    pub name: Option<String>,
+    pub structure: StructureSpec,
+    pub points: PointsSpec,
+    pub slider: SliderSpec,
+    #[serde(default)]
+    pub damper: Option<DamperSpec>,
+    #[serde(default)]
+    pub added_mass: Option<AddedMassSpec>,
+    pub contact: ContactsSpec,
+    #[serde(default)]
+    pub simulation: SimulationSpec,
+}
+
+/// The structure: exactly one of the forms.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct StructureSpec {
+    /// 1-based index (in the retained modes) of the reference mode ω_ref (the paper's ω_6).
+    #[serde(default)]
+    pub reference_mode: Option<usize>,
+    #[serde(default)]
+    pub lumped: Option<LumpedSpec>,
+    #[serde(default)]
+    pub modal: Option<ModalSpec>,
+}
+
+/// Point masses, springs and dashpots along z; modes from `K φ = ω² M φ`.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LumpedSpec {
+    pub masses: Vec<MassSpec>,
+    #[serde(default)]
+    pub springs: Vec<SpringSpec>,
+    #[serde(default)]
+    pub dashpots: Vec<DashpotSpec>,
+    /// Modal damping ratio per mode (ascending frequency), or one value for all. Default 0.
+    #[serde(default)]
+    pub damping_ratios: Option<Ratios>,
+    /// Names of springs/dashpots to ground whose forces make the force to the floor
+    /// (default: every spring and dashpot attached to "ground").
+    #[serde(default)]
+    pub floor: Option<Vec<String>>,
+}
+
+/// One value or one per mode.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum Ratios {
+    All(f64),
+    PerMode(Vec<f64>),
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MassSpec {
+    pub name: String,
+    /// kg.
+    pub mass: f64,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SpringSpec {
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Two mass names, or a mass name and "ground".
+    pub nodes: [String; 2],
+    /// N/m.
+    pub stiffness: f64,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct DashpotSpec {
+    #[serde(default)]
+    pub name: Option<String>,
+    pub nodes: [String; 2],
+    /// N·s/m.
+    pub damping: f64,
+}
+
+/// Modes brought from elsewhere (another FE code, a modal test).
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ModalSpec {
+    /// Natural frequencies (Hz), one per mode; 0 for rigid-body modes.
+    pub frequencies_hz: Vec<f64>,
+    #[serde(default)]
+    pub damping_ratios: Option<Ratios>,
+    /// Mass-normalised mode-shape values in z at named points: `name = [ψ_1, …, ψ_n]` (m/(kg^½·m)…
+    /// i.e. displacement per unit modal coordinate, 1/√kg).
+    pub shapes: BTreeMap<String, Vec<f64>>,
+    /// Force to the floor per unit modal displacement (N) and velocity (N·s), per mode.
+    #[serde(default)]
+    pub floor_force: Option<FloorSpec>,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct FloorSpec {
+    pub stiffness: Vec<f64>,
+    #[serde(default)]
+    pub damping: Option<Vec<f64>>,
+}
+
+/// Which structure points play which role.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PointsSpec {
+    /// O_b: where the slider strikes and the damper touches.
+    pub bed_contact: String,
+    /// O_f: where the damper spring is anchored, or "ground". Default "ground".
+    #[serde(default)]
+    pub damper_anchor: Option<String>,
+    /// B: the accelerometer point.
+    pub measurement: String,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SliderSpec {
+    /// m_s (kg).
+    pub mass: f64,
+    /// v_s (m/s), towards the bed.
+    pub velocity: f64,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum DashpotKindSpec {
+    #[default]
+    OneWay,
+    TwoWay,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct DamperSpec {
+    /// m_d (kg).
+    pub mass: f64,
+    /// k_d (N/m).
+    pub stiffness: f64,
+    /// c_d (N·s/m).
+    #[serde(default)]
+    pub damping: f64,
+    /// "one-way" (paper Eq. 7, default) or "two-way".
+    #[serde(default)]
+    pub dashpot: DashpotKindSpec,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AddedMassSpec {
+    /// kg, fixed to the bed at the contact point.
+    pub mass: f64,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ContactsSpec {
+    pub slider_bed: ContactSpec,
+    #[serde(default)]
+    pub bed_damper: Option<ContactSpec>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum LawSpec {
+    #[default]
+    Linear,
+    Hertz,
+    HuntCrossley,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum ReleaseSpec {
+    #[default]
+    Force,
+    Overlap,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// "linear" (default), "hertz" or "hunt-crossley".
+    #[serde(default)]
+    pub law: LawSpec,
+    /// K: N/m (linear), N/m^1.5 (hertz), N/m^n (hunt-crossley).
+    pub stiffness: f64,
+    /// C (N·s/m), linear law only.
+    #[serde(default)]
+    pub damping: f64,
+    /// n of Hunt-Crossley (default 1.5).
+    #[serde(default)]
+    pub exponent: Option<f64>,
+    /// α (s/m) of Hunt-Crossley.
+    #[serde(default)]
+    pub alpha: f64,
+    /// "force" (default: release when the force returns to zero) or "overlap" (Eqs. 5, 8).
+    #[serde(default)]
+    pub release: ReleaseSpec,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum MethodSpec {
+    #[default]
+    Exact,
+    Dopri5,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationSpec {
+    #[serde(default)]
+    pub method: MethodSpec,
+    /// s.
+    #[serde(default = "default_duration")]
+    pub duration: f64,
+    /// Hz.
+    #[serde(default = "default_rate")]
+    pub sample_rate: f64,
+    #[serde(default = "default_rtol")]
+    pub rtol: f64,
+    #[serde(default = "default_atol")]
+    pub atol: f64,
+}
+
+impl Default for SimulationSpec {
+    fn default() -> Self {
+        Self {
+            method: MethodSpec::Exact,
+            duration: default_duration(),
+            sample_rate: default_rate(),
+            rtol: default_rtol(),
+            atol: default_atol(),
+        }
+    }
+}
+
+fn default_duration() -> f64 {
+    0.5
+}
+fn default_rate() -> f64 {
+    20_000.0
+}
+fn default_rtol() -> f64 {
+    1e-8
+}
+fn default_atol() -> f64 {
+    1e-14
+}
