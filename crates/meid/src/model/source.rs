@@ -124,7 +124,7 @@ pub fn did_you_mean(message: &str) -> Option<String> {
     let rest = message.strip_prefix("unknown field `")?;
     let end = rest.find('`')?;
     let bad = &rest[..end];
-    let expected: Vec<&str> = rest[end..].split('`').skip(1).step_by(2).collect();
+    let expected: Vec<&str> = rest[end..].split('`').skip(2).step_by(2).collect();
     let best = expected
         .iter()
         .map(|c| (strsim::jaro_winkler(bad, c), *c))

@@ -1,0 +1,185 @@
+//! Conservation laws and the paper's findings on the lumped paper example.
+
+use meid::analysis::simulate;
+use meid::integrate::{Method, Options};
+use meid::model::{Case, Model};
+use std::path::PathBuf;
+
+fn example() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-lumped.toml")
+}
+
+fn load(sets: &[&str]) -> Model {
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    Model::from_file(&example(), &sets).unwrap()
+}
+
+fn opts(method: Method, duration: f64, to_end: bool) -> Options {
+    Options {
+        method,
+        duration,
+        sample_rate: None,
+        stop_at_collision_end: to_end,
+        rtol: 1e-8,
+        ..Options::default()
+    }
+}
+
+const UNDAMPED: [&str; 2] = ["structure.lumped.damping_ratios=0.0", "damper.damping=0.0"];
+
+#[test]
+fn undamped_energy_is_conserved() {
+    let m = load(&UNDAMPED);
+    let sys = m.impact_system(Case::AsSpecified).unwrap();
+    for (method, tol) in [(Method::Exact, 1e-10), (Method::Dopri5, 1e-6)] {
+        let run = simulate(&sys, &opts(method, 0.2, false), false).unwrap();
+        let s = &run.summary;
+        assert!(
+            s.energy_balance_residual.unwrap() <= tol,
+            "{method:?}: {:e}",
+            s.energy_balance_residual.unwrap()
+        );
+        assert!(
+            s.energy_balance_residual_run_end <= tol,
+            "{method:?}: run end {:e}",
+            s.energy_balance_residual_run_end
+        );
+        // Without damping nothing is dissipated.
+        assert!(
+            run.solution.totals.dissipated.abs() <= 1e-12,
+            "{method:?}: {}",
+            run.solution.totals.dissipated
+        );
+    }
+}
+
+#[test]
+fn damped_energy_balance_closes() {
+    // With modal damping and the one-way dashpot, stored + dissipated = input.
+    let m = load(&[]);
+    let sys = m.impact_system(Case::AsSpecified).unwrap();
+    let run = simulate(&sys, &opts(Method::Exact, 0.5, false), false).unwrap();
+    assert!(
+        run.solution.totals.dissipated > 1e-3,
+        "the dashpot and modal damping must dissipate"
+    );
+    assert!(
+        run.summary.energy_balance_residual_run_end <= 1e-10,
+        "{:e}",
+        run.summary.energy_balance_residual_run_end
+    );
+    let run = simulate(&sys, &opts(Method::Dopri5, 0.5, false), false).unwrap();
+    assert!(
+        run.summary.energy_balance_residual_run_end <= 1e-6,
+        "{:e}",
+        run.summary.energy_balance_residual_run_end
+    );
+}
+
+/// A free structure (no supports): total momentum m_s v_s is conserved.
+#[test]
+fn free_structure_conserves_momentum() {
+    let text = std::fs::read_to_string(example()).unwrap();
+    let text = text.replace(
+        r#"  { name = "supports", nodes = ["base", "ground"], stiffness = 8.1195270e4 },"#,
+        "",
+    );
+    let text = text.replace(r#"floor = ["supports"]"#, "");
+    let text = text.replace("reference_mode = 1", "reference_mode = 2");
+    let m = Model::from_text(
+        "free.toml",
+        text,
+        &["structure.lumped.damping_ratios=0.0".into()],
+    )
+    .unwrap();
+    assert_eq!(m.structure.omega_rad_per_s[0], 0.0, "rigid-body mode");
+    let sys = m.impact_system(Case::AsSpecified).unwrap();
+    let masses = [("bed", 10.0), ("base", 41.0)];
+    for (method, tol) in [(Method::Exact, 1e-10), (Method::Dopri5, 1e-6)] {
+        let run = simulate(&sys, &opts(method, 0.3, false), false).unwrap();
+        let nd = sys.dofs();
+        let n = sys.n_modes();
+        let x = &run.solution.x_final;
+        let mut p = sys.slider.mass * x[nd + sys.slider_index()] + 3.5 * x[nd + sys.damper_index()];
+        for (name, mass) in masses {
+            let phi = &m.structure.points[name];
+            p += mass * (0..n).map(|j| phi[j] * x[nd + j]).sum::<f64>();
+        }
+        let p0 = sys.slider.mass * sys.slider.velocity;
+        assert!(
+            (p - p0).abs() <= tol * p0,
+            "{method:?}: momentum {p} vs {p0}"
+        );
+        assert!(
+            run.summary.energy_balance_residual_run_end <= tol,
+            "{method:?}"
+        );
+    }
+}
+
+#[test]
+fn exact_and_dopri5_agree_on_the_example() {
+    let m = load(&[]);
+    let sys = m.impact_system(Case::AsSpecified).unwrap();
+    let e = simulate(&sys, &opts(Method::Exact, 0.05, true), false)
+        .unwrap()
+        .summary;
+    let d = simulate(&sys, &opts(Method::Dopri5, 0.05, true), false)
+        .unwrap()
+        .summary;
+    let (re, rd) = (e.energy_ratio.unwrap(), d.energy_ratio.unwrap());
+    assert!((re - rd).abs() <= 1e-6, "exact {re} vs dopri5 {rd}");
+    let (te, td) = (e.collision_end_s.unwrap(), d.collision_end_s.unwrap());
+    assert!((te - td).abs() <= 1e-6 * te, "collision end {te} vs {td}");
+}
+
+fn ratio_at(md: f64, wd_over_ws: f64) -> f64 {
+    // w_s = 150 w_6 fixed by K_s; w_d = r w_s, K_d = m_d w_d².
+    let w6 = 2.0 * std::f64::consts::PI * 6.35;
+    let ws = 150.0 * w6;
+    let kd = md * (wd_over_ws * ws).powi(2);
+    let m = load(&[
+        &format!("damper.mass={md:e}"),
+        &format!("contact.bed_damper.stiffness={kd:e}"),
+    ]);
+    let sys = m.impact_system(Case::AsSpecified).unwrap();
+    simulate(&sys, &opts(Method::Exact, 0.1, true), false)
+        .unwrap()
+        .summary
+        .energy_ratio
+        .unwrap()
+}
+
+/// Paper section 4.1 / Fig. 4: at w_s/w_6 = 150 the machine keeps least energy near w_d = w_s
+/// (the minimum along w_d/w_s lies in [0.8, 1.25]), and the energy falls as m_d/m_b rises.
+#[test]
+fn paper_finding_optimum_near_equal_contact_frequencies() {
+    let n = 41;
+    let grid: Vec<f64> = (0..n)
+        .map(|i| 10f64.powf(-0.5 + i as f64 / (n - 1) as f64))
+        .collect(); // 0.32 .. 3.2
+    let vals: Vec<f64> = grid.iter().map(|&r| ratio_at(3.5, r)).collect();
+    let (imin, _) = vals
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(b.1))
+        .unwrap();
+    let r_best = grid[imin];
+    assert!(
+        (0.8..=1.25).contains(&r_best),
+        "minimum at w_d/w_s = {r_best}: {vals:?}"
+    );
+    // Away from the optimum it is clearly worse.
+    assert!(
+        vals[0] > vals[imin] * 1.3 && vals[n - 1] > vals[imin] * 1.3,
+        "{vals:?}"
+    );
+    let e: Vec<f64> = [0.35, 0.7, 1.0]
+        .iter()
+        .map(|mr| ratio_at(10.0 * mr, 1.0))
+        .collect();
+    assert!(
+        e[0] > e[1] && e[1] > e[2],
+        "energy must fall as m_d/m_b rises: {e:?}"
+    );
+}
