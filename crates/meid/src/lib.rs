@@ -15,6 +15,9 @@
 //! Units are SI throughout (m, kg, s, N, rad/s unless a name says Hz).
 //! The library never prints; progress is reported through callbacks.
 
+// Index loops over several arrays at once are the clearest form of numerical kernels.
+#![allow(clippy::needless_range_loop)]
+
 pub mod analysis;
 pub mod error;
 pub mod impact;

@@ -183,3 +183,54 @@ fn paper_finding_optimum_near_equal_contact_frequencies() {
         "energy must fall as m_d/m_b rises: {e:?}"
     );
 }
+
+/// A critically damped damper return (c_d = 2√(k_d m_d), anchored to the ground) makes the
+/// open-contact mode defective: the exact propagator must fall back to the matrix exponential
+/// and still agree with dopri5 and close the energy balance.
+#[test]
+fn defective_mode_uses_expm_fallback() {
+    let (kd, md) = (1.8e3_f64, 3.5_f64);
+    let cd = 2.0 * (kd * md).sqrt();
+    let sets = [
+        format!("damper.damping={cd:e}"),
+        "points.damper_anchor=\"ground\"".to_string(),
+    ];
+    let m = Model::from_file(&example(), &sets).unwrap();
+    let sys = m.impact_system(Case::AsSpecified).unwrap();
+    let o = |method| Options {
+        method,
+        duration: 0.6,
+        sample_rate: None,
+        rtol: 1e-9,
+        ..Options::default()
+    };
+    let e = simulate(&sys, &o(Method::Exact), false).unwrap();
+    assert!(
+        e.solution.fallback_modes > 0,
+        "expected a matrix-exponential fallback mode"
+    );
+    assert!(
+        e.summary.energy_balance_residual_run_end <= 1e-9,
+        "{:e}",
+        e.summary.energy_balance_residual_run_end
+    );
+    let d = simulate(&sys, &o(Method::Dopri5), false).unwrap();
+    let nd = sys.dofs();
+    let (ze, zd) = (
+        e.solution.x_final[sys.damper_index()],
+        d.solution.x_final[sys.damper_index()],
+    );
+    assert!(
+        (ze - zd).abs() <= 1e-6 * ze.abs().max(1e-6),
+        "damper position {ze} vs {zd}"
+    );
+    let (ve, vd) = (
+        e.solution.x_final[nd + sys.damper_index()],
+        d.solution.x_final[nd + sys.damper_index()],
+    );
+    assert!(
+        (ve - vd).abs() <= 1e-6 * ve.abs().max(1e-3),
+        "damper velocity {ve} vs {vd}"
+    );
+    assert_eq!(e.solution.events.len(), d.solution.events.len());
+}

@@ -213,7 +213,7 @@ struct OnStep<'a> {
     sys: &'a ImpactSystem,
     ind: Indicator,
     linear: Option<&'a [f64]>,
-    scratch: std::cell::RefCell<Vec<f64>>,
+    scratch: &'a std::cell::RefCell<Vec<f64>>,
 }
 
 impl Scalar for OnStep<'_> {
@@ -294,6 +294,7 @@ pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Resu
     let mut collision_end = None;
     let (mut steps, mut rejected) = (0usize, 0usize);
     let mut signs = vec![0.0; inds.len()];
+    let scratch = std::cell::RefCell::new(vec![0.0; ny]);
 
     let sc = |a: f64, b: f64| opts.atol + opts.rtol * a.abs().max(b.abs());
     let err_norm = |y0: &[f64], y1: &[f64], e: &[f64]| -> f64 {
@@ -444,7 +445,7 @@ pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Resu
                 sys,
                 ind,
                 linear: linear_vecs[i].as_deref(),
-                scratch: std::cell::RefCell::new(vec![0.0; ny]),
+                scratch: &scratch,
             };
             if let Some(s) = first_crossing(&f, s_end, signs[i], SearchOptions::default()) {
                 if s < s_end || (s == s_end && !switched) {

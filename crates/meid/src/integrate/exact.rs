@@ -73,9 +73,8 @@ pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Resu
     let mut buf2 = vec![0.0; n];
 
     loop {
-        if !cache.contains_key(&mode) {
-            let md = build(mode)?;
-            cache.insert(mode, md);
+        if let std::collections::hash_map::Entry::Vacant(e) = cache.entry(mode) {
+            e.insert(build(mode)?);
         }
         let md = cache
             .get_mut(&mode)
@@ -286,12 +285,12 @@ fn dissipated(seg: &Segment<'_>, c: &Mat<f64>, nd: usize, len: f64) -> f64 {
     // Quadrature fallback.
     const GL_X: [f64; 4] = [
         0.1834346424956498,
-        0.5255324099163290,
+        0.525_532_409_916_329,
         0.7966664774136267,
         0.9602898564975363,
     ];
     const GL_W: [f64; 4] = [
-        0.3626837833783620,
+        0.362_683_783_378_362,
         0.3137066458778873,
         0.2223810344533745,
         0.1012285362903763,

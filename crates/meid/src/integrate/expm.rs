@@ -38,7 +38,7 @@ pub fn norm1(a: &Mat<f64>) -> f64 {
 /// powers of two `d` such that `D⁻¹AD` has rows and columns of similar norm. For the
 /// first-order form of a stiff oscillator ([[0, 1], [−ω², 0]]) it recovers [[0, ω], [−ω, 0]],
 /// which scaling and squaring handles to round-off instead of losing `log₂ ω²` digits.
-fn balance(a: &Mat<f64>) -> Vec<f64> {
+pub fn balance(a: &Mat<f64>) -> Vec<f64> {
     let n = a.nrows();
     let mut d = vec![1.0; n];
     let mut b = a.clone();

@@ -28,6 +28,8 @@
 //! falls back to the matrix exponential ([`super::expm`]), evaluated on demand.
 
 use faer::linalg::solvers::Solve;
+use std::cell::RefCell;
+
 use faer::{c64, Mat, Side};
 
 use super::expm::expm;
@@ -51,7 +53,16 @@ pub struct Propagator {
 #[derive(Debug, Clone)]
 enum Kind {
     Spectral(Spectral),
-    Expm { norm_f: f64 },
+    /// Matrix-exponential fallback: states on a grid of step `h` by `E = exp(A h)`, and a
+    /// Taylor series of `exp(A τ)` (‖Aτ‖ ≤ 1, 30 terms) inside a grid cell.
+    /// `norm_f` is ‖B‖_F of the balanced `B = D⁻¹AD` (≈ the fastest frequency), `d` the balance.
+    Expm {
+        norm_f: f64,
+        h: f64,
+        e: Mat<f64>,
+        d: Vec<f64>,
+        b: Mat<f64>,
+    },
 }
 
 #[derive(Debug, Clone)]
@@ -80,6 +91,8 @@ pub struct Segment<'p> {
     alpha_dot: Vec<f64>,
     /// Modal coefficients c_k.
     coef: Vec<c64>,
+    /// Fallback only: states at multiples of the grid step, filled on demand.
+    grid: RefCell<Vec<Vec<f64>>>,
 }
 
 /// A linear functional of the state along a segment: `p₀ + p₁ s + Re Σ amp_k e^{λ_k s}`.
@@ -103,11 +116,16 @@ impl Propagator {
                 kind: Kind::Spectral(s),
             }),
             Err(_) => {
-                let norm_f = a.norm_l2();
+                let d = super::expm::balance(&a);
+                let n = a.nrows();
+                let b = Mat::<f64>::from_fn(n, n, |i, j| a[(i, j)] * d[j] / d[i]);
+                let norm_f = b.norm_l2();
+                let h = if norm_f > 0.0 { 1.0 / norm_f } else { 1.0 };
+                let e = expm(&a, h);
                 Ok(Self {
                     a,
                     dofs,
-                    kind: Kind::Expm { norm_f },
+                    kind: Kind::Expm { norm_f, h, e, d, b },
                 })
             }
         }
@@ -122,7 +140,7 @@ impl Propagator {
     pub fn period(&self) -> f64 {
         let lam_max = match &self.kind {
             Kind::Spectral(s) => s.lam_max,
-            Kind::Expm { norm_f } => *norm_f,
+            Kind::Expm { norm_f, .. } => *norm_f,
         };
         if lam_max > 0.0 {
             2.0 * std::f64::consts::PI / lam_max
@@ -156,6 +174,7 @@ impl Propagator {
             alpha0,
             alpha_dot,
             coef,
+            grid: RefCell::new(vec![x0.to_vec()]),
         }
     }
 
@@ -222,10 +241,36 @@ impl<'p> Segment<'p> {
     pub fn state(&self, s: f64, out: &mut [f64]) {
         let nd = self.p.dofs;
         match &self.p.kind {
-            Kind::Expm { .. } => {
-                let e = expm(&self.p.a, s);
-                for (i, o) in out.iter_mut().enumerate() {
-                    *o = (0..2 * nd).map(|j| e[(i, j)] * self.x0[j]).sum();
+            Kind::Expm { h, e, .. } => {
+                let n = 2 * nd;
+                let k = (s / h).floor().max(0.0) as usize;
+                let mut grid = self.grid.borrow_mut();
+                while grid.len() <= k {
+                    let last = &grid[grid.len() - 1];
+                    let next: Vec<f64> = (0..n)
+                        .map(|i| (0..n).map(|j| e[(i, j)] * last[j]).sum())
+                        .collect();
+                    grid.push(next);
+                }
+                let tau = s - k as f64 * h;
+                // exp(Aτ) x_k = Σ (Aτ)^m/m! x_k.
+                let mut term = grid[k].clone();
+                out.copy_from_slice(&term);
+                let mut next = vec![0.0; n];
+                for m in 1..30 {
+                    for i in 0..n {
+                        next[i] = (0..n).map(|j| self.p.a[(i, j)] * term[j]).sum::<f64>() * tau
+                            / m as f64;
+                    }
+                    std::mem::swap(&mut term, &mut next);
+                    let mut mx = 0.0_f64;
+                    for i in 0..n {
+                        out[i] += term[i];
+                        mx = mx.max(term[i].abs());
+                    }
+                    if mx == 0.0 || mx < 1e-18 * out.iter().fold(0.0_f64, |a, b| a.max(b.abs())) {
+                        break;
+                    }
                 }
             }
             Kind::Spectral(sp) => {
@@ -290,14 +335,16 @@ impl<'p> Segment<'p> {
                     period,
                 })
             }
-            Kind::Expm { norm_f } => {
+            Kind::Expm { norm_f, d, b, .. } => {
                 let la = row_times(l, &self.p.a);
-                let la2 = row_times(&la, &self.p.a);
+                // |ℓᵀA²X| = |(ℓᵀD) B² (D⁻¹X)| ≤ ‖ℓᵀD B²‖ ‖D⁻¹X‖.
+                let ld: Vec<f64> = l.iter().zip(d).map(|(x, di)| x * di).collect();
+                let ldb2 = row_times(&row_times(&ld, b), b);
                 Functional::Expm {
                     seg: self,
                     l: l.to_vec(),
                     la,
-                    la2_norm: norm(&la2),
+                    la2_norm: norm(&ldb2),
                     norm_a: *norm_f,
                 }
             }
@@ -378,7 +425,16 @@ impl Scalar for Functional<'_> {
             } => {
                 let mut x = vec![0.0; l.len()];
                 seg.state(a, &mut x);
-                la2_norm * norm(&x) * (norm_a * (b - a)).exp()
+                let dinv_x = match &seg.p.kind {
+                    Kind::Expm { d, .. } => x
+                        .iter()
+                        .zip(d)
+                        .map(|(v, di)| (v / di).powi(2))
+                        .sum::<f64>()
+                        .sqrt(),
+                    Kind::Spectral(_) => norm(&x),
+                };
+                la2_norm * dinv_x * (norm_a * (b - a)).exp()
             }
         }
     }

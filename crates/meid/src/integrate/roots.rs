@@ -51,7 +51,7 @@ pub fn first_crossing<F: Scalar + ?Sized>(
     sign0: f64,
     opts: SearchOptions,
 ) -> Option<f64> {
-    if !(s_max > 0.0) {
+    if s_max.is_nan() || s_max <= 0.0 {
         return None;
     }
     let period = f.fastest_period();

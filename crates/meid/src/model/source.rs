@@ -52,7 +52,7 @@ impl Source {
             let mut cur = v.get_ref();
             if let Some(i) = index {
                 if let DeValue::Array(a) = cur {
-                    if let Some(item) = a.iter().nth(i) {
+                    if let Some(item) = a.get(i) {
                         span = Some(item.span());
                         cur = item.get_ref();
                     }
