@@ -85,7 +85,6 @@ struct Spectral {
 #[derive(Debug, Clone)]
 pub struct Segment<'p> {
     p: &'p Propagator,
-    x0: Vec<f64>,
     /// Rigid coordinates α₀ and α̇₀.
     alpha0: Vec<f64>,
     alpha_dot: Vec<f64>,
@@ -170,7 +169,6 @@ impl Propagator {
         };
         Segment {
             p: self,
-            x0: x0.to_vec(),
             alpha0,
             alpha_dot,
             coef,
