@@ -77,18 +77,10 @@ fn free_lattice_rigid_modes_and_multiplicities() {
     eprintln!("{:?} sturm {} at {}", r.stats, r.sturm_count, r.sturm_shift);
     assert_eq!(r.rigid_body_modes, 3);
     let lmax = exact[exact.len() - 1];
-    for j in 0..20 {
-        let tol = if exact[j] == 0.0 {
-            1e-9 * lmax
-        } else {
-            1e-9 * exact[j]
-        };
-        assert!(
-            (r.eigenvalues[j] - exact[j]).abs() <= tol,
-            "mode {j}: {} vs {}",
-            r.eigenvalues[j],
-            exact[j]
-        );
+    for (j, &ex) in exact.iter().enumerate().take(20) {
+        let tol = if ex == 0.0 { 1e-9 * lmax } else { 1e-9 * ex };
+        let got = r.eigenvalues[j];
+        assert!((got - ex).abs() <= tol, "mode {j}: {got} vs {ex}");
     }
     assert!(r.orthonormality_error <= 1e-10);
     assert!(r.max_residual <= 1e-10, "{}", r.max_residual);
@@ -110,13 +102,12 @@ fn truss_six_rigid_modes_match_dense() {
     eprintln!("{:?}", r.stats);
     assert_eq!(r.rigid_body_modes, 6);
     let lmax = dense[dense.len() - 1];
-    for j in 0..24 {
-        let tol = if j < 6 { 1e-8 * lmax } else { 1e-8 * dense[j] };
+    for (j, &de) in dense.iter().enumerate().take(24) {
+        let tol = if j < 6 { 1e-8 * lmax } else { 1e-8 * de };
         assert!(
-            (r.eigenvalues[j] - dense[j]).abs() <= tol,
-            "mode {j}: {} vs {}",
-            r.eigenvalues[j],
-            dense[j]
+            (r.eigenvalues[j] - de).abs() <= tol,
+            "mode {j}: {} vs {de}",
+            r.eigenvalues[j]
         );
     }
     assert!(dense[5].abs() <= 1e-10 * lmax && dense[6] > 1e-6 * lmax);
