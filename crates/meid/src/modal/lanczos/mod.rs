@@ -58,7 +58,11 @@
 //! (condition ≈ 1e6 in the M-norm, so rigid-body modes are resolved), close enough that the
 //! wanted eigenvalues stay separated. If after a cycle the k-th Ritz value `λ̃_k` lies far
 //! below `|σ|` (`|σ| > 4 λ̃_k`; slender or very finely meshed models), the factorisation is
-//! redone at `σ = -max(λ̃_k, 1e-12 s)` and the iteration restarts from the Ritz vectors.
+//! redone at `σ = -max(λ̃_k, 1e-9 s)` and the iteration restarts from the Ritz vectors. A
+//! shift much closer to zero (user-given, e.g. -1e-12 s) makes `K - σM` so ill-conditioned
+//! that solve errors stall convergence when rigid-body modes are present; the solver then
+//! fails with "no convergence" rather than return a wrong set (the Sturm check guards the
+//! rest).
 //!
 //! # Sturm check
 //! After convergence, `K - σ_u M` with `σ_u` just above the largest returned eigenvalue (in
@@ -96,6 +100,10 @@ const DEFLATION_TOL: f64 = 1e-10;
 /// A mode whose residual is below `ATTAINABLE_FACTOR · ε · s / |λ|` (the size of the residual
 /// of the exact eigenvector rounded to double precision) is accepted even above `tol`.
 const ATTAINABLE_FACTOR: f64 = 4.0;
+/// Smallest automatic |σ| as a fraction of s: below it, K - σM has a condition number
+/// beyond 1e9 and the solve error (≈ ε · condition) stalls convergence when rigid-body
+/// modes are present (observed at 1e-12: see the tests).
+const RESHIFT_FLOOR: f64 = 1e-9;
 /// Largest number of automatic re-shifts.
 const MAX_RESHIFTS: usize = 3;
 
@@ -355,7 +363,7 @@ pub fn lowest_modes(
             && lam_k > 0.0
             && -sigma > 4.0 * lam_k
         {
-            sigma = -lam_k.max(1e-12 * s_ref);
+            sigma = -lam_k.max(RESHIFT_FLOOR * s_ref);
             drop(llt);
             let fclock = Instant::now();
             llt = pencil.factor_llt(sigma, par)?;
