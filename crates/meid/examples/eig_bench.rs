@@ -1,7 +1,7 @@
 //! Benchmark of the sparse shift-invert block Lanczos solver (`meid::modal::lanczos`).
 //!
 //! ```text
-//! cargo run --release -p meid --example eig_bench -- [plate|lattice|truss] NX NY NZ [COUNT] [BLOCK] [--export DIR] [--peer]
+//! cargo run --release -p meid --example eig_bench -- [plate|lattice|truss] NX NY NZ [COUNT] [BLOCK] [--threads T] [--basis N] [--export DIR] [--peer]
 //! ```
 //! Builds a free-floating test model (see `tests/lanczos_support`), solves for COUNT modes
 //! (default 20), prints a JSON line with times, frequencies and checks. `--export DIR` writes
@@ -25,6 +25,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut pos: Vec<&str> = Vec::new();
     let mut export: Option<PathBuf> = None;
     let mut peer = false;
+    let mut basis: Option<usize> = None;
     let mut i = 0;
     while i < args.len() {
         match args[i].as_str() {
@@ -35,6 +36,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 i += 1;
             }
             "--peer" => peer = true,
+            "--basis" => {
+                basis = Some(args.get(i + 1).ok_or("--basis needs a number")?.parse()?);
+                i += 1;
+            }
+            "--threads" => {
+                let t: usize = args.get(i + 1).ok_or("--threads needs a number")?.parse()?;
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(t)
+                    .build_global()?;
+                faer::set_global_parallelism(if t <= 1 {
+                    faer::Par::Seq
+                } else {
+                    faer::Par::rayon(t)
+                });
+                i += 1;
+            }
             a => pos.push(a),
         }
         i += 1;
@@ -58,6 +75,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let opts = LanczosOptions {
         count,
         block_size: block,
+        basis_size: basis,
         ..Default::default()
     };
     let t1 = Instant::now();

@@ -80,7 +80,7 @@ use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
 use faer::sparse::SparseColMatRef;
-use faer::{Accum, Mat, Par, Side};
+use faer::{Accum, Mat, MatRef, Par, Side};
 
 use std::time::Instant;
 
@@ -290,7 +290,7 @@ pub fn lowest_modes(
         for c in 0..b {
             w.col_mut(c).copy_from(fill_random(&mut rng, n));
         }
-        st.append_block(w, m, &mut rng, &mut stats, false, par)?;
+        st.append_block(w, m, &mut rng, &mut stats, false, Par::Seq)?;
     }
 
     let mut tol_op = opts.tol;
@@ -306,7 +306,7 @@ pub fn lowest_modes(
             stats.block_steps += 1;
             stats.solve_s += clock.elapsed().as_secs_f64();
             let clock = Instant::now();
-            st.append_block(w, m, &mut rng, &mut stats, true, par)?;
+            st.append_block(w, m, &mut rng, &mut stats, true, Par::Seq)?;
             stats.orthogonalise_s += clock.elapsed().as_secs_f64();
         }
         stats.cycles += 1;
@@ -322,7 +322,7 @@ pub fn lowest_modes(
         best_converged = best_converged.max(n_conv);
 
         if n_conv == want {
-            let x = st.v.get(.., ..basis) * y.get(.., ..want);
+            let x = mul(st.v.get(.., ..basis), y.get(.., ..want));
             let fin = finalize(k, m, x, s_ref, &mut stats)?;
             stats.ritz_s += clock.elapsed().as_secs_f64();
             clock = Instant::now();
@@ -371,14 +371,14 @@ pub fn lowest_modes(
             stats.factorizations += 1;
             stats.reshifts += 1;
             // New start block: the Ritz vectors folded into b columns.
-            let x = st.v.get(.., ..basis) * y.get(.., ..basis.min(want + b));
+            let x = mul(st.v.get(.., ..basis), y.get(.., ..basis.min(want + b)));
             let mut w = Mat::<f64>::zeros(n, b);
             for i in 0..x.ncols() {
                 let mut col = w.col_mut(i % b);
                 col += x.col(i);
             }
             st.reset();
-            st.append_block(w, m, &mut rng, &mut stats, false, par)?;
+            st.append_block(w, m, &mut rng, &mut stats, false, Par::Seq)?;
             continue;
         }
 
@@ -732,8 +732,8 @@ impl Basis {
         let q = ((m - want) / (2 * b)).max(1);
         let l = m - q * b;
         let yl = y.get(.., ..l);
-        let nv_new = self.v.get(.., ..m) * yl;
-        let nmv_new = self.mv.get(.., ..m) * yl;
+        let nv_new = mul(self.v.get(.., ..m), yl);
+        let nmv_new = mul(self.mv.get(.., ..m), yl);
         self.v.get_mut(.., ..l).copy_from(&nv_new);
         self.mv.get_mut(.., ..l).copy_from(&nmv_new);
         let res_v = self.v.get(.., m..m + b).to_owned();
@@ -776,8 +776,8 @@ fn finalize(
     sym_matmul(k, x.as_ref(), kx.as_mut());
     sym_matmul(m, x.as_ref(), mx.as_mut());
     stats.matvec_columns += 2 * p;
-    let a = symmetrised(x.transpose() * &kx);
-    let bm = symmetrised(x.transpose() * &mx);
+    let a = symmetrised(mul(x.transpose(), kx.as_ref()));
+    let bm = symmetrised(mul(x.transpose(), mx.as_ref()));
     let llt = bm.llt(Side::Lower).map_err(|_| {
         Error::numerical(
             "sparse eigen-solver",
@@ -799,11 +799,11 @@ fn finalize(
     let eigenvalues: Vec<f64> = (0..p).map(|i| evd.S()[i]).collect();
     let mut g = evd.U().to_owned();
     solve_upper_triangular_in_place(l.transpose(), g.as_mut(), Par::Seq);
-    let shapes = &x * &g;
+    let shapes = mul(x.as_ref(), g.as_ref());
     sym_matmul(k, shapes.as_ref(), kx.as_mut());
     sym_matmul(m, shapes.as_ref(), mx.as_mut());
     stats.matvec_columns += 2 * p;
-    let gram = shapes.transpose() * &mx;
+    let gram = mul(shapes.transpose(), mx.as_ref());
     let mut orth = 0.0_f64;
     for j in 0..p {
         for i in 0..p {
@@ -835,6 +835,13 @@ fn finalize(
         residuals,
         orthonormality_error: orth,
     })
+}
+
+/// `a b` with a sequential kernel (faer's parallel GEMM stalls on a loaded 2-core machine).
+fn mul(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
+    let mut c = Mat::<f64>::zeros(a.nrows(), b.ncols());
+    matmul(c.as_mut(), Accum::Replace, a, b, 1.0, Par::Seq);
+    c
 }
 
 fn symmetrised(mut a: Mat<f64>) -> Mat<f64> {
