@@ -123,24 +123,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         let text = String::from_utf8(out.stdout)?;
         println!("{}", text.trim());
-        // Minimal parse of the peer's "time_s" and "frequencies_hz".
-        let field = |name: &str| -> Option<&str> {
-            let at = text.find(&format!("\"{name}\":"))? + name.len() + 3;
-            Some(&text[at..])
-        };
-        let peer_time: f64 = field("time_s")
-            .and_then(|s| s.split([',', '}']).next())
-            .and_then(|s| s.trim().parse().ok())
-            .ok_or("peer output has no time_s")?;
-        let peer_f: Vec<f64> = field("frequencies_hz")
-            .and_then(|s| s.split(']').next())
-            .map(|s| {
-                s.trim_start_matches('[')
-                    .split(',')
-                    .filter_map(|v| v.trim().parse().ok())
-                    .collect()
-            })
-            .ok_or("peer output has no frequencies_hz")?;
+        let v: serde_json::Value = serde_json::from_str(text.trim())?;
+        let peer_time = v["time_s"].as_f64().ok_or("peer output has no time_s")?;
+        let peer_f: Vec<f64> = v["frequencies_hz"]
+            .as_array()
+            .ok_or("peer output has no frequencies_hz")?
+            .iter()
+            .filter_map(|x| x.as_f64())
+            .collect();
         let fmax = r.frequency_hz.iter().fold(0.0_f64, |a, &b| a.max(b));
         let max_diff = r
             .frequency_hz
