@@ -193,4 +193,13 @@ fn bad_options_are_rejected() {
         ..Default::default()
     })
     .contains("too few"));
+    let (k2, m2) = chain_fixed_free(2, 1.0, 1.0);
+    let o = LanczosOptions {
+        count: 1,
+        ..Default::default()
+    };
+    let e = lowest_modes(k2.as_ref(), m2.as_ref(), &o)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("too few"), "{e}");
 }

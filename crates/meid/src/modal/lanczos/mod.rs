@@ -70,7 +70,8 @@
 //! negative pivots equals the number of eigenvalues below `σ_u` (Sylvester's law of
 //! inertia). It must equal the number of computed eigenvalues below `σ_u` (the returned modes
 //! plus any further Ritz values in the gap, e.g. the rest of a multiple eigenvalue); otherwise
-//! a mode was missed and an error is returned. See [`shifted`] for how D is read from faer.
+//! a mode was missed and an error is returned. See `lanczos/shifted.rs` for how D is read from
+//! faer's factor (faer 0.24 has no accessor for it).
 
 mod block;
 mod shifted;
@@ -254,7 +255,7 @@ pub fn lowest_modes(
         let target = opts.basis_size.unwrap_or(2 * want + 2 * b).max(want + b);
         let mut mm = target.div_ceil(b) * b;
         if mm + b > n {
-            mm = (n - b) / b * b;
+            mm = n.saturating_sub(b) / b * b;
         }
         mm
     };
