@@ -74,6 +74,7 @@ fn shift_near_zero_keeps_rigid_modes_or_fails_loudly() {
     };
     match lowest_modes(k.as_ref(), m.as_ref(), &opts) {
         Ok(r) => {
+            eprintln!("near-zero shift: solved, {:?}", r.stats);
             assert_eq!(r.rigid_body_modes, 6);
             assert_eq!(r.sturm_count, r.computed_below_sturm_shift);
             for (got, de) in r.eigenvalues.iter().zip(&dense).skip(6) {
@@ -82,7 +83,12 @@ fn shift_near_zero_keeps_rigid_modes_or_fails_loudly() {
         }
         Err(e) => {
             let e = e.to_string();
-            assert!(e.contains("Sturm") || e.contains("no convergence"), "{e}");
+            eprintln!("near-zero shift: {e}");
+            assert!(
+                e.contains("Sturm")
+                    || (e.contains("no convergence") && e.contains("nearly singular")),
+                "{e}"
+            );
         }
     }
 }

@@ -386,10 +386,17 @@ pub fn lowest_modes(
         st.thick_restart(&theta, &y, &coupling, want)?;
         stats.ritz_s += clock.elapsed().as_secs_f64();
     }
+    let hint = if -sigma < RESHIFT_FLOOR * s_ref {
+        format!(
+            "; the shift σ = {sigma:.3e} is closer to zero than 1e-9 × the stiffness scale {s_ref:.3e}, so K - σM is nearly singular: use a more negative shift or the automatic one"
+        )
+    } else {
+        "; raise max_iter, block_size or basis_size".to_string()
+    };
     Err(Error::numerical(
         "sparse eigen-solver",
         format!(
-            "no convergence after {} restart cycles ({} of {want} modes converged); raise max_iter, block_size or basis_size",
+            "no convergence after {} restart cycles ({} of {want} modes converged){hint}",
             opts.max_iter, best_converged
         ),
     ))
