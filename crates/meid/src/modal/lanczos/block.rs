@@ -2,6 +2,7 @@
 //! deterministic random generator, and M-orthonormalisation of a new block against the basis.
 
 use faer::linalg::matmul::matmul;
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::SparseColMatRef;
 use faer::{Accum, Col, Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
@@ -47,8 +48,6 @@ pub(crate) fn sym_matmul(
         }
     }
 }
-
-use faer::reborrow::ReborrowMut;
 
 /// SplitMix64 (Steele, Lea & Flood, OOPSLA 2014): a small deterministic generator for
 /// start vectors, so that runs are reproducible without a `rand` dependency.
@@ -99,8 +98,6 @@ pub(crate) fn project_column(
         *c += *di;
     }
 }
-
-use faer::reborrow::Reborrow;
 
 /// M-norm `sqrt(wᵀ M w)` of a column given `mw = M w` (0 if round-off made it negative).
 pub(crate) fn m_norm(w: MatRef<'_, f64>, mw: MatRef<'_, f64>) -> f64 {
