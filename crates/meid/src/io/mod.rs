@@ -3,6 +3,8 @@
 //! Every file is written to a temporary file in the target directory and renamed into place,
 //! so an interrupted run never leaves a half-written output.
 
+pub mod matrix_market;
+
 use std::io::Write;
 use std::path::{Path, PathBuf};
 

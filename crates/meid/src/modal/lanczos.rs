@@ -1,1 +1,0 @@
-//! Sparse shift-invert block Lanczos (to be written).
