@@ -60,8 +60,9 @@ pub enum Window {
     /// scalloping loss up to 1.42 dB (half-bin offset).
     #[default]
     Hann,
-    /// Flat-top HFT90D (Heinzel 2002): `w_j = 1 - 1.942604 cos z + 1.340318 cos 2z
-    /// - 0.440811 cos 3z + 0.043097 cos 4z`. ENBW 3.8832 bins, amplitude error at most
+    /// Flat-top HFT90D (Heinzel 2002):
+    /// `w_j = 1 - 1.942604 cos z + 1.340318 cos 2z - 0.440811 cos 3z + 0.043097 cos 4z`,
+    /// `z = 2π j / N`. ENBW 3.8832 bins, amplitude error at most
     /// 0.0039 dB anywhere between bins: the window for reading amplitudes.
     FlatTop,
 }
@@ -438,7 +439,7 @@ fn check_reference(reference: f64) -> Result<()> {
 /// `-inf`. Example: `A = √2 m/s²` re 1 m/s² is 0 dB; re 1e-6 m/s² it is 120 dB.
 pub fn level_db(amplitude: f64, reference: f64) -> Result<f64> {
     check_reference(reference)?;
-    if !(amplitude >= 0.0) || amplitude.is_infinite() {
+    if !(amplitude.is_finite() && amplitude >= 0.0) {
         return Err(Error::invalid(
             "amplitude",
             format!("must be a finite non-negative number, got {amplitude}"),
@@ -450,7 +451,7 @@ pub fn level_db(amplitude: f64, reference: f64) -> Result<f64> {
 /// Level in dB of a power spectral density: `10 log10(G / A_ref²)` (dB re A_ref²/Hz).
 pub fn psd_level_db(density: f64, reference: f64) -> Result<f64> {
     check_reference(reference)?;
-    if !(density >= 0.0) || density.is_infinite() {
+    if !(density.is_finite() && density >= 0.0) {
         return Err(Error::invalid(
             "density",
             format!("must be a finite non-negative number, got {density}"),
