@@ -76,8 +76,8 @@ pub fn marching_squares(x: &[f64], y: &[f64], z: &[f64], level: f64) -> Result<V
                     // Corner k lies between edge k-1 and edge k.
                     let centre = corners.iter().map(|c| c.2).sum::<f64>() / 4.0;
                     let centre_above = centre >= level;
-                    for k in 0..4 {
-                        if above[k] != centre_above {
+                    for (k, &corner_above) in above.iter().enumerate() {
+                        if corner_above != centre_above {
                             if let (Some(p), Some(q)) = (crossing((k + 3) % 4), crossing(k)) {
                                 segments.push([p, q]);
                             }
