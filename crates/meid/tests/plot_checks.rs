@@ -171,6 +171,29 @@ fn line_plot_writes_png_and_svg() {
     };
     assert_written(&line_plot(out_dir("line").join("amplification"), &family).unwrap());
 
+    // A log axis spanning less than a decade still gets decade ticks (labels 10 and 100).
+    let narrow = LinePlot {
+        title: "Narrow log range".into(),
+        x_label: "frequency (Hz)".into(),
+        y_label: "level (dB re 1 m/s²)".into(),
+        x_log: true,
+        series: vec![Series {
+            label: "band".into(),
+            x: vec![20.0, 40.0, 80.0],
+            y: vec![1.0, 3.0, 2.0],
+        }],
+        ..LinePlot::default()
+    };
+    let files = line_plot(out_dir("line").join("narrow-log"), &narrow).unwrap();
+    assert_written(&files);
+    let svg = std::fs::read_to_string(&files.svg)
+        .unwrap()
+        .replace('\n', "");
+    assert!(
+        svg.contains(">10</text>") && svg.contains(">100</text>"),
+        "decade ticks missing"
+    );
+
     // Errors: missing label, mismatched lengths, nothing drawable.
     let mut bad = plot.clone();
     bad.x_label.clear();

@@ -85,15 +85,21 @@ fn extent(values: impl Iterator<Item = f64>, log: bool) -> Option<(f64, f64)> {
 }
 
 /// Axis range with a 4 % margin (in log space for a log axis); a single value is widened.
+/// A log axis is widened to whole decades when it would otherwise show fewer than two
+/// decade ticks (plotters labels a log axis at decades only).
 fn padded((lo, hi): (f64, f64), log: bool) -> Range<f64> {
     if log {
         let (l, h) = (lo.log10(), hi.log10());
-        let (l, h) = if h - l < 1e-12 {
+        let (mut l, mut h) = if h - l < 1e-12 {
             (l - 0.5, h + 0.5)
         } else {
             let m = 0.04 * (h - l);
             (l - m, h + m)
         };
+        if h.floor() - l.ceil() < 1.0 {
+            l = l.floor();
+            h = h.ceil().max(l + 1.0);
+        }
         10f64.powf(l)..10f64.powf(h)
     } else if hi - lo <= 1e-12 * hi.abs().max(lo.abs()) {
         let w = if lo == 0.0 { 1.0 } else { 0.1 * lo.abs() };
