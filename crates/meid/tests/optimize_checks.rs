@@ -244,3 +244,40 @@ fn nelder_mead_respects_the_budget() {
     assert!(m.evaluations <= 60);
     assert!(!m.converged);
 }
+
+#[test]
+fn random_starts_find_the_global_minimum() {
+    // f = (x² - 1)² + 0.3 x + y² has two wells; the global one is at the root of
+    // f'(x) = 4x(x² - 1) + 0.3 near x = -1 (found here by Newton's method, independent of
+    // the optimiser), the local one near x = +1. Started in the right-hand well, a single
+    // local search stays there; seeded random starts reach the global well.
+    let f = |v: &[f64]| (v[0] * v[0] - 1.0).powi(2) + 0.3 * v[0] + v[1] * v[1];
+    let mut x_star: f64 = -1.0;
+    for _ in 0..50 {
+        let g = 4.0 * x_star * (x_star * x_star - 1.0) + 0.3;
+        let h = 12.0 * x_star * x_star - 4.0;
+        x_star -= g / h;
+    }
+    let (lo, hi) = ([-2.0, -2.0], [2.0, 2.0]);
+    let single = minimize_box(f, &[0.9, 0.5], &lo, &hi, &tight()).unwrap();
+    assert!(
+        single.x[0] > 0.0,
+        "single start left its well: {:?}",
+        single.x
+    );
+    let multi = minimize_box(
+        f,
+        &[0.9, 0.5],
+        &lo,
+        &hi,
+        &NelderMeadOptions {
+            random_starts: 10,
+            seed: 3,
+            ..tight()
+        },
+    )
+    .unwrap();
+    assert!((multi.x[0] - x_star).abs() < 1e-6, "x = {:?}", multi.x);
+    assert!(multi.x[1].abs() < 1e-6);
+    assert!(multi.f < single.f);
+}
