@@ -234,10 +234,13 @@ where
 pub struct NelderMeadOptions {
     /// Edge of the initial simplex as a fraction of each box width (0 < step ≤ 0.5).
     pub initial_step: f64,
-    /// Stop a simplex when its vertices are within this distance of the best one, per
-    /// coordinate, as a fraction of the box width...
+    /// A simplex has converged when every vertex is within `x_tolerance` of the best one in
+    /// every coordinate, measured as a fraction of the box width, and (see `f_tolerance`)
+    /// its values agree.
     pub x_tolerance: f64,
-    /// ...and the spread of its values is below `f_tolerance · (1 + |f_best|)`.
+    /// A simplex has converged when the spread of its values is at most
+    /// `f_tolerance · (1 + |f_best|)` (and see `x_tolerance`); a restart cycle that gains
+    /// no more than that ends the search from this start.
     pub f_tolerance: f64,
     /// Evaluation budget over all starts, restarts and polishing.
     pub max_evaluations: usize,
