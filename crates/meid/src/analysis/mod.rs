@@ -1,5 +1,7 @@
 //! Studies built on the impact engine: energy accounting, spectra, sweeps, optimisation.
 
 pub mod energy;
+pub mod optimize;
+pub mod spectrum;
 
 pub use energy::{simulate, EnergyTerms, History, Run, Summary};

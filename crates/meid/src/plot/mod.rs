@@ -1,1 +1,234 @@
-//! (module under construction)
+//! Pictures of studies: line plots (families of curves), heat maps with a colour bar,
+//! contour lines and overlays, stacked or overlaid area plots (energy histories) and
+//! spectra in dB.
+//!
+//! The API takes plain data (no dependency on the impact engine). Every picture is written
+//! twice, `<stem>.png` (raster, 100 px per inch-ish, small for heat maps) and `<stem>.svg`
+//! (vector), each atomically: rendered to a temporary file in the target directory and
+//! renamed over the final name, so a reader never sees a half-written picture.
+//!
+//! Rendering is plotters (bitmap and SVG back ends) with the DejaVu Sans font bundled in
+//! `assets/` (Bitstream Vera licence, `assets/DejaVuSans-LICENSE.txt`), registered from
+//! bytes: the machine may have no system fonts. plotters has no contour primitive, so
+//! iso-lines are computed here by marching squares ([`contour`]).
+//!
+//! Conventions: axis labels must be given and should carry quantity and unit, e.g.
+//! `"frequency (Hz)"`. Non-finite values (failed design points) are never drawn as data:
+//! lines break there and a grey × marks the failed abscissa at the bottom of the frame;
+//! heat-map cells are painted neutral grey and listed in the legend as "failed".
+//! Points ≤ 0 on a logarithmic axis are left out.
+
+mod charts;
+pub mod contour;
+
+pub use charts::{area_plot, heat_map, line_plot, spectrum_plot};
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::OnceLock;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::{Error, Result};
+
+/// One curve: `y` against `x` (same length), named in the legend by `label`
+/// (an empty label leaves the curve out of the legend).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Series {
+    /// Legend text.
+    pub label: String,
+    /// Abscissae.
+    pub x: Vec<f64>,
+    /// Ordinates; non-finite values are failed points.
+    pub y: Vec<f64>,
+}
+
+/// A family of curves on common axes.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LinePlot {
+    /// Title above the frame.
+    pub title: String,
+    /// Horizontal axis label with unit, e.g. `"time (s)"`.
+    pub x_label: String,
+    /// Vertical axis label with unit.
+    pub y_label: String,
+    /// Logarithmic horizontal axis.
+    pub x_log: bool,
+    /// Logarithmic vertical axis.
+    pub y_log: bool,
+    /// The curves, coloured in order from a ten-colour palette (Tableau 10).
+    pub series: Vec<Series>,
+}
+
+/// A field `z(x, y)` on a rectilinear grid, drawn as coloured cells (viridis) with a colour
+/// bar, optional contour lines and overlay curves.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct HeatMap {
+    /// Title above the frame.
+    pub title: String,
+    /// Horizontal axis label with unit.
+    pub x_label: String,
+    /// Vertical axis label with unit.
+    pub y_label: String,
+    /// Cell-centre abscissae, strictly increasing (`nx ≥ 2`).
+    pub x: Vec<f64>,
+    /// Cell-centre ordinates, strictly increasing (`ny ≥ 2`).
+    pub y: Vec<f64>,
+    /// Values, row-major `ny × nx`: `z[j * nx + i]` at `(x[i], y[j])`. Non-finite = failed.
+    pub z: Vec<f64>,
+    /// Logarithmic horizontal axis (cell edges at geometric midpoints).
+    pub x_log: bool,
+    /// Logarithmic vertical axis.
+    pub y_log: bool,
+    /// Levels of black contour lines (also marked on the colour bar).
+    pub contour_levels: Vec<f64>,
+    /// Curves drawn over the map, e.g. the ω_d = ω_s diagonal.
+    pub overlay_lines: Vec<Series>,
+    /// Colour bar label with unit.
+    pub colorbar_label: String,
+}
+
+/// Several histories on a common time axis, filled, either stacked (each band is one
+/// series, the top edge is the total) or overlaid (each filled down to zero).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct AreaPlot {
+    /// Title above the frame.
+    pub title: String,
+    /// Horizontal axis label with unit.
+    pub x_label: String,
+    /// Vertical axis label with unit.
+    pub y_label: String,
+    /// Stack the series (they must then share the same `x`).
+    pub stacked: bool,
+    /// The histories, bottom band first when stacked.
+    pub series: Vec<Series>,
+}
+
+/// Spectra in dB against frequency in Hz (a line plot with a linear dB axis).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SpectrumPlot {
+    /// Title above the frame.
+    pub title: String,
+    /// Level label with its reference, e.g. `"acceleration level (dB re 1 m/s²)"`.
+    pub y_label: String,
+    /// Logarithmic frequency axis.
+    pub x_log: bool,
+    /// Spectra: `x` in Hz, `y` in dB (`-inf` for empty bins is left out).
+    pub series: Vec<Series>,
+}
+
+/// The two files a picture was written to.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PlotFiles {
+    /// `<stem>.png`.
+    pub png: PathBuf,
+    /// `<stem>.svg`.
+    pub svg: PathBuf,
+}
+
+/// Font family name the bundled font is registered under.
+pub(crate) const FONT: &str = "sans-serif";
+
+static FONT_BYTES: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+
+/// Registers the bundled DejaVu Sans for plotters (once per process).
+fn ensure_font() -> Result<()> {
+    static REGISTERED: OnceLock<bool> = OnceLock::new();
+    let ok = *REGISTERED.get_or_init(|| {
+        plotters::style::register_font(FONT, FontStyle::Normal, FONT_BYTES).is_ok()
+    });
+    if ok {
+        Ok(())
+    } else {
+        Err(Error::numerical(
+            "plotting",
+            "the bundled font assets/DejaVuSans.ttf could not be loaded",
+        ))
+    }
+}
+
+/// Something that can draw itself on any plotters back end.
+pub(crate) trait Figure {
+    /// Picture size in pixels (width, height).
+    fn size(&self) -> (u32, u32);
+    /// Draws on `area`; errors are returned as text.
+    fn draw<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+    ) -> std::result::Result<(), String>;
+}
+
+/// A unique temporary name next to `final_path`, keeping its extension (the PNG encoder
+/// chooses the format from it).
+fn temporary_path(dir: &Path, name: &str, ext: &str) -> PathBuf {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    dir.join(format!(".{name}.{}.{n}.tmp.{ext}", std::process::id()))
+}
+
+/// Writes `figure` as `<stem>.png` and `<stem>.svg`, each through a temporary file renamed
+/// into place.
+pub(crate) fn write_figure<F: Figure>(stem: &Path, figure: &F) -> Result<PlotFiles> {
+    ensure_font()?;
+    let name = stem
+        .file_name()
+        .and_then(|n| n.to_str())
+        .filter(|n| !n.is_empty())
+        .ok_or_else(|| {
+            Error::invalid(
+                "path_stem",
+                format!("'{}' does not end in a file name", stem.display()),
+            )
+        })?
+        .to_string();
+    let dir = match stem.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    let png = dir.join(format!("{name}.png"));
+    let svg = dir.join(format!("{name}.svg"));
+    let size = figure.size();
+    let draw_error = |path: &Path, msg: String| Error::io(path, std::io::Error::other(msg));
+
+    // PNG.
+    let tmp_png = temporary_path(&dir, &name, "png");
+    let rendered = (|| {
+        let root = BitMapBackend::new(&tmp_png, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        figure.draw(&root)?;
+        root.present().map_err(|e| e.to_string())
+    })();
+    if let Err(msg) = rendered {
+        let _ = std::fs::remove_file(&tmp_png);
+        return Err(draw_error(&png, msg));
+    }
+    rename(&tmp_png, &png)?;
+
+    // SVG, rendered to memory.
+    let mut text = String::new();
+    let rendered = (|| {
+        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        figure.draw(&root)?;
+        root.present().map_err(|e| e.to_string())
+    })();
+    if let Err(msg) = rendered {
+        return Err(draw_error(&svg, msg));
+    }
+    let tmp_svg = temporary_path(&dir, &name, "svg");
+    if let Err(e) = std::fs::write(&tmp_svg, text.as_bytes()) {
+        let _ = std::fs::remove_file(&tmp_svg);
+        return Err(Error::io(&svg, e));
+    }
+    rename(&tmp_svg, &svg)?;
+    Ok(PlotFiles { png, svg })
+}
+
+fn rename(from: &Path, to: &Path) -> Result<()> {
+    std::fs::rename(from, to).map_err(|e| {
+        let _ = std::fs::remove_file(from);
+        Error::io(to, e)
+    })
+}

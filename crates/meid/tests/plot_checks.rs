@@ -1,0 +1,348 @@
+//! Checks of `plot`: marching-squares contours against closed-form iso-lines, and that
+//! every chart writes a PNG and an SVG (atomically, no temporary files left behind).
+//! The pictures are kept in `$TMPDIR/meid-plot-checks/` for inspection.
+
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+use meid::plot::contour::marching_squares;
+use meid::plot::{
+    area_plot, heat_map, line_plot, spectrum_plot, AreaPlot, HeatMap, LinePlot, Series,
+    SpectrumPlot,
+};
+
+fn out_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join("meid-plot-checks").join(name);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| a + (b - a) * i as f64 / (n - 1) as f64)
+        .collect()
+}
+
+fn assert_written(files: &meid::plot::PlotFiles) {
+    let png = std::fs::read(&files.png).unwrap();
+    assert!(png.len() > 1000, "PNG too small: {} bytes", png.len());
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "not a PNG");
+    let svg = std::fs::read_to_string(&files.svg).unwrap();
+    assert!(svg.contains("<svg") && svg.trim_end().ends_with("</svg>"));
+    // No temporary file left next to the pictures.
+    let dir = files.png.parent().unwrap();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let name = entry.unwrap().file_name().into_string().unwrap();
+        assert!(!name.contains(".tmp."), "left-over temporary file {name}");
+    }
+}
+
+#[test]
+fn circle_contour_lies_on_the_circle() {
+    // z = x² + y² at level r²: the iso-line is the circle of radius r. Along an edge of
+    // length h, linear interpolation of z errs by at most h² max|z''|/8 = h²/4, a radial
+    // error of at most (h²/4)/|∇z| = h²/(8 r).
+    let n = 81;
+    let x = linspace(-2.0, 2.0, n);
+    let y = linspace(-2.0, 2.0, n);
+    let h = x[1] - x[0];
+    let z: Vec<f64> = y
+        .iter()
+        .flat_map(|yj| x.iter().map(move |xi| xi * xi + yj * yj))
+        .collect();
+    for r in [0.5, 1.0, 1.37, 1.9] {
+        let segs = marching_squares(&x, &y, &z, r * r).unwrap();
+        assert!(!segs.is_empty());
+        let bound = h * h / (8.0 * r) + 1e-12;
+        let mut worst: f64 = 0.0;
+        let mut length = 0.0;
+        for s in &segs {
+            for (px, py) in s {
+                worst = worst.max(((px * px + py * py).sqrt() - r).abs());
+            }
+            length += ((s[1].0 - s[0].0).powi(2) + (s[1].1 - s[0].1).powi(2)).sqrt();
+        }
+        assert!(
+            worst <= bound,
+            "r = {r}: worst radial error {worst} > {bound}"
+        );
+        // The chords of the polygon are shorter than the arc, by well under 1 % here.
+        assert!(
+            (length / (2.0 * PI * r) - 1.0).abs() < 0.01,
+            "r = {r}: length {length}"
+        );
+        // Closed curve: every end point is shared by exactly two segments.
+        let mut ends: Vec<(f64, f64)> = segs.iter().flat_map(|s| [s[0], s[1]]).collect();
+        ends.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        for pair in ends.chunks(2) {
+            assert!((pair[0].0 - pair[1].0).abs() < 1e-12 && (pair[0].1 - pair[1].1).abs() < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn saddle_contour_is_exact_for_bilinear_field() {
+    // z = x y is bilinear, so edge interpolation is exact: the zero level set consists of
+    // the axes x = 0 and y = 0, and every crossing lies on one of them to rounding.
+    let x = linspace(-1.05, 0.95, 21);
+    let y = linspace(-0.93, 1.07, 21);
+    let z: Vec<f64> = y
+        .iter()
+        .flat_map(|yj| x.iter().map(move |xi| xi * yj))
+        .collect();
+    let segs = marching_squares(&x, &y, &z, 0.0).unwrap();
+    assert!(segs.len() >= 38); // 20 cells crossed by each axis, minus the shared cell
+    for s in &segs {
+        for (px, py) in s {
+            assert!(px.abs() < 1e-12 || py.abs() < 1e-12, "({px}, {py})");
+        }
+    }
+}
+
+#[test]
+fn contours_skip_failed_cells_and_reject_bad_grids() {
+    let x = linspace(0.0, 1.0, 3);
+    let y = linspace(0.0, 1.0, 3);
+    let mut z: Vec<f64> = y
+        .iter()
+        .flat_map(|yj| x.iter().map(move |xi| xi + yj))
+        .collect();
+    let all = marching_squares(&x, &y, &z, 1.0).unwrap().len();
+    z[4] = f64::NAN; // the centre point touches all four cells
+    assert_eq!(marching_squares(&x, &y, &z, 1.0).unwrap().len(), 0);
+    assert!(all > 0);
+    assert!(marching_squares(&x, &y, &z[..8], 1.0).is_err());
+    assert!(marching_squares(&x, &y, &z, f64::NAN).is_err());
+}
+
+#[test]
+fn line_plot_writes_png_and_svg() {
+    let t = linspace(0.0, 0.2, 400);
+    let mut damped: Vec<f64> = t
+        .iter()
+        .map(|t| (-15.0 * t).exp() * (2.0 * PI * 40.0 * t).sin())
+        .collect();
+    for v in damped.iter_mut().skip(150).take(20) {
+        *v = f64::NAN; // failed points
+    }
+    let plot = LinePlot {
+        title: "Bed acceleration after one impact".into(),
+        x_label: "time (s)".into(),
+        y_label: "acceleration (m/s²)".into(),
+        series: vec![
+            Series {
+                label: "without damper".into(),
+                x: t.clone(),
+                y: t.iter()
+                    .map(|t| 1.4 * (-10.0 * t).exp() * (2.0 * PI * 40.0 * t).sin())
+                    .collect(),
+            },
+            Series {
+                label: "with damper, μ = 0.35".into(),
+                x: t.clone(),
+                y: damped,
+            },
+        ],
+        ..LinePlot::default()
+    };
+    let files = line_plot(out_dir("line").join("acceleration"), &plot).unwrap();
+    assert_written(&files);
+
+    // Log-log family.
+    let w = (0..200)
+        .map(|i| 10f64.powf(-1.0 + 3.0 * i as f64 / 199.0))
+        .collect::<Vec<_>>();
+    let family = LinePlot {
+        title: "Dynamic amplification".into(),
+        x_label: "frequency ratio ω/ωₙ (–)".into(),
+        y_label: "|H| (–)".into(),
+        x_log: true,
+        y_log: true,
+        series: [0.02, 0.1, 0.3]
+            .iter()
+            .map(|zeta| Series {
+                label: format!("ζ = {zeta}"),
+                x: w.clone(),
+                y: w.iter()
+                    .map(|r| 1.0 / ((1.0 - r * r).powi(2) + (2.0 * zeta * r).powi(2)).sqrt())
+                    .collect(),
+            })
+            .collect(),
+    };
+    assert_written(&line_plot(out_dir("line").join("amplification"), &family).unwrap());
+
+    // A log axis spanning less than a decade still gets decade ticks (labels 10 and 100).
+    let narrow = LinePlot {
+        title: "Narrow log range".into(),
+        x_label: "frequency (Hz)".into(),
+        y_label: "level (dB re 1 m/s²)".into(),
+        x_log: true,
+        series: vec![Series {
+            label: "band".into(),
+            x: vec![20.0, 40.0, 80.0],
+            y: vec![1.0, 3.0, 2.0],
+        }],
+        ..LinePlot::default()
+    };
+    let files = line_plot(out_dir("line").join("narrow-log"), &narrow).unwrap();
+    assert_written(&files);
+    let svg = std::fs::read_to_string(&files.svg)
+        .unwrap()
+        .replace('\n', "");
+    assert!(
+        svg.contains(">10</text>") && svg.contains(">100</text>"),
+        "decade ticks missing"
+    );
+
+    // Errors: missing label, mismatched lengths, nothing drawable.
+    let mut bad = plot.clone();
+    bad.x_label.clear();
+    assert!(line_plot(out_dir("line").join("bad"), &bad).is_err());
+    let mut bad = plot.clone();
+    bad.series[0].y.pop();
+    assert!(line_plot(out_dir("line").join("bad"), &bad).is_err());
+    let mut bad = family.clone();
+    bad.series = vec![Series {
+        label: "negative".into(),
+        x: vec![1.0, 2.0],
+        y: vec![-1.0, -2.0],
+    }];
+    assert!(line_plot(out_dir("line").join("bad"), &bad).is_err());
+}
+
+#[test]
+fn heat_map_writes_png_and_svg() {
+    // A resonance-like ridge on log axes with a failed region and the diagonal overlay.
+    let x: Vec<f64> = (0..60)
+        .map(|i| 10f64.powf(1.0 + 2.0 * i as f64 / 59.0))
+        .collect();
+    let y: Vec<f64> = (0..50)
+        .map(|j| 10f64.powf(1.0 + 2.0 * j as f64 / 49.0))
+        .collect();
+    let mut z = Vec::new();
+    for yj in &y {
+        for xi in &x {
+            let r = xi / yj;
+            let v = -20.0 * ((1.0 - r * r).powi(2) + (0.2 * r).powi(2)).sqrt().log10();
+            z.push(v);
+        }
+    }
+    for j in 40..45 {
+        for i in 5..12 {
+            z[j * 60 + i] = f64::NAN;
+        }
+    }
+    let map = HeatMap {
+        title: "Energy reduction".into(),
+        x_label: "ω_s (rad/s)".into(),
+        y_label: "ω_d (rad/s)".into(),
+        x: x.clone(),
+        y: y.clone(),
+        z,
+        x_log: true,
+        y_log: true,
+        contour_levels: vec![-20.0, -10.0, 0.0, 10.0],
+        overlay_lines: vec![Series {
+            label: "ω_d = ω_s".into(),
+            x: vec![10.0, 1000.0],
+            y: vec![10.0, 1000.0],
+        }],
+        colorbar_label: "reduction (dB)".into(),
+    };
+    assert_written(&heat_map(out_dir("heat").join("reduction"), &map).unwrap());
+
+    let mut lin = map.clone();
+    lin.x_log = false;
+    lin.y_log = false;
+    assert_written(&heat_map(out_dir("heat").join("reduction-linear"), &lin).unwrap());
+
+    let mut bad = map.clone();
+    bad.z.pop();
+    assert!(heat_map(out_dir("heat").join("bad"), &bad).is_err());
+    let mut bad = map.clone();
+    bad.x.swap(0, 1);
+    assert!(heat_map(out_dir("heat").join("bad"), &bad).is_err());
+    let mut bad = map;
+    bad.colorbar_label.clear();
+    assert!(heat_map(out_dir("heat").join("bad"), &bad).is_err());
+}
+
+#[test]
+fn area_plots_write_png_and_svg() {
+    let t = linspace(0.0, 0.05, 300);
+    let kinetic: Vec<f64> = t.iter().map(|t| 50.0 * (-60.0 * t).exp()).collect();
+    let strain: Vec<f64> = t
+        .iter()
+        .map(|t| 20.0 * (1.0 - (-60.0 * t).exp()) * (0.6 + 0.4 * (2.0 * PI * 80.0 * t).cos()))
+        .collect();
+    let damper: Vec<f64> = t.iter().map(|t| 25.0 * (1.0 - (-90.0 * t).exp())).collect();
+    let series = vec![
+        Series {
+            label: "slider kinetic".into(),
+            x: t.clone(),
+            y: kinetic,
+        },
+        Series {
+            label: "bed strain + kinetic".into(),
+            x: t.clone(),
+            y: strain,
+        },
+        Series {
+            label: "damper kinetic".into(),
+            x: t.clone(),
+            y: damper,
+        },
+    ];
+    let stacked = AreaPlot {
+        title: "Energy shares".into(),
+        x_label: "time (s)".into(),
+        y_label: "energy (J)".into(),
+        stacked: true,
+        series: series.clone(),
+    };
+    assert_written(&area_plot(out_dir("area").join("stacked"), &stacked).unwrap());
+    let overlaid = AreaPlot {
+        stacked: false,
+        ..stacked.clone()
+    };
+    assert_written(&area_plot(out_dir("area").join("overlaid"), &overlaid).unwrap());
+
+    let mut bad = stacked;
+    bad.series[1].x[3] += 1e-3;
+    assert!(area_plot(out_dir("area").join("bad"), &bad).is_err());
+}
+
+#[test]
+fn spectrum_plot_writes_png_and_svg() {
+    let f = linspace(0.0, 500.0, 501);
+    let level = |f0: f64, peak: f64| -> Vec<f64> {
+        f.iter()
+            .map(|f| peak - 10.0 * (1.0 + ((f - f0) / 6.0).powi(2)).log10())
+            .collect()
+    };
+    let mut with = level(120.0, 17.0);
+    with[0] = f64::NEG_INFINITY; // an empty bin: left out
+    let plot = SpectrumPlot {
+        title: "Bed acceleration spectrum".into(),
+        y_label: "acceleration level (dB re 1 m/s²)".into(),
+        x_log: false,
+        series: vec![
+            Series {
+                label: "without damper".into(),
+                x: f.clone(),
+                y: level(118.0, 20.0),
+            },
+            Series {
+                label: "with damper".into(),
+                x: f.clone(),
+                y: with,
+            },
+        ],
+    };
+    assert_written(&spectrum_plot(out_dir("spectrum").join("linear"), &plot).unwrap());
+    let log = SpectrumPlot {
+        x_log: true,
+        ..plot
+    };
+    assert_written(&spectrum_plot(out_dir("spectrum").join("log"), &log).unwrap());
+}
