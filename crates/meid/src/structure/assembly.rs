@@ -231,7 +231,11 @@ impl Collector<'_> {
     }
 }
 
-fn sparse(n: usize, t: &[Triplet<usize, usize, f64>], what: &str) -> Result<SparseColMat<usize, f64>> {
+fn sparse(
+    n: usize,
+    t: &[Triplet<usize, usize, f64>],
+    what: &str,
+) -> Result<SparseColMat<usize, f64>> {
     SparseColMat::try_new_from_triplets(n, n, t)
         .map_err(|e| Error::numerical("assembly", format!("building sparse {what}: {e:?}")))
 }
@@ -247,7 +251,10 @@ impl FeModel {
     pub fn assemble_with_direction(mesh: Mesh, impact_direction: [f64; 3]) -> Result<Self> {
         mesh.validate()?;
         let dir = super::geom::unit(impact_direction).ok_or_else(|| {
-            Error::invalid("impact direction", format!("{impact_direction:?} is not a nonzero vector"))
+            Error::invalid(
+                "impact direction",
+                format!("{impact_direction:?} is not a nonzero vector"),
+            )
         })?;
         let map = DofMap::new(&mesh)?;
         let n = map.n_free();
@@ -344,8 +351,13 @@ impl FeModel {
     pub fn dense_damping(&self) -> Mat<f64> {
         self.damping.to_dense()
     }
-    /// All modes by the dense solver [`crate::modal::dense::solve`] (small models).
+    /// All modes by the dense shift-invert solver [`super::eigen::solve_shift_invert`] with
+    /// its default shift (small models, up to a few thousand DOFs).
     pub fn solve_dense(&self) -> Result<crate::modal::dense::DenseModes> {
-        crate::modal::dense::solve(self.dense_stiffness().as_ref(), self.dense_mass().as_ref())
+        super::eigen::solve_shift_invert(
+            self.dense_stiffness().as_ref(),
+            self.dense_mass().as_ref(),
+            None,
+        )
     }
 }

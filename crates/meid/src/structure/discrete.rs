@@ -55,7 +55,10 @@ pub(crate) fn check_coefficients(what: &str, unit: &str, v: &[f64]) -> Result<()
                 format!(
                     "component {} ({}) must be finite and >= 0 {unit} (got {x})",
                     i + 1,
-                    ["x", "y", "z", "rx", "ry", "rz"].get(i).copied().unwrap_or("?")
+                    ["x", "y", "z", "rx", "ry", "rz"]
+                        .get(i)
+                        .copied()
+                        .unwrap_or("?")
                 ),
             ));
         }

@@ -80,7 +80,9 @@ impl Section {
         if 2.0 * wall_m > outer_diameter_m {
             return Err(Error::invalid(
                 "tube wall",
-                format!("must be at most half the outer diameter {outer_diameter_m} m (got {wall_m} m)"),
+                format!(
+                    "must be at most half the outer diameter {outer_diameter_m} m (got {wall_m} m)"
+                ),
             ));
         }
         let (d_o, d_i) = (outer_diameter_m, outer_diameter_m - 2.0 * wall_m);
@@ -228,7 +230,14 @@ pub fn frame_local_matrices(
     rod(&mut k, 0, 6, e * a / l, 1.0, -1.0);
     rod(&mut m, 0, 6, rho * a * l / 6.0, 2.0, 1.0);
     rod(&mut k, 3, 9, g * section.torsion_constant_m4 / l, 1.0, -1.0);
-    rod(&mut m, 3, 9, rho * section.polar_moment_m4() * l / 6.0, 2.0, 1.0);
+    rod(
+        &mut m,
+        3,
+        9,
+        rho * section.polar_moment_m4() * l / 6.0,
+        2.0,
+        1.0,
+    );
     // Hermite beam in [v1, θ1, v2, θ2] with θ = dv/dx.
     let kb = [
         [12.0, 6.0 * l, -12.0, 6.0 * l],

@@ -102,6 +102,47 @@ impl Mesh {
         self.points.insert(name.into(), nodes);
     }
 
+    /// Adds a structured grid of shell elements in the plane `z = z_m` with grid lines at `xs_m`
+    /// and `ys_m` (each strictly increasing, at least two values). Returns the node indices as
+    /// `grid[i][j]` for the node at `(xs_m[i], ys_m[j])`. Elements are numbered with `i` fastest
+    /// and have counter-clockwise nodes about +z.
+    pub fn add_plate_grid(
+        &mut self,
+        xs_m: &[f64],
+        ys_m: &[f64],
+        z_m: f64,
+        material: super::material::Material,
+        thickness_m: f64,
+    ) -> Result<Vec<Vec<usize>>> {
+        for (name, v) in [("x grid", xs_m), ("y grid", ys_m)] {
+            if v.len() < 2 || v.windows(2).any(|w| !(w[1] > w[0])) {
+                return Err(Error::invalid(
+                    format!("plate {name}"),
+                    "needs at least two strictly increasing coordinates",
+                ));
+            }
+        }
+        let grid: Vec<Vec<usize>> = xs_m
+            .iter()
+            .map(|&x| ys_m.iter().map(|&y| self.add_node([x, y, z_m])).collect())
+            .collect();
+        for j in 0..ys_m.len() - 1 {
+            for i in 0..xs_m.len() - 1 {
+                self.add_shell(ShellElement::new(
+                    [
+                        grid[i][j],
+                        grid[i + 1][j],
+                        grid[i + 1][j + 1],
+                        grid[i][j + 1],
+                    ],
+                    material,
+                    thickness_m,
+                ));
+            }
+        }
+        Ok(grid)
+    }
+
     /// The nodes of a named point; the error lists the known names and the closest one.
     pub fn point(&self, name: &str) -> Result<&[usize]> {
         self.points.get(name).map(|v| v.as_slice()).ok_or_else(|| {
@@ -214,7 +255,10 @@ impl Mesh {
             if !(s.drilling_factor.is_finite() && s.drilling_factor > 0.0) {
                 return Err(Error::invalid(
                     format!("{what}: drilling factor"),
-                    format!("must be > 0 (1e-3 is the default; got {})", s.drilling_factor),
+                    format!(
+                        "must be > 0 (1e-3 is the default; got {})",
+                        s.drilling_factor
+                    ),
                 ));
             }
             let mut distinct = s.nodes.to_vec();
@@ -301,10 +345,7 @@ impl Mesh {
         }
         for (name, set) in &self.points {
             if set.is_empty() {
-                return Err(Error::invalid(
-                    format!("point {name}"),
-                    "names no node",
-                ));
+                return Err(Error::invalid(format!("point {name}"), "names no node"));
             }
             for &n in set {
                 self.check_node(&format!("point {name}"), n)?;
@@ -315,7 +356,10 @@ impl Mesh {
                 if e >= self.shells.len() {
                     return Err(Error::invalid(
                         format!("element set {name}"),
-                        format!("refers to shell element {e}, but the mesh has {}", self.shells.len()),
+                        format!(
+                            "refers to shell element {e}, but the mesh has {}",
+                            self.shells.len()
+                        ),
                     ));
                 }
             }

@@ -111,7 +111,10 @@ impl FeModel {
             if s >= nm {
                 return Err(Error::invalid(
                     "mode selection",
-                    format!("mode index {s} out of range: the solution has modes 0..{}", nm - 1),
+                    format!(
+                        "mode index {s} out of range: the solution has modes 0..{}",
+                        nm - 1
+                    ),
                 ));
             }
         }
@@ -139,19 +142,30 @@ impl FeModel {
         if any_c {
             for a in 0..n {
                 for (b, &sb) in select.iter().enumerate() {
-                    mm.damping[a * n + b] += (0..nd).map(|j| modes.shapes[(j, sb)] * cphi[a][j]).sum::<f64>();
+                    mm.damping[a * n + b] += (0..nd)
+                        .map(|j| modes.shapes[(j, sb)] * cphi[a][j])
+                        .sum::<f64>();
                 }
             }
         }
         for name in self.mesh.points.keys() {
             let f = self.point_functional(name)?;
-            let v = select.iter().map(|&s| self.dot_mode(modes, s, &f)).collect();
+            let v = select
+                .iter()
+                .map(|&s| self.dot_mode(modes, s, &f))
+                .collect();
             mm.points.insert(name.clone(), v);
         }
         if let Some((gk, gc)) = self.floor_force_functional() {
             mm.floor_force = Some(FloorForce {
-                stiffness: select.iter().map(|&s| self.dot_mode(modes, s, gk)).collect(),
-                damping: select.iter().map(|&s| self.dot_mode(modes, s, gc)).collect(),
+                stiffness: select
+                    .iter()
+                    .map(|&s| self.dot_mode(modes, s, gk))
+                    .collect(),
+                damping: select
+                    .iter()
+                    .map(|&s| self.dot_mode(modes, s, gc))
+                    .collect(),
             });
         }
         mm.labels = select

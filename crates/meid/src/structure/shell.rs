@@ -121,7 +121,11 @@ pub fn shell_geometry(x: &[V3; 4]) -> Result<ShellGeometry> {
         ],
         0.25,
     );
-    let warp = x.iter().map(|p| dot(sub(*p, c), n).abs()).fold(0.0, f64::max) / diag;
+    let warp = x
+        .iter()
+        .map(|p| dot(sub(*p, c), n).abs())
+        .fold(0.0, f64::max)
+        / diag;
     if warp > MAX_WARP_RATIO {
         return Err(Error::invalid(
             "shell geometry",
@@ -132,12 +136,17 @@ pub fn shell_geometry(x: &[V3; 4]) -> Result<ShellGeometry> {
         ));
     }
     let dr = sub(
-        scale([x[1][0] + x[2][0], x[1][1] + x[2][1], x[1][2] + x[2][2]], 0.5),
-        scale([x[0][0] + x[3][0], x[0][1] + x[3][1], x[0][2] + x[3][2]], 0.5),
+        scale(
+            [x[1][0] + x[2][0], x[1][1] + x[2][1], x[1][2] + x[2][2]],
+            0.5,
+        ),
+        scale(
+            [x[0][0] + x[3][0], x[0][1] + x[3][1], x[0][2] + x[3][2]],
+            0.5,
+        ),
     );
-    let e1 = unit(sub(dr, scale(n, dot(dr, n)))).ok_or_else(|| {
-        Error::invalid("shell geometry", "degenerate quad (no r-direction)")
-    })?;
+    let e1 = unit(sub(dr, scale(n, dot(dr, n))))
+        .ok_or_else(|| Error::invalid("shell geometry", "degenerate quad (no r-direction)"))?;
     let e2 = cross(n, e1);
     let mut xy = [[0.0; 2]; 4];
     for i in 0..4 {
@@ -267,7 +276,10 @@ pub fn shell_local_matrices(
     };
     let dm = plane(e * t / (1.0 - nu * nu));
     let db = plane(e * t.powi(3) / (12.0 * (1.0 - nu * nu)));
-    let ds = vec![vec![shear_factor * g * t, 0.0], vec![0.0, shear_factor * g * t]];
+    let ds = vec![
+        vec![shear_factor * g * t, 0.0],
+        vec![0.0, shear_factor * g * t],
+    ];
     let dd = vec![vec![drilling_factor * g * t]];
 
     // Tied covariant shear at A(0,1), C(0,-1) (e_rz) and D(1,0), B(-1,0) (e_sz).
@@ -399,11 +411,20 @@ mod tests {
     fn bad_geometry_is_rejected() {
         let sq = |p: [[f64; 2]; 4]| -> [V3; 4] { std::array::from_fn(|i| [p[i][0], p[i][1], 0.0]) };
         let bow = sq([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]]);
-        assert!(shell_geometry(&bow).unwrap_err().to_string().contains("degenerate"));
+        assert!(shell_geometry(&bow)
+            .unwrap_err()
+            .to_string()
+            .contains("degenerate"));
         let concave = sq([[0.0, 0.0], [1.0, 0.0], [0.2, 0.2], [0.0, 1.0]]);
-        assert!(shell_geometry(&concave).unwrap_err().to_string().contains("inverted"));
+        assert!(shell_geometry(&concave)
+            .unwrap_err()
+            .to_string()
+            .contains("inverted"));
         let mut warped = sq([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
         warped[2][2] = 0.05;
-        assert!(shell_geometry(&warped).unwrap_err().to_string().contains("warped"));
+        assert!(shell_geometry(&warped)
+            .unwrap_err()
+            .to_string()
+            .contains("warped"));
     }
 }
