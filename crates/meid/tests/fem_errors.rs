@@ -1,5 +1,8 @@
 //! Bad input gives errors that name the element or node and what would be valid.
 
+// Tests index nodes and modes by position, like the formulas they check.
+#![allow(clippy::needless_range_loop)]
+
 use meid::structure::{FeModel, FrameElement, Material, Mesh, Section, ShellElement};
 
 fn square(mesh: &mut Mesh, p: [[f64; 2]; 4]) -> [usize; 4] {

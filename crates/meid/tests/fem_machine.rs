@@ -10,6 +10,9 @@
 //!   and for fixed columns (support reactions).
 //! * Without springs the machine is free: exactly six zero modes, no other mode below them.
 
+// Tests index nodes and modes by position, like the formulas they check.
+#![allow(clippy::needless_range_loop)]
+
 use faer::prelude::Solve;
 use faer::Mat;
 use meid::structure::machine::PlateSpec;

@@ -117,7 +117,7 @@ pub fn solve_shift_invert(
     let mut y = Mat::<f64>::zeros(n, n);
     for (col, &i) in order.iter().enumerate() {
         let mu = evd.S()[i];
-        if !(mu > 1e-300 * mu_max.max(1e-300)) || mu <= 0.0 {
+        if mu.is_nan() || mu <= 1e-300 * mu_max.max(1e-300) {
             return Err(Error::numerical(
                 "dense eigen-solver",
                 format!("non-positive eigenvalue {mu:e} of the shift-inverted problem: the mass matrix is not positive definite"),

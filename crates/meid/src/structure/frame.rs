@@ -196,7 +196,7 @@ pub fn frame_local_axes(x1: V3, x2: V3, orientation: Option<V3>) -> Result<[V3; 
     };
     let vn = norm(v);
     let e2_raw = sub(v, scale(e1, dot(v, e1)));
-    if !(vn > 0.0) || norm(e2_raw) <= 1e-6 * vn || len <= 0.0 {
+    if vn.is_nan() || vn <= 0.0 || norm(e2_raw) <= 1e-6 * vn || len <= 0.0 {
         return Err(Error::invalid(
             "frame element orientation",
             format!("orientation vector {v:?} is zero or parallel to the element axis {e1:?}; give a vector not parallel to the element"),

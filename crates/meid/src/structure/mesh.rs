@@ -115,7 +115,10 @@ impl Mesh {
         thickness_m: f64,
     ) -> Result<Vec<Vec<usize>>> {
         for (name, v) in [("x grid", xs_m), ("y grid", ys_m)] {
-            if v.len() < 2 || v.windows(2).any(|w| !(w[1] > w[0])) {
+            if v.len() < 2
+                || v.windows(2)
+                    .any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+            {
                 return Err(Error::invalid(
                     format!("plate {name}"),
                     "needs at least two strictly increasing coordinates",

@@ -28,6 +28,7 @@ pub mod discrete;
 pub mod eigen;
 pub mod frame;
 pub(crate) mod geom;
+pub mod gmsh;
 pub mod machine;
 pub mod material;
 pub mod mesh;

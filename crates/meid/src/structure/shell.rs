@@ -106,7 +106,7 @@ pub fn shell_geometry(x: &[V3; 4]) -> Result<ShellGeometry> {
     let diag = norm(d1).max(norm(d2));
     let nn = cross(d1, d2);
     let area = 0.5 * norm(nn);
-    if !(diag > 0.0) || !(area > 1e-10 * diag * diag) {
+    if diag.is_nan() || area.is_nan() || diag <= 0.0 || area <= 1e-10 * diag * diag {
         return Err(Error::invalid(
             "shell geometry",
             "degenerate quad (zero area: coincident nodes or crossing diagonals); give four distinct corners in order around the element",
