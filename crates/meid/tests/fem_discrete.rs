@@ -2,14 +2,17 @@
 //! modal-model helper's damping and floor-force terms.
 //!
 //! * mass m on a spring k and dashpot c to the ground: ω = sqrt(k/m); with the mass-normalised
-//!   shape φ = ±1/sqrt(m): modal damping D = 2ζω + c/m, floor force k φ and c φ (relative 1e-12);
+//!   shape φ = ±1/sqrt(m): modal damping D = 2ζω + c/m, floor force k φ and c φ ;
 //! * two masses joined by a spring: ω² = k (1/m1 + 1/m2) plus one rigid mode;
 //! * rotary inertia I on a torsion spring k_t: ω = sqrt(k_t / I).
+//!
+//! Tolerance 1e-10 relative: the round-off of the dense shift-invert solver
+//! (`ε κ (λ + σ)²/(σ λ)`, see `structure::eigen`).
 
 use meid::structure::{Dashpot, Dof, FeModel, Mesh, PointMass, Spring};
 
 fn close(a: f64, b: f64) -> bool {
-    (a - b).abs() <= 1e-12 * b.abs().max(1e-300)
+    (a - b).abs() <= 1e-10 * b.abs().max(1e-300)
 }
 
 #[test]
@@ -82,7 +85,11 @@ fn two_masses_on_a_spring() {
     let (gk, gc) = model.floor_force_functional().unwrap();
     assert!(gk.iter().chain(gc).all(|&g| g == 0.0));
     let w = (k * (1.0 / m1 + 1.0 / m2)).sqrt();
-    assert!((modes.omega_rad_per_s[1] / w - 1.0).abs() < 1e-12);
+    assert!(
+        (modes.omega_rad_per_s[1] / w - 1.0).abs() < 1e-10,
+        "{:?} vs {w}",
+        modes.omega_rad_per_s
+    );
 }
 
 #[test]
@@ -102,5 +109,5 @@ fn rotary_inertia_on_torsion_spring() {
     });
     mesh.fix(n, &[Dof::Ux, Dof::Uy, Dof::Uz, Dof::Rx, Dof::Ry]);
     let modes = FeModel::assemble(mesh).unwrap().solve_dense().unwrap();
-    assert!(((modes.omega_rad_per_s[0] / (kt / izz).sqrt()) - 1.0).abs() < 1e-12);
+    assert!(((modes.omega_rad_per_s[0] / (kt / izz).sqrt()) - 1.0).abs() < 1e-10);
 }
