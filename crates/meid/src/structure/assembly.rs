@@ -107,12 +107,24 @@ impl DofMap {
             _ => None,
         }
     }
-    /// Full displacement vector `T u_red` (length `6 × nodes`).
-    pub fn expand(&self, u_red: &[f64]) -> Vec<f64> {
-        self.rows
+    /// Full displacement vector `T u_red` (length `6 × nodes`); `u_red` must have
+    /// [`DofMap::n_free`] entries.
+    pub fn expand(&self, u_red: &[f64]) -> Result<Vec<f64>> {
+        if u_red.len() != self.n_free {
+            return Err(Error::invalid(
+                "reduced displacement vector",
+                format!(
+                    "has {} entries; the model has {} DOFs",
+                    u_red.len(),
+                    self.n_free
+                ),
+            ));
+        }
+        Ok(self
+            .rows
             .iter()
             .map(|r| r.iter().map(|&(j, c)| c * u_red[j]).sum())
-            .collect()
+            .collect())
     }
 }
 

@@ -349,7 +349,7 @@ pub fn parse_msh(text: &str, file: &str) -> Result<GmshMesh> {
                     c.real("entity bounding box")?;
                 }
                 let np = c.count("number of physical tags")?;
-                let mut tags = Vec::with_capacity(np);
+                let mut tags = Vec::new();
                 for _ in 0..np {
                     tags.push(c.int("physical tag")?);
                 }
@@ -372,13 +372,13 @@ pub fn parse_msh(text: &str, file: &str) -> Result<GmshMesh> {
     c.count("minimum node tag")?;
     c.count("maximum node tag")?;
     let mut mesh = GmshMesh::default();
-    let mut index_of_tag: HashMap<usize, usize> = HashMap::with_capacity(total);
+    let mut index_of_tag: HashMap<usize, usize> = HashMap::new();
     for _ in 0..nblocks {
         let dim = c.int("entity dimension")?;
         c.int("entity tag")?;
         let parametric = c.int("parametric flag")?;
         let n = c.count("number of nodes in block")?;
-        let mut tags = Vec::with_capacity(n);
+        let mut tags = Vec::new();
         for _ in 0..n {
             let t = c.next("node tag")?;
             let tag: usize = t.text.parse().map_err(|_| {

@@ -245,11 +245,15 @@ impl MachineSpec {
                 format!("must be > 0 m (got {})", self.column_length_m),
             ));
         }
-        if self.elements_per_side < 2 || self.column_elements < 1 {
+        if self.elements_per_side < 2
+            || self.column_elements < 1
+            || self.elements_per_side > 400
+            || self.column_elements > 1000
+        {
             return Err(Error::invalid(
                 "mesh density",
                 format!(
-                    "need at least 2 elements per plate side and 1 per column (got {} and {})",
+                    "need 2..=400 elements per plate side and 1..=1000 per column (got {} and {})",
                     self.elements_per_side, self.column_elements
                 ),
             ));

@@ -171,15 +171,20 @@ impl Mesh {
         })
     }
 
-    /// Total translational mass (kg) of shells, frames and point masses.
+    /// Total translational mass (kg) of shells, frames and point masses (elements with invalid
+    /// nodes or geometry are skipped; [`Mesh::validate`] reports them).
     pub fn total_mass_kg(&self) -> f64 {
         let mut m = 0.0;
         for f in &self.frames {
-            let (a, b) = (self.nodes[f.nodes[0]], self.nodes[f.nodes[1]]);
-            let l = super::geom::norm(super::geom::sub(b, a));
-            m += f.material.density_kg_per_m3 * f.section.area_m2 * l;
+            if let (Some(a), Some(b)) = (self.nodes.get(f.nodes[0]), self.nodes.get(f.nodes[1])) {
+                let l = super::geom::norm(super::geom::sub(*b, *a));
+                m += f.material.density_kg_per_m3 * f.section.area_m2 * l;
+            }
         }
         for s in &self.shells {
+            if s.nodes.iter().any(|&n| n >= self.nodes.len()) {
+                continue;
+            }
             let x = s.nodes.map(|n| self.nodes[n]);
             if let Ok(g) = shell_geometry(&x) {
                 m += s.material.density_kg_per_m3 * s.thickness_m * g.area_m2;

@@ -86,6 +86,16 @@ impl FeModel {
                 ),
             ));
         }
+        if modes.shapes.ncols() != modes.omega_rad_per_s.len() {
+            return Err(Error::invalid(
+                "modes",
+                format!(
+                    "{} mode shapes but {} frequencies",
+                    modes.shapes.ncols(),
+                    modes.omega_rad_per_s.len()
+                ),
+            ));
+        }
         Ok(())
     }
 
