@@ -1,0 +1,463 @@
+//! Parametric finite-element model of the forging machine of the paper's Fig. 1.
+//!
+//! Geometry (global z up, the slider moves in -z, so the model's impact direction is `[0, 0, -1]`):
+//! a rectangular **bed** plate centred on the z axis at `z = column length`, four vertical
+//! **columns** (frame elements) from the bed down to `z = 0` at `(±(Lx/2 - inset), ±(Ly/2 - inset))`
+//! of the bed, and then either
+//! * a **floating base** plate at `z = 0` (centred, larger than the bed) on four **coil springs**
+//!   (per-direction stiffness, optional dashpots) from its corners (or inset positions) to the
+//!   ground; the force to the floor is the sum of the spring forces, or
+//! * **fixed column feet** (clamped at `z = 0`); the force to the floor is the column base reaction
+//!   `-(K u)` at the clamped DOFs (the paper's `F_t = k_c x_c`).
+//!
+//! Each column end is tied to its plate by a rigid spider: the plate node at the column axis is the
+//! master and the other nodes of the plate elements around it are slaves (see [`super::shell`] for
+//! why). Where two spiders would overlap on a coarse mesh, a node joins the first one only. Named points: `O_b` (bed centre, the slider contact point), `O_f` (base centre, where the
+//! damper spring acts; floating base only) and `B` (accelerometer on the bed, offset from the
+//! centre). Plate meshes are structured; the grid lines pass through every column, spring, named
+//! point and added mass, and the element size is `max(Lx, Ly) / elements_per_side`.
+//!
+//! Defaults: steel (E = 2.06e11 Pa, ν = 0.3, ρ = 7850 kg/m³); bed 0.32 × 0.20 × 0.020 m
+//! (10.05 kg, the paper's m_b = 10 kg); base 0.50 × 0.35 × 0.030 m (41.2 kg, m_f = 41 kg);
+//! columns solid Ø25 mm × 0.30 m, 20 mm in from the bed edges; springs 1.5e4 N/m in x, y and z
+//! (the paper gives only the vertical k_f; the lateral value is an assumption) 20 mm in from the
+//! base corners; B at (0.08, 0.05) m from the bed centre. The geometry is not tuned to the paper's
+//! frequencies.
+
+use super::assembly::FeModel;
+use super::discrete::{Dashpot, PointMass, RigidLink, Spring};
+use super::frame::{FrameElement, Section};
+use super::material::Material;
+use super::mesh::Mesh;
+use crate::{Error, Result};
+
+/// A rectangular plate centred on the z axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlateSpec {
+    /// Side along x (m).
+    pub length_x_m: f64,
+    /// Side along y (m).
+    pub length_y_m: f64,
+    pub thickness_m: f64,
+    pub material: Material,
+}
+
+impl PlateSpec {
+    /// Mass ρ Lx Ly t (kg).
+    pub fn mass_kg(&self) -> f64 {
+        self.material.density_kg_per_m3 * self.length_x_m * self.length_y_m * self.thickness_m
+    }
+    fn validate(&self, what: &str) -> Result<()> {
+        for (n, v) in [
+            ("length x", self.length_x_m),
+            ("length y", self.length_y_m),
+            ("thickness", self.thickness_m),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::invalid(
+                    format!("{what} {n}"),
+                    format!("must be > 0 m (got {v})"),
+                ));
+            }
+        }
+        self.material.validate(what)
+    }
+}
+
+/// How the machine stands on the floor.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Support {
+    /// Columns end on a floating-base plate carried by four springs to the ground.
+    FloatingBase {
+        base: PlateSpec,
+        /// Stiffness of each spring in global `[x, y, z]` (N/m); all zero = no springs (free).
+        spring_stiffness_n_per_m: [f64; 3],
+        /// Damping of each spring in `[x, y, z]` (N·s/m); zero for none.
+        spring_damping_n_s_per_m: [f64; 3],
+        /// Distance of the springs from the base edges in x and y (m); 0 = at the corners.
+        spring_inset_m: f64,
+    },
+    /// Column feet clamped to the ground at z = 0.
+    FixedColumns,
+}
+
+/// Which plate an added mass sits on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Plate {
+    Bed,
+    Base,
+}
+
+/// A rigid point mass added on a plate at `offset_m` from the plate centre.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AddedMass {
+    pub plate: Plate,
+    pub offset_m: [f64; 2],
+    pub mass_kg: f64,
+    /// `[Ixx, Iyy, Izz]` about the node (kg·m²).
+    pub inertia_kg_m2: [f64; 3],
+}
+
+/// Parameters of the machine (see the module documentation for the defaults).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MachineSpec {
+    pub bed: PlateSpec,
+    pub column_section: Section,
+    pub column_material: Material,
+    /// Column length = distance between the bed and base mid-planes (m).
+    pub column_length_m: f64,
+    /// Distance of the column axes from the bed edges in x and y (m); 0 = at the corners.
+    pub column_inset_m: f64,
+    /// Frame elements per column.
+    pub column_elements: usize,
+    /// Shell elements along the longer side of each plate (mesh density).
+    pub elements_per_side: usize,
+    pub support: Support,
+    /// Position of the accelerometer point B relative to the bed centre (m).
+    pub b_offset_m: [f64; 2],
+    pub added_masses: Vec<AddedMass>,
+    /// Tie column ends to their plates by rigid spiders over the surrounding element ring.
+    pub spiders: bool,
+}
+
+impl Default for MachineSpec {
+    fn default() -> Self {
+        let steel = Material::STEEL;
+        MachineSpec {
+            bed: PlateSpec {
+                length_x_m: 0.32,
+                length_y_m: 0.20,
+                thickness_m: 0.020,
+                material: steel,
+            },
+            column_section: Section {
+                area_m2: std::f64::consts::PI * 0.025 * 0.025 / 4.0,
+                iy_m4: std::f64::consts::PI * 0.025_f64.powi(4) / 64.0,
+                iz_m4: std::f64::consts::PI * 0.025_f64.powi(4) / 64.0,
+                torsion_constant_m4: std::f64::consts::PI * 0.025_f64.powi(4) / 32.0,
+            },
+            column_material: steel,
+            column_length_m: 0.30,
+            column_inset_m: 0.02,
+            column_elements: 6,
+            elements_per_side: 8,
+            support: Support::FloatingBase {
+                base: PlateSpec {
+                    length_x_m: 0.50,
+                    length_y_m: 0.35,
+                    thickness_m: 0.030,
+                    material: steel,
+                },
+                spring_stiffness_n_per_m: [1.5e4; 3],
+                spring_damping_n_s_per_m: [0.0; 3],
+                spring_inset_m: 0.02,
+            },
+            b_offset_m: [0.08, 0.05],
+            added_masses: Vec::new(),
+            spiders: true,
+        }
+    }
+}
+
+/// A generated machine: the assembled model and where its parts are.
+#[derive(Debug, Clone)]
+pub struct Machine {
+    pub model: FeModel,
+    /// Bed nodes `grid[i][j]` at `(xs[i], ys[j])`.
+    pub bed_grid: Vec<Vec<usize>>,
+    /// Base nodes, floating base only.
+    pub base_grid: Option<Vec<Vec<usize>>>,
+    /// Nodes of each column from the bed down.
+    pub columns: Vec<Vec<usize>>,
+}
+
+/// Grid coordinates on `[-len/2, len/2]` through all `required` coordinates, element size ≈ `h`.
+fn grid_1d(len: f64, required: &[f64], h: f64) -> Vec<f64> {
+    let tol = 1e-9 * len;
+    let mut pts: Vec<f64> = required.to_vec();
+    pts.push(-0.5 * len);
+    pts.push(0.5 * len);
+    pts.sort_by(|a, b| a.total_cmp(b));
+    pts.dedup_by(|a, b| (*a - *b).abs() <= tol);
+    let mut out = vec![pts[0]];
+    for w in pts.windows(2) {
+        let n = ((w[1] - w[0]) / h).round().max(1.0) as usize;
+        for k in 1..=n {
+            out.push(w[0] + (w[1] - w[0]) * k as f64 / n as f64);
+        }
+    }
+    out
+}
+
+fn index_of(xs: &[f64], x: f64) -> usize {
+    xs.iter()
+        .enumerate()
+        .min_by(|a, b| (a.1 - x).abs().total_cmp(&(b.1 - x).abs()))
+        .map(|(i, _)| i)
+        .unwrap_or(0)
+}
+
+fn inside(what: &str, p: [f64; 2], plate: &PlateSpec) -> Result<()> {
+    if p[0].abs() <= 0.5 * plate.length_x_m + 1e-12 && p[1].abs() <= 0.5 * plate.length_y_m + 1e-12
+    {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            what,
+            format!(
+                "position {p:?} m lies outside the {} x {} m plate (coordinates from its centre)",
+                plate.length_x_m, plate.length_y_m
+            ),
+        ))
+    }
+}
+
+/// The nodes of the plate elements around grid node (i, j), without (i, j) itself.
+fn ring(grid: &[Vec<usize>], i: usize, j: usize) -> Vec<usize> {
+    let (nx, ny) = (grid.len(), grid[0].len());
+    let mut out = Vec::new();
+    for a in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
+        for b in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
+            if (a, b) != (i, j) {
+                out.push(grid[a][b]);
+            }
+        }
+    }
+    out
+}
+
+impl MachineSpec {
+    /// Column axis positions (x, y) (m).
+    pub fn column_positions(&self) -> [[f64; 2]; 4] {
+        let cx = 0.5 * self.bed.length_x_m - self.column_inset_m;
+        let cy = 0.5 * self.bed.length_y_m - self.column_inset_m;
+        [[cx, cy], [-cx, cy], [-cx, -cy], [cx, -cy]]
+    }
+
+    /// Builds and assembles the machine.
+    pub fn build(&self) -> Result<Machine> {
+        self.bed.validate("bed")?;
+        self.column_section.validate("column section")?;
+        self.column_material.validate("column")?;
+        if !(self.column_length_m.is_finite() && self.column_length_m > 0.0) {
+            return Err(Error::invalid(
+                "column length",
+                format!("must be > 0 m (got {})", self.column_length_m),
+            ));
+        }
+        if self.elements_per_side < 2
+            || self.column_elements < 1
+            || self.elements_per_side > 400
+            || self.column_elements > 1000
+        {
+            return Err(Error::invalid(
+                "mesh density",
+                format!(
+                    "need 2..=400 elements per plate side and 1..=1000 per column (got {} and {})",
+                    self.elements_per_side, self.column_elements
+                ),
+            ));
+        }
+        let half_min = 0.5 * self.bed.length_x_m.min(self.bed.length_y_m);
+        if !(self.column_inset_m >= 0.0 && self.column_inset_m < half_min) {
+            return Err(Error::invalid(
+                "column inset",
+                format!(
+                    "must lie in [0, {half_min}) m (got {})",
+                    self.column_inset_m
+                ),
+            ));
+        }
+        inside("point B", self.b_offset_m, &self.bed)?;
+        let cols = self.column_positions();
+        let mut mesh = Mesh::new();
+        let zb = self.column_length_m;
+
+        // Bed.
+        let mut bx = vec![0.0, self.b_offset_m[0]];
+        let mut by = vec![0.0, self.b_offset_m[1]];
+        for c in &cols {
+            bx.push(c[0]);
+            by.push(c[1]);
+        }
+        for m in self.added_masses.iter().filter(|m| m.plate == Plate::Bed) {
+            inside("added mass on the bed", m.offset_m, &self.bed)?;
+            bx.push(m.offset_m[0]);
+            by.push(m.offset_m[1]);
+        }
+        let h_bed = self.bed.length_x_m.max(self.bed.length_y_m) / self.elements_per_side as f64;
+        let bxs = grid_1d(self.bed.length_x_m, &bx, h_bed);
+        let bys = grid_1d(self.bed.length_y_m, &by, h_bed);
+        let bed_grid =
+            mesh.add_plate_grid(&bxs, &bys, zb, self.bed.material, self.bed.thickness_m)?;
+        let bed_node = |p: [f64; 2]| (index_of(&bxs, p[0]), index_of(&bys, p[1]));
+        let (i, j) = bed_node([0.0, 0.0]);
+        mesh.name_point("O_b", vec![bed_grid[i][j]]);
+        let (i, j) = bed_node(self.b_offset_m);
+        mesh.name_point("B", vec![bed_grid[i][j]]);
+
+        // Base.
+        let mut base_grid = None;
+        let mut base_lookup: Option<(Vec<f64>, Vec<f64>)> = None;
+        if let Support::FloatingBase {
+            base,
+            spring_stiffness_n_per_m,
+            spring_damping_n_s_per_m,
+            spring_inset_m,
+        } = &self.support
+        {
+            base.validate("floating base")?;
+            for c in &cols {
+                inside("column foot on the floating base", *c, base)?;
+            }
+            let sx = 0.5 * base.length_x_m - spring_inset_m;
+            let sy = 0.5 * base.length_y_m - spring_inset_m;
+            if !(*spring_inset_m >= 0.0 && sx > 0.0 && sy > 0.0) {
+                return Err(Error::invalid(
+                    "spring inset",
+                    format!(
+                        "must lie in [0, {}) m (got {spring_inset_m})",
+                        0.5 * base.length_x_m.min(base.length_y_m)
+                    ),
+                ));
+            }
+            super::discrete::check_coefficients(
+                "spring stiffness",
+                "N/m",
+                spring_stiffness_n_per_m,
+            )?;
+            super::discrete::check_coefficients(
+                "spring damping",
+                "N s/m",
+                spring_damping_n_s_per_m,
+            )?;
+            let springs = [[sx, sy], [-sx, sy], [-sx, -sy], [sx, -sy]];
+            let mut xs = vec![0.0];
+            let mut ys = vec![0.0];
+            for p in cols.iter().chain(springs.iter()) {
+                xs.push(p[0]);
+                ys.push(p[1]);
+            }
+            for m in self.added_masses.iter().filter(|m| m.plate == Plate::Base) {
+                inside("added mass on the base", m.offset_m, base)?;
+                xs.push(m.offset_m[0]);
+                ys.push(m.offset_m[1]);
+            }
+            let h = base.length_x_m.max(base.length_y_m) / self.elements_per_side as f64;
+            let gx = grid_1d(base.length_x_m, &xs, h);
+            let gy = grid_1d(base.length_y_m, &ys, h);
+            let grid = mesh.add_plate_grid(&gx, &gy, 0.0, base.material, base.thickness_m)?;
+            mesh.name_point("O_f", vec![grid[index_of(&gx, 0.0)][index_of(&gy, 0.0)]]);
+            for p in springs {
+                let node = grid[index_of(&gx, p[0])][index_of(&gy, p[1])];
+                let k = spring_stiffness_n_per_m;
+                if k.iter().any(|&v| v > 0.0) {
+                    mesh.add_spring(Spring {
+                        node,
+                        other: None,
+                        stiffness: [k[0], k[1], k[2], 0.0, 0.0, 0.0],
+                    });
+                }
+                let c = spring_damping_n_s_per_m;
+                if c.iter().any(|&v| v > 0.0) {
+                    mesh.add_dashpot(Dashpot {
+                        node,
+                        other: None,
+                        damping: [c[0], c[1], c[2], 0.0, 0.0, 0.0],
+                    });
+                }
+            }
+            base_grid = Some(grid);
+            base_lookup = Some((gx, gy));
+        }
+
+        // Columns and spiders. A plate node joins at most one spider (the first that reaches it)
+        // and never one whose master is another column end.
+        let mut masters = std::collections::BTreeSet::new();
+        for c in &cols {
+            let (bi, bj) = bed_node(*c);
+            masters.insert(bed_grid[bi][bj]);
+            if let (Some(g), Some((gx, gy))) = (&base_grid, &base_lookup) {
+                masters.insert(g[index_of(gx, c[0])][index_of(gy, c[1])]);
+            }
+        }
+        let mut slaved = std::collections::BTreeSet::new();
+        let mut spider = |mesh: &mut Mesh, master: usize, candidates: Vec<usize>| {
+            let slaves: Vec<usize> = candidates
+                .into_iter()
+                .filter(|n| !masters.contains(n) && slaved.insert(*n))
+                .collect();
+            if !slaves.is_empty() {
+                mesh.add_rigid_link(RigidLink { master, slaves });
+            }
+        };
+        let mut columns = Vec::new();
+        for c in &cols {
+            let (bi, bj) = bed_node(*c);
+            let top = bed_grid[bi][bj];
+            let mut nodes = vec![top];
+            let ne = self.column_elements;
+            for k in 1..ne {
+                let z = zb * (1.0 - k as f64 / ne as f64);
+                nodes.push(mesh.add_node([c[0], c[1], z]));
+            }
+            let foot = match (&base_grid, &base_lookup) {
+                (Some(g), Some((gx, gy))) => {
+                    let (fi, fj) = (index_of(gx, c[0]), index_of(gy, c[1]));
+                    if self.spiders {
+                        spider(&mut mesh, g[fi][fj], ring(g, fi, fj));
+                    }
+                    g[fi][fj]
+                }
+                _ => {
+                    let f = mesh.add_node([c[0], c[1], 0.0]);
+                    mesh.fix_all(f);
+                    f
+                }
+            };
+            nodes.push(foot);
+            for w in nodes.windows(2) {
+                mesh.add_frame(FrameElement::new(
+                    [w[0], w[1]],
+                    self.column_material,
+                    self.column_section,
+                ));
+            }
+            if self.spiders {
+                spider(&mut mesh, top, ring(&bed_grid, bi, bj));
+            }
+            columns.push(nodes);
+        }
+
+        for m in &self.added_masses {
+            let node = match m.plate {
+                Plate::Bed => {
+                    let (i, j) = bed_node(m.offset_m);
+                    bed_grid[i][j]
+                }
+                Plate::Base => match (&base_grid, &base_lookup) {
+                    (Some(g), Some((gx, gy))) => {
+                        g[index_of(gx, m.offset_m[0])][index_of(gy, m.offset_m[1])]
+                    }
+                    _ => return Err(Error::invalid(
+                        "added mass",
+                        "is on the floating base, but the machine has fixed columns and no base",
+                    )),
+                },
+            };
+            mesh.add_mass(PointMass {
+                node,
+                mass_kg: m.mass_kg,
+                inertia_kg_m2: m.inertia_kg_m2,
+            });
+        }
+
+        let model = FeModel::assemble_with_direction(mesh, [0.0, 0.0, -1.0])?;
+        Ok(Machine {
+            model,
+            bed_grid,
+            base_grid,
+            columns,
+        })
+    }
+}
