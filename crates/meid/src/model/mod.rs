@@ -23,6 +23,7 @@
 //! Errors name the file, line and column (or the `--set` that caused them), the field and
 //! the valid range; unknown keys get a did-you-mean.
 
+pub mod fem;
 mod lumped;
 pub mod source;
 pub mod spec;
@@ -357,13 +358,27 @@ fn contact(c: &ContactSpec) -> Result<Contact> {
 }
 
 fn build_structure(spec: &ModelSpec, src: &Source) -> Result<ModalModel> {
-    match (&spec.structure.lumped, &spec.structure.modal) {
-        (Some(l), None) => lumped::modal_model(l, src),
-        (None, Some(m)) => lumped::from_modal_spec(m, src),
-        (Some(_), Some(_)) => Err(src.error("structure", "give one of [structure.lumped] or [structure.modal], not both")),
-        (None, None) => Err(src.error(
+    let st = &spec.structure;
+    let given = usize::from(st.lumped.is_some())
+        + usize::from(st.modal.is_some())
+        + usize::from(st.fem.is_some());
+    if given > 1 {
+        return Err(src.error(
             "structure",
-            "the structure is missing: add [structure.lumped] (masses, springs) or [structure.modal] (frequencies_hz, shapes)",
-        )),
+            "give one of [structure.lumped], [structure.modal] or [structure.fem], not several",
+        ));
     }
+    if let Some(l) = &st.lumped {
+        return lumped::modal_model(l, src);
+    }
+    if let Some(m) = &st.modal {
+        return lumped::from_modal_spec(m, src);
+    }
+    if let Some(f) = &st.fem {
+        return fem::modal_model(f, src);
+    }
+    Err(src.error(
+        "structure",
+        "the structure is missing: add [structure.lumped] (masses, springs), [structure.modal] (frequencies_hz, shapes) or [structure.fem]",
+    ))
 }

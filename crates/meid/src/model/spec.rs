@@ -34,6 +34,8 @@ pub struct StructureSpec {
     pub lumped: Option<LumpedSpec>,
     #[serde(default)]
     pub modal: Option<ModalSpec>,
+    #[serde(default)]
+    pub fem: Option<super::fem::FemSpec>,
 }
 
 /// Point masses, springs and dashpots along z; modes from `K φ = ω² M φ`.

@@ -1,0 +1,156 @@
+//! `meid simulate`: one blow.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+
+use meid::analysis;
+use meid::model::{Case, Model};
+
+use crate::load;
+
+#[derive(clap::Args)]
+pub struct SimulateArgs {
+    /// Model file (TOML).
+    model: PathBuf,
+    /// Write time histories (history.csv) and the summary (summary.json) into DIR.
+    #[arg(short, long, value_name = "DIR")]
+    output: Option<PathBuf>,
+    /// Print the summary as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Integration method: exact (piecewise-linear, closed form) or dopri5.
+    #[arg(long, value_parser = ["exact", "dopri5"])]
+    method: Option<String>,
+    /// Simulated time (s).
+    #[arg(long, value_name = "S")]
+    duration: Option<f64>,
+    /// Output sample rate (Hz).
+    #[arg(long, value_name = "HZ")]
+    rate: Option<f64>,
+    /// Override a model field, e.g. --set contact.bed_damper.stiffness=1.26e8 (repeatable).
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    set: Vec<String>,
+    /// Simulate the bare machine or the added-mass alternative instead of the file's case.
+    #[arg(long, value_parser = ["as-specified", "none", "damper", "added-mass"], default_value = "as-specified")]
+    case: String,
+    /// No progress or summary on the terminal (errors are still reported).
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+pub fn run(a: SimulateArgs) -> Result<()> {
+    let model = load(&a.model, &a.set, a.method.as_deref(), a.duration, a.rate)?;
+    let case = match a.case.as_str() {
+        "none" => Case::NoDamper,
+        "damper" => Case::Damper,
+        "added-mass" => Case::AddedMass,
+        _ => Case::AsSpecified,
+    };
+    let sys = model.impact_system(case)?;
+    let opts = model.options();
+    let record = a.output.is_some();
+    let run = analysis::simulate(&sys, &opts, record).context("simulation failed")?;
+    let s = &run.summary;
+    if let Some(dir) = &a.output {
+        if let Some(h) = &run.history {
+            meid::io::write_atomic(&dir.join("history.csv"), &meid::io::history_csv(h)?)?;
+        }
+        meid::io::write_json(&dir.join("summary.json"), s)?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(s)?);
+    } else if !a.quiet {
+        print_summary(&model, s, a.output.as_deref());
+    }
+    Ok(())
+}
+
+fn opt(v: Option<f64>, unit: &str, scale: f64) -> String {
+    v.map_or("—".to_string(), |x| format!("{:.6} {unit}", x * scale))
+}
+
+fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>) {
+    let name = model.spec.name.as_deref().unwrap_or("model");
+    let color = std::io::stdout().is_terminal();
+    let bold = |t: &str| {
+        if color {
+            format!("\x1b[1m{t}\x1b[0m")
+        } else {
+            t.to_string()
+        }
+    };
+    println!("{} — {} ({} method)", bold("meid simulate"), name, s.method);
+    match s.energy_ratio {
+        Some(r) => {
+            println!(
+                "  energy left in the machine E_p+/E_s-   {}",
+                bold(&format!("{:.4} %", 100.0 * r))
+            );
+            println!(
+                "  end of collision                      {}",
+                opt(s.collision_end_s, "ms", 1e3)
+            );
+            println!(
+                "  slider energy before / after          {:.6} J / {}",
+                s.slider_energy_before_j,
+                opt(s.slider_energy_after_j, "J", 1.0)
+            );
+            println!(
+                "  damper energy after                   {}",
+                opt(s.damper_energy_after_j, "J", 1.0)
+            );
+            println!(
+                "  machine energy after (KE, PE, diss.)  {} ({}, {}, {})",
+                opt(s.machine_energy_after_j, "J", 1.0),
+                opt(s.machine_kinetic_energy_after_j, "J", 1.0),
+                opt(s.machine_potential_energy_after_j, "J", 1.0),
+                opt(s.dissipated_energy_after_j, "J", 1.0)
+            );
+            println!(
+                "  slider rebound velocity               {}",
+                opt(s.slider_rebound_velocity_m_per_s, "m/s", 1.0)
+            );
+            println!(
+                "  damper velocity                       {}",
+                opt(s.damper_velocity_m_per_s, "m/s", 1.0)
+            );
+            println!(
+                "  contact time slider-bed / bed-damper  {} / {}",
+                opt(s.contact_time_slider_bed_s, "ms", 1e3),
+                opt(s.contact_time_bed_damper_s, "ms", 1e3)
+            );
+        }
+        None => println!(
+            "  the collision did not end within {:.4} s: no energy ratio",
+            s.simulated_time_s
+        ),
+    }
+    println!(
+        "  peak contact force slider-bed         {:.3} N",
+        s.peak_contact_force_slider_bed_n
+    );
+    println!(
+        "  peak contact force bed-damper         {:.3} N",
+        s.peak_contact_force_bed_damper_n
+    );
+    println!(
+        "  peak bed acceleration at B            {:.3} m/s²",
+        s.peak_bed_acceleration_m_per_s2
+    );
+    println!(
+        "  peak force to the floor               {:.3} N",
+        s.peak_floor_force_n
+    );
+    if let Some(r) = s.energy_balance_residual {
+        println!("  energy-balance residual               {r:.2e} (end of collision), {:.2e} (end of run)", s.energy_balance_residual_run_end);
+    }
+    println!(
+        "  {} events, {} segments/steps over {:.4} s",
+        s.switching_events, s.steps, s.simulated_time_s
+    );
+    if let Some(dir) = out {
+        println!("  wrote {}/history.csv and summary.json", dir.display());
+    }
+}
