@@ -50,16 +50,16 @@ impl EnergyTerms {
             e.pe_machine += 0.5 * w * w * x[i] * x[i];
         }
         if mode.on(Switch::SliderBed) {
-            let d = dot(&sys.relative_vector(Switch::SliderBed), &x[..nd]);
+            let d = dot(sys.relative_vector(Switch::SliderBed), &x[..nd]);
             e.pe_slider_contact = sys.slider_bed.law.potential_energy(d);
         }
         if let (Some(dm), Some(c)) = (&sys.damper, &sys.bed_damper) {
             let vd = x[nd + sys.damper_index()];
             e.ke_damper = 0.5 * dm.mass * vd * vd;
-            let r = dot(&sys.relative_vector(Switch::Dashpot), &x[..nd]);
+            let r = dot(sys.relative_vector(Switch::Dashpot), &x[..nd]);
             e.pe_damper_spring = 0.5 * dm.stiffness * r * r;
             if mode.on(Switch::BedDamper) {
-                let d = dot(&sys.relative_vector(Switch::BedDamper), &x[..nd]);
+                let d = dot(sys.relative_vector(Switch::BedDamper), &x[..nd]);
                 e.pe_damper_contact = c.law.potential_energy(d);
             }
         }

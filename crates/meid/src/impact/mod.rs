@@ -250,6 +250,8 @@ pub struct ImpactSystem {
     pub added_mass: f64,
     floor: FloorForce,
     has_floor: bool,
+    /// `a` vectors of the switches (slider-bed, bed-damper, damper spring), built once.
+    rel: [Vec<f64>; 3],
 }
 
 /// What (if anything) is attached to the bed to reduce the blow's effect.
@@ -317,7 +319,7 @@ impl ImpactSystem {
                 false,
             ),
         };
-        Ok(Self {
+        let mut sys = Self {
             structure,
             points,
             slider,
@@ -327,7 +329,14 @@ impl ImpactSystem {
             added_mass,
             floor,
             has_floor,
-        })
+            rel: Default::default(),
+        };
+        sys.rel = [
+            sys.build_relative_vector(Switch::SliderBed),
+            sys.build_relative_vector(Switch::BedDamper),
+            sys.build_relative_vector(Switch::Dashpot),
+        ];
+        Ok(sys)
     }
 
     /// Number of structural modes n.
@@ -403,8 +412,21 @@ impl ImpactSystem {
         m
     }
 
-    /// The vector `a` with `δ = aᵀx` for a switch (overlap for contacts, `z_d − u_f` for the dashpot).
-    pub fn relative_vector(&self, s: Switch) -> Vec<f64> {
+    /// The vector `a` with `δ = aᵀx` for a switch (overlap for contacts, `z_d − u_f` for the
+    /// damper spring and dashpot). Without a damper the damper entries are all zero.
+    #[inline]
+    pub fn relative_vector(&self, s: Switch) -> &[f64] {
+        match s {
+            Switch::SliderBed => &self.rel[0],
+            Switch::BedDamper => &self.rel[1],
+            Switch::Dashpot => &self.rel[2],
+        }
+    }
+
+    fn build_relative_vector(&self, s: Switch) -> Vec<f64> {
+        if s != Switch::SliderBed && self.damper.is_none() {
+            return vec![0.0; self.dofs()];
+        }
         let n = self.n_modes();
         let mut a = vec![0.0; self.dofs()];
         match s {
@@ -460,7 +482,7 @@ impl ImpactSystem {
             }
             if mode.on(s) {
                 if let ContactLaw::Linear { stiffness, damping } = self.contact(s).law {
-                    add(&self.relative_vector(s), stiffness, damping);
+                    add(self.relative_vector(s), stiffness, damping);
                 }
             }
         }
@@ -470,7 +492,7 @@ impl ImpactSystem {
                 DashpotKind::OneWay => mode.on(Switch::Dashpot),
             };
             add(
-                &self.relative_vector(Switch::Dashpot),
+                self.relative_vector(Switch::Dashpot),
                 d.stiffness,
                 if dashpot_on { d.damping } else { 0.0 },
             );
@@ -509,10 +531,10 @@ impl ImpactSystem {
         let mut l = vec![0.0; 2 * nd];
         match ind {
             Indicator::Overlap(s) => {
-                l[..nd].copy_from_slice(&self.relative_vector(s));
+                l[..nd].copy_from_slice(self.relative_vector(s));
             }
             Indicator::DashpotVelocity => {
-                l[nd..].copy_from_slice(&self.relative_vector(Switch::Dashpot));
+                l[nd..].copy_from_slice(self.relative_vector(Switch::Dashpot));
             }
             Indicator::Force(s) => {
                 let a = self.relative_vector(s);
@@ -523,7 +545,7 @@ impl ImpactSystem {
                             l[nd + i] = damping * a[i];
                         }
                     }
-                    ContactLaw::Hertz { .. } => l[..nd].copy_from_slice(&a),
+                    ContactLaw::Hertz { .. } => l[..nd].copy_from_slice(a),
                     ContactLaw::HuntCrossley { alpha, .. } => {
                         for i in 0..nd {
                             l[nd + i] = 1.5 * alpha * a[i];
@@ -542,15 +564,15 @@ impl ImpactSystem {
             Indicator::Overlap(s) => (s, false),
             Indicator::Force(s) => (s, true),
             Indicator::DashpotVelocity => {
-                return dot(&self.relative_vector(Switch::Dashpot), &x[nd..])
+                return dot(self.relative_vector(Switch::Dashpot), &x[nd..])
             }
         };
         let a = self.relative_vector(s);
-        let d = dot(&a, &x[..nd]);
+        let d = dot(a, &x[..nd]);
         if !is_force {
             return d;
         }
-        let r = dot(&a, &x[nd..]);
+        let r = dot(a, &x[nd..]);
         self.contact(s).law.force_sign_function(d, r)
     }
 
@@ -582,13 +604,13 @@ impl ImpactSystem {
             let a = self.relative_vector(s);
             self.contact(s)
                 .law
-                .force(dot(&a, &x[..nd]), dot(&a, &x[nd..]))
+                .force(dot(a, &x[..nd]), dot(a, &x[nd..]))
         };
         let fbs = f(Switch::SliderBed);
         let (fbd, ffd) = match &self.damper {
             Some(d) => {
                 let a = self.relative_vector(Switch::Dashpot);
-                let (del, rate) = (dot(&a, &x[..nd]), dot(&a, &x[nd..]));
+                let (del, rate) = (dot(a, &x[..nd]), dot(a, &x[nd..]));
                 let c_on = match d.dashpot {
                     DashpotKind::TwoWay => true,
                     DashpotKind::OneWay => mode.on(Switch::Dashpot),

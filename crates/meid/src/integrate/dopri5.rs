@@ -86,14 +86,14 @@ impl<'a> Rhs<'a> {
                 .collect(),
             damping,
             damping_diagonal,
-            a_s: sys.relative_vector(Switch::SliderBed),
+            a_s: sys.relative_vector(Switch::SliderBed).to_vec(),
             a_d: if has_d {
-                sys.relative_vector(Switch::BedDamper)
+                sys.relative_vector(Switch::BedDamper).to_vec()
             } else {
                 Vec::new()
             },
             a_f: if has_d {
-                sys.relative_vector(Switch::Dashpot)
+                sys.relative_vector(Switch::Dashpot).to_vec()
             } else {
                 Vec::new()
             },
@@ -276,7 +276,10 @@ pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Resu
     let mut t = 0.0;
     let t_end = opts.duration;
     let mut mode = if all_linear {
-        select_mode(sys, &y[..nx], Mode(0), &mut |m| sys.first_order(m)).0
+        select_mode(sys, &y[..nx], Mode(0), &mut |m| {
+            std::rc::Rc::new(sys.first_order(m))
+        })
+        .0
     } else {
         initial_mode_numeric(sys, &y[..nx])
     };
@@ -483,7 +486,10 @@ pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Resu
             t += s_end;
             totals.dissipated = y[nx];
             let new_mode = if all_linear {
-                select_mode(sys, &y[..nx], mode, &mut |m| sys.first_order(m)).0
+                select_mode(sys, &y[..nx], mode, &mut |m| {
+                    std::rc::Rc::new(sys.first_order(m))
+                })
+                .0
             } else {
                 mode_after_numeric(sys, &inds, &signs, &dense, s_end, &y[..nx])
             };
@@ -639,8 +645,8 @@ fn initial_mode_numeric(sys: &ImpactSystem, x: &[f64]) -> Mode {
         // At zero: the direction it is moving in.
         match ind {
             Indicator::Overlap(s) => {
-                dot(&sys.relative_vector(s), &x[nd..]).signum()
-                    * f64::from(u8::from(dot(&sys.relative_vector(s), &x[nd..]) != 0.0))
+                dot(sys.relative_vector(s), &x[nd..]).signum()
+                    * f64::from(u8::from(dot(sys.relative_vector(s), &x[nd..]) != 0.0))
             }
             _ => 0.0,
         }
@@ -685,7 +691,7 @@ fn peak_on_step(sys: &ImpactSystem, s: Switch, dense: &Dense, len: f64, buf: &mu
     let law = sys.contact(s).law;
     let mut force = |t: f64| {
         dense.eval(t, buf);
-        law.force(dot(&a, &buf[..nd]), dot(&a, &buf[nd..2 * nd]))
+        law.force(dot(a, &buf[..nd]), dot(a, &buf[nd..2 * nd]))
     };
     let n = 16;
     let mut best = (f64::NEG_INFINITY, 0usize);

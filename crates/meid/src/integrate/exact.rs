@@ -63,7 +63,15 @@ pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Resu
 
     let mut x = sys.initial_state();
     let mut t = 0.0;
-    let (mut mode, _) = select_mode(sys, &x, Mode(0), &mut |m| sys.first_order(m));
+    // First-order matrices of the modes met, for the mode selection.
+    let mut a_cache: HashMap<Mode, std::rc::Rc<Mat<f64>>> = HashMap::new();
+    let mut a_of = |m: Mode| -> std::rc::Rc<Mat<f64>> {
+        a_cache
+            .entry(m)
+            .or_insert_with(|| std::rc::Rc::new(sys.first_order(m)))
+            .clone()
+    };
+    let (mut mode, _) = select_mode(sys, &x, Mode(0), &mut a_of);
     let mut events = Vec::new();
     let mut totals = Totals::default();
     let mut collision_end: Option<CollisionEnd> = None;
@@ -176,8 +184,7 @@ pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Resu
             zero_length = 0;
         }
         // 5: the new mode.
-        let mut mat = |m: Mode| -> Mat<f64> { sys.first_order(m) };
-        let (new_mode, _) = select_mode(sys, &x, mode, &mut mat);
+        let (new_mode, _) = select_mode(sys, &x, mode, &mut a_of);
         if new_mode != mode {
             events.push(Event {
                 t,

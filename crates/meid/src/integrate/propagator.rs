@@ -27,10 +27,11 @@
 //! When `‖V‖‖V⁻¹‖ > 1e8` (near-critical damping, clustered non-symmetric eigenvalues) the mode
 //! falls back to the matrix exponential ([`super::expm`]), evaluated on demand.
 
-use faer::linalg::solvers::Solve;
 use std::cell::RefCell;
 
-use faer::{c64, Mat, Side};
+use faer::{c64, Mat};
+
+use super::small;
 
 use super::expm::expm;
 use super::roots::Scalar;
@@ -455,36 +456,31 @@ fn spectral(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Spectral> {
     let sq: Vec<f64> = m.iter().map(|x| x.sqrt()).collect();
     let kt = Mat::<f64>::from_fn(nd, nd, |i, j| k[(i, j)] / (sq[i] * sq[j]));
     let ct = Mat::<f64>::from_fn(nd, nd, |i, j| c[(i, j)] / (sq[i] * sq[j]));
-    let ek = kt
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::numerical("propagator", format!("{e:?}")))?;
-    let kmax = (0..nd).map(|i| ek.S()[i].abs()).fold(0.0, f64::max);
+    let (ek_s, uk) = small::sym_eigen(&kt)?;
+    let kmax = (0..nd).map(|i| ek_s[i].abs()).fold(0.0, f64::max);
     let null: Vec<usize> = (0..nd)
-        .filter(|&i| ek.S()[i].abs() <= NULL_TOL * kmax.max(f64::MIN_POSITIVE))
+        .filter(|&i| ek_s[i].abs() <= NULL_TOL * kmax.max(f64::MIN_POSITIVE))
         .collect();
     let nonnull: Vec<usize> = (0..nd).filter(|i| !null.contains(i)).collect();
-    let uk = ek.U();
     // Columns of Q̃ and R̃ in the scaled coordinates.
     let mut q_cols: Vec<Vec<f64>> = nonnull
         .iter()
         .map(|&j| (0..nd).map(|i| uk[(i, j)]).collect())
         .collect();
     // Stiffness of each Q̃ column: κ for the eigenvectors of K̃, 0 for damped null directions.
-    let mut kappa: Vec<f64> = nonnull.iter().map(|&j| ek.S()[j]).collect();
+    let mut kappa: Vec<f64> = nonnull.iter().map(|&j| ek_s[j]).collect();
     let mut r_cols: Vec<Vec<f64>> = Vec::new();
     if !null.is_empty() {
         let n0 = null.len();
         let u0 = Mat::<f64>::from_fn(nd, n0, |i, j| uk[(i, null[j])]);
-        let c0 = u0.transpose() * &ct * &u0;
+        let c0 = small::at_b_c(&u0, &ct, &u0);
         let c0 = Mat::<f64>::from_fn(n0, n0, |i, j| 0.5 * (c0[(i, j)] + c0[(j, i)]));
-        let ec = c0
-            .self_adjoint_eigen(Side::Lower)
-            .map_err(|e| Error::numerical("propagator", format!("{e:?}")))?;
+        let (ec_s, ec_u) = small::sym_eigen(&c0)?;
         let cmax = (0..nd).map(|i| ct[(i, i)].abs()).fold(0.0, f64::max);
-        let wv = &u0 * ec.U();
+        let wv = small::mul(&u0, &ec_u);
         for j in 0..n0 {
             let col: Vec<f64> = (0..nd).map(|i| wv[(i, j)]).collect();
-            if ec.S()[j].abs() <= NULL_TOL * cmax.max(f64::MIN_POSITIVE) {
+            if ec_s[j].abs() <= NULL_TOL * cmax.max(f64::MIN_POSITIVE) {
                 r_cols.push(col);
             } else {
                 q_cols.push(col);
@@ -494,7 +490,7 @@ fn spectral(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Spectral> {
     }
     let mr = q_cols.len();
     let q = Mat::<f64>::from_fn(nd, mr, |i, j| q_cols[j][i]);
-    let cr = q.transpose() * &ct * &q;
+    let cr = small::at_b_c(&q, &ct, &q);
     let n2 = 2 * mr;
     // Balanced first-order form: Z = [S y; ẏ] with S = diag(√κ) (1 where κ = 0), so that
     // A_r = [[0, S], [−diag(κ/S), −C_r]] has entries of size ω rather than ω² and is
@@ -521,22 +517,18 @@ fn spectral(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Spectral> {
         }
     });
     let (lam_all, v) = if n2 > 0 {
-        let evd = ar
-            .eigen()
-            .map_err(|e| Error::numerical("propagator", format!("{e:?}")))?;
-        let lam: Vec<c64> = (0..n2).map(|i| evd.S()[i]).collect();
-        (lam, evd.U().to_owned())
+        small::real_eigen(&ar)?
     } else {
         (Vec::new(), Mat::<c64>::zeros(0, 0))
     };
     let vinv = if n2 > 0 {
-        let id = Mat::<c64>::identity(n2, n2);
-        v.partial_piv_lu().solve(&id)
+        small::inverse(&v)
+            .ok_or_else(|| Error::numerical("propagator", "defective eigenvectors"))?
     } else {
         Mat::<c64>::zeros(0, 0)
     };
     if n2 > 0 {
-        let cond = v.norm_l2() * vinv.norm_l2();
+        let cond = small::norm_c(&v) * small::norm_c(&vinv);
         if !cond.is_finite() || cond > MAX_COND {
             return Err(Error::numerical(
                 "propagator",

@@ -10,7 +10,7 @@
 //!    if the two positive stretches of these parabolas cover `[a, b]` no root can hide there.
 //!    For the exact propagator `g` is a sum of exponentials and `M₂ = Σ|A_k||λ_k|² e^{Re λ_k s}`
 //!    is rigorous;
-//! 2. or short (`≤ h_grid`, a sixteenth of the fastest period present in `g`) with a cubic Hermite
+//! 2. or short (`≤ h_grid`, an eighth of the fastest period present in `g`) with a cubic Hermite
 //!    interpolant of `g, g'` that keeps its sign; otherwise the interval is halved, down to
 //!    `h_grid/2¹⁰`, below which a touch without a sign change is a tangency, not a contact.
 //!
@@ -55,7 +55,7 @@ pub fn first_crossing<F: Scalar + ?Sized>(
         return None;
     }
     let period = f.fastest_period();
-    let h_grid = (period / 16.0).min(s_max).min(opts.max_step);
+    let h_grid = (period / 8.0).min(s_max).min(opts.max_step);
     let h_min = (h_grid / 1024.0).max(s_max * 1e-15);
     let (g0, d0) = f.value_slope(0.0);
     let mut a = 0.0;
@@ -218,47 +218,51 @@ fn hermite_dip(ga: f64, da: f64, gb: f64, db: f64, len: f64) -> Option<f64> {
     None
 }
 
-/// Safeguarded Newton-bisection on a bracket with `sign0·g(a) ≥ 0 > sign0·g(b)`;
-/// returns a point `≥` the root, within tolerance of it.
+/// Safeguarded Newton on a bracket with `sign0·g(a) ≥ 0 > sign0·g(b)` (bisection when a
+/// Newton step leaves the bracket or stalls); returns a point `≥` the root, within tolerance.
 fn refine<F: Scalar + ?Sized>(f: &F, mut a: f64, mut b: f64, sign0: f64, period: f64) -> f64 {
     let tol_abs = if period.is_finite() {
         1e-13 * period
     } else {
         0.0
     };
+    let (mut x, mut shrink_ok) = (0.5 * (a + b), true);
     for _ in 0..200 {
         let tol = tol_abs.max(4.0 * f64::EPSILON * b.abs());
         if b - a <= tol {
             break;
         }
-        let mid = 0.5 * (a + b);
-        // Newton step from the better-known end, accepted only inside the bracket.
-        let (gm, dm) = f.value_slope(mid);
-        let mut next = mid;
-        if dm != 0.0 {
-            let cand = mid - gm / dm;
-            if cand > a && cand < b {
-                next = cand;
-            }
-        }
-        let (gn, _) = if next == mid {
-            (gm, dm)
+        let (g, d) = f.value_slope(x);
+        if sign0 * g < 0.0 {
+            b = x;
         } else {
-            f.value_slope(next)
+            a = x;
+        }
+        let width = b - a;
+        let newton = if d != 0.0 { x - g / d } else { f64::NAN };
+        // Newton inside the bracket, and the bracket keeps shrinking fast enough.
+        x = if newton > a && newton < b && shrink_ok {
+            newton
+        } else {
+            0.5 * (a + b)
         };
-        if sign0 * gn < 0.0 {
-            b = next;
-        } else {
-            a = next;
-        }
-        // Also shrink with the midpoint when Newton landed elsewhere.
-        if next != mid {
-            if sign0 * gm < 0.0 {
-                b = b.min(mid);
+        // After a Newton step, also test a point just past it to close the bracket quickly.
+        if x == newton && (x - a).min(b - x) < 0.25 * width {
+            let step = tol.max(1e-3 * width);
+            let probe = if sign0 * f.value_slope(x).0 < 0.0 {
+                (x - step).max(a)
             } else {
-                a = a.max(mid);
+                (x + step).min(b)
+            };
+            let gp = f.value_slope(probe).0;
+            if sign0 * gp < 0.0 {
+                b = b.min(probe);
+            } else {
+                a = a.max(probe);
             }
+            x = x.clamp(a, b);
         }
+        shrink_ok = (b - a) < 0.5 * width || x != newton;
     }
     b
 }

@@ -62,26 +62,30 @@ pub fn implied_mode(sys: &ImpactSystem, sign_of: &dyn Fn(Indicator) -> f64) -> M
 }
 
 /// Selects a consistent mode at state `x`, starting the iteration from `start`.
-/// `matrix(mode)` gives `A_σ`. Returns the mode and whether it is consistent.
+/// `matrix(mode)` gives `A_σ`; `inds`/`vecs` are the system's indicators and their vectors.
+/// Returns the mode and whether it is consistent.
 pub fn select_mode(
     sys: &ImpactSystem,
     x: &[f64],
     start: Mode,
-    matrix: &mut dyn FnMut(Mode) -> Mat<f64>,
+    matrix: &mut dyn FnMut(Mode) -> std::rc::Rc<Mat<f64>>,
 ) -> (Mode, bool) {
     let inds = sys.indicators();
     let vecs: Vec<Vec<f64>> = inds.iter().map(|&i| sys.indicator_vector(i)).collect();
-    let mut cand = start;
-    let mut seen: Vec<Mode> = Vec::new();
-    for _ in 0..16 {
-        let a = matrix(cand);
+    let implied = |m: Mode, matrix: &mut dyn FnMut(Mode) -> std::rc::Rc<Mat<f64>>| {
+        let a = matrix(m);
         let signs: Vec<f64> = vecs.iter().map(|l| lex_sign(l, &a, x)).collect();
         let sign_of = |ind: Indicator| {
             inds.iter()
                 .position(|&i| i == ind)
                 .map_or(0.0, |p| signs[p])
         };
-        let next = implied_mode(sys, &sign_of);
+        implied_mode(sys, &sign_of)
+    };
+    let mut cand = start;
+    let mut seen: Vec<Mode> = Vec::new();
+    for _ in 0..16 {
+        let next = implied(cand, matrix);
         if next == cand {
             return (cand, true);
         }
@@ -92,25 +96,10 @@ pub fn select_mode(
         cand = next;
     }
     // No fixed point along the iteration: try every mode.
-    let all = 1u8 << 3;
-    for bits in 0..all {
+    for bits in 0..8u8 {
         let m = Mode(bits);
-        if sys
-            .switches()
-            .iter()
-            .all(|&s| m.on(s) || (m.0 & Mode::bit(s)) == 0)
-            && valid_bits(sys, m)
-        {
-            let a = matrix(m);
-            let signs: Vec<f64> = vecs.iter().map(|l| lex_sign(l, &a, x)).collect();
-            let sign_of = |ind: Indicator| {
-                inds.iter()
-                    .position(|&i| i == ind)
-                    .map_or(0.0, |p| signs[p])
-            };
-            if implied_mode(sys, &sign_of) == m {
-                return (m, true);
-            }
+        if valid_bits(sys, m) && implied(m, matrix) == m {
+            return (m, true);
         }
     }
     (cand, false)

@@ -1,0 +1,250 @@
+//! Benchmark of the impact engine (issue 2's speed figures).
+//!
+//! ```text
+//! cargo run --release -p meid --example impact_bench [-- --quick] [--no-peer]
+//! ```
+//!
+//! Method: every case is run once to warm up, then in `B` batches of `K` repetitions; the time
+//! per run of each batch is `elapsed / K` (std::time::Instant), and the median and minimum over
+//! batches are printed. Work measured:
+//! 1. one collision of `examples/paper-lumped.toml` (first contact to the end of the collision,
+//!    no output samples), `integrate::solve` on a prepared `ImpactSystem` — the per-mode closed
+//!    forms are built inside each run, as a sweep point would;
+//! 2. the same with `dopri5` (rtol 1e-8, atol 1e-14);
+//! 3. a 2 s run of a 20-mode structure (synthetic modal model: 6.35 Hz rigid-body mode, 283 Hz bed
+//!    mode and 18 modes from 400 Hz to 8 kHz, 1 % damping) with 20 kHz output, recording every
+//!    history channel (what `meid simulate -o` does, without writing the file);
+//! 4. the SciPy peer (`bench/peer/impact_rk45.py`, `solve_ivp` RK45, rtol 1e-8) on case 1's system,
+//!    median of its own repetitions; prints the time ratio and the energy-ratio difference.
+
+use std::path::PathBuf;
+use std::process::Command;
+use std::time::Instant;
+
+use meid::analysis::simulate;
+use meid::impact::{
+    Absorber, Contact, ContactLaw, Damper, DashpotKind, ImpactSystem, Release, Slider,
+};
+use meid::integrate::{self, Method, NoOutput, Options};
+use meid::modal::{FloorForce, ModalModel};
+use meid::model::{Case, Model};
+
+fn time_it(batches: usize, reps: usize, mut f: impl FnMut()) -> (f64, f64) {
+    f();
+    let mut per: Vec<f64> = (0..batches)
+        .map(|_| {
+            let t = Instant::now();
+            for _ in 0..reps {
+                f();
+            }
+            t.elapsed().as_secs_f64() / reps as f64
+        })
+        .collect();
+    per.sort_by(f64::total_cmp);
+    (per[per.len() / 2], per[0])
+}
+
+fn twenty_modes() -> ImpactSystem {
+    let n = 20;
+    let mut f_hz = vec![6.35, 283.0];
+    for i in 0..18 {
+        f_hz.push(400.0 * (20.0f64).powf(i as f64 / 17.0));
+    }
+    let omega: Vec<f64> = f_hz
+        .iter()
+        .map(|f| 2.0 * std::f64::consts::PI * f)
+        .collect();
+    let mut m = ModalModel::with_damping_ratios(omega.clone(), &vec![0.01; n]).unwrap();
+    // Mass-normalised shape values of a ~50 kg machine: O_b, O_f, B.
+    let ob: Vec<f64> = (0..n)
+        .map(|j| {
+            if j == 0 {
+                0.14
+            } else {
+                0.3 / (1.0 + 0.15 * j as f64) * if j % 2 == 0 { 1.0 } else { -1.0 }
+            }
+        })
+        .collect();
+    let of: Vec<f64> = (0..n)
+        .map(|j| {
+            if j == 0 {
+                0.14
+            } else {
+                0.02 / (1.0 + j as f64)
+            }
+        })
+        .collect();
+    let b: Vec<f64> = (0..n).map(|j| 0.8 * ob[j]).collect();
+    m.points.insert("O_b".into(), ob);
+    m.points.insert("O_f".into(), of.clone());
+    m.points.insert("B".into(), b);
+    let kf = 8.1e4;
+    m.floor_force = Some(FloorForce {
+        stiffness: of.iter().map(|p| kf * p).collect(),
+        damping: vec![0.0; n],
+    });
+    let lin = |k| Contact {
+        law: ContactLaw::Linear {
+            stiffness: k,
+            damping: 0.0,
+        },
+        release: Release::Force,
+    };
+    ImpactSystem::new(
+        &m,
+        "O_b",
+        Some("O_f"),
+        "B",
+        Slider {
+            mass: 1.2,
+            velocity: 1.2,
+        },
+        lin(4.298e7),
+        Absorber::Damper(
+            Damper {
+                mass: 3.5,
+                stiffness: 1.8e3,
+                damping: 700.0,
+                dashpot: DashpotKind::OneWay,
+            },
+            lin(1.2536e8),
+        ),
+    )
+    .unwrap()
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if args.iter().any(|a| a == "--seq") {
+        faer::set_global_parallelism(faer::Par::Seq);
+    }
+    let quick = args.iter().any(|a| a == "--quick");
+    let peer = !args.iter().any(|a| a == "--no-peer");
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let model = Model::from_file(&root.join("examples/paper-lumped.toml"), &[]).unwrap();
+    let sys = model.impact_system(Case::AsSpecified).unwrap();
+    let (b, k) = if quick { (5, 50) } else { (15, 400) };
+    let one = |method| Options {
+        method,
+        duration: 0.05,
+        sample_rate: None,
+        stop_at_collision_end: true,
+        rtol: 1e-8,
+        atol: 1e-14,
+        ..Options::default()
+    };
+
+    let oe = one(Method::Exact);
+    if args.iter().any(|a| a == "--callgrind") {
+        for _ in 0..20 {
+            integrate::solve(&sys, &oe, &mut NoOutput).unwrap();
+        }
+        return;
+    }
+    let (med_e, min_e) = time_it(b, k, || {
+        integrate::solve(&sys, &oe, &mut NoOutput).unwrap();
+    });
+    let od = one(Method::Dopri5);
+    let (med_d, min_d) = time_it(b, k, || {
+        integrate::solve(&sys, &od, &mut NoOutput).unwrap();
+    });
+    let ratio_e = simulate(&sys, &oe, false)
+        .unwrap()
+        .summary
+        .energy_ratio
+        .unwrap();
+    let ratio_d = simulate(&sys, &od, false)
+        .unwrap()
+        .summary
+        .energy_ratio
+        .unwrap();
+    println!(
+        "machine: {} cores; method: median (min) of {b} batches x {k} runs",
+        std::thread::available_parallelism().map_or(0, |n| n.get())
+    );
+    println!(
+        "1 collision, exact : {:8.2} us  (min {:.2} us)  energy ratio {ratio_e:.10}",
+        med_e * 1e6,
+        min_e * 1e6
+    );
+    println!(
+        "1 collision, dopri5: {:8.2} us  (min {:.2} us)  energy ratio {ratio_d:.10}",
+        med_d * 1e6,
+        min_d * 1e6
+    );
+
+    if args.iter().any(|a| a == "--profile") {
+        profile_parts(&sys);
+        return;
+    }
+    let s20 = twenty_modes();
+    let o20 = Options {
+        method: Method::Exact,
+        duration: 2.0,
+        sample_rate: Some(20_000.0),
+        ..Options::default()
+    };
+    let (b2, k2) = if quick { (3, 2) } else { (7, 5) };
+    let mut samples = 0;
+    let (med_20, min_20) = time_it(b2, k2, || {
+        let r = simulate(&s20, &o20, true).unwrap();
+        samples = r.history.map_or(0, |h| h.time_s.len());
+    });
+    println!(
+        "2 s, 20 modes, 20 kHz output ({samples} samples, all channels): {:8.2} ms  (min {:.2} ms)",
+        med_20 * 1e3,
+        min_20 * 1e3
+    );
+
+    if peer {
+        let st = &sys.structure;
+        let spec = serde_json::json!({
+            "omega": st.omega_rad_per_s, "damping": st.damping,
+            "phi_b": sys.points.bed_contact, "phi_f": sys.points.damper_anchor,
+            "m_s": sys.slider.mass, "v_s": sys.slider.velocity,
+            "m_d": sys.damper.unwrap().mass, "k_d": sys.damper.unwrap().stiffness, "c_d": sys.damper.unwrap().damping,
+            "K_s": sys.slider_bed.law.stiffness(), "K_d": sys.bed_damper.unwrap().law.stiffness(),
+        });
+        let path = std::env::temp_dir().join("meid_impact_peer.json");
+        std::fs::write(&path, spec.to_string()).unwrap();
+        let out = Command::new("python3")
+            .arg(root.join("bench/peer/impact_rk45.py"))
+            .arg(&path)
+            .arg(if quick { "5" } else { "20" })
+            .output();
+        match out {
+            Ok(o) if o.status.success() => {
+                let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+                let t = v["median_s"].as_f64().unwrap();
+                let r = v["energy_ratio"].as_f64().unwrap();
+                println!("SciPy {} solve_ivp RK45 (rtol 1e-8): {:.2} ms per collision, energy ratio {r:.10}", v["scipy"], t * 1e3);
+                println!("speed-up exact vs SciPy: {:.0}x; dopri5 vs SciPy: {:.0}x; |energy ratio difference| {:.2e}", t / med_e, t / med_d, (r - ratio_e).abs());
+            }
+            Ok(o) => println!("SciPy peer failed: {}", String::from_utf8_lossy(&o.stderr)),
+            Err(e) => println!("SciPy peer not run: {e}"),
+        }
+    }
+}
+
+#[allow(dead_code)]
+pub fn profile_parts(sys: &ImpactSystem) {
+    use meid::impact::Mode;
+    use meid::integrate::propagator::Propagator;
+    let m = sys.mass_diag();
+    for bits in [3u8, 2, 6, 0, 4] {
+        let mode = Mode(bits);
+        let (kk, cc) = sys.matrices(mode);
+        let a = sys.first_order(mode);
+        let (med, _) = time_it(5, 200, || {
+            let _ = Propagator::new(&kk, &cc, &m, a.clone()).unwrap();
+        });
+        let (med2, _) = time_it(5, 200, || {
+            let _ = sys.first_order(mode);
+        });
+        println!(
+            "mode {bits}: propagator build {:.2} us, first_order {:.2} us",
+            med * 1e6,
+            med2 * 1e6
+        );
+    }
+}
