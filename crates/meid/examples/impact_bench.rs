@@ -135,6 +135,17 @@ fn main() {
     };
 
     let oe = one(Method::Exact);
+    if args.iter().any(|a| a == "--callgrind20") {
+        let s20 = twenty_modes();
+        let o20 = Options {
+            method: Method::Exact,
+            duration: 2.0,
+            sample_rate: Some(20_000.0),
+            ..Options::default()
+        };
+        simulate(&s20, &o20, true).unwrap();
+        return;
+    }
     if args.iter().any(|a| a == "--callgrind") {
         for _ in 0..20 {
             integrate::solve(&sys, &oe, &mut NoOutput).unwrap();

@@ -252,6 +252,8 @@ pub struct ImpactSystem {
     has_floor: bool,
     /// `a` vectors of the switches (slider-bed, bed-damper, damper spring), built once.
     rel: [Vec<f64>; 3],
+    /// True when the modal damping matrix is diagonal (modal damping ratios only).
+    damping_diagonal: bool,
 }
 
 /// What (if anything) is attached to the bed to reduce the blow's effect.
@@ -330,7 +332,11 @@ impl ImpactSystem {
             floor,
             has_floor,
             rel: Default::default(),
+            damping_diagonal: false,
         };
+        let nm = sys.structure.len();
+        let d = &sys.structure.damping;
+        sys.damping_diagonal = (0..nm).all(|i| (0..nm).all(|j| i == j || d[i * nm + j] == 0.0));
         sys.rel = [
             sys.build_relative_vector(Switch::SliderBed),
             sys.build_relative_vector(Switch::BedDamper),
@@ -648,13 +654,15 @@ impl ImpactSystem {
         let (fbs, fbd, ffd) = self.element_forces(mode, x);
         let d = &self.structure.damping;
         for i in 0..n {
-            let mut c = 0.0;
-            for j in 0..n {
-                let dij = d[i * n + j];
-                if dij != 0.0 {
-                    c += dij * x[nd + j];
-                }
-            }
+            let c = if self.damping_diagonal {
+                d[i * n + i] * x[nd + i]
+            } else {
+                d[i * n..(i + 1) * n]
+                    .iter()
+                    .zip(&x[nd..nd + n])
+                    .map(|(a, b)| a * b)
+                    .sum()
+            };
             let mut a = -self.structure.omega_rad_per_s[i].powi(2) * x[i] - c
                 + self.points.bed_contact[i] * (fbs - fbd);
             if let Some(f) = &self.points.damper_anchor {

@@ -136,9 +136,15 @@ pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Resu
                 if k % 64 == 0 || step.is_none() {
                     seg.state(tj - t, &mut buf);
                 } else if let Some(e) = step {
-                    for i in 0..n {
-                        buf2[i] = (0..n).map(|c| e[(i, c)] * buf[c]).sum();
-                    }
+                    // faer's kernel (SIMD with run-time dispatch), sequential.
+                    faer::linalg::matmul::matmul(
+                        faer::MatMut::from_column_major_slice_mut(&mut buf2, n, 1),
+                        faer::Accum::Replace,
+                        e.as_ref(),
+                        faer::MatRef::from_column_major_slice(&buf, n, 1),
+                        1.0,
+                        faer::Par::Seq,
+                    );
                     std::mem::swap(&mut buf, &mut buf2);
                 }
                 obs.sample(tj, &buf, mode);
