@@ -3,8 +3,8 @@
 
 use meid::analysis::blows::{run_blows, BlowOptions};
 use meid::analysis::compare::{record_spectrum, CaseName, CompareOptions, Comparison};
-use meid::analysis::spectrum::{level_db, parseval_energy, Window};
 use meid::analysis::simulate;
+use meid::analysis::spectrum::{level_db, parseval_energy, Window};
 use meid::model::{Case, Model};
 
 const M: f64 = 100.0; // mounted mass, kg
@@ -49,7 +49,10 @@ sample_rate = 20000.0
 }
 
 fn paper() -> Model {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/paper-lumped.toml");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/paper-lumped.toml"
+    );
     Model::from_file(path.as_ref(), &[]).unwrap()
 }
 
@@ -92,8 +95,14 @@ fn added_mass_matches_impulse_closed_form() {
         eprintln!(
             "m/M = {ratio}: floor force {time:.4} dB (time), {spec:.4} dB (spectrum), expected {expect_force:.4}; acceleration at the mode {acc:.4} dB, expected {expect_acc:.4}"
         );
-        assert!((time - expect_force).abs() < 0.05, "{time} vs {expect_force}");
-        assert!((spec - expect_force).abs() < 0.05, "{spec} vs {expect_force}");
+        assert!(
+            (time - expect_force).abs() < 0.05,
+            "{time} vs {expect_force}"
+        );
+        assert!(
+            (spec - expect_force).abs() < 0.05,
+            "{spec} vs {expect_force}"
+        );
         assert!((acc - expect_acc).abs() < 0.05, "{acc} vs {expect_acc}");
     }
 }
@@ -105,14 +114,19 @@ fn added_mass_matches_impulse_closed_form() {
 /// must hold for the recorded force to 1e-9.
 #[test]
 fn spectrum_level_of_mounted_mass_matches_closed_form() {
-    let r = Comparison::new(mounted_mass(20.0), flat_top()).run().unwrap();
+    let r = Comparison::new(mounted_mass(20.0), flat_top())
+        .run()
+        .unwrap();
     let none = &r.cases[0];
     assert_eq!(none.case, CaseName::NoDamper);
     let mu = MS * M / (MS + M);
     let f_peak = 2.0 * mu * VS * (K / M).sqrt();
     let expect = level_db(f_peak, 1.0).unwrap();
     let got = none.modes[0].floor_force_level_db;
-    eprintln!("floor force level {got:.5} dB re 1 N, closed form {expect:.5} dB; peak {} N vs {f_peak} N", none.peak_floor_force_n);
+    eprintln!(
+        "floor force level {got:.5} dB re 1 N, closed form {expect:.5} dB; peak {} N vs {f_peak} N",
+        none.peak_floor_force_n
+    );
     assert!((got - expect).abs() < 0.01, "{got} vs {expect}");
     assert!((none.peak_floor_force_n / f_peak - 1.0).abs() < 1e-3);
     let p = parseval_energy(&none.history.floor_force_n, r.sample_rate_hz).unwrap();
@@ -181,7 +195,10 @@ fn one_blow_equals_simulate() {
     };
     let blows = run_blows(&sys, &opts, &b, true).unwrap();
     assert_eq!(blows.interval_s, 0.5);
-    assert_eq!(blows.history.as_ref().unwrap(), run.history.as_ref().unwrap());
+    assert_eq!(
+        blows.history.as_ref().unwrap(),
+        run.history.as_ref().unwrap()
+    );
     let r = &blows.blows[0];
     assert_eq!(r.energy_ratio, run.summary.energy_ratio);
     assert_eq!(r.peak_floor_force_n, run.summary.peak_floor_force_n);
@@ -228,5 +245,8 @@ fn blows_reach_steady_state() {
     assert_eq!(h.time_s.len(), 15 * 20000 + 1);
     // uniform grid across the joins
     let dt = 1.0 / 20000.0;
-    assert!(h.time_s.windows(2).all(|w| ((w[1] - w[0]) / dt - 1.0).abs() < 1e-6));
+    assert!(h
+        .time_s
+        .windows(2)
+        .all(|w| ((w[1] - w[0]) / dt - 1.0).abs() < 1e-6));
 }

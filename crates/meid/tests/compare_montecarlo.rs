@@ -4,7 +4,10 @@ use meid::analysis::montecarlo::{Distribution, MonteCarlo, SplitMix64, Uncertain
 use meid::model::Model;
 
 fn paper() -> Model {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/paper-lumped.toml");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/paper-lumped.toml"
+    );
     Model::from_file(path.as_ref(), &["simulation.duration=0.05".to_string()]).unwrap()
 }
 
@@ -36,7 +39,12 @@ fn same_seed_same_result_any_thread_count() {
     assert_eq!(one.samples, two.samples);
     assert_eq!(one.metric_stats, two.metric_stats);
     assert_eq!(one.samples_csv().unwrap(), two.samples_csv().unwrap());
-    assert_eq!(one.failed, 0, "{:?}", one.samples.iter().find(|s| s.error.is_some()));
+    assert_eq!(
+        one.failed,
+        0,
+        "{:?}",
+        one.samples.iter().find(|s| s.error.is_some())
+    );
     let other = in_pool(2, || study(24, 8).run().unwrap());
     assert_ne!(one.samples[0].inputs, other.samples[0].inputs);
 }
@@ -75,7 +83,12 @@ fn study_input_mean_within_three_standard_errors() {
     let st = &r.input_stats[0];
     let d = r.inputs[0].distribution;
     let se = d.std() / (st.count as f64).sqrt();
-    assert!((st.mean - d.mean()).abs() < 3.0 * se, "{} vs {}", st.mean, d.mean());
+    assert!(
+        (st.mean - d.mean()).abs() < 3.0 * se,
+        "{} vs {}",
+        st.mean,
+        d.mean()
+    );
     assert!(st.p5 < st.p50 && st.p50 < st.p95);
     // metrics are finite and ordered
     let e = &r.metric_stats[0];

@@ -240,9 +240,12 @@ fn append(h: &mut History, b: History, t0: f64, skip_first: bool, dissipated_off
     h.contact_force_bed_damper_n
         .extend(tail(b.contact_force_bed_damper_n));
     h.damper_force_n.extend(tail(b.damper_force_n));
-    h.slider_displacement_m.extend(tail(b.slider_displacement_m));
-    h.slider_velocity_m_per_s.extend(tail(b.slider_velocity_m_per_s));
-    h.damper_displacement_m.extend(tail(b.damper_displacement_m));
+    h.slider_displacement_m
+        .extend(tail(b.slider_displacement_m));
+    h.slider_velocity_m_per_s
+        .extend(tail(b.slider_velocity_m_per_s));
+    h.damper_displacement_m
+        .extend(tail(b.damper_displacement_m));
     h.damper_velocity_m_per_s
         .extend(tail(b.damper_velocity_m_per_s));
     h.energy.extend(b.energy.into_iter().skip(start));

@@ -278,10 +278,7 @@ impl Comparison {
         if !(o.acceleration_reference_m_per_s2.is_finite()
             && o.acceleration_reference_m_per_s2 > 0.0)
         {
-            return Err(Error::invalid(
-                "acceleration reference",
-                "must be > 0 m/s²",
-            ));
+            return Err(Error::invalid("acceleration reference", "must be > 0 m/s²"));
         }
         if let Some(f) = &o.mode_frequencies_hz {
             if f.is_empty() || f.iter().any(|v| !(v.is_finite() && *v > 0.0)) {

@@ -75,10 +75,19 @@ impl SplitMix64 {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Distribution {
-    Normal { mean: f64, std: f64 },
+    Normal {
+        mean: f64,
+        std: f64,
+    },
     /// Arithmetic mean and coefficient of variation (see the module docs).
-    LogNormal { mean: f64, cov: f64 },
-    Uniform { low: f64, high: f64 },
+    LogNormal {
+        mean: f64,
+        cov: f64,
+    },
+    Uniform {
+        low: f64,
+        high: f64,
+    },
 }
 
 impl Distribution {
@@ -88,7 +97,9 @@ impl Distribution {
         let bad = || {
             Error::invalid(
                 "distribution",
-                format!("'{t}': expected normal(mean,std), lognormal(mean,cov) or uniform(low,high)"),
+                format!(
+                    "'{t}': expected normal(mean,std), lognormal(mean,cov) or uniform(low,high)"
+                ),
             )
         };
         let open = t.find('(').ok_or_else(bad)?;
@@ -125,7 +136,9 @@ impl Distribution {
         } else {
             Err(Error::invalid(
                 "distribution",
-                format!("{self:?}: needs std ≥ 0, lognormal mean > 0 and cov ≥ 0, uniform low ≤ high"),
+                format!(
+                    "{self:?}: needs std ≥ 0, lognormal mean > 0 and cov ≥ 0, uniform low ≤ high"
+                ),
             ))
         }
     }
