@@ -341,6 +341,12 @@ impl Comparison {
     pub fn run(&self) -> Result<ComparisonResult> {
         let fs = self.check()?;
         let o = &self.options;
+        if self.cases().len() < 2 {
+            return Err(Error::invalid(
+                "damper",
+                "the model has neither [damper] nor [added_mass]: nothing to compare with",
+            ));
+        }
         let bare = self.model.impact_system(Case::NoDamper)?;
         let specs = self.mode_specs(&bare);
         if specs.is_empty() {
