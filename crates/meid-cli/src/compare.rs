@@ -31,8 +31,8 @@ pub struct CompareArgs {
     /// Acceleration level reference: 1 m/s² (default) or ISO 1683's 1e-6 m/s².
     #[arg(long, value_parser = ["1", "iso1683"], default_value = "1")]
     reference: String,
-    /// Spectral window (whole record).
-    #[arg(long, value_parser = ["hann", "rect", "flattop"], default_value = "hann")]
+    /// Spectral window over the whole record (rect suits a transient that starts at t = 0).
+    #[arg(long, value_parser = ["hann", "rect", "flattop"], default_value = "rect")]
     window: String,
     /// Read mode levels at these frequencies (Hz) instead of the model's dominant modes.
     #[arg(long, value_name = "HZ", value_delimiter = ',')]
@@ -57,9 +57,9 @@ pub struct CompareArgs {
 pub fn run(a: CompareArgs) -> Result<()> {
     let model = load(&a.model, &a.set, a.method.as_deref(), None, a.rate)?;
     let window = match a.window.as_str() {
-        "rect" => Window::Rectangular,
+        "hann" => Window::Hann,
         "flattop" => Window::FlatTop,
-        _ => Window::Hann,
+        _ => Window::Rectangular,
     };
     let options = CompareOptions {
         duration_s: a.duration,
