@@ -9,8 +9,10 @@ use clap::{Parser, Subcommand};
 
 use meid::model::Model;
 
+mod blows;
 mod compare;
 mod modes;
+mod montecarlo;
 mod optimize;
 mod simulate;
 mod sweep;
@@ -38,6 +40,10 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Find the damper that minimises an objective.
     Optimize(optimize::OptimizeArgs),
+    /// A train of blows at a stroke rate: blow-to-blow levels and steady state.
+    Blows(blows::BlowsArgs),
+    /// Monte Carlo over uncertain inputs (seeded): mean, percentiles, histogram.
+    Montecarlo(montecarlo::MonteCarloArgs),
 }
 
 fn main() -> ExitCode {
@@ -48,6 +54,8 @@ fn main() -> ExitCode {
         Command::Sweep(a) => sweep::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Optimize(a) => optimize::run(a),
+        Command::Blows(a) => blows::run(a),
+        Command::Montecarlo(a) => montecarlo::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,6 +1,9 @@
 //! Studies built on the impact engine: energy accounting, spectra, sweeps, optimisation.
 
+pub mod blows;
+pub mod compare;
 pub mod energy;
+pub mod montecarlo;
 pub mod optimize;
 pub mod spectrum;
 

@@ -239,6 +239,17 @@ impl Scalar for OnStep<'_> {
 
 /// Runs Dormand-Prince 5(4). See the module documentation.
 pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Result<Solution> {
+    solve_from(sys, &sys.initial_state(), opts, obs)
+}
+
+/// As [`solve`], from the state `x0 = [x; ẋ]` (length `2 · dofs`) at t = 0 instead of
+/// [`ImpactSystem::initial_state`] (used to chain blows).
+pub fn solve_from(
+    sys: &ImpactSystem,
+    x0: &[f64],
+    opts: &Options,
+    obs: &mut dyn Observer,
+) -> Result<Solution> {
     if !(opts.rtol > 0.0 && opts.rtol < 1.0 && opts.atol > 0.0) {
         return Err(Error::invalid(
             "simulation.rtol/atol",
@@ -272,7 +283,7 @@ pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Resu
         .collect();
 
     let mut y = vec![0.0; ny];
-    y[..nx].copy_from_slice(&sys.initial_state());
+    y[..nx].copy_from_slice(x0);
     let mut t = 0.0;
     let t_end = opts.duration;
     let mut mode = if all_linear {

@@ -33,6 +33,17 @@ struct ModeData {
 
 /// Runs the exact propagator. See the module documentation.
 pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Result<Solution> {
+    solve_from(sys, &sys.initial_state(), opts, obs)
+}
+
+/// As [`solve`], from the state `x0 = [x; ẋ]` (length `2 · dofs`) at t = 0 instead of
+/// [`ImpactSystem::initial_state`] (used to chain blows).
+pub fn solve_from(
+    sys: &ImpactSystem,
+    x0: &[f64],
+    opts: &Options,
+    obs: &mut dyn Observer,
+) -> Result<Solution> {
     for s in [Switch::SliderBed, Switch::BedDamper] {
         if (s == Switch::SliderBed || sys.damper.is_some()) && !sys.contact(s).law.is_linear() {
             return Err(Error::invalid(
@@ -61,7 +72,7 @@ pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Resu
         })
     };
 
-    let mut x = sys.initial_state();
+    let mut x = x0.to_vec();
     let mut t = 0.0;
     // First-order matrices of the modes met, for the mode selection.
     let mut a_cache: HashMap<Mode, std::rc::Rc<Mat<f64>>> = HashMap::new();

@@ -140,6 +140,36 @@ pub struct Solution {
 
 /// Simulates `sys` with `opts`, calling `obs` on the output grid.
 pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Result<Solution> {
+    solve_from(sys, &sys.initial_state(), opts, obs)
+}
+
+/// As [`solve`], but starting from the state `x0 = [x; ẋ]` (length `2 · sys.dofs()`) at
+/// t = 0 instead of [`ImpactSystem::initial_state`]. The initial contact modes are chosen from
+/// `x0` exactly as at the start of [`solve`]. Used to chain blows (`analysis::blows`):
+/// `solve` is `solve_from(sys, &sys.initial_state(), ..)`, bit for bit.
+pub fn solve_from(
+    sys: &ImpactSystem,
+    x0: &[f64],
+    opts: &Options,
+    obs: &mut dyn Observer,
+) -> Result<Solution> {
+    if x0.len() != 2 * sys.dofs() {
+        return Err(Error::invalid(
+            "initial state",
+            format!(
+                "needs {} values ([x; ẋ] for {} coordinates), got {}",
+                2 * sys.dofs(),
+                sys.dofs(),
+                x0.len()
+            ),
+        ));
+    }
+    if let Some(i) = x0.iter().position(|v| !v.is_finite()) {
+        return Err(Error::invalid(
+            "initial state",
+            format!("value {i} is not finite ({})", x0[i]),
+        ));
+    }
     if !(opts.duration.is_finite() && opts.duration > 0.0) {
         return Err(Error::invalid(
             "simulation.duration",
@@ -155,8 +185,8 @@ pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Resu
         }
     }
     match opts.method {
-        Method::Exact => exact::solve(sys, opts, obs),
-        Method::Dopri5 => dopri5::solve(sys, opts, obs),
+        Method::Exact => exact::solve_from(sys, x0, opts, obs),
+        Method::Dopri5 => dopri5::solve_from(sys, x0, opts, obs),
     }
 }
 

@@ -1,0 +1,186 @@
+//! `meid blows`: a train of blows at a stroke rate; steady blow-to-blow levels.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use meid::analysis::blows::{run_blows, BlowOptions};
+use meid::model::Case;
+use meid::plot::{self, LinePlot, Series};
+
+use crate::load;
+
+#[derive(clap::Args)]
+pub struct BlowsArgs {
+    /// Model file (TOML).
+    model: PathBuf,
+    /// Number of blows.
+    #[arg(long, value_name = "N", default_value_t = 10)]
+    blows: usize,
+    /// Stroke rate (blows per minute).
+    #[arg(long, value_name = "R", default_value_t = 60.0)]
+    rate_bpm: f64,
+    /// Relative blow-to-blow change that counts as steady.
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.01)]
+    tolerance: f64,
+    /// Which machine: as the file says, bare, with the damper, or with the added mass.
+    #[arg(long, value_parser = ["as-specified", "none", "damper", "added-mass"], default_value = "as-specified")]
+    case: String,
+    /// Write blows.csv, blows.json, history.csv and pictures into DIR.
+    #[arg(short, long, value_name = "DIR")]
+    output: Option<PathBuf>,
+    /// Integration method: exact or dopri5.
+    #[arg(long, value_parser = ["exact", "dopri5"])]
+    method: Option<String>,
+    /// Output sample rate (Hz).
+    #[arg(long, value_name = "HZ")]
+    rate: Option<f64>,
+    /// Override a model field (repeatable).
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    set: Vec<String>,
+    /// Print the result as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+pub fn run(a: BlowsArgs) -> Result<()> {
+    let model = load(&a.model, &a.set, a.method.as_deref(), None, a.rate)?;
+    let case = match a.case.as_str() {
+        "none" => Case::NoDamper,
+        "damper" => Case::Damper,
+        "added-mass" => Case::AddedMass,
+        _ => Case::AsSpecified,
+    };
+    let sys = model.impact_system(case)?;
+    let opts = model.options();
+    let b = BlowOptions {
+        blows: a.blows,
+        rate_bpm: a.rate_bpm,
+        steady_tolerance: a.tolerance,
+    };
+    let r = run_blows(&sys, &opts, &b, a.output.is_some()).context("blow train failed")?;
+    let out = serde_json::json!({
+        "interval_s": r.interval_s,
+        "blows": r.blows,
+        "steady": r.steady,
+    });
+    if let Some(dir) = &a.output {
+        let mut w = String::from("blow,start_s,energy_ratio,machine_energy_at_strike_j,damper_energy_at_strike_j,peak_bed_acceleration_m_per_s2,peak_floor_force_n,peak_contact_force_slider_bed_n\n");
+        for x in &r.blows {
+            w.push_str(&format!(
+                "{},{:.9e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}\n",
+                x.blow,
+                x.start_s,
+                x.energy_ratio.map_or(String::new(), |v| format!("{v:.9e}")),
+                x.machine_energy_at_strike_j,
+                x.damper_energy_at_strike_j,
+                x.peak_bed_acceleration_m_per_s2,
+                x.peak_floor_force_n,
+                x.peak_contact_force_slider_bed_n
+            ));
+        }
+        meid::io::write_atomic(&dir.join("blows.csv"), w.as_bytes())?;
+        meid::io::write_json(&dir.join("blows.json"), &out)?;
+        if let Some(h) = &r.history {
+            meid::io::write_atomic(&dir.join("history.csv"), &meid::io::history_csv(h)?)?;
+            for (stem, title, label, y) in [
+                (
+                    "acceleration-time",
+                    "bed acceleration at B",
+                    "acceleration (m/s²)",
+                    &h.bed_acceleration_m_per_s2,
+                ),
+                (
+                    "floor-force-time",
+                    "force to the floor",
+                    "force (N)",
+                    &h.floor_force_n,
+                ),
+            ] {
+                plot::line_plot(
+                    dir.join(stem),
+                    &LinePlot {
+                        title: format!("{title}, {} blows at {} /min", a.blows, a.rate_bpm),
+                        x_label: "time (s)".into(),
+                        y_label: label.into(),
+                        series: vec![Series {
+                            label: String::new(),
+                            x: h.time_s.clone(),
+                            y: y.clone(),
+                        }],
+                        ..LinePlot::default()
+                    },
+                )?;
+            }
+        }
+        let n: Vec<f64> = r.blows.iter().map(|x| x.blow as f64).collect();
+        let first_f = r.blows.first().map_or(1.0, |x| x.peak_floor_force_n);
+        let first_a = r
+            .blows
+            .first()
+            .map_or(1.0, |x| x.peak_bed_acceleration_m_per_s2);
+        plot::line_plot(
+            dir.join("blow-levels"),
+            &LinePlot {
+                title: "peak levels per blow (relative to the first blow)".into(),
+                x_label: "blow number".into(),
+                y_label: "peak / first blow's peak (1)".into(),
+                series: vec![
+                    Series {
+                        label: "floor force".into(),
+                        x: n.clone(),
+                        y: r.blows
+                            .iter()
+                            .map(|x| x.peak_floor_force_n / first_f)
+                            .collect(),
+                    },
+                    Series {
+                        label: "bed acceleration".into(),
+                        x: n,
+                        y: r.blows
+                            .iter()
+                            .map(|x| x.peak_bed_acceleration_m_per_s2 / first_a)
+                            .collect(),
+                    },
+                ],
+                ..LinePlot::default()
+            },
+        )?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&out)?);
+    } else if !a.quiet {
+        println!(
+            "meid blows — {} blows every {:.6} s ({} /min)",
+            a.blows, r.interval_s, a.rate_bpm
+        );
+        println!("  blow  E_p+/E_s-   peak accel (m/s²)  peak floor force (N)  machine energy at strike (J)");
+        for x in &r.blows {
+            println!(
+                "  {:>4}  {:>9}  {:>17.4}  {:>20.4}  {:>28.4e}",
+                x.blow,
+                x.energy_ratio.map_or("—".into(), |v| format!("{v:.5}")),
+                x.peak_bed_acceleration_m_per_s2,
+                x.peak_floor_force_n,
+                x.machine_energy_at_strike_j
+            );
+        }
+        let s = &r.steady;
+        match s.from_blow {
+            Some(k) => println!(
+                "  steady (changes < {} ) from blow {k}: floor force {:.4} N, bed acceleration {:.4} m/s²",
+                a.tolerance, s.peak_floor_force_n, s.peak_bed_acceleration_m_per_s2
+            ),
+            None => println!(
+                "  not steady after {} blows: last changes floor {:.2e}, acceleration {:.2e}, energy ratio {:.2e}",
+                a.blows,
+                s.last_change_peak_floor_force,
+                s.last_change_peak_bed_acceleration,
+                s.last_change_energy_ratio
+            ),
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,152 @@
+//! `meid compare`, `meid blows` and `meid montecarlo` end to end.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn meid() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_meid"))
+}
+
+fn example() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-lumped.toml")
+}
+
+fn tmpdir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("meid-cmp-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn compare_writes_every_output_and_json() {
+    let d = tmpdir("compare");
+    let out = meid()
+        .arg("compare")
+        .arg(example())
+        .arg("-o")
+        .arg(&d)
+        .args(["--duration", "0.5", "--json", "--reference", "iso1683"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["acceleration_reference_m_per_s2"].as_f64(), Some(1e-6));
+    assert_eq!(v["cases"].as_array().unwrap().len(), 3);
+    assert!(v["reductions"].as_array().unwrap().len() >= 12);
+    assert!(v["paper"].as_array().unwrap().len() >= 2);
+    for f in [
+        "history-no-damper.csv",
+        "history-damper.csv",
+        "history-added-mass.csv",
+        "spectra.csv",
+        "reductions.txt",
+        "reductions.csv",
+        "reductions.json",
+        "acceleration-time.png",
+        "acceleration-time.svg",
+        "floor-force-time.png",
+        "floor-force-spectrum.svg",
+        "acceleration-spectrum.png",
+    ] {
+        assert!(d.join(f).is_file(), "missing {f}");
+    }
+    let csv = std::fs::read_to_string(d.join("reductions.csv")).unwrap();
+    assert!(csv.starts_with("case,metric,level_db,no_damper_level_db,reduction_db"));
+}
+
+#[test]
+fn compare_rejects_a_model_without_damper_and_bad_options() {
+    let d = tmpdir("bad");
+    let text = std::fs::read_to_string(example()).unwrap();
+    // Drop the [damper] table and its contact.
+    let bare: String = text
+        .split("\n[")
+        .filter(|t| !t.starts_with("damper]") && !t.starts_with("contact.bed_damper]"))
+        .collect::<Vec<_>>()
+        .join("\n[");
+    let f = d.join("bare.toml");
+    std::fs::write(&f, bare).unwrap();
+    let out = meid().arg("compare").arg(&f).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nothing to compare"));
+    let out = meid()
+        .arg("compare")
+        .arg(example())
+        .args(["--duration", "-1"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let out = meid()
+        .arg("compare")
+        .arg(example())
+        .args(["--window", "kaiser"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+}
+
+#[test]
+fn blows_json_reports_steady_state() {
+    let out = meid()
+        .arg("blows")
+        .arg(example())
+        .args(["--blows", "8", "--rate-bpm", "120", "--json"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["blows"].as_array().unwrap().len(), 8);
+    assert_eq!(v["interval_s"].as_f64(), Some(0.5));
+    assert!(v["steady"]["converged"].is_boolean());
+}
+
+#[test]
+fn montecarlo_is_reproducible_across_thread_counts() {
+    let run = |threads: &str, dir: &PathBuf| {
+        let out = meid()
+            .arg("montecarlo")
+            .arg(example())
+            .args([
+                "--vary",
+                "contact.slider_bed.stiffness=lognormal(4.3e7,0.2)",
+                "--samples",
+                "16",
+                "--seed",
+                "3",
+                "--duration",
+                "0.02",
+                "--threads",
+                threads,
+                "--quiet",
+                "-o",
+            ])
+            .arg(dir)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        std::fs::read(dir.join("samples.csv")).unwrap()
+    };
+    let (a, b) = (tmpdir("mc1"), tmpdir("mc2"));
+    assert_eq!(run("1", &a), run("2", &b));
+    assert!(a.join("histogram-energy_ratio.png").is_file());
+    let bad = meid()
+        .arg("montecarlo")
+        .arg(example())
+        .args(["--vary", "slider.velocity=gamma(1,2)"])
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+}
