@@ -3,5 +3,6 @@
 pub mod energy;
 pub mod optimize;
 pub mod spectrum;
+pub mod sweep;
 
 pub use energy::{simulate, EnergyTerms, History, Run, Summary};
