@@ -16,25 +16,32 @@ use std::time::Instant;
 use meid::analysis::sweep::{Sweep, Vary};
 use meid::model::Model;
 
-const REPEATS: usize = 3;
+const REPEATS: usize = 1;
 
 fn main() -> meid::Result<()> {
     let path = std::env::args()
         .nth(1)
         .unwrap_or_else(|| "examples/paper-lumped.toml".into());
+    let n: usize = std::env::args()
+        .nth(2)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(100);
     let model = Model::from_file(path.as_ref(), &[])?;
     let sweep = Sweep::new(
         model,
         vec![
-            Vary::parse("ws/w_ref=10..300:100:log")?,
-            Vary::parse("wd/w_ref=10..300:100:log")?,
+            Vary::parse(&format!("ws/w_ref=10..300:{n}:log"))?,
+            Vary::parse(&format!("wd/w_ref=10..300:{n}:log"))?,
         ],
     )?;
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
     println!(
         "sweep_bench: {} points, method exact, to the end of each collision; load average {}",
         sweep.len(),
-        load.split_whitespace().take(3).collect::<Vec<_>>().join(" ")
+        load.split_whitespace()
+            .take(3)
+            .collect::<Vec<_>>()
+            .join(" ")
     );
     let mut csv = Vec::new();
     let mut best = Vec::new();
@@ -45,13 +52,11 @@ fn main() -> meid::Result<()> {
             .map_err(|e| meid::Error::numerical("rayon", e.to_string()))?;
         let mut t_best = f64::INFINITY;
         let mut text = String::new();
-        for rep in 0..=REPEATS {
+        for rep in 0..REPEATS {
             let t0 = Instant::now();
             let r = pool.install(|| sweep.run(&|_, _| {}));
             let dt = t0.elapsed().as_secs_f64();
-            if rep > 0 {
-                t_best = t_best.min(dt);
-            }
+            t_best = t_best.min(dt);
             text = r.csv();
             if rep == 0 {
                 println!(

@@ -7,8 +7,8 @@
 
 use std::path::{Path, PathBuf};
 
-use meid::analysis::sweep::{Quantity, Spacing, Sweep, Vary, METRICS};
 use meid::analysis::simulate;
+use meid::analysis::sweep::{Quantity, Spacing, Sweep, Vary, METRICS};
 use meid::model::{Case, Model};
 
 fn example() -> PathBuf {
@@ -88,7 +88,10 @@ fn minimum_near_wd_equal_ws_and_bit_identical_to_single_runs() {
                 p.values[1]
             );
         }
-        assert_eq!(p.metric("damper_contact_stiffness_n_per_m").to_bits(), k_d.to_bits());
+        assert_eq!(
+            p.metric("damper_contact_stiffness_n_per_m").to_bits(),
+            k_d.to_bits()
+        );
     }
 }
 

@@ -168,13 +168,21 @@ impl OptimizeStudy {
                 (None, Quantity::WdOverWs) => (0.2, 5.0),
                 (None, Quantity::MdOverMb) => (0.05, 2.0),
                 (None, _) => {
-                    let f = if matches!(q, Quantity::Field(_)) { 10.0 } else { 5.0 };
+                    let f = if matches!(q, Quantity::Field(_)) {
+                        10.0
+                    } else {
+                        5.0
+                    };
                     match current_value(&model, q, bed_mass_kg) {
                         Some(v) if v > 0.0 && v.is_finite() => (v / f, v * f),
                         _ => {
                             return Err(Error::invalid(
                                 "bounds",
-                                format!("no default bounds for {}: give --bounds {}=LO..HI", q.name(), q.name()),
+                                format!(
+                                    "no default bounds for {}: give --bounds {}=LO..HI",
+                                    q.name(),
+                                    q.name()
+                                ),
                             ))
                         }
                     }
@@ -323,15 +331,7 @@ impl OptimizeStudy {
         qs.push(&wd);
         vals.push(1.0);
         let rule = if self.model.spec.damper.is_some() {
-            evaluate(
-                &self.model,
-                &qs,
-                &vals,
-                self.bed_mass_kg,
-                &self.options,
-                0,
-            )
-            .metric(metric)
+            evaluate(&self.model, &qs, &vals, self.bed_mass_kg, &self.options, 0).metric(metric)
         } else {
             f64::NAN
         };

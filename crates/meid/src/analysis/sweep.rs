@@ -153,12 +153,10 @@ pub struct Vary {
 }
 
 fn parse_number(s: &str, spec: &str) -> Result<f64> {
-    let v: f64 = s.trim().parse().map_err(|_| {
-        Error::invalid(
-            "vary",
-            format!("`{spec}`: `{}` is not a number", s.trim()),
-        )
-    })?;
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| Error::invalid("vary", format!("`{spec}`: `{}` is not a number", s.trim())))?;
     if !v.is_finite() {
         return Err(Error::invalid(
             "vary",
@@ -171,14 +169,18 @@ fn parse_number(s: &str, spec: &str) -> Result<f64> {
 impl Vary {
     /// Parses `NAME=LIST`, `NAME=A..B:N` or `NAME=A..B:N:log` (see the module docs).
     pub fn parse(spec: &str) -> Result<Self> {
-        let usage = "expected NAME=LIST (md/mb=0.35,0.7,1.0), NAME=A..B:N (linear) or NAME=A..B:N:log";
+        let usage =
+            "expected NAME=LIST (md/mb=0.35,0.7,1.0), NAME=A..B:N (linear) or NAME=A..B:N:log";
         let (name, rhs) = spec
             .split_once('=')
             .ok_or_else(|| Error::invalid("vary", format!("`{spec}`: {usage}")))?;
         let quantity = Quantity::parse(name)?;
         let rhs = rhs.trim();
         if rhs.is_empty() {
-            return Err(Error::invalid("vary", format!("`{spec}`: no values; {usage}")));
+            return Err(Error::invalid(
+                "vary",
+                format!("`{spec}`: no values; {usage}"),
+            ));
         }
         let (spacing, values) = if let Some((a, rest)) = rhs.split_once("..") {
             let parts: Vec<&str> = rest.split(':').collect();
@@ -420,7 +422,10 @@ impl Sweep {
         }
         for (i, v) in self.vary.iter().enumerate() {
             if v.values.is_empty() {
-                return Err(Error::invalid("vary", format!("`{}` has no values", v.spec)));
+                return Err(Error::invalid(
+                    "vary",
+                    format!("`{}` has no values", v.spec),
+                ));
             }
             if self.vary[..i].iter().any(|w| w.quantity == v.quantity) {
                 return Err(Error::invalid(
@@ -858,23 +863,20 @@ pub fn point_model(
                 model.source.overrides.push(applied);
             }
             use serde::Deserialize;
-            model.spec = crate::model::ModelSpec::deserialize(toml::Value::Table(table))
-                .map_err(|e| Error::Input {
-                    location: fields
-                        .iter()
-                        .map(|f| format!("--vary {f}"))
-                        .collect::<Vec<_>>()
-                        .join(" "),
-                    message: e.message().trim().to_string(),
+            model.spec =
+                crate::model::ModelSpec::deserialize(toml::Value::Table(table)).map_err(|e| {
+                    Error::Input {
+                        location: fields
+                            .iter()
+                            .map(|f| format!("--vary {f}"))
+                            .collect::<Vec<_>>()
+                            .join(" "),
+                        message: e.message().trim().to_string(),
+                    }
                 })?;
         }
     }
-    let get = |q: Quantity| {
-        quantities
-            .iter()
-            .position(|x| **x == q)
-            .map(|i| values[i])
-    };
+    let get = |q: Quantity| quantities.iter().position(|x| **x == q).map(|i| values[i]);
     let w_ref = model.reference_omega();
     let spec = &mut model.spec;
     let m_s = spec.slider.mass;
