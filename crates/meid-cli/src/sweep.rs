@@ -211,15 +211,28 @@ fn increasing(v: &Vary) -> Option<Vec<usize>> {
 
 fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<PathBuf>> {
     let mut out = Vec::new();
-    let vary = &sweep.vary;
+    // Quantities with a single value are fixed: the picture is over the others.
+    let active: Vec<usize> = (0..sweep.vary.len())
+        .filter(|&k| sweep.vary[k].values.len() > 1)
+        .collect();
+    let vary: Vec<&Vary> = active.iter().map(|&k| &sweep.vary[k]).collect();
     let value = |i: usize, j: usize| -> f64 {
-        let n1 = vary.get(1).map_or(1, |v| v.values.len());
-        r.points[i * n1 + j].metric(metric)
+        // Row-major index with the active quantities at (i, j) and the fixed ones at 0.
+        let mut index = 0;
+        for (k, v) in sweep.vary.iter().enumerate() {
+            let at = match active.iter().position(|&a| a == k) {
+                Some(0) => i,
+                Some(1) => j,
+                _ => 0,
+            };
+            index = index * v.values.len() + at;
+        }
+        r.points[index].metric(metric)
     };
     let stem = metric.replace('/', "_");
     match vary.len() {
         1 => {
-            let Some(ix) = increasing(&vary[0]) else {
+            let Some(ix) = increasing(vary[0]) else {
                 return Ok(out);
             };
             let plot = LinePlot {
@@ -237,9 +250,9 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
             let f = line_plot(dir.join(format!("{stem}_curve")), &plot)?;
             out.extend([f.png, f.svg]);
         }
-        2 if vary[1].spacing == Spacing::List || vary[1].values.len() < 2 => {
+        2 if vary[1].spacing == Spacing::List => {
             // Families of curves: x = first quantity, one curve per listed value.
-            let Some(ix) = increasing(&vary[0]) else {
+            let Some(ix) = increasing(vary[0]) else {
                 return Ok(out);
             };
             let series = (0..vary[1].values.len())
@@ -261,7 +274,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
             out.extend([f.png, f.svg]);
         }
         2 => {
-            let (Some(ix), Some(iy)) = (increasing(&vary[0]), increasing(&vary[1])) else {
+            let (Some(ix), Some(iy)) = (increasing(vary[0]), increasing(vary[1])) else {
                 return Ok(out);
             };
             let x: Vec<f64> = ix.iter().map(|&i| vary[0].values[i]).collect();
