@@ -213,7 +213,7 @@ impl OptimizeStudy {
         })
     }
 
-    fn to_search(&self, k: usize, x: f64) -> f64 {
+    fn value_to_search(&self, k: usize, x: f64) -> f64 {
         if self.variables[k].log {
             x.ln()
         } else {
@@ -221,7 +221,7 @@ impl OptimizeStudy {
         }
     }
 
-    fn from_search(&self, k: usize, u: f64) -> f64 {
+    fn search_to_value(&self, k: usize, u: f64) -> f64 {
         let v = &self.variables[k];
         let x = if v.log { u.exp() } else { u };
         x.clamp(v.lower, v.upper)
@@ -238,14 +238,14 @@ impl OptimizeStudy {
         let metric = self.objective.metric();
         let n = self.variables.len();
         let f = |u: &[f64]| -> f64 {
-            let x: Vec<f64> = (0..n).map(|k| self.from_search(k, u[k])).collect();
+            let x: Vec<f64> = (0..n).map(|k| self.search_to_value(k, u[k])).collect();
             self.evaluate(&x).metric(metric)
         };
         let lo: Vec<f64> = (0..n)
-            .map(|k| self.to_search(k, self.variables[k].lower))
+            .map(|k| self.value_to_search(k, self.variables[k].lower))
             .collect();
         let hi: Vec<f64> = (0..n)
-            .map(|k| self.to_search(k, self.variables[k].upper))
+            .map(|k| self.value_to_search(k, self.variables[k].upper))
             .collect();
         let (u_best, simulations, failures, converged) = if n == 1 {
             let m = SCAN_POINTS;
@@ -286,7 +286,7 @@ impl OptimizeStudy {
                     let c = current_value(&self.model, &v.quantity, self.bed_mass_kg)
                         .filter(|c| c.is_finite() && *c > v.lower && *c < v.upper);
                     match c {
-                        Some(c) => self.to_search(k, c),
+                        Some(c) => self.value_to_search(k, c),
                         None => 0.5 * (lo[k] + hi[k]),
                     }
                 })
@@ -304,7 +304,7 @@ impl OptimizeStudy {
             let r = minimize_box(f, &x0, &lo, &hi, &opts)?;
             (r.x, r.evaluations, r.failures, r.converged)
         };
-        let optimum: Vec<f64> = (0..n).map(|k| self.from_search(k, u_best[k])).collect();
+        let optimum: Vec<f64> = (0..n).map(|k| self.search_to_value(k, u_best[k])).collect();
         let point = self.evaluate(&optimum);
         let objective_value = point.metric(metric);
         if !objective_value.is_finite() {
