@@ -1,15 +1,343 @@
-//! `meid sweep` (being built).
+//! `meid sweep`: vary quantities over lists or ranges, record every summary metric, draw the
+//! energy map (2 ranges: paper Figs. 3, 12, 16) or families of curves (1 quantity, optionally
+//! times a listed family parameter: Figs. 4, 5, 9, 17).
 
-use std::path::PathBuf;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use meid::analysis::sweep::{Quantity, Spacing, Sweep, SweepResult, Vary, DERIVED, METRICS};
+use meid::plot::{heat_map, line_plot, HeatMap, LinePlot, Series};
+
+use crate::load;
 
 #[derive(clap::Args)]
 pub struct SweepArgs {
     /// Model file (TOML).
     model: PathBuf,
+    /// NAME=LIST, NAME=A..B:N or NAME=A..B:N:log; NAME is ws/w_ref, wd/w_ref, wd/ws, md/mb or a
+    /// model field path (repeatable; the grid is their Cartesian product, last fastest).
+    #[arg(long = "vary", value_name = "SPEC", required = true)]
+    vary: Vec<String>,
+    /// Output directory (sweep.csv, sweep.json, pictures, the journal sweep.partial.csv).
+    #[arg(short, long, value_name = "DIR", default_value = "sweep-out")]
+    output: PathBuf,
+    /// Reuse the finished points of an interrupted sweep (DIR/sweep.partial.csv).
+    #[arg(long)]
+    resume: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
+    /// No progress bar or summary.
+    #[arg(short, long)]
+    quiet: bool,
+    /// Override a model field (repeatable), as in `meid simulate`.
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    set: Vec<String>,
+    /// Metric drawn in the pictures and summarised (a sweep.csv column).
+    #[arg(long, value_name = "NAME", default_value = "energy_ratio")]
+    metric: String,
+    /// Run every point for S seconds instead of stopping at the end of the collision.
+    #[arg(long, value_name = "S")]
+    duration: Option<f64>,
+    /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point).
+    #[arg(long, value_name = "KG")]
+    bed_mass: Option<f64>,
 }
 
 pub fn run(a: SweepArgs) -> Result<()> {
-    bail!("`meid sweep` is not available yet ({})", a.model.display())
+    if !METRICS.contains(&a.metric.as_str()) && !DERIVED.contains(&a.metric.as_str()) {
+        bail!(
+            "unknown --metric `{}`; valid: {}",
+            a.metric,
+            METRICS.join(", ")
+        );
+    }
+    let model = load(&a.model, &a.set, None, a.duration, None)?;
+    let vary = a
+        .vary
+        .iter()
+        .map(|s| Vary::parse(s))
+        .collect::<meid::Result<Vec<_>>>()?;
+    let mut sweep = Sweep::new(model, vary.clone())?;
+    if let Some(m) = a.bed_mass {
+        if !(m.is_finite() && m > 0.0) {
+            bail!("--bed-mass must be > 0 kg (got {m})");
+        }
+        sweep.bed_mass_kg = Some(m);
+    }
+    if a.duration.is_some() {
+        sweep.options.stop_at_collision_end = false;
+    }
+    let total = sweep.len();
+    let show = !a.quiet && std::io::stderr().is_terminal();
+    let bar = if show {
+        let b = ProgressBar::new(total as u64);
+        b.set_style(
+            ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} points  {per_sec}  ETA {eta}  {elapsed}",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let progress = |done: usize, _total: usize| bar.set_position(done as u64);
+    let journal = a.output.join("sweep.partial.csv");
+    let pool = {
+        let mut b = rayon::ThreadPoolBuilder::new();
+        if let Some(n) = a.threads {
+            if n == 0 {
+                bail!("--threads must be >= 1");
+            }
+            b = b.num_threads(n);
+        }
+        b.build().context("cannot start the worker threads")?
+    };
+    let t0 = std::time::Instant::now();
+    let result = pool.install(|| sweep.run_resumable(&journal, a.resume, &progress))?;
+    bar.finish_and_clear();
+    let elapsed = t0.elapsed().as_secs_f64();
+    result.write(&a.output)?;
+    let pictures = draw(&sweep, &result, &a.metric, &a.output)?;
+    if !a.quiet {
+        summarise(&sweep, &result, &a.metric, elapsed, &a.output, &pictures);
+    }
+    Ok(())
+}
+
+fn summarise(
+    sweep: &Sweep,
+    r: &SweepResult,
+    metric: &str,
+    elapsed: f64,
+    dir: &Path,
+    pictures: &[PathBuf],
+) {
+    println!(
+        "meid sweep — {} points in {:.2} s ({} failed)",
+        r.points.len(),
+        elapsed,
+        r.failures()
+    );
+    let names: Vec<String> = sweep.vary.iter().map(|v| v.quantity.name()).collect();
+    for m in [metric, "energy_ratio"] {
+        match r.argmin(m) {
+            Some(i) => {
+                let p = &r.points[i];
+                let at: Vec<String> = names
+                    .iter()
+                    .zip(&p.values)
+                    .map(|(n, v)| format!("{n} = {v:.6}"))
+                    .collect();
+                println!("  min {m:<32} {:.6e}  at {}", p.metric(m), at.join(", "));
+            }
+            None => println!("  min {m:<32} — (no point succeeded)"),
+        }
+        if metric == "energy_ratio" {
+            break;
+        }
+    }
+    if let Some(p) = r.points.iter().find(|p| p.error.is_some()) {
+        println!(
+            "  first failure: point {}: {}",
+            p.index,
+            p.error.as_deref().unwrap_or("")
+        );
+    }
+    println!("  wrote {}", dir.join("sweep.csv").display());
+    println!("  wrote {}", dir.join("sweep.json").display());
+    for p in pictures {
+        println!("  wrote {}", p.display());
+    }
+}
+
+fn label(q: &Quantity) -> String {
+    match q {
+        Quantity::WsOverWref => "ω_s/ω_ref (1)".into(),
+        Quantity::WdOverWref => "ω_d/ω_ref (1)".into(),
+        Quantity::WdOverWs => "ω_d/ω_s (1)".into(),
+        Quantity::MdOverMb => "m_d/m_b (1)".into(),
+        Quantity::Field(p) => {
+            let unit = if p.ends_with("stiffness") {
+                " (N/m)"
+            } else if p.ends_with("mass") {
+                " (kg)"
+            } else if p.ends_with("damping") {
+                " (N·s/m)"
+            } else if p.ends_with("velocity") {
+                " (m/s)"
+            } else {
+                ""
+            };
+            format!("{p}{unit}")
+        }
+    }
+}
+
+fn metric_label(m: &str) -> String {
+    let unit = if m == "energy_ratio" {
+        "E_p+/E_s− (1)"
+    } else if m.ends_with("_m_per_s2") {
+        "(m/s²)"
+    } else if m.ends_with("_m_per_s") {
+        "(m/s)"
+    } else if m.ends_with("_n_per_m") {
+        "(N/m)"
+    } else if m.ends_with("_kg") {
+        "(kg)"
+    } else if m.ends_with("_j") {
+        "(J)"
+    } else if m.ends_with("_n") {
+        "(N)"
+    } else if m.ends_with("_s") {
+        "(s)"
+    } else {
+        "(1)"
+    };
+    format!("{m} {unit}")
+}
+
+/// Sorted order of a value list (pictures need increasing axes).
+fn increasing(v: &Vary) -> Option<Vec<usize>> {
+    let mut idx: Vec<usize> = (0..v.values.len()).collect();
+    idx.sort_by(|&a, &b| v.values[a].total_cmp(&v.values[b]));
+    let ok = idx.windows(2).all(|w| v.values[w[0]] < v.values[w[1]]);
+    ok.then_some(idx)
+}
+
+fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    // Quantities with a single value are fixed: the picture is over the others.
+    let active: Vec<usize> = (0..sweep.vary.len())
+        .filter(|&k| sweep.vary[k].values.len() > 1)
+        .collect();
+    let vary: Vec<&Vary> = active.iter().map(|&k| &sweep.vary[k]).collect();
+    let value = |i: usize, j: usize| -> f64 {
+        // Row-major index with the active quantities at (i, j) and the fixed ones at 0.
+        let mut index = 0;
+        for (k, v) in sweep.vary.iter().enumerate() {
+            let at = match active.iter().position(|&a| a == k) {
+                Some(0) => i,
+                Some(1) => j,
+                _ => 0,
+            };
+            index = index * v.values.len() + at;
+        }
+        r.points[index].metric(metric)
+    };
+    let stem = metric.replace('/', "_");
+    match vary.len() {
+        1 => {
+            let Some(ix) = increasing(vary[0]) else {
+                return Ok(out);
+            };
+            let plot = LinePlot {
+                title: format!("{metric} over {}", vary[0].quantity.name()),
+                x_label: label(&vary[0].quantity),
+                y_label: metric_label(metric),
+                x_log: vary[0].spacing == Spacing::Log,
+                y_log: false,
+                series: vec![Series {
+                    label: String::new(),
+                    x: ix.iter().map(|&i| vary[0].values[i]).collect(),
+                    y: ix.iter().map(|&i| value(i, 0)).collect(),
+                }],
+            };
+            let f = line_plot(dir.join(format!("{stem}_curve")), &plot)?;
+            out.extend([f.png, f.svg]);
+        }
+        2 if vary[1].spacing == Spacing::List => {
+            // Families of curves: x = first quantity, one curve per listed value.
+            let Some(ix) = increasing(vary[0]) else {
+                return Ok(out);
+            };
+            let series = (0..vary[1].values.len())
+                .map(|j| Series {
+                    label: format!("{} = {}", vary[1].quantity.name(), vary[1].values[j]),
+                    x: ix.iter().map(|&i| vary[0].values[i]).collect(),
+                    y: ix.iter().map(|&i| value(i, j)).collect(),
+                })
+                .collect();
+            let plot = LinePlot {
+                title: format!("{metric} over {}", vary[0].quantity.name()),
+                x_label: label(&vary[0].quantity),
+                y_label: metric_label(metric),
+                x_log: vary[0].spacing == Spacing::Log,
+                y_log: false,
+                series,
+            };
+            let f = line_plot(dir.join(format!("{stem}_family")), &plot)?;
+            out.extend([f.png, f.svg]);
+        }
+        2 => {
+            let (Some(ix), Some(iy)) = (increasing(vary[0]), increasing(vary[1])) else {
+                return Ok(out);
+            };
+            let x: Vec<f64> = ix.iter().map(|&i| vary[0].values[i]).collect();
+            let y: Vec<f64> = iy.iter().map(|&j| vary[1].values[j]).collect();
+            let mut z = Vec::with_capacity(x.len() * y.len());
+            for &j in &iy {
+                for &i in &ix {
+                    z.push(value(i, j));
+                }
+            }
+            let finite: Vec<f64> = z.iter().copied().filter(|v| v.is_finite()).collect();
+            let (lo, hi) = finite
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            let contour_levels: Vec<f64> = if lo < hi {
+                (1..8).map(|k| lo + (hi - lo) * k as f64 / 8.0).collect()
+            } else {
+                Vec::new()
+            };
+            let mut overlay_lines = Vec::new();
+            let (q0, q1) = (&vary[0].quantity, &vary[1].quantity);
+            let diag = matches!(
+                (q0, q1),
+                (Quantity::WsOverWref, Quantity::WdOverWref)
+                    | (Quantity::WdOverWref, Quantity::WsOverWref)
+            );
+            if diag {
+                let a = x[0].max(y[0]);
+                let b = x[x.len() - 1].min(y[y.len() - 1]);
+                if a < b {
+                    overlay_lines.push(Series {
+                        label: "ω_d = ω_s".into(),
+                        x: vec![a, b],
+                        y: vec![a, b],
+                    });
+                }
+            }
+            if matches!(q1, Quantity::WdOverWs) {
+                overlay_lines.push(Series {
+                    label: "ω_d = ω_s".into(),
+                    x: vec![x[0], x[x.len() - 1]],
+                    y: vec![1.0, 1.0],
+                });
+            }
+            let map = HeatMap {
+                title: format!("{metric}: {} × {}", q0.name(), q1.name()),
+                x_label: label(q0),
+                y_label: label(q1),
+                x,
+                y,
+                z,
+                x_log: vary[0].spacing == Spacing::Log,
+                y_log: vary[1].spacing == Spacing::Log,
+                contour_levels,
+                overlay_lines,
+                colorbar_label: metric_label(metric),
+            };
+            let f = heat_map(dir.join(format!("{stem}_map")), &map)?;
+            out.extend([f.png, f.svg]);
+        }
+        _ => {}
+    }
+    Ok(out)
 }

@@ -6,5 +6,7 @@ pub mod energy;
 pub mod montecarlo;
 pub mod optimize;
 pub mod spectrum;
+pub mod study;
+pub mod sweep;
 
 pub use energy::{simulate, EnergyTerms, History, Run, Summary};

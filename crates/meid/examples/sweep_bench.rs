@@ -1,0 +1,83 @@
+//! Benchmark: a 100 x 100 energy map of the lumped paper example.
+//!
+//! Method: `examples/paper-lumped.toml` is loaded once; the sweep varies
+//! `ws/w_ref=10..300:100:log` and `wd/w_ref=10..300:100:log` (10 000 points), each point a
+//! blow simulated with the `exact` method to the end of its collision
+//! (`stop_at_collision_end`), every summary metric recorded. The whole map is run in a rayon
+//! pool of 1 thread and of 2 threads (`ThreadPoolBuilder`), each `REPEATS` times after one
+//! warm-up run; the best wall time (std::time::Instant) of each is printed with the per-point
+//! cost and the speed-up. The CSV of both runs is compared byte for byte.
+//!
+//! Run: `cargo run --release -p meid --example sweep_bench [MODEL.toml]`.
+//! The machine has 2 cores shared with other builds: note the load average beside the figures.
+
+use std::time::Instant;
+
+use meid::analysis::sweep::{Sweep, Vary};
+use meid::model::Model;
+
+const REPEATS: usize = 1;
+
+fn main() -> meid::Result<()> {
+    let path = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "examples/paper-lumped.toml".into());
+    let n: usize = std::env::args()
+        .nth(2)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(100);
+    let model = Model::from_file(path.as_ref(), &[])?;
+    let sweep = Sweep::new(
+        model,
+        vec![
+            Vary::parse(&format!("ws/w_ref=10..300:{n}:log"))?,
+            Vary::parse(&format!("wd/w_ref=10..300:{n}:log"))?,
+        ],
+    )?;
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    println!(
+        "sweep_bench: {} points, method exact, to the end of each collision; load average {}",
+        sweep.len(),
+        load.split_whitespace()
+            .take(3)
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
+    let mut csv = Vec::new();
+    let mut best = Vec::new();
+    for threads in [1usize, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| meid::Error::numerical("rayon", e.to_string()))?;
+        let mut t_best = f64::INFINITY;
+        let mut text = String::new();
+        for rep in 0..REPEATS {
+            let t0 = Instant::now();
+            let r = pool.install(|| sweep.run(&|_, _| {}));
+            let dt = t0.elapsed().as_secs_f64();
+            t_best = t_best.min(dt);
+            text = r.csv();
+            if rep == 0 {
+                println!(
+                    "  {threads} thread(s): {} failed points, min energy ratio {:.4}",
+                    r.failures(),
+                    r.argmin("energy_ratio")
+                        .map_or(f64::NAN, |i| r.points[i].metric("energy_ratio"))
+                );
+            }
+        }
+        println!(
+            "  {threads} thread(s): best of {REPEATS}: {t_best:.3} s ({:.1} us/point)",
+            1e6 * t_best / sweep.len() as f64
+        );
+        csv.push(text);
+        best.push(t_best);
+    }
+    println!(
+        "  speed-up 2 vs 1 thread: {:.2}x; CSV identical: {}",
+        best[0] / best[1],
+        csv[0] == csv[1]
+    );
+    Ok(())
+}

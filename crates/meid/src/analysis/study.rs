@@ -1,0 +1,352 @@
+//! Damper optimisation studies (issue 4, `meid optimize`): choose damper or contact
+//! parameters that minimise a metric of one blow, and compare with the paper's rule w_d = w_s.
+//!
+//! Variables are the quantities of [`super::sweep`] (derived ratios `wd/ws`, `wd/w_ref`,
+//! `ws/w_ref`, `md/mb`, or model field paths), resolved per point by
+//! [`super::sweep::point_model`]. A variable whose bounds are both positive is searched in
+//! `ln x` (stiffnesses, masses and ratios span decades; a bounded search in `ln x` spends
+//! its effort evenly per decade); otherwise linearly.
+//!
+//! * One variable: a coarse scan of [`SCAN_POINTS`] points evenly spaced (in the search
+//!   coordinate) over the bounds, then Brent's method ([`super::optimize::brent_minimize`],
+//!   Brent 1973 ch. 5) on the two scan intervals around the best scan point. The scan guards
+//!   Brent, a local method, against the other local minima of impact metrics.
+//! * Several: the bounded Nelder-Mead with restarts and coordinate polish of
+//!   [`super::optimize::minimize_box`], started from the model's values (clipped to the
+//!   box) plus seeded random starts.
+//!
+//! Objectives: `energy` = E_p+/E_s− at the end of the collision (Eq. 10 over Eq. 11; the
+//! run stops there); `bed-accel` = peak |a_B| (m/s²) and `floor-force` = peak floor force (N)
+//! over the model's whole `simulation.duration`.
+//!
+//! The paper's rule (section 4.1: the best damper has w_d = w_s) is evaluated at the
+//! optimum's other variables with `wd/ws = 1`.
+
+use serde::Serialize;
+
+use super::optimize::{brent_minimize, minimize_box, BrentOptions, NelderMeadOptions};
+use super::sweep::{check_quantities, evaluate, PointResult, Quantity};
+use crate::integrate::Options;
+use crate::model::Model;
+use crate::{Error, Result};
+
+/// Points of the coarse scan before Brent in one variable.
+pub const SCAN_POINTS: usize = 9;
+
+/// What to minimise.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Objective {
+    /// Energy left in the machine, E_p+/E_s− (1).
+    Energy,
+    /// Peak bed acceleration at B (m/s²).
+    BedAccel,
+    /// Peak force to the floor (N).
+    FloorForce,
+}
+
+impl Objective {
+    /// `energy`, `bed-accel` or `floor-force`.
+    pub fn parse(s: &str) -> Result<Self> {
+        match s {
+            "energy" => Ok(Objective::Energy),
+            "bed-accel" => Ok(Objective::BedAccel),
+            "floor-force" => Ok(Objective::FloorForce),
+            _ => Err(Error::invalid(
+                "objective",
+                format!("unknown objective `{s}`; valid: energy, bed-accel, floor-force"),
+            )),
+        }
+    }
+
+    /// The metric column it reads ([`super::sweep::METRICS`]).
+    pub fn metric(self) -> &'static str {
+        match self {
+            Objective::Energy => "energy_ratio",
+            Objective::BedAccel => "peak_bed_acceleration_m_per_s2",
+            Objective::FloorForce => "peak_floor_force_n",
+        }
+    }
+}
+
+/// One variable of an optimisation.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Variable {
+    pub quantity: Quantity,
+    pub lower: f64,
+    pub upper: f64,
+    /// Searched in `ln x`.
+    pub log: bool,
+}
+
+/// An optimisation study; build with [`OptimizeStudy::new`], run with [`OptimizeStudy::run`].
+#[derive(Debug, Clone)]
+pub struct OptimizeStudy {
+    pub model: Model,
+    pub variables: Vec<Variable>,
+    pub objective: Objective,
+    pub options: Options,
+    pub bed_mass_kg: Option<f64>,
+    /// Evaluation budget.
+    pub max_simulations: usize,
+}
+
+/// The result of [`OptimizeStudy::run`].
+#[derive(Debug, Clone, Serialize)]
+pub struct OptimizeReport {
+    pub objective: Objective,
+    pub metric: &'static str,
+    pub variables: Vec<Variable>,
+    /// Best values, in variable order.
+    pub optimum: Vec<f64>,
+    /// The objective there.
+    pub objective_value: f64,
+    /// Simulations run (including failed ones).
+    pub simulations: usize,
+    pub failures: usize,
+    pub converged: bool,
+    /// w_d/w_s at the optimum.
+    pub wd_over_ws_at_optimum: f64,
+    /// The objective with w_d = w_s (other variables at the optimum); NaN if it failed.
+    pub objective_at_wd_equal_ws: f64,
+    /// The whole point at the optimum (every metric).
+    pub point: PointResult,
+}
+
+/// The value of a numeric field path (`a.b.c`) of the model spec, if any.
+fn field_value(model: &Model, path: &str) -> Option<f64> {
+    let table = toml::Table::try_from(&model.spec).ok()?;
+    let mut cur = toml::Value::Table(table);
+    for seg in path.split('.') {
+        cur = cur.as_table()?.get(seg)?.clone();
+    }
+    cur.as_float().or(cur.as_integer().map(|i| i as f64))
+}
+
+/// The current value of a quantity on the model (for default bounds and starts).
+pub fn current_value(model: &Model, q: &Quantity, bed_mass_kg: Option<f64>) -> Option<f64> {
+    let s = &model.spec;
+    let w_s = (s.contact.slider_bed.stiffness / s.slider.mass).sqrt();
+    let w_d = match (&s.damper, &s.contact.bed_damper) {
+        (Some(d), Some(c)) => Some((c.stiffness / d.mass).sqrt()),
+        _ => None,
+    };
+    match q {
+        Quantity::WsOverWref => model.reference_omega().map(|w| w_s / w),
+        Quantity::WdOverWref => Some(w_d? / model.reference_omega()?),
+        Quantity::WdOverWs => w_d.map(|w| w / w_s),
+        Quantity::MdOverMb => Some(s.damper.as_ref()?.mass / bed_mass_kg?),
+        Quantity::Field(p) => field_value(model, p),
+    }
+}
+
+impl OptimizeStudy {
+    /// A study over `over` with optional bounds per variable. Default bounds: `wd/ws`
+    /// 0.2..5, `md/mb` 0.05..2, other quantities a factor 5 (ratios) or 10 (fields) either
+    /// side of the model's value.
+    pub fn new(
+        model: Model,
+        over: Vec<(Quantity, Option<(f64, f64)>)>,
+        objective: Objective,
+    ) -> Result<Self> {
+        if over.is_empty() {
+            return Err(Error::invalid("over", "give at least one variable"));
+        }
+        let bed_mass_kg = model.bed_mass();
+        let qs: Vec<&Quantity> = over.iter().map(|(q, _)| q).collect();
+        check_quantities(&model, &qs, bed_mass_kg)?;
+        let mut variables = Vec::new();
+        for (i, (q, b)) in over.iter().enumerate() {
+            if over[..i].iter().any(|(p, _)| p == q) {
+                return Err(Error::invalid(
+                    "over",
+                    format!("{} is given twice", q.name()),
+                ));
+            }
+            let (lower, upper) = match (b, q) {
+                (Some(b), _) => *b,
+                (None, Quantity::WdOverWs) => (0.2, 5.0),
+                (None, Quantity::MdOverMb) => (0.05, 2.0),
+                (None, _) => {
+                    let f = if matches!(q, Quantity::Field(_)) {
+                        10.0
+                    } else {
+                        5.0
+                    };
+                    match current_value(&model, q, bed_mass_kg) {
+                        Some(v) if v > 0.0 && v.is_finite() => (v / f, v * f),
+                        _ => {
+                            return Err(Error::invalid(
+                                "bounds",
+                                format!(
+                                    "no default bounds for {}: give --bounds {}=LO..HI",
+                                    q.name(),
+                                    q.name()
+                                ),
+                            ))
+                        }
+                    }
+                }
+            };
+            if !(lower.is_finite() && upper.is_finite() && lower < upper) {
+                return Err(Error::invalid(
+                    "bounds",
+                    format!("{}: needs finite LO < HI, got {lower}..{upper}", q.name()),
+                ));
+            }
+            variables.push(Variable {
+                quantity: q.clone(),
+                lower,
+                upper,
+                log: lower > 0.0,
+            });
+        }
+        let mut options = model.options();
+        options.stop_at_collision_end = objective == Objective::Energy;
+        Ok(OptimizeStudy {
+            model,
+            variables,
+            objective,
+            options,
+            bed_mass_kg,
+            max_simulations: 400,
+        })
+    }
+
+    fn value_to_search(&self, k: usize, x: f64) -> f64 {
+        if self.variables[k].log {
+            x.ln()
+        } else {
+            x
+        }
+    }
+
+    fn search_to_value(&self, k: usize, u: f64) -> f64 {
+        let v = &self.variables[k];
+        let x = if v.log { u.exp() } else { u };
+        x.clamp(v.lower, v.upper)
+    }
+
+    /// Simulates a point given in the variables' own units.
+    pub fn evaluate(&self, x: &[f64]) -> PointResult {
+        let qs: Vec<&Quantity> = self.variables.iter().map(|v| &v.quantity).collect();
+        evaluate(&self.model, &qs, x, self.bed_mass_kg, &self.options, 0)
+    }
+
+    /// Runs the search (see the module docs).
+    pub fn run(&self) -> Result<OptimizeReport> {
+        let metric = self.objective.metric();
+        let n = self.variables.len();
+        let f = |u: &[f64]| -> f64 {
+            let x: Vec<f64> = (0..n).map(|k| self.search_to_value(k, u[k])).collect();
+            self.evaluate(&x).metric(metric)
+        };
+        let lo: Vec<f64> = (0..n)
+            .map(|k| self.value_to_search(k, self.variables[k].lower))
+            .collect();
+        let hi: Vec<f64> = (0..n)
+            .map(|k| self.value_to_search(k, self.variables[k].upper))
+            .collect();
+        let (u_best, simulations, failures, converged) = if n == 1 {
+            let m = SCAN_POINTS;
+            let grid: Vec<f64> = (0..m)
+                .map(|i| lo[0] + (hi[0] - lo[0]) * i as f64 / (m - 1) as f64)
+                .collect();
+            let vals: Vec<f64> = grid.iter().map(|&u| f(&[u])).collect();
+            let scan_fail = vals.iter().filter(|v| !v.is_finite()).count();
+            let ib = (0..m)
+                .filter(|&i| vals[i].is_finite())
+                .min_by(|&a, &b| vals[a].total_cmp(&vals[b]))
+                .ok_or_else(|| {
+                    Error::numerical("optimize", "every point of the initial scan failed")
+                })?;
+            let a = grid[ib.saturating_sub(1)];
+            let b = grid[(ib + 1).min(m - 1)];
+            let opts = BrentOptions {
+                x_tolerance: 1e-6 * (hi[0] - lo[0]),
+                relative_tolerance: 1e-8,
+                max_evaluations: self.max_simulations.saturating_sub(m).max(10),
+            };
+            let r = brent_minimize(|u| f(&[u]), a, b, &opts)?;
+            let (u, _) = if r.f <= vals[ib] {
+                (r.x, r.f)
+            } else {
+                (grid[ib], vals[ib])
+            };
+            (
+                vec![u],
+                m + r.evaluations,
+                scan_fail + r.failures,
+                r.converged,
+            )
+        } else {
+            let x0: Vec<f64> = (0..n)
+                .map(|k| {
+                    let v = &self.variables[k];
+                    let c = current_value(&self.model, &v.quantity, self.bed_mass_kg)
+                        .filter(|c| c.is_finite() && *c > v.lower && *c < v.upper);
+                    match c {
+                        Some(c) => self.value_to_search(k, c),
+                        None => 0.5 * (lo[k] + hi[k]),
+                    }
+                })
+                .collect();
+            let opts = NelderMeadOptions {
+                initial_step: 0.2,
+                x_tolerance: 1e-5,
+                f_tolerance: 1e-9,
+                max_evaluations: self.max_simulations,
+                max_restarts: 5,
+                random_starts: 2,
+                seed: 4,
+                polish: true,
+            };
+            let r = minimize_box(f, &x0, &lo, &hi, &opts)?;
+            (r.x, r.evaluations, r.failures, r.converged)
+        };
+        let optimum: Vec<f64> = (0..n).map(|k| self.search_to_value(k, u_best[k])).collect();
+        let point = self.evaluate(&optimum);
+        let objective_value = point.metric(metric);
+        if !objective_value.is_finite() {
+            return Err(Error::numerical(
+                "optimize",
+                format!(
+                    "no valid design found: {}",
+                    point.error.as_deref().unwrap_or("objective undefined")
+                ),
+            ));
+        }
+        // The paper's rule at the optimum's other variables.
+        let mut qs: Vec<&Quantity> = Vec::new();
+        let mut vals: Vec<f64> = Vec::new();
+        for (k, v) in self.variables.iter().enumerate() {
+            let is_wd = matches!(v.quantity, Quantity::WdOverWs | Quantity::WdOverWref)
+                || v.quantity == Quantity::Field("contact.bed_damper.stiffness".into());
+            if !is_wd {
+                qs.push(&v.quantity);
+                vals.push(optimum[k]);
+            }
+        }
+        let wd = Quantity::WdOverWs;
+        qs.push(&wd);
+        vals.push(1.0);
+        let rule = if self.model.spec.damper.is_some() {
+            evaluate(&self.model, &qs, &vals, self.bed_mass_kg, &self.options, 0).metric(metric)
+        } else {
+            f64::NAN
+        };
+        Ok(OptimizeReport {
+            objective: self.objective,
+            metric,
+            variables: self.variables.clone(),
+            optimum,
+            objective_value,
+            simulations: simulations + 1,
+            failures,
+            converged,
+            wd_over_ws_at_optimum: point.metric("wd_over_ws"),
+            objective_at_wd_equal_ws: rule,
+            point,
+        })
+    }
+}

@@ -1,0 +1,980 @@
+//! Parameter sweeps: energy maps and families of curves (paper section 4, Figs. 3-5, 9, 12,
+//! 16, 17).
+//!
+//! A [`Sweep`] varies one or more quantities ([`Vary`]) over a Cartesian grid, simulates one
+//! blow at every point with [`crate::analysis::simulate`] and records every metric of the
+//! [`Summary`](crate::analysis::Summary) plus the varied values and the derived K_s, K_d, m_d.
+//!
+//! # Quantities
+//!
+//! A `SPEC` is `NAME=LIST` (`md/mb=0.35,0.7,1.0`), `NAME=A..B:N` (N linearly spaced values,
+//! `A` and `B` included) or `NAME=A..B:N:log` (N values spaced evenly in `ln`). `NAME` is a
+//! derived ratio of the paper or a model field path (`damper.mass`,
+//! `contact.slider_bed.stiffness`, ...), set as `--set PATH=VALUE` would.
+//!
+//! With `w_s = sqrt(K_s/m_s)` (slider contact), `w_d = sqrt(K_d/m_d)` (damper contact),
+//! `w_ref` = [`Model::reference_omega`] and `m_b` = [`Model::bed_mass`] (or
+//! [`Sweep::bed_mass_kg`]), a point is built in this fixed order:
+//!
+//! 1. field paths, in the order given;
+//! 2. `ws/w_ref = r`: `w_s = r w_ref`, `K_s = m_s w_s w_s`;
+//! 3. `w_d`: `wd/ws = r` gives `w_d = r sqrt(K_s/m_s)`, `wd/w_ref = r` gives `w_d = r w_ref`,
+//!    otherwise `w_d = sqrt(K_d/m_d)` of the point so far;
+//! 4. `md/mb = r`: `m_d = r m_b`;
+//! 5. if a ratio in 3 or 4 was given: `K_d = m_d w_d w_d` (so `md/mb` keeps `w_d`).
+//!
+//! # Cost and reproducibility
+//!
+//! The model file is parsed once. Derived ratios and non-structural fields are set on a clone
+//! of the [`ModelSpec`](crate::model::ModelSpec) and the modal model is reused; only a field
+//! under `structure.` rebuilds the model (with the field as an override). Points run in
+//! parallel (rayon) and are collected in grid order, and numbers are written with Rust's
+//! shortest round-trip formatting (`{:e}`), so the CSV is byte-identical for any thread count
+//! and a resumed sweep reproduces an uninterrupted one exactly.
+//!
+//! The sweep machinery (grid, journal, resume) is hand-written: it is a few hundred lines over
+//! rayon and csv, and no crate offers resumable parameter studies of this shape.
+//!
+//! # Example
+//!
+//! ```no_run
+//! use meid::analysis::sweep::{Sweep, Vary};
+//! use meid::model::Model;
+//!
+//! # fn main() -> meid::Result<()> {
+//! let model = Model::from_file("examples/paper-lumped.toml".as_ref(), &[])?;
+//! let sweep = Sweep::new(model, vec![Vary::parse("wd/ws=0.3..3:41:log")?])?;
+//! let result = sweep.run(&|done, total| { let _ = (done, total); });
+//! let best = result.argmin("energy_ratio").expect("some point succeeded");
+//! let r = result.points[best].metric("energy_ratio");
+//! # let _ = r;
+//! result.write("out".as_ref())?; // sweep.csv, sweep.json
+//! # Ok(())
+//! # }
+//! ```
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::Path;
+use std::sync::Mutex;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::analysis::{simulate, Summary};
+use crate::integrate::{Method, Options};
+use crate::model::{Case, Model};
+use crate::{Error, Result};
+
+/// A quantity a sweep can vary.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub enum Quantity {
+    /// w_s / w_ref.
+    WsOverWref,
+    /// w_d / w_ref.
+    WdOverWref,
+    /// w_d / w_s.
+    WdOverWs,
+    /// m_d / m_b.
+    MdOverMb,
+    /// A model field path, set like `--set PATH=VALUE`.
+    Field(String),
+}
+
+impl Quantity {
+    /// Parses a name: one of the ratios or a dotted field path.
+    pub fn parse(name: &str) -> Result<Self> {
+        let n = name.trim();
+        Ok(match n {
+            "ws/w_ref" | "ws/wref" => Quantity::WsOverWref,
+            "wd/w_ref" | "wd/wref" => Quantity::WdOverWref,
+            "wd/ws" => Quantity::WdOverWs,
+            "md/mb" => Quantity::MdOverMb,
+            _ if n.contains('/') => {
+                return Err(Error::invalid(
+                    "vary",
+                    format!("unknown ratio `{n}`; known ratios: ws/w_ref, wd/w_ref, wd/ws, md/mb (or give a model field path such as damper.mass)"),
+                ))
+            }
+            _ if n.is_empty()
+                || !n
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "._[]-".contains(c)) =>
+            {
+                return Err(Error::invalid(
+                    "vary",
+                    format!("`{n}` is neither a ratio (ws/w_ref, wd/w_ref, wd/ws, md/mb) nor a field path"),
+                ))
+            }
+            _ => Quantity::Field(n.to_string()),
+        })
+    }
+
+    /// The name as written in SPECs and CSV headers.
+    pub fn name(&self) -> String {
+        match self {
+            Quantity::WsOverWref => "ws/w_ref".into(),
+            Quantity::WdOverWref => "wd/w_ref".into(),
+            Quantity::WdOverWs => "wd/ws".into(),
+            Quantity::MdOverMb => "md/mb".into(),
+            Quantity::Field(p) => p.clone(),
+        }
+    }
+
+    /// True for quantities naturally varied on a log scale (ratios, stiffnesses, masses).
+    pub fn is_scale_like(&self) -> bool {
+        match self {
+            Quantity::Field(p) => p.contains("stiffness") || p.contains("mass"),
+            _ => true,
+        }
+    }
+}
+
+/// How the values of a [`Vary`] were given.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Spacing {
+    /// An explicit list.
+    List,
+    /// `A..B:N`.
+    Linear,
+    /// `A..B:N:log`.
+    Log,
+}
+
+/// One varied quantity and its values.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Vary {
+    /// The SPEC as given.
+    pub spec: String,
+    pub quantity: Quantity,
+    pub spacing: Spacing,
+    pub values: Vec<f64>,
+}
+
+fn parse_number(s: &str, spec: &str) -> Result<f64> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| Error::invalid("vary", format!("`{spec}`: `{}` is not a number", s.trim())))?;
+    if !v.is_finite() {
+        return Err(Error::invalid(
+            "vary",
+            format!("`{spec}`: values must be finite, got `{}`", s.trim()),
+        ));
+    }
+    Ok(v)
+}
+
+impl Vary {
+    /// Parses `NAME=LIST`, `NAME=A..B:N` or `NAME=A..B:N:log` (see the module docs).
+    pub fn parse(spec: &str) -> Result<Self> {
+        let usage =
+            "expected NAME=LIST (md/mb=0.35,0.7,1.0), NAME=A..B:N (linear) or NAME=A..B:N:log";
+        let (name, rhs) = spec
+            .split_once('=')
+            .ok_or_else(|| Error::invalid("vary", format!("`{spec}`: {usage}")))?;
+        let quantity = Quantity::parse(name)?;
+        let rhs = rhs.trim();
+        if rhs.is_empty() {
+            return Err(Error::invalid(
+                "vary",
+                format!("`{spec}`: no values; {usage}"),
+            ));
+        }
+        let (spacing, values) = if let Some((a, rest)) = rhs.split_once("..") {
+            let parts: Vec<&str> = rest.split(':').collect();
+            let (b, n, log) = match parts.as_slice() {
+                [b, n] => (*b, *n, false),
+                [b, n, s] if s.trim() == "log" => (*b, *n, true),
+                [_, _, s] => {
+                    return Err(Error::invalid(
+                        "vary",
+                        format!("`{spec}`: unknown spacing `{}` (only `log`)", s.trim()),
+                    ))
+                }
+                _ => {
+                    return Err(Error::invalid(
+                        "vary",
+                        format!("`{spec}`: a range needs a count: A..B:N or A..B:N:log"),
+                    ))
+                }
+            };
+            let a = parse_number(a, spec)?;
+            let b = parse_number(b, spec)?;
+            let n: usize = n.trim().parse().map_err(|_| {
+                Error::invalid(
+                    "vary",
+                    format!("`{spec}`: the count `{}` is not a whole number", n.trim()),
+                )
+            })?;
+            if n < 2 {
+                return Err(Error::invalid(
+                    "vary",
+                    format!("`{spec}`: a range needs N >= 2 points (got {n}); give a single value as NAME=VALUE"),
+                ));
+            }
+            if a >= b {
+                return Err(Error::invalid(
+                    "vary",
+                    format!("`{spec}`: a range needs A < B (got {a}..{b})"),
+                ));
+            }
+            if log && a <= 0.0 {
+                return Err(Error::invalid(
+                    "vary",
+                    format!("`{spec}`: a log range needs A > 0 (got {a})"),
+                ));
+            }
+            let values: Vec<f64> = (0..n)
+                .map(|i| {
+                    let t = i as f64 / (n - 1) as f64;
+                    if i == n - 1 {
+                        b
+                    } else if log {
+                        (a.ln() + t * (b.ln() - a.ln())).exp()
+                    } else {
+                        a + t * (b - a)
+                    }
+                })
+                .collect();
+            (if log { Spacing::Log } else { Spacing::Linear }, values)
+        } else {
+            let values = rhs
+                .split(',')
+                .map(|s| parse_number(s, spec))
+                .collect::<Result<Vec<f64>>>()?;
+            (Spacing::List, values)
+        };
+        if !matches!(quantity, Quantity::Field(_)) && values.iter().any(|&v| v <= 0.0) {
+            return Err(Error::invalid(
+                "vary",
+                format!("`{spec}`: the ratio {} must be > 0", quantity.name()),
+            ));
+        }
+        Ok(Vary {
+            spec: spec.trim().to_string(),
+            quantity,
+            spacing,
+            values,
+        })
+    }
+}
+
+/// Names of the recorded metrics in CSV order: the [`Summary`] fields (units in the names;
+/// ratios and counts are dimensionless). `method` is the same for every point and is kept
+/// in `sweep.json`.
+pub const METRICS: [&str; 24] = [
+    "energy_ratio",
+    "collision_end_s",
+    "slider_energy_before_j",
+    "slider_energy_after_j",
+    "damper_energy_after_j",
+    "machine_energy_after_j",
+    "machine_kinetic_energy_after_j",
+    "machine_potential_energy_after_j",
+    "dissipated_energy_after_j",
+    "slider_rebound_velocity_m_per_s",
+    "damper_velocity_m_per_s",
+    "contact_time_slider_bed_s",
+    "contact_time_bed_damper_s",
+    "peak_contact_force_slider_bed_n",
+    "peak_contact_force_bed_damper_n",
+    "peak_bed_acceleration_m_per_s2",
+    "peak_floor_force_n",
+    "energy_balance_residual",
+    "energy_balance_residual_run_end",
+    "simulated_time_s",
+    "switching_events",
+    "steps",
+    "wd_over_ws",
+    "ws_over_w_ref",
+];
+
+/// Derived columns written after the varied values.
+pub const DERIVED: [&str; 4] = [
+    "slider_contact_stiffness_n_per_m",
+    "damper_contact_stiffness_n_per_m",
+    "damper_mass_kg",
+    "slider_mass_kg",
+];
+
+fn summary_metrics(s: &Summary) -> Vec<Option<f64>> {
+    vec![
+        s.energy_ratio,
+        s.collision_end_s,
+        Some(s.slider_energy_before_j),
+        s.slider_energy_after_j,
+        s.damper_energy_after_j,
+        s.machine_energy_after_j,
+        s.machine_kinetic_energy_after_j,
+        s.machine_potential_energy_after_j,
+        s.dissipated_energy_after_j,
+        s.slider_rebound_velocity_m_per_s,
+        s.damper_velocity_m_per_s,
+        s.contact_time_slider_bed_s,
+        s.contact_time_bed_damper_s,
+        Some(s.peak_contact_force_slider_bed_n),
+        Some(s.peak_contact_force_bed_damper_n),
+        Some(s.peak_bed_acceleration_m_per_s2),
+        Some(s.peak_floor_force_n),
+        s.energy_balance_residual,
+        Some(s.energy_balance_residual_run_end),
+        Some(s.simulated_time_s),
+        Some(s.switching_events as f64),
+        Some(s.steps as f64),
+    ]
+}
+
+/// The result at one grid point.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PointResult {
+    /// Position in the grid (row-major, the last [`Vary`] fastest).
+    pub index: usize,
+    /// Values of the varied quantities, in [`Sweep::vary`] order.
+    pub values: Vec<f64>,
+    /// [`DERIVED`]: K_s (N/m), K_d (N/m), m_d (kg), m_s (kg) of the point (NaN if unknown).
+    pub derived: Vec<f64>,
+    /// [`METRICS`] (None: not defined, e.g. the collision did not end; NaN: the point failed).
+    pub metrics: Vec<Option<f64>>,
+    /// Why the point failed.
+    pub error: Option<String>,
+}
+
+impl PointResult {
+    /// A metric by name ([`METRICS`] or [`DERIVED`]); NaN if undefined or failed.
+    pub fn metric(&self, name: &str) -> f64 {
+        if let Some(i) = METRICS.iter().position(|m| *m == name) {
+            return self.metrics.get(i).copied().flatten().unwrap_or(f64::NAN);
+        }
+        if let Some(i) = DERIVED.iter().position(|m| *m == name) {
+            return self.derived.get(i).copied().unwrap_or(f64::NAN);
+        }
+        f64::NAN
+    }
+}
+
+/// The system of one point: the model with the point's values set, and what was derived.
+#[derive(Debug, Clone)]
+pub struct PointModel {
+    pub model: Model,
+    /// [`DERIVED`] values.
+    pub derived: Vec<f64>,
+}
+
+/// A parameter sweep: build, then [`Sweep::run`] or [`Sweep::run_resumable`].
+#[derive(Debug, Clone)]
+pub struct Sweep {
+    /// The base model (file values and `--set` overrides).
+    pub model: Model,
+    pub vary: Vec<Vary>,
+    /// Integration options of every point. Default: the model's, with
+    /// `stop_at_collision_end = true` (the sample rate then only serves the peak bed
+    /// acceleration and floor force during the collision).
+    pub options: Options,
+    /// m_b (kg) for `md/mb`; default [`Model::bed_mass`].
+    pub bed_mass_kg: Option<f64>,
+}
+
+/// Everything a sweep produced, in grid order.
+#[derive(Debug, Clone, Serialize)]
+pub struct SweepResult {
+    pub spec: SweepSpec,
+    pub points: Vec<PointResult>,
+}
+
+/// The description of a sweep kept with its results (`sweep.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct SweepSpec {
+    pub model: String,
+    pub model_name: Option<String>,
+    pub overrides: Vec<String>,
+    pub vary: Vec<Vary>,
+    pub method: &'static str,
+    pub duration_s: f64,
+    pub stop_at_collision_end: bool,
+    pub sample_rate_hz: Option<f64>,
+    pub reference_omega_rad_per_s: Option<f64>,
+    pub bed_mass_kg: Option<f64>,
+    pub columns: Vec<String>,
+}
+
+impl Sweep {
+    /// A sweep of `model` over the grid of `vary` (checked: quantities distinct, w_ref / m_b /
+    /// damper available where the ratios need them).
+    pub fn new(model: Model, vary: Vec<Vary>) -> Result<Self> {
+        let mut options = model.options();
+        options.stop_at_collision_end = true;
+        let bed_mass_kg = model.bed_mass();
+        let s = Sweep {
+            model,
+            vary,
+            options,
+            bed_mass_kg,
+        };
+        s.check()?;
+        Ok(s)
+    }
+
+    fn check(&self) -> Result<()> {
+        if self.vary.is_empty() {
+            return Err(Error::invalid("vary", "give at least one --vary SPEC"));
+        }
+        for (i, v) in self.vary.iter().enumerate() {
+            if v.values.is_empty() {
+                return Err(Error::invalid(
+                    "vary",
+                    format!("`{}` has no values", v.spec),
+                ));
+            }
+            if self.vary[..i].iter().any(|w| w.quantity == v.quantity) {
+                return Err(Error::invalid(
+                    "vary",
+                    format!("{} is varied twice", v.quantity.name()),
+                ));
+            }
+        }
+        let qs: Vec<&Quantity> = self.vary.iter().map(|v| &v.quantity).collect();
+        check_quantities(&self.model, &qs, self.bed_mass_kg)
+    }
+
+    /// Number of grid points.
+    pub fn len(&self) -> usize {
+        self.vary.iter().map(|v| v.values.len()).product()
+    }
+
+    /// True if the grid is empty.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Values of the varied quantities at grid point `index` (row-major, last fastest).
+    pub fn values_at(&self, index: usize) -> Vec<f64> {
+        let mut rest = index;
+        let mut out = vec![0.0; self.vary.len()];
+        for (k, v) in self.vary.iter().enumerate().rev() {
+            let n = v.values.len();
+            out[k] = v.values[rest % n];
+            rest /= n;
+        }
+        out
+    }
+
+    fn quantities(&self) -> Vec<&Quantity> {
+        self.vary.iter().map(|v| &v.quantity).collect()
+    }
+
+    /// Column names of `sweep.csv`: `index`, varied names, [`DERIVED`], [`METRICS`], `error`.
+    pub fn columns(&self) -> Vec<String> {
+        let mut c = vec!["index".to_string()];
+        c.extend(self.vary.iter().map(|v| v.quantity.name()));
+        c.extend(DERIVED.iter().map(|s| s.to_string()));
+        c.extend(METRICS.iter().map(|s| s.to_string()));
+        c.push("error".into());
+        c
+    }
+
+    /// The model of grid point `index` (see the module docs for the order of resolution).
+    pub fn point_model(&self, index: usize) -> Result<PointModel> {
+        point_model(
+            &self.model,
+            &self.quantities(),
+            &self.values_at(index),
+            self.bed_mass_kg,
+        )
+    }
+
+    /// Simulates grid point `index`; failures become a [`PointResult`] with its error.
+    pub fn run_point(&self, index: usize) -> PointResult {
+        let values = self.values_at(index);
+        evaluate(
+            &self.model,
+            &self.quantities(),
+            &values,
+            self.bed_mass_kg,
+            &self.options,
+            index,
+        )
+    }
+
+    /// Runs every point in parallel (on the current rayon pool); `progress(done, total)` is
+    /// called after each point from the worker threads.
+    pub fn run(&self, progress: &(dyn Fn(usize, usize) + Sync)) -> SweepResult {
+        let all: Vec<usize> = (0..self.len()).collect();
+        let (points, _) = self.run_indices(&all, progress, 0, None);
+        SweepResult {
+            spec: self.spec(),
+            points,
+        }
+    }
+
+    fn run_indices(
+        &self,
+        indices: &[usize],
+        progress: &(dyn Fn(usize, usize) + Sync),
+        already: usize,
+        journal: Option<&Mutex<std::fs::File>>,
+    ) -> (Vec<PointResult>, Option<Error>) {
+        let total = self.len();
+        let done = std::sync::atomic::AtomicUsize::new(already);
+        let journal_error: Mutex<Option<Error>> = Mutex::new(None);
+        let out: Vec<PointResult> = indices
+            .par_iter()
+            .map(|&i| {
+                let r = self.run_point(i);
+                if let Some(j) = journal {
+                    let line = self.row(&r);
+                    if let Ok(mut f) = j.lock() {
+                        if let Err(e) = f.write_all(line.as_bytes()).and_then(|_| f.flush()) {
+                            if let Ok(mut je) = journal_error.lock() {
+                                je.get_or_insert(Error::numerical(
+                                    "sweep journal",
+                                    format!("cannot write: {e}"),
+                                ));
+                            }
+                        }
+                    }
+                }
+                let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress(d, total);
+                r
+            })
+            .collect();
+        let err = journal_error.into_inner().ok().flatten();
+        (out, err)
+    }
+
+    /// The sweep's description (for `sweep.json`).
+    pub fn spec(&self) -> SweepSpec {
+        SweepSpec {
+            model: self.model.source.name.clone(),
+            model_name: self.model.spec.name.clone(),
+            overrides: self
+                .model
+                .source
+                .overrides
+                .iter()
+                .map(|(p, v)| format!("{p}={v}"))
+                .collect(),
+            vary: self.vary.clone(),
+            method: match self.options.method {
+                Method::Exact => "exact",
+                Method::Dopri5 => "dopri5",
+            },
+            duration_s: self.options.duration,
+            stop_at_collision_end: self.options.stop_at_collision_end,
+            sample_rate_hz: self.options.sample_rate,
+            reference_omega_rad_per_s: self.model.reference_omega(),
+            bed_mass_kg: self.bed_mass_kg,
+            columns: self.columns(),
+        }
+    }
+
+    /// One CSV row (with its newline) for a point.
+    pub fn row(&self, r: &PointResult) -> String {
+        format_row(r)
+    }
+
+    fn header(&self) -> String {
+        let mut s = self.columns().join(",");
+        s.push('\n');
+        s
+    }
+
+    /// A fingerprint of everything that determines the results (model spec, grid, options):
+    /// FNV-1a 64 over their JSON/debug text. A journal from another sweep is refused.
+    fn fingerprint(&self) -> String {
+        let mut text = serde_json::to_string(&self.model.spec).unwrap_or_default();
+        let _ = write!(
+            text,
+            "|{:?}|{:?}|{:?}|{}",
+            self.vary, self.options, self.bed_mass_kg, self.model.source.text
+        );
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for b in text.bytes() {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        format!("{h:016x}")
+    }
+
+    /// Runs the sweep keeping a journal: every finished point is appended (and flushed) to
+    /// `journal` as its CSV row, so an interrupted sweep loses no finished point. With
+    /// `resume`, the rows already in the journal are reused (a truncated last line is
+    /// dropped) and only the missing points are computed. The journal is kept; delete it
+    /// after [`SweepResult::write`] if wanted.
+    pub fn run_resumable(
+        &self,
+        journal: &Path,
+        resume: bool,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<SweepResult> {
+        let total = self.len();
+        let first = format!("# meid sweep journal v1 {}\n", self.fingerprint());
+        let header = self.header();
+        let mut known: Vec<Option<PointResult>> = vec![None; total];
+        let mut valid_prefix = 0usize;
+        if resume {
+            if let Ok(bytes) = std::fs::read(journal) {
+                let text = String::from_utf8_lossy(&bytes);
+                if !text.starts_with(&first) {
+                    return Err(Error::invalid(
+                        "resume",
+                        format!(
+                            "{} is the journal of a different sweep (model, --vary or options changed); remove it or drop --resume",
+                            journal.display()
+                        ),
+                    ));
+                }
+                let mut offset = first.len();
+                let body = &text[first.len()..];
+                for line in body.split_inclusive('\n') {
+                    if !line.ends_with('\n') {
+                        break; // truncated by an interruption
+                    }
+                    if line == header {
+                        offset += line.len();
+                        continue;
+                    }
+                    match self.parse_row(line.trim_end_matches('\n')) {
+                        Some(r) if r.index < total => {
+                            let i = r.index;
+                            known[i] = Some(r);
+                        }
+                        _ => break,
+                    }
+                    offset += line.len();
+                }
+                valid_prefix = offset;
+            }
+        }
+        // (Re)write the journal: the kept prefix, or a fresh header.
+        let file = if valid_prefix > 0 {
+            let f = std::fs::OpenOptions::new()
+                .write(true)
+                .open(journal)
+                .map_err(|e| Error::io(journal, e))?;
+            f.set_len(valid_prefix as u64)
+                .map_err(|e| Error::io(journal, e))?;
+            let mut f = std::fs::OpenOptions::new()
+                .append(true)
+                .open(journal)
+                .map_err(|e| Error::io(journal, e))?;
+            f.flush().map_err(|e| Error::io(journal, e))?;
+            f
+        } else {
+            if let Some(dir) = journal.parent().filter(|p| !p.as_os_str().is_empty()) {
+                std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+            }
+            let mut f = std::fs::File::create(journal).map_err(|e| Error::io(journal, e))?;
+            f.write_all(first.as_bytes())
+                .and_then(|_| f.write_all(header.as_bytes()))
+                .and_then(|_| f.flush())
+                .map_err(|e| Error::io(journal, e))?;
+            f
+        };
+        let missing: Vec<usize> = (0..total).filter(|&i| known[i].is_none()).collect();
+        let already = total - missing.len();
+        let lock = Mutex::new(file);
+        let (fresh, journal_error) = self.run_indices(&missing, progress, already, Some(&lock));
+        if let Some(e) = journal_error {
+            return Err(e);
+        }
+        for r in fresh {
+            let i = r.index;
+            known[i] = Some(r);
+        }
+        let points: Vec<PointResult> = known.into_iter().flatten().collect();
+        if points.len() != total {
+            return Err(Error::numerical("sweep", "points missing after the run"));
+        }
+        Ok(SweepResult {
+            spec: self.spec(),
+            points,
+        })
+    }
+
+    /// Parses a journal row; `None` if it does not fit this sweep.
+    fn parse_row(&self, line: &str) -> Option<PointResult> {
+        let mut rdr = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .from_reader(line.as_bytes());
+        let rec = rdr.records().next()?.ok()?;
+        let nv = self.vary.len();
+        if rec.len() != 1 + nv + DERIVED.len() + METRICS.len() + 1 {
+            return None;
+        }
+        let num = |s: &str| -> Option<f64> { s.parse().ok() };
+        let index: usize = rec.get(0)?.parse().ok()?;
+        let values: Option<Vec<f64>> = (1..=nv).map(|k| num(rec.get(k)?)).collect();
+        let values = values?;
+        if values != self.values_at(index.min(self.len().saturating_sub(1))) {
+            return None;
+        }
+        let derived: Option<Vec<f64>> = (0..DERIVED.len())
+            .map(|k| num(rec.get(1 + nv + k)?))
+            .collect();
+        let mut metrics = Vec::with_capacity(METRICS.len());
+        for k in 0..METRICS.len() {
+            let s = rec.get(1 + nv + DERIVED.len() + k)?;
+            metrics.push(if s.is_empty() { None } else { Some(num(s)?) });
+        }
+        let e = rec.get(rec.len() - 1)?;
+        Some(PointResult {
+            index,
+            values,
+            derived: derived?,
+            metrics,
+            error: if e.is_empty() {
+                None
+            } else {
+                Some(e.to_string())
+            },
+        })
+    }
+}
+
+fn csv_quote(s: &str) -> String {
+    let clean = s.replace(['\n', '\r'], " | ");
+    format!("\"{}\"", clean.replace('"', "\"\""))
+}
+
+impl SweepResult {
+    /// `sweep.csv`: header with units, one row per point in grid order.
+    pub fn csv(&self) -> String {
+        let mut s = self.spec.columns.join(",");
+        s.push('\n');
+        for p in &self.points {
+            s.push_str(&format_row(p));
+        }
+        s
+    }
+
+    /// Writes `sweep.csv` (atomically) and `sweep.json` (spec and rows) into `dir`.
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        crate::io::write_atomic(&dir.join("sweep.csv"), self.csv().as_bytes())?;
+        crate::io::write_json(&dir.join("sweep.json"), self)
+    }
+
+    /// Index (into `points`) of the smallest finite value of a metric.
+    pub fn argmin(&self, metric: &str) -> Option<usize> {
+        let mut best: Option<(usize, f64)> = None;
+        for (i, p) in self.points.iter().enumerate() {
+            let v = p.metric(metric);
+            if v.is_finite() && best.is_none_or(|(_, b)| v < b) {
+                best = Some((i, v));
+            }
+        }
+        best.map(|(i, _)| i)
+    }
+
+    /// Number of failed points.
+    pub fn failures(&self) -> usize {
+        self.points.iter().filter(|p| p.error.is_some()).count()
+    }
+}
+
+/// One CSV row: numbers in shortest round-trip form (`{:e}`), empty for undefined metrics,
+/// `NaN` for failed points, the error quoted.
+fn format_row(r: &PointResult) -> String {
+    let mut fields: Vec<String> = vec![r.index.to_string()];
+    fields.extend(r.values.iter().map(|v| format!("{v:e}")));
+    fields.extend(r.derived.iter().map(|v| format!("{v:e}")));
+    fields.extend(
+        r.metrics
+            .iter()
+            .map(|m| m.map_or(String::new(), |v| format!("{v:e}"))),
+    );
+    fields.push(r.error.as_deref().map_or(String::new(), csv_quote));
+    let mut s = fields.join(",");
+    s.push('\n');
+    s
+}
+
+/// Checks that the quantities can be resolved on `model`.
+pub fn check_quantities(model: &Model, qs: &[&Quantity], bed_mass_kg: Option<f64>) -> Result<()> {
+    let has = |q: &Quantity| qs.contains(&q);
+    if has(&Quantity::WdOverWs) && has(&Quantity::WdOverWref) {
+        return Err(Error::invalid(
+            "vary",
+            "give w_d either as wd/ws or as wd/w_ref, not both",
+        ));
+    }
+    let needs_ref = has(&Quantity::WsOverWref) || has(&Quantity::WdOverWref);
+    if needs_ref && model.reference_omega().is_none() {
+        return Err(Error::invalid(
+            "vary",
+            "ws/w_ref and wd/w_ref need the model's reference mode: set structure.reference_mode",
+        ));
+    }
+    let needs_damper =
+        has(&Quantity::WdOverWs) || has(&Quantity::WdOverWref) || has(&Quantity::MdOverMb);
+    if needs_damper && (model.spec.damper.is_none() || model.spec.contact.bed_damper.is_none()) {
+        return Err(Error::invalid(
+            "vary",
+            "wd/ws, wd/w_ref and md/mb need a [damper] and [contact.bed_damper] in the model",
+        ));
+    }
+    if has(&Quantity::MdOverMb) && !bed_mass_kg.is_some_and(|m| m > 0.0) {
+        return Err(Error::invalid(
+            "vary",
+            "md/mb needs the bed mass: the model has no lumped mass at the bed contact point; give --bed-mass",
+        ));
+    }
+    Ok(())
+}
+
+/// Builds the model of one point: `base` with `quantities = values` resolved in the order of
+/// the module docs. The structure's modes are reused unless a `structure.` field is set.
+pub fn point_model(
+    base: &Model,
+    quantities: &[&Quantity],
+    values: &[f64],
+    bed_mass_kg: Option<f64>,
+) -> Result<PointModel> {
+    let mut model = base.clone();
+    // 1. Field paths.
+    let fields: Vec<String> = quantities
+        .iter()
+        .zip(values)
+        .filter_map(|(q, v)| match q {
+            Quantity::Field(p) => Some(format!("{p}={v:e}")),
+            _ => None,
+        })
+        .collect();
+    if !fields.is_empty() {
+        let structural = quantities
+            .iter()
+            .any(|q| matches!(q, Quantity::Field(p) if p.starts_with("structure")));
+        if structural {
+            let mut ov: Vec<String> = base
+                .source
+                .overrides
+                .iter()
+                .map(|(p, v)| format!("{p}={v}"))
+                .collect();
+            ov.extend(fields);
+            model = Model::from_text(&base.source.name, base.source.text.clone(), &ov)?;
+        } else {
+            let mut table = toml::Table::try_from(&base.spec)
+                .map_err(|e| Error::numerical("sweep", format!("cannot serialise model: {e}")))?;
+            for f in &fields {
+                let applied = crate::model::source::apply_override(&mut table, f)?;
+                model.source.overrides.push(applied);
+            }
+            use serde::Deserialize;
+            model.spec =
+                crate::model::ModelSpec::deserialize(toml::Value::Table(table)).map_err(|e| {
+                    Error::Input {
+                        location: fields
+                            .iter()
+                            .map(|f| format!("--vary {f}"))
+                            .collect::<Vec<_>>()
+                            .join(" "),
+                        message: e.message().trim().to_string(),
+                    }
+                })?;
+        }
+    }
+    let get = |q: Quantity| quantities.iter().position(|x| **x == q).map(|i| values[i]);
+    let w_ref = model.reference_omega();
+    let spec = &mut model.spec;
+    let m_s = spec.slider.mass;
+    // 2. w_s.
+    if let Some(r) = get(Quantity::WsOverWref) {
+        let w_ref = w_ref.ok_or_else(|| Error::invalid("vary", "ws/w_ref needs w_ref"))?;
+        let w_s = r * w_ref;
+        spec.contact.slider_bed.stiffness = m_s * w_s * w_s;
+    }
+    let k_s = spec.contact.slider_bed.stiffness;
+    // 3.-5. w_d and m_d.
+    let wd_ratio = get(Quantity::WdOverWs).map(|r| (r, true));
+    let wd_ratio = wd_ratio.or(get(Quantity::WdOverWref).map(|r| (r, false)));
+    let md_ratio = get(Quantity::MdOverMb);
+    if wd_ratio.is_some() || md_ratio.is_some() {
+        let (Some(d), Some(c)) = (spec.damper.as_mut(), spec.contact.bed_damper.as_mut()) else {
+            return Err(Error::invalid(
+                "vary",
+                "wd/ws, wd/w_ref and md/mb need a [damper] and [contact.bed_damper]",
+            ));
+        };
+        let w_d = match wd_ratio {
+            Some((r, true)) => r * (k_s / m_s).sqrt(),
+            Some((r, false)) => {
+                r * w_ref.ok_or_else(|| Error::invalid("vary", "wd/w_ref needs w_ref"))?
+            }
+            None => (c.stiffness / d.mass).sqrt(),
+        };
+        if let Some(r) = md_ratio {
+            let m_b = bed_mass_kg.ok_or_else(|| Error::invalid("vary", "md/mb needs m_b"))?;
+            d.mass = r * m_b;
+        }
+        c.stiffness = d.mass * w_d * w_d;
+    }
+    let derived = vec![
+        model.spec.contact.slider_bed.stiffness,
+        model
+            .spec
+            .contact
+            .bed_damper
+            .as_ref()
+            .map_or(f64::NAN, |c| c.stiffness),
+        model.spec.damper.as_ref().map_or(f64::NAN, |d| d.mass),
+        model.spec.slider.mass,
+    ];
+    Ok(PointModel { model, derived })
+}
+
+/// Simulates one point (`quantities = values`); never fails: errors are recorded.
+pub fn evaluate(
+    base: &Model,
+    quantities: &[&Quantity],
+    values: &[f64],
+    bed_mass_kg: Option<f64>,
+    options: &Options,
+    index: usize,
+) -> PointResult {
+    let nan_metrics = || vec![Some(f64::NAN); METRICS.len()];
+    let pm = match point_model(base, quantities, values, bed_mass_kg) {
+        Ok(pm) => pm,
+        Err(e) => {
+            return PointResult {
+                index,
+                values: values.to_vec(),
+                derived: vec![f64::NAN; DERIVED.len()],
+                metrics: nan_metrics(),
+                error: Some(e.to_string()),
+            }
+        }
+    };
+    let run = pm
+        .model
+        .impact_system(Case::AsSpecified)
+        .and_then(|sys| simulate(&sys, options, false));
+    match run {
+        Ok(run) => {
+            let mut metrics = summary_metrics(&run.summary);
+            let [k_s, k_d, m_d, m_s] = [pm.derived[0], pm.derived[1], pm.derived[2], pm.derived[3]];
+            let w_s = (k_s / m_s).sqrt();
+            let w_d = (k_d / m_d).sqrt();
+            metrics.push(Some(w_d / w_s));
+            metrics.push(Some(
+                pm.model.reference_omega().map_or(f64::NAN, |w| w_s / w),
+            ));
+            PointResult {
+                index,
+                values: values.to_vec(),
+                derived: pm.derived,
+                metrics,
+                error: None,
+            }
+        }
+        Err(e) => PointResult {
+            index,
+            values: values.to_vec(),
+            derived: pm.derived,
+            metrics: nan_metrics(),
+            error: Some(e.to_string()),
+        },
+    }
+}
