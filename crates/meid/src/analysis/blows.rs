@@ -159,7 +159,7 @@ pub fn run_blows(
         match &sys.damper {
             Some(d) => {
                 let vd = x[nd + sys.damper_index()];
-                let r = dot(&sys.relative_vector(Switch::Dashpot), &x[..nd]);
+                let r = dot(sys.relative_vector(Switch::Dashpot), &x[..nd]);
                 0.5 * d.mass * vd * vd + 0.5 * d.stiffness * r * r
             }
             None => 0.0,
@@ -177,7 +177,7 @@ pub fn run_blows(
             if s == Switch::BedDamper && sys.damper.is_none() {
                 continue;
             }
-            let d = dot(&sys.relative_vector(s), &x0[..nd]);
+            let d = dot(sys.relative_vector(s), &x0[..nd]);
             mode0 = mode0.with(s, d > 0.0);
         }
         let e0 = EnergyTerms::at(sys, mode0, &x0);
