@@ -777,3 +777,236 @@ fn auto_select(
 pub fn modal_model(spec: &FemSpec, src: &Source) -> Result<ModalModel> {
     Ok(analyse(spec, src)?.modal)
 }
+
+/// Effective modal masses of one mode (kg for translations, kg·m² for rotations about global
+/// axes through the origin).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct EffectiveMass {
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+    pub rx: f64,
+    pub ry: f64,
+    pub rz: f64,
+}
+
+/// One row of the mode table.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct ModeRow {
+    /// 1-based mode number (ascending frequency).
+    pub index: usize,
+    pub frequency_hz: f64,
+    /// `None` for lumped/tabulated models (no mass matrix in global directions).
+    pub effective_mass_kg: Option<EffectiveMass>,
+    /// |ψ_i(P)| along the impact direction at each named point (1/√kg).
+    pub participation: BTreeMap<String, f64>,
+    /// Participation score `Σ_A ψ_i(A)²` at the contact points (1/kg), FE models only.
+    pub score: Option<f64>,
+    pub selected: bool,
+}
+
+/// What `meid modes` reports.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct ModeReport {
+    pub modes: Vec<ModeRow>,
+    /// Selected modes (1-based).
+    pub selected: Vec<usize>,
+    /// Why these modes were selected.
+    pub selection: String,
+    /// "dense", "lanczos", or "lumped/modal".
+    pub solver: String,
+    /// Reduced DOFs of the FE model (0 for lumped/modal).
+    pub dofs: usize,
+    /// Total `rᵀ M r` per direction (x, y, z, rx, ry, rz).
+    pub total_mass: Option<EffectiveMass>,
+    /// Relative residual of each selected mode.
+    pub selected_residuals: Vec<f64>,
+    /// max |Φᵀ M Φ − I| over the computed modes.
+    pub orthonormality_error: Option<f64>,
+}
+
+fn eff(a: [f64; 6]) -> EffectiveMass {
+    EffectiveMass {
+        x: a[0],
+        y: a[1],
+        z: a[2],
+        rx: a[3],
+        ry: a[4],
+        rz: a[5],
+    }
+}
+
+impl FemAnalysis {
+    /// The mode table of an FE analysis: all computed modes, participation along the impact
+    /// direction at the named points, and the selection with its reason.
+    pub fn report(&self) -> Result<ModeReport> {
+        let nm = self.table.frequency_hz.len();
+        let mut part: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+        for name in self.model.mesh.points.keys() {
+            let f = self.model.point_functional(name)?;
+            part.insert(
+                name.clone(),
+                (0..nm)
+                    .map(|i| {
+                        (0..f.len())
+                            .map(|j| f[j] * self.modes.shapes[(j, i)])
+                            .sum::<f64>()
+                            .abs()
+                    })
+                    .collect(),
+            );
+        }
+        let modes = (0..nm)
+            .map(|i| ModeRow {
+                index: i + 1,
+                frequency_hz: self.table.frequency_hz[i],
+                effective_mass_kg: Some(eff(self.table.effective_mass[i])),
+                participation: part.iter().map(|(k, v)| (k.clone(), v[i])).collect(),
+                score: Some(self.scores[i]),
+                selected: self.selected.contains(&i),
+            })
+            .collect();
+        let selection = match &self.selection {
+            Selection::Indices => "by index (select = [...])".to_string(),
+            Selection::Band(b) => format!("by frequency band {} to {} Hz", b[0], b[1]),
+            Selection::Auto { count, points } => format!(
+                "auto: the {count} modes with the largest participation score sum of psi(P)^2 at {}",
+                points.join(", ")
+            ),
+        };
+        Ok(ModeReport {
+            modes,
+            selected: self.selected.iter().map(|i| i + 1).collect(),
+            selection,
+            solver: self.solver.to_string(),
+            dofs: self.model.n_dofs(),
+            total_mass: Some(eff(self.table.total_mass)),
+            selected_residuals: self.selected_residuals.clone(),
+            orthonormality_error: Some(self.modes.orthonormality_error),
+        })
+    }
+}
+
+/// The mode table of a lumped or tabulated structure (all its modes are retained).
+pub fn report_from_modal(m: &ModalModel) -> ModeReport {
+    let n = m.len();
+    let modes = (0..n)
+        .map(|i| ModeRow {
+            index: i + 1,
+            frequency_hz: m.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI),
+            effective_mass_kg: None,
+            participation: m
+                .points
+                .iter()
+                .map(|(k, v)| (k.clone(), v[i].abs()))
+                .collect(),
+            score: None,
+            selected: true,
+        })
+        .collect();
+    ModeReport {
+        modes,
+        selected: (1..=n).collect(),
+        selection: "all modes of the lumped/tabulated structure".into(),
+        solver: "lumped/modal".into(),
+        dofs: 0,
+        total_mass: None,
+        selected_residuals: Vec::new(),
+        orthonormality_error: None,
+    }
+}
+
+impl ModeReport {
+    /// A fixed-width text table (one line per mode) followed by the selection.
+    pub fn to_text(&self) -> String {
+        use std::fmt::Write;
+        let points: Vec<String> = self
+            .modes
+            .first()
+            .map(|r| r.participation.keys().cloned().collect())
+            .unwrap_or_default();
+        let mut s = String::new();
+        let _ = write!(
+            s,
+            "{:>4} {:>12} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}",
+            "mode", "Hz", "m_x kg", "m_y kg", "m_z kg", "I_rx", "I_ry", "I_rz"
+        );
+        for p in &points {
+            let _ = write!(s, " {:>10}", format!("|psi({p})|"));
+        }
+        s.push_str("  sel\n");
+        for r in &self.modes {
+            let _ = write!(s, "{:>4} {:>12.4}", r.index, r.frequency_hz);
+            match &r.effective_mass_kg {
+                Some(e) => {
+                    for v in [e.x, e.y, e.z, e.rx, e.ry, e.rz] {
+                        let _ = write!(s, " {v:>9.3}");
+                    }
+                }
+                None => {
+                    for _ in 0..6 {
+                        let _ = write!(s, " {:>9}", "-");
+                    }
+                }
+            }
+            for p in &points {
+                let _ = write!(
+                    s,
+                    " {:>10.4e}",
+                    r.participation.get(p).copied().unwrap_or(0.0)
+                );
+            }
+            s.push_str(if r.selected { "  *\n" } else { "\n" });
+        }
+        let _ = writeln!(
+            s,
+            "selected modes {:?} ({}); solver {}, {} DOFs",
+            self.selected, self.selection, self.solver, self.dofs
+        );
+        if !self.selected_residuals.is_empty() {
+            let _ = writeln!(
+                s,
+                "relative residuals of the selected modes: {:?}",
+                self.selected_residuals
+                    .iter()
+                    .map(|r| format!("{r:.1e}"))
+                    .collect::<Vec<_>>()
+            );
+        }
+        s
+    }
+
+    /// CSV: `mode,frequency_hz,m_x_kg,...,I_rz_kg_m2,psi_<P>_per_sqrt_kg...,selected`.
+    pub fn to_csv(&self) -> String {
+        let points: Vec<String> = self
+            .modes
+            .first()
+            .map(|r| r.participation.keys().cloned().collect())
+            .unwrap_or_default();
+        let mut s =
+            String::from("mode,frequency_hz,m_x_kg,m_y_kg,m_z_kg,i_rx_kg_m2,i_ry_kg_m2,i_rz_kg_m2");
+        for p in &points {
+            s.push_str(&format!(",psi_{p}_per_sqrt_kg"));
+        }
+        s.push_str(",selected\n");
+        for r in &self.modes {
+            s.push_str(&format!("{},{:e}", r.index, r.frequency_hz));
+            match &r.effective_mass_kg {
+                Some(e) => {
+                    for v in [e.x, e.y, e.z, e.rx, e.ry, e.rz] {
+                        s.push_str(&format!(",{v:e}"));
+                    }
+                }
+                None => s.push_str(",,,,,,"),
+            }
+            for p in &points {
+                s.push_str(&format!(
+                    ",{:e}",
+                    r.participation.get(p).copied().unwrap_or(0.0)
+                ));
+            }
+            s.push_str(if r.selected { ",1\n" } else { ",0\n" });
+        }
+        s
+    }
+}
