@@ -12,7 +12,8 @@ use meid::model::{fem, Model};
 pub struct ModesArgs {
     /// Model file (TOML).
     model: PathBuf,
-    /// Write modes.csv, modes.json, modes.vtu + modes.pvd (FE models) into DIR.
+    /// Write modes.csv, modes.json, modes.vtu + modes.pvd and mode_<n>.png/.svg of the selected
+    /// modes (FE models) into DIR.
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
     /// Print the table as JSON on stdout.
@@ -61,6 +62,21 @@ pub fn run(a: ModesArgs) -> Result<()> {
             let vtu = io::vtk::modes_vtu(&an.model, &an.modes, &which)?;
             io::write_atomic(&dir.join("modes.vtu"), vtu.as_bytes())?;
             io::write_atomic(&dir.join("modes.pvd"), io::vtk::pvd("modes.vtu").as_bytes())?;
+            // Pictures of the selected modes (paper Figs. 2 and 15).
+            let edges = io::vtk::mesh_edges(&an.model);
+            for &i in &an.selected {
+                let plot = meid::plot::mesh::MeshPlot {
+                    title: format!(
+                        "mode {}, {:.2} Hz",
+                        i + 1,
+                        an.modes.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI)
+                    ),
+                    nodes: an.model.mesh.nodes.clone(),
+                    edges: edges.clone(),
+                    displacement: io::vtk::mode_translations(&an.model, &an.modes, i)?,
+                };
+                meid::plot::mesh::mesh_plot(dir.join(format!("mode_{}", i + 1)), &plot)?;
+            }
             if a.export_matrices {
                 io::matrix_market::write_symmetric(
                     &dir.join("K.mtx"),

@@ -89,3 +89,33 @@ pub fn pvd(vtu_file: &str) -> String {
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n<DataSet timestep=\"0\" group=\"\" part=\"0\" file=\"{vtu_file}\"/>\n</Collection>\n</VTKFile>\n"
     )
 }
+
+/// Wireframe edges of the mesh: the four sides of each shell (each edge once) and each frame.
+pub fn mesh_edges(model: &FeModel) -> Vec<[usize; 2]> {
+    let mut set = std::collections::BTreeSet::new();
+    for e in &model.mesh.shells {
+        for k in 0..4 {
+            let (a, b) = (e.nodes[k], e.nodes[(k + 1) % 4]);
+            set.insert([a.min(b), a.max(b)]);
+        }
+    }
+    for e in &model.mesh.frames {
+        set.insert([e.nodes[0].min(e.nodes[1]), e.nodes[0].max(e.nodes[1])]);
+    }
+    set.into_iter().collect()
+}
+
+/// Translations `[ux, uy, uz]` per mesh node of mode `i` (0-based).
+pub fn mode_translations(model: &FeModel, modes: &DenseModes, i: usize) -> Result<Vec<[f64; 3]>> {
+    if i >= modes.shapes.ncols() {
+        return Err(Error::invalid(
+            "modes",
+            format!("mode index {i} out of range"),
+        ));
+    }
+    let phi: Vec<f64> = modes.shapes.col(i).iter().copied().collect();
+    let full = model.dofs.expand(&phi)?;
+    Ok((0..model.mesh.nodes.len())
+        .map(|n| [full[6 * n], full[6 * n + 1], full[6 * n + 2]])
+        .collect())
+}
