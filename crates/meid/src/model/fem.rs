@@ -41,7 +41,7 @@ use serde::{Deserialize, Serialize};
 
 use super::spec::Ratios;
 use super::Source;
-use crate::modal::dense::{self, DenseModes};
+use crate::modal::dense::{DenseModes, DEFAULT_RELATIVE_SHIFT};
 use crate::modal::lanczos::{self, LanczosOptions};
 use crate::modal::ModalModel;
 use crate::structure::machine::{AddedMass, Plate, PlateSpec};
@@ -712,13 +712,7 @@ pub fn analyse(spec: &FemSpec, src: &Source) -> Result<FemAnalysis> {
             modal.damping[i * ns + i] += a + b * w * w;
         }
     }
-    let selected_residuals = dense::mode_residuals(
-        model.dense_stiffness().as_ref(),
-        model.dense_mass().as_ref(),
-        &modes,
-        &selected,
-    )
-    .unwrap_or_default();
+    let selected_residuals = sparse_residuals(&model, &modes, &selected);
     Ok(FemAnalysis {
         model,
         modes,
@@ -731,6 +725,51 @@ pub fn analyse(spec: &FemSpec, src: &Source) -> Result<FemAnalysis> {
         selected_residuals,
         modal,
     })
+}
+
+/// Relative residuals `‖K φ − λ M φ‖ / (‖K φ‖ + (|λ| + σ) ‖M φ‖)` of the modes `which`, with
+/// the sparse K and M (σ = 1e-4 tr K / tr M, as in [`crate::modal::dense::mode_residuals`]).
+fn sparse_residuals(model: &FeModel, modes: &DenseModes, which: &[usize]) -> Vec<f64> {
+    let n = model.n_dofs();
+    let (mut tr_k, mut tr_m) = (0.0, 0.0);
+    for t in model.stiffness.triplet_iter() {
+        if t.row == t.col {
+            tr_k += *t.val;
+        }
+    }
+    for t in model.mass.triplet_iter() {
+        if t.row == t.col {
+            tr_m += *t.val;
+        }
+    }
+    let sigma = DEFAULT_RELATIVE_SHIFT * tr_k / tr_m.max(f64::MIN_POSITIVE);
+    which
+        .iter()
+        .map(|&j| {
+            let mut kp = vec![0.0; n];
+            let mut mp = vec![0.0; n];
+            for t in model.stiffness.triplet_iter() {
+                kp[t.row] += t.val * modes.shapes[(t.col, j)];
+            }
+            for t in model.mass.triplet_iter() {
+                mp[t.row] += t.val * modes.shapes[(t.col, j)];
+            }
+            let lam = modes.eigenvalues[j];
+            let (mut r2, mut kn, mut mn) = (0.0, 0.0, 0.0);
+            for i in 0..n {
+                let r = kp[i] - lam * mp[i];
+                r2 += r * r;
+                kn += kp[i] * kp[i];
+                mn += mp[i] * mp[i];
+            }
+            let d = kn.sqrt() + (lam.abs() + sigma) * mn.sqrt();
+            if d > 0.0 {
+                r2.sqrt() / d
+            } else {
+                0.0
+            }
+        })
+        .collect()
 }
 
 fn auto_select(
