@@ -1,15 +1,95 @@
-//! `meid modes` (being built).
+//! `meid modes`: modal analysis of the model's structure (thin: the library builds the report,
+//! the VTK and the Matrix Market files).
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
+
+use meid::io;
+use meid::model::{fem, Model};
 
 #[derive(clap::Args)]
 pub struct ModesArgs {
     /// Model file (TOML).
     model: PathBuf,
+    /// Write modes.csv, modes.json, modes.vtu + modes.pvd and mode_<n>.png/.svg of the selected
+    /// modes (FE models) into DIR.
+    #[arg(short, long, value_name = "DIR")]
+    output: Option<PathBuf>,
+    /// Print the table as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Number of lowest modes to compute and show (FE models).
+    #[arg(long, value_name = "N")]
+    count: Option<usize>,
+    /// Also write the reduced stiffness and mass matrices as K.mtx and M.mtx (needs -o).
+    #[arg(long)]
+    export_matrices: bool,
+    /// Override a model field, e.g. --set structure.fem.machine.elements_per_side=12 (repeatable).
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    set: Vec<String>,
 }
 
 pub fn run(a: ModesArgs) -> Result<()> {
-    bail!("`meid modes` is not available yet ({})", a.model.display())
+    if a.count == Some(0) {
+        anyhow::bail!("--count must be at least 1");
+    }
+    if a.export_matrices && a.output.is_none() {
+        anyhow::bail!("--export-matrices needs an output directory (-o DIR)");
+    }
+    let model = Model::from_file(&a.model, &a.set)?;
+    let (report, analysis) = match &model.spec.structure.fem {
+        Some(spec) => {
+            let mut spec = spec.clone();
+            if let Some(c) = a.count {
+                spec.count = Some(c);
+            }
+            let an = fem::analyse(&spec, &model.source)?;
+            (an.report()?, Some(an))
+        }
+        None => (fem::report_from_modal(&model.structure), None),
+    };
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", report.to_text());
+    }
+    if let Some(dir) = &a.output {
+        io::write_atomic(&dir.join("modes.csv"), report.to_csv().as_bytes())?;
+        io::write_json(&dir.join("modes.json"), &report)?;
+        if let Some(an) = &analysis {
+            let which: Vec<usize> = (0..an.modes.omega_rad_per_s.len()).collect();
+            let vtu = io::vtk::modes_vtu(&an.model, &an.modes, &which)?;
+            io::write_atomic(&dir.join("modes.vtu"), vtu.as_bytes())?;
+            io::write_atomic(&dir.join("modes.pvd"), io::vtk::pvd("modes.vtu").as_bytes())?;
+            // Pictures of the selected modes (paper Figs. 2 and 15).
+            let edges = io::vtk::mesh_edges(&an.model);
+            for &i in &an.selected {
+                let plot = meid::plot::mesh::MeshPlot {
+                    title: format!(
+                        "mode {}, {:.2} Hz",
+                        i + 1,
+                        an.modes.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI)
+                    ),
+                    nodes: an.model.mesh.nodes.clone(),
+                    edges: edges.clone(),
+                    displacement: io::vtk::mode_translations(&an.model, &an.modes, i)?,
+                };
+                meid::plot::mesh::mesh_plot(dir.join(format!("mode_{}", i + 1)), &plot)?;
+            }
+            if a.export_matrices {
+                io::matrix_market::write_symmetric(
+                    &dir.join("K.mtx"),
+                    an.model.stiffness.as_ref(),
+                )?;
+                io::matrix_market::write_symmetric(&dir.join("M.mtx"), an.model.mass.as_ref())?;
+            }
+        } else if a.export_matrices {
+            anyhow::bail!("--export-matrices needs a [structure.fem] model");
+        }
+        if !a.json {
+            println!("wrote {}", dir.display());
+        }
+    }
+    Ok(())
 }

@@ -53,7 +53,7 @@ fn beam(n: usize, clamp: bool, planar: bool) -> Mesh {
 fn hz(model: &FeModel) -> (Vec<f64>, usize) {
     let modes = model.solve_dense().unwrap();
     // The low modes used below are M-orthonormal (the dense solver favours them; see
-    // structure::eigen for the accuracy of the top of the spectrum).
+    // modal::dense for the accuracy of the top of the spectrum).
     let nl = 12.min(modes.shapes.ncols());
     let phi = modes.shapes.subcols(0, nl);
     let gram = phi.transpose() * model.dense_mass() * phi;

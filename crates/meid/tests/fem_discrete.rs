@@ -7,7 +7,7 @@
 //! * rotary inertia I on a torsion spring k_t: ω = sqrt(k_t / I).
 //!
 //! Tolerance 1e-10 relative: the round-off of the dense shift-invert solver
-//! (`ε κ (λ + σ)²/(σ λ)`, see `structure::eigen`).
+//! (`ε κ (λ + σ)²/(σ λ)`, see `modal::dense`).
 
 use meid::structure::{Dashpot, Dof, FeModel, Mesh, PointMass, Spring};
 

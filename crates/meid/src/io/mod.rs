@@ -4,6 +4,7 @@
 //! so an interrupted run never leaves a half-written output.
 
 pub mod matrix_market;
+pub mod vtk;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};

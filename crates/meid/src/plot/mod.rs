@@ -20,6 +20,7 @@
 
 mod charts;
 pub mod contour;
+pub mod mesh;
 
 pub use charts::{area_plot, heat_map, line_plot, spectrum_plot};
 

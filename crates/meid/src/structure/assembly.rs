@@ -363,10 +363,10 @@ impl FeModel {
     pub fn dense_damping(&self) -> Mat<f64> {
         self.damping.to_dense()
     }
-    /// All modes by the dense shift-invert solver [`super::eigen::solve_shift_invert`] with
-    /// its default shift (small models, up to a few thousand DOFs).
+    /// All modes by the dense shift-invert solver [`crate::modal::dense::solve_shift_invert`]
+    /// with its default shift (small models, up to a few thousand DOFs).
     pub fn solve_dense(&self) -> Result<crate::modal::dense::DenseModes> {
-        super::eigen::solve_shift_invert(
+        crate::modal::dense::solve_shift_invert(
             self.dense_stiffness().as_ref(),
             self.dense_mass().as_ref(),
             None,

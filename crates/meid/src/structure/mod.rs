@@ -9,7 +9,6 @@
 //! | [`discrete`] | springs, dashpots, point masses, rigid links |
 //! | [`mesh`] | nodes, elements, supports, named points, validation |
 //! | [`assembly`] | DOF numbering with rigid-link elimination, sparse/dense K, M, C, floor force |
-//! | [`eigen`] | dense shift-invert eigen-solver (accurate low modes for Mindlin shells) |
 //! | [`modes`] | modal model (paper Eq. 9) and mode tables from the dense modes |
 //! | [`machine`] | the parametric forging machine (paper Fig. 1) |
 //! | [`gmsh`] | Gmsh `.msh` 4.1 ASCII quad meshes |
@@ -25,7 +24,6 @@
 
 pub mod assembly;
 pub mod discrete;
-pub mod eigen;
 pub mod frame;
 pub(crate) mod geom;
 pub mod gmsh;

@@ -1,0 +1,191 @@
+//! `meid modes` end to end: table, JSON keys, files, VTU structure, bad input.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn meid() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_meid"))
+}
+
+fn example(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples")
+        .join(name)
+}
+
+fn tmpdir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("meid-modes-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Minimal well-formedness check: every start tag is closed in order (no attributes with '>').
+fn check_xml(text: &str) -> Result<(), String> {
+    let mut stack: Vec<String> = Vec::new();
+    let mut rest = text;
+    while let Some(i) = rest.find('<') {
+        let j = rest[i..].find('>').ok_or("unterminated tag")? + i;
+        let tag = &rest[i + 1..j];
+        rest = &rest[j + 1..];
+        if tag.starts_with('?') {
+            continue;
+        }
+        if let Some(name) = tag.strip_prefix('/') {
+            let open = stack.pop().ok_or(format!("close {name} without open"))?;
+            if open != name {
+                return Err(format!("close {name} but open {open}"));
+            }
+        } else if !tag.ends_with('/') {
+            let name = tag.split_whitespace().next().ok_or("empty tag")?;
+            stack.push(name.to_string());
+        }
+    }
+    if stack.is_empty() {
+        Ok(())
+    } else {
+        Err(format!("unclosed {stack:?}"))
+    }
+}
+
+#[test]
+fn fem_model_table_json_and_files() {
+    let out = meid()
+        .args(["modes", "--count", "12"])
+        .arg(example("paper-soft-base.toml"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("selected modes [5, 10]"), "{text}");
+    assert_eq!(text.lines().filter(|l| l.ends_with('*')).count(), 2);
+
+    let d = tmpdir("fem");
+    let out = meid()
+        .args([
+            "modes",
+            "--json",
+            "--count",
+            "12",
+            "--export-matrices",
+            "-o",
+        ])
+        .arg(&d)
+        .arg(example("paper-soft-base.toml"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let modes = v["modes"].as_array().unwrap();
+    assert_eq!(modes.len(), 12);
+    for key in [
+        "index",
+        "frequency_hz",
+        "effective_mass_kg",
+        "participation",
+    ] {
+        assert!(modes[0].get(key).is_some(), "missing {key}");
+    }
+    for key in ["x", "y", "z", "rx", "ry", "rz"] {
+        assert!(
+            modes[0]["effective_mass_kg"].get(key).is_some(),
+            "missing {key}"
+        );
+    }
+    assert!(modes[4]["participation"]["O_b"].as_f64().unwrap() > 0.0);
+    // Paper: 6.35 Hz (3 %).
+    let f5 = modes[4]["frequency_hz"].as_f64().unwrap();
+    assert!((f5 - 6.35).abs() <= 0.03 * 6.35, "{f5}");
+    for f in [
+        "modes.csv",
+        "modes.json",
+        "modes.vtu",
+        "modes.pvd",
+        "K.mtx",
+        "M.mtx",
+    ] {
+        assert!(d.join(f).is_file(), "{f} not written");
+    }
+    let csv = std::fs::read_to_string(d.join("modes.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 13);
+    let vtu = std::fs::read_to_string(d.join("modes.vtu")).unwrap();
+    check_xml(&vtu).unwrap();
+    check_xml(&std::fs::read_to_string(d.join("modes.pvd")).unwrap()).unwrap();
+    // Points: the mesh nodes; NumberOfPoints must match the rows of the Points array.
+    let np: usize = vtu
+        .split("NumberOfPoints=\"")
+        .nth(1)
+        .unwrap()
+        .split('"')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let pts = vtu
+        .split("<Points>")
+        .nth(1)
+        .unwrap()
+        .split("</Points>")
+        .next()
+        .unwrap();
+    let rows = pts
+        .lines()
+        .filter(|l| !l.starts_with('<') && !l.is_empty())
+        .count();
+    assert_eq!(rows, np);
+    assert_eq!(vtu.matches("Name=\"mode_").count(), 12);
+}
+
+#[test]
+fn lumped_model_table() {
+    let out = meid()
+        .args(["modes", "--json"])
+        .arg(example("paper-lumped.toml"))
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let f = v["modes"][1]["frequency_hz"].as_f64().unwrap();
+    // examples/paper-lumped.toml is built for 283 Hz.
+    assert!((f - 283.0).abs() < 1e-3 * 283.0, "{f}");
+}
+
+#[test]
+fn bad_input_fails_with_a_message() {
+    let out = meid()
+        .args(["modes", "/nonexistent/model.toml"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("error"));
+
+    let out = meid()
+        .args([
+            "modes",
+            "--set",
+            "structure.fem.machine.bed.thickness=-0.01",
+        ])
+        .arg(example("paper-soft-base.toml"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("thickness"), "{err}");
+
+    let out = meid()
+        .args(["modes", "--set", "structure.fem.select=[99]"])
+        .arg(example("paper-soft-base.toml"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("mode 99 does not exist"), "{err}");
+}
