@@ -47,12 +47,7 @@ pub struct BlowsArgs {
 
 pub fn run(a: BlowsArgs) -> Result<()> {
     let model = load(&a.model, &a.set, a.method.as_deref(), None, a.rate)?;
-    let case = match a.case.as_str() {
-        "none" => Case::NoDamper,
-        "damper" => Case::Damper,
-        "added-mass" => Case::AddedMass,
-        _ => Case::AsSpecified,
-    };
+    let case: Case = a.case.parse()?;
     let sys = model.impact_system(case)?;
     let opts = model.options();
     let b = BlowOptions {

@@ -42,12 +42,7 @@ pub struct SimulateArgs {
 
 pub fn run(a: SimulateArgs) -> Result<()> {
     let model = load(&a.model, &a.set, a.method.as_deref(), a.duration, a.rate)?;
-    let case = match a.case.as_str() {
-        "none" => Case::NoDamper,
-        "damper" => Case::Damper,
-        "added-mass" => Case::AddedMass,
-        _ => Case::AsSpecified,
-    };
+    let case: Case = a.case.parse()?;
     let sys = model.impact_system(case)?;
     let opts = model.options();
     let record = a.output.is_some();

@@ -64,6 +64,23 @@ pub enum Case {
     AddedMass,
 }
 
+impl std::str::FromStr for Case {
+    type Err = Error;
+    /// `as-specified`, `none`, `damper` or `added-mass` (the CLI's `--case`).
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "as-specified" => Ok(Case::AsSpecified),
+            "none" => Ok(Case::NoDamper),
+            "damper" => Ok(Case::Damper),
+            "added-mass" => Ok(Case::AddedMass),
+            _ => Err(Error::invalid(
+                "case",
+                format!("unknown case '{s}'; valid: as-specified, none, damper, added-mass"),
+            )),
+        }
+    }
+}
+
 impl Model {
     /// Reads and validates a model file, applying `--set PATH=VALUE` overrides in order.
     pub fn from_file(path: &Path, overrides: &[String]) -> Result<Self> {
