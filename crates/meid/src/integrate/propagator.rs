@@ -103,6 +103,8 @@ pub struct ExpSum {
     pub amp: Vec<c64>,
     pub lam: Vec<c64>,
     period: f64,
+    /// Round-off of computed values (see [`Scalar::noise`]).
+    noise: f64,
 }
 
 impl Propagator {
@@ -326,13 +328,21 @@ impl<'p> Segment<'p> {
                 } else {
                     f64::INFINITY
                 };
-                Functional::Exp(ExpSum {
+                // Round-off: a few ulps of the terms, and at least the discrepancy between the
+                // closed form at s = 0 and ℓᵀX₀ computed directly (it grows with the condition
+                // of the eigenvectors).
+                let mut e = ExpSum {
                     p0,
                     p1,
                     amp,
                     lam: sp.lam.clone(),
                     period,
-                })
+                    noise: 0.0,
+                };
+                let direct = dot(l, &self.grid.borrow()[0]);
+                let terms = p0.abs() + total;
+                e.noise = 64.0 * f64::EPSILON * terms + 4.0 * (e.value_slope(0.0).0 - direct).abs();
+                Functional::Exp(e)
             }
             Kind::Expm { norm_f, d, b, .. } => {
                 let la = row_times(l, &self.p.a);
@@ -399,6 +409,9 @@ impl Scalar for ExpSum {
     fn fastest_period(&self) -> f64 {
         self.period
     }
+    fn noise(&self) -> f64 {
+        self.noise
+    }
 }
 
 impl Scalar for Functional<'_> {
@@ -435,6 +448,12 @@ impl Scalar for Functional<'_> {
                 };
                 la2_norm * dinv_x * (norm_a * (b - a)).exp()
             }
+        }
+    }
+    fn noise(&self) -> f64 {
+        match self {
+            Functional::Exp(e) => e.noise(),
+            Functional::Expm { .. } => 0.0,
         }
     }
     fn fastest_period(&self) -> f64 {

@@ -25,6 +25,32 @@ pub trait Scalar {
     fn curvature_bound(&self, a: f64, b: f64) -> f64;
     /// The shortest period (s) present in the function, or `f64::INFINITY`.
     fn fastest_period(&self) -> f64;
+    /// Size of the round-off in computed values of `g` (the same units as `g`): values within
+    /// it of zero are not taken as a sign change. Without it a function that starts at zero
+    /// and moves off it slowly (a dashpot's relative velocity at rest) "crosses" on its own
+    /// round-off at `s ≈ 1e-17` again and again.
+    fn noise(&self) -> f64 {
+        0.0
+    }
+}
+
+/// `g + sign0·noise`: the function whose sign changes are the ones that count.
+struct Lifted<'a, F: ?Sized> {
+    f: &'a F,
+    lift: f64,
+}
+
+impl<F: Scalar + ?Sized> Scalar for Lifted<'_, F> {
+    fn value_slope(&self, s: f64) -> (f64, f64) {
+        let (g, d) = self.f.value_slope(s);
+        (g + self.lift, d)
+    }
+    fn curvature_bound(&self, a: f64, b: f64) -> f64 {
+        self.f.curvature_bound(a, b)
+    }
+    fn fastest_period(&self) -> f64 {
+        self.f.fastest_period()
+    }
 }
 
 /// Settings of the crossing search.
@@ -54,6 +80,18 @@ pub fn first_crossing<F: Scalar + ?Sized>(
     if s_max.is_nan() || s_max <= 0.0 {
         return None;
     }
+    let noise = f.noise();
+    if noise > 0.0 {
+        let lifted = Lifted {
+            f,
+            lift: sign0 * noise,
+        };
+        return crossing(&lifted, s_max, sign0, opts);
+    }
+    crossing(f, s_max, sign0, opts)
+}
+
+fn crossing<F: Scalar + ?Sized>(f: &F, s_max: f64, sign0: f64, opts: SearchOptions) -> Option<f64> {
     let period = f.fastest_period();
     let h_grid = (period / 8.0).min(s_max).min(opts.max_step);
     let h_min = (h_grid / 1024.0).max(s_max * 1e-15);
@@ -112,7 +150,7 @@ pub fn all_crossings<F: Scalar + ?Sized>(
     let mut out = Vec::new();
     let mut start = 0.0;
     let (g0, d0) = f.value_slope(0.0);
-    let mut sign = if g0 != 0.0 {
+    let mut sign = if g0.abs() > f.noise() {
         g0.signum()
     } else if d0 != 0.0 {
         d0.signum()
@@ -154,6 +192,9 @@ impl<F: Scalar + ?Sized> Scalar for Shifted<'_, F> {
     }
     fn fastest_period(&self) -> f64 {
         self.f.fastest_period()
+    }
+    fn noise(&self) -> f64 {
+        self.f.noise()
     }
 }
 
