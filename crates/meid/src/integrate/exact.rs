@@ -18,7 +18,7 @@ use std::collections::HashMap;
 use faer::{c64, Mat};
 
 use super::propagator::{Functional, Propagator, Segment};
-use super::roots::{all_crossings, first_crossing, SearchOptions};
+use super::roots::{all_crossings, Search, SearchOptions};
 use super::switching::{lex_sign, select_mode};
 use super::{CollisionEnd, Event, Grid, Observer, Options, Solution, Totals};
 use crate::impact::{ImpactSystem, Indicator, Mode, Switch};
@@ -108,21 +108,55 @@ pub fn solve_from(
         let search = SearchOptions::default();
         segments += 1;
 
-        // 1-2: the first switch.
+        // 1-2: the first switch. All indicators are searched over common windows growing
+        // from one fastest period, so the search stops at the earliest crossing.
         let mut s_end = t_end - t;
         let mut switched = false;
+        let mut funcs = Vec::with_capacity(ind_vecs.len());
         for l in &ind_vecs {
             let sign0 = lex_sign(l, &prop.a, &x);
-            if sign0 == 0.0 {
-                continue; // identically zero: never crosses
+            if sign0 != 0.0 {
+                // (sign 0: identically zero, never crosses)
+                funcs.push((seg.functional(l), sign0));
             }
-            let f = seg.functional(l);
-            if let Some(s) = first_crossing(&f, s_end, sign0, search) {
-                if s < s_end {
-                    s_end = s;
-                    switched = true;
+        }
+        let mut searches: Vec<Search<'_, Functional<'_>>> = funcs
+            .iter()
+            .map(|(f, sign0)| Search::new(f, *sign0, search))
+            .collect();
+        let horizon = s_end;
+        let mut limit = if period.is_finite() {
+            period.min(horizon)
+        } else {
+            horizon
+        };
+        loop {
+            // Brackets of the crossings up to `limit`; the earliest root is refined, then any
+            // other bracket starting before it.
+            let mut brackets: Vec<(f64, f64, usize)> = Vec::new();
+            for (i, sr) in searches.iter_mut().enumerate() {
+                if let Some((a, b)) = sr.advance(limit) {
+                    brackets.push((a, b, i));
                 }
             }
+            if !brackets.is_empty() {
+                brackets.sort_by(|p, q| p.0.total_cmp(&q.0));
+                let mut first = f64::INFINITY;
+                for &(a, b, i) in &brackets {
+                    if a < first {
+                        first = first.min(searches[i].refine(a, b));
+                    }
+                }
+                if first < s_end {
+                    s_end = first;
+                    switched = true;
+                }
+                break;
+            }
+            if limit >= horizon {
+                break;
+            }
+            limit = (4.0 * limit).min(horizon);
         }
         if s_end < 0.0 {
             s_end = 0.0;

@@ -34,25 +34,6 @@ pub trait Scalar {
     }
 }
 
-/// `g + sign0·noise`: the function whose sign changes are the ones that count.
-struct Lifted<'a, F: ?Sized> {
-    f: &'a F,
-    lift: f64,
-}
-
-impl<F: Scalar + ?Sized> Scalar for Lifted<'_, F> {
-    fn value_slope(&self, s: f64) -> (f64, f64) {
-        let (g, d) = self.f.value_slope(s);
-        (g + self.lift, d)
-    }
-    fn curvature_bound(&self, a: f64, b: f64) -> f64 {
-        self.f.curvature_bound(a, b)
-    }
-    fn fastest_period(&self) -> f64 {
-        self.f.fastest_period()
-    }
-}
-
 /// Settings of the crossing search.
 #[derive(Debug, Clone, Copy)]
 pub struct SearchOptions {
@@ -80,65 +61,195 @@ pub fn first_crossing<F: Scalar + ?Sized>(
     if s_max.is_nan() || s_max <= 0.0 {
         return None;
     }
-    let noise = f.noise();
-    if noise > 0.0 {
-        let lifted = Lifted {
-            f,
-            lift: sign0 * noise,
-        };
-        return crossing(&lifted, s_max, sign0, opts);
-    }
-    crossing(f, s_max, sign0, opts)
+    let mut search = Search::new(f, sign0, opts);
+    search.advance(s_max).map(|(a, b)| search.refine(a, b))
 }
 
-fn crossing<F: Scalar + ?Sized>(f: &F, s_max: f64, sign0: f64, opts: SearchOptions) -> Option<f64> {
-    let period = f.fastest_period();
-    let h_grid = (period / 8.0).min(s_max).min(opts.max_step);
-    let h_min = (h_grid / 1024.0).max(s_max * 1e-15);
-    let (g0, d0) = f.value_slope(0.0);
-    let mut a = 0.0;
-    // A start value of the wrong sign within round-off counts as zero.
-    let mut ga = (sign0 * g0).max(0.0);
-    let mut da = sign0 * d0;
-    let mut h = h_grid;
-    while a < s_max {
-        let b = if s_max - a <= h * 1.000001 {
-            s_max
-        } else {
-            a + h
-        };
-        let (gb_raw, db_raw) = f.value_slope(b);
-        let (gb, db) = (sign0 * gb_raw, sign0 * db_raw);
-        if gb < 0.0 {
-            return Some(refine(f, a, b, sign0, period));
+/// A crossing search that can be resumed: [`Search::advance`] proves "no crossing" up to a
+/// limit and can later go on from there. Several indicators searched in growing common windows
+/// stop as soon as the earliest crossing is known, instead of each running to the end of the
+/// run.
+pub struct Search<'f, F: ?Sized> {
+    f: &'f F,
+    sign0: f64,
+    /// `sign0 · noise`, added to `g` so that round-off around zero is not a sign change.
+    lift: f64,
+    period: f64,
+    h_grid: f64,
+    max_step: f64,
+    /// Proved free of crossings up to `a`, where `G = sign0 (g + lift)` and `G'` are `ga`, `da`.
+    a: f64,
+    ga: f64,
+    da: f64,
+    h: f64,
+    found: Option<(f64, f64)>,
+    /// `G` at the ends of `found`.
+    found_values: (f64, f64),
+}
+
+impl<'f, F: Scalar + ?Sized> Search<'f, F> {
+    /// Starts a search for the first `s > 0` where `sign0·g` becomes negative.
+    pub fn new(f: &'f F, sign0: f64, opts: SearchOptions) -> Self {
+        let period = f.fastest_period();
+        let h_grid = (period / 8.0).min(opts.max_step);
+        let lift = sign0 * f.noise();
+        let (g0, d0) = f.value_slope(0.0);
+        // A start value of the wrong sign within round-off counts as zero.
+        let ga = (sign0 * (g0 + lift)).max(0.0);
+        // Starting at zero (within round-off), the caller's sign says where `g` is heading
+        // (from its derivatives); a slope of the wrong sign is then round-off too.
+        let mut da = sign0 * d0;
+        if ga <= 2.0 * lift.abs() {
+            da = da.max(0.0);
         }
-        let len = b - a;
-        let bound = f.curvature_bound(a, b);
-        if proved_positive(ga, da, gb, db, bound, len) {
-            a = b;
-            ga = gb;
-            da = db;
-            h = (2.0 * h).min(opts.max_step);
-            continue;
+        Self {
+            f,
+            sign0,
+            lift,
+            period,
+            h_grid,
+            max_step: opts.max_step,
+            a: 0.0,
+            ga,
+            da,
+            h: h_grid,
+            found: None,
+            found_values: (0.0, 0.0),
         }
-        if len <= h_grid * 1.000001 {
-            if let Some(s_dip) = hermite_dip(ga, da, gb, db, len) {
-                if len > h_min {
-                    // The cubic dips below zero: look closer, left part first.
-                    let _ = s_dip;
-                    h = len / 2.0;
+    }
+
+    /// `sign0 · (g + lift)` and its slope.
+    fn eval(&self, s: f64) -> (f64, f64) {
+        let (g, d) = self.f.value_slope(s);
+        (self.sign0 * (g + self.lift), self.sign0 * d)
+    }
+
+    /// Searches `(a, limit]` where `a` is how far earlier calls got; returns a bracket
+    /// `[a, b]` of the first crossing if there is one up to `limit` (and keeps returning it);
+    /// [`Search::refine`] locates the root in it.
+    pub fn advance(&mut self, limit: f64) -> Option<(f64, f64)> {
+        if self.found.is_some() {
+            return self.found;
+        }
+        let h_grid = self.h_grid.min(limit);
+        let h_min = (h_grid / 1024.0).max(limit * 1e-15);
+        if !self.h.is_finite() {
+            self.h = h_grid;
+        }
+        while self.a < limit {
+            let a = self.a;
+            let h = self.h;
+            let b = if limit - a <= h * 1.000001 {
+                limit
+            } else {
+                a + h
+            };
+            let (gb, db) = self.eval(b);
+            let len = b - a;
+            if gb < 0.0 {
+                if len > h_grid * 1.000001 {
+                    // A long interval may hold several crossings: narrow it to the grid step
+                    // before taking it as the bracket of the first.
+                    self.h = len / 2.0;
                     continue;
                 }
+                self.found = Some((a, b));
+                self.found_values = (self.ga, gb);
+                return self.found;
             }
-            a = b;
-            ga = gb;
-            da = db;
-            h = h_grid;
-            continue;
+            let bound = self.f.curvature_bound(a, b);
+            if proved_positive(self.ga, self.da, gb, db, bound, len) {
+                self.a = b;
+                self.ga = gb;
+                self.da = db;
+                self.h = (2.0 * h).min(self.max_step);
+                continue;
+            }
+            if len <= h_grid * 1.000001 {
+                if hermite_dip(self.ga, self.da, gb, db, len).is_some() && len > h_min {
+                    // The cubic dips below zero: look closer, left part first.
+                    self.h = len / 2.0;
+                    continue;
+                }
+                self.a = b;
+                self.ga = gb;
+                self.da = db;
+                self.h = h_grid;
+                continue;
+            }
+            self.h = len / 2.0;
         }
-        h = len / 2.0;
+        None
     }
-    None
+
+    /// Safeguarded Newton on a bracket `[a, b]` from [`Search::advance`], `G(a) ≥ 0 > G(b)`:
+    /// starts from the secant point, falls back to bisection when a Newton step leaves the
+    /// bracket or the bracket stops shrinking, and, once the steps are small, probes one
+    /// tolerance past the Newton point so that the bracket closes from both sides. Returns a
+    /// point `≥` the root within `1e-13` of the fastest period (or a few ulps of `b`).
+    pub fn refine(&self, mut a: f64, mut b: f64) -> f64 {
+        let tol_abs = if self.period.is_finite() {
+            1e-13 * self.period
+        } else {
+            0.0
+        };
+        let (ga, gb) = if self.found == Some((a, b)) {
+            self.found_values
+        } else {
+            (self.eval(a).0, self.eval(b).0)
+        };
+        let ga = ga.max(0.0);
+        let mut x = if ga - gb > 0.0 {
+            (a + (b - a) * ga / (ga - gb)).clamp(a, b)
+        } else {
+            0.5 * (a + b)
+        };
+        // rtsafe-style safeguard: Newton only while its steps at least halve. Once a Newton
+        // step is below the tolerance, the next point is put half a tolerance past the Newton
+        // root, on the other side of the current point, so that the bracket closes.
+        let mut dx_old = b - a;
+        for _ in 0..200 {
+            let tol = tol_abs.max(4.0 * f64::EPSILON * b.abs());
+            if b - a <= tol {
+                break;
+            }
+            let (g, d) = self.eval(x);
+            if g < 0.0 {
+                b = x;
+            } else {
+                a = x;
+            }
+            let width = b - a;
+            if width <= tol {
+                break;
+            }
+            let newton = if d != 0.0 { x - g / d } else { f64::NAN };
+            let dx = (newton - x).abs();
+            if newton >= a && newton <= b && 2.0 * dx <= dx_old {
+                dx_old = dx;
+                x = if dx < 0.5 * tol {
+                    if g < 0.0 {
+                        newton - 0.5 * tol
+                    } else {
+                        newton + 0.5 * tol
+                    }
+                } else {
+                    newton
+                };
+                if x <= a || x >= b {
+                    x = if g < 0.0 {
+                        a + 0.5 * (b - a).min(tol)
+                    } else {
+                        b - 0.5 * (b - a).min(tol)
+                    };
+                }
+            } else {
+                dx_old = 0.5 * width;
+                x = 0.5 * (a + b);
+            }
+        }
+        b
+    }
 }
 
 /// All sign changes of `g` in `(0, s_max]`, in order, each with the sign `g` had before it.
@@ -257,55 +368,6 @@ fn hermite_dip(ga: f64, da: f64, gb: f64, db: f64, len: f64) -> Option<f64> {
         }
     }
     None
-}
-
-/// Safeguarded Newton on a bracket with `sign0·g(a) ≥ 0 > sign0·g(b)` (bisection when a
-/// Newton step leaves the bracket or stalls); returns a point `≥` the root, within tolerance.
-fn refine<F: Scalar + ?Sized>(f: &F, mut a: f64, mut b: f64, sign0: f64, period: f64) -> f64 {
-    let tol_abs = if period.is_finite() {
-        1e-13 * period
-    } else {
-        0.0
-    };
-    let (mut x, mut shrink_ok) = (0.5 * (a + b), true);
-    for _ in 0..200 {
-        let tol = tol_abs.max(4.0 * f64::EPSILON * b.abs());
-        if b - a <= tol {
-            break;
-        }
-        let (g, d) = f.value_slope(x);
-        if sign0 * g < 0.0 {
-            b = x;
-        } else {
-            a = x;
-        }
-        let width = b - a;
-        let newton = if d != 0.0 { x - g / d } else { f64::NAN };
-        // Newton inside the bracket, and the bracket keeps shrinking fast enough.
-        x = if newton > a && newton < b && shrink_ok {
-            newton
-        } else {
-            0.5 * (a + b)
-        };
-        // After a Newton step, also test a point just past it to close the bracket quickly.
-        if x == newton && (x - a).min(b - x) < 0.25 * width {
-            let step = tol.max(1e-3 * width);
-            let probe = if sign0 * f.value_slope(x).0 < 0.0 {
-                (x - step).max(a)
-            } else {
-                (x + step).min(b)
-            };
-            let gp = f.value_slope(probe).0;
-            if sign0 * gp < 0.0 {
-                b = b.min(probe);
-            } else {
-                a = a.max(probe);
-            }
-            x = x.clamp(a, b);
-        }
-        shrink_ok = (b - a) < 0.5 * width || x != newton;
-    }
-    b
 }
 
 #[cfg(test)]
