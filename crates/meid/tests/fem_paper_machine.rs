@@ -118,7 +118,15 @@ fn rigid_body_mode_signs_follow_the_impact_direction() {
 /// The machine of an example with another mesh density.
 fn machine(name: &str, elements_per_side: usize) -> MachineSpec {
     let m = load(name);
-    let file = m.spec.structure.fem.as_ref().unwrap().machine.as_ref().unwrap();
+    let file = m
+        .spec
+        .structure
+        .fem
+        .as_ref()
+        .unwrap()
+        .machine
+        .as_ref()
+        .unwrap();
     let mut spec = fem::machine_spec(file).unwrap();
     spec.elements_per_side = elements_per_side;
     spec
@@ -213,7 +221,10 @@ fn soft_lateral_springs_are_not_rigid_body_modes() {
         "s = {:.3e}, lowest {:?} Hz, reference {f_ref} Hz (M = {total} kg)",
         r.stiffness_scale, r.frequency_hz
     );
-    assert!(r.stiffness_scale * 1e-10 > 7.5, "the case does not probe the threshold");
+    assert!(
+        r.stiffness_scale * 1e-10 > 7.5,
+        "the case does not probe the threshold"
+    );
     assert_eq!(r.rigid_body_modes, 0);
     for f in &r.frequency_hz[..2] {
         assert!((f - f_ref).abs() <= 5e-3 * f_ref, "{f} Hz vs {f_ref} Hz");
