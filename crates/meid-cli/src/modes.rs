@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 
 use meid::io;
-use meid::model::{fem, Model};
+use meid::model::fem;
 
 #[derive(clap::Args)]
 pub struct ModesArgs {
@@ -37,17 +37,11 @@ pub fn run(a: ModesArgs) -> Result<()> {
     if a.export_matrices && a.output.is_none() {
         anyhow::bail!("--export-matrices needs an output directory (-o DIR)");
     }
-    let model = Model::from_file(&a.model, &a.set)?;
-    let (report, analysis) = match &model.spec.structure.fem {
-        Some(spec) => {
-            let mut spec = spec.clone();
-            if let Some(c) = a.count {
-                spec.count = Some(c);
-            }
-            let an = fem::analyse(&spec, &model.source)?;
-            (an.report()?, Some(an))
-        }
-        None => (fem::report_from_modal(&model.structure), None),
+    // One build and one solve: the analysis the model's modes came from.
+    let (model, analysis) = fem::from_file_with_analysis(&a.model, &a.set, a.count)?;
+    let report = match &analysis {
+        Some(an) => an.report()?,
+        None => fem::report_from_modal(&model.structure),
     };
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

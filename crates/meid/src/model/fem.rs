@@ -40,7 +40,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::spec::Ratios;
-use super::Source;
+use super::{Model, Source};
 use crate::modal::dense::{DenseModes, DEFAULT_RELATIVE_SHIFT};
 use crate::modal::lanczos::{self, LanczosOptions};
 use crate::modal::ModalModel;
@@ -242,6 +242,9 @@ pub struct MachineFileSpec {
     pub added_masses: Vec<AddedMassFileSpec>,
     #[serde(default)]
     pub spiders: Option<bool>,
+    /// Half-size of the square column footprint tied rigidly to each plate (m, default 0.02).
+    #[serde(default)]
+    pub spider_half_size: Option<f64>,
 }
 
 /// `[structure.fem.mesh]`: a Gmsh quad mesh (shells of one thickness and material).
@@ -367,6 +370,9 @@ pub fn machine_spec(m: &MachineFileSpec) -> Result<MachineSpec> {
     }
     if let Some(v) = m.spiders {
         spec.spiders = v;
+    }
+    if let Some(v) = m.spider_half_size {
+        spec.spider_half_size_m = v;
     }
     match m.support.unwrap_or(SupportSpec::FloatingBase) {
         SupportSpec::FixedColumns => {
@@ -815,6 +821,42 @@ fn auto_select(
 /// Builds, solves and reduces the finite-element structure.
 pub fn modal_model(spec: &FemSpec, src: &Source) -> Result<ModalModel> {
     Ok(analyse(spec, src)?.modal)
+}
+
+/// Reads a model file like [`Model::from_file`] and, when its structure is `[structure.fem]`,
+/// also returns the [`FemAnalysis`] the model's modes came from: the FE model is built and solved
+/// **once** (what `meid modes` shows is what the impact engine gets). `count` overrides
+/// `structure.fem.count` (the number of modes computed) before the solve; the returned model's
+/// spec says so too. For lumped or tabulated structures the analysis is `None`.
+pub fn from_file_with_analysis(
+    path: &Path,
+    overrides: &[String],
+    count: Option<usize>,
+) -> Result<(Model, Option<FemAnalysis>)> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let mut analysis = None;
+    let mut model = Model::from_text_with(
+        &path.display().to_string(),
+        text,
+        overrides,
+        |spec, src| match &spec.structure.fem {
+            Some(f) if spec.structure.lumped.is_none() && spec.structure.modal.is_none() => {
+                let mut f = f.clone();
+                if count.is_some() {
+                    f.count = count;
+                }
+                let an = analyse(&f, src)?;
+                let modal = an.modal.clone();
+                analysis = Some(an);
+                Ok(modal)
+            }
+            _ => super::build_structure(spec, src),
+        },
+    )?;
+    if let (Some(f), Some(c)) = (model.spec.structure.fem.as_mut(), count) {
+        f.count = Some(c);
+    }
+    Ok((model, analysis))
 }
 
 /// Effective modal masses of one mode (kg for translations, kg·m² for rotations about global

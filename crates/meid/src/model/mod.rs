@@ -90,6 +90,16 @@ impl Model {
 
     /// Parses and validates model text; `name` is used in error messages.
     pub fn from_text(name: &str, text: String, overrides: &[String]) -> Result<Self> {
+        Self::from_text_with(name, text, overrides, build_structure)
+    }
+
+    /// [`Model::from_text`] with the structure built by `build` (see `fem::from_file_with_analysis`).
+    pub(crate) fn from_text_with(
+        name: &str,
+        text: String,
+        overrides: &[String],
+        build: impl FnOnce(&ModelSpec, &Source) -> Result<ModalModel>,
+    ) -> Result<Self> {
         // 1. The file as written: syntax, unknown keys and types, with positions.
         let mut table: toml::Table =
             toml::from_str(&text).map_err(|e| source::toml_error(name, &text, &e))?;
@@ -125,7 +135,7 @@ impl Model {
             })?
         };
         // 3. Values.
-        let structure = build_structure(&spec, &src)?;
+        let structure = build(&spec, &src)?;
         let model = Model {
             spec,
             structure,

@@ -10,19 +10,28 @@
 //! * **fixed column feet** (clamped at `z = 0`); the force to the floor is the column base reaction
 //!   `-(K u)` at the clamped DOFs (the paper's `F_t = k_c x_c`).
 //!
-//! Each column end is tied to its plate by a rigid spider: the plate node at the column axis is the
-//! master and the other nodes of the plate elements around it are slaves (see [`super::shell`] for
-//! why). Where two spiders would overlap on a coarse mesh, a node joins the first one only. Named points: `O_b` (bed centre, the slider contact point), `O_f` (base centre, where the
+//! Each column end is tied to its plate by a rigid spider (RBE2) over the column's **footprint**, a
+//! square of half-size `spider_half_size_m` centred on the column axis (clipped at the plate
+//! edges): the plate node at the axis is the master and every other plate node in the square is a
+//! slave (see [`super::shell`] for why a spider and not the drilling DOF). The grid lines pass
+//! through the footprint's edges, so the rigid patch is the same physical square on every mesh and
+//! refining the mesh converges to one answer (a plate with rigid square inclusions). A spider over
+//! "the ring of elements around the node" instead shrinks with the mesh and the bed mode then keeps
+//! falling (311 → 272 Hz from 4 to 20 elements per side; docs/paper-machine.md). Where two
+//! footprints overlap, a node joins the first spider only, and a master is never a slave.
+//!
+//! Named points: `O_b` (bed centre, the slider contact point), `O_f` (base centre, where the
 //! damper spring acts; floating base only) and `B` (accelerometer on the bed, offset from the
-//! centre). Plate meshes are structured; the grid lines pass through every column, spring, named
-//! point and added mass, and the element size is `max(Lx, Ly) / elements_per_side`.
+//! centre). Plate meshes are structured; the grid lines pass through every column, footprint edge,
+//! spring, named point and added mass, and the element size is `max(Lx, Ly) / elements_per_side`.
 //!
 //! Defaults: steel (E = 2.06e11 Pa, ν = 0.3, ρ = 7850 kg/m³); bed 0.32 × 0.20 × 0.020 m
 //! (10.05 kg, the paper's m_b = 10 kg); base 0.50 × 0.35 × 0.030 m (41.2 kg, m_f = 41 kg);
 //! columns solid Ø25 mm × 0.30 m, 20 mm in from the bed edges; springs 1.5e4 N/m in x, y and z
 //! (the paper gives only the vertical k_f; the lateral value is an assumption) 20 mm in from the
-//! base corners; B at (0.08, 0.05) m from the bed centre. The geometry is not tuned to the paper's
-//! frequencies.
+//! base corners; B at (0.08, 0.05) m from the bed centre; column footprints 40 × 40 mm
+//! (`spider_half_size_m = 0.02`). The geometry is not tuned to the paper's frequencies (the
+//! examples `examples/paper-*.toml` are).
 
 use super::assembly::FeModel;
 use super::discrete::{Dashpot, PointMass, RigidLink, Spring};
@@ -116,8 +125,11 @@ pub struct MachineSpec {
     /// Position of the accelerometer point B relative to the bed centre (m).
     pub b_offset_m: [f64; 2],
     pub added_masses: Vec<AddedMass>,
-    /// Tie column ends to their plates by rigid spiders over the surrounding element ring.
+    /// Tie column ends to their plates by rigid spiders over the column footprint.
     pub spiders: bool,
+    /// Half-size of the square column footprint tied rigidly to the plate (m), measured from the
+    /// column axis; the same on the bed and the base. Default 0.02 m (a 40 × 40 mm foot).
+    pub spider_half_size_m: f64,
 }
 
 impl Default for MachineSpec {
@@ -155,6 +167,7 @@ impl Default for MachineSpec {
             b_offset_m: [0.08, 0.05],
             added_masses: Vec::new(),
             spiders: true,
+            spider_half_size_m: 0.02,
         }
     }
 }
@@ -212,14 +225,63 @@ fn inside(what: &str, p: [f64; 2], plate: &PlateSpec) -> Result<()> {
     }
 }
 
-/// The nodes of the plate elements around grid node (i, j), without (i, j) itself.
-fn ring(grid: &[Vec<usize>], i: usize, j: usize) -> Vec<usize> {
-    let (nx, ny) = (grid.len(), grid[0].len());
+/// A footprint edge closer than `FOOTPRINT_SNAP · a` to a plate edge or to another grid line the
+/// mesh must keep (column, spring, named point, added mass) moves onto it, so that no sliver
+/// element appears (a 50 µm sliver made `max K_ii/M_ii` ~1e16 and the eigen-solver's rigid-body
+/// threshold then swallowed the 6 Hz and 141 Hz modes). The move is a fixed physical distance,
+/// independent of the mesh, so the patch is the same on every mesh.
+const FOOTPRINT_SNAP: f64 = 0.25;
+
+/// Extent `[lo, hi]` along one axis of the footprint of a column at `c` of half-size `a`: `c ± a`
+/// clipped to the plate `[-len/2, len/2]`, edges snapped onto `hard` coordinates (see
+/// [`FOOTPRINT_SNAP`]).
+fn footprint_extent(c: f64, a: f64, len: f64, hard: &[f64]) -> [f64; 2] {
+    let snap = |v: f64| -> f64 {
+        let v = v.clamp(-0.5 * len, 0.5 * len);
+        hard.iter()
+            .chain([-0.5 * len, 0.5 * len].iter())
+            .copied()
+            .filter(|h| (h - v).abs() <= FOOTPRINT_SNAP * a && (h - c).abs() > 0.5 * a)
+            .min_by(|x, y| (x - v).abs().total_cmp(&(y - v).abs()))
+            .unwrap_or(v)
+    };
+    [snap(c - a), snap(c + a)]
+}
+
+/// Footprint extents of the columns along one axis (see [`footprint_extent`]); their edges are
+/// appended to `req` (the grid lines the plate mesh must pass through).
+fn footprint_lines(req: &mut Vec<f64>, centres: &[f64], a: f64, len: f64) -> Vec<[f64; 2]> {
+    let hard = req.clone();
+    let ext: Vec<[f64; 2]> = centres
+        .iter()
+        .map(|&c| footprint_extent(c, a, len, &hard))
+        .collect();
+    for e in &ext {
+        req.extend_from_slice(e);
+    }
+    ext
+}
+
+/// The nodes of `grid` (coordinates `xs`, `ys`) inside the rectangle `ex × ey`, without the node
+/// at `centre` itself.
+fn footprint(
+    grid: &[Vec<usize>],
+    xs: &[f64],
+    ys: &[f64],
+    centre: [f64; 2],
+    ex: [f64; 2],
+    ey: [f64; 2],
+) -> Vec<usize> {
+    let (ic, jc) = (index_of(xs, centre[0]), index_of(ys, centre[1]));
+    let tol = 1e-9 * (xs[xs.len() - 1] - xs[0] + ys[ys.len() - 1] - ys[0]);
     let mut out = Vec::new();
-    for a in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
-        for b in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
-            if (a, b) != (i, j) {
-                out.push(grid[a][b]);
+    for (i, x) in xs.iter().enumerate() {
+        if *x < ex[0] - tol || *x > ex[1] + tol {
+            continue;
+        }
+        for (j, y) in ys.iter().enumerate() {
+            if *y >= ey[0] - tol && *y <= ey[1] + tol && (i, j) != (ic, jc) {
+                out.push(grid[i][j]);
             }
         }
     }
@@ -268,6 +330,19 @@ impl MachineSpec {
                 ),
             ));
         }
+        if self.spiders
+            && !(self.spider_half_size_m.is_finite()
+                && self.spider_half_size_m > 0.0
+                && self.spider_half_size_m < half_min)
+        {
+            return Err(Error::invalid(
+                "spider half-size",
+                format!(
+                    "the column footprint half-size must lie in (0, {half_min}) m (got {})",
+                    self.spider_half_size_m
+                ),
+            ));
+        }
         inside("point B", self.b_offset_m, &self.bed)?;
         let cols = self.column_positions();
         let mut mesh = Mesh::new();
@@ -285,6 +360,17 @@ impl MachineSpec {
             bx.push(m.offset_m[0]);
             by.push(m.offset_m[1]);
         }
+        let a = self.spider_half_size_m;
+        let col_x: Vec<f64> = cols.iter().map(|c| c[0]).collect();
+        let col_y: Vec<f64> = cols.iter().map(|c| c[1]).collect();
+        let (bed_fx, bed_fy) = if self.spiders {
+            (
+                footprint_lines(&mut bx, &col_x, a, self.bed.length_x_m),
+                footprint_lines(&mut by, &col_y, a, self.bed.length_y_m),
+            )
+        } else {
+            (Vec::new(), Vec::new())
+        };
         let h_bed = self.bed.length_x_m.max(self.bed.length_y_m) / self.elements_per_side as f64;
         let bxs = grid_1d(self.bed.length_x_m, &bx, h_bed);
         let bys = grid_1d(self.bed.length_y_m, &by, h_bed);
@@ -298,7 +384,8 @@ impl MachineSpec {
 
         // Base.
         let mut base_grid = None;
-        let mut base_lookup: Option<(Vec<f64>, Vec<f64>)> = None;
+        #[allow(clippy::type_complexity)]
+        let mut base_lookup: Option<(Vec<f64>, Vec<f64>, Vec<[f64; 2]>, Vec<[f64; 2]>)> = None;
         if let Support::FloatingBase {
             base,
             spring_stiffness_n_per_m,
@@ -343,6 +430,14 @@ impl MachineSpec {
                 xs.push(m.offset_m[0]);
                 ys.push(m.offset_m[1]);
             }
+            let (fx, fy) = if self.spiders {
+                (
+                    footprint_lines(&mut xs, &col_x, a, base.length_x_m),
+                    footprint_lines(&mut ys, &col_y, a, base.length_y_m),
+                )
+            } else {
+                (Vec::new(), Vec::new())
+            };
             let h = base.length_x_m.max(base.length_y_m) / self.elements_per_side as f64;
             let gx = grid_1d(base.length_x_m, &xs, h);
             let gy = grid_1d(base.length_y_m, &ys, h);
@@ -368,7 +463,7 @@ impl MachineSpec {
                 }
             }
             base_grid = Some(grid);
-            base_lookup = Some((gx, gy));
+            base_lookup = Some((gx, gy, fx, fy));
         }
 
         // Columns and spiders. A plate node joins at most one spider (the first that reaches it)
@@ -377,7 +472,7 @@ impl MachineSpec {
         for c in &cols {
             let (bi, bj) = bed_node(*c);
             masters.insert(bed_grid[bi][bj]);
-            if let (Some(g), Some((gx, gy))) = (&base_grid, &base_lookup) {
+            if let (Some(g), Some((gx, gy, _, _))) = (&base_grid, &base_lookup) {
                 masters.insert(g[index_of(gx, c[0])][index_of(gy, c[1])]);
             }
         }
@@ -392,20 +487,20 @@ impl MachineSpec {
             }
         };
         let mut columns = Vec::new();
-        for c in &cols {
+        for (k, c) in cols.iter().enumerate() {
             let (bi, bj) = bed_node(*c);
             let top = bed_grid[bi][bj];
             let mut nodes = vec![top];
             let ne = self.column_elements;
-            for k in 1..ne {
-                let z = zb * (1.0 - k as f64 / ne as f64);
+            for e in 1..ne {
+                let z = zb * (1.0 - e as f64 / ne as f64);
                 nodes.push(mesh.add_node([c[0], c[1], z]));
             }
             let foot = match (&base_grid, &base_lookup) {
-                (Some(g), Some((gx, gy))) => {
+                (Some(g), Some((gx, gy, fx, fy))) => {
                     let (fi, fj) = (index_of(gx, c[0]), index_of(gy, c[1]));
                     if self.spiders {
-                        spider(&mut mesh, g[fi][fj], ring(g, fi, fj));
+                        spider(&mut mesh, g[fi][fj], footprint(g, gx, gy, *c, fx[k], fy[k]));
                     }
                     g[fi][fj]
                 }
@@ -424,7 +519,11 @@ impl MachineSpec {
                 ));
             }
             if self.spiders {
-                spider(&mut mesh, top, ring(&bed_grid, bi, bj));
+                spider(
+                    &mut mesh,
+                    top,
+                    footprint(&bed_grid, &bxs, &bys, *c, bed_fx[k], bed_fy[k]),
+                );
             }
             columns.push(nodes);
         }
@@ -436,7 +535,7 @@ impl MachineSpec {
                     bed_grid[i][j]
                 }
                 Plate::Base => match (&base_grid, &base_lookup) {
-                    (Some(g), Some((gx, gy))) => {
+                    (Some(g), Some((gx, gy, _, _))) => {
                         g[index_of(gx, m.offset_m[0])][index_of(gy, m.offset_m[1])]
                     }
                     _ => return Err(Error::invalid(
