@@ -208,3 +208,45 @@ fn three_body_chain_complete_exchange() {
         assert!(last.from.on(Switch::SliderBed) && last.from.on(Switch::BedDamper));
     }
 }
+
+/// Hertz contact `f = K δ^{3/2}` between two free bodies (dopri5): energy
+/// `½ μ v₀² = (2/5) K δ_max^{5/2}` gives `δ_max = (5 μ v₀² / (4K))^{2/5}`, the peak force
+/// `K δ_max^{3/2}`, the contact time `2.9432 δ_max / v₀` (`2 ∫₀¹ dx / √(1 − x^{5/2})`; Johnson,
+/// Contact Mechanics §11.4) and an elastic exchange (v₂ = 2 m₁ v₀ /(m₁ + m₂)).
+#[test]
+fn two_bodies_hertz_dopri5() {
+    let (m1, m2, k, v0) = (1.0, 3.0, 1.0e9, 1.0);
+    let s = free_body(m2);
+    let sys = ImpactSystem::new(
+        &s,
+        "b",
+        None,
+        "b",
+        Slider {
+            mass: m1,
+            velocity: v0,
+        },
+        Contact {
+            law: ContactLaw::Hertz { stiffness: k },
+            release: Release::Force,
+        },
+        Absorber::None,
+    )
+    .unwrap();
+    let sol = integrate::solve(&sys, &opts(Method::Dopri5), &mut NoOutput).unwrap();
+    let end = sol.collision_end.expect("collision must end");
+    let mu = m1 * m2 / (m1 + m2);
+    let d_max = (5.0 * mu * v0 * v0 / (4.0 * k)).powf(0.4);
+    // ∫₀¹ (1 − x^{5/2})^{-1/2} dx = Γ(7/5) Γ(1/2) / Γ(9/10) = 1.4716375921623.
+    let t_c = 2.0 * 1.471_637_592_162_3 * d_max / v0;
+    let f_max = k * d_max.powf(1.5);
+    let nd = sys.dofs();
+    let v2 = end.x[nd] / m2.sqrt();
+    assert!(
+        rel(end.totals.peak_force[0], f_max) < 1e-6,
+        "peak {} vs {f_max}",
+        end.totals.peak_force[0]
+    );
+    assert!(rel(end.t, t_c) < 1e-6, "contact time {} vs {t_c}", end.t);
+    assert!(rel(v2, 2.0 * m1 * v0 / (m1 + m2)) < 1e-6, "v2 {v2}");
+}

@@ -232,8 +232,11 @@ impl Scalar for OnStep<'_> {
     fn curvature_bound(&self, _a: f64, _b: f64) -> f64 {
         f64::INFINITY
     }
+    /// Eight steps: the search's grid step is then the whole step (values and slopes at both
+    /// ends, a cubic Hermite test for a dip in between, halving only where it dips). The step
+    /// is far shorter than the motion's periods, as the error control makes it.
     fn fastest_period(&self) -> f64 {
-        self.dense.h
+        8.0 * self.dense.h
     }
 }
 
@@ -487,7 +490,7 @@ pub fn solve_from(
         {
             if mode.on(s) && (ci == 0 || sys.damper.is_some()) {
                 totals.closed_time[ci] += s_end;
-                let peak = peak_on_step(sys, s, &dense, s_end, &mut ybuf);
+                let peak = peak_on_step(sys, s, &dense, s_end);
                 totals.peak_force[ci] = totals.peak_force[ci].max(peak);
             }
         }
@@ -694,46 +697,56 @@ fn mode_after_numeric(
     implied_mode(sys, &sign_of)
 }
 
-/// Largest contact force on `[0, len]` of a step: 17 samples, then golden-section refinement
-/// around the best one on the dense output.
-fn peak_on_step(sys: &ImpactSystem, s: Switch, dense: &Dense, len: f64, buf: &mut [f64]) -> f64 {
+/// Largest contact force on `[0, len]` of a step. A step is far shorter than any period of
+/// the motion (the error control sees to that), so the force has at most one interior maximum
+/// there, and only if its slope goes from positive at the start to negative at the end: then
+/// the slope's root is found by safeguarded secant steps on the dense output. Otherwise the
+/// maximum is at an end. The slope is `∂f/∂δ·δ̇ + ∂f/∂δ̇·δ̈` with the law's partial derivatives by
+/// central differences and `δ̇`, `δ̈` from the dense output.
+fn peak_on_step(sys: &ImpactSystem, s: Switch, dense: &Dense, len: f64) -> f64 {
     let nd = sys.dofs();
     let a = sys.relative_vector(s);
     let law = sys.contact(s).law;
-    let mut force = |t: f64| {
-        dense.eval(t, buf);
-        law.force(dot(a, &buf[..nd]), dot(a, &buf[nd..2 * nd]))
+    let mut lx = vec![0.0; 2 * nd + 1];
+    let mut lv = vec![0.0; 2 * nd + 1];
+    lx[..nd].copy_from_slice(&a[..nd]);
+    lv[nd..2 * nd].copy_from_slice(&a[..nd]);
+    let force_slope = |t: f64| -> (f64, f64) {
+        let (d, dd) = dense.functional(&lx, t);
+        let (r, dr) = dense.functional(&lv, t);
+        let f = law.force(d, r);
+        let ed = 1e-7 * d.abs().max(1e-12);
+        let er = 1e-7 * r.abs().max(1e-9);
+        let fd = (law.force(d + ed, r) - law.force(d - ed, r)) / (2.0 * ed);
+        let fr = (law.force(d, r + er) - law.force(d, r - er)) / (2.0 * er);
+        (f, fd * dd + fr * dr)
     };
-    let n = 16;
-    let mut best = (f64::NEG_INFINITY, 0usize);
-    for i in 0..=n {
-        let f = force(len * i as f64 / n as f64);
-        if f > best.0 {
-            best = (f, i);
+    let (f0, s0) = force_slope(0.0);
+    let (f1, s1) = force_slope(len);
+    let mut best = f0.max(f1);
+    if s0 > 0.0 && s1 < 0.0 {
+        let (mut lo, mut hi, mut slo, mut shi) = (0.0, len, s0, s1);
+        for _ in 0..60 {
+            if hi - lo <= 1e-12 * len {
+                break;
+            }
+            // Secant point, kept away from the ends (Illinois-like safeguard by bisection).
+            let mut m = lo + (hi - lo) * slo / (slo - shi);
+            if !(m > lo + 0.01 * (hi - lo) && m < hi - 0.01 * (hi - lo)) {
+                m = 0.5 * (lo + hi);
+            }
+            let (fm, sm) = force_slope(m);
+            best = best.max(fm);
+            if sm > 0.0 {
+                lo = m;
+                slo = sm;
+            } else if sm < 0.0 {
+                hi = m;
+                shi = sm;
+            } else {
+                break;
+            }
         }
     }
-    let (mut lo, mut hi) = (
-        len * (best.1.saturating_sub(1)) as f64 / n as f64,
-        len * ((best.1 + 1).min(n)) as f64 / n as f64,
-    );
-    let gr = 0.5 * (5.0_f64.sqrt() - 1.0);
-    let mut c = hi - gr * (hi - lo);
-    let mut d = lo + gr * (hi - lo);
-    let (mut fc, mut fd) = (force(c), force(d));
-    while hi - lo > 1e-12 * len {
-        if fc > fd {
-            hi = d;
-            d = c;
-            fd = fc;
-            c = hi - gr * (hi - lo);
-            fc = force(c);
-        } else {
-            lo = c;
-            c = d;
-            fc = fd;
-            d = lo + gr * (hi - lo);
-            fd = force(d);
-        }
-    }
-    best.0.max(fc).max(fd)
+    best
 }

@@ -105,6 +105,8 @@ pub struct ExpSum {
     period: f64,
     /// Round-off of computed values (see [`Scalar::noise`]).
     noise: f64,
+    /// `|amp_k| |λ_k|²`, for the curvature bound.
+    curv: Vec<f64>,
 }
 
 impl Propagator {
@@ -338,7 +340,14 @@ impl<'p> Segment<'p> {
                     lam: sp.lam.clone(),
                     period,
                     noise: 0.0,
+                    curv: Vec::new(),
                 };
+                e.curv = e
+                    .amp
+                    .iter()
+                    .zip(&e.lam)
+                    .map(|(a, l)| a.norm() * l.norm_sqr())
+                    .collect();
                 let direct = dot(l, &self.grid.borrow()[0]);
                 let terms = p0.abs() + total;
                 e.noise = 64.0 * f64::EPSILON * terms + 4.0 * (e.value_slope(0.0).0 - direct).abs();
@@ -399,11 +408,18 @@ impl Scalar for ExpSum {
         }
         (g, d)
     }
+    /// `Σ |amp_k| |λ_k|² max(e^{Re λ_k a}, e^{Re λ_k b})`.
     fn curvature_bound(&self, a: f64, b: f64) -> f64 {
-        self.amp
+        self.curv
             .iter()
             .zip(&self.lam)
-            .map(|(amp, l)| amp.norm() * l.norm_sqr() * (l.re * a).exp().max((l.re * b).exp()))
+            .map(|(c, l)| {
+                if l.re == 0.0 {
+                    *c
+                } else {
+                    c * (l.re * if l.re < 0.0 { a } else { b }).exp()
+                }
+            })
             .sum()
     }
     fn fastest_period(&self) -> f64 {
