@@ -146,6 +146,13 @@ fn main() {
         simulate(&s20, &o20, true).unwrap();
         return;
     }
+    if args.iter().any(|a| a == "--callgrind-dopri5") {
+        let od = one(Method::Dopri5);
+        for _ in 0..20 {
+            integrate::solve(&sys, &od, &mut NoOutput).unwrap();
+        }
+        return;
+    }
     if args.iter().any(|a| a == "--callgrind") {
         for _ in 0..20 {
             integrate::solve(&sys, &oe, &mut NoOutput).unwrap();

@@ -285,15 +285,34 @@ pub fn solve_from(
         })
         .collect();
 
+    let ind_vecs: Vec<Vec<f64>> = inds.iter().map(|&i| sys.indicator_vector(i)).collect();
+    let mut a_cache: std::collections::HashMap<Mode, std::rc::Rc<faer::Mat<f64>>> =
+        std::collections::HashMap::new();
+    let mut a_of = |m: Mode| -> std::rc::Rc<faer::Mat<f64>> {
+        a_cache
+            .entry(m)
+            .or_insert_with(|| std::rc::Rc::new(sys.first_order(m)))
+            .clone()
+    };
+    // `δ` and `δ̇` of each contact as functionals of the dense output.
+    let peak_vecs: Vec<(Vec<f64>, Vec<f64>)> = [Switch::SliderBed, Switch::BedDamper]
+        .into_iter()
+        .map(|s| {
+            let (mut lx, mut lv) = (vec![0.0; ny], vec![0.0; ny]);
+            if s == Switch::SliderBed || sys.damper.is_some() {
+                let a = sys.relative_vector(s);
+                lx[..nd].copy_from_slice(&a[..nd]);
+                lv[nd..2 * nd].copy_from_slice(&a[..nd]);
+            }
+            (lx, lv)
+        })
+        .collect();
     let mut y = vec![0.0; ny];
     y[..nx].copy_from_slice(x0);
     let mut t = 0.0;
     let t_end = opts.duration;
     let mut mode = if all_linear {
-        select_mode(sys, &y[..nx], Mode(0), &mut |m| {
-            std::rc::Rc::new(sys.first_order(m))
-        })
-        .0
+        select_mode(sys, &y[..nx], Mode(0), &ind_vecs, &mut a_of).0
     } else {
         initial_mode_numeric(sys, &y[..nx])
     };
@@ -336,6 +355,7 @@ pub fn solve_from(
         if need_k1 {
             rhs.eval(mode, &y, &mut k[0]);
             // Indicator sides at the (re)start.
+            let a_mode = if all_linear { Some(a_of(mode)) } else { None };
             for (i, &ind) in inds.iter().enumerate() {
                 signs[i] = start_sign(
                     sys,
@@ -343,7 +363,7 @@ pub fn solve_from(
                     mode,
                     &y[..nx],
                     linear_vecs[i].as_deref(),
-                    all_linear,
+                    a_mode.as_deref(),
                 );
             }
             if h == 0.0 {
@@ -372,50 +392,49 @@ pub fn solve_from(
                 format!("step size underflow at t = {t:.9e} s"),
             ));
         }
-        // Stages.
-        for i in 0..ny {
-            ytmp[i] = y[i] + h * A21 * k[0][i];
-        }
+        // Stages: `out = y + h Σ c_j k_j`, one contiguous pass per term.
         let (k0, rest) = k.split_at_mut(1);
         let k0 = &k0[0];
         {
+            combo(&mut ytmp, &y, h, &[(A21, k0)]);
             let (k1, rest) = rest.split_at_mut(1);
             let k1 = &mut k1[0];
             rhs.eval(mode, &ytmp, k1);
-            for i in 0..ny {
-                ytmp[i] = y[i] + h * (A31 * k0[i] + A32 * k1[i]);
-            }
+            combo(&mut ytmp, &y, h, &[(A31, k0), (A32, k1)]);
             let (k2, rest) = rest.split_at_mut(1);
             let k2 = &mut k2[0];
             rhs.eval(mode, &ytmp, k2);
-            for i in 0..ny {
-                ytmp[i] = y[i] + h * (A41 * k0[i] + A42 * k1[i] + A43 * k2[i]);
-            }
+            combo(&mut ytmp, &y, h, &[(A41, k0), (A42, k1), (A43, k2)]);
             let (k3, rest) = rest.split_at_mut(1);
             let k3 = &mut k3[0];
             rhs.eval(mode, &ytmp, k3);
-            for i in 0..ny {
-                ytmp[i] = y[i] + h * (A51 * k0[i] + A52 * k1[i] + A53 * k2[i] + A54 * k3[i]);
-            }
+            combo(&mut ytmp, &y, h, &[(A51, k0), (A52, k1), (A53, k2), (A54, k3)]);
             let (k4, rest) = rest.split_at_mut(1);
             let k4 = &mut k4[0];
             rhs.eval(mode, &ytmp, k4);
-            for i in 0..ny {
-                ytmp[i] = y[i]
-                    + h * (A61 * k0[i] + A62 * k1[i] + A63 * k2[i] + A64 * k3[i] + A65 * k4[i]);
-            }
+            combo(
+                &mut ytmp,
+                &y,
+                h,
+                &[(A61, k0), (A62, k1), (A63, k2), (A64, k3), (A65, k4)],
+            );
             let (k5, rest) = rest.split_at_mut(1);
             let k5 = &mut k5[0];
             rhs.eval(mode, &ytmp, k5);
-            for i in 0..ny {
-                ynew[i] = y[i]
-                    + h * (A71 * k0[i] + A73 * k2[i] + A74 * k3[i] + A75 * k4[i] + A76 * k5[i]);
-            }
+            combo(
+                &mut ynew,
+                &y,
+                h,
+                &[(A71, k0), (A73, k2), (A74, k3), (A75, k4), (A76, k5)],
+            );
             let k6 = &mut rest[0];
             rhs.eval(mode, &ynew, k6);
-            for i in 0..ny {
-                ytmp[i] = h
-                    * (E1 * k0[i] + E3 * k2[i] + E4 * k3[i] + E5 * k4[i] + E6 * k5[i] + E7 * k6[i]);
+            ytmp.iter_mut().for_each(|v| *v = 0.0);
+            for (c, kj) in [(E1, &*k0), (E3, k2), (E4, k3), (E5, k4), (E6, k5), (E7, k6)] {
+                let hc = h * c;
+                for (o, &v) in ytmp.iter_mut().zip(kj.iter()) {
+                    *o += hc * v;
+                }
             }
         }
         let err = err_norm(&y, &ynew, &ytmp);
@@ -490,7 +509,15 @@ pub fn solve_from(
         {
             if mode.on(s) && (ci == 0 || sys.damper.is_some()) {
                 totals.closed_time[ci] += s_end;
-                let peak = peak_on_step(sys, s, &dense, s_end);
+                let law = sys.contact(s).law;
+                let rel = sys.relative_vector(s);
+                let start = force_slope_at(&law, rel, &y, &k[0], nd);
+                let end = if switched {
+                    None
+                } else {
+                    Some(force_slope_at(&law, rel, &ynew, &k[6], nd))
+                };
+                let peak = peak_on_step(&law, &peak_vecs[ci], &dense, s_end, start, end);
                 totals.peak_force[ci] = totals.peak_force[ci].max(peak);
             }
         }
@@ -500,10 +527,7 @@ pub fn solve_from(
             t += s_end;
             totals.dissipated = y[nx];
             let new_mode = if all_linear {
-                select_mode(sys, &y[..nx], mode, &mut |m| {
-                    std::rc::Rc::new(sys.first_order(m))
-                })
-                .0
+                select_mode(sys, &y[..nx], mode, &ind_vecs, &mut a_of).0
             } else {
                 mode_after_numeric(sys, &inds, &signs, &dense, s_end, &y[..nx])
             };
@@ -620,12 +644,10 @@ fn start_sign(
     mode: Mode,
     x: &[f64],
     linear: Option<&[f64]>,
-    all_linear: bool,
+    a: Option<&faer::Mat<f64>>,
 ) -> f64 {
-    if all_linear {
-        if let Some(l) = linear {
-            return lex_sign(l, &sys.first_order(mode), x);
-        }
+    if let (Some(a), Some(l)) = (a, linear) {
+        return lex_sign(l, a, x);
     }
     let v = sys.indicator_value(ind, x);
     if v != 0.0 {
@@ -697,32 +719,58 @@ fn mode_after_numeric(
     implied_mode(sys, &sign_of)
 }
 
+/// `out = y + h Σ c_j k_j`.
+fn combo(out: &mut [f64], y: &[f64], h: f64, terms: &[(f64, &Vec<f64>)]) {
+    out.copy_from_slice(y);
+    for &(c, kj) in terms {
+        let hc = h * c;
+        for (o, &v) in out.iter_mut().zip(kj.iter()) {
+            *o += hc * v;
+        }
+    }
+}
+
+/// Contact force and its time derivative from `δ`, `δ̇`, `δ̈`: `f(δ, δ̇)` and
+/// `∂f/∂δ·δ̇ + ∂f/∂δ̇·δ̈`, the partial derivatives of the law by central differences.
+fn force_and_slope(law: &ContactLaw, d: f64, r: f64, acc: f64) -> (f64, f64) {
+    let f = law.force(d, r);
+    let ed = 1e-7 * d.abs().max(1e-12);
+    let er = 1e-7 * r.abs().max(1e-9);
+    let fd = (law.force(d + ed, r) - law.force(d - ed, r)) / (2.0 * ed);
+    let fr = (law.force(d, r + er) - law.force(d, r - er)) / (2.0 * er);
+    (f, fd * r + fr * acc)
+}
+
+/// Force and slope at a step end from the state `y` and its derivative `dy` (a stage).
+fn force_slope_at(law: &ContactLaw, a: &[f64], y: &[f64], dy: &[f64], nd: usize) -> (f64, f64) {
+    let d = dot(&a[..nd], &y[..nd]);
+    let r = dot(&a[..nd], &y[nd..2 * nd]);
+    let acc = dot(&a[..nd], &dy[nd..2 * nd]);
+    force_and_slope(law, d, r, acc)
+}
+
 /// Largest contact force on `[0, len]` of a step. A step is far shorter than any period of
 /// the motion (the error control sees to that), so the force has at most one interior maximum
 /// there, and only if its slope goes from positive at the start to negative at the end: then
 /// the slope's root is found by safeguarded secant steps on the dense output. Otherwise the
-/// maximum is at an end. The slope is `∂f/∂δ·δ̇ + ∂f/∂δ̇·δ̈` with the law's partial derivatives by
-/// central differences and `δ̇`, `δ̈` from the dense output.
-fn peak_on_step(sys: &ImpactSystem, s: Switch, dense: &Dense, len: f64) -> f64 {
-    let nd = sys.dofs();
-    let a = sys.relative_vector(s);
-    let law = sys.contact(s).law;
-    let mut lx = vec![0.0; 2 * nd + 1];
-    let mut lv = vec![0.0; 2 * nd + 1];
-    lx[..nd].copy_from_slice(&a[..nd]);
-    lv[nd..2 * nd].copy_from_slice(&a[..nd]);
+/// maximum is at an end. `start` and `end` are `(f, f')` at the ends (`end` is `None` when the
+/// step was cut at an event: then it comes from the dense output).
+fn peak_on_step(
+    law: &ContactLaw,
+    vecs: &(Vec<f64>, Vec<f64>),
+    dense: &Dense,
+    len: f64,
+    start: (f64, f64),
+    end: Option<(f64, f64)>,
+) -> f64 {
+    let (lx, lv) = vecs;
     let force_slope = |t: f64| -> (f64, f64) {
-        let (d, dd) = dense.functional(&lx, t);
-        let (r, dr) = dense.functional(&lv, t);
-        let f = law.force(d, r);
-        let ed = 1e-7 * d.abs().max(1e-12);
-        let er = 1e-7 * r.abs().max(1e-9);
-        let fd = (law.force(d + ed, r) - law.force(d - ed, r)) / (2.0 * ed);
-        let fr = (law.force(d, r + er) - law.force(d, r - er)) / (2.0 * er);
-        (f, fd * dd + fr * dr)
+        let (d, _) = dense.functional(lx, t);
+        let (r, dr) = dense.functional(lv, t);
+        force_and_slope(law, d, r, dr)
     };
-    let (f0, s0) = force_slope(0.0);
-    let (f1, s1) = force_slope(len);
+    let (f0, s0) = start;
+    let (f1, s1) = end.unwrap_or_else(|| force_slope(len));
     let mut best = f0.max(f1);
     if s0 > 0.0 && s1 < 0.0 {
         let (mut lo, mut hi, mut slo, mut shi) = (0.0, len, s0, s1);
@@ -730,7 +778,7 @@ fn peak_on_step(sys: &ImpactSystem, s: Switch, dense: &Dense, len: f64) -> f64 {
             if hi - lo <= 1e-12 * len {
                 break;
             }
-            // Secant point, kept away from the ends (Illinois-like safeguard by bisection).
+            // Secant point, kept away from the ends (bisection otherwise).
             let mut m = lo + (hi - lo) * slo / (slo - shi);
             if !(m > lo + 0.01 * (hi - lo) && m < hi - 0.01 * (hi - lo)) {
                 m = 0.5 * (lo + hi);

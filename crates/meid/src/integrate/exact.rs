@@ -82,7 +82,7 @@ pub fn solve_from(
             .or_insert_with(|| std::rc::Rc::new(sys.first_order(m)))
             .clone()
     };
-    let (mut mode, _) = select_mode(sys, &x, Mode(0), &mut a_of);
+    let (mut mode, _, mut signs) = select_mode(sys, &x, Mode(0), &ind_vecs, &mut a_of);
     let mut events = Vec::new();
     let mut totals = Totals::default();
     let mut collision_end: Option<CollisionEnd> = None;
@@ -113,8 +113,7 @@ pub fn solve_from(
         let mut s_end = t_end - t;
         let mut switched = false;
         let mut funcs = Vec::with_capacity(ind_vecs.len());
-        for l in &ind_vecs {
-            let sign0 = lex_sign(l, &prop.a, &x);
+        for (l, &sign0) in ind_vecs.iter().zip(&signs) {
             if sign0 != 0.0 {
                 // (sign 0: identically zero, never crosses)
                 funcs.push((seg.functional(l), sign0));
@@ -235,7 +234,15 @@ pub fn solve_from(
             zero_length = 0;
         }
         // 5: the new mode.
-        let (new_mode, _) = select_mode(sys, &x, mode, &mut a_of);
+        let (new_mode, consistent, new_signs) = select_mode(sys, &x, mode, &ind_vecs, &mut a_of);
+        // The signs are those under `new_mode`'s dynamics when it is consistent; otherwise
+        // (no consistent mode) they are recomputed for the mode taken.
+        signs = if consistent {
+            new_signs
+        } else {
+            let a = a_of(new_mode);
+            ind_vecs.iter().map(|l| lex_sign(l, &a, &x)).collect()
+        };
         if new_mode != mode {
             events.push(Event {
                 t,

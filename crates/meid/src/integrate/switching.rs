@@ -23,8 +23,17 @@ const K_MAX: usize = 8;
 pub fn lex_sign(l: &[f64], a: &Mat<f64>, x: &[f64]) -> f64 {
     let n = x.len();
     let l_norm = l.iter().map(|v| v * v).sum::<f64>().sqrt();
-    let mut y = x.to_vec();
-    let mut next = vec![0.0; n];
+    // Stack buffers for the usual sizes (no allocation per call).
+    let mut stack = [0.0; 128];
+    let mut heap = Vec::new();
+    let (y, next) = if 2 * n <= stack.len() {
+        stack[..2 * n].split_at_mut(n)
+    } else {
+        heap.resize(2 * n, 0.0);
+        heap.split_at_mut(n)
+    };
+    y.copy_from_slice(x);
+    let (mut y, mut next) = (y, next);
     for k in 0..=K_MAX {
         let (mut val, mut scale, mut y2) = (0.0, 0.0, 0.0);
         for i in 0..n {
@@ -38,8 +47,17 @@ pub fn lex_sign(l: &[f64], a: &Mat<f64>, x: &[f64]) -> f64 {
         if val.abs() > tol * scale && val.abs() > floor {
             return val.signum();
         }
-        for (i, nx) in next.iter_mut().enumerate() {
-            *nx = (0..n).map(|j| a[(i, j)] * y[j]).sum();
+        if k == K_MAX {
+            break;
+        }
+        // next = A y, column by column (contiguous in faer's column-major storage).
+        next.iter_mut().for_each(|v| *v = 0.0);
+        for (j, &yj) in y.iter().enumerate() {
+            if yj != 0.0 {
+                for (nx, aij) in next.iter_mut().zip(a.col(j).iter()) {
+                    *nx += aij * yj;
+                }
+            }
         }
         std::mem::swap(&mut y, &mut next);
     }
@@ -62,16 +80,17 @@ pub fn implied_mode(sys: &ImpactSystem, sign_of: &dyn Fn(Indicator) -> f64) -> M
 }
 
 /// Selects a consistent mode at state `x`, starting the iteration from `start`.
-/// `matrix(mode)` gives `A_σ`; `inds`/`vecs` are the system's indicators and their vectors.
-/// Returns the mode and whether it is consistent.
+/// `matrix(mode)` gives `A_σ`; `vecs` are the vectors of the system's indicators
+/// ([`ImpactSystem::indicators`], [`ImpactSystem::indicator_vector`]). Returns the mode,
+/// whether it is consistent, and the indicators' signs under that mode's dynamics.
 pub fn select_mode(
     sys: &ImpactSystem,
     x: &[f64],
     start: Mode,
+    vecs: &[Vec<f64>],
     matrix: &mut dyn FnMut(Mode) -> std::rc::Rc<Mat<f64>>,
-) -> (Mode, bool) {
+) -> (Mode, bool, Vec<f64>) {
     let inds = sys.indicators();
-    let vecs: Vec<Vec<f64>> = inds.iter().map(|&i| sys.indicator_vector(i)).collect();
     let implied = |m: Mode, matrix: &mut dyn FnMut(Mode) -> std::rc::Rc<Mat<f64>>| {
         let a = matrix(m);
         let signs: Vec<f64> = vecs.iter().map(|l| lex_sign(l, &a, x)).collect();
@@ -80,15 +99,17 @@ pub fn select_mode(
                 .position(|&i| i == ind)
                 .map_or(0.0, |p| signs[p])
         };
-        implied_mode(sys, &sign_of)
+        (implied_mode(sys, &sign_of), signs)
     };
     let mut cand = start;
     let mut seen: Vec<Mode> = Vec::new();
+    let mut last_signs = Vec::new();
     for _ in 0..16 {
-        let next = implied(cand, matrix);
+        let (next, signs) = implied(cand, matrix);
         if next == cand {
-            return (cand, true);
+            return (cand, true, signs);
         }
+        last_signs = signs;
         if seen.contains(&next) {
             break;
         }
@@ -98,11 +119,14 @@ pub fn select_mode(
     // No fixed point along the iteration: try every mode.
     for bits in 0..8u8 {
         let m = Mode(bits);
-        if valid_bits(sys, m) && implied(m, matrix) == m {
-            return (m, true);
+        if valid_bits(sys, m) {
+            let (next, signs) = implied(m, matrix);
+            if next == m {
+                return (m, true, signs);
+            }
         }
     }
-    (cand, false)
+    (cand, false, last_signs)
 }
 
 fn valid_bits(sys: &ImpactSystem, m: Mode) -> bool {
