@@ -17,8 +17,10 @@
 //! 4. the SciPy peer (`bench/peer/impact_rk45.py`, `solve_ivp` RK45, rtol 1e-8) on case 1's system,
 //!    median of its own repetitions; prints the time ratio and the energy-ratio difference.
 
+#[path = "common/peer.rs"]
+mod peer;
+
 use std::path::PathBuf;
-use std::process::Command;
 use std::time::Instant;
 
 use meid::analysis::simulate;
@@ -215,30 +217,21 @@ fn main() {
     );
 
     if peer {
-        let st = &sys.structure;
-        let spec = serde_json::json!({
-            "omega": st.omega_rad_per_s, "damping": st.damping,
-            "phi_b": sys.points.bed_contact, "phi_f": sys.points.damper_anchor,
-            "m_s": sys.slider.mass, "v_s": sys.slider.velocity,
-            "m_d": sys.damper.unwrap().mass, "k_d": sys.damper.unwrap().stiffness, "c_d": sys.damper.unwrap().damping,
-            "K_s": sys.slider_bed.law.stiffness(), "K_d": sys.bed_damper.unwrap().law.stiffness(),
-        });
-        let path = std::env::temp_dir().join("meid_impact_peer.json");
-        std::fs::write(&path, spec.to_string()).unwrap();
-        let out = Command::new("python3")
-            .arg(root.join("bench/peer/impact_rk45.py"))
-            .arg(&path)
-            .arg(if quick { "5" } else { "20" })
-            .output();
-        match out {
-            Ok(o) if o.status.success() => {
-                let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-                let t = v["median_s"].as_f64().unwrap();
-                let r = v["energy_ratio"].as_f64().unwrap();
-                println!("SciPy {} solve_ivp RK45 (rtol 1e-8): {:.2} ms per collision, energy ratio {r:.10}", v["scipy"], t * 1e3);
-                println!("speed-up exact vs SciPy: {:.0}x; dopri5 vs SciPy: {:.0}x; |energy ratio difference| {:.2e}", t / med_e, t / med_d, (r - ratio_e).abs());
+        match peer::scipy_collision(&sys, &root, if quick { 5 } else { 20 }) {
+            Ok(p) => {
+                let (t, r) = (p.median_s, p.energy_ratio);
+                println!(
+                    "SciPy {} solve_ivp RK45 (rtol 1e-8): {:.2} ms per collision, energy ratio {r:.10}",
+                    p.scipy,
+                    t * 1e3
+                );
+                println!(
+                    "speed-up exact vs SciPy: {:.0}x; dopri5 vs SciPy: {:.0}x; |energy ratio difference| {:.2e}",
+                    t / med_e,
+                    t / med_d,
+                    (r - ratio_e).abs()
+                );
             }
-            Ok(o) => println!("SciPy peer failed: {}", String::from_utf8_lossy(&o.stderr)),
             Err(e) => println!("SciPy peer not run: {e}"),
         }
     }

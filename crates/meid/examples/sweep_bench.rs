@@ -8,10 +8,17 @@
 //! warm-up run; the best wall time (std::time::Instant) of each is printed with the per-point
 //! cost and the speed-up. The CSV of both runs is compared byte for byte.
 //!
-//! Run: `cargo run --release -p meid --example sweep_bench [MODEL.toml]`.
+//! Then the SciPy peer (`bench/peer/impact_rk45.py`, RK45 rtol 1e-8) runs on five of the map's
+//! points (corners and centre, 3 runs each, median) and the per-point ratio is printed
+//! (`--no-peer` skips it).
+//!
+//! Run: `cargo run --release -p meid --example sweep_bench [MODEL.toml] [N]`.
 //! The machine has 2 cores shared with other builds: note the load average beside the figures.
 
 use std::time::Instant;
+
+#[path = "common/peer.rs"]
+mod peer;
 
 use meid::analysis::sweep::{Sweep, Vary};
 use meid::model::Model;
@@ -45,6 +52,7 @@ fn main() -> meid::Result<()> {
     );
     let mut csv = Vec::new();
     let mut best = Vec::new();
+    let mut last = None;
     for threads in [1usize, 2] {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -58,6 +66,7 @@ fn main() -> meid::Result<()> {
             let dt = t0.elapsed().as_secs_f64();
             t_best = t_best.min(dt);
             text = r.csv();
+            last = Some(r.clone());
             if rep == 0 {
                 println!(
                     "  {threads} thread(s): {} failed points, min energy ratio {:.4}",
@@ -79,5 +88,49 @@ fn main() -> meid::Result<()> {
         best[0] / best[1],
         csv[0] == csv[1]
     );
+    // The SciPy peer on a sample of the map's points (corners and centre), to put a per-point
+    // ratio on the whole map.
+    if !std::env::args().any(|a| a == "--no-peer") {
+        let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let side = (sweep.len() as f64).sqrt().round() as usize;
+        let picks = [
+            0,
+            side - 1,
+            sweep.len() / 2 + side / 2,
+            sweep.len() - side,
+            sweep.len() - 1,
+        ];
+        let mut total = 0.0;
+        let mut count = 0usize;
+        let mut max_diff = 0.0_f64;
+        let mut version = String::new();
+        for &i in &picks {
+            let pm = sweep.point_model(i)?;
+            let sys = pm.model.impact_system(meid::model::Case::AsSpecified)?;
+            match peer::scipy_collision(&sys, &root, 3) {
+                Ok(p) => {
+                    total += p.median_s;
+                    count += 1;
+                    version = p.scipy;
+                    if let Some(r) = &last {
+                        let ours: f64 = r.points[i].metric("energy_ratio");
+                        max_diff = max_diff.max((ours - p.energy_ratio).abs());
+                    }
+                }
+                Err(e) => println!("  SciPy peer not run at point {i}: {e}"),
+            }
+        }
+        if count > 0 {
+            let scipy_point = total / count as f64;
+            let meid_point = best[0] / sweep.len() as f64;
+            println!(
+                "  SciPy {version} RK45 (rtol 1e-8), mean of {count} sampled points: {:.2} ms/point -> the map would take {:.1} min; meid 1 thread {:.1} us/point: {:.0}x per point; max |energy ratio difference| {max_diff:.1e}",
+                scipy_point * 1e3,
+                scipy_point * sweep.len() as f64 / 60.0,
+                meid_point * 1e6,
+                scipy_point / meid_point
+            );
+        }
+    }
     Ok(())
 }
