@@ -1,0 +1,244 @@
+//! Dense kernels for the small matrices of the impact engine (a few to ~100 rows), run
+//! sequentially.
+//!
+//! The three eigen-kernels the exact propagator calls for every contact state it meets
+//! ([`sym_eigen`], [`real_eigen`], [`inverse`]) are **hand-written** rather than faer calls:
+//! faer 0.24 has no small-matrix fast path, and its general EVD spends ~190k instructions on
+//! an 8×8 matrix (dispatch, workspace queries, blocking) for ~10k flops of arithmetic, while a
+//! collision builds ~5 such decompositions within a 50 µs budget. The kernels here are the
+//! textbook unblocked algorithms on flat column-major buffers:
+//!
+//! * [`sym_eigen`]: cyclic Jacobi with threshold (Rutishauser), see the `jacobi` submodule;
+//! * [`real_eigen`]: Householder Hessenberg + Francis double-shift QR + triangular
+//!   back-substitution (EISPACK `hqr2` / LAPACK `dlahqr` + `dtrevc`), see the `hqr` submodule;
+//! * [`inverse`]: Gauss-Jordan with partial pivoting, in place.
+//!
+//! When Jacobi or QR fails to converge within its iteration limit, the faer routines
+//! ([`sym_eigen_faer`], [`real_eigen_faer`]) are used instead. They are also called with
+//! `Par::Seq`: faer's convenience methods use the global (rayon) parallelism, whose task
+//! overhead dominates at this size and would also nest inside parallel sweeps.
+
+mod hqr;
+mod jacobi;
+
+use faer::diag::Diag;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::evd::{self, ComputeEigenvectors};
+use faer::{c64, Mat, Par};
+
+use crate::{Error, Result};
+
+fn check_square_finite(a: &Mat<f64>, what: &str) -> Result<()> {
+    if a.nrows() != a.ncols() {
+        return Err(Error::invalid(
+            what,
+            format!("matrix is {}x{}, not square", a.nrows(), a.ncols()),
+        ));
+    }
+    for j in 0..a.ncols() {
+        for i in 0..a.nrows() {
+            if !a[(i, j)].is_finite() {
+                return Err(Error::numerical(
+                    what,
+                    format!("non-finite entry at ({i}, {j})"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Symmetric eigen-decomposition `A = U diag(s) Uᵀ` of `(A + Aᵀ)/2`, eigenvalues ascending,
+/// `U` orthonormal. Cyclic Jacobi (`jacobi` submodule); faer's tridiagonal QR if Jacobi does not
+/// converge in 60 sweeps.
+pub fn sym_eigen(a: &Mat<f64>) -> Result<(Vec<f64>, Mat<f64>)> {
+    check_square_finite(a, "symmetric eigen-decomposition")?;
+    match jacobi::jacobi_eigen(a) {
+        Some(r) => Ok(r),
+        None => sym_eigen_faer(a),
+    }
+}
+
+/// Eigen-decomposition of a real matrix, `A V = V diag(λ)`, columns of `V` of unit 2-norm.
+/// A complex conjugate pair occupies adjacent positions, the eigenvalue with positive imaginary
+/// part first, and the pair's eigenvalues and vectors are exact conjugates. Hessenberg + Francis
+/// QR + back-substitution (`hqr` submodule); faer's EVD if QR does not converge. A defective matrix
+/// gives a `V` of huge condition (check `‖V‖‖V⁻¹‖`).
+pub fn real_eigen(a: &Mat<f64>) -> Result<(Vec<c64>, Mat<c64>)> {
+    check_square_finite(a, "eigen-decomposition")?;
+    match hqr::hqr_eigen(a) {
+        Some(r) => Ok(r),
+        None => real_eigen_faer(a),
+    }
+}
+
+/// Symmetric eigen-decomposition by faer (`self_adjoint_evd`, sequential): the fallback of
+/// [`sym_eigen`], and the reference of the benchmark.
+pub fn sym_eigen_faer(a: &Mat<f64>) -> Result<(Vec<f64>, Mat<f64>)> {
+    let n = a.nrows();
+    let mut u = Mat::<f64>::zeros(n, n);
+    let mut s = Diag::<f64>::zeros(n);
+    let req = evd::self_adjoint_evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::Yes,
+        Par::Seq,
+        Default::default(),
+    );
+    let mut buf = MemBuffer::new(req);
+    evd::self_adjoint_evd(
+        a.as_ref(),
+        s.as_mut(),
+        Some(u.as_mut()),
+        Par::Seq,
+        MemStack::new(&mut buf),
+        Default::default(),
+    )
+    .map_err(|e| Error::numerical("symmetric eigen-decomposition", format!("{e:?}")))?;
+    Ok(((0..n).map(|i| s[i]).collect(), u))
+}
+
+/// Eigen-decomposition of a real matrix by faer (`evd_real`, sequential), same conventions as
+/// [`real_eigen`] (LAPACK order of the pairs): the fallback of [`real_eigen`], and the
+/// reference of the benchmark.
+pub fn real_eigen_faer(a: &Mat<f64>) -> Result<(Vec<c64>, Mat<c64>)> {
+    let n = a.nrows();
+    let mut ur = Mat::<f64>::zeros(n, n);
+    let mut sre = Diag::<f64>::zeros(n);
+    let mut sim = Diag::<f64>::zeros(n);
+    let req = evd::evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::No,
+        ComputeEigenvectors::Yes,
+        Par::Seq,
+        Default::default(),
+    );
+    let mut buf = MemBuffer::new(req);
+    evd::evd_real(
+        a.as_ref(),
+        sre.as_mut(),
+        sim.as_mut(),
+        None,
+        Some(ur.as_mut()),
+        Par::Seq,
+        MemStack::new(&mut buf),
+        Default::default(),
+    )
+    .map_err(|e| Error::numerical("eigen-decomposition", format!("{e:?}")))?;
+    // Real form (LAPACK convention): a pair λ = a ± ib at (j, j+1) has vectors U[:,j] ± i U[:,j+1].
+    let mut lam = Vec::with_capacity(n);
+    let mut v = Mat::<c64>::zeros(n, n);
+    let mut j = 0;
+    while j < n {
+        if sim[j] != 0.0 && j + 1 < n {
+            lam.push(c64::new(sre[j], sim[j]));
+            lam.push(c64::new(sre[j + 1], sim[j + 1]));
+            for i in 0..n {
+                v[(i, j)] = c64::new(ur[(i, j)], ur[(i, j + 1)]);
+                v[(i, j + 1)] = c64::new(ur[(i, j)], -ur[(i, j + 1)]);
+            }
+            j += 2;
+        } else {
+            lam.push(c64::new(sre[j], 0.0));
+            for i in 0..n {
+                v[(i, j)] = c64::new(ur[(i, j)], 0.0);
+            }
+            j += 1;
+        }
+    }
+    Ok((lam, v))
+}
+
+/// Inverse by in-place Gauss-Jordan elimination with partial (row) pivoting (Golub & Van Loan
+/// §3.4; pivot rows are swapped whole and the column permutation is undone at the end);
+/// `None` if a pivot is exactly zero or the result is not finite. ~n³ complex multiply-adds.
+pub fn inverse(a: &Mat<c64>) -> Option<Mat<c64>> {
+    let n = a.nrows();
+    if a.ncols() != n {
+        return None;
+    }
+    let zero = c64::new(0.0, 0.0);
+    let mut m: Vec<c64> = Vec::with_capacity(n * n);
+    for j in 0..n {
+        for i in 0..n {
+            m.push(a[(i, j)]);
+        }
+    }
+    let mut piv = vec![0usize; n];
+    let mut col = vec![zero; n];
+    for k in 0..n {
+        let ck = k * n;
+        let mut p = k;
+        let mut best = -1.0;
+        for (i, e) in m[ck + k..ck + n].iter().enumerate() {
+            let v = e.re.abs() + e.im.abs();
+            if v > best {
+                best = v;
+                p = k + i;
+            }
+        }
+        if !(best > 0.0 && best.is_finite()) {
+            return None;
+        }
+        piv[k] = p;
+        if p != k {
+            for j in 0..n {
+                m.swap(p + j * n, k + j * n);
+            }
+        }
+        let d = hqr::cdiv(c64::new(1.0, 0.0), m[ck + k]);
+        col.copy_from_slice(&m[ck..ck + n]);
+        col[k] = zero;
+        m[ck..ck + n].iter_mut().for_each(|e| *e = zero);
+        m[ck + k] = c64::new(1.0, 0.0);
+        for j in 0..n {
+            m[k + j * n] *= d;
+        }
+        for j in 0..n {
+            let mkj = m[k + j * n];
+            if mkj == zero {
+                continue;
+            }
+            for (e, c) in m[j * n..j * n + n].iter_mut().zip(&col) {
+                *e -= c * mkj;
+            }
+        }
+    }
+    for k in (0..n).rev() {
+        let p = piv[k];
+        if p != k {
+            for i in 0..n {
+                m.swap(i + k * n, i + p * n);
+            }
+        }
+    }
+    if m.iter().any(|e| !(e.re.is_finite() && e.im.is_finite())) {
+        return None;
+    }
+    Some(Mat::<c64>::from_fn(n, n, |i, j| m[i + j * n]))
+}
+
+/// `aᵀ b c` for real matrices (plain loops).
+pub fn at_b_c(a: &Mat<f64>, b: &Mat<f64>, c: &Mat<f64>) -> Mat<f64> {
+    let bc = mul(b, c);
+    Mat::<f64>::from_fn(a.ncols(), bc.ncols(), |i, j| {
+        (0..a.nrows()).map(|k| a[(k, i)] * bc[(k, j)]).sum()
+    })
+}
+
+/// `a b` for real matrices (plain loops).
+pub fn mul(a: &Mat<f64>, b: &Mat<f64>) -> Mat<f64> {
+    Mat::<f64>::from_fn(a.nrows(), b.ncols(), |i, j| {
+        (0..a.ncols()).map(|k| a[(i, k)] * b[(k, j)]).sum()
+    })
+}
+
+/// Frobenius norm of a complex matrix.
+pub fn norm_c(a: &Mat<c64>) -> f64 {
+    let mut s = 0.0;
+    for j in 0..a.ncols() {
+        for i in 0..a.nrows() {
+            s += a[(i, j)].norm_sqr();
+        }
+    }
+    s.sqrt()
+}
