@@ -18,9 +18,7 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use faer::Mat;
-use meid::integrate::small::{
-    inverse, real_eigen, real_eigen_faer, sym_eigen, sym_eigen_faer,
-};
+use meid::integrate::small::{inverse, real_eigen, real_eigen_faer, sym_eigen, sym_eigen_faer};
 
 /// splitmix64 → uniform in [0, 1).
 struct Rng(u64);
@@ -65,7 +63,11 @@ fn balanced(n: usize, seed: u64) -> Result<Mat<f64>, meid::Error> {
     let (kappa, q) = sym_eigen(&kt)?;
     let cr = Mat::<f64>::from_fn(n, n, |i, j| {
         (0..n)
-            .map(|a| (0..n).map(|b| q[(a, i)] * ct[(a, b)] * q[(b, j)]).sum::<f64>())
+            .map(|a| {
+                (0..n)
+                    .map(|b| q[(a, i)] * ct[(a, b)] * q[(b, j)])
+                    .sum::<f64>()
+            })
             .sum()
     });
     Ok(Mat::<f64>::from_fn(2 * n, 2 * n, |i, j| {
@@ -112,6 +114,31 @@ fn time<F: FnMut()>(mut f: F) -> (f64, f64, f64) {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    // `-- calls CASE N`: run one case N times without timing (for callgrind instruction counts:
+    // (Ir(N) − Ir(0)) / N). CASE: real8, real24, real8faer, inv8, sym4, sym22, sym4faer.
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().map(String::as_str) == Some("calls") {
+        let case = args.get(1).ok_or("calls CASE N")?.as_str();
+        let reps: usize = args.get(2).ok_or("calls CASE N")?.parse()?;
+        let a8 = balanced(4, 11)?;
+        let a24 = balanced(12, 19)?;
+        let v8 = real_eigen(&a8)?.1;
+        let (k4, _) = chain(4, 7);
+        let (k22, _) = chain(22, 25);
+        for _ in 0..reps {
+            match case {
+                "real8" => drop(black_box(real_eigen(black_box(&a8)))),
+                "real8faer" => drop(black_box(real_eigen_faer(black_box(&a8)))),
+                "real24" => drop(black_box(real_eigen(black_box(&a24)))),
+                "inv8" => drop(black_box(inverse(black_box(&v8)))),
+                "sym4" => drop(black_box(sym_eigen(black_box(&k4)))),
+                "sym4faer" => drop(black_box(sym_eigen_faer(black_box(&k4)))),
+                "sym22" => drop(black_box(sym_eigen(black_box(&k22)))),
+                _ => return Err(format!("unknown case {case}").into()),
+            }
+        }
+        return Ok(());
+    }
     println!("case                          median_us   min_us   max_us");
     let show = |name: &str, t: (f64, f64, f64)| {
         println!("{name:<30}{:>9.3}{:>9.3}{:>9.3}", t.0, t.1, t.2);

@@ -85,7 +85,10 @@ fn check_structure(lam: &[c64], v: &Mat<c64>) {
         let nrm: f64 = (0..n).map(|i| v[(i, j)].norm_sqr()).sum::<f64>().sqrt();
         assert!((nrm - 1.0).abs() <= 1e-14, "column {j} norm {nrm}");
         if lam[j].im != 0.0 {
-            assert!(lam[j].im > 0.0, "pair at {j} starts with negative imaginary part");
+            assert!(
+                lam[j].im > 0.0,
+                "pair at {j} starts with negative imaginary part"
+            );
             assert!(j + 1 < n, "unpaired complex eigenvalue");
             assert_eq!(lam[j + 1], lam[j].conj());
             for i in 0..n {
@@ -291,7 +294,9 @@ fn damped_chains_random_psd_damping() {
     for (n, seed) in [(4usize, 11u64), (12, 12), (25, 13)] {
         let mut r = Rng(seed);
         let m: Vec<f64> = (0..n).map(|_| 1.0 + 10.0 * r.next().abs()).collect();
-        let ks: Vec<f64> = (0..n).map(|_| 1e5 * (1.0 + 100.0 * r.next().abs())).collect();
+        let ks: Vec<f64> = (0..n)
+            .map(|_| 1e5 * (1.0 + 100.0 * r.next().abs()))
+            .collect();
         let k = chain_k(&ks);
         let bcols = n / 2;
         let b = Mat::<f64>::from_fn(n, bcols, |_, _| 30.0 * r.next());
@@ -359,11 +364,27 @@ fn check_defective(a: &Mat<f64>, min_cond: f64) {
 #[test]
 fn defective_matrices_are_flagged() {
     // Jordan blocks J₂(1), J₂(0), J₃(−2) and a similarity transform of J₂(3) ⊕ [5].
-    let j2 = Mat::<f64>::from_fn(2, 2, |i, j| if i == j { 1.0 } else if j == i + 1 { 1.0 } else { 0.0 });
+    let j2 = Mat::<f64>::from_fn(2, 2, |i, j| {
+        if i == j {
+            1.0
+        } else if j == i + 1 {
+            1.0
+        } else {
+            0.0
+        }
+    });
     check_defective(&j2, 1e12);
     let n2 = Mat::<f64>::from_fn(2, 2, |i, j| if j == i + 1 { 1.0 } else { 0.0 });
     check_defective(&n2, 1e12);
-    let j3 = Mat::<f64>::from_fn(3, 3, |i, j| if i == j { -2.0 } else if j == i + 1 { 1.0 } else { 0.0 });
+    let j3 = Mat::<f64>::from_fn(3, 3, |i, j| {
+        if i == j {
+            -2.0
+        } else if j == i + 1 {
+            1.0
+        } else {
+            0.0
+        }
+    });
     check_defective(&j3, 1e8);
     let jb = Mat::<f64>::from_fn(3, 3, |i, j| match (i, j) {
         (0, 0) | (1, 1) => 3.0,
@@ -474,7 +495,12 @@ fn check_sym(a: &Mat<f64>) -> (Vec<f64>, Mat<f64>) {
 #[test]
 fn sym_two_by_two_closed_form() {
     // [[a, b], [b, d]]: λ = (a+d)/2 ∓ √(((a−d)/2)² + b²).
-    for (a, b, d) in [(2.0, 1.0, -3.0), (1.0, 1e-9, 1.0), (5.0, 0.0, 5.0), (0.0, 4.0, 0.0)] {
+    for (a, b, d) in [
+        (2.0, 1.0, -3.0),
+        (1.0, 1e-9, 1.0),
+        (5.0, 0.0, 5.0),
+        (0.0, 4.0, 0.0),
+    ] {
         let m = Mat::<f64>::from_fn(2, 2, |i, j| match (i, j) {
             (0, 0) => a,
             (1, 1) => d,
@@ -497,7 +523,11 @@ fn sym_two_by_two_closed_form() {
     let (s, _) = sym_eigen(&m).unwrap();
     let big = (a + d) / 2.0 + (((a - d) / 2.0).powi(2) + b * b).sqrt();
     let small = (a * d - b * b) / big;
-    assert!((s[0] - small).abs() <= 4.0 * f64::EPSILON * small, "{} vs {small}", s[0]);
+    assert!(
+        (s[0] - small).abs() <= 4.0 * f64::EPSILON * small,
+        "{} vs {small}",
+        s[0]
+    );
     assert!((s[1] - big).abs() <= 2.0 * f64::EPSILON * big);
 }
 
@@ -517,7 +547,10 @@ fn sym_path_laplacians_closed_form() {
         let (s, _) = check_sym(&a);
         for (k, x) in s.iter().enumerate() {
             let e = 2.0 - 2.0 * ((k + 1) as f64 * std::f64::consts::PI / (n + 1) as f64).cos();
-            assert!((x - e).abs() <= 4.0 * f64::EPSILON * 4.0, "n={n} k={k}: {x} vs {e}");
+            assert!(
+                (x - e).abs() <= 4.0 * f64::EPSILON * 4.0,
+                "n={n} k={k}: {x} vs {e}"
+            );
         }
         // Free chain (graph Laplacian of the path): λ_k = 2 − 2cos(kπ/n), k = 0..n−1; λ_0 = 0
         // is a rigid-body mode and must come out at round-off level.
@@ -536,10 +569,17 @@ fn sym_path_laplacians_closed_form() {
                 }
             });
             let (s, _) = check_sym(&l);
-            assert!(s[0].abs() <= 1e-15 * fro(&l), "n={n}: zero mode {:.3e}", s[0]);
+            assert!(
+                s[0].abs() <= 1e-15 * fro(&l),
+                "n={n}: zero mode {:.3e}",
+                s[0]
+            );
             for (k, x) in s.iter().enumerate() {
                 let e = 2.0 - 2.0 * (k as f64 * std::f64::consts::PI / n as f64).cos();
-                assert!((x - e).abs() <= 16.0 * f64::EPSILON, "n={n} k={k}: {x} vs {e}");
+                assert!(
+                    (x - e).abs() <= 16.0 * f64::EPSILON,
+                    "n={n} k={k}: {x} vs {e}"
+                );
             }
         }
     }
@@ -552,7 +592,9 @@ fn random_orthogonal(n: usize, seed: u64) -> Mat<f64> {
     for _ in 0..n {
         let v: Vec<f64> = (0..n).map(|_| r.next()).collect();
         let vv: f64 = v.iter().map(|x| x * x).sum();
-        let qv: Vec<f64> = (0..n).map(|i| (0..n).map(|k| q[(i, k)] * v[k]).sum()).collect();
+        let qv: Vec<f64> = (0..n)
+            .map(|i| (0..n).map(|k| q[(i, k)] * v[k]).sum())
+            .collect();
         for i in 0..n {
             for j in 0..n {
                 q[(i, j)] -= 2.0 * qv[i] * v[j] / vv;
@@ -566,16 +608,23 @@ fn random_orthogonal(n: usize, seed: u64) -> Mat<f64> {
 fn sym_repeated_and_zero_eigenvalues() {
     // A = Q diag(d) Qᵀ with exactly repeated and zero entries in d.
     for (n, seed) in [(6usize, 21u64), (22, 22)] {
-        let d: Vec<f64> = (0..n).map(|i| [0.0, 0.0, 0.0, 1.0, 1.0, 2.5][i % 6] * 1e6).collect();
+        let d: Vec<f64> = (0..n)
+            .map(|i| [0.0, 0.0, 0.0, 1.0, 1.0, 2.5][i % 6] * 1e6)
+            .collect();
         let q = random_orthogonal(n, seed);
-        let a = Mat::<f64>::from_fn(n, n, |i, j| (0..n).map(|k| q[(i, k)] * d[k] * q[(j, k)]).sum());
+        let a = Mat::<f64>::from_fn(n, n, |i, j| {
+            (0..n).map(|k| q[(i, k)] * d[k] * q[(j, k)]).sum()
+        });
         let a = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
         let (s, _) = check_sym(&a);
         let mut e = d.clone();
         e.sort_by(f64::total_cmp);
         let na = fro(&a);
         for (x, y) in s.iter().zip(&e) {
-            assert!((x - y).abs() <= 1e-15 * na * (n as f64).sqrt(), "{x} vs {y}");
+            assert!(
+                (x - y).abs() <= 1e-15 * na * (n as f64).sqrt(),
+                "{x} vs {y}"
+            );
         }
     }
     // Stiffness of a free 4-DOF chain with a free mass (two rigid-body modes, λ = 0 twice).

@@ -36,13 +36,11 @@ fn check_square_finite(a: &Mat<f64>, what: &str) -> Result<()> {
         ));
     }
     for j in 0..a.ncols() {
-        for i in 0..a.nrows() {
-            if !a[(i, j)].is_finite() {
-                return Err(Error::numerical(
-                    what,
-                    format!("non-finite entry at ({i}, {j})"),
-                ));
-            }
+        if let Some(i) = a.col_as_slice(j).iter().position(|x| !x.is_finite()) {
+            return Err(Error::numerical(
+                what,
+                format!("non-finite entry at ({i}, {j})"),
+            ));
         }
     }
     Ok(())
@@ -156,24 +154,28 @@ pub fn inverse(a: &Mat<c64>) -> Option<Mat<c64>> {
     if a.ncols() != n {
         return None;
     }
-    let zero = c64::new(0.0, 0.0);
-    let mut m: Vec<c64> = Vec::with_capacity(n * n);
+    let nn = n * n;
+    // Real and imaginary parts in separate column-major arrays (vectorisable updates).
+    let mut work = vec![0.0f64; 2 * nn + 2 * n];
+    let (re, rest) = work.split_at_mut(nn);
+    let (im, rest) = rest.split_at_mut(nn);
+    let (cre, cim) = rest.split_at_mut(n);
+    let mut piv = vec![0usize; n];
     for j in 0..n {
-        for i in 0..n {
-            m.push(a[(i, j)]);
+        for (i, e) in a.col_as_slice(j).iter().enumerate() {
+            re[j * n + i] = e.re;
+            im[j * n + i] = e.im;
         }
     }
-    let mut piv = vec![0usize; n];
-    let mut col = vec![zero; n];
     for k in 0..n {
         let ck = k * n;
         let mut p = k;
         let mut best = -1.0;
-        for (i, e) in m[ck + k..ck + n].iter().enumerate() {
-            let v = e.re.abs() + e.im.abs();
+        for i in k..n {
+            let v = re[ck + i].abs() + im[ck + i].abs();
             if v > best {
                 best = v;
-                p = k + i;
+                p = i;
             }
         }
         if !(best > 0.0 && best.is_finite()) {
@@ -182,24 +184,34 @@ pub fn inverse(a: &Mat<c64>) -> Option<Mat<c64>> {
         piv[k] = p;
         if p != k {
             for j in 0..n {
-                m.swap(p + j * n, k + j * n);
+                re.swap(p + j * n, k + j * n);
+                im.swap(p + j * n, k + j * n);
             }
         }
-        let d = hqr::cdiv(c64::new(1.0, 0.0), m[ck + k]);
-        col.copy_from_slice(&m[ck..ck + n]);
-        col[k] = zero;
-        m[ck..ck + n].iter_mut().for_each(|e| *e = zero);
-        m[ck + k] = c64::new(1.0, 0.0);
+        let d = hqr::cdiv(c64::new(1.0, 0.0), c64::new(re[ck + k], im[ck + k]));
+        cre.copy_from_slice(&re[ck..ck + n]);
+        cim.copy_from_slice(&im[ck..ck + n]);
+        cre[k] = 0.0;
+        cim[k] = 0.0;
+        re[ck..ck + n].iter_mut().for_each(|e| *e = 0.0);
+        im[ck..ck + n].iter_mut().for_each(|e| *e = 0.0);
+        re[ck + k] = 1.0;
         for j in 0..n {
-            m[k + j * n] *= d;
+            let (r, i) = (re[k + j * n], im[k + j * n]);
+            re[k + j * n] = r * d.re - i * d.im;
+            im[k + j * n] = r * d.im + i * d.re;
         }
         for j in 0..n {
-            let mkj = m[k + j * n];
-            if mkj == zero {
+            let (mr, mi) = (re[k + j * n], im[k + j * n]);
+            if mr == 0.0 && mi == 0.0 {
                 continue;
             }
-            for (e, c) in m[j * n..j * n + n].iter_mut().zip(&col) {
-                *e -= c * mkj;
+            let rj = &mut re[j * n..j * n + n];
+            let ij = &mut im[j * n..j * n + n];
+            let (cr, ci) = (&cre[..n], &cim[..n]);
+            for i in 0..n {
+                rj[i] -= cr[i] * mr - ci[i] * mi;
+                ij[i] -= cr[i] * mi + ci[i] * mr;
             }
         }
     }
@@ -207,14 +219,21 @@ pub fn inverse(a: &Mat<c64>) -> Option<Mat<c64>> {
         let p = piv[k];
         if p != k {
             for i in 0..n {
-                m.swap(i + k * n, i + p * n);
+                re.swap(i + k * n, i + p * n);
+                im.swap(i + k * n, i + p * n);
             }
         }
     }
-    if m.iter().any(|e| !(e.re.is_finite() && e.im.is_finite())) {
+    if re.iter().chain(im.iter()).any(|e| !e.is_finite()) {
         return None;
     }
-    Some(Mat::<c64>::from_fn(n, n, |i, j| m[i + j * n]))
+    let mut out = Mat::<c64>::zeros(n, n);
+    for j in 0..n {
+        for (i, o) in out.col_as_slice_mut(j).iter_mut().enumerate() {
+            *o = c64::new(re[j * n + i], im[j * n + i]);
+        }
+    }
+    Some(out)
 }
 
 /// `aᵀ b c` for real matrices (plain loops).
