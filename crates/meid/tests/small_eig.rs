@@ -364,15 +364,7 @@ fn check_defective(a: &Mat<f64>, min_cond: f64) {
 #[test]
 fn defective_matrices_are_flagged() {
     // Jordan blocks J₂(1), J₂(0), J₃(−2) and a similarity transform of J₂(3) ⊕ [5].
-    let j2 = Mat::<f64>::from_fn(2, 2, |i, j| {
-        if i == j {
-            1.0
-        } else if j == i + 1 {
-            1.0
-        } else {
-            0.0
-        }
-    });
+    let j2 = Mat::<f64>::from_fn(2, 2, |i, j| if j == i || j == i + 1 { 1.0 } else { 0.0 });
     check_defective(&j2, 1e12);
     let n2 = Mat::<f64>::from_fn(2, 2, |i, j| if j == i + 1 { 1.0 } else { 0.0 });
     check_defective(&n2, 1e12);
