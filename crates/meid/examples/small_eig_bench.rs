@@ -115,7 +115,7 @@ fn time<F: FnMut()>(mut f: F) -> (f64, f64, f64) {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     // `-- calls CASE N`: run one case N times without timing (for callgrind instruction counts:
-    // (Ir(N) − Ir(0)) / N). CASE: real8, real24, real8faer, inv8, sym4, sym22, sym4faer.
+    // (Ir(N) − Ir(0)) / N). CASE: real8, real24, real8faer, inv8, sym{4,8,12,22}[faer].
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.first().map(String::as_str) == Some("calls") {
         let case = args.get(1).ok_or("calls CASE N")?.as_str();
@@ -125,6 +125,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let v8 = real_eigen(&a8)?.1;
         let (k4, _) = chain(4, 7);
         let (k22, _) = chain(22, 25);
+        let (k8, _) = chain(8, 9);
+        let (k12, _) = chain(12, 13);
         for _ in 0..reps {
             match case {
                 "real8" => drop(black_box(real_eigen(black_box(&a8)))),
@@ -134,6 +136,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 "sym4" => drop(black_box(sym_eigen(black_box(&k4)))),
                 "sym4faer" => drop(black_box(sym_eigen_faer(black_box(&k4)))),
                 "sym22" => drop(black_box(sym_eigen(black_box(&k22)))),
+                "sym22faer" => drop(black_box(sym_eigen_faer(black_box(&k22)))),
+                "sym8" => drop(black_box(sym_eigen(black_box(&k8)))),
+                "sym8faer" => drop(black_box(sym_eigen_faer(black_box(&k8)))),
+                "sym12" => drop(black_box(sym_eigen(black_box(&k12)))),
+                "sym12faer" => drop(black_box(sym_eigen_faer(black_box(&k12)))),
                 _ => return Err(format!("unknown case {case}").into()),
             }
         }

@@ -6,7 +6,7 @@
 //! oscillator roots `(−c ± √(c² − 4mk))/(2m)`), never the output of another eigen-solver.
 
 use faer::{c64, Mat};
-use meid::integrate::small::{inverse, norm_c, real_eigen, sym_eigen};
+use meid::integrate::small::{inverse, norm_c, real_eigen, sym_eigen, sym_eigen_jacobi};
 use proptest::prelude::*;
 
 /// splitmix64 → uniform in [−1, 1).
@@ -474,14 +474,23 @@ fn sym_residual(a: &Mat<f64>, s: &[f64], u: &Mat<f64>) -> f64 {
     e / fro(a).max(f64::MIN_POSITIVE)
 }
 
+/// Checks `sym_eigen` (the API, size-dispatched) and the Jacobi kernel at the same order; returns
+/// the Jacobi result (so closed-form checks below test the hand-written kernel at every n).
 fn check_sym(a: &Mat<f64>) -> (Vec<f64>, Mat<f64>) {
-    let (s, u) = sym_eigen(a).unwrap();
-    assert!(s.windows(2).all(|w| w[0] <= w[1]), "not ascending");
-    let o = ortho_err(&u);
-    assert!(o <= 1e-14, "orthonormality {o:.3e}");
-    let r = sym_residual(a, &s, &u);
-    assert!(r <= 1e-14, "residual {r:.3e}");
-    (s, u)
+    let api = sym_eigen(a).unwrap();
+    let jac = sym_eigen_jacobi(a).unwrap().expect("Jacobi converges");
+    for (s, u) in [&api, &jac] {
+        assert!(s.windows(2).all(|w| w[0] <= w[1]), "not ascending");
+        let o = ortho_err(u);
+        assert!(o <= 1e-14, "orthonormality {o:.3e}");
+        let r = sym_residual(a, s, u);
+        assert!(r <= 1e-14, "residual {r:.3e}");
+    }
+    // Both solve the same problem: eigenvalues agree to round-off of ‖A‖.
+    for (x, y) in api.0.iter().zip(&jac.0) {
+        assert!((x - y).abs() <= 1e-14 * fro(a).max(f64::MIN_POSITIVE));
+    }
+    jac
 }
 
 #[test]

@@ -27,26 +27,27 @@ const MAX_SWEEPS: usize = 60;
 /// `(A + Aᵀ)/2` of `a`; `None` if the sweeps do not converge.
 pub(super) fn jacobi_eigen(a: &Mat<f64>) -> Option<(Vec<f64>, Mat<f64>)> {
     let n = a.nrows();
-    // Column-major copy of the strict upper triangle: entry (i, j), i < j, at i + j n.
-    let mut w = vec![0.0f64; n * n];
-    let mut d = vec![0.0f64; n];
+    // One workspace: strict upper triangle of A, column-major (entry (i, j), i < j, at i + j n),
+    // the eigenvector accumulator U, and Rutishauser's d, b, z vectors.
+    let mut work = vec![0.0f64; 2 * n * n + 3 * n];
+    let (w, rest) = work.split_at_mut(n * n);
+    let (u, rest) = rest.split_at_mut(n * n);
+    let (d, rest) = rest.split_at_mut(n);
+    let (b, z) = rest.split_at_mut(n);
     let mut amax = 0.0f64;
     for j in 0..n {
+        let col = a.col_as_slice(j);
         for i in 0..j {
-            let x = 0.5 * (a[(i, j)] + a[(j, i)]);
+            let x = 0.5 * (col[i] + a.col_as_slice(i)[j]);
             w[i + j * n] = x;
             amax = amax.max(x.abs());
         }
-        d[j] = a[(j, j)];
+        d[j] = col[j];
         amax = amax.max(d[j].abs());
-    }
-    let mut u = vec![0.0f64; n * n];
-    for i in 0..n {
-        u[i + i * n] = 1.0;
+        u[j + j * n] = 1.0;
     }
     let floor = amax * (f64::MIN_POSITIVE / f64::EPSILON);
-    let mut b = d.clone();
-    let mut z = vec![0.0f64; n];
+    b.copy_from_slice(d);
     let mut converged = n <= 1;
     for sweep in 0..MAX_SWEEPS {
         if converged {
@@ -148,6 +149,10 @@ pub(super) fn jacobi_eigen(a: &Mat<f64>) -> Option<(Vec<f64>, Mat<f64>)> {
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&x, &y| d[x].total_cmp(&d[y]));
     let vals = order.iter().map(|&k| d[k]).collect();
-    let vecs = Mat::<f64>::from_fn(n, n, |i, j| u[i + order[j] * n]);
+    let mut vecs = Mat::<f64>::zeros(n, n);
+    for (j, &k) in order.iter().enumerate() {
+        vecs.col_as_slice_mut(j)
+            .copy_from_slice(&u[k * n..k * n + n]);
+    }
     Some((vals, vecs))
 }
