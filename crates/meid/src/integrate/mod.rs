@@ -18,7 +18,7 @@ pub mod exact;
 pub mod expm;
 pub mod propagator;
 pub mod roots;
-mod small;
+pub mod small;
 mod switching;
 
 use crate::impact::{ImpactSystem, Mode};
