@@ -408,7 +408,12 @@ pub fn solve_from(
             let (k3, rest) = rest.split_at_mut(1);
             let k3 = &mut k3[0];
             rhs.eval(mode, &ytmp, k3);
-            combo(&mut ytmp, &y, h, &[(A51, k0), (A52, k1), (A53, k2), (A54, k3)]);
+            combo(
+                &mut ytmp,
+                &y,
+                h,
+                &[(A51, k0), (A52, k1), (A53, k2), (A54, k3)],
+            );
             let (k4, rest) = rest.split_at_mut(1);
             let k4 = &mut k4[0];
             rhs.eval(mode, &ytmp, k4);

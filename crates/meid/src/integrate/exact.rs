@@ -18,7 +18,7 @@ use std::collections::HashMap;
 use faer::{c64, Mat};
 
 use super::propagator::{Functional, Propagator, Segment};
-use super::roots::{all_crossings, Search, SearchOptions};
+use super::roots::{maxima, Search, SearchOptions};
 use super::switching::{lex_sign, select_mode};
 use super::{CollisionEnd, Event, Grid, Observer, Options, Solution, Totals};
 use crate::impact::{ImpactSystem, Indicator, Mode, Switch};
@@ -61,9 +61,9 @@ pub fn solve_from(
     let mut grid = Grid::new(opts.sample_rate);
     let t_end = opts.duration;
 
-    let build = |mode: Mode| -> Result<ModeData> {
+    // `a` is the mode's first-order matrix (shared with the mode selection's cache).
+    let build = |mode: Mode, a: Mat<f64>| -> Result<ModeData> {
         let (k, c) = sys.matrices(mode);
-        let a = sys.first_order(mode);
         let prop = Propagator::new(&k, &c, &masses, a)?;
         Ok(ModeData {
             prop,
@@ -93,7 +93,7 @@ pub fn solve_from(
 
     loop {
         if let std::collections::hash_map::Entry::Vacant(e) = cache.entry(mode) {
-            e.insert(build(mode)?);
+            e.insert(build(mode, (*a_of(mode)).clone())?);
         }
         let md = cache
             .get_mut(&mode)
@@ -306,10 +306,8 @@ fn max_on_segment(seg: &Segment<'_>, l: &[f64], a: &Mat<f64>, len: f64, _period:
         .map(|j| (0..a.nrows()).map(|i| l[i] * a[(i, j)]).sum())
         .collect();
     let df = seg.functional(&la);
-    for (s, sign_before) in all_crossings(&df, len, SearchOptions::default()) {
-        if sign_before > 0.0 {
-            best = best.max(val(s));
-        }
+    for s in maxima(&df, len, SearchOptions::default()) {
+        best = best.max(val(s));
     }
     best
 }

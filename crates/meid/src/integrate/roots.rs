@@ -252,6 +252,47 @@ impl<'f, F: Scalar + ?Sized> Search<'f, F> {
     }
 }
 
+/// The maxima of `g` inside `(0, s_max]`, as the sign changes of `slope` (= g') from + to −,
+/// located to the search tolerance; sign changes from − to + (minima) are only bracketed and
+/// stepped over, not refined.
+pub fn maxima<F: Scalar + ?Sized>(slope: &F, s_max: f64, opts: SearchOptions) -> Vec<f64> {
+    let mut out = Vec::new();
+    let mut start = 0.0;
+    let (g0, d0) = slope.value_slope(0.0);
+    let mut sign = if g0.abs() > slope.noise() {
+        g0.signum()
+    } else if d0 != 0.0 {
+        d0.signum()
+    } else {
+        1.0
+    };
+    while start < s_max {
+        let shifted = Shifted {
+            f: slope,
+            offset: start,
+        };
+        let mut search = Search::new(&shifted, sign, opts);
+        match search.advance(s_max - start) {
+            Some((a, b)) => {
+                let t = if sign > 0.0 {
+                    let t = start + search.refine(a, b);
+                    out.push(t);
+                    t
+                } else {
+                    start + b
+                };
+                if t <= start || out.len() > 1_000_000 {
+                    break;
+                }
+                start = t;
+                sign = -sign;
+            }
+            None => break,
+        }
+    }
+    out
+}
+
 /// All sign changes of `g` in `(0, s_max]`, in order, each with the sign `g` had before it.
 pub fn all_crossings<F: Scalar + ?Sized>(
     f: &F,
