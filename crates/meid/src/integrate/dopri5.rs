@@ -435,7 +435,14 @@ pub fn solve_from(
             let k6 = &mut rest[0];
             rhs.eval(mode, &ynew, k6);
             ytmp.iter_mut().for_each(|v| *v = 0.0);
-            for (c, kj) in [(E1, &*k0), (E3, k2), (E4, k3), (E5, k4), (E6, k5), (E7, k6)] {
+            for (c, kj) in [
+                (E1, k0),
+                (E3, &*k2),
+                (E4, &*k3),
+                (E5, &*k4),
+                (E6, &*k5),
+                (E7, &*k6),
+            ] {
                 let hc = h * c;
                 for (o, &v) in ytmp.iter_mut().zip(kj.iter()) {
                     *o += hc * v;
