@@ -25,7 +25,7 @@ use crate::impact::{ImpactSystem, Indicator, Mode, Switch};
 use crate::{Error, Result};
 
 struct ModeData {
-    prop: Propagator,
+    prop: std::rc::Rc<Propagator>,
     c: Mat<f64>,
     /// Transition matrix for the output step.
     step: Option<Mat<f64>>,
@@ -64,7 +64,7 @@ pub fn solve_from(
     // `a` is the mode's first-order matrix (shared with the mode selection's cache).
     let build = |mode: Mode, a: Mat<f64>| -> Result<ModeData> {
         let (k, c) = sys.matrices(mode);
-        let prop = Propagator::new(&k, &c, &masses, a)?;
+        let prop = Propagator::shared(&k, &c, &masses, a)?;
         Ok(ModeData {
             prop,
             c,
