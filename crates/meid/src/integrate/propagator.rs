@@ -367,12 +367,13 @@ impl<'p> Segment<'p> {
                     })
                     .collect::<Vec<_>>();
                 // Fastest period among terms that matter.
-                let total: f64 = amp.iter().map(|a| a.norm()).sum();
+                let mags: Vec<f64> = amp.iter().map(|a| abs(*a)).collect();
+                let total: f64 = mags.iter().sum();
                 let lam_max = amp
                     .iter()
                     .zip(&sp.lam)
-                    .filter(|(a, _)| a.norm() > 1e-14 * total)
-                    .map(|(_, l)| l.norm())
+                    .filter(|(a, _)| abs(**a) > 1e-14 * total)
+                    .map(|(_, l)| abs(*l))
                     .fold(0.0, f64::max);
                 let period = if lam_max > 0.0 {
                     2.0 * std::f64::consts::PI / lam_max
@@ -391,11 +392,10 @@ impl<'p> Segment<'p> {
                     noise: 0.0,
                     curv: Vec::new(),
                 };
-                e.curv = e
-                    .amp
+                e.curv = mags
                     .iter()
                     .zip(&e.lam)
-                    .map(|(a, l)| a.norm() * l.norm_sqr())
+                    .map(|(m, l)| m * l.norm_sqr())
                     .collect();
                 let direct = dot(l, &self.grid.borrow()[0]);
                 let terms = p0.abs() + total;
@@ -688,6 +688,12 @@ fn spectral(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Spectral> {
         w,
         lam_max,
     })
+}
+
+/// `|z|` without `hypot`'s overflow guard (the magnitudes here are far from overflow).
+#[inline]
+fn abs(z: c64) -> f64 {
+    (z.re * z.re + z.im * z.im).sqrt()
 }
 
 #[inline]
