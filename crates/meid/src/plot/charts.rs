@@ -468,7 +468,12 @@ impl Figure for AreaPlot {
         let xr = xe.0..xe.1;
         let yr = padded(ye, false);
         let y_bottom = yr.start;
-        let mut chart = frame(area, &self.title, RangedCoordf64::from(xr), RangedCoordf64::from(yr))?;
+        let mut chart = frame(
+            area,
+            &self.title,
+            RangedCoordf64::from(xr),
+            RangedCoordf64::from(yr),
+        )?;
         axes(&mut chart, &self.x_label, &self.y_label, true)?;
         let fill_alpha = if self.stacked { 0.55 } else { 0.25 };
         let mut failed_x = Vec::new();
