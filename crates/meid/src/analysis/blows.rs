@@ -486,7 +486,7 @@ sample_rate = 20000.0
     fn damper_free_return_matches_the_closed_form() {
         let model = paper(&["points.damper_anchor=\"ground\""]);
         let sys = model.impact_system(Case::Damper).unwrap();
-        let d = sys.damper.clone().unwrap();
+        let d = sys.damper.unwrap();
         let b = BlowOptions {
             blows: 2,
             rate_bpm: 120.0,
