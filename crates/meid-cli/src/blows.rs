@@ -4,10 +4,9 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use meid::analysis::blows::{run_blows, BlowOptions};
-use meid::model::Case;
 use meid::plot::{self, LinePlot, Series};
 
-use crate::load;
+use crate::args::{CaseArg, PrintArgs, RunArgs};
 
 #[derive(clap::Args)]
 pub struct BlowsArgs {
@@ -22,33 +21,20 @@ pub struct BlowsArgs {
     /// Relative blow-to-blow change that counts as steady.
     #[arg(long, value_name = "FRACTION", default_value_t = 0.01)]
     tolerance: f64,
-    /// Which machine: as the file says, bare, with the damper, or with the added mass.
-    #[arg(long, value_parser = ["as-specified", "none", "damper", "added-mass"], default_value = "as-specified")]
-    case: String,
+    #[command(flatten)]
+    case: CaseArg,
     /// Write blows.csv, blows.json, history.csv and pictures into DIR.
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
-    /// Integration method: exact or dopri5.
-    #[arg(long, value_parser = ["exact", "dopri5"])]
-    method: Option<String>,
-    /// Output sample rate (Hz).
-    #[arg(long, value_name = "HZ")]
-    rate: Option<f64>,
-    /// Override a model field (repeatable).
-    #[arg(long = "set", value_name = "PATH=VALUE")]
-    set: Vec<String>,
-    /// Print the result as JSON on stdout.
-    #[arg(long)]
-    json: bool,
-    /// Print nothing but errors.
-    #[arg(short, long)]
-    quiet: bool,
+    #[command(flatten)]
+    run: RunArgs,
+    #[command(flatten)]
+    print: PrintArgs,
 }
 
 pub fn run(a: BlowsArgs) -> Result<()> {
-    let model = load(&a.model, &a.set, a.method.as_deref(), None, a.rate)?;
-    let case: Case = a.case.parse()?;
-    let sys = model.impact_system(case)?;
+    let model = a.run.load(&a.model, None)?;
+    let sys = model.impact_system(a.case.parse()?)?;
     let opts = model.options();
     let b = BlowOptions {
         blows: a.blows,
@@ -60,20 +46,24 @@ pub fn run(a: BlowsArgs) -> Result<()> {
         "interval_s": r.interval_s,
         "blows": r.blows,
         "steady": r.steady,
+        "damper_gap_at_next_strike_m": r.damper_gap_at_next_strike_m,
     });
     if let Some(dir) = &a.output {
-        let mut w = String::from("blow,start_s,energy_ratio,machine_energy_at_strike_j,damper_energy_at_strike_j,peak_bed_acceleration_m_per_s2,peak_floor_force_n,peak_contact_force_slider_bed_n\n");
+        let mut w = String::from("blow,start_s,energy_ratio,machine_energy_at_strike_j,damper_energy_at_strike_j,peak_bed_acceleration_m_per_s2,peak_floor_force_n,peak_contact_force_slider_bed_n,damper_gap_at_strike_m,damper_contact_time_s\n");
+        let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.9e}"));
         for x in &r.blows {
             w.push_str(&format!(
-                "{},{:.9e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}\n",
+                "{},{:.9e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{},{}\n",
                 x.blow,
                 x.start_s,
-                x.energy_ratio.map_or(String::new(), |v| format!("{v:.9e}")),
+                opt(x.energy_ratio),
                 x.machine_energy_at_strike_j,
                 x.damper_energy_at_strike_j,
                 x.peak_bed_acceleration_m_per_s2,
                 x.peak_floor_force_n,
-                x.peak_contact_force_slider_bed_n
+                x.peak_contact_force_slider_bed_n,
+                opt(x.damper_gap_at_strike_m),
+                opt(x.damper_contact_time_s)
             ));
         }
         meid::io::write_atomic(&dir.join("blows.csv"), w.as_bytes())?;
@@ -144,22 +134,24 @@ pub fn run(a: BlowsArgs) -> Result<()> {
             },
         )?;
     }
-    if a.json {
+    if a.print.json {
         println!("{}", serde_json::to_string_pretty(&out)?);
-    } else if !a.quiet {
+    } else if a.print.human() {
         println!(
             "meid blows — {} blows every {:.6} s ({} /min)",
             a.blows, r.interval_s, a.rate_bpm
         );
-        println!("  blow  E_p+/E_s-   peak accel (m/s²)  peak floor force (N)  machine energy at strike (J)");
+        println!("  blow  E_p+/E_s-   peak accel (m/s²)  peak floor force (N)  machine energy at strike (J)  damper gap (mm)");
         for x in &r.blows {
             println!(
-                "  {:>4}  {:>9}  {:>17.4}  {:>20.4}  {:>28.4e}",
+                "  {:>4}  {:>9}  {:>17.4}  {:>20.4}  {:>28.4e}  {:>15}",
                 x.blow,
                 x.energy_ratio.map_or("—".into(), |v| format!("{v:.5}")),
                 x.peak_bed_acceleration_m_per_s2,
                 x.peak_floor_force_n,
-                x.machine_energy_at_strike_j
+                x.machine_energy_at_strike_j,
+                x.damper_gap_at_strike_m
+                    .map_or("—".into(), |g| format!("{:.4}", g * 1e3))
             );
         }
         let s = &r.steady;
@@ -176,6 +168,45 @@ pub fn run(a: BlowsArgs) -> Result<()> {
                 s.last_change_energy_ratio
             ),
         }
+        if let Some(hint) = damper_hint(&r) {
+            println!("  {hint}");
+        }
     }
     Ok(())
+}
+
+/// Below this gap (m) the damper counts as back against the bed (10 µm: far below the bed's
+/// travel during a collision, ~0.2 mm on the paper example).
+const RETURNED_GAP_M: f64 = 1e-5;
+
+/// One line on the damper's return: its gap to the bed at the next strike and, when it has
+/// not come back, the blows in which it never touched the bed (docs/studies.md explains why
+/// a one-way dashpot holds it off).
+fn damper_hint(r: &meid::analysis::blows::BlowsRun) -> Option<String> {
+    let gap = r.damper_gap_at_next_strike_m?;
+    if gap <= RETURNED_GAP_M {
+        return Some(format!(
+            "damper gap at next blow: {:.4} mm (back against the bed)",
+            gap.max(0.0) * 1e3
+        ));
+    }
+    let idle: Vec<usize> = r
+        .blows
+        .iter()
+        .filter(|x| x.damper_contact_time_s == Some(0.0))
+        .map(|x| x.blow)
+        .collect();
+    let touch = if idle.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; it never touched the bed in {} of {} blows",
+            idle.len(),
+            r.blows.len()
+        )
+    };
+    Some(format!(
+        "damper gap at next blow: {:.4} mm (not returned{touch}; see docs/studies.md)",
+        gap * 1e3
+    ))
 }

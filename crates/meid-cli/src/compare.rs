@@ -10,7 +10,7 @@ use meid::analysis::spectrum::{
 };
 use meid::plot::{self, LinePlot, Series, SpectrumPlot};
 
-use crate::load;
+use crate::args::{PrintArgs, RunArgs};
 
 #[derive(clap::Args)]
 pub struct CompareArgs {
@@ -37,25 +37,14 @@ pub struct CompareArgs {
     /// Read mode levels at these frequencies (Hz) instead of the model's dominant modes.
     #[arg(long, value_name = "HZ", value_delimiter = ',')]
     frequencies: Vec<f64>,
-    /// Integration method: exact or dopri5.
-    #[arg(long, value_parser = ["exact", "dopri5"])]
-    method: Option<String>,
-    /// Output sample rate (Hz).
-    #[arg(long, value_name = "HZ")]
-    rate: Option<f64>,
-    /// Override a model field (repeatable).
-    #[arg(long = "set", value_name = "PATH=VALUE")]
-    set: Vec<String>,
-    /// Print the comparison as JSON on stdout.
-    #[arg(long)]
-    json: bool,
-    /// Print nothing but errors.
-    #[arg(short, long)]
-    quiet: bool,
+    #[command(flatten)]
+    run: RunArgs,
+    #[command(flatten)]
+    print: PrintArgs,
 }
 
 pub fn run(a: CompareArgs) -> Result<()> {
-    let model = load(&a.model, &a.set, a.method.as_deref(), None, a.rate)?;
+    let model = a.run.load(&a.model, None)?;
     let window = match a.window.as_str() {
         "hann" => Window::Hann,
         "flattop" => Window::FlatTop,
@@ -80,9 +69,9 @@ pub fn run(a: CompareArgs) -> Result<()> {
     if let Some(dir) = &a.output {
         write_outputs(dir, &result)?;
     }
-    if a.json {
+    if a.print.json {
         println!("{}", serde_json::to_string_pretty(&result.summary())?);
-    } else if !a.quiet {
+    } else if a.print.human() {
         println!("meid compare — {}", a.model.display());
         print!("{}", result.table_text());
         if let Some(dir) = &a.output {

@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 
 use meid::model::Model;
 
+mod args;
 mod blows;
 mod compare;
 mod modes;

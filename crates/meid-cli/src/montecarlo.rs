@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 use meid::analysis::montecarlo::{histogram_outline, MonteCarlo, Uncertain, METRICS};
 use meid::plot::{self, AreaPlot, Series};
 
+use crate::args::{MethodArg, PrintArgs, SetArgs};
 use crate::load;
 
 #[derive(clap::Args)]
@@ -32,25 +33,25 @@ pub struct MonteCarloArgs {
     /// Write samples.csv, stats.json and the histogram into DIR.
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
-    /// Integration method: exact or dopri5.
-    #[arg(long, value_parser = ["exact", "dopri5"])]
-    method: Option<String>,
+    #[command(flatten)]
+    method: MethodArg,
     /// Simulated time per sample (s).
     #[arg(long, value_name = "S")]
     duration: Option<f64>,
-    /// Override a model field (repeatable).
-    #[arg(long = "set", value_name = "PATH=VALUE")]
-    set: Vec<String>,
-    /// Print the statistics as JSON on stdout.
-    #[arg(long)]
-    json: bool,
-    /// Print nothing but errors.
-    #[arg(short, long)]
-    quiet: bool,
+    #[command(flatten)]
+    set: SetArgs,
+    #[command(flatten)]
+    print: PrintArgs,
 }
 
 pub fn run(a: MonteCarloArgs) -> Result<()> {
-    let model = load(&a.model, &a.set, a.method.as_deref(), a.duration, None)?;
+    let model = load(
+        &a.model,
+        &a.set.set,
+        a.method.method.as_deref(),
+        a.duration,
+        None,
+    )?;
     let inputs = a
         .vary
         .iter()
@@ -104,9 +105,9 @@ pub fn run(a: MonteCarloArgs) -> Result<()> {
             )?;
         }
     }
-    if a.json {
+    if a.print.json {
         println!("{}", serde_json::to_string_pretty(&stats)?);
-    } else if !a.quiet {
+    } else if a.print.human() {
         println!(
             "meid montecarlo — {} samples, seed {}, {} failed",
             r.samples.len(),

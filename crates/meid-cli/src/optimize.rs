@@ -7,6 +7,7 @@ use anyhow::{bail, Context, Result};
 use meid::analysis::study::{Objective, OptimizeStudy};
 use meid::analysis::sweep::Quantity;
 
+use crate::args::SetArgs;
 use crate::load;
 
 #[derive(clap::Args)]
@@ -29,9 +30,8 @@ pub struct OptimizeArgs {
     /// Bounds of a variable, PATH=LO..HI (repeatable). Positive bounds are searched in log scale.
     #[arg(long = "bounds", value_name = "PATH=LO..HI")]
     bounds: Vec<String>,
-    /// Override a model field (repeatable), as in `meid simulate`.
-    #[arg(long = "set", value_name = "PATH=VALUE")]
-    set: Vec<String>,
+    #[command(flatten)]
+    set: SetArgs,
     /// Simulation budget.
     #[arg(long, value_name = "N", default_value_t = 400)]
     max_simulations: usize,
@@ -59,7 +59,7 @@ fn parse_bounds(s: &str) -> Result<(Quantity, (f64, f64))> {
 }
 
 pub fn run(a: OptimizeArgs) -> Result<()> {
-    let model = load(&a.model, &a.set, None, None, None)?;
+    let model = load(&a.model, &a.set.set, None, None, None)?;
     let over: Vec<Quantity> = a
         .over
         .iter()

@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 
 use meid::analysis;
-use meid::model::{Case, Model};
+use meid::model::Model;
 
-use crate::load;
+use crate::args::{CaseArg, PrintArgs, RunArgs};
 
 #[derive(clap::Args)]
 pub struct SimulateArgs {
@@ -17,33 +17,20 @@ pub struct SimulateArgs {
     /// Write time histories (history.csv) and the summary (summary.json) into DIR.
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
-    /// Print the summary as JSON on stdout.
-    #[arg(long)]
-    json: bool,
-    /// Integration method: exact (piecewise-linear, closed form) or dopri5.
-    #[arg(long, value_parser = ["exact", "dopri5"])]
-    method: Option<String>,
     /// Simulated time (s).
     #[arg(long, value_name = "S")]
     duration: Option<f64>,
-    /// Output sample rate (Hz).
-    #[arg(long, value_name = "HZ")]
-    rate: Option<f64>,
-    /// Override a model field, e.g. --set contact.bed_damper.stiffness=1.26e8 (repeatable).
-    #[arg(long = "set", value_name = "PATH=VALUE")]
-    set: Vec<String>,
-    /// Simulate the bare machine or the added-mass alternative instead of the file's case.
-    #[arg(long, value_parser = ["as-specified", "none", "damper", "added-mass"], default_value = "as-specified")]
-    case: String,
-    /// No progress or summary on the terminal (errors are still reported).
-    #[arg(short, long)]
-    quiet: bool,
+    #[command(flatten)]
+    run: RunArgs,
+    #[command(flatten)]
+    case: CaseArg,
+    #[command(flatten)]
+    print: PrintArgs,
 }
 
 pub fn run(a: SimulateArgs) -> Result<()> {
-    let model = load(&a.model, &a.set, a.method.as_deref(), a.duration, a.rate)?;
-    let case: Case = a.case.parse()?;
-    let sys = model.impact_system(case)?;
+    let model = a.run.load(&a.model, a.duration)?;
+    let sys = model.impact_system(a.case.parse()?)?;
     let opts = model.options();
     let record = a.output.is_some();
     let run = analysis::simulate(&sys, &opts, record).context("simulation failed")?;
@@ -54,9 +41,9 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         }
         meid::io::write_json(&dir.join("summary.json"), s)?;
     }
-    if a.json {
+    if a.print.json {
         println!("{}", serde_json::to_string_pretty(s)?);
-    } else if !a.quiet {
+    } else if a.print.human() {
         print_summary(&model, s, a.output.as_deref());
     }
     Ok(())

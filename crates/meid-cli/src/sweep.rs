@@ -11,6 +11,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use meid::analysis::sweep::{Quantity, Spacing, Sweep, SweepResult, Vary, DERIVED, METRICS};
 use meid::plot::{heat_map, line_plot, HeatMap, LinePlot, Series};
 
+use crate::args::SetArgs;
 use crate::load;
 
 #[derive(clap::Args)]
@@ -33,9 +34,8 @@ pub struct SweepArgs {
     /// No progress bar or summary.
     #[arg(short, long)]
     quiet: bool,
-    /// Override a model field (repeatable), as in `meid simulate`.
-    #[arg(long = "set", value_name = "PATH=VALUE")]
-    set: Vec<String>,
+    #[command(flatten)]
+    set: SetArgs,
     /// Metric drawn in the pictures and summarised (a sweep.csv column).
     #[arg(long, value_name = "NAME", default_value = "energy_ratio")]
     metric: String,
@@ -55,7 +55,7 @@ pub fn run(a: SweepArgs) -> Result<()> {
             METRICS.join(", ")
         );
     }
-    let model = load(&a.model, &a.set, None, a.duration, None)?;
+    let model = load(&a.model, &a.set.set, None, a.duration, None)?;
     let vary = a
         .vary
         .iter()

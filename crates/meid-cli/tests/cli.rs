@@ -1,25 +1,18 @@
 //! The `meid` command end to end: good runs and one test per class of bad input.
 
+mod common;
+
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn meid() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_meid"))
-}
+use common::{meid, paper_example as example, stderr};
 
-fn example() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-lumped.toml")
+fn tmpdir(tag: &str) -> PathBuf {
+    common::tmpdir("cli", tag)
 }
 
 fn example_text() -> String {
     std::fs::read_to_string(example()).unwrap()
-}
-
-fn tmpdir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("meid-cli-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 /// Writes `text` as a model file and runs `meid simulate` on it.
@@ -29,10 +22,6 @@ fn run_model(tag: &str, text: &str, extra: &[&str]) -> (Output, PathBuf) {
     std::fs::write(&f, text).unwrap();
     let out = meid().arg("simulate").arg(&f).args(extra).output().unwrap();
     (out, f)
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
 }
 
 #[test]

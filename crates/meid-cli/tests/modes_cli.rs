@@ -1,23 +1,13 @@
 //! `meid modes` end to end: table, JSON keys, files, VTU structure, bad input.
 
+mod common;
+
 use std::path::PathBuf;
-use std::process::Command;
 
-fn meid() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_meid"))
-}
-
-fn example(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples")
-        .join(name)
-}
+use common::{example_file as example, meid};
 
 fn tmpdir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("meid-modes-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::tmpdir("modes", tag)
 }
 
 /// Minimal well-formedness check: every start tag is closed in order (no attributes with '>').

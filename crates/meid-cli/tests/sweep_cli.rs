@@ -3,31 +3,14 @@
 //! References: thread-count independence and resume are byte-for-byte comparisons; the
 //! minimum over w_d/w_s at w_s/w_ref = 150 must lie in [0.8, 1.25] (paper section 4.1).
 
+mod common;
+
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
-fn meid() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_meid"))
-}
-
-fn example() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-lumped.toml")
-}
+use common::{meid, ok, paper_example as example};
 
 fn tmpdir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("meid-sweep-cli-{}-{tag}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn ok(o: Output) -> String {
-    assert!(
-        o.status.success(),
-        "stderr: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8(o.stdout).unwrap()
+    common::tmpdir("sweep-cli", tag)
 }
 
 fn sweep(dir: &PathBuf, extra: &[&str]) -> String {

@@ -154,6 +154,111 @@ fn e2s<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
 
+// ---------------------------------------------------------------- shared frame
+
+type Chart<'a, DB, X, Y> = ChartContext<'a, DB, Cartesian2d<X, Y>>;
+
+/// The frame every main chart shares: caption, margin and the axis label areas.
+fn frame<'a, DB, X, Y>(
+    area: &'a DrawingArea<DB, Shift>,
+    title: &str,
+    xc: X,
+    yc: Y,
+) -> std::result::Result<Chart<'a, DB, X, Y>, String>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    ChartBuilder::on(area)
+        .caption(title, (FONT, 26))
+        .margin(18)
+        .x_label_area_size(58)
+        .y_label_area_size(88)
+        .build_cartesian_2d(xc, yc)
+        .map_err(e2s)
+}
+
+/// Axes with their descriptions and tick labels; a light grid unless `grid` is false.
+fn axes<DB, X, Y>(
+    chart: &mut Chart<'_, DB, X, Y>,
+    x_label: &str,
+    y_label: &str,
+    grid: bool,
+) -> std::result::Result<(), String>
+where
+    DB: DrawingBackend,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let mut mesh = chart.configure_mesh();
+    if grid {
+        mesh.bold_line_style(RGBColor(215, 215, 215))
+            .light_line_style(RGBColor(240, 240, 240));
+    } else {
+        mesh.disable_mesh();
+    }
+    mesh.x_desc(x_label)
+        .y_desc(y_label)
+        .axis_desc_style((FONT, 20))
+        .label_style((FONT, 15))
+        .x_label_formatter(&fmt_tick)
+        .y_label_formatter(&fmt_tick)
+        .draw()
+        .map_err(e2s)
+}
+
+/// The legend box: white at the upper right on curves, dark at the upper left on a heat map.
+fn legend<'a, DB, X, Y>(
+    chart: &mut Chart<'a, DB, X, Y>,
+    dark: bool,
+) -> std::result::Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let mut l = chart.configure_series_labels();
+    if dark {
+        l.background_style(RGBColor(90, 90, 90).mix(0.9))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font((FONT, 15).into_font().color(&WHITE));
+    } else {
+        l.label_font((FONT, 15))
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(120, 120, 120))
+            .position(SeriesLabelPosition::UpperRight);
+    }
+    l.draw().map_err(e2s)
+}
+
+/// Grey × at the bottom of the frame for the x of failed (non-finite) points, with a legend
+/// entry; nothing when there are none.
+fn failed_marks<'a, DB, X, Y>(
+    chart: &mut Chart<'a, DB, X, Y>,
+    xs: &[f64],
+    y_bottom: f64,
+) -> std::result::Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    if xs.is_empty() {
+        return Ok(());
+    }
+    chart
+        .draw_series(
+            xs.iter()
+                .map(|&x| Cross::new((x, y_bottom), 6, FAILED.stroke_width(2))),
+        )
+        .map_err(e2s)?
+        .label("failed point")
+        .legend(|(x, y)| Cross::new((x + 12, y), 5, FAILED.stroke_width(2)));
+    Ok(())
+}
+
 // ---------------------------------------------------------------- line plots
 
 /// Draws a family of curves with a legend to `<path_stem>.png` and `<path_stem>.svg`.
@@ -218,25 +323,8 @@ where
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
     let y_bottom = yc.range().start;
-    let mut chart = ChartBuilder::on(area)
-        .caption(&p.title, (FONT, 26))
-        .margin(18)
-        .x_label_area_size(58)
-        .y_label_area_size(88)
-        .build_cartesian_2d(xc, yc)
-        .map_err(e2s)?;
-    chart
-        .configure_mesh()
-        .x_desc(&p.x_label)
-        .y_desc(&p.y_label)
-        .axis_desc_style((FONT, 20))
-        .label_style((FONT, 15))
-        .x_label_formatter(&fmt_tick)
-        .y_label_formatter(&fmt_tick)
-        .bold_line_style(RGBColor(215, 215, 215))
-        .light_line_style(RGBColor(240, 240, 240))
-        .draw()
-        .map_err(e2s)?;
+    let mut chart = frame(area, &p.title, xc, yc)?;
+    axes(&mut chart, &p.x_label, &p.y_label, true)?;
 
     let mut failed_x = Vec::new();
     let mut any_label = false;
@@ -280,27 +368,10 @@ where
             }
         }
     }
-    if !failed_x.is_empty() {
-        any_label = true;
-        chart
-            .draw_series(
-                failed_x
-                    .iter()
-                    .map(|&x| Cross::new((x, y_bottom), 6, FAILED.stroke_width(2))),
-            )
-            .map_err(e2s)?
-            .label("failed point")
-            .legend(|(x, y)| Cross::new((x + 12, y), 5, FAILED.stroke_width(2)));
-    }
+    any_label |= !failed_x.is_empty();
+    failed_marks(&mut chart, &failed_x, y_bottom)?;
     if any_label {
-        chart
-            .configure_series_labels()
-            .label_font((FONT, 15))
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(120, 120, 120))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(e2s)?;
+        legend(&mut chart, false)?;
     }
     Ok(())
 }
@@ -397,25 +468,13 @@ impl Figure for AreaPlot {
         let xr = xe.0..xe.1;
         let yr = padded(ye, false);
         let y_bottom = yr.start;
-        let mut chart = ChartBuilder::on(area)
-            .caption(&self.title, (FONT, 26))
-            .margin(18)
-            .x_label_area_size(58)
-            .y_label_area_size(88)
-            .build_cartesian_2d(xr, yr)
-            .map_err(e2s)?;
-        chart
-            .configure_mesh()
-            .x_desc(&self.x_label)
-            .y_desc(&self.y_label)
-            .axis_desc_style((FONT, 20))
-            .label_style((FONT, 15))
-            .x_label_formatter(&fmt_tick)
-            .y_label_formatter(&fmt_tick)
-            .bold_line_style(RGBColor(215, 215, 215))
-            .light_line_style(RGBColor(240, 240, 240))
-            .draw()
-            .map_err(e2s)?;
+        let mut chart = frame(
+            area,
+            &self.title,
+            RangedCoordf64::from(xr),
+            RangedCoordf64::from(yr),
+        )?;
+        axes(&mut chart, &self.x_label, &self.y_label, true)?;
         let fill_alpha = if self.stacked { 0.55 } else { 0.25 };
         let mut failed_x = Vec::new();
         for (k, (s, (lo, hi))) in self.series.iter().zip(&bands).enumerate() {
@@ -443,25 +502,8 @@ impl Figure for AreaPlot {
                     .map(|(x, _)| *x),
             );
         }
-        if !failed_x.is_empty() {
-            chart
-                .draw_series(
-                    failed_x
-                        .iter()
-                        .map(|&x| Cross::new((x, y_bottom), 6, FAILED.stroke_width(2))),
-                )
-                .map_err(e2s)?
-                .label("failed point")
-                .legend(|(x, y)| Cross::new((x + 10, y), 5, FAILED.stroke_width(2)));
-        }
-        chart
-            .configure_series_labels()
-            .label_font((FONT, 15))
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(120, 120, 120))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(e2s)?;
+        failed_marks(&mut chart, &failed_x, y_bottom)?;
+        legend(&mut chart, false)?;
         Ok(())
     }
 }
@@ -629,24 +671,8 @@ where
 {
     let nx = map.x.len();
     let zr = map.z_range();
-    let mut chart = ChartBuilder::on(area)
-        .caption(&map.title, (FONT, 26))
-        .margin(18)
-        .x_label_area_size(58)
-        .y_label_area_size(88)
-        .build_cartesian_2d(xc, yc)
-        .map_err(e2s)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc(&map.x_label)
-        .y_desc(&map.y_label)
-        .axis_desc_style((FONT, 20))
-        .label_style((FONT, 15))
-        .x_label_formatter(&fmt_tick)
-        .y_label_formatter(&fmt_tick)
-        .draw()
-        .map_err(e2s)?;
+    let mut chart = frame(area, &map.title, xc, yc)?;
+    axes(&mut chart, &map.x_label, &map.y_label, false)?;
     chart
         .draw_series(map.z.iter().enumerate().map(|(k, &z)| {
             let (i, j) = (k % nx, k / nx);
@@ -709,15 +735,7 @@ where
         }
     }
     if any_label {
-        chart
-            .configure_series_labels()
-            .label_font((FONT, 15))
-            .background_style(RGBColor(90, 90, 90).mix(0.9))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font((FONT, 15).into_font().color(&WHITE))
-            .draw()
-            .map_err(e2s)?;
+        legend(&mut chart, true)?;
     }
     Ok(())
 }
