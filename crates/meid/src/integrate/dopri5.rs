@@ -14,7 +14,7 @@
 //! from the interpolated state in the new mode. The dissipated energy is integrated as an
 //! extra state component (not under error control).
 
-use super::roots::{first_crossing, Scalar, SearchOptions};
+use super::roots::{first_crossing, hermite_dip, Scalar, SearchOptions};
 use super::switching::{implied_mode, lex_sign, select_mode};
 use super::{CollisionEnd, Event, Grid, Observer, Options, Solution, Totals};
 use crate::impact::{dot, ContactLaw, DashpotKind, ImpactSystem, Indicator, Mode, Switch};
@@ -487,6 +487,20 @@ pub fn solve_from(
         for (i, &ind) in inds.iter().enumerate() {
             if signs[i] == 0.0 {
                 continue;
+            }
+            if let Some(l) = linear_vecs[i].as_deref() {
+                // Values and slopes at the step ends come from the state and the stages
+                // (k₁ = f(y), k₇ = f(y_new)); the search on the dense output runs only where the
+                // step may hold a crossing: a sign change at the end, or a dip of the cubic
+                // Hermite interpolant in between (what its first interval would test).
+                let sg = signs[i];
+                let ga = (sg * dot(l, &y[..nx])).max(0.0);
+                let da = sg * dot(l, &k[0][..nx]);
+                let gb = sg * dot(l, &ynew[..nx]);
+                let db = sg * dot(l, &k[6][..nx]);
+                if gb >= 0.0 && hermite_dip(ga, da, gb, db, h).is_none() {
+                    continue;
+                }
             }
             let f = OnStep {
                 dense: &dense,

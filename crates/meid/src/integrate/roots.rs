@@ -378,7 +378,7 @@ fn proved_positive(ga: f64, da: f64, gb: f64, db: f64, m2: f64, len: f64) -> boo
 
 /// If the cubic Hermite interpolant through (0, ga, da), (len, gb, db) dips to ≤ 0 inside,
 /// returns where (relative to the interval start).
-fn hermite_dip(ga: f64, da: f64, gb: f64, db: f64, len: f64) -> Option<f64> {
+pub(crate) fn hermite_dip(ga: f64, da: f64, gb: f64, db: f64, len: f64) -> Option<f64> {
     // p(u) on u in [0,1]: h00 ga + h10 len da + h01 gb + h11 len db.
     let p = |u: f64| {
         let u2 = u * u;
