@@ -256,41 +256,11 @@ impl<'f, F: Scalar + ?Sized> Search<'f, F> {
 /// located to the search tolerance; sign changes from − to + (minima) are only bracketed and
 /// stepped over, not refined.
 pub fn maxima<F: Scalar + ?Sized>(slope: &F, s_max: f64, opts: SearchOptions) -> Vec<f64> {
-    let mut out = Vec::new();
-    let mut start = 0.0;
-    let (g0, d0) = slope.value_slope(0.0);
-    let mut sign = if g0.abs() > slope.noise() {
-        g0.signum()
-    } else if d0 != 0.0 {
-        d0.signum()
-    } else {
-        1.0
-    };
-    while start < s_max {
-        let shifted = Shifted {
-            f: slope,
-            offset: start,
-        };
-        let mut search = Search::new(&shifted, sign, opts);
-        match search.advance(s_max - start) {
-            Some((a, b)) => {
-                let t = if sign > 0.0 {
-                    let t = start + search.refine(a, b);
-                    out.push(t);
-                    t
-                } else {
-                    start + b
-                };
-                if t <= start || out.len() > 1_000_000 {
-                    break;
-                }
-                start = t;
-                sign = -sign;
-            }
-            None => break,
-        }
-    }
-    out
+    crossings(slope, s_max, opts, false)
+        .into_iter()
+        .filter(|&(_, sign)| sign > 0.0)
+        .map(|(t, _)| t)
+        .collect()
 }
 
 /// All sign changes of `g` in `(0, s_max]`, in order, each with the sign `g` had before it.
@@ -298,6 +268,17 @@ pub fn all_crossings<F: Scalar + ?Sized>(
     f: &F,
     s_max: f64,
     opts: SearchOptions,
+) -> Vec<(f64, f64)> {
+    crossings(f, s_max, opts, true)
+}
+
+/// Sign changes of `g` in order with the sign before each; those from − to + are refined only
+/// when `refine_rising` (otherwise the end of their bracket is reported).
+fn crossings<F: Scalar + ?Sized>(
+    f: &F,
+    s_max: f64,
+    opts: SearchOptions,
+    refine_rising: bool,
 ) -> Vec<(f64, f64)> {
     let mut out = Vec::new();
     let mut start = 0.0;
@@ -311,20 +292,23 @@ pub fn all_crossings<F: Scalar + ?Sized>(
     };
     while start < s_max {
         let shifted = Shifted { f, offset: start };
-        match first_crossing(&shifted, s_max - start, sign, opts) {
-            Some(s) => {
-                let t = start + s;
+        let mut search = Search::new(&shifted, sign, opts);
+        match search.advance(s_max - start) {
+            Some((a, b)) => {
+                let t = start
+                    + if sign > 0.0 || refine_rising {
+                        search.refine(a, b)
+                    } else {
+                        b
+                    };
                 out.push((t, sign));
-                if t <= start {
+                if t <= start || out.len() > 1_000_000 {
                     break;
                 }
                 start = t;
                 sign = -sign;
             }
             None => break,
-        }
-        if out.len() > 1_000_000 {
-            break;
         }
     }
     out
