@@ -1,11 +1,14 @@
 //! Exact event-driven propagation of the piecewise-linear impact system.
 //!
 //! Each mode's closed-form [`Propagator`] is built the first time the mode is entered and kept
-//! for the run. A stretch in one mode is handled as follows:
+//! for the run (and in a small per-thread cache, [`Propagator::shared`], for the next run of
+//! the same matrices). A stretch in one mode is handled as follows:
 //!
-//! 1. the side of every indicator at the stretch start ([`super::switching::lex_sign`]);
-//! 2. the first sign change of any indicator on the closed-form solution ([`super::roots`]),
-//!    capped by the end of the run;
+//! 1. the side of every indicator at the stretch start ([`super::switching::lex_sign`], from the
+//!    mode selection that chose the mode);
+//! 2. the first sign change of any indicator on the closed-form solution ([`super::roots`]):
+//!    all indicators are searched over common windows growing from one fastest period, so the
+//!    search ends at the earliest crossing; capped by the end of the run;
 //! 3. output samples inside the stretch: the first evaluated in closed form, the next ones by
 //!    the real transition matrix `E = exp(A Δt)` (one mat-vec per sample), re-seeded from the
 //!    closed form every 64 samples;
