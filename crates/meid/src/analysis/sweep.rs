@@ -3,7 +3,7 @@
 //!
 //! A [`Sweep`] varies one or more quantities ([`Vary`]) over a Cartesian grid, simulates one
 //! blow at every point with [`crate::analysis::simulate`] and records every metric of the
-//! [`Summary`](crate::analysis::Summary) plus the varied values and the derived K_s, K_d, m_d.
+//! [`Summary`] plus the varied values and the derived K_s, K_d, m_d.
 //!
 //! # Quantities
 //!

@@ -4,7 +4,7 @@
 //! for the run (and in a small per-thread cache, [`Propagator::shared`], for the next run of
 //! the same matrices). A stretch in one mode is handled as follows:
 //!
-//! 1. the side of every indicator at the stretch start ([`super::switching::lex_sign`], from the
+//! 1. the side of every indicator at the stretch start (`switching::lex_sign`, from the
 //!    mode selection that chose the mode);
 //! 2. the first sign change of any indicator on the closed-form solution ([`super::roots`]):
 //!    all indicators are searched over common windows growing from one fastest period, so the
@@ -14,7 +14,7 @@
 //!    closed form every 64 samples;
 //! 4. exact contact-force maxima (roots of the force's derivative), closed-contact times, and
 //!    the dissipated energy `∫ ẋᵀ C_σ ẋ dt` integrated in closed form;
-//! 5. the new mode at the switch ([`super::switching::select_mode`]).
+//! 5. the new mode at the switch (`switching::select_mode`).
 
 use std::collections::HashMap;
 
