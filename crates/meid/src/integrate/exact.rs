@@ -34,6 +34,16 @@ struct ModeData {
     step: Option<Mat<f64>>,
 }
 
+/// A stretch handled by the Taylor propagator: the switch at `s_end` lies within its validity.
+struct TaylorStretch {
+    prop: Propagator,
+    s_end: f64,
+    /// The mode's damping matrix (dissipation).
+    c: Mat<f64>,
+    /// Transition matrix for the output step.
+    step: Option<Mat<f64>>,
+}
+
 /// Runs the exact propagator. See the module documentation.
 pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Result<Solution> {
     solve_from(sys, &sys.initial_state(), opts, obs)
@@ -95,70 +105,68 @@ pub fn solve_from(
     let mut buf2 = vec![0.0; n];
 
     loop {
-        if let std::collections::hash_map::Entry::Vacant(e) = cache.entry(mode) {
-            e.insert(build(mode, (*a_of(mode)).clone())?);
-        }
-        let md = cache
-            .get_mut(&mode)
-            .ok_or_else(|| Error::numerical("exact", "mode cache"))?;
-        if let (Some(g), None) = (&grid, &md.step) {
-            md.step = Some(md.prop.transition(g.dt));
-        }
-        let md = &*md;
-        let prop = &md.prop;
-        let seg = prop.segment(&x);
-        let period = prop.period();
         let search = SearchOptions::default();
+        let horizon = t_end - t;
         segments += 1;
-
-        // 1-2: the first switch. All indicators are searched over common windows growing
-        // from one fastest period, so the search stops at the earliest crossing.
-        let mut s_end = t_end - t;
-        let mut switched = false;
-        let mut funcs = Vec::with_capacity(ind_vecs.len());
-        for (l, &sign0) in ind_vecs.iter().zip(&signs) {
-            if sign0 != 0.0 {
-                // (sign 0: identically zero, never crosses)
-                funcs.push((seg.functional(l), sign0));
-            }
-        }
-        let mut searches: Vec<Search<'_, Functional<'_>>> = funcs
-            .iter()
-            .map(|(f, sign0)| Search::new(f, *sign0, search))
-            .collect();
-        let horizon = s_end;
-        let mut limit = if period.is_finite() {
-            period.min(horizon)
-        } else {
-            horizon
-        };
-        loop {
-            // Brackets of the crossings up to `limit`; the earliest root is refined, then any
-            // other bracket starting before it.
-            let mut brackets: Vec<(f64, f64, usize)> = Vec::new();
-            for (i, sr) in searches.iter_mut().enumerate() {
-                if let Some((a, b)) = sr.advance(limit) {
-                    brackets.push((a, b, i));
-                }
-            }
-            if !brackets.is_empty() {
-                brackets.sort_by(|p, q| p.0.total_cmp(&q.0));
-                let mut first = f64::INFINITY;
-                for &(a, b, i) in &brackets {
-                    if a < first {
-                        first = first.min(searches[i].refine(a, b));
+        // A mode met for the first time is tried with the Taylor propagator from this state
+        // first: when a switch comes within its validity (a few tenths of the fastest period)
+        // the stretch needs no eigen-decomposition. Otherwise the closed form is built. The
+        // choice depends only on the run's own history (never on the per-thread cache), so
+        // results do not depend on the thread count.
+        let mut taylor: Option<TaylorStretch> = None;
+        if !cache.contains_key(&mode) {
+            if let Some(tp) = Propagator::taylor((*a_of(mode)).clone(), &x) {
+                let seg = tp.segment(&x);
+                let reach = tp.validity().min(horizon);
+                if let Some(s) = first_switch(&seg, &ind_vecs, &signs, tp.period(), reach, search) {
+                    if s < reach {
+                        let (_, c) = sys.matrices(mode);
+                        let step = grid.as_ref().map(|g| tp.transition(g.dt));
+                        taylor = Some(TaylorStretch {
+                            prop: tp,
+                            s_end: s,
+                            c,
+                            step,
+                        });
                     }
                 }
-                if first < s_end {
-                    s_end = first;
-                    switched = true;
-                }
-                break;
             }
-            if limit >= horizon {
-                break;
+        }
+        if taylor.is_none() {
+            if let std::collections::hash_map::Entry::Vacant(e) = cache.entry(mode) {
+                e.insert(build(mode, (*a_of(mode)).clone())?);
             }
-            limit = (4.0 * limit).min(horizon);
+            let md = cache
+                .get_mut(&mode)
+                .ok_or_else(|| Error::numerical("exact", "mode cache"))?;
+            if let (Some(g), None) = (&grid, &md.step) {
+                md.step = Some(md.prop.transition(g.dt));
+            }
+        }
+        let (prop, c_mode, step_mat): (&Propagator, &Mat<f64>, Option<&Mat<f64>>) = match &taylor {
+            Some(ts) => (&ts.prop, &ts.c, ts.step.as_ref()),
+            None => {
+                let md = cache
+                    .get(&mode)
+                    .ok_or_else(|| Error::numerical("exact", "mode cache"))?;
+                (&*md.prop, &md.c, md.step.as_ref())
+            }
+        };
+        let seg = prop.segment(&x);
+        let period = prop.period();
+
+        // 1-2: the first switch.
+        let mut s_end = horizon;
+        let mut switched = false;
+        let found = match &taylor {
+            Some(ts) => Some(ts.s_end),
+            None => first_switch(&seg, &ind_vecs, &signs, period, horizon, search),
+        };
+        if let Some(s) = found {
+            if s < s_end {
+                s_end = s;
+                switched = true;
+            }
         }
         if s_end < 0.0 {
             s_end = 0.0;
@@ -169,7 +177,7 @@ pub fn solve_from(
             let last = !switched;
             let mut j = g.next;
             let mut k = 0usize;
-            let step = md.step.as_ref();
+            let step = step_mat;
             loop {
                 let tj = g.time(j);
                 let inside = if last {
@@ -213,7 +221,7 @@ pub fn solve_from(
                 totals.peak_force[ci] = totals.peak_force[ci].max(peak);
             }
         }
-        totals.dissipated += dissipated(&seg, &md.c, nd, s_end);
+        totals.dissipated += dissipated(&seg, c_mode, nd, s_end);
 
         // Advance.
         seg.state(s_end, &mut buf);
@@ -289,6 +297,58 @@ pub fn solve_from(
         rejected: 0,
         fallback_modes,
     })
+}
+
+/// The first switch on a segment within `horizon` (s after its start), or `None`. All
+/// indicators (those with a non-zero sign) are searched over common windows growing from one
+/// fastest period, so the search ends at the earliest crossing; only the earliest bracket is
+/// refined (and any other bracket starting before its root).
+fn first_switch(
+    seg: &Segment<'_>,
+    ind_vecs: &[Vec<f64>],
+    signs: &[f64],
+    period: f64,
+    horizon: f64,
+    search: SearchOptions,
+) -> Option<f64> {
+    let mut funcs = Vec::with_capacity(ind_vecs.len());
+    for (l, &sign0) in ind_vecs.iter().zip(signs) {
+        if sign0 != 0.0 {
+            // (sign 0: identically zero, never crosses)
+            funcs.push((seg.functional(l), sign0));
+        }
+    }
+    let mut searches: Vec<Search<'_, Functional<'_>>> = funcs
+        .iter()
+        .map(|(f, sign0)| Search::new(f, *sign0, search))
+        .collect();
+    let mut limit = if period.is_finite() {
+        period.min(horizon)
+    } else {
+        horizon
+    };
+    loop {
+        let mut brackets: Vec<(f64, f64, usize)> = Vec::new();
+        for (i, sr) in searches.iter_mut().enumerate() {
+            if let Some((a, b)) = sr.advance(limit) {
+                brackets.push((a, b, i));
+            }
+        }
+        if !brackets.is_empty() {
+            brackets.sort_by(|p, q| p.0.total_cmp(&q.0));
+            let mut first = f64::INFINITY;
+            for &(a, b, i) in &brackets {
+                if a < first {
+                    first = first.min(searches[i].refine(a, b));
+                }
+            }
+            return Some(first);
+        }
+        if limit >= horizon {
+            return None;
+        }
+        limit = (4.0 * limit).min(horizon);
+    }
 }
 
 /// `ℓ` with `f = ℓᵀX` for a closed linear contact's force.

@@ -65,7 +65,18 @@ enum Kind {
         d: Vec<f64>,
         b: Mat<f64>,
     },
+    /// Truncated Taylor series from one start state, `X(s) = Σ_{k≤P} c_k s^k`,
+    /// `c_k = A^k X₀ / k!`, valid on `[0, tau]` with `tau = 1/‖D⁻¹AD‖_F` (balanced): there
+    /// `‖D⁻¹(X(s) − Σ)‖ ≤ ‖D⁻¹X₀‖ Σ_{k>P} 1/k! < 1e-19 ‖D⁻¹X₀‖` for P = 20.
+    Taylor {
+        coef: Vec<Vec<f64>>,
+        tau: f64,
+        rate: f64,
+    },
 }
+
+/// Order of the Taylor propagator.
+const TAYLOR_ORDER: usize = 20;
 
 #[derive(Debug, Clone)]
 struct Spectral {
@@ -184,6 +195,62 @@ impl Propagator {
         }
     }
 
+    /// The Taylor propagator of `Ẋ = A X` from `x0`, valid for `s ∈ [0, validity()]` (a few
+    /// tenths of the fastest period). Building it costs `P` mat-vecs instead of an
+    /// eigen-decomposition: the exact integrator uses it for stretches that end soon after they
+    /// start (a dashpot switching off 0.8 µs into a blow), and builds the closed form otherwise.
+    pub fn taylor(a: Mat<f64>, x0: &[f64]) -> Option<Self> {
+        let n = a.nrows();
+        if n == 0 || x0.len() != n {
+            return None;
+        }
+        let d = super::expm::balance(&a);
+        let mut f2 = 0.0;
+        for j in 0..n {
+            for i in 0..n {
+                let v = a[(i, j)] * d[j] / d[i];
+                f2 += v * v;
+            }
+        }
+        let rate = f2.sqrt();
+        if !(rate > 0.0 && rate.is_finite()) {
+            return None;
+        }
+        let mut coef = Vec::with_capacity(TAYLOR_ORDER + 1);
+        coef.push(x0.to_vec());
+        for k in 1..=TAYLOR_ORDER {
+            let prev = &coef[k - 1];
+            let mut next = vec![0.0; n];
+            for (j, &pj) in prev.iter().enumerate() {
+                if pj != 0.0 {
+                    for (nx, aij) in next.iter_mut().zip(a.col(j).iter()) {
+                        *nx += aij * pj;
+                    }
+                }
+            }
+            let inv = 1.0 / k as f64;
+            next.iter_mut().for_each(|v| *v *= inv);
+            coef.push(next);
+        }
+        Some(Self {
+            a,
+            dofs: n / 2,
+            kind: Kind::Taylor {
+                coef,
+                tau: 1.0 / rate,
+                rate,
+            },
+        })
+    }
+
+    /// How far from its start the propagator holds (s): the Taylor form's `tau`, else infinity.
+    pub fn validity(&self) -> f64 {
+        match &self.kind {
+            Kind::Taylor { tau, .. } => *tau,
+            _ => f64::INFINITY,
+        }
+    }
+
     /// True when this mode uses the spectral (not the matrix-exponential) form.
     pub fn is_spectral(&self) -> bool {
         matches!(self.kind, Kind::Spectral(_))
@@ -194,6 +261,7 @@ impl Propagator {
         let lam_max = match &self.kind {
             Kind::Spectral(s) => s.lam_max,
             Kind::Expm { norm_f, .. } => *norm_f,
+            Kind::Taylor { rate, .. } => *rate,
         };
         if lam_max > 0.0 {
             2.0 * std::f64::consts::PI / lam_max
@@ -219,7 +287,7 @@ impl Propagator {
                         .collect();
                 (alpha0, alpha_dot, coef)
             }
-            Kind::Expm { .. } => (Vec::new(), Vec::new(), Vec::new()),
+            Kind::Expm { .. } | Kind::Taylor { .. } => (Vec::new(), Vec::new(), Vec::new()),
         };
         Segment {
             p: self,
@@ -234,7 +302,7 @@ impl Propagator {
     pub fn transition(&self, h: f64) -> Mat<f64> {
         let n = 2 * self.dofs;
         match &self.kind {
-            Kind::Expm { .. } => expm(&self.a, h),
+            Kind::Expm { .. } | Kind::Taylor { .. } => expm(&self.a, h),
             Kind::Spectral(s) => {
                 let nd = self.dofs;
                 let mut e = Mat::<f64>::zeros(n, n);
@@ -285,7 +353,7 @@ impl<'p> Segment<'p> {
                     .collect();
                 Some((beta, sp.lam.clone()))
             }
-            Kind::Expm { .. } => None,
+            Kind::Expm { .. } | Kind::Taylor { .. } => None,
         }
     }
 
@@ -293,6 +361,15 @@ impl<'p> Segment<'p> {
     pub fn state(&self, s: f64, out: &mut [f64]) {
         let nd = self.p.dofs;
         match &self.p.kind {
+            Kind::Taylor { coef, .. } => {
+                // Horner in s.
+                out.copy_from_slice(&coef[TAYLOR_ORDER]);
+                for c in coef[..TAYLOR_ORDER].iter().rev() {
+                    for (o, ci) in out.iter_mut().zip(c) {
+                        *o = *o * s + ci;
+                    }
+                }
+            }
             Kind::Expm { h, e, .. } => {
                 let n = 2 * nd;
                 let k = (s / h).floor().max(0.0) as usize;
@@ -402,6 +479,20 @@ impl<'p> Segment<'p> {
                 e.noise = 64.0 * f64::EPSILON * terms + 4.0 * (e.value_slope(0.0).0 - direct).abs();
                 Functional::Exp(e)
             }
+            Kind::Taylor { coef, tau, rate } => {
+                let a: Vec<f64> = coef.iter().map(|c| dot(l, c)).collect();
+                let mut size = 0.0;
+                let mut p = 1.0;
+                for ak in &a {
+                    size += ak.abs() * p;
+                    p *= tau;
+                }
+                Functional::Poly(PolySum {
+                    a,
+                    period: 2.0 * std::f64::consts::PI / rate,
+                    noise: 64.0 * f64::EPSILON * size,
+                })
+            }
             Kind::Expm { norm_f, d, b, .. } => {
                 let la = row_times(l, &self.p.a);
                 // |ℓᵀA²X| = |(ℓᵀD) B² (D⁻¹X)| ≤ ‖ℓᵀD B²‖ ‖D⁻¹X‖.
@@ -422,6 +513,8 @@ impl<'p> Segment<'p> {
 /// A linear functional of the state along a segment, as a [`Scalar`] function of time.
 pub enum Functional<'s> {
     Exp(ExpSum),
+    /// A polynomial (Taylor propagator): `Σ a_k s^k`.
+    Poly(PolySum),
     Expm {
         seg: &'s Segment<'s>,
         l: Vec<f64>,
@@ -429,6 +522,42 @@ pub enum Functional<'s> {
         la2_norm: f64,
         norm_a: f64,
     },
+}
+
+/// `Σ a_k s^k` with its period scale and round-off (Taylor propagator).
+#[derive(Debug, Clone)]
+pub struct PolySum {
+    a: Vec<f64>,
+    period: f64,
+    noise: f64,
+}
+
+impl Scalar for PolySum {
+    fn value_slope(&self, s: f64) -> (f64, f64) {
+        let (mut v, mut d) = (0.0, 0.0);
+        for (k, ak) in self.a.iter().enumerate().rev() {
+            d = d * s + v;
+            v = v * s + ak;
+            let _ = k;
+        }
+        (v, d)
+    }
+    /// `Σ k(k−1)|a_k| b^{k−2}` (s ≥ 0).
+    fn curvature_bound(&self, _a: f64, b: f64) -> f64 {
+        let mut total = 0.0;
+        let mut p = 1.0;
+        for (k, ak) in self.a.iter().enumerate().skip(2) {
+            total += (k * (k - 1)) as f64 * ak.abs() * p;
+            p *= b.abs();
+        }
+        total
+    }
+    fn fastest_period(&self) -> f64 {
+        self.period
+    }
+    fn noise(&self) -> f64 {
+        self.noise
+    }
 }
 
 impl ExpSum {
@@ -483,6 +612,7 @@ impl Scalar for Functional<'_> {
     fn value_slope(&self, s: f64) -> (f64, f64) {
         match self {
             Functional::Exp(e) => e.value_slope(s),
+            Functional::Poly(p) => p.value_slope(s),
             Functional::Expm { seg, l, la, .. } => {
                 let mut x = vec![0.0; l.len()];
                 seg.state(s, &mut x);
@@ -493,6 +623,7 @@ impl Scalar for Functional<'_> {
     fn curvature_bound(&self, a: f64, b: f64) -> f64 {
         match self {
             Functional::Exp(e) => e.curvature_bound(a, b),
+            Functional::Poly(p) => p.curvature_bound(a, b),
             Functional::Expm {
                 seg,
                 la2_norm,
@@ -509,7 +640,7 @@ impl Scalar for Functional<'_> {
                         .map(|(v, di)| (v / di).powi(2))
                         .sum::<f64>()
                         .sqrt(),
-                    Kind::Spectral(_) => norm(&x),
+                    Kind::Spectral(_) | Kind::Taylor { .. } => norm(&x),
                 };
                 la2_norm * dinv_x * (norm_a * (b - a)).exp()
             }
@@ -518,12 +649,14 @@ impl Scalar for Functional<'_> {
     fn noise(&self) -> f64 {
         match self {
             Functional::Exp(e) => e.noise(),
+            Functional::Poly(p) => p.noise(),
             Functional::Expm { .. } => 0.0,
         }
     }
     fn fastest_period(&self) -> f64 {
         match self {
             Functional::Exp(e) => e.fastest_period(),
+            Functional::Poly(p) => p.fastest_period(),
             Functional::Expm { norm_a, .. } => {
                 if *norm_a > 0.0 {
                     2.0 * std::f64::consts::PI / norm_a
