@@ -20,25 +20,14 @@ use std::time::Instant;
 use faer::Mat;
 use meid::integrate::small::{inverse, real_eigen, real_eigen_faer, sym_eigen, sym_eigen_faer};
 
-/// splitmix64 → uniform in [0, 1).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+use meid::rng::SplitMix64 as Rng;
 
 /// Mass-normalised stiffness and damping of a grounded chain with n DOF.
 fn chain(n: usize, seed: u64) -> (Mat<f64>, Mat<f64>) {
-    let mut r = Rng(seed);
-    let m: Vec<f64> = (0..n).map(|_| 1.0 + 20.0 * r.next()).collect();
-    let ks: Vec<f64> = (0..n).map(|_| 1e6 * (1.0 + 50.0 * r.next())).collect();
-    let cs: Vec<f64> = (0..n).map(|_| 50.0 * r.next()).collect();
+    let mut r = Rng::new(seed);
+    let m: Vec<f64> = (0..n).map(|_| 1.0 + 20.0 * r.next_f64()).collect();
+    let ks: Vec<f64> = (0..n).map(|_| 1e6 * (1.0 + 50.0 * r.next_f64())).collect();
+    let cs: Vec<f64> = (0..n).map(|_| 50.0 * r.next_f64()).collect();
     let mut k = Mat::<f64>::zeros(n, n);
     let mut c = Mat::<f64>::zeros(n, n);
     for i in 0..n {

@@ -26,6 +26,7 @@ pub mod io;
 pub mod modal;
 pub mod model;
 pub mod plot;
+pub mod rng;
 pub mod structure;
 
 pub use error::{Error, Result};

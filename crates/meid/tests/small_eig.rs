@@ -9,22 +9,11 @@ use faer::{c64, Mat};
 use meid::integrate::small::{inverse, norm_c, real_eigen, sym_eigen, sym_eigen_jacobi};
 use proptest::prelude::*;
 
-/// splitmix64 → uniform in [−1, 1).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    }
-}
+use meid::rng::SplitMix64 as Rng;
 
 fn random(n: usize, seed: u64) -> Mat<f64> {
-    let mut r = Rng(seed);
-    Mat::<f64>::from_fn(n, n, |_, _| r.next())
+    let mut r = Rng::new(seed);
+    Mat::<f64>::from_fn(n, n, |_, _| r.next_sym())
 }
 
 fn fro(a: &Mat<f64>) -> f64 {
@@ -292,14 +281,14 @@ fn damped_chains_random_psd_damping() {
     // Balanced matrices of 4-, 12- and 25-DOF chains with random masses, stiffnesses and a
     // random PSD damping C = B Bᵀ (rank n/2): identities only.
     for (n, seed) in [(4usize, 11u64), (12, 12), (25, 13)] {
-        let mut r = Rng(seed);
-        let m: Vec<f64> = (0..n).map(|_| 1.0 + 10.0 * r.next().abs()).collect();
+        let mut r = Rng::new(seed);
+        let m: Vec<f64> = (0..n).map(|_| 1.0 + 10.0 * r.next_sym().abs()).collect();
         let ks: Vec<f64> = (0..n)
-            .map(|_| 1e5 * (1.0 + 100.0 * r.next().abs()))
+            .map(|_| 1e5 * (1.0 + 100.0 * r.next_sym().abs()))
             .collect();
         let k = chain_k(&ks);
         let bcols = n / 2;
-        let b = Mat::<f64>::from_fn(n, bcols, |_, _| 30.0 * r.next());
+        let b = Mat::<f64>::from_fn(n, bcols, |_, _| 30.0 * r.next_sym());
         let c = Mat::<f64>::from_fn(n, n, |i, j| (0..bcols).map(|l| b[(i, l)] * b[(j, l)]).sum());
         let a = balanced(&k, &c, &m);
         let (lam, _, cond) = check_eig(&a, 1e-13);
@@ -588,10 +577,10 @@ fn sym_path_laplacians_closed_form() {
 
 /// Random orthogonal matrix: product of Householder reflectors.
 fn random_orthogonal(n: usize, seed: u64) -> Mat<f64> {
-    let mut r = Rng(seed);
+    let mut r = Rng::new(seed);
     let mut q = Mat::<f64>::identity(n, n);
     for _ in 0..n {
-        let v: Vec<f64> = (0..n).map(|_| r.next()).collect();
+        let v: Vec<f64> = (0..n).map(|_| r.next_sym()).collect();
         let vv: f64 = v.iter().map(|x| x * x).sum();
         let qv: Vec<f64> = (0..n)
             .map(|i| (0..n).map(|k| q[(i, k)] * v[k]).sum())

@@ -25,6 +25,7 @@
 //!   starting points drawn uniformly in the box from a seeded SplitMix64 generator give a
 //!   deterministic multi-start.
 
+use crate::rng::SplitMix64;
 use crate::{Error, Result};
 
 /// What an objective may return. `None`, `Err(_)` and non-finite numbers are failures,
@@ -286,24 +287,6 @@ pub struct MinimumNd {
     pub restarts: usize,
     /// Every evaluation in order, `(x, f)`, with `f = +∞` for failures.
     pub history: Vec<(Vec<f64>, f64)>,
-}
-
-/// SplitMix64 (G. L. Steele, D. Lea, C. H. Flood, OOPSLA 2014): a tiny, well-mixed,
-/// portable generator, so results depend on the seed only (not on a crate's version).
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 /// The objective in normalised coordinates, with counting and history.
@@ -593,7 +576,7 @@ where
         failures: 0,
         history: Vec::new(),
     };
-    let mut rng = SplitMix64(o.seed);
+    let mut rng = SplitMix64::new(o.seed);
     let mut starts: Vec<Vec<f64>> = vec![x0
         .iter()
         .zip(lower)
@@ -601,7 +584,7 @@ where
         .map(|((x, lo), w)| (x - lo) / w)
         .collect()];
     for _ in 0..o.random_starts {
-        starts.push((0..n).map(|_| rng.uniform()).collect());
+        starts.push((0..n).map(|_| rng.next_f64()).collect());
     }
 
     let mut best: Option<(Vec<f64>, f64)> = None;

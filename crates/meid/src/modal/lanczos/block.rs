@@ -1,6 +1,7 @@
 //! Dense block kernels for the Lanczos driver: symmetric sparse × dense products, a
 //! deterministic random generator, and M-orthonormalisation of a new block against the basis.
 
+use crate::rng::SplitMix64;
 use faer::linalg::matmul::matmul;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::SparseColMatRef;
@@ -46,24 +47,6 @@ pub(crate) fn sym_matmul(
         for i in 0..n {
             col[i] = yr[i * b + c];
         }
-    }
-}
-
-/// SplitMix64 (Steele, Lea & Flood, OOPSLA 2014): a small deterministic generator for
-/// start vectors, so that runs are reproducible without a `rand` dependency.
-pub(crate) struct SplitMix64(pub u64);
-
-impl SplitMix64 {
-    pub(crate) fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [-1, 1).
-    pub(crate) fn next_sym(&mut self) -> f64 {
-        ((self.next_u64() >> 11) as f64) * (2.0 / (1u64 << 53) as f64) - 1.0
     }
 }
 

@@ -86,8 +86,9 @@ use faer::{Accum, Mat, MatRef, Par, Side};
 
 use std::time::Instant;
 
+use crate::rng::SplitMix64;
 use crate::{Error, Result};
-use block::{fill_random, m_norm, norm2, project_column, sym_matmul, SplitMix64};
+use block::{fill_random, m_norm, norm2, project_column, sym_matmul};
 use shifted::ShiftedPencil;
 
 /// Relative size (to `s = max K_ii/M_ii`) below which an eigenvalue is a rigid-body mode for the
@@ -292,7 +293,7 @@ pub fn lowest_modes(
     stats.factorizations += 1;
     stats.factor_s += clock.elapsed().as_secs_f64();
 
-    let mut rng = SplitMix64(opts.seed);
+    let mut rng = SplitMix64::new(opts.seed);
     let mut st = Basis::new(n, basis, b);
     // Random start block.
     {
