@@ -179,24 +179,23 @@ fn label(q: &Quantity) -> String {
 }
 
 fn metric_label(m: &str) -> String {
+    // Unit by the metric's name suffix (longest suffixes first).
+    const UNITS: [(&str, &str); 7] = [
+        ("_m_per_s2", "(m/s²)"),
+        ("_m_per_s", "(m/s)"),
+        ("_n_per_m", "(N/m)"),
+        ("_kg", "(kg)"),
+        ("_j", "(J)"),
+        ("_n", "(N)"),
+        ("_s", "(s)"),
+    ];
     let unit = if m == "energy_ratio" {
         "E_p+/E_s− (1)"
-    } else if m.ends_with("_m_per_s2") {
-        "(m/s²)"
-    } else if m.ends_with("_m_per_s") {
-        "(m/s)"
-    } else if m.ends_with("_n_per_m") {
-        "(N/m)"
-    } else if m.ends_with("_kg") {
-        "(kg)"
-    } else if m.ends_with("_j") {
-        "(J)"
-    } else if m.ends_with("_n") {
-        "(N)"
-    } else if m.ends_with("_s") {
-        "(s)"
     } else {
-        "(1)"
+        UNITS
+            .iter()
+            .find(|(suffix, _)| m.ends_with(suffix))
+            .map_or("(1)", |(_, u)| u)
     };
     format!("{m} {unit}")
 }

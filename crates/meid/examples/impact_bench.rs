@@ -141,12 +141,7 @@ fn main() {
     let oe = one(Method::Exact);
     if args.iter().any(|a| a == "--callgrind20") {
         let s20 = twenty_modes();
-        let o20 = Options {
-            method: Method::Exact,
-            duration: 2.0,
-            sample_rate: Some(20_000.0),
-            ..Options::default()
-        };
+        let o20 = twenty_mode_run();
         simulate(&s20, &o20, true).unwrap();
         return;
     }
@@ -210,12 +205,7 @@ fn main() {
         return;
     }
     let s20 = twenty_modes();
-    let o20 = Options {
-        method: Method::Exact,
-        duration: 2.0,
-        sample_rate: Some(20_000.0),
-        ..Options::default()
-    };
+    let o20 = twenty_mode_run();
     let (b2, k2) = if quick { (3, 2) } else { (7, 5) };
     let mut samples = 0;
     let (med_20, min_20) = time_it(b2, k2, || {
@@ -246,6 +236,16 @@ fn main() {
             }
             Err(e) => println!("SciPy peer not run: {e}"),
         }
+    }
+}
+
+/// Case 3's options: 2 s, `exact`, 20 kHz output.
+fn twenty_mode_run() -> Options {
+    Options {
+        method: Method::Exact,
+        duration: 2.0,
+        sample_rate: Some(20_000.0),
+        ..Options::default()
     }
 }
 

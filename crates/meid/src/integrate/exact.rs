@@ -70,6 +70,17 @@ pub fn solve_from(
     let masses = sys.mass_diag();
     let inds = sys.indicators();
     let ind_vecs: Vec<Vec<f64>> = inds.iter().map(|&i| sys.indicator_vector(i)).collect();
+    // `ℓ` of each contact's force (for its peaks), built once per run.
+    let force_vecs: Vec<Vec<f64>> = [Switch::SliderBed, Switch::BedDamper]
+        .into_iter()
+        .map(|s| {
+            if s == Switch::SliderBed || sys.damper.is_some() {
+                contact_force_vector(sys, s)
+            } else {
+                Vec::new()
+            }
+        })
+        .collect();
     let mut cache: HashMap<Mode, ModeData> = HashMap::new();
     let mut grid = Grid::new(opts.sample_rate);
     let t_end = opts.duration;
@@ -216,8 +227,7 @@ pub fn solve_from(
         {
             if mode.on(s) && (ci == 0 || sys.damper.is_some()) {
                 totals.closed_time[ci] += s_end;
-                let lf = contact_force_vector(sys, s);
-                let peak = max_on_segment(&seg, &lf, &prop.a, s_end, period);
+                let peak = max_on_segment(&seg, &force_vecs[ci], &prop.a, s_end, period);
                 totals.peak_force[ci] = totals.peak_force[ci].max(peak);
             }
         }
