@@ -4,6 +4,9 @@
 //! cargo run --release -p meid --example impact_bench [-- --quick] [--no-peer]
 //! ```
 //!
+//! (`--events` prints the collision's stretches and switches and each mode's Taylor step
+//! instead; `--callgrind*` run one case for `valgrind --tool=callgrind`.)
+//!
 //! Method: every case is run once to warm up, then in `B` batches of `K` repetitions; the time
 //! per run of each batch is `elapsed / K` (std::time::Instant), and the median and minimum over
 //! batches are printed. Work measured:
@@ -139,6 +142,28 @@ fn main() {
     };
 
     let oe = one(Method::Exact);
+    if args.iter().any(|a| a == "--events") {
+        let sol = integrate::solve(&sys, &oe, &mut NoOutput).unwrap();
+        println!(
+            "{} stretches; collision end {:?} s",
+            sol.steps,
+            sol.collision_end.as_ref().map(|c| c.t)
+        );
+        for e in &sol.events {
+            println!("t = {:.6e} s: mode {:?} -> {:?}", e.t, e.from, e.to);
+        }
+        for bits in [7u8, 3, 2, 0] {
+            let a = sys.first_order(meid::impact::Mode(bits));
+            let x = sys.initial_state();
+            let tp = meid::integrate::propagator::Propagator::taylor(a, &x).unwrap();
+            println!(
+                "mode {bits}: Taylor validity {:.3e} s, period {:.3e} s",
+                tp.validity(),
+                tp.period()
+            );
+        }
+        return;
+    }
     if args.iter().any(|a| a == "--callgrind20") {
         let s20 = twenty_modes();
         let o20 = twenty_mode_run();

@@ -24,9 +24,24 @@ fn linear(k: f64, c: f64, release: Release) -> Contact {
     }
 }
 
-fn opts(method: Method) -> Options {
+/// The engines checked: `exact` as run by default (Taylor steps first, closed forms for long
+/// stretches), `exact` with closed forms only, and `dopri5`.
+#[derive(Debug, Clone, Copy)]
+enum Engine {
+    Taylor,
+    ClosedForm,
+    Dopri5,
+}
+
+fn opts(engine: Engine) -> Options {
+    let (method, taylor) = match engine {
+        Engine::Taylor => (Method::Exact, integrate::exact::TAYLOR_STEPS_PER_MODE),
+        Engine::ClosedForm => (Method::Exact, 0),
+        Engine::Dopri5 => (Method::Dopri5, 0),
+    };
     Options {
         method,
+        taylor_steps_per_mode: taylor,
         duration: 0.05,
         sample_rate: None,
         stop_at_collision_end: true,
@@ -42,12 +57,12 @@ struct TwoBody {
     peak: f64,
 }
 
-fn two_body(m1: f64, m2: f64, k: f64, c: f64, release: Release, method: Method) -> TwoBody {
+fn two_body(m1: f64, m2: f64, k: f64, c: f64, release: Release, method: Engine) -> TwoBody {
     two_body_with(m1, m2, 1.0, linear(k, c, release), method)
 }
 
 /// Slider `m1` at `v0` against a free body `m2` through `contact`, to the end of the collision.
-fn two_body_with(m1: f64, m2: f64, v0: f64, contact: Contact, method: Method) -> TwoBody {
+fn two_body_with(m1: f64, m2: f64, v0: f64, contact: Contact, method: Engine) -> TwoBody {
     let s = free_body(m2);
     let sys = ImpactSystem::new(
         &s,
@@ -84,24 +99,26 @@ fn two_bodies_undamped_exact() {
     // m1 = 1 kg, m2 = 3 kg, k = 1e6 N/m, v0 = 1 m/s: T = 2.7207 ms, F_max = 866.0 N, share 0.75.
     let (m1, m2, k) = (1.0, 3.0, 1.0e6);
     let mu = m1 * m2 / (m1 + m2);
-    let r = two_body(m1, m2, k, 0.0, Release::Overlap, Method::Exact);
-    let t_exact = PI / (k / mu).sqrt();
-    assert!(
-        rel(r.t, t_exact) < 1e-9,
-        "contact time {} vs {}",
-        r.t,
-        t_exact
-    );
-    assert!(
-        rel(r.peak, (k * mu).sqrt()) < 1e-9,
-        "peak {} vs {}",
-        r.peak,
-        (k * mu).sqrt()
-    );
-    // Elastic: v1 = (m1 − m2)/(m1 + m2), v2 = 2 m1/(m1 + m2); share to m2 = 4 m1 m2/(m1+m2)².
-    assert!(rel(r.v1, (m1 - m2) / (m1 + m2)) < 1e-9, "v1 {}", r.v1);
-    let share = m2 * r.v2 * r.v2 / m1;
-    assert!(rel(share, 0.75) < 1e-9, "share {share}");
+    for engine in [Engine::Taylor, Engine::ClosedForm] {
+        let r = two_body(m1, m2, k, 0.0, Release::Overlap, engine);
+        let t_exact = PI / (k / mu).sqrt();
+        assert!(
+            rel(r.t, t_exact) < 1e-9,
+            "contact time {} vs {}",
+            r.t,
+            t_exact
+        );
+        assert!(
+            rel(r.peak, (k * mu).sqrt()) < 1e-9,
+            "peak {} vs {}",
+            r.peak,
+            (k * mu).sqrt()
+        );
+        // Elastic: v1 = (m1 − m2)/(m1 + m2), v2 = 2 m1/(m1 + m2); share to m2 = 4 m1 m2/(m1+m2)².
+        assert!(rel(r.v1, (m1 - m2) / (m1 + m2)) < 1e-9, "v1 {}", r.v1);
+        let share = m2 * r.v2 * r.v2 / m1;
+        assert!(rel(share, 0.75) < 1e-9, "share {share}");
+    }
 }
 
 #[test]
@@ -111,7 +128,11 @@ fn two_bodies_damped_overlap_release() {
     let c = 2.0 * zeta * (k * mu).sqrt();
     let wd = (k / mu).sqrt() * (1.0 - zeta * zeta).sqrt();
     let e_exact = (-zeta * PI / (1.0 - zeta * zeta).sqrt()).exp();
-    for (method, tol) in [(Method::Exact, 1e-9), (Method::Dopri5, 1e-6)] {
+    for (method, tol) in [
+        (Engine::Taylor, 1e-9),
+        (Engine::ClosedForm, 1e-9),
+        (Engine::Dopri5, 1e-6),
+    ] {
         let r = two_body(m1, m2, k, c, Release::Overlap, method);
         assert!(
             rel(r.t, PI / wd) < tol,
@@ -142,7 +163,11 @@ fn two_bodies_damped_force_release() {
     // Relative velocity at t_F from the damped free response δ = (v0/ω_d) e^{−ζω_n t} sin ω_d t.
     let dv = (-zeta * wn * tf).exp() * ((wd * tf).cos() - zeta * wn / wd * (wd * tf).sin());
     let e_exact = -dv;
-    for (method, tol) in [(Method::Exact, 1e-9), (Method::Dopri5, 1e-6)] {
+    for (method, tol) in [
+        (Engine::Taylor, 1e-9),
+        (Engine::ClosedForm, 1e-9),
+        (Engine::Dopri5, 1e-6),
+    ] {
         let r = two_body(m1, m2, k, c, Release::Force, method);
         assert!(rel(r.t, tf) < tol, "{method:?}: T {} vs {}", r.t, tf);
         let e = r.v2 - r.v1;
@@ -158,7 +183,7 @@ fn two_bodies_damped_force_release() {
 fn two_bodies_dopri5_undamped() {
     let (m1, m2, k) = (1.0, 3.0, 1.0e6);
     let mu = m1 * m2 / (m1 + m2);
-    let r = two_body(m1, m2, k, 0.0, Release::Overlap, Method::Dopri5);
+    let r = two_body(m1, m2, k, 0.0, Release::Overlap, Engine::Dopri5);
     assert!(rel(r.t, PI / (k / mu).sqrt()) < 1e-6);
     assert!(rel(r.peak, (k * mu).sqrt()) < 1e-6, "peak {}", r.peak);
     assert!(rel(r.v1, -0.5) < 1e-6);
@@ -176,7 +201,11 @@ fn three_body_chain_complete_exchange() {
         damping: 0.0,
         dashpot: DashpotKind::OneWay,
     };
-    for (method, tol) in [(Method::Exact, 1e-9), (Method::Dopri5, 1e-6)] {
+    for (method, tol) in [
+        (Engine::Taylor, 1e-9),
+        (Engine::ClosedForm, 1e-9),
+        (Engine::Dopri5, 1e-6),
+    ] {
         let sys = ImpactSystem::new(
             &s,
             "b",
@@ -229,7 +258,7 @@ fn two_bodies_hertz_dopri5() {
             law: ContactLaw::Hertz { stiffness: k },
             release: Release::Force,
         },
-        Method::Dopri5,
+        Engine::Dopri5,
     );
     let mu = m1 * m2 / (m1 + m2);
     let d_max = (5.0 * mu * v0 * v0 / (4.0 * k)).powf(0.4);

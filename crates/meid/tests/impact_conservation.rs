@@ -234,3 +234,39 @@ fn defective_mode_uses_expm_fallback() {
     );
     assert_eq!(e.solution.events.len(), d.solution.events.len());
 }
+
+/// The two exact forms, Taylor steps (the default for a blow) and closed forms only
+/// (`taylor_steps_per_mode = 0`), are both exact to round-off: on the example (modal damping
+/// and the one-way dashpot) they agree on the energy ratio, the end of the collision and the
+/// peak forces to 1e-10, and the energy balance closes to 1e-12 with either.
+#[test]
+fn taylor_steps_and_closed_forms_agree() {
+    let m = load(&[]);
+    let sys = m.impact_system(Case::AsSpecified).unwrap();
+    let run = |taylor: usize| {
+        let o = Options {
+            taylor_steps_per_mode: taylor,
+            ..opts(Method::Exact, 0.05, true)
+        };
+        simulate(&sys, &o, false).unwrap()
+    };
+    let (t, c) = (run(meid::integrate::exact::TAYLOR_STEPS_PER_MODE), run(0));
+    assert!(t.solution.taylor_steps > 0 && c.solution.taylor_steps == 0);
+    let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+    let (st, sc) = (&t.summary, &c.summary);
+    let (rt, rc) = (st.energy_ratio.unwrap(), sc.energy_ratio.unwrap());
+    assert!(rel(rt, rc) <= 1e-10, "energy ratio {rt} vs {rc}");
+    let (et, ec) = (st.collision_end_s.unwrap(), sc.collision_end_s.unwrap());
+    assert!(rel(et, ec) <= 1e-10, "collision end {et} vs {ec}");
+    for i in 0..2 {
+        let (pt, pc) = (
+            t.solution.totals.peak_force[i],
+            c.solution.totals.peak_force[i],
+        );
+        assert!(rel(pt, pc) <= 1e-10, "peak force {i}: {pt} vs {pc}");
+    }
+    for s in [st, sc] {
+        let r = s.energy_balance_residual.unwrap();
+        assert!(r <= 1e-12, "energy balance residual {r:e}");
+    }
+}

@@ -461,14 +461,33 @@ impl ImpactSystem {
     /// Second-order stiffness and damping matrices `K_σ`, `C_σ` (`dofs × dofs`) of a mode,
     /// for linear contact laws (a non-linear law contributes its linear part, none for Hertz).
     pub fn matrices(&self, mode: Mode) -> (Mat<f64>, Mat<f64>) {
-        let n = self.n_modes();
         let nd = self.dofs();
         let mut k = Mat::<f64>::zeros(nd, nd);
         let mut c = Mat::<f64>::zeros(nd, nd);
+        self.for_each_entry(mode, |i, j, dk, dc| {
+            k[(i, j)] += dk;
+            c[(i, j)] += dc;
+        });
+        (k, c)
+    }
+
+    /// Calls `f(i, j, K_ij, C_ij)` with the contributions to `K_σ` and `C_σ` (summed over
+    /// repeated `(i, j)`): the structure's modal stiffness and damping, the closed linear
+    /// contacts, the damper spring and its dashpot when on.
+    fn for_each_entry(&self, mode: Mode, mut f: impl FnMut(usize, usize, f64, f64)) {
+        let n = self.n_modes();
+        let nd = self.dofs();
         for i in 0..n {
-            k[(i, i)] = self.structure.omega_rad_per_s[i].powi(2);
             for j in 0..n {
-                c[(i, j)] = self.structure.damping[i * n + j];
+                let kk = if i == j {
+                    self.structure.omega_rad_per_s[i].powi(2)
+                } else {
+                    0.0
+                };
+                let cc = self.structure.damping[i * n + j];
+                if kk != 0.0 || cc != 0.0 {
+                    f(i, j, kk, cc);
+                }
             }
         }
         let mut add = |a: &[f64], kk: f64, cc: f64| {
@@ -477,8 +496,9 @@ impl ImpactSystem {
                     continue;
                 }
                 for j in 0..nd {
-                    k[(i, j)] += kk * a[i] * a[j];
-                    c[(i, j)] += cc * a[i] * a[j];
+                    if a[j] != 0.0 {
+                        f(i, j, kk * a[i] * a[j], cc * a[i] * a[j]);
+                    }
                 }
             }
         };
@@ -503,20 +523,26 @@ impl ImpactSystem {
                 if dashpot_on { d.damping } else { 0.0 },
             );
         }
-        (k, c)
     }
 
     /// First-order matrix `A_σ = [[0, I], [−M⁻¹K_σ, −M⁻¹C_σ]]` for the state `X = [x; ẋ]`.
     pub fn first_order(&self, mode: Mode) -> Mat<f64> {
         let nd = self.dofs();
-        let (k, c) = self.matrices(mode);
         let m = self.mass_diag();
         let mut a = Mat::<f64>::zeros(2 * nd, 2 * nd);
         for i in 0..nd {
             a[(i, nd + i)] = 1.0;
-            for j in 0..nd {
-                a[(nd + i, j)] = -k[(i, j)] / m[i];
-                a[(nd + i, nd + j)] = -c[(i, j)] / m[i];
+        }
+        self.for_each_entry(mode, |i, j, dk, dc| {
+            a[(nd + i, j)] += dk;
+            a[(nd + i, nd + j)] += dc;
+        });
+        for j in 0..2 * nd {
+            for i in 0..nd {
+                let v = a[(nd + i, j)];
+                if v != 0.0 {
+                    a[(nd + i, j)] = -v / m[i];
+                }
             }
         }
         a

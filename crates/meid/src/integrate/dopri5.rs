@@ -613,6 +613,7 @@ pub fn solve_from(
         mode_final,
         totals,
         steps,
+        taylor_steps: 0,
         rejected,
         fallback_modes: 0,
     })

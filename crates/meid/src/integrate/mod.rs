@@ -20,6 +20,7 @@ pub mod propagator;
 pub mod roots;
 pub mod small;
 mod switching;
+pub mod taylor;
 
 use crate::impact::{ImpactSystem, Mode};
 use crate::{Error, Result};
@@ -64,6 +65,10 @@ pub struct Options {
     pub atol: f64,
     /// Give up after this many switching events (chattering guard).
     pub max_events: usize,
+    /// Exact method: Taylor steps a run may take in one mode before it builds the mode's closed
+    /// form (default [`exact::TAYLOR_STEPS_PER_MODE`]; 0 for closed forms only). Both are exact
+    /// to round-off; the choice is a matter of speed.
+    pub taylor_steps_per_mode: usize,
 }
 
 impl Default for Options {
@@ -76,6 +81,7 @@ impl Default for Options {
             rtol: 1e-8,
             atol: 1e-14,
             max_events: 100_000,
+            taylor_steps_per_mode: exact::TAYLOR_STEPS_PER_MODE,
         }
     }
 }
@@ -130,8 +136,11 @@ pub struct Solution {
     pub mode_final: Mode,
     /// Totals over the whole run.
     pub totals: Totals,
-    /// Closed-form segments (exact) or accepted steps (dopri5).
+    /// Stretches propagated (exact: closed-form segments and Taylor steps, see
+    /// [`exact::TAYLOR_STEPS_PER_MODE`]) or accepted steps (dopri5).
     pub steps: usize,
+    /// Of `steps`, those taken by the Taylor propagator (exact).
+    pub taylor_steps: usize,
     /// Rejected steps (dopri5).
     pub rejected: usize,
     /// Modes that needed the matrix-exponential fallback (exact).

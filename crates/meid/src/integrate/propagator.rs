@@ -33,6 +33,7 @@ use std::rc::Rc;
 use faer::{c64, Mat};
 
 use super::small;
+use super::taylor::{Poly, TaylorMatrix};
 
 use super::expm::expm;
 use super::roots::Scalar;
@@ -77,7 +78,7 @@ enum Kind {
 }
 
 /// Order of the Taylor propagator.
-const TAYLOR_ORDER: usize = 20;
+const TAYLOR_ORDER: usize = super::taylor::ORDER;
 
 #[derive(Debug, Clone)]
 struct Spectral {
@@ -202,48 +203,19 @@ impl Propagator {
     /// start (a dashpot switching off 0.8 µs into a blow), and builds the closed form otherwise.
     pub fn taylor(a: Mat<f64>, x0: &[f64]) -> Option<Self> {
         let n = a.nrows();
-        if n == 0 || x0.len() != n {
+        if n == 0 || x0.len() != n || a.ncols() != n {
             return None;
         }
-        // Growth rate: ‖D⁻¹AD‖_∞ with D = diag(1/ν, …, 1/ν, 1, …, 1) (positions scaled by
-        // ν = √‖A₂₁‖_∞, the stiffness block's size), so that ‖D⁻¹A^k X₀‖_∞ ≤ rate^k ‖D⁻¹X₀‖_∞
-        // for any A; for the first-order form it is about the fastest frequency.
-        let nd = n / 2;
-        let mut r21 = 0.0_f64;
-        for i in nd..n {
-            r21 = r21.max((0..nd).map(|j| a[(i, j)].abs()).sum::<f64>());
-        }
-        let nu = if r21 > 0.0 { r21.sqrt() } else { 1.0 };
-        let d = |i: usize| if i < nd { 1.0 / nu } else { 1.0 };
-        let mut rate = 0.0_f64;
-        for i in 0..n {
-            let row: f64 = (0..n).map(|j| a[(i, j)].abs() * d(j)).sum::<f64>() / d(i);
-            rate = rate.max(row);
-        }
-        // c_k = A c_{k-1} / k, all in one buffer of (P + 1) rows of n.
+        let tm = TaylorMatrix::new(&a);
         let mut coef = vec![0.0; (TAYLOR_ORDER + 1) * n];
-        coef[..n].copy_from_slice(x0);
-        for k in 1..=TAYLOR_ORDER {
-            let (done, rest) = coef.split_at_mut(k * n);
-            let prev = &done[(k - 1) * n..];
-            let next = &mut rest[..n];
-            for (j, &pj) in prev.iter().enumerate() {
-                if pj != 0.0 {
-                    for (nx, aij) in next.iter_mut().zip(a.col(j).iter()) {
-                        *nx += aij * pj;
-                    }
-                }
-            }
-            let inv = 1.0 / k as f64;
-            next.iter_mut().for_each(|v| *v *= inv);
-        }
+        tm.expand(x0, &mut coef);
         Some(Self {
             a,
             dofs: n / 2,
             kind: Kind::Taylor {
                 coef,
-                tau: 1.0 / rate,
-                rate,
+                tau: tm.validity(),
+                rate: tm.rate(),
             },
         })
     }
@@ -362,20 +334,20 @@ impl<'p> Segment<'p> {
         }
     }
 
+    /// The Taylor form's coefficients, `X(s) = Σ_k c_k s^k`: rows `c_k` of length `2·dofs`
+    /// for k = 0..=P, one after the other; `None` for the other forms.
+    pub fn taylor_coefficients(&self) -> Option<&'p [f64]> {
+        match &self.p.kind {
+            Kind::Taylor { coef, .. } => Some(coef),
+            _ => None,
+        }
+    }
+
     /// State at time `s` after the segment start, written into `out`.
     pub fn state(&self, s: f64, out: &mut [f64]) {
         let nd = self.p.dofs;
         match &self.p.kind {
-            Kind::Taylor { coef, .. } => {
-                // Horner in s.
-                let n = out.len();
-                out.copy_from_slice(&coef[TAYLOR_ORDER * n..]);
-                for c in coef[..TAYLOR_ORDER * n].chunks_exact(n).rev() {
-                    for (o, ci) in out.iter_mut().zip(c) {
-                        *o = *o * s + ci;
-                    }
-                }
-            }
+            Kind::Taylor { coef, .. } => super::taylor::state(coef, s, out),
             Kind::Expm { h, e, .. } => {
                 let n = 2 * nd;
                 let k = (s / h).floor().max(0.0) as usize;
@@ -486,17 +458,13 @@ impl<'p> Segment<'p> {
                 Functional::Exp(e)
             }
             Kind::Taylor { coef, tau, rate } => {
-                let a: Vec<f64> = coef.chunks_exact(l.len()).map(|c| dot(l, c)).collect();
-                let mut size = 0.0;
-                let mut p = 1.0;
-                for ak in &a {
-                    size += ak.abs() * p;
-                    p *= tau;
-                }
+                let mut a = vec![0.0; TAYLOR_ORDER + 1];
+                super::taylor::project(l, coef, &mut a);
+                let noise = Poly::new(&a, *tau, 0.0).noise();
                 Functional::Poly(PolySum {
                     a,
                     period: 2.0 * std::f64::consts::PI / rate,
-                    noise: 64.0 * f64::EPSILON * size,
+                    noise,
                 })
             }
             Kind::Expm { norm_f, d, b, .. } => {
@@ -538,25 +506,18 @@ pub struct PolySum {
     noise: f64,
 }
 
+impl PolySum {
+    fn poly(&self) -> Poly<'_> {
+        Poly::with_noise(&self.a, self.period, self.noise)
+    }
+}
+
 impl Scalar for PolySum {
     fn value_slope(&self, s: f64) -> (f64, f64) {
-        let (mut v, mut d) = (0.0, 0.0);
-        for (k, ak) in self.a.iter().enumerate().rev() {
-            d = d * s + v;
-            v = v * s + ak;
-            let _ = k;
-        }
-        (v, d)
+        self.poly().value_slope(s)
     }
-    /// `Σ k(k−1)|a_k| b^{k−2}` (s ≥ 0).
-    fn curvature_bound(&self, _a: f64, b: f64) -> f64 {
-        let mut total = 0.0;
-        let mut p = 1.0;
-        for (k, ak) in self.a.iter().enumerate().skip(2) {
-            total += (k * (k - 1)) as f64 * ak.abs() * p;
-            p *= b.abs();
-        }
-        total
+    fn curvature_bound(&self, a: f64, b: f64) -> f64 {
+        self.poly().curvature_bound(a, b)
     }
     fn fastest_period(&self) -> f64 {
         self.period

@@ -54,7 +54,7 @@ pub fn lex_sign(l: &[f64], a: &Mat<f64>, x: &[f64]) -> f64 {
         next.iter_mut().for_each(|v| *v = 0.0);
         for (j, &yj) in y.iter().enumerate() {
             if yj != 0.0 {
-                for (nx, aij) in next.iter_mut().zip(a.col(j).iter()) {
+                for (nx, aij) in next.iter_mut().zip(a.col_as_slice(j)) {
                     *nx += aij * yj;
                 }
             }

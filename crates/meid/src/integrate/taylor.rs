@@ -1,0 +1,289 @@
+//! Taylor steps of one mode, `Ẋ = A X`: the truncated series
+//!
+//! ```text
+//! X(s) = Σ_{k≤P} c_k s^k,   c_k = A^k X₀ / k! = A c_{k−1} / k,   P = 20,
+//! ```
+//!
+//! valid on `[0, τ]` with `τ = 1/ρ`, `ρ = ‖D⁻¹AD‖_∞` and `D = diag(1/ν, …, 1/ν, 1, …, 1)`
+//! (positions scaled by `ν = √‖A₂₁‖_∞`, the stiffness block's size). Then
+//! `‖D⁻¹A^k X₀‖_∞ ≤ ρ^k ‖D⁻¹X₀‖_∞`, so the remainder on `[0, τ]` is at most
+//! `Σ_{k>P} 1/k! < 1e-19` of `‖D⁻¹X₀‖_∞`: below round-off, the series *is* the exact solution
+//! there. For the first-order form `ρ` is about the fastest frequency, so `τ` is about a sixth of
+//! the fastest period.
+//!
+//! A step costs `P` products with the lower half of `A` (for `A = [[0, I], [A₂₁, A₂₂]]` the upper
+//! half of `c_k` is the lower half of `c_{k−1}` over `k`) and no eigen-decomposition; a linear
+//! functional `ℓᵀX(s)` is the polynomial `Σ (ℓᵀc_k) s^k`, cheap to evaluate and with an explicit
+//! curvature bound for the event search ([`super::roots`]). The exact integrator
+//! ([`super::exact`]) takes Taylor steps for the first stretches of each mode and builds the
+//! closed form ([`super::propagator`]) only for modes that stay long. Hand-written: it is a
+//! dozen lines on slices, and the structure of `A` (and no allocation per step) is what makes
+//! it fast.
+
+use faer::Mat;
+
+use super::roots::Scalar;
+
+/// Order `P` of the series.
+pub const ORDER: usize = 20;
+
+/// A mode's first-order matrix prepared for Taylor steps: its growth rate `ρ` and the rows that
+/// take products.
+#[derive(Debug, Clone)]
+pub struct TaylorMatrix {
+    n: usize,
+    /// `A = [[0, I], [A₂₁, A₂₂]]`: only the lower rows are stored and multiplied.
+    structured: bool,
+    /// Rows of `A` from `first_row` on (all rows, or the lower half when `structured`), stored
+    /// column by column: `cols[j·m + i] = A[first_row + i, j]` with `m` rows kept.
+    cols: Vec<f64>,
+    rate: f64,
+}
+
+impl TaylorMatrix {
+    /// Prepares `a` (square, `2·dofs`).
+    pub fn new(a: &Mat<f64>) -> Self {
+        let n = a.nrows();
+        let nd = n / 2;
+        let mut r21 = 0.0_f64;
+        for i in nd..n {
+            r21 = r21.max((0..nd).map(|j| a[(i, j)].abs()).sum::<f64>());
+        }
+        let nu = if r21 > 0.0 { r21.sqrt() } else { 1.0 };
+        // d_j / d_i with d = 1/ν for positions, 1 for velocities.
+        let d = |i: usize| if i < nd { 1.0 / nu } else { 1.0 };
+        let mut rate = 0.0_f64;
+        for i in 0..n {
+            let row: f64 = (0..n).map(|j| a[(i, j)].abs() * d(j)).sum::<f64>() / d(i);
+            rate = rate.max(row);
+        }
+        let structured =
+            n % 2 == 0 && (0..nd).all(|i| (0..n).all(|j| a[(i, j)] == f64::from(j == nd + i)));
+        let first_row = if structured { nd } else { 0 };
+        let m = n - first_row;
+        let mut cols = vec![0.0; m * n];
+        for (j, col) in cols.chunks_exact_mut(m.max(1)).enumerate() {
+            for (i, r) in col.iter_mut().enumerate() {
+                *r = a[(first_row + i, j)];
+            }
+        }
+        Self {
+            n,
+            structured,
+            cols,
+            rate,
+        }
+    }
+
+    /// Dimension `n` of the state.
+    pub fn dim(&self) -> usize {
+        self.n
+    }
+
+    /// The growth rate `ρ = ‖D⁻¹AD‖_∞` (1/s).
+    pub fn rate(&self) -> f64 {
+        self.rate
+    }
+
+    /// How far a step reaches: `τ = 1/ρ` (s).
+    pub fn validity(&self) -> f64 {
+        if self.rate > 0.0 {
+            1.0 / self.rate
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The time scale `2π/ρ` (s) used by the event search.
+    pub fn period(&self) -> f64 {
+        if self.rate > 0.0 {
+            2.0 * std::f64::consts::PI / self.rate
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// Writes `c_0 … c_P` (rows of `n`, one after the other) from `x0` into `coef`
+    /// (length `(P + 1)·n`).
+    pub fn expand(&self, x0: &[f64], coef: &mut [f64]) {
+        let n = self.n;
+        let nd = n / 2;
+        // Small lumped machines: fixed sizes, fully unrolled (the loops below spend more on
+        // their own overhead than on the few products of a column of 2–8 entries).
+        if self.structured {
+            match nd {
+                2 => return self.expand_small::<2, 4>(x0, coef),
+                3 => return self.expand_small::<3, 6>(x0, coef),
+                4 => return self.expand_small::<4, 8>(x0, coef),
+                5 => return self.expand_small::<5, 10>(x0, coef),
+                6 => return self.expand_small::<6, 12>(x0, coef),
+                7 => return self.expand_small::<7, 14>(x0, coef),
+                8 => return self.expand_small::<8, 16>(x0, coef),
+                _ => {}
+            }
+        }
+        let first_row = if self.structured { nd } else { 0 };
+        let m = n - first_row;
+        coef[..n].copy_from_slice(x0);
+        // Σ_j A[:, j] c_{k−1, j} over the kept rows, column by column (equal-length slices, so
+        // the inner loop has no bounds checks and vectorises).
+        let mut acc = vec![0.0; m];
+        for k in 1..=ORDER {
+            let (done, rest) = coef.split_at_mut(k * n);
+            let prev = &done[(k - 1) * n..];
+            let next = &mut rest[..n];
+            let inv = 1.0 / k as f64;
+            if self.structured {
+                for i in 0..nd {
+                    next[i] = prev[nd + i] * inv;
+                }
+            }
+            acc.fill(0.0);
+            for (j, &pj) in prev.iter().enumerate() {
+                if pj != 0.0 {
+                    axpy(&mut acc, &self.cols[j * m..j * m + m], pj);
+                }
+            }
+            for (nx, v) in next[first_row..].iter_mut().zip(&acc) {
+                *nx = v * inv;
+            }
+        }
+    }
+}
+
+impl TaylorMatrix {
+    /// [`TaylorMatrix::expand`] for the structured form with `ND` degrees of freedom
+    /// (`N = 2·ND`), on arrays of fixed size.
+    fn expand_small<const ND: usize, const N: usize>(&self, x0: &[f64], coef: &mut [f64]) {
+        let mut cols = [[0.0; ND]; N];
+        for (c, src) in cols.iter_mut().zip(self.cols.chunks_exact(ND)) {
+            c.copy_from_slice(src);
+        }
+        let mut prev = [0.0; N];
+        prev.copy_from_slice(&x0[..N]);
+        coef[..N].copy_from_slice(&prev);
+        for (k, out) in coef[N..].chunks_exact_mut(N).take(ORDER).enumerate() {
+            let inv = 1.0 / (k + 1) as f64;
+            let mut acc = [0.0; ND];
+            for (c, pj) in cols.iter().zip(&prev) {
+                for i in 0..ND {
+                    acc[i] += c[i] * pj;
+                }
+            }
+            let mut next = [0.0; N];
+            for i in 0..ND {
+                next[i] = prev[ND + i] * inv;
+                next[ND + i] = acc[i] * inv;
+            }
+            out.copy_from_slice(&next);
+            prev = next;
+        }
+    }
+}
+
+/// `y += a·x` on equal-length slices, in blocks of four of fixed size (unrolled and vectorised
+/// also for the short columns of a lumped machine).
+#[inline]
+fn axpy(y: &mut [f64], x: &[f64], a: f64) {
+    let mut yb = y.chunks_exact_mut(4);
+    let mut xb = x.chunks_exact(4);
+    for (yq, xq) in (&mut yb).zip(&mut xb) {
+        if let (Ok(yq), Ok(xq)) = (<&mut [f64; 4]>::try_from(yq), <&[f64; 4]>::try_from(xq)) {
+            for q in 0..4 {
+                yq[q] += xq[q] * a;
+            }
+        }
+    }
+    for (yi, xi) in yb.into_remainder().iter_mut().zip(xb.remainder()) {
+        *yi += xi * a;
+    }
+}
+
+/// The coefficients `ℓᵀc_k`, k = 0..=P, of the functional `ℓᵀX(s)` into `out`, over `ℓ`'s
+/// non-zero entries (an indicator touches a few coordinates).
+pub fn project(l: &[f64], coef: &[f64], out: &mut [f64]) {
+    let n = l.len();
+    out.iter_mut().for_each(|o| *o = 0.0);
+    for (i, &li) in l.iter().enumerate() {
+        if li != 0.0 {
+            for (o, ck) in out.iter_mut().zip(coef.chunks_exact(n)) {
+                *o += li * ck[i];
+            }
+        }
+    }
+}
+
+/// `X(s) = Σ c_k s^k` into `out` (Horner).
+pub fn state(coef: &[f64], s: f64, out: &mut [f64]) {
+    let n = out.len();
+    let p = coef.len() / n;
+    out.copy_from_slice(&coef[(p - 1) * n..p * n]);
+    for c in coef[..(p - 1) * n].chunks_exact(n).rev() {
+        for (o, ci) in out.iter_mut().zip(c) {
+            *o = *o * s + ci;
+        }
+    }
+}
+
+/// A polynomial `Σ a_k s^k` on `[0, τ]`, as a [`Scalar`] for the event search.
+#[derive(Debug, Clone, Copy)]
+pub struct Poly<'a> {
+    a: &'a [f64],
+    period: f64,
+    noise: f64,
+}
+
+impl<'a> Poly<'a> {
+    /// The polynomial with coefficients `a`, used on `[0, tau]`, with the search's time scale
+    /// `period`. Its round-off is taken as 64 ulps of `Σ|a_k| τ^k`.
+    pub fn new(a: &'a [f64], tau: f64, period: f64) -> Self {
+        let mut size = 0.0;
+        let mut p = 1.0;
+        for ak in a {
+            size += ak.abs() * p;
+            p *= tau;
+        }
+        Self {
+            a,
+            period,
+            noise: 64.0 * f64::EPSILON * size,
+        }
+    }
+
+    /// The polynomial with its round-off `noise` given.
+    pub fn with_noise(a: &'a [f64], period: f64, noise: f64) -> Self {
+        Self { a, period, noise }
+    }
+
+    /// `p(s)`.
+    pub fn value(&self, s: f64) -> f64 {
+        self.a.iter().rev().fold(0.0, |v, ak| v * s + ak)
+    }
+}
+
+impl Scalar for Poly<'_> {
+    fn value_slope(&self, s: f64) -> (f64, f64) {
+        let (mut v, mut d) = (0.0, 0.0);
+        for ak in self.a.iter().rev() {
+            d = d * s + v;
+            v = v * s + ak;
+        }
+        (v, d)
+    }
+    /// `Σ k(k−1)|a_k| b^{k−2}` (s ≥ 0).
+    fn curvature_bound(&self, _a: f64, b: f64) -> f64 {
+        let mut total = 0.0;
+        let mut p = 1.0;
+        for (k, ak) in self.a.iter().enumerate().skip(2) {
+            total += (k * (k - 1)) as f64 * ak.abs() * p;
+            p *= b.abs();
+        }
+        total
+    }
+    fn fastest_period(&self) -> f64 {
+        self.period
+    }
+    fn noise(&self) -> f64 {
+        self.noise
+    }
+}
