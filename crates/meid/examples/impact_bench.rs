@@ -143,6 +143,24 @@ fn main() {
 
     let oe = one(Method::Exact);
     if args.iter().any(|a| a == "--events") {
+        let closed = Options {
+            taylor_steps_per_mode: 0,
+            ..oe
+        };
+        let sc = integrate::solve(&sys, &closed, &mut NoOutput).unwrap();
+        for e in &sc.events {
+            println!(
+                "closed forms only: t = {:.12e} s: mode {:?} -> {:?}",
+                e.t, e.from, e.to
+            );
+        }
+        let sd = integrate::solve(&sys, &one(Method::Dopri5), &mut NoOutput).unwrap();
+        println!(
+            "dopri5: {} accepted steps, {} rejected, {} events",
+            sd.steps,
+            sd.rejected,
+            sd.events.len()
+        );
         let sol = integrate::solve(&sys, &oe, &mut NoOutput).unwrap();
         println!(
             "{} stretches; collision end {:?} s",
@@ -150,7 +168,7 @@ fn main() {
             sol.collision_end.as_ref().map(|c| c.t)
         );
         for e in &sol.events {
-            println!("t = {:.6e} s: mode {:?} -> {:?}", e.t, e.from, e.to);
+            println!("t = {:.12e} s: mode {:?} -> {:?}", e.t, e.from, e.to);
         }
         for bits in [7u8, 3, 2, 0] {
             let a = sys.first_order(meid::impact::Mode(bits));

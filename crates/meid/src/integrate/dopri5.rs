@@ -62,10 +62,48 @@ struct Rhs<'a> {
     omega2: Vec<f64>,
     damping: &'a [f64],
     damping_diagonal: bool,
-    a_s: Vec<f64>,
-    a_d: Vec<f64>,
-    a_f: Vec<f64>,
+    a_s: Sparse,
+    a_d: Sparse,
+    a_f: Sparse,
     masses: Vec<f64>,
+}
+
+/// A relative vector `a` (`δ = aᵀx`) by its non-zero entries: a contact or the damper touches
+/// a few coordinates, and the right-hand side is evaluated six times per step.
+struct Sparse {
+    idx: Vec<usize>,
+    val: Vec<f64>,
+}
+
+impl Sparse {
+    fn new(a: &[f64]) -> Self {
+        let (idx, val) = a
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| **v != 0.0)
+            .map(|(i, v)| (i, *v))
+            .unzip();
+        Self { idx, val }
+    }
+
+    /// `(aᵀx, aᵀv)`.
+    #[inline]
+    fn dots(&self, x: &[f64], v: &[f64]) -> (f64, f64) {
+        let (mut d, mut r) = (0.0, 0.0);
+        for (&i, &a) in self.idx.iter().zip(&self.val) {
+            d += a * x[i];
+            r += a * v[i];
+        }
+        (d, r)
+    }
+
+    /// `acc −= a f`.
+    #[inline]
+    fn apply(&self, f: f64, acc: &mut [f64]) {
+        for (&i, &a) in self.idx.iter().zip(&self.val) {
+            acc[i] -= a * f;
+        }
+    }
 }
 
 impl<'a> Rhs<'a> {
@@ -86,17 +124,17 @@ impl<'a> Rhs<'a> {
                 .collect(),
             damping,
             damping_diagonal,
-            a_s: sys.relative_vector(Switch::SliderBed).to_vec(),
-            a_d: if has_d {
-                sys.relative_vector(Switch::BedDamper).to_vec()
+            a_s: Sparse::new(sys.relative_vector(Switch::SliderBed)),
+            a_d: Sparse::new(if has_d {
+                sys.relative_vector(Switch::BedDamper)
             } else {
-                Vec::new()
-            },
-            a_f: if has_d {
-                sys.relative_vector(Switch::Dashpot).to_vec()
+                &[]
+            }),
+            a_f: Sparse::new(if has_d {
+                sys.relative_vector(Switch::Dashpot)
             } else {
-                Vec::new()
-            },
+                &[]
+            }),
             masses: sys.mass_diag(),
         }
     }
@@ -123,30 +161,25 @@ impl<'a> Rhs<'a> {
         for a in acc[n..].iter_mut() {
             *a = 0.0;
         }
-        let apply = |a: &[f64], f: f64, acc: &mut [f64]| {
-            for i in 0..nd {
-                acc[i] -= a[i] * f;
-            }
-        };
         if mode.on(Switch::SliderBed) {
             let law = self.sys.slider_bed.law;
-            let (d, r) = (dot(&self.a_s, x), dot(&self.a_s, v));
+            let (d, r) = self.a_s.dots(x, v);
             let f = law.force(d, r);
             power += (f - elastic(&law, d)) * r;
-            apply(&self.a_s, f, acc);
+            self.a_s.apply(f, acc);
         }
         if let (Some(dmp), Some(c)) = (&self.sys.damper, &self.sys.bed_damper) {
             if mode.on(Switch::BedDamper) {
-                let (d, r) = (dot(&self.a_d, x), dot(&self.a_d, v));
+                let (d, r) = self.a_d.dots(x, v);
                 let f = c.law.force(d, r);
                 power += (f - elastic(&c.law, d)) * r;
-                apply(&self.a_d, f, acc);
+                self.a_d.apply(f, acc);
             }
-            let (d, r) = (dot(&self.a_f, x), dot(&self.a_f, v));
+            let (d, r) = self.a_f.dots(x, v);
             let c_on = dmp.dashpot == DashpotKind::TwoWay || mode.on(Switch::Dashpot);
             let cd = if c_on { dmp.damping } else { 0.0 };
             power += cd * r * r;
-            apply(&self.a_f, dmp.stiffness * d + cd * r, acc);
+            self.a_f.apply(dmp.stiffness * d + cd * r, acc);
         }
         for i in n..nd {
             acc[i] /= self.masses[i];

@@ -21,8 +21,17 @@ const K_MAX: usize = 8;
 /// `1e-11` for higher orders) or below `1e-12 ‖ℓ‖‖y‖`: the latter catches quantities whose terms
 /// are all physically zero (bodies at rest, forces zero) and only carry round-off.
 pub fn lex_sign(l: &[f64], a: &Mat<f64>, x: &[f64]) -> f64 {
+    let mut out = [0.0];
+    lex_signs(std::slice::from_ref(&l), a, x, &mut out);
+    out[0]
+}
+
+/// [`lex_sign`] of several functionals at once (`out[i]` for `ls[i]`): the derivatives `Aᵏ X`
+/// are computed once, as far as the last undecided functional needs them.
+pub fn lex_signs<L: AsRef<[f64]>>(ls: &[L], a: &Mat<f64>, x: &[f64], out: &mut [f64]) {
     let n = x.len();
-    let l_norm = l.iter().map(|v| v * v).sum::<f64>().sqrt();
+    out.iter_mut().for_each(|o| *o = 0.0);
+    let mut open = ls.len();
     // Stack buffers for the usual sizes (no allocation per call).
     let mut stack = [0.0; 128];
     let mut heap = Vec::new();
@@ -34,20 +43,37 @@ pub fn lex_sign(l: &[f64], a: &Mat<f64>, x: &[f64]) -> f64 {
     };
     y.copy_from_slice(x);
     let (mut y, mut next) = (y, next);
+    let mut decided = [false; 16];
+    let mut decided_heap = Vec::new();
+    let decided: &mut [bool] = if ls.len() <= decided.len() {
+        &mut decided[..ls.len()]
+    } else {
+        decided_heap.resize(ls.len(), false);
+        &mut decided_heap
+    };
     for k in 0..=K_MAX {
-        let (mut val, mut scale, mut y2) = (0.0, 0.0, 0.0);
-        for i in 0..n {
-            let t = l[i] * y[i];
-            val += t;
-            scale += t.abs();
-            y2 += y[i] * y[i];
-        }
+        let y_norm = y.iter().map(|v| v * v).sum::<f64>().sqrt();
         let tol = if k == 0 { 1e-9 } else { 1e-11 };
-        let floor = 1e-12 * l_norm * y2.sqrt();
-        if val.abs() > tol * scale && val.abs() > floor {
-            return val.signum();
+        for (i, l) in ls.iter().enumerate() {
+            if decided[i] {
+                continue;
+            }
+            let l = l.as_ref();
+            let (mut val, mut scale, mut l2) = (0.0, 0.0, 0.0);
+            for (li, yi) in l.iter().zip(y.iter()) {
+                let t = li * yi;
+                val += t;
+                scale += t.abs();
+                l2 += li * li;
+            }
+            let floor = 1e-12 * l2.sqrt() * y_norm;
+            if val.abs() > tol * scale && val.abs() > floor {
+                out[i] = val.signum();
+                decided[i] = true;
+                open -= 1;
+            }
         }
-        if k == K_MAX {
+        if open == 0 || k == K_MAX {
             break;
         }
         // next = A y, column by column (contiguous in faer's column-major storage).
@@ -61,7 +87,6 @@ pub fn lex_sign(l: &[f64], a: &Mat<f64>, x: &[f64]) -> f64 {
         }
         std::mem::swap(&mut y, &mut next);
     }
-    0.0
 }
 
 /// The mode implied by indicator signs. An indicator that is identically zero (sign 0: no
@@ -93,7 +118,8 @@ pub fn select_mode(
     let inds = sys.indicators();
     let implied = |m: Mode, matrix: &mut dyn FnMut(Mode) -> std::rc::Rc<Mat<f64>>| {
         let a = matrix(m);
-        let signs: Vec<f64> = vecs.iter().map(|l| lex_sign(l, &a, x)).collect();
+        let mut signs = vec![0.0; vecs.len()];
+        lex_signs(vecs, &a, x, &mut signs);
         let sign_of = |ind: Indicator| {
             inds.iter()
                 .position(|&i| i == ind)
