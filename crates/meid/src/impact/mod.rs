@@ -533,15 +533,17 @@ impl ImpactSystem {
         for i in 0..nd {
             a[(i, nd + i)] = 1.0;
         }
+        // K_σ and C_σ summed (column-major, nd × 2nd), then rows scaled by −1/m_i.
+        let mut kc = vec![0.0; 2 * nd * nd];
         self.for_each_entry(mode, |i, j, dk, dc| {
-            a[(nd + i, j)] += dk;
-            a[(nd + i, nd + j)] += dc;
+            kc[j * nd + i] += dk;
+            kc[(nd + j) * nd + i] += dc;
         });
-        for j in 0..2 * nd {
-            for i in 0..nd {
-                let v = a[(nd + i, j)];
-                if v != 0.0 {
-                    a[(nd + i, j)] = -v / m[i];
+        for (j, col) in kc.chunks_exact(nd).enumerate() {
+            let dst = &mut a.col_as_slice_mut(j)[nd..];
+            for ((d, v), mi) in dst.iter_mut().zip(col).zip(&m) {
+                if *v != 0.0 {
+                    *d = -v / mi;
                 }
             }
         }

@@ -49,27 +49,41 @@ impl TaylorMatrix {
     pub fn new(a: &Mat<f64>) -> Self {
         let n = a.nrows();
         let nd = n / 2;
-        let mut r21 = 0.0_f64;
-        for i in nd..n {
-            r21 = r21.max((0..nd).map(|j| a[(i, j)].abs()).sum::<f64>());
-        }
-        let nu = if r21 > 0.0 { r21.sqrt() } else { 1.0 };
-        // d_j / d_i with d = 1/ν for positions, 1 for velocities.
-        let d = |i: usize| if i < nd { 1.0 / nu } else { 1.0 };
-        let mut rate = 0.0_f64;
-        for i in 0..n {
-            let row: f64 = (0..n).map(|j| a[(i, j)].abs() * d(j)).sum::<f64>() / d(i);
-            rate = rate.max(row);
-        }
-        let structured =
-            n % 2 == 0 && (0..nd).all(|i| (0..n).all(|j| a[(i, j)] == f64::from(j == nd + i)));
-        let first_row = if structured { nd } else { 0 };
-        let m = n - first_row;
-        let mut cols = vec![0.0; m * n];
-        for (j, col) in cols.chunks_exact_mut(m.max(1)).enumerate() {
-            for (i, r) in col.iter_mut().enumerate() {
-                *r = a[(first_row + i, j)];
+        // Columns of A, contiguous in faer's column-major storage.
+        let col = |j: usize| a.col_as_slice(j);
+        let mut r21 = vec![0.0; n - nd];
+        for j in 0..nd {
+            for (r, v) in r21.iter_mut().zip(&col(j)[nd..]) {
+                *r += v.abs();
             }
+        }
+        let r21 = r21.iter().fold(0.0_f64, |m, v| m.max(*v));
+        let nu = if r21 > 0.0 { r21.sqrt() } else { 1.0 };
+        // Row sums of |D⁻¹AD| with d = 1/ν for positions, 1 for velocities:
+        // |a_ij| d_j / d_i.
+        let d = |i: usize| if i < nd { 1.0 / nu } else { 1.0 };
+        let mut rows = vec![0.0; n];
+        for j in 0..n {
+            let dj = d(j);
+            for (r, v) in rows.iter_mut().zip(col(j)) {
+                *r += v.abs() * dj;
+            }
+        }
+        let rate = rows
+            .iter()
+            .enumerate()
+            .fold(0.0_f64, |m, (i, r)| m.max(r / d(i)));
+        let structured = n % 2 == 0
+            && (0..n).all(|j| {
+                col(j)[..nd]
+                    .iter()
+                    .enumerate()
+                    .all(|(i, v)| *v == f64::from(j == nd + i))
+            });
+        let first_row = if structured { nd } else { 0 };
+        let mut cols = Vec::with_capacity((n - first_row) * n);
+        for j in 0..n {
+            cols.extend_from_slice(&col(j)[first_row..]);
         }
         Self {
             n,
@@ -207,13 +221,27 @@ fn axpy(y: &mut [f64], x: &[f64], a: f64) {
 /// non-zero entries (an indicator touches a few coordinates).
 pub fn project(l: &[f64], coef: &[f64], out: &mut [f64]) {
     let n = l.len();
-    out.iter_mut().for_each(|o| *o = 0.0);
+    // The non-zeros of ℓ (up to 8 on the stack; a denser ℓ goes entry by entry).
+    let mut nz = [(0usize, 0.0); 8];
+    let mut m = 0;
     for (i, &li) in l.iter().enumerate() {
         if li != 0.0 {
-            for (o, ck) in out.iter_mut().zip(coef.chunks_exact(n)) {
-                *o += li * ck[i];
+            if m == nz.len() {
+                m = usize::MAX;
+                break;
             }
+            nz[m] = (i, li);
+            m += 1;
         }
+    }
+    if m == usize::MAX {
+        for (o, ck) in out.iter_mut().zip(coef.chunks_exact(n)) {
+            *o = l.iter().zip(ck).map(|(a, b)| a * b).sum();
+        }
+        return;
+    }
+    for (o, ck) in out.iter_mut().zip(coef.chunks_exact(n)) {
+        *o = nz[..m].iter().map(|&(i, li)| li * ck[i]).sum();
     }
 }
 
