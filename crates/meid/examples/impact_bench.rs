@@ -172,12 +172,11 @@ fn main() {
         }
         for bits in [7u8, 3, 2, 0] {
             let a = sys.first_order(meid::impact::Mode(bits));
-            let x = sys.initial_state();
-            let tp = meid::integrate::propagator::Propagator::taylor(a, &x).unwrap();
+            let tm = meid::integrate::taylor::TaylorMatrix::new(&a).unwrap();
             println!(
-                "mode {bits}: Taylor validity {:.3e} s, period {:.3e} s",
-                tp.validity(),
-                tp.period()
+                "mode {bits}: Taylor step {:.3e} s, period scale {:.3e} s",
+                tm.validity(),
+                tm.period()
             );
         }
         return;

@@ -50,6 +50,14 @@ fn opts(engine: Engine) -> Options {
     }
 }
 
+/// The run used the form the engine names: Taylor steps, or closed forms only.
+fn check_engine(engine: Engine, sol: &integrate::Solution) {
+    match engine {
+        Engine::Taylor => assert!(sol.taylor_steps > 0, "no Taylor step taken"),
+        Engine::ClosedForm | Engine::Dopri5 => assert_eq!(sol.taylor_steps, 0),
+    }
+}
+
 struct TwoBody {
     t: f64,
     v1: f64,
@@ -78,6 +86,7 @@ fn two_body_with(m1: f64, m2: f64, v0: f64, contact: Contact, method: Engine) ->
     )
     .unwrap();
     let sol = integrate::solve(&sys, &opts(method), &mut NoOutput).unwrap();
+    check_engine(method, &sol);
     let end = sol.collision_end.expect("collision must end");
     let nd = sys.dofs();
     let v1 = end.x[nd + sys.slider_index()];
@@ -220,6 +229,7 @@ fn three_body_chain_complete_exchange() {
         )
         .unwrap();
         let sol = integrate::solve(&sys, &opts(method), &mut NoOutput).unwrap();
+        check_engine(method, &sol);
         let end = sol.collision_end.expect("collision must end");
         let t_exact = PI * (m / k).sqrt();
         assert!(

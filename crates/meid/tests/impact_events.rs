@@ -25,21 +25,9 @@ fn dashpot_at_rest_does_not_creep() {
     let mut o = model.options();
     o.stop_at_collision_end = true;
     let sol = integrate::solve(&sys, &o, &mut NoOutput).unwrap();
-    // At most one closed-form stretch per event (plus the last), and Taylor steps within their
-    // budget per mode (the creep took thousands of stretches).
-    let closed_form = sol.steps - sol.taylor_steps;
-    assert!(
-        closed_form <= 5,
-        "{closed_form} closed-form segments: {:?}",
-        sol.events
-    );
-    let modes = 1 + sol.events.len();
-    assert!(
-        sol.taylor_steps <= modes * integrate::exact::TAYLOR_STEPS_PER_MODE,
-        "{} Taylor steps: {:?}",
-        sol.taylor_steps,
-        sol.events
-    );
+    // The collision lasts 3.9 ms: 18 stretches (Taylor steps of ~0.2 ms, one more at each
+    // switch). The creep took 8,040.
+    assert!(sol.steps <= 25, "{} stretches: {:?}", sol.steps, sol.events);
     assert_eq!(sol.events.len(), 4, "{:?}", sol.events);
     // The first switch (the dashpot turning off as the damper is pushed away) happens after
     // the bed has moved, not at round-off times.

@@ -1,8 +1,17 @@
-//! The Taylor propagator (short stretches of the exact integrator) against closed forms and
-//! against the spectral propagator.
+//! Taylor steps (`integrate::taylor`, short stretches of the exact integrator) against closed
+//! forms, against the spectral propagator and against a plain `A^k X₀ / k!`.
 
 use faer::Mat;
 use meid::integrate::propagator::Propagator;
+use meid::integrate::taylor::{self, TaylorMatrix, ORDER};
+
+/// The coefficients of a step from `x0` (rows of `n`) and its validity.
+fn expand(a: &Mat<f64>, x0: &[f64]) -> (Vec<f64>, f64) {
+    let tm = TaylorMatrix::new(a).unwrap();
+    let mut coef = vec![0.0; (ORDER + 1) * x0.len()];
+    tm.expand(x0, &mut coef);
+    (coef, tm.validity())
+}
 
 /// `ẍ + 2ζω ẋ + ω² x = 0`, x(0) = 1, ẋ(0) = 0:
 /// `x = e^{−ζωs}(cos ω_d s + ζω/ω_d sin ω_d s)`, `ẋ = −(ω²/ω_d) e^{−ζωs} sin ω_d s`.
@@ -16,15 +25,13 @@ fn damped_oscillator_within_validity() {
         (1, 1) => -2.0 * z * w,
         _ => 0.0,
     });
-    let p = Propagator::taylor(a, &[1.0, 0.0]).unwrap();
-    let tau = p.validity();
+    let (coef, tau) = expand(&a, &[1.0, 0.0]);
     // The validity is 2/‖D⁻¹AD‖_∞: a fraction of the period 2π/ω.
     assert!(tau > 0.5 / w && tau <= 2.0 / w, "tau {tau}");
-    let seg = p.segment(&[1.0, 0.0]);
     let mut out = [0.0; 2];
     for frac in [0.0, 0.1, 0.5, 1.0] {
         let s = frac * tau;
-        seg.state(s, &mut out);
+        taylor::state(&coef, s, &mut out);
         let e = (-z * w * s).exp();
         let x = e * ((wd * s).cos() + z * w / wd * (wd * s).sin());
         let v = -(w * w / wd) * e * (wd * s).sin();
@@ -76,14 +83,13 @@ fn chain_agrees_with_spectral_form() {
         }
     });
     let x0 = [0.0, 1e-6, 0.0, 1.2, 0.0, -0.3];
-    let spectral = Propagator::new(&k, &c, &m, a.clone()).unwrap();
-    let taylor = Propagator::taylor(a, &x0).unwrap();
-    let (ss, ts) = (spectral.segment(&x0), taylor.segment(&x0));
+    let (coef, tau) = expand(&a, &x0);
+    let spectral = Propagator::new(&k, &c, &m, a).unwrap();
+    let ss = spectral.segment(&x0);
     let (mut xs, mut xt) = ([0.0; 6], [0.0; 6]);
-    let tau = taylor.validity();
     for frac in [0.25, 0.5, 1.0] {
         ss.state(frac * tau, &mut xs);
-        ts.state(frac * tau, &mut xt);
+        taylor::state(&coef, frac * tau, &mut xt);
         for i in 0..6 {
             let scale = if i < 3 { 1e-4 } else { 1.0 };
             assert!(
@@ -92,6 +98,43 @@ fn chain_agrees_with_spectral_form() {
                 xs[i],
                 xt[i]
             );
+        }
+    }
+}
+
+/// The fixed-size expansion (first-order form, 2 to 8 degrees of freedom), the general one
+/// (9 degrees of freedom) and the one for a matrix without the `[[0, I], …]` structure all equal
+/// `A^k X₀ / k!` computed by plain mat-vecs, to round-off.
+#[test]
+fn expansion_equals_matrix_powers() {
+    let mut rng = meid::rng::SplitMix64::new(7);
+    for (nd, structured) in (2..=9).map(|nd| (nd, true)).chain([(3, false)]) {
+        let n = 2 * nd;
+        let a = Mat::<f64>::from_fn(n, n, |i, j| {
+            let r = rng.next_f64() - 0.5;
+            match (structured, i < nd) {
+                (true, true) => f64::from(j == nd + i),
+                _ => 1e3 * r,
+            }
+        });
+        let x0: Vec<f64> = (0..n).map(|_| rng.next_f64() - 0.5).collect();
+        let (coef, _) = expand(&a, &x0);
+        let mut y = x0.clone();
+        for k in 0..=ORDER {
+            let ck = &coef[k * n..(k + 1) * n];
+            let scale = y.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            for i in 0..n {
+                assert!(
+                    (ck[i] - y[i]).abs() <= 1e-13 * scale,
+                    "nd {nd}, structured {structured}, k {k}, i {i}: {} vs {}",
+                    ck[i],
+                    y[i]
+                );
+            }
+            // y ← A y / (k + 1)
+            y = (0..n)
+                .map(|i| (0..n).map(|j| a[(i, j)] * y[j]).sum::<f64>() / (k + 1) as f64)
+                .collect();
         }
     }
 }

@@ -58,6 +58,9 @@ struct ModeData {
 /// closed form after this many steps.
 pub const TAYLOR_STEPS_PER_MODE: usize = 16;
 
+/// Number of modes: three switch bits (slider-bed, bed-damper, dashpot).
+const MODES: usize = 8;
+
 /// Runs the exact propagator. See the module documentation.
 pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Result<Solution> {
     solve_from(sys, &sys.initial_state(), opts, obs)
@@ -124,7 +127,7 @@ pub fn solve_from(
     let mut zero_length = 0usize;
     let mut buf = vec![0.0; n];
     let mut buf2 = vec![0.0; n];
-    let mut taylor_steps = [0usize; 8];
+    let mut taylor_steps = [0usize; MODES];
     // Damping matrices of the modes met (dissipation).
     let mut c_cache: HashMap<Mode, std::rc::Rc<Mat<f64>>> = HashMap::new();
     let mut c_of = |m: Mode| -> std::rc::Rc<Mat<f64>> {
@@ -136,7 +139,7 @@ pub fn solve_from(
 
     // Taylor-step workspace: the first-order matrices prepared per mode, the coefficients
     // c_0 … c_P of the current step, and the polynomials of the indicators and of a force.
-    let mut tmats: [Option<TaylorMatrix>; 8] = Default::default();
+    let mut tmats: [Option<TaylorMatrix>; MODES] = Default::default();
     let mut coef = vec![0.0; (taylor::ORDER + 1) * n];
     let mut ind_polys = vec![[0.0; taylor::ORDER + 1]; ind_vecs.len()];
     let mut gl_work = Vec::new();
@@ -152,7 +155,8 @@ pub fn solve_from(
         // is over in a few periods, never builds one. The choice depends only on the run's own
         // history (never on the per-thread cache), so results do not depend on the thread
         // count.
-        let mi = usize::from(mode.0) & 7;
+        debug_assert!(usize::from(mode.0) < MODES, "three switch bits");
+        let mi = usize::from(mode.0) % MODES;
         let use_taylor =
             !cache.contains_key(&mode) && taylor_steps[mi] < opts.taylor_steps_per_mode;
         let (s_end, switched, run_ends, period);
@@ -160,7 +164,12 @@ pub fn solve_from(
             taylor_steps[mi] += 1;
             let tm = match &tmats[mi] {
                 Some(tm) => tm,
-                None => tmats[mi].insert(TaylorMatrix::new(&a_of(mode))),
+                None => {
+                    let tm = TaylorMatrix::new(&a_of(mode)).ok_or_else(|| {
+                        Error::numerical("exact", format!("mode {mode:?}: non-finite matrix"))
+                    })?;
+                    tmats[mi].insert(tm)
+                }
             };
             tm.expand(&x, &mut coef);
             let tau = tm.validity();
@@ -178,7 +187,8 @@ pub fn solve_from(
                 .map(|(p, s)| (Poly::new(p, tau, period), *s))
                 .filter(|(p, s)| !p.keeps_sign(*s, reach))
                 .collect();
-            (s_end, switched) = stretch_end(first_switch(&funcs, period, reach, search), reach);
+            let found = first_switch(&funcs, period, reach, search);
+            (s_end, switched) = stretch_end(found, reach, reach >= horizon);
             run_ends = !switched && s_end >= horizon;
             // 3: output samples, from the polynomial.
             if let Some(g) = grid.as_mut() {
@@ -217,7 +227,8 @@ pub fn solve_from(
                 .filter(|(_, s)| **s != 0.0)
                 .map(|(l, s)| (seg.functional(l), *s))
                 .collect();
-            (s_end, switched) = stretch_end(first_switch(&funcs, period, horizon, search), horizon);
+            let found = first_switch(&funcs, period, horizon, search);
+            (s_end, switched) = stretch_end(found, horizon, true);
             run_ends = !switched;
             // 3: output samples.
             if let Some(g) = grid.as_mut() {
@@ -302,6 +313,13 @@ pub fn solve_from(
             }
         }
         if t >= t_end {
+            // A switch at the very end of the run: the sample at t_end, if still due.
+            if let Some(g) = grid.as_mut() {
+                let xe = x.clone();
+                let state = |_: f64, out: &mut [f64]| out.copy_from_slice(&xe);
+                let span = (t, 0.0, true, t_end);
+                emit_samples(g, span, mode, &state, None, obs, &mut buf, &mut buf2);
+            }
             break;
         }
     }
@@ -321,10 +339,12 @@ pub fn solve_from(
 }
 
 /// Where a stretch ends: at the first switch `found` if it comes before `reach`, else at
-/// `reach`; and whether it ends at a switch.
-fn stretch_end(found: Option<f64>, reach: f64) -> (f64, bool) {
+/// `reach`; and whether it ends at a switch. A switch found exactly at `reach` counts when
+/// `reach` is only the end of a Taylor step (`reach_is_run_end` false): the sign change is real
+/// (the search bracketed it), and the next step must not start past it.
+fn stretch_end(found: Option<f64>, reach: f64, reach_is_run_end: bool) -> (f64, bool) {
     match found {
-        Some(s) if s < reach => (s.max(0.0), true),
+        Some(s) if s < reach || (s <= reach && !reach_is_run_end) => (s.clamp(0.0, reach), true),
         _ => (reach, false),
     }
 }
@@ -467,16 +487,13 @@ const GL_W: [f64; 4] = [
     0.1012285362903763,
 ];
 
-/// `∫₀^len ẋᵀ C ẋ ds` on a segment, in closed form for the spectral form
-/// (`ẋ = Re Σ β_k e^{λ_k s}`, so the integrand is a sum of exponentials) and for a Taylor step
-/// (a polynomial), otherwise by 8-point Gauss-Legendre quadrature on sub-intervals of a quarter
-/// of the fastest period.
+/// `∫₀^len ẋᵀ C ẋ ds` on a closed-form segment: exactly for the spectral form
+/// (`ẋ = Re Σ β_k e^{λ_k s}`, so the integrand is a sum of exponentials), otherwise (the
+/// matrix-exponential fallback) by 8-point Gauss-Legendre quadrature on sub-intervals of a
+/// quarter of the fastest period. Taylor steps have [`taylor_dissipated`].
 fn dissipated(seg: &Segment<'_>, c: &Mat<f64>, nd: usize, len: f64) -> f64 {
     if len <= 0.0 || c.norm_l2() == 0.0 {
         return 0.0;
-    }
-    if let Some(coef) = seg.taylor_coefficients() {
-        return taylor_dissipated(coef, c, nd, len, &mut Vec::new());
     }
     if let Some((beta, lam)) = seg.velocity_terms() {
         // ẋᵀCẋ = ½ Σ_kl Re[(β_kᵀCβ_l) e^{(λ_k+λ_l)s} + (β_kᵀCβ̄_l) e^{(λ_k+λ̄_l)s}].
@@ -530,17 +547,18 @@ const GL10_X: [f64; 5] = [
     0.973_906_528_517_171_7,
 ];
 const GL10_W: [f64; 5] = [
-    0.295_524_224_714_752_8,
-    0.269_266_719_309_996_5,
-    0.219_086_362_515_982,
-    0.149_451_349_150_580_4,
+    0.295_524_224_714_752_87,
+    0.269_266_719_309_996_35,
+    0.219_086_362_515_982_04,
+    0.149_451_349_150_580_6,
     0.066_671_344_308_688_14,
 ];
 
 /// `∫₀^len ẋᵀ C ẋ ds` on a Taylor step with coefficients `coef` (`len` within its validity
 /// `2/ρ`, ρ bounding the growth rate of ẋ and so `2ρ` that of ẋᵀCẋ): the 10-point
-/// Gauss-Legendre rule's error, `(2ρL)^20/20! · (10!)^4/(21 (20!)^3) ≤ 6e-19` of the
-/// integrand's size, is below round-off. Only the velocity half of the polynomial is evaluated.
+/// Gauss-Legendre rule's error, `L^21 (10!)^4 / (21 (20!)^3) · max|f⁽²⁰⁾|` with
+/// `|f⁽²⁰⁾| ≤ (2ρ)^20 max|f|`, is at most `4^20 (10!)^4 / (21 (20!)^3) ≈ 6.4e-19` of
+/// `L max|f|`: below round-off. Only the velocity half of the polynomial is evaluated.
 /// `work` is scratch space (reused between calls).
 fn taylor_dissipated(
     coef: &[f64],
@@ -549,7 +567,7 @@ fn taylor_dissipated(
     len: f64,
     work: &mut Vec<[f64; 10]>,
 ) -> f64 {
-    if len <= 0.0 {
+    if len <= 0.0 || (0..nd).all(|j| c.col_as_slice(j).iter().all(|v| *v == 0.0)) {
         return 0.0;
     }
     // The 10 nodes and weights on [0, len].

@@ -33,7 +33,6 @@ use std::rc::Rc;
 use faer::{c64, Mat};
 
 use super::small;
-use super::taylor::{Poly, TaylorMatrix};
 
 use super::expm::expm;
 use super::roots::Scalar;
@@ -66,19 +65,7 @@ enum Kind {
         d: Vec<f64>,
         b: Mat<f64>,
     },
-    /// Truncated Taylor series from one start state, `X(s) = Σ_{k≤P} c_k s^k`,
-    /// `c_k = A^k X₀ / k!`, valid on `[0, tau]` (see [`super::taylor`]: the remainder there is
-    /// below 2.4e-18 of the scaled state).
-    Taylor {
-        /// `c_k` for k = 0..=P, rows of length 2·dofs, one after the other.
-        coef: Vec<f64>,
-        tau: f64,
-        rate: f64,
-    },
 }
-
-/// Order of the Taylor propagator.
-const TAYLOR_ORDER: usize = super::taylor::ORDER;
 
 #[derive(Debug, Clone)]
 struct Spectral {
@@ -197,37 +184,6 @@ impl Propagator {
         }
     }
 
-    /// The Taylor propagator of `Ẋ = A X` from `x0`, valid for `s ∈ [0, validity()]` (a few
-    /// tenths of the fastest period). Building it costs `P` mat-vecs instead of an
-    /// eigen-decomposition: the exact integrator uses it for stretches that end soon after they
-    /// start (a dashpot switching off 0.8 µs into a blow), and builds the closed form otherwise.
-    pub fn taylor(a: Mat<f64>, x0: &[f64]) -> Option<Self> {
-        let n = a.nrows();
-        if n == 0 || x0.len() != n || a.ncols() != n {
-            return None;
-        }
-        let tm = TaylorMatrix::new(&a);
-        let mut coef = vec![0.0; (TAYLOR_ORDER + 1) * n];
-        tm.expand(x0, &mut coef);
-        Some(Self {
-            a,
-            dofs: n / 2,
-            kind: Kind::Taylor {
-                coef,
-                tau: tm.validity(),
-                rate: tm.rate(),
-            },
-        })
-    }
-
-    /// How far from its start the propagator holds (s): the Taylor form's `tau`, else infinity.
-    pub fn validity(&self) -> f64 {
-        match &self.kind {
-            Kind::Taylor { tau, .. } => *tau,
-            _ => f64::INFINITY,
-        }
-    }
-
     /// True when this mode uses the spectral (not the matrix-exponential) form.
     pub fn is_spectral(&self) -> bool {
         matches!(self.kind, Kind::Spectral(_))
@@ -238,7 +194,6 @@ impl Propagator {
         let lam_max = match &self.kind {
             Kind::Spectral(s) => s.lam_max,
             Kind::Expm { norm_f, .. } => *norm_f,
-            Kind::Taylor { rate, .. } => *rate,
         };
         if lam_max > 0.0 {
             2.0 * std::f64::consts::PI / lam_max
@@ -264,7 +219,7 @@ impl Propagator {
                         .collect();
                 (alpha0, alpha_dot, coef)
             }
-            Kind::Expm { .. } | Kind::Taylor { .. } => (Vec::new(), Vec::new(), Vec::new()),
+            Kind::Expm { .. } => (Vec::new(), Vec::new(), Vec::new()),
         };
         Segment {
             p: self,
@@ -279,7 +234,7 @@ impl Propagator {
     pub fn transition(&self, h: f64) -> Mat<f64> {
         let n = 2 * self.dofs;
         match &self.kind {
-            Kind::Expm { .. } | Kind::Taylor { .. } => expm(&self.a, h),
+            Kind::Expm { .. } => expm(&self.a, h),
             Kind::Spectral(s) => {
                 let nd = self.dofs;
                 let mut e = Mat::<f64>::zeros(n, n);
@@ -330,16 +285,7 @@ impl<'p> Segment<'p> {
                     .collect();
                 Some((beta, sp.lam.clone()))
             }
-            Kind::Expm { .. } | Kind::Taylor { .. } => None,
-        }
-    }
-
-    /// The Taylor form's coefficients, `X(s) = Σ_k c_k s^k`: rows `c_k` of length `2·dofs`
-    /// for k = 0..=P, one after the other; `None` for the other forms.
-    pub fn taylor_coefficients(&self) -> Option<&'p [f64]> {
-        match &self.p.kind {
-            Kind::Taylor { coef, .. } => Some(coef),
-            _ => None,
+            Kind::Expm { .. } => None,
         }
     }
 
@@ -347,7 +293,6 @@ impl<'p> Segment<'p> {
     pub fn state(&self, s: f64, out: &mut [f64]) {
         let nd = self.p.dofs;
         match &self.p.kind {
-            Kind::Taylor { coef, .. } => super::taylor::state(coef, s, out),
             Kind::Expm { h, e, .. } => {
                 let n = 2 * nd;
                 let k = (s / h).floor().max(0.0) as usize;
@@ -457,16 +402,6 @@ impl<'p> Segment<'p> {
                 e.noise = 64.0 * f64::EPSILON * terms + 4.0 * (e.value_slope(0.0).0 - direct).abs();
                 Functional::Exp(e)
             }
-            Kind::Taylor { coef, tau, rate } => {
-                let mut a = vec![0.0; TAYLOR_ORDER + 1];
-                super::taylor::project(l, coef, &mut a);
-                let noise = Poly::new(&a, *tau, 0.0).noise();
-                Functional::Poly(PolySum {
-                    a,
-                    period: 2.0 * std::f64::consts::PI / rate,
-                    noise,
-                })
-            }
             Kind::Expm { norm_f, d, b, .. } => {
                 let la = row_times(l, &self.p.a);
                 // |ℓᵀA²X| = |(ℓᵀD) B² (D⁻¹X)| ≤ ‖ℓᵀD B²‖ ‖D⁻¹X‖.
@@ -487,8 +422,6 @@ impl<'p> Segment<'p> {
 /// A linear functional of the state along a segment, as a [`Scalar`] function of time.
 pub enum Functional<'s> {
     Exp(ExpSum),
-    /// A polynomial (Taylor propagator): `Σ a_k s^k`.
-    Poly(PolySum),
     Expm {
         seg: &'s Segment<'s>,
         l: Vec<f64>,
@@ -496,35 +429,6 @@ pub enum Functional<'s> {
         la2_norm: f64,
         norm_a: f64,
     },
-}
-
-/// `Σ a_k s^k` with its period scale and round-off (Taylor propagator).
-#[derive(Debug, Clone)]
-pub struct PolySum {
-    a: Vec<f64>,
-    period: f64,
-    noise: f64,
-}
-
-impl PolySum {
-    fn poly(&self) -> Poly<'_> {
-        Poly::with_noise(&self.a, self.period, self.noise)
-    }
-}
-
-impl Scalar for PolySum {
-    fn value_slope(&self, s: f64) -> (f64, f64) {
-        self.poly().value_slope(s)
-    }
-    fn curvature_bound(&self, a: f64, b: f64) -> f64 {
-        self.poly().curvature_bound(a, b)
-    }
-    fn fastest_period(&self) -> f64 {
-        self.period
-    }
-    fn noise(&self) -> f64 {
-        self.noise
-    }
 }
 
 impl ExpSum {
@@ -579,7 +483,6 @@ impl Scalar for Functional<'_> {
     fn value_slope(&self, s: f64) -> (f64, f64) {
         match self {
             Functional::Exp(e) => e.value_slope(s),
-            Functional::Poly(p) => p.value_slope(s),
             Functional::Expm { seg, l, la, .. } => {
                 let mut x = vec![0.0; l.len()];
                 seg.state(s, &mut x);
@@ -590,7 +493,6 @@ impl Scalar for Functional<'_> {
     fn curvature_bound(&self, a: f64, b: f64) -> f64 {
         match self {
             Functional::Exp(e) => e.curvature_bound(a, b),
-            Functional::Poly(p) => p.curvature_bound(a, b),
             Functional::Expm {
                 seg,
                 la2_norm,
@@ -607,7 +509,7 @@ impl Scalar for Functional<'_> {
                         .map(|(v, di)| (v / di).powi(2))
                         .sum::<f64>()
                         .sqrt(),
-                    Kind::Spectral(_) | Kind::Taylor { .. } => norm(&x),
+                    Kind::Spectral(_) => norm(&x),
                 };
                 la2_norm * dinv_x * (norm_a * (b - a)).exp()
             }
@@ -616,14 +518,12 @@ impl Scalar for Functional<'_> {
     fn noise(&self) -> f64 {
         match self {
             Functional::Exp(e) => e.noise(),
-            Functional::Poly(p) => p.noise(),
             Functional::Expm { .. } => 0.0,
         }
     }
     fn fastest_period(&self) -> f64 {
         match self {
             Functional::Exp(e) => e.fastest_period(),
-            Functional::Poly(p) => p.fastest_period(),
             Functional::Expm { norm_a, .. } => {
                 if *norm_a > 0.0 {
                     2.0 * std::f64::consts::PI / norm_a

@@ -45,9 +45,12 @@ pub struct TaylorMatrix {
 }
 
 impl TaylorMatrix {
-    /// Prepares `a` (square, `2·dofs`).
-    pub fn new(a: &Mat<f64>) -> Self {
+    /// Prepares `a` (square); `None` when it is not square or has non-finite entries.
+    pub fn new(a: &Mat<f64>) -> Option<Self> {
         let n = a.nrows();
+        if a.ncols() != n {
+            return None;
+        }
         let nd = n / 2;
         // Columns of A, contiguous in faer's column-major storage.
         let col = |j: usize| a.col_as_slice(j);
@@ -80,17 +83,20 @@ impl TaylorMatrix {
                     .enumerate()
                     .all(|(i, v)| *v == f64::from(j == nd + i))
             });
+        if !rate.is_finite() {
+            return None;
+        }
         let first_row = if structured { nd } else { 0 };
         let mut cols = Vec::with_capacity((n - first_row) * n);
         for j in 0..n {
             cols.extend_from_slice(&col(j)[first_row..]);
         }
-        Self {
+        Some(Self {
             n,
             structured,
             cols,
             rate,
-        }
+        })
     }
 
     /// Dimension `n` of the state.
@@ -121,10 +127,18 @@ impl TaylorMatrix {
         }
     }
 
-    /// Writes `c_0 … c_P` (rows of `n`, one after the other) from `x0` into `coef`
-    /// (length `(P + 1)·n`).
+    /// Writes `c_0 … c_P` (rows of `n`, one after the other) from `x0` into `coef`.
+    ///
+    /// # Panics
+    /// When `x0.len() != n` or `coef.len() != (P + 1)·n`.
     pub fn expand(&self, x0: &[f64], coef: &mut [f64]) {
         let n = self.n;
+        assert_eq!(x0.len(), n, "Taylor expansion: state length");
+        assert_eq!(
+            coef.len(),
+            (ORDER + 1) * n,
+            "Taylor expansion: buffer length"
+        );
         let nd = n / 2;
         // Small lumped machines: fixed sizes, fully unrolled (the loops below spend more on
         // their own overhead than on the few products of a column of 2–8 entries).
@@ -221,6 +235,10 @@ fn axpy(y: &mut [f64], x: &[f64], a: f64) {
 /// non-zero entries (an indicator touches a few coordinates).
 pub fn project(l: &[f64], coef: &[f64], out: &mut [f64]) {
     let n = l.len();
+    if n == 0 {
+        out.iter_mut().for_each(|o| *o = 0.0);
+        return;
+    }
     // The non-zeros of ℓ (up to 8 on the stack; a denser ℓ goes entry by entry).
     let mut nz = [(0usize, 0.0); 8];
     let mut m = 0;
@@ -248,7 +266,11 @@ pub fn project(l: &[f64], coef: &[f64], out: &mut [f64]) {
 /// `X(s) = Σ c_k s^k` into `out` (Horner).
 pub fn state(coef: &[f64], s: f64, out: &mut [f64]) {
     let n = out.len();
-    let p = coef.len() / n;
+    let p = coef.len().checked_div(n).unwrap_or(0);
+    if p == 0 {
+        out.iter_mut().for_each(|o| *o = 0.0);
+        return;
+    }
     out.copy_from_slice(&coef[(p - 1) * n..p * n]);
     for c in coef[..(p - 1) * n].chunks_exact(n).rev() {
         for (o, ci) in out.iter_mut().zip(c) {
