@@ -66,6 +66,9 @@ struct Rhs<'a> {
     a_d: Sparse,
     a_f: Sparse,
     masses: Vec<f64>,
+    /// Linear contact laws only: per mode, the lower half of `A_σ` (`nd` rows of `2·nd`), built
+    /// on first use; then `f(y) = A_σ y` and the dissipated power is `−Σ m_i ẋ_i (A₂₂ ẋ)_i`.
+    linear_rows: Option<[std::cell::OnceCell<Vec<f64>>; 8]>,
 }
 
 /// A relative vector `a` (`δ = aᵀx`) by its non-zero entries: a contact or the damper touches
@@ -136,7 +139,29 @@ impl<'a> Rhs<'a> {
                 &[]
             }),
             masses: sys.mass_diag(),
+            linear_rows: [Switch::SliderBed, Switch::BedDamper]
+                .iter()
+                .all(|&s| {
+                    (s == Switch::BedDamper && sys.damper.is_none())
+                        || sys.contact(s).law.is_linear()
+                })
+                .then(Default::default),
         }
+    }
+
+    /// The lower half of `A_σ`, row by row (linear laws).
+    fn lower_rows(&self, mode: Mode) -> Option<&[f64]> {
+        let rows = self.linear_rows.as_ref()?;
+        let cell = rows.get(usize::from(mode.0))?;
+        Some(cell.get_or_init(|| {
+            let a = self.sys.first_order(mode);
+            let nd = self.nd;
+            let mut r = Vec::with_capacity(2 * nd * nd);
+            for i in nd..2 * nd {
+                r.extend((0..2 * nd).map(|j| a[(i, j)]));
+            }
+            r
+        }))
     }
 
     /// `dy = f(y)`, `y = [x; ẋ; E_diss]`.
@@ -144,6 +169,28 @@ impl<'a> Rhs<'a> {
         let (n, nd) = (self.n, self.nd);
         let (x, v) = (&y[..nd], &y[nd..2 * nd]);
         dy[..nd].copy_from_slice(v);
+        if let Some(rows) = self.lower_rows(mode) {
+            // Fixed sizes for small lumped machines (fully unrolled).
+            match nd {
+                2 => return linear_small::<2>(rows, &self.masses, y, dy),
+                3 => return linear_small::<3>(rows, &self.masses, y, dy),
+                4 => return linear_small::<4>(rows, &self.masses, y, dy),
+                5 => return linear_small::<5>(rows, &self.masses, y, dy),
+                6 => return linear_small::<6>(rows, &self.masses, y, dy),
+                7 => return linear_small::<7>(rows, &self.masses, y, dy),
+                8 => return linear_small::<8>(rows, &self.masses, y, dy),
+                _ => {}
+            }
+            let mut power = 0.0;
+            for (i, row) in rows.chunks_exact(2 * nd).enumerate() {
+                let (rx, rv) = row.split_at(nd);
+                let damp = dot(rv, v);
+                dy[nd + i] = dot(rx, x) + damp;
+                power -= self.masses[i] * v[i] * damp;
+            }
+            dy[2 * nd] = power;
+            return;
+        }
         let acc = &mut dy[nd..2 * nd];
         let mut power = 0.0;
         for i in 0..n {
@@ -186,6 +233,27 @@ impl<'a> Rhs<'a> {
         }
         dy[2 * nd] = power;
     }
+}
+
+/// [`Rhs::eval`] for linear laws with `ND` degrees of freedom: `ẋ` copied, `ẍ = A₂₁x + A₂₂ẋ`
+/// from the rows of `A_σ`'s lower half, the dissipated power `−Σ m_i ẋ_i (A₂₂ẋ)_i`.
+fn linear_small<const ND: usize>(rows: &[f64], masses: &[f64], y: &[f64], dy: &mut [f64]) {
+    let mut x = [0.0; ND];
+    let mut v = [0.0; ND];
+    x.copy_from_slice(&y[..ND]);
+    v.copy_from_slice(&y[ND..2 * ND]);
+    let mut power = 0.0;
+    for (i, row) in rows.chunks_exact(2 * ND).take(ND).enumerate() {
+        let (mut ax, mut damp) = (0.0, 0.0);
+        for j in 0..ND {
+            ax += row[j] * x[j];
+            damp += row[ND + j] * v[j];
+        }
+        dy[i] = v[i];
+        dy[ND + i] = ax + damp;
+        power -= masses[i] * v[i] * damp;
+    }
+    dy[2 * ND] = power;
 }
 
 fn elastic(law: &ContactLaw, d: f64) -> f64 {
@@ -791,14 +859,10 @@ fn combo(out: &mut [f64], y: &[f64], h: f64, terms: &[(f64, &Vec<f64>)]) {
 }
 
 /// Contact force and its time derivative from `δ`, `δ̇`, `δ̈`: `f(δ, δ̇)` and
-/// `∂f/∂δ·δ̇ + ∂f/∂δ̇·δ̈`, the partial derivatives of the law by central differences.
+/// `∂f/∂δ·δ̇ + ∂f/∂δ̇·δ̈` ([`ContactLaw::partials`]).
 fn force_and_slope(law: &ContactLaw, d: f64, r: f64, acc: f64) -> (f64, f64) {
-    let f = law.force(d, r);
-    let ed = 1e-7 * d.abs().max(1e-12);
-    let er = 1e-7 * r.abs().max(1e-9);
-    let fd = (law.force(d + ed, r) - law.force(d - ed, r)) / (2.0 * ed);
-    let fr = (law.force(d, r + er) - law.force(d, r - er)) / (2.0 * er);
-    (f, fd * r + fr * acc)
+    let (fd, fr) = law.partials(d, r);
+    (law.force(d, r), fd * r + fr * acc)
 }
 
 /// Force and slope at a step end from the state `y` and its derivative `dy` (a stage).
