@@ -143,6 +143,17 @@ pub fn solve_from(
     let mut coef = vec![0.0; (taylor::ORDER + 1) * n];
     let mut ind_polys = vec![[0.0; taylor::ORDER + 1]; ind_vecs.len()];
     let mut gl_work = Vec::new();
+    // Each linear contact's force from its overlap polynomial: (indicator index, K, C).
+    let force_from_overlap: [Option<(usize, f64, f64)>; 2] = [Switch::SliderBed, Switch::BedDamper]
+        .map(|s| {
+            let i = inds.iter().position(|&ind| ind == Indicator::Overlap(s))?;
+            match sys.contact(s).law {
+                crate::impact::ContactLaw::Linear { stiffness, damping } => {
+                    Some((i, stiffness, damping))
+                }
+                _ => None,
+            }
+        });
 
     loop {
         let search = SearchOptions::default();
@@ -200,7 +211,19 @@ pub fn solve_from(
             for ci in 0..2 {
                 if closed(sys, mode, ci) {
                     totals.closed_time[ci] += s_end;
-                    let peak = poly_max(&force_vecs[ci], &coef, tau, period, s_end);
+                    let mut f = [0.0; taylor::ORDER + 1];
+                    match force_from_overlap[ci] {
+                        // f = K δ + C δ̇ from the overlap's polynomial (δ̇ its derivative).
+                        Some((i, k, c)) => {
+                            let d = &ind_polys[i];
+                            for (j, fj) in f.iter_mut().enumerate() {
+                                let next = d.get(j + 1).map_or(0.0, |v| (j + 1) as f64 * v);
+                                *fj = k * d[j] + c * next;
+                            }
+                        }
+                        None => taylor::project(&force_vecs[ci], &coef, &mut f),
+                    }
+                    let peak = poly_max(&f, tau, period, s_end);
                     totals.peak_force[ci] = totals.peak_force[ci].max(peak);
                 }
             }
@@ -610,17 +633,15 @@ fn taylor_dissipated(
     total
 }
 
-/// Maximum over `[0, len]` of the force `ℓᵀX(s)` on a Taylor step (`tau` its validity): the
+/// Maximum over `[0, len]` of a force `Σ a_k s^k` on a Taylor step (`tau` its validity): the
 /// endpoints and the interior maxima, where the derivative `Σ (k+1) a_{k+1} s^k` changes sign
 /// from + to −.
-fn poly_max(l: &[f64], coef: &[f64], tau: f64, period: f64, len: f64) -> f64 {
-    let mut a = [0.0; taylor::ORDER + 1];
-    taylor::project(l, coef, &mut a);
+fn poly_max(a: &[f64; taylor::ORDER + 1], tau: f64, period: f64, len: f64) -> f64 {
     let mut da = [0.0; taylor::ORDER];
     for (k, d) in da.iter_mut().enumerate() {
         *d = (k + 1) as f64 * a[k + 1];
     }
-    let f = Poly::new(&a, tau, period);
+    let f = Poly::new(a, tau, period);
     let mut best = f.value(0.0).max(f.value(len));
     let df = Poly::new(&da, tau, period);
     // A slope of one sign throughout (by dominance) leaves the maximum at an end.

@@ -93,8 +93,17 @@ pub fn lex_signs<L: AsRef<[f64]>>(ls: &[L], a: &Mat<f64>, x: &[f64], out: &mut [
 /// overlap and none coming, no relative velocity) leaves its contact open and its dashpot off:
 /// either choice exerts no force, and "open" ends a collision whose bodies merely touch.
 pub fn implied_mode(sys: &ImpactSystem, sign_of: &dyn Fn(Indicator) -> f64) -> Mode {
+    implied_mode_of(sys, &sys.switches(), sign_of)
+}
+
+/// [`implied_mode`] over the given `switches` (the system's, computed once by the caller).
+fn implied_mode_of(
+    sys: &ImpactSystem,
+    switches: &[Switch],
+    sign_of: &dyn Fn(Indicator) -> f64,
+) -> Mode {
     let mut mode = Mode(0);
-    for s in sys.switches() {
+    for &s in switches {
         let on = match s {
             Switch::Dashpot => sign_of(Indicator::DashpotVelocity) < 0.0,
             _ => sys.switch_on(s, sign_of),
@@ -116,49 +125,44 @@ pub fn select_mode(
     matrix: &mut dyn FnMut(Mode) -> std::rc::Rc<Mat<f64>>,
 ) -> (Mode, bool, Vec<f64>) {
     let inds = sys.indicators();
-    let implied = |m: Mode, matrix: &mut dyn FnMut(Mode) -> std::rc::Rc<Mat<f64>>| {
-        let a = matrix(m);
-        let mut signs = vec![0.0; vecs.len()];
-        lex_signs(vecs, &a, x, &mut signs);
-        let sign_of = |ind: Indicator| {
-            inds.iter()
-                .position(|&i| i == ind)
-                .map_or(0.0, |p| signs[p])
+    let switches = sys.switches();
+    let implied =
+        |m: Mode, signs: &mut [f64], matrix: &mut dyn FnMut(Mode) -> std::rc::Rc<Mat<f64>>| {
+            let a = matrix(m);
+            lex_signs(vecs, &a, x, signs);
+            let sign_of = |ind: Indicator| {
+                inds.iter()
+                    .position(|&i| i == ind)
+                    .map_or(0.0, |p| signs[p])
+            };
+            implied_mode_of(sys, &switches, &sign_of)
         };
-        (implied_mode(sys, &sign_of), signs)
-    };
+    let mut signs = vec![0.0; vecs.len()];
     let mut cand = start;
-    let mut seen: Vec<Mode> = Vec::new();
-    let mut last_signs = Vec::new();
+    // Modes tried, one bit each (three switch bits: modes 0-7).
+    let mut seen = 0u32;
     for _ in 0..16 {
-        let (next, signs) = implied(cand, matrix);
+        let next = implied(cand, &mut signs, matrix);
         if next == cand {
             return (cand, true, signs);
         }
-        last_signs = signs;
-        if seen.contains(&next) {
+        if seen & (1 << (next.0 & 31)) != 0 {
             break;
         }
-        seen.push(cand);
+        seen |= 1 << (cand.0 & 31);
         cand = next;
     }
+    let last_signs = signs.clone();
     // No fixed point along the iteration: try every mode.
+    let allowed = switches.iter().fold(0u8, |a, &s| a | Mode::bit(s));
     for bits in 0..8u8 {
         let m = Mode(bits);
-        if valid_bits(sys, m) {
-            let (next, signs) = implied(m, matrix);
+        if m.0 & !allowed == 0 {
+            let next = implied(m, &mut signs, matrix);
             if next == m {
                 return (m, true, signs);
             }
         }
     }
     (cand, false, last_signs)
-}
-
-fn valid_bits(sys: &ImpactSystem, m: Mode) -> bool {
-    let mut allowed = 0u8;
-    for s in sys.switches() {
-        allowed |= Mode::bit(s);
-    }
-    m.0 & !allowed == 0
 }
