@@ -637,8 +637,8 @@ fn taylor_dissipated(
 /// endpoints and the interior maxima, where the derivative `Σ (k+1) a_{k+1} s^k` changes sign
 /// from + to −.
 fn poly_max(a: &[f64; taylor::ORDER + 1], tau: f64, period: f64, len: f64) -> f64 {
-    let mut da = [0.0; taylor::ORDER];
-    for (k, d) in da.iter_mut().enumerate() {
+    let mut da = [0.0; taylor::ORDER + 1];
+    for (k, d) in da.iter_mut().take(taylor::ORDER).enumerate() {
         *d = (k + 1) as f64 * a[k + 1];
     }
     let f = Poly::new(a, tau, period);

@@ -76,16 +76,46 @@ pub fn lex_signs<L: AsRef<[f64]>>(ls: &[L], a: &Mat<f64>, x: &[f64], out: &mut [
         if open == 0 || k == K_MAX {
             break;
         }
-        // next = A y, column by column (contiguous in faer's column-major storage).
-        next.iter_mut().for_each(|v| *v = 0.0);
-        for (j, &yj) in y.iter().enumerate() {
+        mat_vec(a, y, next);
+        std::mem::swap(&mut y, &mut next);
+    }
+}
+
+/// `out = A y`, column by column (contiguous in faer's column-major storage); fixed-size columns
+/// for the small first-order systems of lumped machines (4 to 16 states), where a loop of
+/// run-time length costs more than its products.
+fn mat_vec(a: &Mat<f64>, y: &[f64], out: &mut [f64]) {
+    fn fixed<const N: usize>(a: &Mat<f64>, y: &[f64], out: &mut [f64]) {
+        let mut acc = [0.0; N];
+        for (j, &yj) in y.iter().enumerate().take(N) {
             if yj != 0.0 {
-                for (nx, aij) in next.iter_mut().zip(a.col_as_slice(j)) {
-                    *nx += aij * yj;
+                if let Ok(col) = <&[f64; N]>::try_from(a.col_as_slice(j)) {
+                    for i in 0..N {
+                        acc[i] += col[i] * yj;
+                    }
                 }
             }
         }
-        std::mem::swap(&mut y, &mut next);
+        out[..N].copy_from_slice(&acc);
+    }
+    match y.len() {
+        4 => fixed::<4>(a, y, out),
+        6 => fixed::<6>(a, y, out),
+        8 => fixed::<8>(a, y, out),
+        10 => fixed::<10>(a, y, out),
+        12 => fixed::<12>(a, y, out),
+        14 => fixed::<14>(a, y, out),
+        16 => fixed::<16>(a, y, out),
+        _ => {
+            out.iter_mut().for_each(|v| *v = 0.0);
+            for (j, &yj) in y.iter().enumerate() {
+                if yj != 0.0 {
+                    for (nx, aij) in out.iter_mut().zip(a.col_as_slice(j)) {
+                        *nx += aij * yj;
+                    }
+                }
+            }
+        }
     }
 }
 

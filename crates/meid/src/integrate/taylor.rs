@@ -239,6 +239,28 @@ pub fn project(l: &[f64], coef: &[f64], out: &mut [f64]) {
         out.iter_mut().for_each(|o| *o = 0.0);
         return;
     }
+    // Small lumped machines: a dense dot of fixed size per coefficient (unrolled).
+    fn fixed<const N: usize>(l: &[f64], coef: &[f64], out: &mut [f64]) {
+        let mut lf = [0.0; N];
+        lf.copy_from_slice(&l[..N]);
+        for (o, ck) in out.iter_mut().zip(coef.chunks_exact(N)) {
+            if let Ok(ck) = <&[f64; N]>::try_from(ck) {
+                let mut t = 0.0;
+                for i in 0..N {
+                    t += lf[i] * ck[i];
+                }
+                *o = t;
+            }
+        }
+    }
+    match n {
+        4 => return fixed::<4>(l, coef, out),
+        6 => return fixed::<6>(l, coef, out),
+        8 => return fixed::<8>(l, coef, out),
+        10 => return fixed::<10>(l, coef, out),
+        12 => return fixed::<12>(l, coef, out),
+        _ => {}
+    }
     // The non-zeros of ℓ (up to 8 on the stack; a denser ℓ goes entry by entry).
     let mut nz = [(0usize, 0.0); 8];
     let mut m = 0;
@@ -279,10 +301,14 @@ pub fn state(coef: &[f64], s: f64, out: &mut [f64]) {
     }
 }
 
+/// The `P + 1` coefficients of a polynomial of a Taylor step (fixed size, so that loops over
+/// them are unrolled).
+pub type Coefficients = [f64; ORDER + 1];
+
 /// A polynomial `Σ a_k s^k` on `[0, τ]`, as a [`Scalar`] for the event search.
 #[derive(Debug, Clone, Copy)]
 pub struct Poly<'a> {
-    a: &'a [f64],
+    a: &'a Coefficients,
     period: f64,
     noise: f64,
 }
@@ -290,7 +316,7 @@ pub struct Poly<'a> {
 impl<'a> Poly<'a> {
     /// The polynomial with coefficients `a`, used on `[0, tau]`, with the search's time scale
     /// `period`. Its round-off is taken as 64 ulps of `Σ|a_k| τ^k`.
-    pub fn new(a: &'a [f64], tau: f64, period: f64) -> Self {
+    pub fn new(a: &'a Coefficients, tau: f64, period: f64) -> Self {
         let mut size = 0.0;
         let mut p = 1.0;
         for ak in a {
@@ -302,11 +328,6 @@ impl<'a> Poly<'a> {
             period,
             noise: 64.0 * f64::EPSILON * size,
         }
-    }
-
-    /// The polynomial with its round-off `noise` given.
-    pub fn with_noise(a: &'a [f64], period: f64, noise: f64) -> Self {
-        Self { a, period, noise }
     }
 
     /// True when `sign·p > 0` on all of `[0, len]` by dominance of the constant term:
