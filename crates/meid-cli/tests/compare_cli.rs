@@ -144,11 +144,7 @@ fn montecarlo_is_reproducible_across_thread_counts() {
             .arg(dir)
             .output()
             .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        common::ok(out);
         std::fs::read(dir.join("samples.csv")).unwrap()
     };
     let (a, b) = (tmpdir("mc1"), tmpdir("mc2"));

@@ -45,12 +45,7 @@ fn fem_model_table_json_and_files() {
         .arg(example("paper-soft-base.toml"))
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8_lossy(&out.stdout);
+    let text = common::ok(out);
     assert!(text.contains("selected modes [5, 10]"), "{text}");
     assert_eq!(text.lines().filter(|l| l.ends_with('*')).count(), 2);
 
@@ -68,12 +63,7 @@ fn fem_model_table_json_and_files() {
         .arg(example("paper-soft-base.toml"))
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = common::ok_json(out);
     let modes = v["modes"].as_array().unwrap();
     assert_eq!(modes.len(), 12);
     for key in [
@@ -199,12 +189,7 @@ fn gmsh_mesh_model_runs_through_simulate() {
         .arg(&model)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = common::ok_json(out);
     let r = v["energy_ratio"].as_f64().unwrap();
     assert!(r > 0.0 && r < 1.0, "energy ratio {r}");
 
@@ -213,12 +198,7 @@ fn gmsh_mesh_model_runs_through_simulate() {
         .arg(&model)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = common::ok_json(out);
     let sel: Vec<u64> = v["selected"]
         .as_array()
         .unwrap()

@@ -66,6 +66,9 @@ struct Rhs<'a> {
     a_d: Sparse,
     a_f: Sparse,
     masses: Vec<f64>,
+    /// The first-order matrices `A_σ` of the modes met, built on first use (mode selection and
+    /// the right-hand side share them).
+    first_order: [std::cell::OnceCell<std::rc::Rc<faer::Mat<f64>>>; 8],
     /// Linear contact laws only: per mode, the lower half of `A_σ` (`nd` rows of `2·nd`), built
     /// on first use; then `f(y) = A_σ y` and the dissipated power is `−Σ m_i ẋ_i (A₂₂ ẋ)_i`.
     linear_rows: Option<[std::cell::OnceCell<Vec<f64>>; 8]>,
@@ -139,6 +142,7 @@ impl<'a> Rhs<'a> {
                 &[]
             }),
             masses: sys.mass_diag(),
+            first_order: Default::default(),
             linear_rows: [Switch::SliderBed, Switch::BedDamper]
                 .iter()
                 .all(|&s| {
@@ -149,12 +153,22 @@ impl<'a> Rhs<'a> {
         }
     }
 
+    /// `A_σ` of `mode` ([`ImpactSystem::first_order`]), built once per run.
+    fn matrix(&self, mode: Mode) -> std::rc::Rc<faer::Mat<f64>> {
+        match self.first_order.get(usize::from(mode.0)) {
+            Some(cell) => cell
+                .get_or_init(|| std::rc::Rc::new(self.sys.first_order(mode)))
+                .clone(),
+            None => std::rc::Rc::new(self.sys.first_order(mode)),
+        }
+    }
+
     /// The lower half of `A_σ`, row by row (linear laws).
     fn lower_rows(&self, mode: Mode) -> Option<&[f64]> {
         let rows = self.linear_rows.as_ref()?;
         let cell = rows.get(usize::from(mode.0))?;
         Some(cell.get_or_init(|| {
-            let a = self.sys.first_order(mode);
+            let a = self.matrix(mode);
             let nd = self.nd;
             let mut r = Vec::with_capacity(2 * nd * nd);
             for i in nd..2 * nd {
@@ -387,14 +401,7 @@ pub fn solve_from(
         .collect();
 
     let ind_vecs: Vec<Vec<f64>> = inds.iter().map(|&i| sys.indicator_vector(i)).collect();
-    let mut a_cache: std::collections::HashMap<Mode, std::rc::Rc<faer::Mat<f64>>> =
-        std::collections::HashMap::new();
-    let mut a_of = |m: Mode| -> std::rc::Rc<faer::Mat<f64>> {
-        a_cache
-            .entry(m)
-            .or_insert_with(|| std::rc::Rc::new(sys.first_order(m)))
-            .clone()
-    };
+    let mut a_of = |m: Mode| rhs.matrix(m);
     // `δ` and `δ̇` of each contact as functionals of the dense output.
     let peak_vecs: Vec<(Vec<f64>, Vec<f64>)> = [Switch::SliderBed, Switch::BedDamper]
         .into_iter()
