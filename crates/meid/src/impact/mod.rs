@@ -549,27 +549,51 @@ impl ImpactSystem {
 
     /// First-order matrix `A_σ = [[0, I], [−M⁻¹K_σ, −M⁻¹C_σ]]` for the state `X = [x; ẋ]`.
     pub fn first_order(&self, mode: Mode) -> Mat<f64> {
+        let n = 2 * self.dofs();
+        let mut buf = vec![0.0; n * n];
+        self.first_order_into(mode, &mut buf);
+        Mat::from_fn(n, n, |i, j| buf[j * n + i])
+    }
+
+    /// [`Self::first_order`] written column-major into `out` (length `(2·dofs)²`), without
+    /// allocating: the runs build the matrices of the modes they meet with it.
+    ///
+    /// # Panics
+    /// When `out` has the wrong length.
+    pub fn first_order_into(&self, mode: Mode, out: &mut [f64]) {
         let nd = self.dofs();
-        let m = self.mass_diag();
-        let mut a = Mat::<f64>::zeros(2 * nd, 2 * nd);
+        let n = 2 * nd;
+        assert_eq!(out.len(), n * n, "first-order matrix buffer");
+        out.fill(0.0);
         for i in 0..nd {
-            a[(i, nd + i)] = 1.0;
+            out[(nd + i) * n + i] = 1.0;
         }
-        // K_σ and C_σ summed (column-major, nd × 2nd), then rows scaled by −1/m_i.
-        let mut kc = vec![0.0; 2 * nd * nd];
+        // K_σ and C_σ summed into the lower rows (column j of K in column j, of C in column
+        // nd + j), then scaled by −1/m_i.
         self.for_each_entry(mode, |i, j, dk, dc| {
-            kc[j * nd + i] += dk;
-            kc[(nd + j) * nd + i] += dc;
+            out[j * n + nd + i] += dk;
+            out[(nd + j) * n + nd + i] += dc;
         });
-        for (j, col) in kc.chunks_exact(nd).enumerate() {
-            let dst = &mut a.col_as_slice_mut(j)[nd..];
-            for ((d, v), mi) in dst.iter_mut().zip(col).zip(&m) {
-                if *v != 0.0 {
-                    *d = -v / mi;
+        for col in out.chunks_exact_mut(n) {
+            for (i, d) in col[nd..].iter_mut().enumerate() {
+                if *d != 0.0 {
+                    *d = -*d / self.mass(i);
                 }
             }
         }
-        a
+    }
+
+    /// Mass (kg) of coordinate `i`: 1 for a modal coordinate (mass-normalised modes), `m_s`
+    /// for the slider, `m_d` for the damper ([`Self::mass_diag`] entry by entry).
+    #[inline]
+    pub fn mass(&self, i: usize) -> f64 {
+        if i == self.slider_index() {
+            self.slider.mass
+        } else if i == self.damper_index() {
+            self.damper.as_ref().map_or(1.0, |d| d.mass)
+        } else {
+            1.0
+        }
     }
 
     /// The initial state: everything at rest at 0, the slider moving at `v_s`.

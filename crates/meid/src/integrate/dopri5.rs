@@ -15,7 +15,7 @@
 //! extra state component (not under error control).
 
 use super::roots::{first_crossing, hermite_dip, Scalar, SearchOptions};
-use super::switching::{implied_mode, lex_sign, select_mode};
+use super::switching::{implied_mode, lex_sign, ModeSelector};
 use super::{CollisionEnd, Event, Grid, Observer, Options, Solution, Totals};
 use crate::impact::{dot, ContactLaw, DashpotKind, ImpactSystem, Indicator, Mode, Switch};
 use crate::{Error, Result};
@@ -66,9 +66,6 @@ struct Rhs<'a> {
     a_d: Sparse,
     a_f: Sparse,
     masses: Vec<f64>,
-    /// The first-order matrices `A_σ` of the modes met, built on first use (mode selection and
-    /// the right-hand side share them).
-    first_order: [std::cell::OnceCell<std::rc::Rc<faer::Mat<f64>>>; 8],
     /// Linear contact laws only: per mode, the lower half of `A_σ` (`nd` rows of `2·nd`), built
     /// on first use; then `f(y) = A_σ y` and the dissipated power is `−Σ m_i ẋ_i (A₂₂ ẋ)_i`.
     linear_rows: Option<[std::cell::OnceCell<Vec<f64>>; 8]>,
@@ -142,7 +139,6 @@ impl<'a> Rhs<'a> {
                 &[]
             }),
             masses: sys.mass_diag(),
-            first_order: Default::default(),
             linear_rows: [Switch::SliderBed, Switch::BedDamper]
                 .iter()
                 .all(|&s| {
@@ -153,26 +149,17 @@ impl<'a> Rhs<'a> {
         }
     }
 
-    /// `A_σ` of `mode` ([`ImpactSystem::first_order`]), built once per run.
-    fn matrix(&self, mode: Mode) -> std::rc::Rc<faer::Mat<f64>> {
-        match self.first_order.get(usize::from(mode.0)) {
-            Some(cell) => cell
-                .get_or_init(|| std::rc::Rc::new(self.sys.first_order(mode)))
-                .clone(),
-            None => std::rc::Rc::new(self.sys.first_order(mode)),
-        }
-    }
-
     /// The lower half of `A_σ`, row by row (linear laws).
     fn lower_rows(&self, mode: Mode) -> Option<&[f64]> {
         let rows = self.linear_rows.as_ref()?;
         let cell = rows.get(usize::from(mode.0))?;
         Some(cell.get_or_init(|| {
-            let a = self.matrix(mode);
-            let nd = self.nd;
-            let mut r = Vec::with_capacity(2 * nd * nd);
-            for i in nd..2 * nd {
-                r.extend((0..2 * nd).map(|j| a[(i, j)]));
+            let n = 2 * self.nd;
+            let mut a = vec![0.0; n * n];
+            self.sys.first_order_into(mode, &mut a);
+            let mut r = Vec::with_capacity(self.nd * n);
+            for i in self.nd..n {
+                r.extend((0..n).map(|j| a[j * n + i]));
             }
             r
         }))
@@ -400,8 +387,9 @@ pub fn solve_from(
         })
         .collect();
 
-    let ind_vecs: Vec<Vec<f64>> = inds.iter().map(|&i| sys.indicator_vector(i)).collect();
-    let mut a_of = |m: Mode| rhs.matrix(m);
+    let mut selector = ModeSelector::new(sys);
+    // The signs the mode selection works with (the step's own are `signs`, below).
+    let mut selected_signs = vec![0.0; inds.len()];
     // `δ` and `δ̇` of each contact as functionals of the dense output.
     let peak_vecs: Vec<(Vec<f64>, Vec<f64>)> = [Switch::SliderBed, Switch::BedDamper]
         .into_iter()
@@ -420,7 +408,7 @@ pub fn solve_from(
     let mut t = 0.0;
     let t_end = opts.duration;
     let mut mode = if all_linear {
-        select_mode(sys, &y[..nx], Mode(0), &ind_vecs, &mut a_of).0
+        selector.select(&y[..nx], Mode(0), &mut selected_signs).0
     } else {
         initial_mode_numeric(sys, &y[..nx])
     };
@@ -463,16 +451,13 @@ pub fn solve_from(
         if need_k1 {
             rhs.eval(mode, &y, &mut k[0]);
             // Indicator sides at the (re)start.
-            let a_mode = if all_linear { Some(a_of(mode)) } else { None };
+            let a_mode = if all_linear {
+                Some(selector.matrix(mode))
+            } else {
+                None
+            };
             for (i, &ind) in inds.iter().enumerate() {
-                signs[i] = start_sign(
-                    sys,
-                    ind,
-                    mode,
-                    &y[..nx],
-                    linear_vecs[i].as_deref(),
-                    a_mode.as_deref(),
-                );
+                signs[i] = start_sign(sys, ind, mode, &y[..nx], linear_vecs[i].as_deref(), a_mode);
             }
             if h == 0.0 {
                 let (k0, k1) = k.split_at_mut(1);
@@ -661,7 +646,7 @@ pub fn solve_from(
             t += s_end;
             totals.dissipated = y[nx];
             let new_mode = if all_linear {
-                select_mode(sys, &y[..nx], mode, &ind_vecs, &mut a_of).0
+                selector.select(&y[..nx], mode, &mut selected_signs).0
             } else {
                 mode_after_numeric(sys, &inds, &signs, &dense, s_end, &y[..nx])
             };
@@ -779,7 +764,7 @@ fn start_sign(
     mode: Mode,
     x: &[f64],
     linear: Option<&[f64]>,
-    a: Option<&faer::Mat<f64>>,
+    a: Option<&[f64]>,
 ) -> f64 {
     if let (Some(a), Some(l)) = (a, linear) {
         return lex_sign(l, a, x);

@@ -29,13 +29,11 @@
 //!    on a Taylor step);
 //! 5. the new mode at the switch (`switching::select_mode`).
 
-use std::collections::HashMap;
-
 use faer::{c64, Mat};
 
 use super::propagator::{Functional, Propagator, Segment};
-use super::roots::{maxima, Scalar, Search, SearchOptions};
-use super::switching::{lex_signs, select_mode};
+use super::roots::{for_each_maximum, Scalar, Search, SearchOptions};
+use super::switching::{ModeSelector, MODES};
 use super::taylor::{self, Poly, TaylorMatrix};
 use super::{CollisionEnd, Event, Grid, Observer, Options, Solution, Totals};
 use crate::impact::{ImpactSystem, Indicator, Mode, Switch};
@@ -57,9 +55,6 @@ struct ModeData {
 /// contact in 3 steps, 0.17 ms of damper contact in 1); a long free flight switches to the
 /// closed form after this many steps.
 pub const TAYLOR_STEPS_PER_MODE: usize = 16;
-
-/// Number of modes: three switch bits (slider-bed, bed-damper, dashpot).
-const MODES: usize = 8;
 
 /// Runs the exact propagator. See the module documentation.
 pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Result<Solution> {
@@ -85,8 +80,8 @@ pub fn solve_from(
     let nd = sys.dofs();
     let n = 2 * nd;
     let masses = sys.mass_diag();
-    let inds = sys.indicators();
-    let ind_vecs: Vec<Vec<f64>> = inds.iter().map(|&i| sys.indicator_vector(i)).collect();
+    let mut selector = ModeSelector::new(sys);
+    let n_ind = selector.indicators().len();
     // `ℓ` of each contact's force (for its peaks), built once per run.
     let force_vecs: Vec<Vec<f64>> = [Switch::SliderBed, Switch::BedDamper]
         .into_iter()
@@ -98,28 +93,15 @@ pub fn solve_from(
             }
         })
         .collect();
-    let mut cache: HashMap<Mode, ModeData> = HashMap::new();
+    // Closed forms of the modes that stay long, built on first use.
+    let mut cache: [Option<ModeData>; MODES] = Default::default();
     let mut grid = Grid::new(opts.sample_rate);
     let t_end = opts.duration;
 
-    // `a` is the mode's first-order matrix (shared with the mode selection's cache).
-    let build = |mode: Mode, a: Mat<f64>| -> Result<ModeData> {
-        let (k, c) = sys.matrices(mode);
-        let prop = Propagator::shared(&k, &c, &masses, a)?;
-        Ok(ModeData { prop, step: None })
-    };
-
     let mut x = x0.to_vec();
     let mut t = 0.0;
-    // First-order matrices of the modes met, for the mode selection.
-    let mut a_cache: HashMap<Mode, std::rc::Rc<Mat<f64>>> = HashMap::new();
-    let mut a_of = |m: Mode| -> std::rc::Rc<Mat<f64>> {
-        a_cache
-            .entry(m)
-            .or_insert_with(|| std::rc::Rc::new(sys.first_order(m)))
-            .clone()
-    };
-    let (mut mode, _, mut signs) = select_mode(sys, &x, Mode(0), &ind_vecs, &mut a_of);
+    let mut signs = vec![0.0; n_ind];
+    let (mut mode, _) = selector.select(&x, Mode(0), &mut signs);
     let mut events = Vec::new();
     let mut totals = Totals::default();
     let mut collision_end: Option<CollisionEnd> = None;
@@ -128,25 +110,22 @@ pub fn solve_from(
     let mut buf = vec![0.0; n];
     let mut buf2 = vec![0.0; n];
     let mut taylor_steps = [0usize; MODES];
-    // Damping matrices of the modes met (dissipation).
-    let mut c_cache: HashMap<Mode, std::rc::Rc<Mat<f64>>> = HashMap::new();
-    let mut c_of = |m: Mode| -> std::rc::Rc<Mat<f64>> {
-        c_cache
-            .entry(m)
-            .or_insert_with(|| std::rc::Rc::new(sys.matrices(m).1))
-            .clone()
-    };
 
     // Taylor-step workspace: the first-order matrices prepared per mode, the coefficients
-    // c_0 … c_P of the current step, and the polynomials of the indicators and of a force.
+    // c_0 … c_P of the current step, the polynomials of the indicators, and the searches (kept
+    // from step to step).
     let mut tmats: [Option<TaylorMatrix>; MODES] = Default::default();
     let mut coef = vec![0.0; (taylor::ORDER + 1) * n];
-    let mut ind_polys = vec![[0.0; taylor::ORDER + 1]; ind_vecs.len()];
-    let mut gl_work = Vec::new();
+    let mut ind_polys = vec![[0.0; taylor::ORDER + 1]; n_ind];
+    let mut searches: Vec<Search<Poly>> = Vec::with_capacity(n_ind);
+    let mut work = Vec::new();
     // Each linear contact's force from its overlap polynomial: (indicator index, K, C).
     let force_from_overlap: [Option<(usize, f64, f64)>; 2] = [Switch::SliderBed, Switch::BedDamper]
         .map(|s| {
-            let i = inds.iter().position(|&ind| ind == Indicator::Overlap(s))?;
+            let i = selector
+                .indicators()
+                .iter()
+                .position(|&ind| ind == Indicator::Overlap(s))?;
             match sys.contact(s).law {
                 crate::impact::ContactLaw::Linear { stiffness, damping } => {
                     Some((i, stiffness, damping))
@@ -168,17 +147,16 @@ pub fn solve_from(
         // count.
         debug_assert!(usize::from(mode.0) < MODES, "three switch bits");
         let mi = usize::from(mode.0) % MODES;
-        let use_taylor =
-            !cache.contains_key(&mode) && taylor_steps[mi] < opts.taylor_steps_per_mode;
+        let use_taylor = cache[mi].is_none() && taylor_steps[mi] < opts.taylor_steps_per_mode;
         let (s_end, switched, run_ends, period);
         if use_taylor {
             taylor_steps[mi] += 1;
             let tm = match &tmats[mi] {
                 Some(tm) => tm,
                 None => {
-                    let tm = TaylorMatrix::new(&a_of(mode)).ok_or_else(|| {
-                        Error::numerical("exact", format!("mode {mode:?}: non-finite matrix"))
-                    })?;
+                    let tm = TaylorMatrix::from_col_major(n, selector.matrix(mode)).ok_or_else(
+                        || Error::numerical("exact", format!("mode {mode:?}: non-finite matrix")),
+                    )?;
                     tmats[mi].insert(tm)
                 }
             };
@@ -187,18 +165,20 @@ pub fn solve_from(
             period = tm.period();
             // 1-2: the first switch, within the step's validity.
             let reach = tau.min(horizon);
-            for (l, p) in ind_vecs.iter().zip(ind_polys.iter_mut()) {
+            for (l, p) in selector.vectors().iter().zip(ind_polys.iter_mut()) {
                 taylor::project(l, &coef, p);
             }
             // (Indicators whose constant term dominates cannot cross within the step.)
-            let funcs: Vec<(Poly<'_>, f64)> = ind_polys
-                .iter()
-                .zip(&signs)
-                .filter(|(_, s)| **s != 0.0)
-                .map(|(p, s)| (Poly::new(p, tau, period), *s))
-                .filter(|(p, s)| !p.keeps_sign(*s, reach))
-                .collect();
-            let found = first_switch(&funcs, period, reach, search);
+            searches.clear();
+            for (p, &sign) in ind_polys.iter().zip(&signs) {
+                if sign != 0.0 {
+                    let p = Poly::new(p, tau, period);
+                    if !p.keeps_sign(sign, reach) {
+                        searches.push(Search::new(p, sign, search));
+                    }
+                }
+            }
+            let found = first_switch(&mut searches, period, reach);
             (s_end, switched) = stretch_end(found, reach, reach >= horizon);
             run_ends = !switched && s_end >= horizon;
             // 3: output samples, from the polynomial.
@@ -227,14 +207,19 @@ pub fn solve_from(
                     totals.peak_force[ci] = totals.peak_force[ci].max(peak);
                 }
             }
-            totals.dissipated += taylor_dissipated(&coef, &c_of(mode), nd, s_end, &mut gl_work);
+            totals.dissipated += tm
+                .dissipated(&coef, &masses, s_end, &mut work)
+                .ok_or_else(|| Error::numerical("exact", "first-order matrix without [0, I]"))?;
             taylor::state(&coef, s_end, &mut x);
         } else {
-            if let std::collections::hash_map::Entry::Vacant(e) = cache.entry(mode) {
-                e.insert(build(mode, (*a_of(mode)).clone())?);
+            if cache[mi].is_none() {
+                let (k, c) = sys.matrices(mode);
+                let a = Mat::from_fn(n, n, |i, j| selector.matrix(mode)[j * n + i]);
+                let prop = Propagator::shared(&k, &c, &masses, a)?;
+                cache[mi] = Some(ModeData { prop, step: None });
             }
-            let md = cache
-                .get_mut(&mode)
+            let md = cache[mi]
+                .as_mut()
                 .ok_or_else(|| Error::numerical("exact", "mode cache"))?;
             if let (Some(g), None) = (&grid, &md.step) {
                 md.step = Some(md.prop.transition(g.dt));
@@ -244,13 +229,18 @@ pub fn solve_from(
             let seg = prop.segment(&x);
             period = prop.period();
             // 1-2: the first switch.
-            let funcs: Vec<(Functional<'_>, f64)> = ind_vecs
+            let funcs: Vec<Functional<'_>> = selector
+                .vectors()
+                .iter()
+                .map(|l| seg.functional(l))
+                .collect();
+            let mut closed_searches: Vec<Search<&Functional<'_>>> = funcs
                 .iter()
                 .zip(&signs)
                 .filter(|(_, s)| **s != 0.0)
-                .map(|(l, s)| (seg.functional(l), *s))
+                .map(|(f, s)| Search::new(f, *s, search))
                 .collect();
-            let found = first_switch(&funcs, period, horizon, search);
+            let found = first_switch(&mut closed_searches, period, horizon);
             (s_end, switched) = stretch_end(found, horizon, true);
             run_ends = !switched;
             // 3: output samples.
@@ -268,7 +258,7 @@ pub fn solve_from(
                     totals.peak_force[ci] = totals.peak_force[ci].max(peak);
                 }
             }
-            totals.dissipated += dissipated(&seg, &c_of(mode), nd, s_end);
+            totals.dissipated += dissipated(&seg, &sys.matrices(mode).1, nd, s_end);
             seg.state(s_end, &mut buf);
             x.copy_from_slice(&buf);
         }
@@ -296,18 +286,9 @@ pub fn solve_from(
         } else {
             zero_length = 0;
         }
-        // 5: the new mode.
-        let (new_mode, consistent, new_signs) = select_mode(sys, &x, mode, &ind_vecs, &mut a_of);
-        // The signs are those under `new_mode`'s dynamics when it is consistent; otherwise
-        // (no consistent mode) they are recomputed for the mode taken.
-        signs = if consistent {
-            new_signs
-        } else {
-            let a = a_of(new_mode);
-            let mut s = vec![0.0; ind_vecs.len()];
-            lex_signs(&ind_vecs, &a, &x, &mut s);
-            s
-        };
+        // 5: the new mode, and the indicators' sides under its dynamics (those of the mode
+        // taken when no mode is consistent).
+        let (new_mode, _) = selector.select(&x, mode, &mut signs);
         if new_mode != mode {
             events.push(Event {
                 t,
@@ -346,7 +327,11 @@ pub fn solve_from(
             break;
         }
     }
-    let fallback_modes = cache.values().filter(|m| !m.prop.is_spectral()).count();
+    let fallback_modes = cache
+        .iter()
+        .flatten()
+        .filter(|m| !m.prop.is_spectral())
+        .count();
     Ok(Solution {
         events,
         collision_end,
@@ -429,39 +414,37 @@ fn emit_samples(
 }
 
 /// The first switch within `horizon` (s after the stretch start), or `None`, of the
-/// indicators `funcs` (each with its side at the start; those identically zero left out).
-/// All are searched over common windows growing from one fastest period, so the search ends
-/// at the earliest crossing; only the earliest bracket is refined (and any other bracket
-/// starting before its root).
-fn first_switch<F: Scalar>(
-    funcs: &[(F, f64)],
-    period: f64,
-    horizon: f64,
-    search: SearchOptions,
-) -> Option<f64> {
-    let mut searches: Vec<Search<'_, F>> = funcs
-        .iter()
-        .map(|(f, sign0)| Search::new(f, *sign0, search))
-        .collect();
+/// indicators being searched (each search started with the indicator's side at the start;
+/// those identically zero left out). All are searched over common windows growing from one
+/// fastest period, so the search ends at the earliest crossing; only the earliest bracket is
+/// refined (and any other bracket starting before its root), in the order of their starts.
+fn first_switch<F: Scalar>(searches: &mut [Search<F>], period: f64, horizon: f64) -> Option<f64> {
     let mut limit = if period.is_finite() {
         period.min(horizon)
     } else {
         horizon
     };
     loop {
-        let mut brackets: Vec<(f64, f64, usize)> = Vec::new();
-        for (i, sr) in searches.iter_mut().enumerate() {
-            if let Some((a, b)) = sr.advance(limit) {
-                brackets.push((a, b, i));
-            }
+        let mut any = false;
+        for sr in searches.iter_mut() {
+            any |= sr.advance(limit).is_some();
         }
-        if !brackets.is_empty() {
-            brackets.sort_by(|p, q| p.0.total_cmp(&q.0));
+        if any {
+            // Brackets by increasing start (ties by index), without sorting into a buffer.
             let mut first = f64::INFINITY;
-            for &(a, b, i) in &brackets {
+            let mut last: Option<(f64, usize)> = None;
+            loop {
+                let next = searches
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, sr)| sr.found().map(|(a, b)| (a, b, i)))
+                    .filter(|&(a, _, i)| last.is_none_or(|(la, li)| (a, i) > (la, li)))
+                    .min_by(|p, q| p.0.total_cmp(&q.0).then(p.2.cmp(&q.2)));
+                let Some((a, b, i)) = next else { break };
                 if a < first {
                     first = first.min(searches[i].refine(a, b));
                 }
+                last = Some((a, i));
             }
             return Some(first);
         }
@@ -490,9 +473,9 @@ fn max_on_segment(seg: &Segment<'_>, l: &[f64], a: &Mat<f64>, len: f64, _period:
         .map(|j| (0..a.nrows()).map(|i| l[i] * a[(i, j)]).sum())
         .collect();
     let df = seg.functional(&la);
-    for s in maxima(&df, len, SearchOptions::default()) {
-        best = best.max(val(s));
-    }
+    for_each_maximum(&df, len, SearchOptions::default(), |s| {
+        best = best.max(val(s))
+    });
     best
 }
 
@@ -561,78 +544,6 @@ fn dissipated(seg: &Segment<'_>, c: &Mat<f64>, nd: usize, len: f64) -> f64 {
     total
 }
 
-/// 10-point Gauss-Legendre rule on [−1, 1]: the positive nodes and their weights.
-const GL10_X: [f64; 5] = [
-    0.148_874_338_981_631_22,
-    0.433_395_394_129_247_2,
-    0.679_409_568_299_024_4,
-    0.865_063_366_688_984_5,
-    0.973_906_528_517_171_7,
-];
-const GL10_W: [f64; 5] = [
-    0.295_524_224_714_752_87,
-    0.269_266_719_309_996_35,
-    0.219_086_362_515_982_04,
-    0.149_451_349_150_580_6,
-    0.066_671_344_308_688_14,
-];
-
-/// `∫₀^len ẋᵀ C ẋ ds` on a Taylor step with coefficients `coef` (`len` within its validity
-/// `2/ρ`, ρ bounding the growth rate of ẋ and so `2ρ` that of ẋᵀCẋ): the 10-point
-/// Gauss-Legendre rule's error, `L^21 (10!)^4 / (21 (20!)^3) · max|f⁽²⁰⁾|` with
-/// `|f⁽²⁰⁾| ≤ (2ρ)^20 max|f|`, is at most `4^20 (10!)^4 / (21 (20!)^3) ≈ 6.4e-19` of
-/// `L max|f|`: below round-off. Only the velocity half of the polynomial is evaluated.
-/// `work` is scratch space (reused between calls).
-fn taylor_dissipated(
-    coef: &[f64],
-    c: &Mat<f64>,
-    nd: usize,
-    len: f64,
-    work: &mut Vec<[f64; 10]>,
-) -> f64 {
-    if len <= 0.0 || (0..nd).all(|j| c.col_as_slice(j).iter().all(|v| *v == 0.0)) {
-        return 0.0;
-    }
-    // The 10 nodes and weights on [0, len].
-    let mut s = [0.0; 10];
-    let mut w = [0.0; 10];
-    for (q, (xi, wi)) in GL10_X.iter().zip(GL10_W).enumerate() {
-        s[2 * q] = 0.5 * len * (1.0 - xi);
-        s[2 * q + 1] = 0.5 * len * (1.0 + xi);
-        w[2 * q] = 0.5 * len * wi;
-        w[2 * q + 1] = 0.5 * len * wi;
-    }
-    // ẋ at all nodes at once (Horner over k; `v[i]` holds component i at the 10 nodes).
-    let n = 2 * nd;
-    work.clear();
-    work.resize(2 * nd, [0.0; 10]);
-    let (v, cv) = work.split_at_mut(nd);
-    for ck in coef.chunks_exact(n).rev() {
-        for (vi, &cki) in v.iter_mut().zip(&ck[nd..]) {
-            for (x, sj) in vi.iter_mut().zip(&s) {
-                *x = *x * sj + cki;
-            }
-        }
-    }
-    // Σ_nodes w ẋᵀCẋ, with (Cẋ)_i = Σ_j C_ij ẋ_j column by column.
-    let mut total = 0.0;
-    for (j, vj) in v.iter().enumerate() {
-        for (i, cij) in c.col_as_slice(j).iter().enumerate() {
-            if *cij != 0.0 {
-                for (x, y) in cv[i].iter_mut().zip(vj) {
-                    *x += cij * y;
-                }
-            }
-        }
-    }
-    for (vi, cvi) in v.iter().zip(cv.iter()) {
-        for q in 0..10 {
-            total += w[q] * vi[q] * cvi[q];
-        }
-    }
-    total
-}
-
 /// Maximum over `[0, len]` of a force `Σ a_k s^k` on a Taylor step (`tau` its validity): the
 /// endpoints and the interior maxima, where the derivative `Σ (k+1) a_{k+1} s^k` changes sign
 /// from + to −.
@@ -646,9 +557,9 @@ fn poly_max(a: &[f64; taylor::ORDER + 1], tau: f64, period: f64, len: f64) -> f6
     let df = Poly::new(&da, tau, period);
     // A slope of one sign throughout (by dominance) leaves the maximum at an end.
     if !(df.keeps_sign(1.0, len) || df.keeps_sign(-1.0, len)) {
-        for s in maxima(&df, len, SearchOptions::default()) {
-            best = best.max(f.value(s));
-        }
+        for_each_maximum(&df, len, SearchOptions::default(), |s| {
+            best = best.max(f.value(s))
+        });
     }
     best
 }

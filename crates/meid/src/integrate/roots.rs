@@ -34,6 +34,25 @@ pub trait Scalar {
     }
 }
 
+impl<T: Scalar + ?Sized> Scalar for &T {
+    #[inline]
+    fn value_slope(&self, s: f64) -> (f64, f64) {
+        (**self).value_slope(s)
+    }
+    #[inline]
+    fn curvature_bound(&self, a: f64, b: f64) -> f64 {
+        (**self).curvature_bound(a, b)
+    }
+    #[inline]
+    fn fastest_period(&self) -> f64 {
+        (**self).fastest_period()
+    }
+    #[inline]
+    fn noise(&self) -> f64 {
+        (**self).noise()
+    }
+}
+
 /// Settings of the crossing search.
 #[derive(Debug, Clone, Copy)]
 pub struct SearchOptions {
@@ -68,9 +87,9 @@ pub fn first_crossing<F: Scalar + ?Sized>(
 /// A crossing search that can be resumed: [`Search::advance`] proves "no crossing" up to a
 /// limit and can later go on from there. Several indicators searched in growing common windows
 /// stop as soon as the earliest crossing is known, instead of each running to the end of the
-/// run.
-pub struct Search<'f, F: ?Sized> {
-    f: &'f F,
+/// run. The search owns its function (a reference works too: `&F` is a [`Scalar`]).
+pub struct Search<F> {
+    f: F,
     sign0: f64,
     /// `sign0 · noise`, added to `g` so that round-off around zero is not a sign change.
     lift: f64,
@@ -87,9 +106,9 @@ pub struct Search<'f, F: ?Sized> {
     found_values: (f64, f64),
 }
 
-impl<'f, F: Scalar + ?Sized> Search<'f, F> {
+impl<F: Scalar> Search<F> {
     /// Starts a search for the first `s > 0` where `sign0·g` becomes negative.
-    pub fn new(f: &'f F, sign0: f64, opts: SearchOptions) -> Self {
+    pub fn new(f: F, sign0: f64, opts: SearchOptions) -> Self {
         let period = f.fastest_period();
         let h_grid = (period / 8.0).min(opts.max_step);
         let lift = sign0 * f.noise();
@@ -116,6 +135,11 @@ impl<'f, F: Scalar + ?Sized> Search<'f, F> {
             found: None,
             found_values: (0.0, 0.0),
         }
+    }
+
+    /// The bracket found by [`Search::advance`], if any.
+    pub fn found(&self) -> Option<(f64, f64)> {
+        self.found
     }
 
     /// `sign0 · (g + lift)` and its slope.
@@ -256,11 +280,23 @@ impl<'f, F: Scalar + ?Sized> Search<'f, F> {
 /// located to the search tolerance; sign changes from − to + (minima) are only bracketed and
 /// stepped over, not refined.
 pub fn maxima<F: Scalar + ?Sized>(slope: &F, s_max: f64, opts: SearchOptions) -> Vec<f64> {
-    crossings(slope, s_max, opts, false)
-        .into_iter()
-        .filter(|&(_, sign)| sign > 0.0)
-        .map(|(t, _)| t)
-        .collect()
+    let mut out = Vec::new();
+    for_each_maximum(slope, s_max, opts, |t| out.push(t));
+    out
+}
+
+/// [`maxima`] without collecting them: `visit(t)` for each maximum, in order.
+pub fn for_each_maximum<F: Scalar + ?Sized>(
+    slope: &F,
+    s_max: f64,
+    opts: SearchOptions,
+    mut visit: impl FnMut(f64),
+) {
+    crossings(slope, s_max, opts, false, |t, sign| {
+        if sign > 0.0 {
+            visit(t);
+        }
+    });
 }
 
 /// All sign changes of `g` in `(0, s_max]`, in order, each with the sign `g` had before it.
@@ -269,19 +305,22 @@ pub fn all_crossings<F: Scalar + ?Sized>(
     s_max: f64,
     opts: SearchOptions,
 ) -> Vec<(f64, f64)> {
-    crossings(f, s_max, opts, true)
+    let mut out = Vec::new();
+    crossings(f, s_max, opts, true, |t, sign| out.push((t, sign)));
+    out
 }
 
-/// Sign changes of `g` in order with the sign before each; those from − to + are refined only
-/// when `refine_rising` (otherwise the end of their bracket is reported).
+/// Sign changes of `g` in order, `visit(t, sign before)` for each; those from − to + are
+/// refined only when `refine_rising` (otherwise the end of their bracket is reported).
 fn crossings<F: Scalar + ?Sized>(
     f: &F,
     s_max: f64,
     opts: SearchOptions,
     refine_rising: bool,
-) -> Vec<(f64, f64)> {
-    let mut out = Vec::new();
+    mut visit: impl FnMut(f64, f64),
+) {
     let mut start = 0.0;
+    let mut count = 0usize;
     let (g0, d0) = f.value_slope(0.0);
     let mut sign = if g0.abs() > f.noise() {
         g0.signum()
@@ -301,8 +340,9 @@ fn crossings<F: Scalar + ?Sized>(
                     } else {
                         b
                     };
-                out.push((t, sign));
-                if t <= start || out.len() > 1_000_000 {
+                visit(t, sign);
+                count += 1;
+                if t <= start || count > 1_000_000 {
                     break;
                 }
                 start = t;
@@ -311,7 +351,6 @@ fn crossings<F: Scalar + ?Sized>(
             None => break,
         }
     }
-    out
 }
 
 struct Shifted<'a, F: ?Sized> {

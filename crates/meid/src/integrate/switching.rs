@@ -6,10 +6,16 @@
 //! `ℓᵀA_σᵏX` (k = 0, 1, 2, …), which resolves grazing and simultaneous switches alike.
 //! Candidate modes are iterated to a fixed point; if none exists the switch rule of the last
 //! candidate is taken (and the next search starts from it).
-
-use faer::Mat;
+//!
+//! Matrices here are square and stored column-major in plain slices (`a[j·n + i] = A_ij`): the
+//! runs build the first-order matrices of the modes they meet into such buffers
+//! ([`ModeSelector`]), without faer's aligned allocations, and the small products below are
+//! hand-unrolled for the sizes of lumped machines.
 
 use crate::impact::{ImpactSystem, Indicator, Mode, Switch};
+
+/// Number of modes: three switch bits (slider-bed, bed-damper, dashpot).
+pub(crate) const MODES: usize = 8;
 
 /// Highest derivative order consulted.
 const K_MAX: usize = 8;
@@ -20,7 +26,9 @@ const K_MAX: usize = 8;
 /// (`1e-9 Σ|ℓᵢyᵢ|` for the value itself, which root location leaves at ~1e-13 of its terms,
 /// `1e-11` for higher orders) or below `1e-12 ‖ℓ‖‖y‖`: the latter catches quantities whose terms
 /// are all physically zero (bodies at rest, forces zero) and only carry round-off.
-pub fn lex_sign(l: &[f64], a: &Mat<f64>, x: &[f64]) -> f64 {
+///
+/// `a` is `A` column-major (`n × n`, `n = x.len()`).
+pub fn lex_sign(l: &[f64], a: &[f64], x: &[f64]) -> f64 {
     let mut out = [0.0];
     lex_signs(std::slice::from_ref(&l), a, x, &mut out);
     out[0]
@@ -28,8 +36,12 @@ pub fn lex_sign(l: &[f64], a: &Mat<f64>, x: &[f64]) -> f64 {
 
 /// [`lex_sign`] of several functionals at once (`out[i]` for `ls[i]`): the derivatives `Aᵏ X`
 /// are computed once, as far as the last undecided functional needs them.
-pub fn lex_signs<L: AsRef<[f64]>>(ls: &[L], a: &Mat<f64>, x: &[f64], out: &mut [f64]) {
+///
+/// # Panics
+/// When `a.len() != x.len()²`.
+pub fn lex_signs<L: AsRef<[f64]>>(ls: &[L], a: &[f64], x: &[f64], out: &mut [f64]) {
     let n = x.len();
+    assert_eq!(a.len(), n * n, "lexicographic signs: matrix size");
     out.iter_mut().for_each(|o| *o = 0.0);
     let mut open = ls.len();
     // Stack buffers for the usual sizes (no allocation per call).
@@ -51,6 +63,11 @@ pub fn lex_signs<L: AsRef<[f64]>>(ls: &[L], a: &Mat<f64>, x: &[f64], out: &mut [
         decided_heap.resize(ls.len(), false);
         &mut decided_heap
     };
+    // ‖ℓ‖ of each functional, once.
+    let mut norms = [0.0; 16];
+    for (nm, l) in norms.iter_mut().zip(ls) {
+        *nm = l.as_ref().iter().map(|v| v * v).sum::<f64>().sqrt();
+    }
     for k in 0..=K_MAX {
         let y_norm = y.iter().map(|v| v * v).sum::<f64>().sqrt();
         let tol = if k == 0 { 1e-9 } else { 1e-11 };
@@ -59,14 +76,17 @@ pub fn lex_signs<L: AsRef<[f64]>>(ls: &[L], a: &Mat<f64>, x: &[f64], out: &mut [
                 continue;
             }
             let l = l.as_ref();
-            let (mut val, mut scale, mut l2) = (0.0, 0.0, 0.0);
+            let (mut val, mut scale) = (0.0, 0.0);
             for (li, yi) in l.iter().zip(y.iter()) {
                 let t = li * yi;
                 val += t;
                 scale += t.abs();
-                l2 += li * li;
             }
-            let floor = 1e-12 * l2.sqrt() * y_norm;
+            let l_norm = match norms.get(i) {
+                Some(v) => *v,
+                None => l.iter().map(|v| v * v).sum::<f64>().sqrt(),
+            };
+            let floor = 1e-12 * l_norm * y_norm;
             if val.abs() > tol * scale && val.abs() > floor {
                 out[i] = val.signum();
                 decided[i] = true;
@@ -81,15 +101,15 @@ pub fn lex_signs<L: AsRef<[f64]>>(ls: &[L], a: &Mat<f64>, x: &[f64], out: &mut [
     }
 }
 
-/// `out = A y`, column by column (contiguous in faer's column-major storage); fixed-size columns
-/// for the small first-order systems of lumped machines (4 to 16 states), where a loop of
-/// run-time length costs more than its products.
-fn mat_vec(a: &Mat<f64>, y: &[f64], out: &mut [f64]) {
-    fn fixed<const N: usize>(a: &Mat<f64>, y: &[f64], out: &mut [f64]) {
+/// `out = A y` with `A` column-major; fixed-size columns for the small first-order systems of
+/// lumped machines (4 to 16 states), where a loop of run-time length costs more than its
+/// products.
+fn mat_vec(a: &[f64], y: &[f64], out: &mut [f64]) {
+    fn fixed<const N: usize>(a: &[f64], y: &[f64], out: &mut [f64]) {
         let mut acc = [0.0; N];
-        for (j, &yj) in y.iter().enumerate().take(N) {
+        for (col, &yj) in a.chunks_exact(N).zip(y) {
             if yj != 0.0 {
-                if let Ok(col) = <&[f64; N]>::try_from(a.col_as_slice(j)) {
+                if let Ok(col) = <&[f64; N]>::try_from(col) {
                     for i in 0..N {
                         acc[i] += col[i] * yj;
                     }
@@ -98,7 +118,8 @@ fn mat_vec(a: &Mat<f64>, y: &[f64], out: &mut [f64]) {
         }
         out[..N].copy_from_slice(&acc);
     }
-    match y.len() {
+    let n = y.len();
+    match n {
         4 => fixed::<4>(a, y, out),
         6 => fixed::<6>(a, y, out),
         8 => fixed::<8>(a, y, out),
@@ -108,9 +129,9 @@ fn mat_vec(a: &Mat<f64>, y: &[f64], out: &mut [f64]) {
         16 => fixed::<16>(a, y, out),
         _ => {
             out.iter_mut().for_each(|v| *v = 0.0);
-            for (j, &yj) in y.iter().enumerate() {
+            for (col, &yj) in a.chunks_exact(n.max(1)).zip(y) {
                 if yj != 0.0 {
-                    for (nx, aij) in out.iter_mut().zip(a.col_as_slice(j)) {
+                    for (nx, aij) in out.iter_mut().zip(col) {
                         *nx += aij * yj;
                     }
                 }
@@ -143,56 +164,105 @@ fn implied_mode_of(
     mode
 }
 
-/// Selects a consistent mode at state `x`, starting the iteration from `start`.
-/// `matrix(mode)` gives `A_σ`; `vecs` are the vectors of the system's indicators
-/// ([`ImpactSystem::indicators`], [`ImpactSystem::indicator_vector`]). Returns the mode,
-/// whether it is consistent, and the indicators' signs under that mode's dynamics.
-pub fn select_mode(
-    sys: &ImpactSystem,
-    x: &[f64],
-    start: Mode,
-    vecs: &[Vec<f64>],
-    matrix: &mut dyn FnMut(Mode) -> std::rc::Rc<Mat<f64>>,
-) -> (Mode, bool, Vec<f64>) {
-    let inds = sys.indicators();
-    let switches = sys.switches();
-    let implied =
-        |m: Mode, signs: &mut [f64], matrix: &mut dyn FnMut(Mode) -> std::rc::Rc<Mat<f64>>| {
-            let a = matrix(m);
-            lex_signs(vecs, &a, x, signs);
-            let sign_of = |ind: Indicator| {
-                inds.iter()
-                    .position(|&i| i == ind)
-                    .map_or(0.0, |p| signs[p])
-            };
-            implied_mode_of(sys, &switches, &sign_of)
-        };
-    let mut signs = vec![0.0; vecs.len()];
-    let mut cand = start;
-    // Modes tried, one bit each (three switch bits: modes 0-7).
-    let mut seen = 0u32;
-    for _ in 0..16 {
-        let next = implied(cand, &mut signs, matrix);
-        if next == cand {
-            return (cand, true, signs);
+/// Mode selection for one run: the system's indicators and their vectors, and the first-order
+/// matrices `A_σ` of the modes met (built on first use, [`ImpactSystem::first_order_into`]).
+pub struct ModeSelector<'s> {
+    sys: &'s ImpactSystem,
+    inds: Vec<Indicator>,
+    switches: Vec<Switch>,
+    vecs: Vec<Vec<f64>>,
+    n: usize,
+    /// `A_σ` per mode (index `σ`), column-major; empty until first used.
+    mats: [Vec<f64>; MODES],
+}
+
+impl<'s> ModeSelector<'s> {
+    /// The selector of `sys` ([`ImpactSystem::indicators`] and their vectors).
+    pub fn new(sys: &'s ImpactSystem) -> Self {
+        let inds = sys.indicators();
+        let vecs = inds.iter().map(|&i| sys.indicator_vector(i)).collect();
+        Self {
+            sys,
+            switches: sys.switches(),
+            inds,
+            vecs,
+            n: 2 * sys.dofs(),
+            mats: Default::default(),
         }
-        if seen & (1 << (next.0 & 31)) != 0 {
-            break;
-        }
-        seen |= 1 << (cand.0 & 31);
-        cand = next;
     }
-    let last_signs = signs.clone();
-    // No fixed point along the iteration: try every mode.
-    let allowed = switches.iter().fold(0u8, |a, &s| a | Mode::bit(s));
-    for bits in 0..8u8 {
-        let m = Mode(bits);
-        if m.0 & !allowed == 0 {
-            let next = implied(m, &mut signs, matrix);
-            if next == m {
-                return (m, true, signs);
+
+    /// The indicators, in the order of the signs.
+    pub fn indicators(&self) -> &[Indicator] {
+        &self.inds
+    }
+
+    /// The vectors `ℓ` of the indicators (`g = ℓᵀX`).
+    pub fn vectors(&self) -> &[Vec<f64>] {
+        &self.vecs
+    }
+
+    /// `A_σ` of `mode`, column-major (`n × n`, `n = 2·dofs`).
+    pub fn matrix(&mut self, mode: Mode) -> &[f64] {
+        let n = self.n;
+        let a = &mut self.mats[usize::from(mode.0) % MODES];
+        if a.is_empty() {
+            a.resize(n * n, 0.0);
+            self.sys.first_order_into(mode, a);
+        }
+        a
+    }
+
+    /// The signs of the indicators just after the state `x` under `mode`'s dynamics
+    /// ([`lex_signs`]) into `out`.
+    pub fn signs(&mut self, mode: Mode, x: &[f64], out: &mut [f64]) {
+        self.matrix(mode);
+        let a = &self.mats[usize::from(mode.0) % MODES];
+        lex_signs(&self.vecs, a, x, out);
+    }
+
+    /// The mode implied by `signs` (one per indicator).
+    fn implied(&self, signs: &[f64]) -> Mode {
+        let sign_of = |ind: Indicator| {
+            self.inds
+                .iter()
+                .position(|&i| i == ind)
+                .map_or(0.0, |p| signs[p])
+        };
+        implied_mode_of(self.sys, &self.switches, &sign_of)
+    }
+
+    /// Selects a consistent mode at state `x`, starting the iteration from `start`. Returns the
+    /// mode and whether it is consistent; `signs` (one per indicator) receives the indicators'
+    /// signs under the returned mode's dynamics.
+    pub fn select(&mut self, x: &[f64], start: Mode, signs: &mut [f64]) -> (Mode, bool) {
+        let mut cand = start;
+        // Modes tried, one bit each (three switch bits: modes 0-7).
+        let mut seen = 0u32;
+        for _ in 0..16 {
+            self.signs(cand, x, signs);
+            let next = self.implied(signs);
+            if next == cand {
+                return (cand, true);
+            }
+            if seen & (1 << (next.0 & 31)) != 0 {
+                break;
+            }
+            seen |= 1 << (cand.0 & 31);
+            cand = next;
+        }
+        // No fixed point along the iteration: try every mode.
+        let allowed = self.switches.iter().fold(0u8, |a, &s| a | Mode::bit(s));
+        for bits in 0..8u8 {
+            let m = Mode(bits);
+            if m.0 & !allowed == 0 {
+                self.signs(m, x, signs);
+                if self.implied(signs) == m {
+                    return (m, true);
+                }
             }
         }
+        // None consistent: the last candidate, with its own signs.
+        self.signs(cand, x, signs);
+        (cand, false)
     }
-    (cand, false, last_signs)
 }
