@@ -138,3 +138,100 @@ fn expansion_equals_matrix_powers() {
         }
     }
 }
+
+/// The energy a Taylor step dissipates, `∫ ẋᵀCẋ ds` (10-point Gauss-Legendre on the step's
+/// polynomial, `C = −M A₂₂`), equals the loss of mechanical energy `E(0) − E(s)`,
+/// `E = ½ẋᵀMẋ + ½xᵀKx`: for one oscillator (closed form of x(s)), and for chains of 3 and 9
+/// masses (fixed-size and general code), where `E(s)` comes from the step's state. Damping is
+/// strong (ζ of a few per cent to 30 %) so that the loss is not a small difference.
+#[test]
+fn dissipation_equals_energy_loss() {
+    // One oscillator: m = 2 kg, k = 7.2e7 N/m, ζ = 0.3.
+    let (m, k, z) = (2.0_f64, 7.2e7_f64, 0.3_f64);
+    let w = (k / m).sqrt();
+    let c = 2.0 * z * w * m;
+    let a = Mat::<f64>::from_fn(2, 2, |i, j| match (i, j) {
+        (0, 1) => 1.0,
+        (1, 0) => -k / m,
+        (1, 1) => -c / m,
+        _ => 0.0,
+    });
+    let tm = TaylorMatrix::new(&a).unwrap();
+    let mut coef = vec![0.0; (ORDER + 1) * 2];
+    tm.expand(&[0.0, 1.5], &mut coef);
+    let wd = w * (1.0 - z * z).sqrt();
+    let mut work = Vec::new();
+    for frac in [0.2, 0.7, 1.0] {
+        let s = frac * tm.validity();
+        // x(0) = 0, ẋ(0) = v0: x = v0/ω_d e^{−ζωs} sin ω_d s.
+        let e = (-z * w * s).exp();
+        let x = 1.5 / wd * e * (wd * s).sin();
+        let v = 1.5 * e * ((wd * s).cos() - z * w / wd * (wd * s).sin());
+        let loss = 0.5 * m * 1.5 * 1.5 - (0.5 * m * v * v + 0.5 * k * x * x);
+        let d = tm.dissipated(&coef, &[m], s, &mut work).unwrap();
+        assert!(
+            (d - loss).abs() <= 1e-13 * loss,
+            "oscillator at {frac} tau: {d} vs {loss}"
+        );
+    }
+    // Chains: masses to the right, springs and dashpots between neighbours and to the ground.
+    for n in [3usize, 9] {
+        let mass: Vec<f64> = (0..n).map(|i| 1.0 + 0.7 * i as f64).collect();
+        let ks: Vec<f64> = (0..=n).map(|i| 2.0e7 * (1.0 + 0.3 * i as f64)).collect();
+        let cs: Vec<f64> = (0..=n).map(|i| 900.0 * (1.0 + 0.5 * i as f64)).collect();
+        let band = |v: &[f64], i: usize, j: usize| -> f64 {
+            if i == j {
+                v[i] + v[i + 1]
+            } else if i + 1 == j || j + 1 == i {
+                -v[i.max(j)]
+            } else {
+                0.0
+            }
+        };
+        let kk = Mat::<f64>::from_fn(n, n, |i, j| band(&ks, i, j));
+        let cc = Mat::<f64>::from_fn(n, n, |i, j| band(&cs, i, j));
+        let a = Mat::<f64>::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+            (true, true) => 0.0,
+            (true, false) => f64::from(j - n == i),
+            (false, true) => -kk[(i - n, j)] / mass[i - n],
+            (false, false) => -cc[(i - n, j - n)] / mass[i - n],
+        });
+        let tm = TaylorMatrix::new(&a).unwrap();
+        let x0: Vec<f64> = (0..2 * n)
+            .map(|i| {
+                if i < n {
+                    1e-5 * (i as f64 - 1.0)
+                } else {
+                    0.4 - 0.1 * (i - n) as f64
+                }
+            })
+            .collect();
+        let mut coef = vec![0.0; (ORDER + 1) * 2 * n];
+        tm.expand(&x0, &mut coef);
+        let energy = |x: &[f64]| -> f64 {
+            let mut e = 0.0;
+            for i in 0..n {
+                e += 0.5 * mass[i] * x[n + i] * x[n + i];
+                for j in 0..n {
+                    e += 0.5 * x[i] * kk[(i, j)] * x[j];
+                }
+            }
+            e
+        };
+        let mut xs = vec![0.0; 2 * n];
+        for frac in [0.3, 1.0] {
+            let s = frac * tm.validity();
+            taylor::state(&coef, s, &mut xs);
+            let loss = energy(&x0) - energy(&xs);
+            let d = tm.dissipated(&coef, &mass, s, &mut work).unwrap();
+            assert!(
+                loss > 1e-3 * energy(&x0),
+                "{n} masses: loss {loss} too small to test"
+            );
+            assert!(
+                (d - loss).abs() <= 1e-12 * energy(&x0),
+                "{n} masses at {frac} tau: {d} vs {loss}"
+            );
+        }
+    }
+}

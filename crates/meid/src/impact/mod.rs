@@ -274,6 +274,9 @@ pub struct ImpactSystem {
     has_floor: bool,
     /// `a` vectors of the switches (slider-bed, bed-damper, damper spring), built once.
     rel: [Vec<f64>; 3],
+    /// The non-zero entries `(i, a_i)` of each `rel` vector (first-order matrices are built
+    /// from them).
+    rel_nz: [Vec<(usize, f64)>; 3],
     /// True when the modal damping matrix is diagonal (modal damping ratios only).
     damping_diagonal: bool,
 }
@@ -354,6 +357,7 @@ impl ImpactSystem {
             floor,
             has_floor,
             rel: Default::default(),
+            rel_nz: Default::default(),
             damping_diagonal: false,
         };
         let nm = sys.structure.len();
@@ -364,6 +368,13 @@ impl ImpactSystem {
             sys.build_relative_vector(Switch::BedDamper),
             sys.build_relative_vector(Switch::Dashpot),
         ];
+        sys.rel_nz = sys.rel.clone().map(|a| {
+            a.iter()
+                .enumerate()
+                .filter(|(_, v)| **v != 0.0)
+                .map(|(i, v)| (i, *v))
+                .collect()
+        });
         Ok(sys)
     }
 
@@ -569,11 +580,57 @@ impl ImpactSystem {
             out[(nd + i) * n + i] = 1.0;
         }
         // K_σ and C_σ summed into the lower rows (column j of K in column j, of C in column
-        // nd + j), then scaled by −1/m_i.
-        self.for_each_entry(mode, |i, j, dk, dc| {
-            out[j * n + nd + i] += dk;
-            out[(nd + j) * n + nd + i] += dc;
-        });
+        // nd + j), in the order of `for_each_entry` but over the non-zeros of the relative
+        // vectors only, then scaled by −1/m_i.
+        let nm = self.n_modes();
+        for i in 0..nm {
+            let kk = self.structure.omega_rad_per_s[i].powi(2);
+            if kk != 0.0 {
+                out[i * n + nd + i] += kk;
+            }
+            for j in 0..nm {
+                let cc = self.structure.damping[i * nm + j];
+                if cc != 0.0 {
+                    out[(nd + j) * n + nd + i] += cc;
+                }
+            }
+        }
+        let mut add = |s: Switch, kk: f64, cc: f64| {
+            let nz = match s {
+                Switch::SliderBed => &self.rel_nz[0],
+                Switch::BedDamper => &self.rel_nz[1],
+                Switch::Dashpot => &self.rel_nz[2],
+            };
+            for &(i, ai) in nz {
+                for &(j, aj) in nz {
+                    out[j * n + nd + i] += kk * ai * aj;
+                    if cc != 0.0 {
+                        out[(nd + j) * n + nd + i] += cc * ai * aj;
+                    }
+                }
+            }
+        };
+        for s in [Switch::SliderBed, Switch::BedDamper] {
+            if s == Switch::BedDamper && self.damper.is_none() {
+                continue;
+            }
+            if mode.on(s) {
+                if let ContactLaw::Linear { stiffness, damping } = self.contact(s).law {
+                    add(s, stiffness, damping);
+                }
+            }
+        }
+        if let Some(d) = &self.damper {
+            let dashpot_on = match d.dashpot {
+                DashpotKind::TwoWay => true,
+                DashpotKind::OneWay => mode.on(Switch::Dashpot),
+            };
+            add(
+                Switch::Dashpot,
+                d.stiffness,
+                if dashpot_on { d.damping } else { 0.0 },
+            );
+        }
         for col in out.chunks_exact_mut(n) {
             for (i, d) in col[nd..].iter_mut().enumerate() {
                 if *d != 0.0 {

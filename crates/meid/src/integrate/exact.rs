@@ -118,6 +118,15 @@ pub fn solve_from(
     let mut coef = vec![0.0; (taylor::ORDER + 1) * n];
     let mut ind_polys = vec![[0.0; taylor::ORDER + 1]; n_ind];
     let mut searches: Vec<Search<Poly>> = Vec::with_capacity(n_ind);
+    let ind_proj: Vec<taylor::Projector> = selector
+        .vectors()
+        .iter()
+        .map(|l| taylor::Projector::new(l))
+        .collect();
+    let force_proj: Vec<taylor::Projector> = force_vecs
+        .iter()
+        .map(|l| taylor::Projector::new(l))
+        .collect();
     let mut work = Vec::new();
     // Each linear contact's force from its overlap polynomial: (indicator index, K, C).
     let force_from_overlap: [Option<(usize, f64, f64)>; 2] = [Switch::SliderBed, Switch::BedDamper]
@@ -165,8 +174,8 @@ pub fn solve_from(
             period = tm.period();
             // 1-2: the first switch, within the step's validity.
             let reach = tau.min(horizon);
-            for (l, p) in selector.vectors().iter().zip(ind_polys.iter_mut()) {
-                taylor::project(l, &coef, p);
+            for (l, p) in ind_proj.iter().zip(ind_polys.iter_mut()) {
+                l.apply(&coef, p);
             }
             // (Indicators whose constant term dominates cannot cross within the step.)
             searches.clear();
@@ -196,12 +205,16 @@ pub fn solve_from(
                         // f = K δ + C δ̇ from the overlap's polynomial (δ̇ its derivative).
                         Some((i, k, c)) => {
                             let d = &ind_polys[i];
-                            for (j, fj) in f.iter_mut().enumerate() {
-                                let next = d.get(j + 1).map_or(0.0, |v| (j + 1) as f64 * v);
-                                *fj = k * d[j] + c * next;
+                            for (fj, dj) in f.iter_mut().zip(d) {
+                                *fj = k * dj;
+                            }
+                            if c != 0.0 {
+                                for (j, fj) in f.iter_mut().take(taylor::ORDER).enumerate() {
+                                    *fj += c * ((j + 1) as f64 * d[j + 1]);
+                                }
                             }
                         }
-                        None => taylor::project(&force_vecs[ci], &coef, &mut f),
+                        None => force_proj[ci].apply(&coef, &mut f),
                     }
                     let peak = poly_max(&f, tau, period, s_end);
                     totals.peak_force[ci] = totals.peak_force[ci].max(peak);

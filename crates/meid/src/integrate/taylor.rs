@@ -445,6 +445,74 @@ pub fn project(l: &[f64], coef: &[f64], out: &mut [f64]) {
     }
 }
 
+/// A functional `ℓᵀX` prepared for [`Projector::apply`]: its non-zero entries (an indicator or a
+/// contact force touches a few coordinates: two or three modal coordinates and a body), so a
+/// projection costs `(P + 1)·m` products for `m` non-zeros instead of `(P + 1)·n`.
+#[derive(Debug, Clone)]
+pub struct Projector {
+    idx: Vec<usize>,
+    val: Vec<f64>,
+    n: usize,
+}
+
+impl Projector {
+    /// The functional `ℓ` (length `n`, the state's).
+    pub fn new(l: &[f64]) -> Self {
+        let (idx, val) = l
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| **v != 0.0)
+            .map(|(i, v)| (i, *v))
+            .unzip();
+        Self {
+            idx,
+            val,
+            n: l.len(),
+        }
+    }
+
+    /// The coefficients `ℓᵀc_k`, k = 0..=P, of `ℓᵀX(s)` into `out` (the same sums, in the same
+    /// order, as [`project`]).
+    pub fn apply(&self, coef: &[f64], out: &mut [f64]) {
+        fn fixed<const M: usize>(
+            idx: &[usize],
+            val: &[f64],
+            n: usize,
+            coef: &[f64],
+            out: &mut [f64],
+        ) {
+            let mut ix = [0usize; M];
+            let mut lv = [0.0; M];
+            ix.copy_from_slice(&idx[..M]);
+            lv.copy_from_slice(&val[..M]);
+            for (o, ck) in out.iter_mut().zip(coef.chunks_exact(n)) {
+                let mut t = 0.0;
+                for q in 0..M {
+                    t += lv[q] * ck[ix[q]];
+                }
+                *o = t;
+            }
+        }
+        let (idx, val, n) = (&self.idx[..], &self.val[..], self.n);
+        if n == 0 {
+            out.iter_mut().for_each(|o| *o = 0.0);
+            return;
+        }
+        match idx.len() {
+            0 => out.iter_mut().for_each(|o| *o = 0.0),
+            1 => fixed::<1>(idx, val, n, coef, out),
+            2 => fixed::<2>(idx, val, n, coef, out),
+            3 => fixed::<3>(idx, val, n, coef, out),
+            4 => fixed::<4>(idx, val, n, coef, out),
+            _ => {
+                for (o, ck) in out.iter_mut().zip(coef.chunks_exact(n)) {
+                    *o = idx.iter().zip(val).map(|(&i, &l)| l * ck[i]).sum();
+                }
+            }
+        }
+    }
+}
+
 /// `X(s) = Σ c_k s^k` into `out` (Horner).
 pub fn state(coef: &[f64], s: f64, out: &mut [f64]) {
     let n = out.len();
@@ -519,6 +587,7 @@ impl Poly {
 }
 
 impl Scalar for Poly {
+    #[inline]
     fn value_slope(&self, s: f64) -> (f64, f64) {
         let (mut v, mut d) = (0.0, 0.0);
         for ak in self.a.iter().rev() {
@@ -528,6 +597,7 @@ impl Scalar for Poly {
         (v, d)
     }
     /// `Σ k(k−1)|a_k| b^{k−2}` (s ≥ 0).
+    #[inline]
     fn curvature_bound(&self, _a: f64, b: f64) -> f64 {
         let b = b.abs();
         self.a
