@@ -3,7 +3,7 @@
 //! A stretch in one mode is propagated in one of two forms, both exact to round-off:
 //!
 //! * **Taylor steps** ([`super::taylor`]): `X(s) = Σ_{k≤24} A^k X₀ s^k / k!` over a third of
-//!   the fastest period, where the truncation is below 2.4e-18. No eigen-decomposition is needed;
+//!   the fastest period, where the truncation is below 2.6e-17. No eigen-decomposition is needed;
 //!   a run takes them in a mode until it has spent [`Options::taylor_steps_per_mode`] there
 //!   (default [`TAYLOR_STEPS_PER_MODE`]). A blow of the paper's machine is over in 5 such
 //!   steps (0.68 ms), so it never builds a closed form;
@@ -48,7 +48,7 @@ struct ModeData {
 /// Taylor steps a run may take in one mode before it builds the mode's closed form (the default
 /// of [`super::Options::taylor_steps_per_mode`]).
 ///
-/// A Taylor step costs `P` mat-vecs and a polynomial search and spans `2/‖D⁻¹AD‖_∞` (about a
+/// A Taylor step costs `P` mat-vecs and a polynomial search and spans `2.2/‖D⁻¹AD‖_∞` (about a
 /// third of the fastest period); the closed form costs an eigen-decomposition up front and a
 /// sum of exponentials per evaluation, and pays off over long stretches. A blow of the paper's
 /// machine takes 5 steps in all (a dashpot switching off after 0.8 µs, 0.5 ms of slider
