@@ -20,7 +20,7 @@
 
 use serde::Serialize;
 
-use crate::impact::{dot, ImpactSystem, Mode, Switch};
+use crate::impact::{dot, ImpactSystem, Mode, Motions, Switch};
 use crate::integrate::{self, Method, Observer, Options, Solution};
 use crate::Result;
 
@@ -39,6 +39,11 @@ pub struct EnergyTerms {
 impl EnergyTerms {
     /// Evaluates Eqs. (16)-(22) at state `X` in `mode`.
     pub fn at(sys: &ImpactSystem, mode: Mode, x: &[f64]) -> Self {
+        Self::with_motions(sys, mode, x, &sys.motions(x))
+    }
+
+    /// [`Self::at`] given the relative motions of the state ([`ImpactSystem::motions`]).
+    pub fn with_motions(sys: &ImpactSystem, mode: Mode, x: &[f64], m: &Motions) -> Self {
         let n = sys.n_modes();
         let nd = sys.dofs();
         let mut e = EnergyTerms::default();
@@ -50,16 +55,16 @@ impl EnergyTerms {
             e.pe_machine += 0.5 * w * w * x[i] * x[i];
         }
         if mode.on(Switch::SliderBed) {
-            let d = dot(sys.relative_vector(Switch::SliderBed), &x[..nd]);
+            let d = m[0].0;
             e.pe_slider_contact = sys.slider_bed.law.potential_energy(d);
         }
         if let (Some(dm), Some(c)) = (&sys.damper, &sys.bed_damper) {
             let vd = x[nd + sys.damper_index()];
             e.ke_damper = 0.5 * dm.mass * vd * vd;
-            let r = dot(sys.relative_vector(Switch::Dashpot), &x[..nd]);
+            let r = m[2].0;
             e.pe_damper_spring = 0.5 * dm.stiffness * r * r;
             if mode.on(Switch::BedDamper) {
-                let d = dot(sys.relative_vector(Switch::BedDamper), &x[..nd]);
+                let d = m[1].0;
                 e.pe_damper_contact = c.law.potential_energy(d);
             }
         }
@@ -129,17 +134,19 @@ impl Observer for Recorder<'_> {
         let sys = self.sys;
         let n = sys.n_modes();
         let nd = sys.dofs();
-        sys.accelerations(mode, x, &mut self.acc);
+        let motions = sys.motions(x);
+        let forces = sys.element_forces_from(mode, &motions);
+        sys.accelerations_with(x, forces, &mut self.acc);
         let phi_m = &sys.points.measurement;
         let a_b = dot(phi_m, &self.acc[..n]);
-        let f_floor = sys.floor_force(mode, x);
+        let f_floor = sys.floor_force_with(x, forces.2);
         self.peak_bed_acceleration = self.peak_bed_acceleration.max(a_b.abs());
         self.peak_floor_force = self.peak_floor_force.max(f_floor.abs());
         if !self.keep {
             return;
         }
         let h = &mut self.history;
-        let (fbs, fbd, ffd) = sys.element_forces(mode, x);
+        let (fbs, fbd, ffd) = forces;
         h.time_s.push(t);
         h.bed_displacement_m.push(dot(phi_m, &x[..n]));
         h.bed_velocity_m_per_s.push(dot(phi_m, &x[nd..nd + n]));
@@ -157,7 +164,7 @@ impl Observer for Recorder<'_> {
         };
         h.damper_displacement_m.push(zd);
         h.damper_velocity_m_per_s.push(vd);
-        let e = EnergyTerms::at(sys, mode, x);
+        let e = EnergyTerms::with_motions(sys, mode, x, &motions);
         h.dissipated_j.push(self.e_in - e.total());
         h.energy.push(e);
     }

@@ -214,6 +214,10 @@ pub enum Switch {
     Dashpot,
 }
 
+/// Relative motions `(δ, δ̇)` (m, m/s) of the slider-bed contact, the bed-damper contact and the
+/// damper spring/dashpot at one state ([`ImpactSystem::motions`]).
+pub type Motions = [(f64, f64); 3];
+
 /// The discrete state: bit 0 slider-bed closed, bit 1 bed-damper closed, bit 2 dashpot acting.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, PartialOrd, Ord)]
 pub struct Mode(pub u8);
@@ -733,27 +737,27 @@ impl ImpactSystem {
     /// Generalised contact and damper forces at state `X` in mode `mode`, for any law:
     /// returns `(f_bs, f_bd, f_fd)` (N).
     pub fn element_forces(&self, mode: Mode, x: &[f64]) -> (f64, f64, f64) {
-        let nd = self.dofs();
-        let f = |s: Switch| {
+        self.element_forces_from(mode, &self.motions(x))
+    }
+
+    /// [`Self::element_forces`] from the relative motions ([`Self::motions`]) of the state.
+    pub fn element_forces_from(&self, mode: Mode, m: &Motions) -> (f64, f64, f64) {
+        let f = |s: Switch, (del, rate): (f64, f64)| {
             if !mode.on(s) {
                 return 0.0;
             }
-            let a = self.relative_vector(s);
-            self.contact(s)
-                .law
-                .force(dot(a, &x[..nd]), dot(a, &x[nd..]))
+            self.contact(s).law.force(del, rate)
         };
-        let fbs = f(Switch::SliderBed);
+        let fbs = f(Switch::SliderBed, m[0]);
         let (fbd, ffd) = match &self.damper {
             Some(d) => {
-                let a = self.relative_vector(Switch::Dashpot);
-                let (del, rate) = (dot(a, &x[..nd]), dot(a, &x[nd..]));
+                let (del, rate) = m[2];
                 let c_on = match d.dashpot {
                     DashpotKind::TwoWay => true,
                     DashpotKind::OneWay => mode.on(Switch::Dashpot),
                 };
                 (
-                    f(Switch::BedDamper),
+                    f(Switch::BedDamper, m[1]),
                     d.stiffness * del + if c_on { d.damping * rate } else { 0.0 },
                 )
             }
@@ -762,14 +766,51 @@ impl ImpactSystem {
         (fbs, fbd, ffd)
     }
 
+    /// The relative motions `(δ, δ̇)` of the slider-bed contact, the bed-damper contact and the
+    /// damper spring (in that order, [`Self::relative_motion`]) at the state `X = [x; ẋ]`; the
+    /// damper's are zero without a damper.
+    pub fn motions(&self, state: &[f64]) -> Motions {
+        [Switch::SliderBed, Switch::BedDamper, Switch::Dashpot]
+            .map(|s| self.relative_motion(s, state))
+    }
+
+    /// `(δ, δ̇) = (aᵀx, aᵀẋ)` of a switch's relative vector `a` ([`Self::relative_vector`]) at the
+    /// state `X = [x; ẋ]`, over `a`'s non-zero entries.
+    #[inline]
+    pub fn relative_motion(&self, s: Switch, state: &[f64]) -> (f64, f64) {
+        let nd = self.dofs();
+        let k = match s {
+            Switch::SliderBed => 0,
+            Switch::BedDamper => 1,
+            Switch::Dashpot => 2,
+        };
+        let nz = &self.rel_nz[k];
+        if 3 * nz.len() > nd {
+            // Dense (a point of the structure moves in every mode): plain dots.
+            let a = &self.rel[k];
+            return (dot(a, &state[..nd]), dot(a, &state[nd..2 * nd]));
+        }
+        let (mut d, mut r) = (0.0, 0.0);
+        for &(i, a) in nz {
+            d += a * state[i];
+            r += a * state[nd + i];
+        }
+        (d, r)
+    }
+
     /// Force to the floor (N) at state `X`: the structure's ground reactions plus the damper
     /// spring/dashpot force when the damper is anchored to the ground.
     pub fn floor_force(&self, mode: Mode, x: &[f64]) -> f64 {
+        self.floor_force_with(x, self.element_forces(mode, x).2)
+    }
+
+    /// [`Self::floor_force`] given the damper force `f_fd` (from [`Self::element_forces`]).
+    pub fn floor_force_with(&self, x: &[f64], ffd: f64) -> f64 {
         let n = self.n_modes();
         let nd = self.dofs();
         let mut f = dot(&self.floor.stiffness, &x[..n]) + dot(&self.floor.damping, &x[nd..nd + n]);
         if self.damper.is_some() && self.points.damper_anchor.is_none() {
-            f += self.element_forces(mode, x).2;
+            f += ffd;
         }
         f
     }
@@ -780,26 +821,35 @@ impl ImpactSystem {
     /// (length `dofs`): `q̈ = −Ω²q − D q̇ + ψ_b f_bs − ψ_b f_bd + ψ_f f_fd`,
     /// `z̈_s = −f_bs/m_s`, `z̈_d = (f_bd − f_fd)/m_d`.
     pub fn accelerations(&self, mode: Mode, x: &[f64], out: &mut [f64]) {
+        self.accelerations_with(x, self.element_forces(mode, x), out);
+    }
+
+    /// [`Self::accelerations`] given the element forces `(f_bs, f_bd, f_fd)` at `x` (from
+    /// [`Self::element_forces`]).
+    pub fn accelerations_with(&self, x: &[f64], forces: (f64, f64, f64), out: &mut [f64]) {
         let n = self.n_modes();
         let nd = self.dofs();
-        let (fbs, fbd, ffd) = self.element_forces(mode, x);
+        let (fbs, fbd, ffd) = forces;
         let d = &self.structure.damping;
-        for i in 0..n {
-            let c = if self.damping_diagonal {
-                d[i * n + i] * x[nd + i]
-            } else {
-                d[i * n..(i + 1) * n]
-                    .iter()
-                    .zip(&x[nd..nd + n])
-                    .map(|(a, b)| a * b)
-                    .sum()
-            };
-            let mut a = -self.structure.omega_rad_per_s[i].powi(2) * x[i] - c
-                + self.points.bed_contact[i] * (fbs - fbd);
-            if let Some(f) = &self.points.damper_anchor {
-                a += f[i] * ffd;
+        let w = &self.structure.omega_rad_per_s;
+        let (q, qd) = (&x[..n], &x[nd..nd + n]);
+        let psi_b = &self.points.bed_contact;
+        let contact = fbs - fbd;
+        if self.damping_diagonal {
+            let rows = out[..n].iter_mut().zip(q).zip(qd).zip(w).zip(psi_b);
+            for (i, ((((o, qi), vi), wi), pi)) in rows.enumerate() {
+                *o = -(wi * wi) * qi - d[i * n + i] * vi + pi * contact;
             }
-            out[i] = a;
+        } else {
+            for i in 0..n {
+                let c = dot(&d[i * n..(i + 1) * n], qd);
+                out[i] = -(w[i] * w[i]) * q[i] - c + psi_b[i] * contact;
+            }
+        }
+        if let Some(f) = &self.points.damper_anchor {
+            for (o, fi) in out[..n].iter_mut().zip(f) {
+                *o += fi * ffd;
+            }
         }
         out[self.slider_index()] = -fbs / self.slider.mass;
         if let Some(dm) = &self.damper {
@@ -808,10 +858,25 @@ impl ImpactSystem {
     }
 }
 
-/// `Σ a_i b_i`.
+/// `Σ a_i b_i` (over the shorter length), in four interleaved partial sums (so that the loop
+/// vectorises; the grouping differs from a left-to-right sum by round-off only).
 #[inline]
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+    let m = a.len().min(b.len());
+    let (a, b) = (&a[..m], &b[..m]);
+    let mut acc = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for q in 0..4 {
+            acc[q] += x[q] * y[q];
+        }
+    }
+    let mut tail = 0.0;
+    for (x, y) in ra.iter().zip(rb) {
+        tail += x * y;
+    }
+    (acc[0] + acc[2]) + (acc[1] + acc[3]) + tail
 }
 
 fn check_positive(field: &str, v: f64, unit: &str) -> Result<()> {
