@@ -15,7 +15,7 @@
 //! extra state component (not under error control).
 
 use super::roots::{first_crossing, hermite_dip, Scalar, SearchOptions};
-use super::switching::{implied_mode, lex_sign, ModeSelector};
+use super::switching::{implied_mode, ModeSelector};
 use super::{CollisionEnd, Event, Grid, Observer, Options, Solution, Totals};
 use crate::impact::{dot, ContactLaw, DashpotKind, ImpactSystem, Indicator, Mode, Switch};
 use crate::{Error, Result};
@@ -98,6 +98,16 @@ impl Sparse {
             r += a * v[i];
         }
         (d, r)
+    }
+
+    /// `aᵀx`.
+    #[inline]
+    fn dot(&self, x: &[f64]) -> f64 {
+        self.idx
+            .iter()
+            .zip(&self.val)
+            .map(|(&i, &a)| a * x[i])
+            .sum()
     }
 
     /// `acc −= a f`.
@@ -387,6 +397,11 @@ pub fn solve_from(
         })
         .collect();
 
+    // The linear indicators by their non-zero entries (the per-step pre-check).
+    let linear_sparse: Vec<Sparse> = linear_vecs
+        .iter()
+        .map(|l| Sparse::new(l.as_deref().unwrap_or(&[])))
+        .collect();
     let mut selector = ModeSelector::new(sys);
     // The signs the mode selection works with (the step's own are `signs`, below).
     let mut selected_signs = vec![0.0; inds.len()];
@@ -451,13 +466,13 @@ pub fn solve_from(
         if need_k1 {
             rhs.eval(mode, &y, &mut k[0]);
             // Indicator sides at the (re)start.
-            let a_mode = if all_linear {
-                Some(selector.matrix(mode))
+            if all_linear {
+                // Lexicographic signs under the mode's dynamics (`switching::lex_signs`).
+                selector.signs(mode, &y[..nx], &mut signs);
             } else {
-                None
-            };
-            for (i, &ind) in inds.iter().enumerate() {
-                signs[i] = start_sign(sys, ind, mode, &y[..nx], linear_vecs[i].as_deref(), a_mode);
+                for (i, &ind) in inds.iter().enumerate() {
+                    signs[i] = start_sign(sys, ind, mode, &y[..nx]);
+                }
             }
             if h == 0.0 {
                 let (k0, k1) = k.split_at_mut(1);
@@ -581,16 +596,17 @@ pub fn solve_from(
             if signs[i] == 0.0 {
                 continue;
             }
-            if let Some(l) = linear_vecs[i].as_deref() {
+            if linear_vecs[i].is_some() {
                 // Values and slopes at the step ends come from the state and the stages
                 // (k₁ = f(y), k₇ = f(y_new)); the search on the dense output runs only where the
                 // step may hold a crossing: a sign change at the end, or a dip of the cubic
                 // Hermite interpolant in between (what its first interval would test).
                 let sg = signs[i];
-                let ga = (sg * dot(l, &y[..nx])).max(0.0);
-                let da = sg * dot(l, &k[0][..nx]);
-                let gb = sg * dot(l, &ynew[..nx]);
-                let db = sg * dot(l, &k[6][..nx]);
+                let sl = &linear_sparse[i];
+                let ga = (sg * sl.dot(&y[..nx])).max(0.0);
+                let da = sg * sl.dot(&k[0][..nx]);
+                let gb = sg * sl.dot(&ynew[..nx]);
+                let db = sg * sl.dot(&k[6][..nx]);
                 if gb >= 0.0 && hermite_dip(ga, da, gb, db, h).is_none() {
                     continue;
                 }
@@ -758,17 +774,9 @@ fn initial_step(
     (100.0 * h0).min(h1).min(span)
 }
 
-fn start_sign(
-    sys: &ImpactSystem,
-    ind: Indicator,
-    mode: Mode,
-    x: &[f64],
-    linear: Option<&[f64]>,
-    a: Option<&[f64]>,
-) -> f64 {
-    if let (Some(a), Some(l)) = (a, linear) {
-        return lex_sign(l, a, x);
-    }
+/// The side of indicator `ind` at `x` when a contact law is not linear: its value's sign, or at
+/// zero the side the mode implies.
+fn start_sign(sys: &ImpactSystem, ind: Indicator, mode: Mode, x: &[f64]) -> f64 {
     let v = sys.indicator_value(ind, x);
     if v != 0.0 {
         return v.signum();

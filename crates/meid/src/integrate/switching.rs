@@ -20,77 +20,85 @@ pub(crate) const MODES: usize = 8;
 /// Highest derivative order consulted.
 const K_MAX: usize = 8;
 
-/// Sign (+1, −1, or 0 when identically zero to order `K_MAX`) of `ℓᵀX(t)` just after `t`.
+/// A functional `ℓ` prepared for [`lex_signs`]: its non-zero entries (an indicator touches a
+/// few coordinates) and its norm.
+#[derive(Debug, Clone)]
+struct Linear {
+    idx: Vec<usize>,
+    val: Vec<f64>,
+    norm: f64,
+}
+
+impl Linear {
+    fn new(l: &[f64]) -> Self {
+        let (idx, val) = l
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| **v != 0.0)
+            .map(|(i, v)| (i, *v))
+            .unzip();
+        Self {
+            idx,
+            val,
+            norm: l.iter().map(|v| v * v).sum::<f64>().sqrt(),
+        }
+    }
+
+    /// `(ℓᵀy, Σ|ℓᵢyᵢ|)` (the same sums as over all entries: the zeros add nothing).
+    #[inline]
+    fn dot_abs(&self, y: &[f64]) -> (f64, f64) {
+        let (mut val, mut scale) = (0.0, 0.0);
+        for (&i, &l) in self.idx.iter().zip(&self.val) {
+            let t = l * y[i];
+            val += t;
+            scale += t.abs();
+        }
+        (val, scale)
+    }
+}
+
+/// Signs (+1, −1, or 0 when identically zero to order `K_MAX`) of the functionals `ℓᵀX(t)`
+/// just after `t` (`out[i]` for `ls[i]`), from the first non-vanishing derivative `ℓᵀAᵏX`; the
+/// derivatives `Aᵏ X` are computed once, as far as the last undecided functional needs them.
 ///
 /// A derivative `ℓᵀy` (`y = Aᵏ X`) counts as zero when it is below round-off of its own terms
 /// (`1e-9 Σ|ℓᵢyᵢ|` for the value itself, which root location leaves at ~1e-13 of its terms,
 /// `1e-11` for higher orders) or below `1e-12 ‖ℓ‖‖y‖`: the latter catches quantities whose terms
 /// are all physically zero (bodies at rest, forces zero) and only carry round-off.
 ///
-/// `a` is `A` column-major (`n × n`, `n = x.len()`).
-pub fn lex_sign(l: &[f64], a: &[f64], x: &[f64]) -> f64 {
-    let mut out = [0.0];
-    lex_signs(std::slice::from_ref(&l), a, x, &mut out);
-    out[0]
-}
-
-/// [`lex_sign`] of several functionals at once (`out[i]` for `ls[i]`): the derivatives `Aᵏ X`
-/// are computed once, as far as the last undecided functional needs them.
+/// `a` is `A` column-major (`n × n`, `n = x.len()`); `work` is scratch space (reused between
+/// calls).
 ///
 /// # Panics
 /// When `a.len() != x.len()²`.
-pub fn lex_signs<L: AsRef<[f64]>>(ls: &[L], a: &[f64], x: &[f64], out: &mut [f64]) {
+fn lex_signs(ls: &[Linear], a: &[f64], x: &[f64], out: &mut [f64], work: &mut Vec<f64>) {
     let n = x.len();
     assert_eq!(a.len(), n * n, "lexicographic signs: matrix size");
+    // `out[i] == 0` marks functional i as undecided.
     out.iter_mut().for_each(|o| *o = 0.0);
     let mut open = ls.len();
-    // Stack buffers for the usual sizes (no allocation per call).
-    let mut stack = [0.0; 128];
-    let mut heap = Vec::new();
-    let (y, next) = if 2 * n <= stack.len() {
-        stack[..2 * n].split_at_mut(n)
-    } else {
-        heap.resize(2 * n, 0.0);
-        heap.split_at_mut(n)
-    };
+    if work.len() < 2 * n {
+        work.resize(2 * n, 0.0);
+    }
+    let (y, next) = work[..2 * n].split_at_mut(n);
     y.copy_from_slice(x);
     let (mut y, mut next) = (y, next);
-    let mut decided = [false; 16];
-    let mut decided_heap = Vec::new();
-    let decided: &mut [bool] = if ls.len() <= decided.len() {
-        &mut decided[..ls.len()]
-    } else {
-        decided_heap.resize(ls.len(), false);
-        &mut decided_heap
-    };
-    // ‖ℓ‖ of each functional, once.
-    let mut norms = [0.0; 16];
-    for (nm, l) in norms.iter_mut().zip(ls) {
-        *nm = l.as_ref().iter().map(|v| v * v).sum::<f64>().sqrt();
-    }
     for k in 0..=K_MAX {
-        let y_norm = y.iter().map(|v| v * v).sum::<f64>().sqrt();
+        // ‖y‖, when a functional needs its floor.
+        let mut y_norm = None;
         let tol = if k == 0 { 1e-9 } else { 1e-11 };
-        for (i, l) in ls.iter().enumerate() {
-            if decided[i] {
+        for (l, o) in ls.iter().zip(out.iter_mut()) {
+            if *o != 0.0 {
                 continue;
             }
-            let l = l.as_ref();
-            let (mut val, mut scale) = (0.0, 0.0);
-            for (li, yi) in l.iter().zip(y.iter()) {
-                let t = li * yi;
-                val += t;
-                scale += t.abs();
-            }
-            let l_norm = match norms.get(i) {
-                Some(v) => *v,
-                None => l.iter().map(|v| v * v).sum::<f64>().sqrt(),
-            };
-            let floor = 1e-12 * l_norm * y_norm;
-            if val.abs() > tol * scale && val.abs() > floor {
-                out[i] = val.signum();
-                decided[i] = true;
-                open -= 1;
+            let (val, scale) = l.dot_abs(y);
+            if val.abs() > tol * scale {
+                let y_norm =
+                    *y_norm.get_or_insert_with(|| y.iter().map(|v| v * v).sum::<f64>().sqrt());
+                if val.abs() > 1e-12 * l.norm * y_norm {
+                    *o = val.signum();
+                    open -= 1;
+                }
             }
         }
         if open == 0 || k == K_MAX {
@@ -171,6 +179,9 @@ pub struct ModeSelector<'s> {
     inds: Vec<Indicator>,
     switches: Vec<Switch>,
     vecs: Vec<Vec<f64>>,
+    /// The indicators prepared for [`lex_signs`], and its scratch space.
+    linear: Vec<Linear>,
+    work: Vec<f64>,
     n: usize,
     /// `A_σ` per mode (index `σ`), column-major; empty until first used.
     mats: [Vec<f64>; MODES],
@@ -180,11 +191,13 @@ impl<'s> ModeSelector<'s> {
     /// The selector of `sys` ([`ImpactSystem::indicators`] and their vectors).
     pub fn new(sys: &'s ImpactSystem) -> Self {
         let inds = sys.indicators();
-        let vecs = inds.iter().map(|&i| sys.indicator_vector(i)).collect();
+        let vecs: Vec<Vec<f64>> = inds.iter().map(|&i| sys.indicator_vector(i)).collect();
         Self {
             sys,
             switches: sys.switches(),
             inds,
+            linear: vecs.iter().map(|l| Linear::new(l)).collect(),
+            work: Vec::new(),
             vecs,
             n: 2 * sys.dofs(),
             mats: Default::default(),
@@ -217,7 +230,7 @@ impl<'s> ModeSelector<'s> {
     pub fn signs(&mut self, mode: Mode, x: &[f64], out: &mut [f64]) {
         self.matrix(mode);
         let a = &self.mats[usize::from(mode.0) % MODES];
-        lex_signs(&self.vecs, a, x, out);
+        lex_signs(&self.linear, a, x, out, &mut self.work);
     }
 
     /// The mode implied by `signs` (one per indicator).
