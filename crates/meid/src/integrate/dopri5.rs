@@ -80,12 +80,7 @@ struct Sparse {
 
 impl Sparse {
     fn new(a: &[f64]) -> Self {
-        let (idx, val) = a
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| **v != 0.0)
-            .map(|(i, v)| (i, *v))
-            .unzip();
+        let (idx, val) = super::nonzeros(a);
         Self { idx, val }
     }
 

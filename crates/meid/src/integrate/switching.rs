@@ -31,12 +31,7 @@ struct Linear {
 
 impl Linear {
     fn new(l: &[f64]) -> Self {
-        let (idx, val) = l
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| **v != 0.0)
-            .map(|(i, v)| (i, *v))
-            .unzip();
+        let (idx, val) = super::nonzeros(l);
         Self {
             idx,
             val,

@@ -460,12 +460,7 @@ pub struct Projector {
 impl Projector {
     /// The functional `ℓ` (length `n`, the state's).
     pub fn new(l: &[f64]) -> Self {
-        let (idx, val) = l
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| **v != 0.0)
-            .map(|(i, v)| (i, *v))
-            .unzip();
+        let (idx, val) = super::nonzeros(l);
         Self {
             idx,
             val,
