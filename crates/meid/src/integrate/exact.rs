@@ -486,9 +486,7 @@ fn max_on_segment(seg: &Segment<'_>, l: &[f64], a: &Mat<f64>, len: f64, _period:
         .map(|j| (0..a.nrows()).map(|i| l[i] * a[(i, j)]).sum())
         .collect();
     let df = seg.functional(&la);
-    for_each_maximum(&df, len, SearchOptions::default(), |s| {
-        best = best.max(val(s))
-    });
+    for_each_maximum(&df, len, PEAK_SEARCH, |s| best = best.max(val(s)));
     best
 }
 
@@ -557,22 +555,24 @@ fn dissipated(seg: &Segment<'_>, c: &Mat<f64>, nd: usize, len: f64) -> f64 {
     total
 }
 
+/// The search for force peaks: a maximum's location to `1e-9` of the fastest period `T` is
+/// enough, since the value there is off by `½|f''|δ² ≤ ½ f_max (2π/T)² (1e-9 T)² ≈ 2e-17 f_max`
+/// (`|f''| ≤ ω² f_max` for a force oscillating at up to `ω = 2π/T`): below round-off.
+const PEAK_SEARCH: SearchOptions = SearchOptions {
+    max_step: f64::INFINITY,
+    tolerance: 1e-9,
+};
+
 /// Maximum over `[0, len]` of a force `Σ a_k s^k` on a Taylor step (`tau` its validity): the
 /// endpoints and the interior maxima, where the derivative `Σ (k+1) a_{k+1} s^k` changes sign
 /// from + to −.
 fn poly_max(a: &[f64; taylor::ORDER + 1], tau: f64, period: f64, len: f64) -> f64 {
-    let mut da = [0.0; taylor::ORDER + 1];
-    for (k, d) in da.iter_mut().take(taylor::ORDER).enumerate() {
-        *d = (k + 1) as f64 * a[k + 1];
-    }
     let f = Poly::new(a, tau, period);
     let mut best = f.value(0.0).max(f.value(len));
-    let df = Poly::new(&da, tau, period);
-    // A slope of one sign throughout (by dominance) leaves the maximum at an end.
+    let df = Poly::new(f.derivative(), tau, period);
+    // A slope of one sign throughout (a concave bound) leaves the maximum at an end.
     if !(df.keeps_sign(1.0, len) || df.keeps_sign(-1.0, len)) {
-        for_each_maximum(&df, len, SearchOptions::default(), |s| {
-            best = best.max(f.value(s))
-        });
+        for_each_maximum(&df, len, PEAK_SEARCH, |s| best = best.max(f.value(s)));
     }
     best
 }

@@ -58,12 +58,15 @@ impl<T: Scalar + ?Sized> Scalar for &T {
 pub struct SearchOptions {
     /// Intervals between samples never exceed this (s); `INFINITY` for no limit.
     pub max_step: f64,
+    /// Tolerance of the refined root, relative to the fastest period (default `1e-13`).
+    pub tolerance: f64,
 }
 
 impl Default for SearchOptions {
     fn default() -> Self {
         Self {
             max_step: f64::INFINITY,
+            tolerance: 1e-13,
         }
     }
 }
@@ -96,6 +99,7 @@ pub struct Search<F> {
     period: f64,
     h_grid: f64,
     max_step: f64,
+    tolerance: f64,
     /// Proved free of crossings up to `a`, where `G = sign0 (g + lift)` and `G'` are `ga`, `da`.
     a: f64,
     ga: f64,
@@ -128,6 +132,7 @@ impl<F: Scalar> Search<F> {
             period,
             h_grid,
             max_step: opts.max_step,
+            tolerance: opts.tolerance,
             a: 0.0,
             ga,
             da,
@@ -210,10 +215,11 @@ impl<F: Scalar> Search<F> {
     /// starts from the secant point, falls back to bisection when a Newton step leaves the
     /// bracket or the bracket stops shrinking, and, once the steps are small, probes one
     /// tolerance past the Newton point so that the bracket closes from both sides. Returns a
-    /// point `≥` the root within `1e-13` of the fastest period (or a few ulps of `b`).
+    /// point `≥` the root within the tolerance (`1e-13` of the fastest period by default; or a
+    /// few ulps of `b`).
     pub fn refine(&self, mut a: f64, mut b: f64) -> f64 {
         let tol_abs = if self.period.is_finite() {
-            1e-13 * self.period
+            self.tolerance * self.period
         } else {
             0.0
         };
