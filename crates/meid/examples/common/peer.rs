@@ -12,6 +12,8 @@ pub struct PeerRun {
     pub scipy: String,
     /// Median wall time of one collision (s).
     pub median_s: f64,
+    /// Minimum wall time of one collision over the runs (s).
+    pub min_s: f64,
     /// Its energy ratio E_p+/E_s-.
     pub energy_ratio: f64,
 }
@@ -49,6 +51,7 @@ pub fn scipy_collision(sys: &ImpactSystem, root: &Path, runs: usize) -> Result<P
     Ok(PeerRun {
         scipy: v["scipy"].as_str().unwrap_or("?").to_string(),
         median_s: num("median_s")?,
+        min_s: num("min_s")?,
         energy_ratio: num("energy_ratio")?,
     })
 }
