@@ -339,20 +339,26 @@ fn dissipated_small<const ND: usize>(
     s: &[f64; 10],
     w: &[f64; 10],
 ) -> f64 {
-    // Node by node, all components at once: the velocity half of each coefficient is
-    // contiguous, so the Horner recurrence runs on whole rows.
+    // Five nodes at a time, all components at once: the velocity half of each coefficient is
+    // contiguous, so the Horner recurrence runs on whole rows, and the five nodes' recurrences
+    // are independent chains (latency overlapped).
     let mut v = [[0.0; 10]; ND];
-    for (q, &sq) in s.iter().enumerate() {
-        let mut acc = [0.0; ND];
+    for half in 0..2 {
+        let sq: [f64; 5] = std::array::from_fn(|b| s[5 * half + b]);
+        let mut acc = [[0.0; ND]; 5];
         for ck in coef.chunks_exact(2 * ND).rev() {
             if let Ok(cv) = <&[f64; ND]>::try_from(&ck[ND..]) {
-                for i in 0..ND {
-                    acc[i] = acc[i] * sq + cv[i];
+                for (ab, &sb) in acc.iter_mut().zip(&sq) {
+                    for i in 0..ND {
+                        ab[i] = ab[i] * sb + cv[i];
+                    }
                 }
             }
         }
-        for i in 0..ND {
-            v[i][q] = acc[i];
+        for (b, ab) in acc.iter().enumerate() {
+            for i in 0..ND {
+                v[i][5 * half + b] = ab[i];
+            }
         }
     }
     let mut total = 0.0;
