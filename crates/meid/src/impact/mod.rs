@@ -858,12 +858,16 @@ impl ImpactSystem {
     }
 }
 
-/// `Σ a_i b_i` (over the shorter length), in four interleaved partial sums (so that the loop
-/// vectorises; the grouping differs from a left-to-right sum by round-off only).
+/// `Σ a_i b_i` (over the shorter length); from 8 entries on in four interleaved partial sums (so
+/// that the loop vectorises; the grouping differs from a left-to-right sum by round-off only).
 #[inline]
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     let m = a.len().min(b.len());
     let (a, b) = (&a[..m], &b[..m]);
+    if m < 8 {
+        // Short (a lumped machine's coordinates): one sum, no set-up.
+        return a.iter().zip(b).map(|(x, y)| x * y).sum();
+    }
     let mut acc = [0.0; 4];
     let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
     let (ra, rb) = (ca.remainder(), cb.remainder());
