@@ -110,8 +110,9 @@ fn main() -> meid::Result<()> {
             let sys = pm.model.impact_system(meid::model::Case::AsSpecified)?;
             match peer::scipy_collision(&sys, &root, 3) {
                 Ok(p) => {
-                    total += p.median_s;
-                    total_min += p.min_s;
+                    let (med, min) = p.median_min();
+                    total += med;
+                    total_min += min;
                     count += 1;
                     version = p.scipy;
                     if let Some(r) = &last {

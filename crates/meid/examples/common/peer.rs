@@ -10,12 +10,20 @@ use meid::impact::ImpactSystem;
 pub struct PeerRun {
     /// SciPy's version string.
     pub scipy: String,
-    /// Median wall time of one collision (s).
-    pub median_s: f64,
-    /// Minimum wall time of one collision over the runs (s).
-    pub min_s: f64,
+    /// Every run's wall time (s).
+    pub times_s: Vec<f64>,
     /// Its energy ratio E_p+/E_s-.
     pub energy_ratio: f64,
+}
+
+impl PeerRun {
+    /// `(median, minimum)` of the runs' wall times (s).
+    #[allow(dead_code)] // (`impact_bench` pools the times with its own rounds instead)
+    pub fn median_min(&self) -> (f64, f64) {
+        let mut t = self.times_s.clone();
+        t.sort_by(f64::total_cmp);
+        (t[t.len() / 2], t[0])
+    }
 }
 
 /// Writes `sys` as the peer's JSON spec and runs the script `runs` times on it.
@@ -50,8 +58,11 @@ pub fn scipy_collision(sys: &ImpactSystem, root: &Path, runs: usize) -> Result<P
     let num = |k: &str| v[k].as_f64().ok_or(format!("peer output has no {k}"));
     Ok(PeerRun {
         scipy: v["scipy"].as_str().unwrap_or("?").to_string(),
-        median_s: num("median_s")?,
-        min_s: num("min_s")?,
+        times_s: v["times_s"]
+            .as_array()
+            .map(|a| a.iter().filter_map(|t| t.as_f64()).collect())
+            .filter(|t: &Vec<f64>| !t.is_empty())
+            .ok_or("peer output has no times_s")?,
         energy_ratio: num("energy_ratio")?,
     })
 }
