@@ -5,7 +5,7 @@
 //! * **Taylor steps** ([`super::taylor`]): `X(s) = Σ_{k≤24} A^k X₀ s^k / k!` over a third of
 //!   the fastest period, where the truncation is below 2.6e-17. No eigen-decomposition is needed;
 //!   a run takes them in a mode until it has spent [`Options::taylor_steps_per_mode`] there
-//!   (default [`TAYLOR_STEPS_PER_MODE`]). A blow of the paper's machine is over in 5 such
+//!   (default [`TAYLOR_STEPS_PER_MODE`]). A blow of the paper's machine is over in 4 such
 //!   steps (0.68 ms), so it never builds a closed form;
 //! * **closed form** ([`Propagator`], spectral with a matrix-exponential fallback): built the
 //!   first time a run needs it (and kept for the run, and in a small per-thread cache,
@@ -51,8 +51,8 @@ struct ModeData {
 /// A Taylor step costs `P` mat-vecs and a polynomial search and spans `2.2/‖D⁻¹AD‖_∞` (about a
 /// third of the fastest period); the closed form costs an eigen-decomposition up front and a
 /// sum of exponentials per evaluation, and pays off over long stretches. A blow of the paper's
-/// machine takes 5 steps in all (a dashpot switching off after 0.8 µs, 0.5 ms of slider
-/// contact in 3 steps, 0.17 ms of damper contact in 1); a long free flight switches to the
+/// machine takes 4 steps in all (a dashpot switching off after 0.8 µs, 0.5 ms of slider
+/// contact in 2 steps, 0.17 ms of damper contact in 1); a long free flight switches to the
 /// closed form after this many steps.
 pub const TAYLOR_STEPS_PER_MODE: usize = 16;
 
