@@ -20,10 +20,21 @@ impl PeerRun {
     /// `(median, minimum)` of the runs' wall times (s).
     #[allow(dead_code)] // (`impact_bench` pools the times with its own rounds instead)
     pub fn median_min(&self) -> (f64, f64) {
-        let mut t = self.times_s.clone();
-        t.sort_by(f64::total_cmp);
-        (t[t.len() / 2], t[0])
+        median_min(self.times_s.clone())
     }
+}
+
+/// `(median, minimum)` of `v` (not empty; the median of an even count is the mean of the two
+/// middle values).
+pub fn median_min(mut v: Vec<f64>) -> (f64, f64) {
+    v.sort_by(f64::total_cmp);
+    let m = v.len() / 2;
+    let median = if v.len() % 2 == 0 {
+        0.5 * (v[m - 1] + v[m])
+    } else {
+        v[m]
+    };
+    (median, v[0])
 }
 
 /// Writes `sys` as the peer's JSON spec and runs the script `runs` times on it.

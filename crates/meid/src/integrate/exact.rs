@@ -25,9 +25,9 @@
 //!    the first evaluated directly, the next ones by the real transition matrix
 //!    `E = exp(A Δt)` (one mat-vec per sample), re-seeded every 64 samples;
 //! 4. exact contact-force maxima (roots of the force's derivative), closed-contact times, and
-//!    the dissipated energy `∫ ẋᵀ C_σ ẋ dt` (closed form, or Gauss-Legendre below round-off
+//!    the dissipated energy `∫ ẋᵀ C_σ ẋ dt` (closed form, or Gauss-Legendre at round-off level
 //!    on a Taylor step);
-//! 5. the new mode at the switch (`switching::select_mode`).
+//! 5. the new mode at the switch (`switching::ModeSelector::select`).
 
 use faer::{c64, Mat};
 
@@ -41,6 +41,8 @@ use crate::{Error, Result};
 
 struct ModeData {
     prop: std::rc::Rc<Propagator>,
+    /// The mode's damping matrix `C_σ` (dissipation).
+    damping: Mat<f64>,
     /// Transition matrix for the output step.
     step: Option<Mat<f64>>,
 }
@@ -112,7 +114,7 @@ pub fn solve_from(
     let mut taylor_steps = [0usize; MODES];
 
     // Taylor-step workspace: the first-order matrices prepared per mode, the coefficients
-    // c_0 … c_P of the current step, the polynomials of the indicators, and the searches (kept
+    // c_0 … c_P of the current step, the polynomials of the indicators, and the searches' buffer (reused
     // from step to step).
     let mut tmats: [Option<TaylorMatrix>; MODES] = Default::default();
     let mut coef = vec![0.0; (taylor::ORDER + 1) * n];
@@ -177,7 +179,8 @@ pub fn solve_from(
             for (l, p) in ind_proj.iter().zip(ind_polys.iter_mut()) {
                 l.apply(&coef, p);
             }
-            // (Indicators whose constant term dominates cannot cross within the step.)
+            // (Indicators proved to keep their sign on the step, `Poly::keeps_sign`, are not
+            // searched.)
             searches.clear();
             for (p, &sign) in ind_polys.iter().zip(&signs) {
                 if sign != 0.0 {
@@ -229,7 +232,11 @@ pub fn solve_from(
                 let (k, c) = sys.matrices(mode);
                 let a = Mat::from_fn(n, n, |i, j| selector.matrix(mode)[j * n + i]);
                 let prop = Propagator::shared(&k, &c, &masses, a)?;
-                cache[mi] = Some(ModeData { prop, step: None });
+                cache[mi] = Some(ModeData {
+                    prop,
+                    damping: c,
+                    step: None,
+                });
             }
             let md = cache[mi]
                 .as_mut()
@@ -271,7 +278,7 @@ pub fn solve_from(
                     totals.peak_force[ci] = totals.peak_force[ci].max(peak);
                 }
             }
-            totals.dissipated += dissipated(&seg, &sys.matrices(mode).1, nd, s_end);
+            totals.dissipated += dissipated(&seg, &md.damping, nd, s_end);
             seg.state(s_end, &mut buf);
             x.copy_from_slice(&buf);
         }
@@ -556,8 +563,9 @@ fn dissipated(seg: &Segment<'_>, c: &Mat<f64>, nd: usize, len: f64) -> f64 {
 }
 
 /// The search for force peaks: a maximum's location to `1e-9` of the fastest period `T` is
-/// enough, since the value there is off by `½|f''|δ² ≤ ½ f_max (2π/T)² (1e-9 T)² ≈ 2e-17 f_max`
-/// (`|f''| ≤ ω² f_max` for a force oscillating at up to `ω = 2π/T`): below round-off.
+/// enough, since the value there is off by `½|f''|δ²`; for a force oscillating at up to
+/// `ω = 2π/T`, `|f''| ≈ ω² f_max` (an estimate, not a bound), that is
+/// `½ f_max (2π/T)² (1e-9 T)² ≈ 2e-17 f_max`: below round-off.
 const PEAK_SEARCH: SearchOptions = SearchOptions {
     max_step: f64::INFINITY,
     tolerance: 1e-9,

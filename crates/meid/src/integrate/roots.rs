@@ -15,7 +15,8 @@
 //!    `h_grid/2¹⁰`, below which a touch without a sign change is a tangency, not a contact.
 //!
 //! A sign change found this way is refined by safeguarded Newton-bisection on the exact `g`
-//! to `1e-13` of the fastest period (and a few ulps of `s`).
+//! to [`SearchOptions::tolerance`] of the fastest period (`1e-13` by default; a few ulps of `s`
+//! at least).
 
 /// A scalar function of time with its slope and a bound on its second derivative.
 pub trait Scalar {

@@ -65,7 +65,7 @@ impl TaylorMatrix {
     /// Prepares the `n × n` matrix stored column-major in `a` (`a[j·n + i] = A_ij`); `None` when
     /// `a.len() != n²` or an entry is not finite.
     pub fn from_col_major(n: usize, a: &[f64]) -> Option<Self> {
-        if a.len() != n * n {
+        if a.len() != n * n || !a.iter().all(|v| v.is_finite()) {
             return None;
         }
         let nd = n / 2;
@@ -256,10 +256,12 @@ impl TaylorMatrix {
     /// `A = [[0, I], [−M⁻¹K, −M⁻¹C]]` with `masses` the diagonal of `M`: then
     /// `ẋᵀCẋ = −Σ_i m_i ẋ_i (A₂₂ ẋ)_i`. `None` when the matrix is not of that form.
     ///
-    /// 10-point Gauss-Legendre: `ρ` bounds the growth rate of `ẋ` and so `2ρ` that of `ẋᵀCẋ`,
-    /// and the rule's error `L^21 (10!)^4 / (21 (20!)^3) · max|f⁽²⁰⁾|` with
-    /// `|f⁽²⁰⁾| ≤ (2ρ)^20 max|f|` is at most `4.4^20 (10!)^4 / (21 (20!)^3) ≈ 4.3e-18` of
-    /// `L max|f|` for `L ≤ 2.2/ρ`: below round-off. `work` is scratch space for systems of more
+    /// 10-point Gauss-Legendre; the rule's error is `L^21 (10!)^4 / (21 (20!)^3) · max|f⁽²⁰⁾|`.
+    /// With `ẋ⁽ʲ⁾ = (AʲX)_velocity`, `|ẋ⁽ʲ⁾| ≤ ρʲ ‖D⁻¹X(s)‖_∞ ≤ ρʲ e^{ρs} ‖D⁻¹X₀‖_∞`, so
+    /// `|f⁽²⁰⁾| ≤ (2ρ)^20 e^{2ρL} Σ|C_ij| ‖D⁻¹X₀‖²_∞` (Leibniz), and for `L ≤ 2.2/ρ` the error is
+    /// at most `4.4^20 (10!)^4 / (21 (20!)^3) · e^{4.4} ≈ 3.5e-16` of
+    /// `L Σ|C_ij| ‖D⁻¹X₀‖²_∞`, the integrand's scale: a few units of round-off in the worst case
+    /// (the bound ignores that a damped state does not grow). `work` is scratch space for systems of more
     /// than 8 degrees of freedom (reused between calls).
     ///
     /// # Panics
@@ -548,9 +550,10 @@ const K_K1: Coefficients = {
 };
 
 /// `Σ_{k<M} c(k) x^k` in four interleaved Horner chains on `x⁴` (`Σ_r x^r Σ_g c(4g + r) x^{4g}`):
-/// the same operations as one Horner chain, a quarter of its latency (each step of a chain waits
-/// for the previous multiply and add; four independent chains keep the pipeline busy). Polynomial
-/// evaluation is most of an event search on a Taylor step.
+/// about the operations of one Horner chain (a few more to combine the chains) and a quarter of
+/// its latency (each step of a chain waits for the previous multiply and add; four independent
+/// chains keep the pipeline busy). It rounds differently from one chain, with an error of the
+/// same order. Polynomial evaluation is most of an event search on a Taylor step.
 #[inline(always)]
 fn poly4<const M: usize>(x: f64, c: impl Fn(usize) -> f64) -> f64 {
     let x2 = x * x;
@@ -574,8 +577,8 @@ fn abs_horner(a: &Coefficients, x: f64) -> f64 {
 }
 
 /// A polynomial `Σ a_k s^k` on `[0, τ]`, as a [`Scalar`] for the event search (it holds its
-/// coefficients and those of its derivative, so searches can be kept from one step to the next
-/// without borrowing).
+/// coefficients and those of its derivative, so a buffer of searches can be reused from one step
+/// to the next without borrowing the step's data).
 #[derive(Debug, Clone, Copy)]
 pub struct Poly {
     a: Coefficients,
@@ -646,5 +649,128 @@ impl Scalar for Poly {
     }
     fn noise(&self) -> f64 {
         self.noise
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A deterministic stream of numbers in [−1, 1) (64-bit LCG).
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        }
+    }
+
+    /// `Σ c_k x^k` term by term (summed from the highest power) and `Σ|c_k x^k|`.
+    fn naive(c: &[f64], x: f64) -> (f64, f64) {
+        let terms: Vec<f64> = c
+            .iter()
+            .enumerate()
+            .map(|(k, ck)| ck * x.powi(k as i32))
+            .collect();
+        let size = terms.iter().map(|t| t.abs()).sum::<f64>();
+        (terms.iter().rev().sum(), size)
+    }
+
+    /// The four interleaved chains equal the plain sum for every length used (25, 24, 23) and
+    /// for the edge cases 0 and 1, to a few ulps of `Σ|c_k x^k|`.
+    #[test]
+    fn four_chains_equal_the_plain_sum() {
+        let mut r = Lcg(7);
+        let c: Vec<f64> = (0..ORDER + 1).map(|_| r.next()).collect();
+        for x in [0.0, 0.37, -0.8, 1.0, 2.2] {
+            let check = |got: f64, m: usize| {
+                let (want, size) = naive(&c[..m], x);
+                assert!(
+                    (got - want).abs() <= 16.0 * f64::EPSILON * size.max(f64::MIN_POSITIVE),
+                    "M = {m}, x = {x}: {got} vs {want}"
+                );
+            };
+            check(poly4::<25>(x, |k| c[k]), 25);
+            check(poly4::<24>(x, |k| c[k]), 24);
+            check(poly4::<23>(x, |k| c[k]), 23);
+            check(poly4::<1>(x, |k| c[k]), 1);
+            assert_eq!(poly4::<0>(x, |k| c[k]), 0.0);
+        }
+    }
+
+    /// Value, slope and curvature bound of a `Poly` against term-by-term sums; the bound holds
+    /// the second derivative at sampled points.
+    #[test]
+    fn poly_value_slope_and_curvature() {
+        let mut r = Lcg(11);
+        let mut a = [0.0; ORDER + 1];
+        for (k, ak) in a.iter_mut().enumerate() {
+            // Coefficients of a Taylor step: |a_k| τ^k ~ 2.2^k / k!.
+            *ak = r.next() * 2.2_f64.powi(k as i32) / (1..=k).map(|i| i as f64).product::<f64>();
+        }
+        let p = Poly::new(&a, 1.0, 6.0);
+        let da: Vec<f64> = (1..=ORDER).map(|k| k as f64 * a[k]).collect();
+        let d2: Vec<f64> = (2..=ORDER).map(|k| (k * (k - 1)) as f64 * a[k]).collect();
+        for s in [0.0, 0.25, 0.6, 1.0] {
+            let (v, d) = p.value_slope(s);
+            let (wv, sv) = naive(&a, s);
+            let (wd, sd) = naive(&da, s);
+            assert!((v - wv).abs() <= 16.0 * f64::EPSILON * sv, "value at {s}");
+            assert!((d - wd).abs() <= 16.0 * f64::EPSILON * sd, "slope at {s}");
+            assert!((p.value(s) - wv).abs() <= 16.0 * f64::EPSILON * sv);
+            let bound = p.curvature_bound(0.0, s);
+            let (abs_d2, _) = naive(&d2.iter().map(|x| x.abs()).collect::<Vec<_>>(), s);
+            assert!((bound - abs_d2).abs() <= 16.0 * f64::EPSILON * abs_d2);
+            for t in [0.0, 0.5 * s, s] {
+                assert!(
+                    naive(&d2, t).0.abs() <= bound * (1.0 + 1e-12),
+                    "|p''({t})| ≤ bound"
+                );
+            }
+        }
+    }
+
+    /// The sign certificate is sound: whenever it says `sign·p > 0` on `[0, len]`, a fine grid
+    /// finds no point where `sign·p ≤ 0`; it holds for a polynomial moving away from zero, and
+    /// fails for one that dips through zero.
+    #[test]
+    fn sign_certificate_is_sound() {
+        let mut r = Lcg(3);
+        let mut proved = 0;
+        for case in 0..2000 {
+            let mut a = [0.0; ORDER + 1];
+            for (k, ak) in a.iter_mut().enumerate().take(6) {
+                *ak = r.next() / (1..=k).map(|i| i as f64).product::<f64>();
+            }
+            a[0] = 0.05 + 0.5 * r.next().abs();
+            let len = 0.2 + 2.0 * r.next().abs();
+            for sign in [1.0, -1.0] {
+                let q = Poly::new(&a, len, 6.0);
+                if q.keeps_sign(sign, len) {
+                    proved += 1;
+                    for i in 0..=400 {
+                        let s = len * i as f64 / 400.0;
+                        assert!(
+                            sign * q.value(s) > 0.0,
+                            "case {case}: proved but p({s}) ≤ 0"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(
+            proved > 200,
+            "the certificate proved only {proved} of 4000 cases"
+        );
+        // Moving away: p = 1e-3 + s − s²/2 on [0, 1.5] (the constant alone does not dominate).
+        let mut a = [0.0; ORDER + 1];
+        (a[0], a[1], a[2]) = (1e-3, 1.0, -0.5);
+        assert!(Poly::new(&a, 1.5, 6.0).keeps_sign(1.0, 1.5));
+        // Dips through zero: p = 0.1 − s + s² has roots at 0.113 and 0.887.
+        (a[0], a[1], a[2]) = (0.1, -1.0, 1.0);
+        assert!(!Poly::new(&a, 1.0, 6.0).keeps_sign(1.0, 1.0));
     }
 }
