@@ -280,7 +280,7 @@ pub struct ImpactSystem {
     rel: [Vec<f64>; 3],
     /// The non-zero entries `(i, a_i)` of each `rel` vector (first-order matrices are built
     /// from them).
-    rel_nz: [Vec<(usize, f64)>; 3],
+    rel_nz: [SparseVec; 3],
     /// True when the modal damping matrix is diagonal (modal damping ratios only).
     damping_diagonal: bool,
 }
@@ -372,13 +372,7 @@ impl ImpactSystem {
             sys.build_relative_vector(Switch::BedDamper),
             sys.build_relative_vector(Switch::Dashpot),
         ];
-        sys.rel_nz = sys.rel.clone().map(|a| {
-            a.iter()
-                .enumerate()
-                .filter(|(_, v)| **v != 0.0)
-                .map(|(i, v)| (i, *v))
-                .collect()
-        });
+        sys.rel_nz = [0, 1, 2].map(|k| SparseVec::new(&sys.rel[k]));
         Ok(sys)
     }
 
@@ -459,11 +453,7 @@ impl ImpactSystem {
     /// damper spring and dashpot). Without a damper the damper entries are all zero.
     #[inline]
     pub fn relative_vector(&self, s: Switch) -> &[f64] {
-        match s {
-            Switch::SliderBed => &self.rel[0],
-            Switch::BedDamper => &self.rel[1],
-            Switch::Dashpot => &self.rel[2],
-        }
+        &self.rel[rel_index(s)]
     }
 
     fn build_relative_vector(&self, s: Switch) -> Vec<f64> {
@@ -600,13 +590,9 @@ impl ImpactSystem {
             }
         }
         let mut add = |s: Switch, kk: f64, cc: f64| {
-            let nz = match s {
-                Switch::SliderBed => &self.rel_nz[0],
-                Switch::BedDamper => &self.rel_nz[1],
-                Switch::Dashpot => &self.rel_nz[2],
-            };
-            for &(i, ai) in nz {
-                for &(j, aj) in nz {
+            let (idx, val) = self.rel_nz[rel_index(s)].parts();
+            for (&i, &ai) in idx.iter().zip(val) {
+                for (&j, &aj) in idx.iter().zip(val) {
                     out[j * n + nd + i] += kk * ai * aj;
                     if cc != 0.0 {
                         out[(nd + j) * n + nd + i] += cc * ai * aj;
@@ -779,23 +765,15 @@ impl ImpactSystem {
     #[inline]
     pub fn relative_motion(&self, s: Switch, state: &[f64]) -> (f64, f64) {
         let nd = self.dofs();
-        let k = match s {
-            Switch::SliderBed => 0,
-            Switch::BedDamper => 1,
-            Switch::Dashpot => 2,
-        };
+        let k = rel_index(s);
+        let (x, v) = (&state[..nd], &state[nd..2 * nd]);
         let nz = &self.rel_nz[k];
-        if 3 * nz.len() > nd {
+        if 3 * nz.parts().0.len() > nd {
             // Dense (a point of the structure moves in every mode): plain dots.
             let a = &self.rel[k];
-            return (dot(a, &state[..nd]), dot(a, &state[nd..2 * nd]));
+            return (dot(a, x), dot(a, v));
         }
-        let (mut d, mut r) = (0.0, 0.0);
-        for &(i, a) in nz {
-            d += a * state[i];
-            r += a * state[nd + i];
-        }
-        (d, r)
+        nz.dots(x, v)
     }
 
     /// Force to the floor (N) at state `X`: the structure's ground reactions plus the damper
@@ -881,6 +859,87 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
         tail += x * y;
     }
     (acc[0] + acc[2]) + (acc[1] + acc[3]) + tail
+}
+
+/// A vector by its non-zero entries (a contact's relative vector, an indicator: a few coordinates
+/// of many), built once per system or per run: the sparse dots and updates of the system's
+/// matrices and of the integrators.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SparseVec {
+    idx: Vec<usize>,
+    val: Vec<f64>,
+}
+
+impl SparseVec {
+    /// The non-zeros of `l` (allocated to size).
+    pub(crate) fn new(l: &[f64]) -> Self {
+        let m = l.iter().filter(|v| **v != 0.0).count();
+        let (mut idx, mut val) = (Vec::with_capacity(m), Vec::with_capacity(m));
+        for (i, &v) in l.iter().enumerate() {
+            if v != 0.0 {
+                idx.push(i);
+                val.push(v);
+            }
+        }
+        Self { idx, val }
+    }
+
+    /// The indices and values of the non-zeros.
+    #[inline]
+    pub(crate) fn parts(&self) -> (&[usize], &[f64]) {
+        (&self.idx, &self.val)
+    }
+
+    /// `aᵀx` (the same sum as over all entries: the zeros add nothing).
+    #[inline]
+    pub(crate) fn dot(&self, x: &[f64]) -> f64 {
+        self.idx
+            .iter()
+            .zip(&self.val)
+            .map(|(&i, &a)| a * x[i])
+            .sum()
+    }
+
+    /// `(aᵀx, aᵀv)`.
+    #[inline]
+    pub(crate) fn dots(&self, x: &[f64], v: &[f64]) -> (f64, f64) {
+        let (mut d, mut r) = (0.0, 0.0);
+        for (&i, &a) in self.idx.iter().zip(&self.val) {
+            d += a * x[i];
+            r += a * v[i];
+        }
+        (d, r)
+    }
+
+    /// `(aᵀy, Σ|a_i y_i|)`.
+    #[inline]
+    pub(crate) fn dot_abs(&self, y: &[f64]) -> (f64, f64) {
+        let (mut val, mut scale) = (0.0, 0.0);
+        for (&i, &a) in self.idx.iter().zip(&self.val) {
+            let t = a * y[i];
+            val += t;
+            scale += t.abs();
+        }
+        (val, scale)
+    }
+
+    /// `acc −= a f`.
+    #[inline]
+    pub(crate) fn sub_scaled(&self, f: f64, acc: &mut [f64]) {
+        for (&i, &a) in self.idx.iter().zip(&self.val) {
+            acc[i] -= a * f;
+        }
+    }
+}
+
+/// Index of a switch's relative vector in `ImpactSystem::rel` (and `rel_nz`).
+#[inline]
+fn rel_index(s: Switch) -> usize {
+    match s {
+        Switch::SliderBed => 0,
+        Switch::BedDamper => 1,
+        Switch::Dashpot => 2,
+    }
 }
 
 fn check_positive(field: &str, v: f64, unit: &str) -> Result<()> {

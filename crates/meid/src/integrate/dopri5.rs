@@ -17,6 +17,7 @@
 use super::roots::{first_crossing, hermite_dip, Scalar, SearchOptions};
 use super::switching::{implied_mode, ModeSelector};
 use super::{CollisionEnd, Event, Grid, Observer, Options, Solution, Totals};
+use crate::impact::SparseVec;
 use crate::impact::{dot, ContactLaw, DashpotKind, ImpactSystem, Indicator, Mode, Switch};
 use crate::{Error, Result};
 
@@ -62,56 +63,13 @@ struct Rhs<'a> {
     omega2: Vec<f64>,
     damping: &'a [f64],
     damping_diagonal: bool,
-    a_s: Sparse,
-    a_d: Sparse,
-    a_f: Sparse,
+    a_s: SparseVec,
+    a_d: SparseVec,
+    a_f: SparseVec,
     masses: Vec<f64>,
     /// Linear contact laws only: per mode, the lower half of `A_σ` (`nd` rows of `2·nd`), built
     /// on first use; then `f(y) = A_σ y` and the dissipated power is `−Σ m_i ẋ_i (A₂₂ ẋ)_i`.
     linear_rows: Option<[std::cell::OnceCell<Vec<f64>>; 8]>,
-}
-
-/// A relative vector `a` (`δ = aᵀx`) by its non-zero entries: a contact or the damper touches
-/// a few coordinates, and the right-hand side is evaluated six times per step.
-struct Sparse {
-    idx: Vec<usize>,
-    val: Vec<f64>,
-}
-
-impl Sparse {
-    fn new(a: &[f64]) -> Self {
-        let (idx, val) = super::nonzeros(a);
-        Self { idx, val }
-    }
-
-    /// `(aᵀx, aᵀv)`.
-    #[inline]
-    fn dots(&self, x: &[f64], v: &[f64]) -> (f64, f64) {
-        let (mut d, mut r) = (0.0, 0.0);
-        for (&i, &a) in self.idx.iter().zip(&self.val) {
-            d += a * x[i];
-            r += a * v[i];
-        }
-        (d, r)
-    }
-
-    /// `aᵀx`.
-    #[inline]
-    fn dot(&self, x: &[f64]) -> f64 {
-        self.idx
-            .iter()
-            .zip(&self.val)
-            .map(|(&i, &a)| a * x[i])
-            .sum()
-    }
-
-    /// `acc −= a f`.
-    #[inline]
-    fn apply(&self, f: f64, acc: &mut [f64]) {
-        for (&i, &a) in self.idx.iter().zip(&self.val) {
-            acc[i] -= a * f;
-        }
-    }
 }
 
 impl<'a> Rhs<'a> {
@@ -132,13 +90,13 @@ impl<'a> Rhs<'a> {
                 .collect(),
             damping,
             damping_diagonal,
-            a_s: Sparse::new(sys.relative_vector(Switch::SliderBed)),
-            a_d: Sparse::new(if has_d {
+            a_s: SparseVec::new(sys.relative_vector(Switch::SliderBed)),
+            a_d: SparseVec::new(if has_d {
                 sys.relative_vector(Switch::BedDamper)
             } else {
                 &[]
             }),
-            a_f: Sparse::new(if has_d {
+            a_f: SparseVec::new(if has_d {
                 sys.relative_vector(Switch::Dashpot)
             } else {
                 &[]
@@ -154,20 +112,34 @@ impl<'a> Rhs<'a> {
         }
     }
 
-    /// The lower half of `A_σ`, row by row (linear laws).
-    fn lower_rows(&self, mode: Mode) -> Option<&[f64]> {
-        let rows = self.linear_rows.as_ref()?;
-        let cell = rows.get(usize::from(mode.0))?;
-        Some(cell.get_or_init(|| {
+    /// Linear laws: keeps the lower half of `mode`'s `A_σ` (given column-major, as the mode
+    /// selection built it), row by row, for [`Rhs::eval`]. Until a mode's rows are set its
+    /// right-hand side takes the general path (the same values, force by force).
+    fn set_lower_rows(&self, mode: Mode, a: &[f64]) {
+        let Some(cell) = self
+            .linear_rows
+            .as_ref()
+            .and_then(|rows| rows.get(usize::from(mode.0)))
+        else {
+            return;
+        };
+        cell.get_or_init(|| {
             let n = 2 * self.nd;
-            let mut a = vec![0.0; n * n];
-            self.sys.first_order_into(mode, &mut a);
             let mut r = Vec::with_capacity(self.nd * n);
             for i in self.nd..n {
                 r.extend((0..n).map(|j| a[j * n + i]));
             }
             r
-        }))
+        });
+    }
+
+    /// The lower half of `A_σ`, row by row, once set ([`Rhs::set_lower_rows`]).
+    fn lower_rows(&self, mode: Mode) -> Option<&[f64]> {
+        self.linear_rows
+            .as_ref()?
+            .get(usize::from(mode.0))?
+            .get()
+            .map(|r| &r[..])
     }
 
     /// `dy = f(y)`, `y = [x; ẋ; E_diss]`.
@@ -219,20 +191,20 @@ impl<'a> Rhs<'a> {
             let (d, r) = self.a_s.dots(x, v);
             let f = law.force(d, r);
             power += (f - elastic(&law, d)) * r;
-            self.a_s.apply(f, acc);
+            self.a_s.sub_scaled(f, acc);
         }
         if let (Some(dmp), Some(c)) = (&self.sys.damper, &self.sys.bed_damper) {
             if mode.on(Switch::BedDamper) {
                 let (d, r) = self.a_d.dots(x, v);
                 let f = c.law.force(d, r);
                 power += (f - elastic(&c.law, d)) * r;
-                self.a_d.apply(f, acc);
+                self.a_d.sub_scaled(f, acc);
             }
             let (d, r) = self.a_f.dots(x, v);
             let c_on = dmp.dashpot == DashpotKind::TwoWay || mode.on(Switch::Dashpot);
             let cd = if c_on { dmp.damping } else { 0.0 };
             power += cd * r * r;
-            self.a_f.apply(dmp.stiffness * d + cd * r, acc);
+            self.a_f.sub_scaled(dmp.stiffness * d + cd * r, acc);
         }
         for i in n..nd {
             acc[i] /= self.masses[i];
@@ -393,9 +365,9 @@ pub fn solve_from(
         .collect();
 
     // The linear indicators by their non-zero entries (the per-step pre-check).
-    let linear_sparse: Vec<Sparse> = linear_vecs
+    let linear_sparse: Vec<SparseVec> = linear_vecs
         .iter()
-        .map(|l| Sparse::new(l.as_deref().unwrap_or(&[])))
+        .map(|l| SparseVec::new(l.as_deref().unwrap_or(&[])))
         .collect();
     let mut selector = ModeSelector::new(sys);
     // The signs the mode selection works with (the step's own are `signs`, below).
@@ -459,6 +431,10 @@ pub fn solve_from(
     let mut last_reject = false;
     'outer: loop {
         if need_k1 {
+            if all_linear {
+                // The mode's first-order matrix, shared with the mode selection.
+                rhs.set_lower_rows(mode, selector.matrix(mode));
+            }
             rhs.eval(mode, &y, &mut k[0]);
             // Indicator sides at the (re)start.
             if all_linear {

@@ -183,11 +183,8 @@ pub fn solve_from(
             // searched.)
             searches.clear();
             for (p, &sign) in ind_polys.iter().zip(&signs) {
-                if sign != 0.0 {
-                    let p = Poly::new(p, tau, period);
-                    if !p.keeps_sign(sign, reach) {
-                        searches.push(Search::new(p, sign, search));
-                    }
+                if sign != 0.0 && !taylor::keeps_sign(p, sign, reach) {
+                    searches.push(Search::new(Poly::new(p, tau, period), sign, search));
                 }
             }
             let found = first_switch(&mut searches, period, reach);
@@ -230,7 +227,8 @@ pub fn solve_from(
         } else {
             if cache[mi].is_none() {
                 let (k, c) = sys.matrices(mode);
-                let a = Mat::from_fn(n, n, |i, j| selector.matrix(mode)[j * n + i]);
+                let am = selector.matrix(mode);
+                let a = Mat::from_fn(n, n, |i, j| am[j * n + i]);
                 let prop = Propagator::shared(&k, &c, &masses, a)?;
                 cache[mi] = Some(ModeData {
                     prop,

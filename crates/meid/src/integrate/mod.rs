@@ -147,20 +147,6 @@ pub struct Solution {
     pub fallback_modes: usize,
 }
 
-/// The non-zero entries of `l`: their indices and values (allocated to size; the sparse
-/// functionals of the integrators are built from it once per run).
-pub(crate) fn nonzeros(l: &[f64]) -> (Vec<usize>, Vec<f64>) {
-    let m = l.iter().filter(|v| **v != 0.0).count();
-    let (mut idx, mut val) = (Vec::with_capacity(m), Vec::with_capacity(m));
-    for (i, &v) in l.iter().enumerate() {
-        if v != 0.0 {
-            idx.push(i);
-            val.push(v);
-        }
-    }
-    (idx, val)
-}
-
 /// Simulates `sys` with `opts`, calling `obs` on the output grid.
 pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Result<Solution> {
     solve_from(sys, &sys.initial_state(), opts, obs)

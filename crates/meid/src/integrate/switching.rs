@@ -12,6 +12,7 @@
 //! ([`ModeSelector`]), without faer's aligned allocations, and the small products below are
 //! hand-unrolled for the sizes of lumped machines.
 
+use crate::impact::SparseVec;
 use crate::impact::{ImpactSystem, Indicator, Mode, Switch};
 
 /// Number of modes: three switch bits (slider-bed, bed-damper, dashpot).
@@ -24,31 +25,16 @@ const K_MAX: usize = 8;
 /// few coordinates) and its norm.
 #[derive(Debug, Clone)]
 struct Linear {
-    idx: Vec<usize>,
-    val: Vec<f64>,
+    v: SparseVec,
     norm: f64,
 }
 
 impl Linear {
     fn new(l: &[f64]) -> Self {
-        let (idx, val) = super::nonzeros(l);
         Self {
-            idx,
-            val,
+            v: SparseVec::new(l),
             norm: l.iter().map(|v| v * v).sum::<f64>().sqrt(),
         }
-    }
-
-    /// `(ℓᵀy, Σ|ℓᵢyᵢ|)` (the same sums as over all entries: the zeros add nothing).
-    #[inline]
-    fn dot_abs(&self, y: &[f64]) -> (f64, f64) {
-        let (mut val, mut scale) = (0.0, 0.0);
-        for (&i, &l) in self.idx.iter().zip(&self.val) {
-            let t = l * y[i];
-            val += t;
-            scale += t.abs();
-        }
-        (val, scale)
     }
 }
 
@@ -86,7 +72,7 @@ fn lex_signs(ls: &[Linear], a: &[f64], x: &[f64], out: &mut [f64], work: &mut Ve
             if *o != 0.0 {
                 continue;
             }
-            let (val, scale) = l.dot_abs(y);
+            let (val, scale) = l.v.dot_abs(y);
             if val.abs() > tol * scale {
                 let y_norm =
                     *y_norm.get_or_insert_with(|| y.iter().map(|v| v * v).sum::<f64>().sqrt());

@@ -26,6 +26,7 @@
 use faer::Mat;
 
 use super::roots::Scalar;
+use crate::impact::SparseVec;
 
 /// Order `P` of the series.
 pub const ORDER: usize = 24;
@@ -401,83 +402,26 @@ fn axpy(y: &mut [f64], x: &[f64], a: f64) {
     }
 }
 
-/// The coefficients `ℓᵀc_k`, k = 0..=P, of the functional `ℓᵀX(s)` into `out`, over `ℓ`'s
-/// non-zero entries (an indicator touches a few coordinates).
-pub fn project(l: &[f64], coef: &[f64], out: &mut [f64]) {
-    let n = l.len();
-    if n == 0 {
-        out.iter_mut().for_each(|o| *o = 0.0);
-        return;
-    }
-    // Small lumped machines: a dense dot of fixed size per coefficient (unrolled).
-    fn fixed<const N: usize>(l: &[f64], coef: &[f64], out: &mut [f64]) {
-        let mut lf = [0.0; N];
-        lf.copy_from_slice(&l[..N]);
-        for (o, ck) in out.iter_mut().zip(coef.chunks_exact(N)) {
-            if let Ok(ck) = <&[f64; N]>::try_from(ck) {
-                let mut t = 0.0;
-                for i in 0..N {
-                    t += lf[i] * ck[i];
-                }
-                *o = t;
-            }
-        }
-    }
-    match n {
-        4 => return fixed::<4>(l, coef, out),
-        6 => return fixed::<6>(l, coef, out),
-        8 => return fixed::<8>(l, coef, out),
-        10 => return fixed::<10>(l, coef, out),
-        12 => return fixed::<12>(l, coef, out),
-        _ => {}
-    }
-    // The non-zeros of ℓ (up to 8 on the stack; a denser ℓ goes entry by entry).
-    let mut nz = [(0usize, 0.0); 8];
-    let mut m = 0;
-    for (i, &li) in l.iter().enumerate() {
-        if li != 0.0 {
-            if m == nz.len() {
-                m = usize::MAX;
-                break;
-            }
-            nz[m] = (i, li);
-            m += 1;
-        }
-    }
-    if m == usize::MAX {
-        for (o, ck) in out.iter_mut().zip(coef.chunks_exact(n)) {
-            *o = l.iter().zip(ck).map(|(a, b)| a * b).sum();
-        }
-        return;
-    }
-    for (o, ck) in out.iter_mut().zip(coef.chunks_exact(n)) {
-        *o = nz[..m].iter().map(|&(i, li)| li * ck[i]).sum();
-    }
-}
-
 /// A functional `ℓᵀX` prepared for [`Projector::apply`]: its non-zero entries (an indicator or a
 /// contact force touches a few coordinates: two or three modal coordinates and a body), so a
 /// projection costs `(P + 1)·m` products for `m` non-zeros instead of `(P + 1)·n`.
 #[derive(Debug, Clone)]
 pub struct Projector {
-    idx: Vec<usize>,
-    val: Vec<f64>,
+    v: SparseVec,
     n: usize,
 }
 
 impl Projector {
     /// The functional `ℓ` (length `n`, the state's).
     pub fn new(l: &[f64]) -> Self {
-        let (idx, val) = super::nonzeros(l);
         Self {
-            idx,
-            val,
+            v: SparseVec::new(l),
             n: l.len(),
         }
     }
 
-    /// The coefficients `ℓᵀc_k`, k = 0..=P, of `ℓᵀX(s)` into `out` (the same sums, in the same
-    /// order, as [`project`]).
+    /// The coefficients `ℓᵀc_k`, k = 0..=P, of `ℓᵀX(s)` into `out` (rows of `n` in `coef`), a
+    /// dot over `ℓ`'s non-zeros per coefficient, with fixed-size code for up to 4 of them.
     pub fn apply(&self, coef: &[f64], out: &mut [f64]) {
         fn fixed<const M: usize>(
             idx: &[usize],
@@ -498,7 +442,7 @@ impl Projector {
                 *o = t;
             }
         }
-        let (idx, val, n) = (&self.idx[..], &self.val[..], self.n);
+        let ((idx, val), n) = (self.v.parts(), self.n);
         if n == 0 {
             out.iter_mut().for_each(|o| *o = 0.0);
             return;
@@ -511,7 +455,7 @@ impl Projector {
             4 => fixed::<4>(idx, val, n, coef, out),
             _ => {
                 for (o, ck) in out.iter_mut().zip(coef.chunks_exact(n)) {
-                    *o = idx.iter().zip(val).map(|(&i, &l)| l * ck[i]).sum();
+                    *o = self.v.dot(ck);
                 }
             }
         }
@@ -576,6 +520,25 @@ fn abs_horner(a: &Coefficients, x: f64) -> f64 {
     poly4::<{ ORDER + 1 }>(x, |k| a[k].abs())
 }
 
+/// True when `sign·p > 0` on all of `[0, len]` (`p(s) = Σ a_k s^k`, `len ≥ 0`), by a concave
+/// lower bound: with `b_k = sign·a_k`, dropping the positive terms of degree ≥ 2 leaves
+/// `h(s) = b₀ + b₁s + Σ_{k≥2} min(b_k, 0) s^k ≤ sign·p(s)` for `s ≥ 0`, and `h` is concave
+/// there, so `h(0) = b₀ > 0` and `h(len) > 0` prove `sign·p > 0` on the whole interval. A
+/// certificate that needs no search: it holds for an indicator far from zero and for one
+/// moving away from zero (an overlap growing, a contact separating further).
+///
+/// It needs only the coefficients, so the step's indicators are tested before a [`Poly`] (with
+/// its derivative and round-off size) is built for a search.
+pub fn keeps_sign(a: &Coefficients, sign: f64, len: f64) -> bool {
+    let b0 = sign * a[0];
+    if b0.is_nan() || b0 <= 0.0 {
+        return false;
+    }
+    // Σ_{k≥2} min(b_k, 0) len^(k−2).
+    let neg = poly4::<{ ORDER - 1 }>(len, |k| (sign * a[k + 2]).min(0.0));
+    b0 + len * (sign * a[1] + len * neg) > 0.0
+}
+
 /// A polynomial `Σ a_k s^k` on `[0, τ]`, as a [`Scalar`] for the event search (it holds its
 /// coefficients and those of its derivative, so a buffer of searches can be reused from one step
 /// to the next without borrowing the step's data).
@@ -609,20 +572,9 @@ impl Poly {
         &self.da
     }
 
-    /// True when `sign·p > 0` on all of `[0, len]` (`len ≥ 0`), by a concave lower bound: with
-    /// `b_k = sign·a_k`, dropping the positive terms of degree ≥ 2 leaves
-    /// `h(s) = b₀ + b₁s + Σ_{k≥2} min(b_k, 0) s^k ≤ sign·p(s)` for `s ≥ 0`, and `h` is concave
-    /// there, so `h(0) = b₀ > 0` and `h(len) > 0` prove `sign·p > 0` on the whole interval. A
-    /// certificate that needs no search: it holds for an indicator far from zero and for one
-    /// moving away from zero (an overlap growing, a contact separating further).
+    /// [`keeps_sign`] of this polynomial.
     pub fn keeps_sign(&self, sign: f64, len: f64) -> bool {
-        let b0 = sign * self.a[0];
-        if b0.is_nan() || b0 <= 0.0 {
-            return false;
-        }
-        // Σ_{k≥2} min(b_k, 0) len^(k−2).
-        let neg = poly4::<{ ORDER - 1 }>(len, |k| (sign * self.a[k + 2]).min(0.0));
-        b0 + len * (sign * self.a[1] + len * neg) > 0.0
+        keeps_sign(&self.a, sign, len)
     }
 
     /// `p(s)`.
