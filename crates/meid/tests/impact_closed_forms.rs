@@ -95,7 +95,7 @@ fn two_body_with(m1: f64, m2: f64, v0: f64, contact: Contact, method: Engine) ->
         t: end.t,
         v1,
         v2,
-        peak: end.totals.peak_force[0],
+        peak: end.totals.peak_force(0),
     }
 }
 

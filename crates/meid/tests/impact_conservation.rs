@@ -260,8 +260,8 @@ fn taylor_steps_and_closed_forms_agree() {
     assert!(rel(et, ec) <= 1e-10, "collision end {et} vs {ec}");
     for i in 0..2 {
         let (pt, pc) = (
-            t.solution.totals.peak_force[i],
-            c.solution.totals.peak_force[i],
+            t.solution.totals.peak_force(i),
+            c.solution.totals.peak_force(i),
         );
         assert!(rel(pt, pc) <= 1e-10, "peak force {i}: {pt} vs {pc}");
     }

@@ -38,8 +38,8 @@
 
 use serde::Serialize;
 
-use super::energy::{EnergyTerms, History, Recorder};
-use crate::impact::{dot, ImpactSystem, Mode, Switch};
+use super::energy::{check_run, EnergyTerms, History, Recorder};
+use crate::impact::{dot, Channel, ImpactSystem, Mode, Switch};
 use crate::integrate::{self, Options};
 use crate::{Error, Result};
 
@@ -206,8 +206,21 @@ pub fn run_blows(
         }
         let e0 = EnergyTerms::at(sys, mode0, &x0);
         let ed0 = damper_energy(&x0);
-        let mut rec = Recorder::new(sys, record);
-        let sol = integrate::solve_from(sys, &x0, &o, &mut rec)?;
+        let mut rec = Recorder::new(sys);
+        let o_blow = if record {
+            o
+        } else {
+            Options {
+                sample_rate: None,
+                ..o
+            }
+        };
+        let sol = integrate::solve_from(sys, &x0, &o_blow, &mut rec)?;
+        // The blow's energy balance: what was stored at the strike = what is stored at its
+        // end + what it dissipated.
+        let e_end = EnergyTerms::at(sys, sol.mode_final, &sol.x_final);
+        let residual = (e0.total() - e_end.total() - sol.totals.dissipated).abs() / e0.total();
+        check_run(sys, &o_blow, &sol, residual)?;
         let end = sol.collision_end.as_ref();
         let energy_ratio = end.map(|c| {
             let vs = c.x[nd + sys.slider_index()];
@@ -223,10 +236,14 @@ pub fn run_blows(
             damper_energy_at_strike_j: ed0,
             damper_gap_at_strike_m: damper_gap(&x0),
             damper_contact_time_s: sys.damper.as_ref().map(|_| sol.totals.closed_time[1]),
-            peak_bed_acceleration_m_per_s2: rec.peak_bed_acceleration,
-            peak_floor_force_n: rec.peak_floor_force,
+            peak_bed_acceleration_m_per_s2: sol
+                .totals
+                .peaks
+                .get(Channel::BedAcceleration)
+                .abs_peak(),
+            peak_floor_force_n: sol.totals.peaks.get(Channel::FloorForce).abs_peak(),
             peak_contact_force_slider_bed_n: end
-                .map_or(sol.totals.peak_force[0], |c| c.totals.peak_force[0]),
+                .map_or(sol.totals.peak_force(0), |c| c.totals.peak_force(0)),
         });
         if let Some(h) = history.as_mut() {
             // The recorder counts dissipation as E_s− − Σ stored; add what was stored at the

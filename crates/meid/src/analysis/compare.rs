@@ -364,7 +364,8 @@ impl Comparison {
         let mut cases = Vec::new();
         for c in self.cases() {
             let sys = self.model.impact_system(c.case())?;
-            let (history, energy_ratio) = if o.blows > 1 {
+            // Peaks on the continuous solution (not the samples): (bed acceleration, floor force).
+            let (history, energy_ratio, peaks) = if o.blows > 1 {
                 let b = BlowOptions {
                     blows: o.blows,
                     rate_bpm: o.rate_bpm,
@@ -372,14 +373,22 @@ impl Comparison {
                 };
                 let r = run_blows(&sys, &opts, &b, true)?;
                 let e = r.blows.first().and_then(|b| b.energy_ratio);
-                (r.history, e)
+                let peaks = r.blows.iter().fold((0.0_f64, 0.0_f64), |p, b| {
+                    (
+                        p.0.max(b.peak_bed_acceleration_m_per_s2),
+                        p.1.max(b.peak_floor_force_n),
+                    )
+                });
+                (r.history, e, peaks)
             } else {
                 let r = simulate(&sys, &opts, true)?;
-                (r.history, r.summary.energy_ratio)
+                let s = &r.summary;
+                let peaks = (s.peak_bed_acceleration_m_per_s2, s.peak_floor_force_n);
+                (r.history, s.energy_ratio, peaks)
             };
             let history = history
                 .ok_or_else(|| Error::numerical("compare", "the run recorded no history"))?;
-            cases.push(self.analyse(c, &sys, history, energy_ratio, &specs, fs)?);
+            cases.push(self.analyse(c, &sys, history, energy_ratio, peaks, &specs, fs)?);
         }
         let reductions = reductions(&cases);
         Ok(ComparisonResult {
@@ -397,6 +406,7 @@ impl Comparison {
         sys: &ImpactSystem,
         history: History,
         energy_ratio: Option<f64>,
+        peaks: (f64, f64),
         specs: &[ModeSpec],
         fs: f64,
     ) -> Result<CaseResult> {
@@ -428,11 +438,10 @@ impl Comparison {
                 floor_force_level_db: level_db(pf.value, REF_FORCE_N)?,
             });
         }
-        let peak = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
         Ok(CaseResult {
             case,
-            peak_bed_acceleration_m_per_s2: peak(a),
-            peak_floor_force_n: peak(f),
+            peak_bed_acceleration_m_per_s2: peaks.0,
+            peak_floor_force_n: peaks.1,
             acceleration_spectrum: acc,
             floor_force_spectrum: force,
             history,

@@ -20,9 +20,12 @@
 
 use serde::Serialize;
 
-use crate::impact::{dot, ImpactSystem, Mode, Motions, Switch};
+use crate::impact::{
+    Channel, ChannelMap, ContactLaw, ImpactSystem, Mode, Motions, Switch, CHANNELS,
+};
+use crate::integrate::peaks::Peaks;
 use crate::integrate::{self, Method, Observer, Options, Solution};
-use crate::Result;
+use crate::{Error, Result};
 
 /// Stored energies at one instant (J).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
@@ -103,46 +106,22 @@ pub struct History {
     pub dissipated_j: Vec<f64>,
 }
 
-/// Observer that records histories (optionally) and always tracks peak levels.
+/// Observer that records the histories on the output grid. Peaks do not come from here: the
+/// integrators locate them on the continuous solution ([`crate::integrate::peaks`]).
 pub struct Recorder<'a> {
     sys: &'a ImpactSystem,
-    keep: bool,
+    map: ChannelMap,
     pub history: History,
-    pub peak_bed_acceleration: f64,
-    pub peak_floor_force: f64,
-    /// The bed acceleration at B, `φ_Bᵀq̈`, as `wqᵀq + wvᵀq̇ + w_c (f_bs − f_bd) + w_f f_fd`
-    /// (the modal equations of motion, [`ImpactSystem::accelerations`], folded with `φ_B` once):
-    /// `wq = −φ_B∘ω²`, `wv = −Dᵀφ_B`, `w_c = φ_Bᵀψ_b`, `w_f = φ_Bᵀψ_f`.
-    acc_q: Vec<f64>,
-    acc_v: Vec<f64>,
-    acc_contact: f64,
-    acc_damper: f64,
     e_in: f64,
 }
 
 impl<'a> Recorder<'a> {
-    pub fn new(sys: &'a ImpactSystem, keep: bool) -> Self {
+    pub fn new(sys: &'a ImpactSystem) -> Self {
         let e_in = 0.5 * sys.slider.mass * sys.slider.velocity.powi(2);
-        let n = sys.n_modes();
-        let phi = &sys.points.measurement;
-        let w = &sys.structure.omega_rad_per_s;
-        let d = &sys.structure.damping;
         Recorder {
             sys,
-            keep,
+            map: ChannelMap::new(sys),
             history: History::default(),
-            peak_bed_acceleration: 0.0,
-            peak_floor_force: 0.0,
-            acc_q: (0..n).map(|i| -phi[i] * (w[i] * w[i])).collect(),
-            acc_v: (0..n)
-                .map(|j| -(0..n).map(|i| phi[i] * d[i * n + j]).sum::<f64>())
-                .collect(),
-            acc_contact: dot(phi, &sys.points.bed_contact),
-            acc_damper: sys
-                .points
-                .damper_anchor
-                .as_ref()
-                .map_or(0.0, |f| dot(phi, f)),
             e_in,
         }
     }
@@ -151,31 +130,22 @@ impl<'a> Recorder<'a> {
 impl Observer for Recorder<'_> {
     fn sample(&mut self, t: f64, x: &[f64], mode: Mode) {
         let sys = self.sys;
-        let n = sys.n_modes();
         let nd = sys.dofs();
-        let motions = sys.motions(x);
-        let forces = sys.element_forces_from(mode, &motions);
-        let phi_m = &sys.points.measurement;
-        let a_b = dot(&self.acc_q, &x[..n])
-            + dot(&self.acc_v, &x[nd..nd + n])
-            + self.acc_contact * (forces.0 - forces.1)
-            + self.acc_damper * forces.2;
-        let f_floor = sys.floor_force_with(x, forces.2);
-        self.peak_bed_acceleration = self.peak_bed_acceleration.max(a_b.abs());
-        self.peak_floor_force = self.peak_floor_force.max(f_floor.abs());
-        if !self.keep {
-            return;
-        }
+        let v = self.map.values(sys, mode, x);
+        let ch = |c: Channel| v[c.index()];
         let h = &mut self.history;
-        let (fbs, fbd, ffd) = forces;
         h.time_s.push(t);
-        h.bed_displacement_m.push(dot(phi_m, &x[..n]));
-        h.bed_velocity_m_per_s.push(dot(phi_m, &x[nd..nd + n]));
-        h.bed_acceleration_m_per_s2.push(a_b);
-        h.floor_force_n.push(f_floor);
-        h.contact_force_slider_bed_n.push(fbs);
-        h.contact_force_bed_damper_n.push(fbd);
-        h.damper_force_n.push(ffd);
+        h.bed_displacement_m.push(ch(Channel::BedDisplacement));
+        h.bed_velocity_m_per_s.push(ch(Channel::BedVelocity));
+        h.bed_acceleration_m_per_s2
+            .push(ch(Channel::BedAcceleration));
+        h.floor_force_n.push(ch(Channel::FloorForce));
+        h.contact_force_slider_bed_n
+            .push(ch(Channel::ContactSliderBed));
+        h.contact_force_bed_damper_n
+            .push(ch(Channel::ContactBedDamper));
+        h.damper_force_n
+            .push(ch(Channel::DamperSpring) + ch(Channel::DamperDashpot));
         h.slider_displacement_m.push(x[sys.slider_index()]);
         h.slider_velocity_m_per_s.push(x[nd + sys.slider_index()]);
         let (zd, vd) = if sys.damper.is_some() {
@@ -185,10 +155,146 @@ impl Observer for Recorder<'_> {
         };
         h.damper_displacement_m.push(zd);
         h.damper_velocity_m_per_s.push(vd);
-        let e = EnergyTerms::with_motions(sys, mode, x, &motions);
+        let e = EnergyTerms::at(sys, mode, x);
         h.dissipated_j.push(self.e_in - e.total());
         h.energy.push(e);
     }
+}
+
+/// The exact peak of one response channel over a run ([`crate::integrate::peaks`]): located on
+/// the continuous solution, so it does not depend on the output sample rate.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ChannelPeak {
+    /// Channel key with its unit ([`Channel::key`]).
+    pub channel: &'static str,
+    pub unit: &'static str,
+    /// Largest magnitude.
+    pub peak: f64,
+    /// Time of the peak (s).
+    pub time_s: f64,
+    /// Largest and smallest values, with their times (s).
+    pub max: f64,
+    pub max_time_s: f64,
+    pub min: f64,
+    pub min_time_s: f64,
+}
+
+/// The peaks of every channel the system has, in [`CHANNELS`] order.
+pub fn channel_peaks(sys: &ImpactSystem, peaks: &Peaks) -> Vec<ChannelPeak> {
+    CHANNELS
+        .into_iter()
+        .filter(|c| !(c.needs_damper() && sys.damper.is_none()))
+        .map(|c| {
+            let e = peaks.get(c);
+            let (v, t) = e.peak();
+            let set = e.is_set();
+            ChannelPeak {
+                channel: c.key(),
+                unit: c.unit(),
+                peak: v.abs(),
+                time_s: if set { t } else { 0.0 },
+                max: if set { e.max } else { 0.0 },
+                max_time_s: if set { e.t_max } else { 0.0 },
+                min: if set { e.min } else { 0.0 },
+                min_time_s: if set { e.t_min } else { 0.0 },
+            }
+        })
+        .collect()
+}
+
+/// The energy-balance residual a run of `method` must stay within (relative to the blow's
+/// energy E_s−): `1e-9` for `exact` (closed forms, round-off only), `max(1e-6, 100·rtol)` for
+/// `dopri5` (1e-6 at the default rtol 1e-8).
+pub fn residual_bound(opts: &Options) -> f64 {
+    match opts.method {
+        Method::Exact => 1e-9,
+        Method::Dopri5 => (100.0 * opts.rtol).max(1e-6),
+    }
+}
+
+/// What in the model most likely makes a run fail its checks: the contact laws and
+/// stiffnesses, and the spread of the time scales (the structure's frequencies against the
+/// contact frequencies `√(K/m)`).
+fn likely_causes(sys: &ImpactSystem) -> String {
+    let law = |c: &crate::impact::Contact| match c.law {
+        ContactLaw::Linear { stiffness, damping } => {
+            format!("linear, K = {stiffness:e} N/m, C = {damping:e} N·s/m")
+        }
+        ContactLaw::Hertz { stiffness } => format!("hertz, K = {stiffness:e} N/m^1.5"),
+        ContactLaw::HuntCrossley {
+            stiffness,
+            exponent,
+            alpha,
+        } => format!("hunt-crossley, K = {stiffness:e} N/m^{exponent}, alpha = {alpha:e} s/m"),
+    };
+    let mut out = format!("contact.slider_bed ({})", law(&sys.slider_bed));
+    if let (Some(c), Some(d)) = (&sys.bed_damper, &sys.damper) {
+        out += &format!(
+            ", contact.bed_damper ({}), damper (m_d = {:e} kg, k_d = {:e} N/m, c_d = {:e} N·s/m)",
+            law(c),
+            d.mass,
+            d.stiffness,
+            d.damping
+        );
+    }
+    let w = &sys.structure.omega_rad_per_s;
+    let w_max = w.iter().copied().fold(0.0, f64::max);
+    let w_min = w
+        .iter()
+        .copied()
+        .filter(|v| *v > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if w_max > 0.0 && w_min.is_finite() {
+        out += &format!(
+            ", structure modes {:.4e}-{:.4e} Hz",
+            w_min / (2.0 * std::f64::consts::PI),
+            w_max / (2.0 * std::f64::consts::PI)
+        );
+    }
+    out
+}
+
+/// Checks a finished run: a finite state and finite peaks, and an energy balance within
+/// [`residual_bound`]. `residual` is `|E_s− − Σ stored − ∫P dt| / E_s−` at the run's end.
+pub fn check_run(sys: &ImpactSystem, opts: &Options, sol: &Solution, residual: f64) -> Result<()> {
+    if let Some(c) = sol.totals.peaks.non_finite() {
+        return Err(Error::numerical(
+            "simulation",
+            format!(
+                "the {} became non-finite (by t = {:.6e} s): the state overflowed. Likely cause: {}",
+                c.label(),
+                sol.t_final,
+                likely_causes(sys)
+            ),
+        ));
+    }
+    if sol.x_final.iter().any(|v| !v.is_finite()) || !residual.is_finite() {
+        return Err(Error::numerical(
+            "simulation",
+            format!(
+                "the state became non-finite by t = {:.6e} s. Likely cause: {}",
+                sol.t_final,
+                likely_causes(sys)
+            ),
+        ));
+    }
+    let bound = residual_bound(opts);
+    if residual > bound {
+        let method = match opts.method {
+            Method::Exact => "exact".to_string(),
+            Method::Dopri5 => format!("dopri5, rtol {:e}", opts.rtol),
+        };
+        return Err(Error::numerical(
+            "simulation",
+            format!(
+                "energy balance violated at t = {:.6e} s: residual {residual:.3e} of the blow's \
+                 energy > {bound:e} allowed ({method}). Likely cause: {}",
+                sol.t_final,
+                likely_causes(sys)
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// The summary of a run: what happened to the blow's energy. Keys are stable (JSON output).
@@ -215,9 +321,14 @@ pub struct Summary {
     /// Peak contact forces during the collision (during the run if it did not end).
     pub peak_contact_force_slider_bed_n: f64,
     pub peak_contact_force_bed_damper_n: f64,
-    /// Largest |bed acceleration at B| and |force to the floor| on the output grid.
+    /// Largest |bed acceleration at B| and |force to the floor| over the run, on the
+    /// continuous solution (independent of the output sample rate), and their times.
     pub peak_bed_acceleration_m_per_s2: f64,
+    pub peak_bed_acceleration_time_s: f64,
     pub peak_floor_force_n: f64,
+    pub peak_floor_force_time_s: f64,
+    /// The exact peaks of every channel over the run.
+    pub peaks: Vec<ChannelPeak>,
     /// |E_s− − Σ stored − ∫ P_diss dt| / E_s− at the end of the collision.
     pub energy_balance_residual: Option<f64>,
     /// The same at the end of the run.
@@ -237,8 +348,19 @@ pub struct Run {
 
 /// Simulates `sys`, records histories when `record` is true, and summarises.
 pub fn simulate(sys: &ImpactSystem, opts: &Options, record: bool) -> Result<Run> {
-    let mut rec = Recorder::new(sys, record);
-    let sol = integrate::solve(sys, opts, &mut rec)?;
+    let mut rec = Recorder::new(sys);
+    let sol = if record {
+        integrate::solve(sys, opts, &mut rec)?
+    } else {
+        integrate::solve(
+            sys,
+            &Options {
+                sample_rate: None,
+                ..*opts
+            },
+            &mut rec,
+        )?
+    };
     let nd = sys.dofs();
     let e_in = 0.5 * sys.slider.mass * sys.slider.velocity.powi(2);
     let end = sol.collision_end.as_ref();
@@ -255,6 +377,8 @@ pub fn simulate(sys: &ImpactSystem, opts: &Options, record: bool) -> Result<Run>
     });
     let e_final = EnergyTerms::at(sys, sol.mode_final, &sol.x_final);
     let residual_run_end = (e_in - e_final.total() - sol.totals.dissipated).abs() / e_in;
+    check_run(sys, opts, &sol, residual_run_end)?;
+    let pk = |c: Channel| sol.totals.peaks.get(c).peak();
     let summary = Summary {
         method: match opts.method {
             Method::Exact => "exact",
@@ -276,11 +400,14 @@ pub fn simulate(sys: &ImpactSystem, opts: &Options, record: bool) -> Result<Run>
         contact_time_slider_bed_s: end.map(|c| c.totals.closed_time[0]),
         contact_time_bed_damper_s: end.map(|c| c.totals.closed_time[1]),
         peak_contact_force_slider_bed_n: end
-            .map_or(sol.totals.peak_force[0], |c| c.totals.peak_force[0]),
+            .map_or(sol.totals.peak_force(0), |c| c.totals.peak_force(0)),
         peak_contact_force_bed_damper_n: end
-            .map_or(sol.totals.peak_force[1], |c| c.totals.peak_force[1]),
-        peak_bed_acceleration_m_per_s2: rec.peak_bed_acceleration,
-        peak_floor_force_n: rec.peak_floor_force,
+            .map_or(sol.totals.peak_force(1), |c| c.totals.peak_force(1)),
+        peak_bed_acceleration_m_per_s2: pk(Channel::BedAcceleration).0.abs(),
+        peak_bed_acceleration_time_s: pk(Channel::BedAcceleration).1,
+        peak_floor_force_n: pk(Channel::FloorForce).0.abs(),
+        peak_floor_force_time_s: pk(Channel::FloorForce).1,
+        peaks: channel_peaks(sys, &sol.totals.peaks),
         energy_balance_residual: at_end
             .map(|(e, .., c)| (e_in - e.total() - c.totals.dissipated).abs() / e_in),
         energy_balance_residual_run_end: residual_run_end,

@@ -38,6 +38,10 @@
 //! Between switches the system is linear and time invariant (for [`ContactLaw::Linear`]);
 //! [`crate::integrate`] propagates it exactly. Hertz and Hunt-Crossley laws need `dopri5`.
 
+mod channels;
+
+pub use channels::{Channel, ChannelMap, CHANNELS, N_CHANNELS};
+
 use faer::Mat;
 
 use crate::modal::{FloorForce, ModalModel};

@@ -16,9 +16,11 @@
 
 use super::roots::{first_crossing, hermite_dip, Scalar, SearchOptions};
 use super::switching::{implied_mode, ModeSelector};
-use super::{CollisionEnd, Event, Grid, Observer, Options, Solution, Totals};
+use super::{CollisionEnd, Event, Grid, Observer, Options, PathPoint, Solution, Totals};
 use crate::impact::SparseVec;
-use crate::impact::{dot, ContactLaw, DashpotKind, ImpactSystem, Indicator, Mode, Switch};
+use crate::impact::{
+    dot, Channel, ChannelMap, ContactLaw, DashpotKind, ImpactSystem, Indicator, Mode, Switch,
+};
 use crate::{Error, Result};
 
 // The system is autonomous, so the nodes c_i are not needed.
@@ -404,7 +406,17 @@ pub fn solve_from(
     };
     let mut ybuf = vec![0.0; ny];
     let mut events = Vec::new();
+    let map = ChannelMap::new(sys);
+    let mut path = vec![PathPoint {
+        t: 0.0,
+        mode,
+        x: y[..nx].to_vec(),
+    }];
     let mut totals = Totals::default();
+    // Interim: channel values at the start and at every step end and switch (both sides).
+    totals
+        .peaks
+        .offer_all(&map.values(sys, mode, &y[..nx]), 0.0);
     let mut collision_end = None;
     let (mut steps, mut rejected) = (0usize, 0usize);
     let mut signs = vec![0.0; inds.len()];
@@ -624,7 +636,8 @@ pub fn solve_from(
                     Some(force_slope_at(&law, rel, &ynew, &k[6], nd))
                 };
                 let peak = peak_on_step(&law, &peak_vecs[ci], &dense, s_end, start, end);
-                totals.peak_force[ci] = totals.peak_force[ci].max(peak);
+                // Interim: the value of the peak (its time is the step's start).
+                totals.peaks.0[Channel::ContactSliderBed.index() + ci].offer(peak, t);
             }
         }
         if switched {
@@ -637,7 +650,16 @@ pub fn solve_from(
             } else {
                 mode_after_numeric(sys, &inds, &signs, &dense, s_end, &y[..nx])
             };
+            totals.peaks.offer_all(&map.values(sys, mode, &y[..nx]), t);
+            totals
+                .peaks
+                .offer_all(&map.values(sys, new_mode, &y[..nx]), t);
             if new_mode != mode {
+                path.push(PathPoint {
+                    t,
+                    mode: new_mode,
+                    x: y[..nx].to_vec(),
+                });
                 events.push(Event {
                     t,
                     from: mode,
@@ -672,6 +694,7 @@ pub fn solve_from(
         y.copy_from_slice(&ynew);
         k.swap(0, 6);
         t += h;
+        totals.peaks.offer_all(&map.values(sys, mode, &y[..nx]), t);
         totals.dissipated = y[nx];
         // PI control.
         let mut fac = fac11 / facold.powf(0.04);
@@ -687,6 +710,7 @@ pub fn solve_from(
     let mode_final = mode;
     Ok(Solution {
         events,
+        path,
         collision_end,
         t_final: t,
         x_final: y[..nx].to_vec(),

@@ -31,12 +31,13 @@
 
 use faer::{c64, Mat};
 
+use super::peaks;
 use super::propagator::{Functional, Propagator, Segment};
-use super::roots::{for_each_maximum, Scalar, Search, SearchOptions};
+use super::roots::{Scalar, Search, SearchOptions};
 use super::switching::{ModeSelector, MODES};
 use super::taylor::{self, Poly, TaylorMatrix};
-use super::{CollisionEnd, Event, Grid, Observer, Options, Solution, Totals};
-use crate::impact::{ImpactSystem, Indicator, Mode, Switch};
+use super::{CollisionEnd, Event, Grid, Observer, Options, PathPoint, Solution, Totals};
+use crate::impact::{ChannelMap, ImpactSystem, Mode, Switch, CHANNELS};
 use crate::{Error, Result};
 
 struct ModeData {
@@ -84,17 +85,6 @@ pub fn solve_from(
     let masses = sys.mass_diag();
     let mut selector = ModeSelector::new(sys);
     let n_ind = selector.indicators().len();
-    // `ℓ` of each contact's force (for its peaks), built once per run.
-    let force_vecs: Vec<Vec<f64>> = [Switch::SliderBed, Switch::BedDamper]
-        .into_iter()
-        .map(|s| {
-            if s == Switch::SliderBed || sys.damper.is_some() {
-                contact_force_vector(sys, s)
-            } else {
-                Vec::new()
-            }
-        })
-        .collect();
     // Closed forms of the modes that stay long, built on first use.
     let mut cache: [Option<ModeData>; MODES] = Default::default();
     let mut grid = Grid::new(opts.sample_rate);
@@ -125,25 +115,17 @@ pub fn solve_from(
         .iter()
         .map(|l| taylor::Projector::new(l))
         .collect();
-    let force_proj: Vec<taylor::Projector> = force_vecs
-        .iter()
-        .map(|l| taylor::Projector::new(l))
-        .collect();
     let mut work = Vec::new();
-    // Each linear contact's force from its overlap polynomial: (indicator index, K, C).
-    let force_from_overlap: [Option<(usize, f64, f64)>; 2] = [Switch::SliderBed, Switch::BedDamper]
-        .map(|s| {
-            let i = selector
-                .indicators()
-                .iter()
-                .position(|&ind| ind == Indicator::Overlap(s))?;
-            match sys.contact(s).law {
-                crate::impact::ContactLaw::Linear { stiffness, damping } => {
-                    Some((i, stiffness, damping))
-                }
-                _ => None,
-            }
-        });
+    // The response channels of each mode met (their vectors, projectors and slopes), built on
+    // first use: their exact extremes are tracked stretch by stretch (`super::peaks`).
+    let map = ChannelMap::new(sys);
+    let mut channels: [Option<ModeChannels>; MODES] = Default::default();
+    let mut chan_poly = [0.0; taylor::ORDER + 1];
+    let mut path = vec![PathPoint {
+        t: 0.0,
+        mode,
+        x: x.clone(),
+    }];
 
     loop {
         let search = SearchOptions::default();
@@ -200,25 +182,15 @@ pub fn solve_from(
             for ci in 0..2 {
                 if closed(sys, mode, ci) {
                     totals.closed_time[ci] += s_end;
-                    let mut f = [0.0; taylor::ORDER + 1];
-                    match force_from_overlap[ci] {
-                        // f = K δ + C δ̇ from the overlap's polynomial (δ̇ its derivative).
-                        Some((i, k, c)) => {
-                            let d = &ind_polys[i];
-                            for (fj, dj) in f.iter_mut().zip(d) {
-                                *fj = k * dj;
-                            }
-                            if c != 0.0 {
-                                for (j, fj) in f.iter_mut().take(taylor::ORDER).enumerate() {
-                                    *fj += c * ((j + 1) as f64 * d[j + 1]);
-                                }
-                            }
-                        }
-                        None => force_proj[ci].apply(&coef, &mut f),
-                    }
-                    let peak = poly_max(&f, tau, period, s_end);
-                    totals.peak_force[ci] = totals.peak_force[ci].max(peak);
                 }
+            }
+            let mc = mode_channels(&mut channels, &map, sys, &mut selector, mode)?;
+            for &c in &mc.zero {
+                totals.peaks.0[c].offer(0.0, t);
+            }
+            for (&c, proj) in mc.index.iter().zip(&mc.proj) {
+                proj.apply(&coef, &mut chan_poly);
+                peaks::on_poly(&chan_poly, tau, period, t, s_end, &mut totals.peaks.0[c]);
             }
             totals.dissipated += tm
                 .dissipated(&coef, &masses, s_end, &mut work)
@@ -272,9 +244,14 @@ pub fn solve_from(
             for ci in 0..2 {
                 if closed(sys, mode, ci) {
                     totals.closed_time[ci] += s_end;
-                    let peak = max_on_segment(&seg, &force_vecs[ci], &prop.a, s_end, period);
-                    totals.peak_force[ci] = totals.peak_force[ci].max(peak);
                 }
+            }
+            let mc = mode_channels(&mut channels, &map, sys, &mut selector, mode)?;
+            for &c in &mc.zero {
+                totals.peaks.0[c].offer(0.0, t);
+            }
+            for ((&c, l), la) in mc.index.iter().zip(&mc.vecs).zip(&mc.slopes) {
+                peaks::on_segment(&seg, l, la, t, s_end, &mut totals.peaks.0[c]);
             }
             totals.dissipated += dissipated(&seg, &md.damping, nd, s_end);
             seg.state(s_end, &mut buf);
@@ -308,6 +285,11 @@ pub fn solve_from(
         // taken when no mode is consistent).
         let (new_mode, _) = selector.select(&x, mode, &mut signs);
         if new_mode != mode {
+            path.push(PathPoint {
+                t,
+                mode: new_mode,
+                x: x.clone(),
+            });
             events.push(Event {
                 t,
                 from: mode,
@@ -352,6 +334,7 @@ pub fn solve_from(
         .count();
     Ok(Solution {
         events,
+        path,
         collision_end,
         t_final: t,
         x_final: x,
@@ -473,26 +456,66 @@ fn first_switch<F: Scalar>(searches: &mut [Search<F>], period: f64, horizon: f64
     }
 }
 
-/// `ℓ` with `f = ℓᵀX` for a closed linear contact's force.
-pub(crate) fn contact_force_vector(sys: &ImpactSystem, s: Switch) -> Vec<f64> {
-    sys.indicator_vector(Indicator::Force(s))
+/// The response channels of one mode: those that move (their vectors `ℓ_σ`, the Taylor
+/// projectors and the slope vectors `ℓ_σᵀA_σ`), and those identically zero in it.
+struct ModeChannels {
+    index: Vec<usize>,
+    vecs: Vec<Vec<f64>>,
+    proj: Vec<taylor::Projector>,
+    slopes: Vec<Vec<f64>>,
+    zero: Vec<usize>,
 }
 
-/// Maximum of `ℓᵀX(s)` on `[0, len]`: endpoints and the interior maxima, where the derivative
-/// `ℓᵀA X` changes sign from + to −.
-fn max_on_segment(seg: &Segment<'_>, l: &[f64], a: &Mat<f64>, len: f64, _period: f64) -> f64 {
-    let f = seg.functional(l);
-    let val = |s: f64| match &f {
-        Functional::Exp(e) => e.derivative(0, s),
-        other => super::roots::Scalar::value_slope(other, s).0,
-    };
-    let mut best = val(0.0).max(val(len));
-    let la: Vec<f64> = (0..a.ncols())
-        .map(|j| (0..a.nrows()).map(|i| l[i] * a[(i, j)]).sum())
-        .collect();
-    let df = seg.functional(&la);
-    for_each_maximum(&df, len, PEAK_SEARCH, |s| best = best.max(val(s)));
-    best
+/// The channels of `mode`, built on first use.
+fn mode_channels<'c>(
+    cache: &'c mut [Option<ModeChannels>; MODES],
+    map: &ChannelMap,
+    sys: &ImpactSystem,
+    selector: &mut ModeSelector,
+    mode: Mode,
+) -> Result<&'c ModeChannels> {
+    let mi = usize::from(mode.0) % MODES;
+    if cache[mi].is_none() {
+        let vecs = map
+            .vectors(sys, mode)
+            .ok_or_else(|| Error::numerical("exact", "a closed contact has a non-linear law"))?;
+        let n = 2 * sys.dofs();
+        let a = selector.matrix(mode);
+        let mut mc = ModeChannels {
+            index: Vec::new(),
+            vecs: Vec::new(),
+            proj: Vec::new(),
+            slopes: Vec::new(),
+            zero: Vec::new(),
+        };
+        for (c, l) in CHANNELS.into_iter().zip(vecs) {
+            if c.needs_damper() && sys.damper.is_none() {
+                continue;
+            }
+            if l.iter().all(|v| *v == 0.0) {
+                mc.zero.push(c.index());
+                continue;
+            }
+            // ℓᵀA with A column-major: (ℓᵀA)_j = Σ_i ℓ_i A_ij.
+            let la = (0..n)
+                .map(|j| {
+                    a[j * n..(j + 1) * n]
+                        .iter()
+                        .zip(&l)
+                        .map(|(x, y)| x * y)
+                        .sum()
+                })
+                .collect();
+            mc.index.push(c.index());
+            mc.proj.push(taylor::Projector::new(&l));
+            mc.vecs.push(l);
+            mc.slopes.push(la);
+        }
+        cache[mi] = Some(mc);
+    }
+    cache[mi]
+        .as_ref()
+        .ok_or_else(|| Error::numerical("exact", "channel cache"))
 }
 
 /// 8-point Gauss-Legendre rule on [−1, 1]: the positive nodes and their weights.
@@ -558,29 +581,6 @@ fn dissipated(seg: &Segment<'_>, c: &Mat<f64>, nd: usize, len: f64) -> f64 {
         }
     }
     total
-}
-
-/// The search for force peaks: a maximum's location to `1e-9` of the fastest period `T` is
-/// enough, since the value there is off by `½|f''|δ²`; for a force oscillating at up to
-/// `ω = 2π/T`, `|f''| ≈ ω² f_max` (an estimate, not a bound), that is
-/// `½ f_max (2π/T)² (1e-9 T)² ≈ 2e-17 f_max`: below round-off.
-const PEAK_SEARCH: SearchOptions = SearchOptions {
-    max_step: f64::INFINITY,
-    tolerance: 1e-9,
-};
-
-/// Maximum over `[0, len]` of a force `Σ a_k s^k` on a Taylor step (`tau` its validity): the
-/// endpoints and the interior maxima, where the derivative `Σ (k+1) a_{k+1} s^k` changes sign
-/// from + to −.
-fn poly_max(a: &[f64; taylor::ORDER + 1], tau: f64, period: f64, len: f64) -> f64 {
-    let f = Poly::new(a, tau, period);
-    let mut best = f.value(0.0).max(f.value(len));
-    let df = Poly::new(f.derivative(), tau, period);
-    // A slope of one sign throughout (a concave bound) leaves the maximum at an end.
-    if !(df.keeps_sign(1.0, len) || df.keeps_sign(-1.0, len)) {
-        for_each_maximum(&df, len, PEAK_SEARCH, |s| best = best.max(f.value(s)));
-    }
-    best
 }
 
 /// `vᵀ C v`.

@@ -16,13 +16,14 @@
 pub mod dopri5;
 pub mod exact;
 pub mod expm;
+pub mod peaks;
 pub mod propagator;
 pub mod roots;
 pub mod small;
 mod switching;
 pub mod taylor;
 
-use crate::impact::{ImpactSystem, Mode};
+use crate::impact::{Channel, ImpactSystem, Mode};
 use crate::{Error, Result};
 
 /// Integration method.
@@ -112,10 +113,38 @@ pub struct Event {
 pub struct Totals {
     /// Energy dissipated by every dashpot and modal damping (J), integrated exactly.
     pub dissipated: f64,
-    /// Peak compressive contact force (N): slider-bed, bed-damper.
-    pub peak_force: [f64; 2],
+    /// Extremes of every response channel ([`crate::impact::Channel`]) on the continuous
+    /// solution, with their times ([`peaks`]).
+    pub peaks: peaks::Peaks,
     /// Time each contact has been closed (s): slider-bed, bed-damper.
     pub closed_time: [f64; 2],
+}
+
+impl Totals {
+    /// Peak compressive contact force (N) of contact `ci` (0 slider-bed, 1 bed-damper): the
+    /// largest value of its force channel, 0 if it never closed.
+    pub fn peak_force(&self, ci: usize) -> f64 {
+        let c = [Channel::ContactSliderBed, Channel::ContactBedDamper][ci.min(1)];
+        let e = self.peaks.get(c);
+        if e.is_set() {
+            e.max.max(0.0)
+        } else {
+            0.0
+        }
+    }
+}
+
+/// A point of the run's path: from time `t` on, the system is in `mode`, starting from state
+/// `x = [x; ẋ]` there. A run's [`Solution::path`] has one at t = 0 and one at each mode change,
+/// so that each stretch between two of them is a linear time-invariant motion for linear
+/// contact laws: the exact spectrum ([`crate::analysis::spectrum`]) is built from them. Where a
+/// closed contact has a non-linear law, `dopri5` adds one at each accepted step (knots of its
+/// dense output) with the same mode.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathPoint {
+    pub t: f64,
+    pub mode: Mode,
+    pub x: Vec<f64>,
 }
 
 /// The state of the run at the end of the collision.
@@ -130,6 +159,8 @@ pub struct CollisionEnd {
 #[derive(Debug, Clone)]
 pub struct Solution {
     pub events: Vec<Event>,
+    /// The path of the run (see [`PathPoint`]); the run ends at (`t_final`, `x_final`).
+    pub path: Vec<PathPoint>,
     pub collision_end: Option<CollisionEnd>,
     pub t_final: f64,
     pub x_final: Vec<f64>,

@@ -306,6 +306,24 @@ pub fn for_each_maximum<F: Scalar + ?Sized>(
     });
 }
 
+/// The extrema of `g` inside `(a, b]` as the sign changes of `slope` (= g'), each located to
+/// the search tolerance: `visit(t, is_max)` in order (`is_max` for a change from + to −).
+pub fn for_each_extremum<F: Scalar + ?Sized>(
+    slope: &F,
+    a: f64,
+    b: f64,
+    opts: SearchOptions,
+    mut visit: impl FnMut(f64, bool),
+) {
+    let shifted = Shifted {
+        f: slope,
+        offset: a,
+    };
+    crossings(&shifted, b - a, opts, true, |t, sign| {
+        visit(a + t, sign > 0.0)
+    });
+}
+
 /// All sign changes of `g` in `(0, s_max]`, in order, each with the sign `g` had before it.
 pub fn all_crossings<F: Scalar + ?Sized>(
     f: &F,

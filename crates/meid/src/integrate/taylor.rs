@@ -514,9 +514,9 @@ fn poly4<const M: usize>(x: f64, c: impl Fn(usize) -> f64) -> f64 {
     (v[0] + x * v[1]) + x2 * (v[2] + x * v[3])
 }
 
-/// `Σ |a_k| x^k` (x ≥ 0).
+/// `Σ |a_k| x^k` (x ≥ 0): a bound of `|p(s)|` on `[0, x]`.
 #[inline]
-fn abs_horner(a: &Coefficients, x: f64) -> f64 {
+pub(crate) fn abs_horner(a: &Coefficients, x: f64) -> f64 {
     poly4::<{ ORDER + 1 }>(x, |k| a[k].abs())
 }
 
