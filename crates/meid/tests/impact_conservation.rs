@@ -373,13 +373,30 @@ fn recorded_bed_acceleration_equals_modal_accelerations() {
         let mut acc = vec![0.0; nd];
         sys.accelerations(mode, &x, &mut acc);
         let want: f64 = (0..n).map(|i| phi[i] * acc[i]).sum();
-        let mut rec = Recorder::new(&sys, true);
+        let mut rec = Recorder::new(&sys);
         rec.sample(0.0, &x, mode);
         let got = rec.history.bed_acceleration_m_per_s2[0];
         let scale: f64 = (0..n).map(|i| (phi[i] * acc[i]).abs()).sum();
         assert!(
             (got - want).abs() <= 1e-13 * scale,
             "mode {bits}: {got} vs {want}"
+        );
+        // The linear functionals of every channel (used for exact peaks) give the same values.
+        let map = meid::impact::ChannelMap::new(&sys);
+        let values = map.values(&sys, mode, &x);
+        let vecs = map.vectors(&sys, mode).expect("linear laws");
+        for (c, l) in meid::impact::CHANNELS.iter().zip(&vecs) {
+            let lin: f64 = l.iter().zip(&x).map(|(a, b)| a * b).sum();
+            let size: f64 = l.iter().zip(&x).map(|(a, b)| (a * b).abs()).sum();
+            let v = values[c.index()];
+            assert!(
+                (lin - v).abs() <= 1e-13 * size.max(1e-300),
+                "mode {bits}, {}: {lin} vs {v}",
+                c.key()
+            );
+        }
+        assert!(
+            (values[meid::impact::Channel::BedAcceleration.index()] - want).abs() <= 1e-13 * scale
         );
         assert!(want.abs() > 1e-3 * scale, "mode {bits}: a trivial state");
     }
