@@ -44,15 +44,26 @@ impl Linear {
 ///
 /// A derivative `ℓᵀy` (`y = Aᵏ X`) counts as zero when it is below round-off of its own terms
 /// (`1e-9 Σ|ℓᵢyᵢ|` for the value itself, which root location leaves at ~1e-13 of its terms,
-/// `1e-11` for higher orders) or below `1e-12 ‖ℓ‖‖y‖`: the latter catches quantities whose terms
-/// are all physically zero (bodies at rest, forces zero) and only carry round-off.
+/// `1e-11` for higher orders) or below `1e-12 ‖ℓ‖‖y_S‖`: the latter catches quantities whose
+/// terms are all physically zero (bodies at rest, forces zero) and only carry round-off. `S`
+/// (`comps[i]` for functional `i`; all coordinates when empty) is the part of the state coupled
+/// to the functional under `A`: the slider flying away after the blow (metres, m/s) must not
+/// make the centimetre-per-second motion of the damper against the bed decades later look
+/// like round-off.
 ///
 /// `a` is `A` column-major (`n × n`, `n = x.len()`); `work` is scratch space (reused between
 /// calls).
 ///
 /// # Panics
 /// When `a.len() != x.len()²`.
-fn lex_signs(ls: &[Linear], a: &[f64], x: &[f64], out: &mut [f64], work: &mut Vec<f64>) {
+fn lex_signs(
+    ls: &[Linear],
+    comps: &[Vec<usize>],
+    a: &[f64],
+    x: &[f64],
+    out: &mut [f64],
+    work: &mut Vec<f64>,
+) {
     let n = x.len();
     assert_eq!(a.len(), n * n, "lexicographic signs: matrix size");
     // `out[i] == 0` marks functional i as undecided.
@@ -65,17 +76,19 @@ fn lex_signs(ls: &[Linear], a: &[f64], x: &[f64], out: &mut [f64], work: &mut Ve
     y.copy_from_slice(x);
     let (mut y, mut next) = (y, next);
     for k in 0..=K_MAX {
-        // ‖y‖, when a functional needs its floor.
+        // ‖y‖, when a functional coupled to the whole state needs its floor.
         let mut y_norm = None;
         let tol = if k == 0 { 1e-9 } else { 1e-11 };
-        for (l, o) in ls.iter().zip(out.iter_mut()) {
+        for (i, (l, o)) in ls.iter().zip(out.iter_mut()).enumerate() {
             if *o != 0.0 {
                 continue;
             }
             let (val, scale) = l.v.dot_abs(y);
             if val.abs() > tol * scale {
-                let y_norm =
-                    *y_norm.get_or_insert_with(|| y.iter().map(|v| v * v).sum::<f64>().sqrt());
+                let y_norm = match comps.get(i) {
+                    Some(c) if !c.is_empty() => c.iter().map(|&j| y[j] * y[j]).sum::<f64>().sqrt(),
+                    _ => *y_norm.get_or_insert_with(|| y.iter().map(|v| v * v).sum::<f64>().sqrt()),
+                };
                 if val.abs() > 1e-12 * l.norm * y_norm {
                     *o = val.signum();
                     open -= 1;
@@ -88,6 +101,41 @@ fn lex_signs(ls: &[Linear], a: &[f64], x: &[f64], out: &mut [f64], work: &mut Ve
         mat_vec(a, y, next);
         std::mem::swap(&mut y, &mut next);
     }
+}
+
+/// The coordinates coupled to the functional `l` under `A` (column-major, `n × n`): the
+/// connected components, in the graph of `A`'s non-zeros taken both ways, of the coordinates
+/// `l` reads. Ascending.
+fn coupled(a: &[f64], n: usize, l: &[f64]) -> Vec<usize> {
+    // Union-find over the coordinates.
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(p: &mut [usize], mut i: usize) -> usize {
+        while p[i] != i {
+            p[i] = p[p[i]];
+            i = p[i];
+        }
+        i
+    }
+    for j in 0..n {
+        for i in 0..n {
+            if i != j && a[j * n + i] != 0.0 {
+                let (ri, rj) = (root(&mut parent, i), root(&mut parent, j));
+                if ri != rj {
+                    parent[ri] = rj;
+                }
+            }
+        }
+    }
+    let roots: Vec<usize> = (0..n)
+        .filter(|&i| l.get(i).is_some_and(|v| *v != 0.0))
+        .map(|i| root(&mut parent, i))
+        .collect();
+    (0..n)
+        .filter(|&i| {
+            let r = root(&mut parent, i);
+            roots.contains(&r)
+        })
+        .collect()
 }
 
 /// `out = A y` with `A` column-major; fixed-size columns for the small first-order systems of
@@ -166,6 +214,9 @@ pub struct ModeSelector<'s> {
     n: usize,
     /// `A_σ` per mode (index `σ`), column-major; empty until first used.
     mats: [Vec<f64>; MODES],
+    /// Per mode, per indicator: the coordinates coupled to it under `A_σ` ([`lex_signs`]'s
+    /// floor); built with the matrix.
+    comps: [Vec<Vec<usize>>; MODES],
 }
 
 impl<'s> ModeSelector<'s> {
@@ -182,6 +233,7 @@ impl<'s> ModeSelector<'s> {
             vecs,
             n: 2 * sys.dofs(),
             mats: Default::default(),
+            comps: Default::default(),
         }
     }
 
@@ -198,20 +250,29 @@ impl<'s> ModeSelector<'s> {
     /// `A_σ` of `mode`, column-major (`n × n`, `n = 2·dofs`).
     pub fn matrix(&mut self, mode: Mode) -> &[f64] {
         let n = self.n;
-        let a = &mut self.mats[usize::from(mode.0) % MODES];
+        let mi = usize::from(mode.0) % MODES;
+        let a = &mut self.mats[mi];
         if a.is_empty() {
             a.resize(n * n, 0.0);
             self.sys.first_order_into(mode, a);
+            self.comps[mi] = self.vecs.iter().map(|l| coupled(a, n, l)).collect();
         }
-        a
+        &self.mats[mi]
     }
 
     /// The signs of the indicators just after the state `x` under `mode`'s dynamics
     /// ([`lex_signs`]) into `out`.
     pub fn signs(&mut self, mode: Mode, x: &[f64], out: &mut [f64]) {
         self.matrix(mode);
-        let a = &self.mats[usize::from(mode.0) % MODES];
-        lex_signs(&self.linear, a, x, out, &mut self.work);
+        let mi = usize::from(mode.0) % MODES;
+        lex_signs(
+            &self.linear,
+            &self.comps[mi],
+            &self.mats[mi],
+            x,
+            out,
+            &mut self.work,
+        );
     }
 
     /// The mode implied by `signs` (one per indicator).
