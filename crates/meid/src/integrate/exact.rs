@@ -184,7 +184,7 @@ pub fn solve_from(
                     totals.closed_time[ci] += s_end;
                 }
             }
-            let mc = mode_channels(&mut channels, &map, sys, &mut selector, mode)?;
+            let mc = mode_channels(&mut channels, &map, sys, &mut selector, mode, false)?;
             for &c in &mc.zero {
                 totals.peaks.0[c].offer(0.0, t);
             }
@@ -246,7 +246,7 @@ pub fn solve_from(
                     totals.closed_time[ci] += s_end;
                 }
             }
-            let mc = mode_channels(&mut channels, &map, sys, &mut selector, mode)?;
+            let mc = mode_channels(&mut channels, &map, sys, &mut selector, mode, true)?;
             for &c in &mc.zero {
                 totals.peaks.0[c].offer(0.0, t);
             }
@@ -462,25 +462,25 @@ struct ModeChannels {
     index: Vec<usize>,
     vecs: Vec<Vec<f64>>,
     proj: Vec<taylor::Projector>,
+    /// Built when a closed-form segment first needs them.
     slopes: Vec<Vec<f64>>,
     zero: Vec<usize>,
 }
 
-/// The channels of `mode`, built on first use.
+/// The channels of `mode`, built on first use (with their slope vectors when `need_slopes`).
 fn mode_channels<'c>(
     cache: &'c mut [Option<ModeChannels>; MODES],
     map: &ChannelMap,
     sys: &ImpactSystem,
     selector: &mut ModeSelector,
     mode: Mode,
+    need_slopes: bool,
 ) -> Result<&'c ModeChannels> {
     let mi = usize::from(mode.0) % MODES;
     if cache[mi].is_none() {
         let vecs = map
             .vectors(sys, mode)
             .ok_or_else(|| Error::numerical("exact", "a closed contact has a non-linear law"))?;
-        let n = 2 * sys.dofs();
-        let a = selector.matrix(mode);
         let mut mc = ModeChannels {
             index: Vec::new(),
             vecs: Vec::new(),
@@ -496,22 +496,33 @@ fn mode_channels<'c>(
                 mc.zero.push(c.index());
                 continue;
             }
-            // ℓᵀA with A column-major: (ℓᵀA)_j = Σ_i ℓ_i A_ij.
-            let la = (0..n)
-                .map(|j| {
-                    a[j * n..(j + 1) * n]
-                        .iter()
-                        .zip(&l)
-                        .map(|(x, y)| x * y)
-                        .sum()
-                })
-                .collect();
             mc.index.push(c.index());
             mc.proj.push(taylor::Projector::new(&l));
             mc.vecs.push(l);
-            mc.slopes.push(la);
         }
         cache[mi] = Some(mc);
+    }
+    if need_slopes {
+        if let Some(mc) = cache[mi].as_mut().filter(|mc| mc.slopes.is_empty()) {
+            // ℓᵀA with A column-major: (ℓᵀA)_j = Σ_i ℓ_i A_ij.
+            let n = 2 * sys.dofs();
+            let a = selector.matrix(mode);
+            mc.slopes = mc
+                .vecs
+                .iter()
+                .map(|l| {
+                    (0..n)
+                        .map(|j| {
+                            a[j * n..(j + 1) * n]
+                                .iter()
+                                .zip(l)
+                                .map(|(x, y)| x * y)
+                                .sum()
+                        })
+                        .collect()
+                })
+                .collect();
+        }
     }
     cache[mi]
         .as_ref()

@@ -129,15 +129,18 @@ pub(crate) fn on_poly(
         // The end value cannot beat the extremes either: nothing to do.
         return;
     }
-    let p = Poly::new(a, tau, period);
-    ext.offer(p.value(len), t0 + len);
-    let slope = Poly::new(p.derivative(), tau, period);
+    ext.offer(taylor::eval(a, len), t0 + len);
+    let mut da = [0.0; taylor::ORDER + 1];
+    for (k, d) in da.iter_mut().take(taylor::ORDER).enumerate() {
+        *d = (k + 1) as f64 * a[k + 1];
+    }
     // A slope of one sign throughout (a concave bound) leaves the extremes at the ends.
-    if slope.keeps_sign(1.0, len) || slope.keeps_sign(-1.0, len) {
+    if taylor::keeps_sign(&da, 1.0, len) || taylor::keeps_sign(&da, -1.0, len) {
         return;
     }
+    let slope = Poly::new(&da, tau, period);
     for_each_extremum(&slope, 0.0, len, EXTREMUM_SEARCH, |s, _| {
-        ext.offer(p.value(s), t0 + s)
+        ext.offer(taylor::eval(a, s), t0 + s)
     });
 }
 

@@ -46,10 +46,10 @@ impl Linear {
 /// (`1e-9 Σ|ℓᵢyᵢ|` for the value itself, which root location leaves at ~1e-13 of its terms,
 /// `1e-11` for higher orders) or below `1e-12 ‖ℓ‖‖y_S‖`: the latter catches quantities whose
 /// terms are all physically zero (bodies at rest, forces zero) and only carry round-off. `S`
-/// (`comps[i]` for functional `i`; all coordinates when empty) is the part of the state coupled
-/// to the functional under `A`: the slider flying away after the blow (metres, m/s) must not
-/// make the centimetre-per-second motion of the damper against the bed decades later look
-/// like round-off.
+/// is the whole state, or, for a functional with `skip[i]` set, the state without the
+/// coordinates `skip_idx` (the slider's, in a mode where its contact is open and it moves on
+/// its own, uncoupled): the slider flying away after the blow (metres, m/s) must not make the
+/// micrometre motion of the damper against the bed seconds later look like round-off.
 ///
 /// `a` is `A` column-major (`n × n`, `n = x.len()`); `work` is scratch space (reused between
 /// calls).
@@ -58,7 +58,8 @@ impl Linear {
 /// When `a.len() != x.len()²`.
 fn lex_signs(
     ls: &[Linear],
-    comps: &[Vec<usize>],
+    skip: &[bool],
+    skip_idx: &[usize],
     a: &[f64],
     x: &[f64],
     out: &mut [f64],
@@ -76,8 +77,9 @@ fn lex_signs(
     y.copy_from_slice(x);
     let (mut y, mut next) = (y, next);
     for k in 0..=K_MAX {
-        // ‖y‖, when a functional coupled to the whole state needs its floor.
+        // ‖y‖ and ‖y_S‖, when a functional needs its floor.
         let mut y_norm = None;
+        let mut y_part = None;
         let tol = if k == 0 { 1e-9 } else { 1e-11 };
         for (i, (l, o)) in ls.iter().zip(out.iter_mut()).enumerate() {
             if *o != 0.0 {
@@ -85,9 +87,18 @@ fn lex_signs(
             }
             let (val, scale) = l.v.dot_abs(y);
             if val.abs() > tol * scale {
-                let y_norm = match comps.get(i) {
-                    Some(c) if !c.is_empty() => c.iter().map(|&j| y[j] * y[j]).sum::<f64>().sqrt(),
-                    _ => *y_norm.get_or_insert_with(|| y.iter().map(|v| v * v).sum::<f64>().sqrt()),
+                let y_norm = if skip.get(i).copied().unwrap_or(false) {
+                    *y_part.get_or_insert_with(|| {
+                        let s: f64 = y
+                            .iter()
+                            .enumerate()
+                            .filter(|(j, _)| !skip_idx.contains(j))
+                            .map(|(_, v)| v * v)
+                            .sum();
+                        s.sqrt()
+                    })
+                } else {
+                    *y_norm.get_or_insert_with(|| y.iter().map(|v| v * v).sum::<f64>().sqrt())
                 };
                 if val.abs() > 1e-12 * l.norm * y_norm {
                     *o = val.signum();
@@ -101,41 +112,6 @@ fn lex_signs(
         mat_vec(a, y, next);
         std::mem::swap(&mut y, &mut next);
     }
-}
-
-/// The coordinates coupled to the functional `l` under `A` (column-major, `n × n`): the
-/// connected components, in the graph of `A`'s non-zeros taken both ways, of the coordinates
-/// `l` reads. Ascending.
-fn coupled(a: &[f64], n: usize, l: &[f64]) -> Vec<usize> {
-    // Union-find over the coordinates.
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn root(p: &mut [usize], mut i: usize) -> usize {
-        while p[i] != i {
-            p[i] = p[p[i]];
-            i = p[i];
-        }
-        i
-    }
-    for j in 0..n {
-        for i in 0..n {
-            if i != j && a[j * n + i] != 0.0 {
-                let (ri, rj) = (root(&mut parent, i), root(&mut parent, j));
-                if ri != rj {
-                    parent[ri] = rj;
-                }
-            }
-        }
-    }
-    let roots: Vec<usize> = (0..n)
-        .filter(|&i| l.get(i).is_some_and(|v| *v != 0.0))
-        .map(|i| root(&mut parent, i))
-        .collect();
-    (0..n)
-        .filter(|&i| {
-            let r = root(&mut parent, i);
-            roots.contains(&r)
-        })
-        .collect()
 }
 
 /// `out = A y` with `A` column-major; fixed-size columns for the small first-order systems of
@@ -214,9 +190,11 @@ pub struct ModeSelector<'s> {
     n: usize,
     /// `A_σ` per mode (index `σ`), column-major; empty until first used.
     mats: [Vec<f64>; MODES],
-    /// Per mode, per indicator: the coordinates coupled to it under `A_σ` ([`lex_signs`]'s
-    /// floor); built with the matrix.
-    comps: [Vec<Vec<usize>>; MODES],
+    /// Per indicator: true when it does not read the slider (its round-off floor leaves the
+    /// slider out in modes where the slider flies free, [`lex_signs`]).
+    no_slider: Vec<bool>,
+    /// The slider's coordinates `z_s`, `ż_s` in the state.
+    slider_idx: [usize; 2],
 }
 
 impl<'s> ModeSelector<'s> {
@@ -224,6 +202,8 @@ impl<'s> ModeSelector<'s> {
     pub fn new(sys: &'s ImpactSystem) -> Self {
         let inds = sys.indicators();
         let vecs: Vec<Vec<f64>> = inds.iter().map(|&i| sys.indicator_vector(i)).collect();
+        let (zs, vs) = (sys.slider_index(), sys.dofs() + sys.slider_index());
+        let vecs_ref_no_slider = vecs.iter().map(|l| l[zs] == 0.0 && l[vs] == 0.0).collect();
         Self {
             sys,
             switches: sys.switches(),
@@ -233,7 +213,8 @@ impl<'s> ModeSelector<'s> {
             vecs,
             n: 2 * sys.dofs(),
             mats: Default::default(),
-            comps: Default::default(),
+            no_slider: vecs_ref_no_slider,
+            slider_idx: [sys.slider_index(), sys.dofs() + sys.slider_index()],
         }
     }
 
@@ -250,14 +231,12 @@ impl<'s> ModeSelector<'s> {
     /// `A_σ` of `mode`, column-major (`n × n`, `n = 2·dofs`).
     pub fn matrix(&mut self, mode: Mode) -> &[f64] {
         let n = self.n;
-        let mi = usize::from(mode.0) % MODES;
-        let a = &mut self.mats[mi];
+        let a = &mut self.mats[usize::from(mode.0) % MODES];
         if a.is_empty() {
             a.resize(n * n, 0.0);
             self.sys.first_order_into(mode, a);
-            self.comps[mi] = self.vecs.iter().map(|l| coupled(a, n, l)).collect();
         }
-        &self.mats[mi]
+        a
     }
 
     /// The signs of the indicators just after the state `x` under `mode`'s dynamics
@@ -265,9 +244,16 @@ impl<'s> ModeSelector<'s> {
     pub fn signs(&mut self, mode: Mode, x: &[f64], out: &mut [f64]) {
         self.matrix(mode);
         let mi = usize::from(mode.0) % MODES;
+        // With the slider-bed contact open the slider moves on its own.
+        let free = if mode.on(Switch::SliderBed) {
+            &[][..]
+        } else {
+            &self.no_slider[..]
+        };
         lex_signs(
             &self.linear,
-            &self.comps[mi],
+            free,
+            &self.slider_idx,
             &self.mats[mi],
             x,
             out,

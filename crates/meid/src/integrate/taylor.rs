@@ -514,6 +514,12 @@ fn poly4<const M: usize>(x: f64, c: impl Fn(usize) -> f64) -> f64 {
     (v[0] + x * v[1]) + x2 * (v[2] + x * v[3])
 }
 
+/// `p(s) = Σ a_k s^k`.
+#[inline]
+pub(crate) fn eval(a: &Coefficients, s: f64) -> f64 {
+    poly4::<{ ORDER + 1 }>(s, |k| a[k])
+}
+
 /// `Σ |a_k| x^k` (x ≥ 0): a bound of `|p(s)|` on `[0, x]`.
 #[inline]
 pub(crate) fn abs_horner(a: &Coefficients, x: f64) -> f64 {
