@@ -110,21 +110,28 @@ fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>) {
         ),
     }
     println!(
-        "  peak contact force slider-bed         {:.3} N",
+        "  peak contact force slider-bed         {:.3} N (during the collision)",
         s.peak_contact_force_slider_bed_n
     );
-    println!(
-        "  peak contact force bed-damper         {:.3} N",
-        s.peak_contact_force_bed_damper_n
-    );
-    println!(
-        "  peak bed acceleration at B            {:.3} m/s²",
-        s.peak_bed_acceleration_m_per_s2
-    );
-    println!(
-        "  peak force to the floor               {:.3} N",
-        s.peak_floor_force_n
-    );
+    if s.peaks
+        .iter()
+        .any(|p| p.channel == "contact_force_bed_damper_n")
+    {
+        println!(
+            "  peak contact force bed-damper         {:.3} N (during the collision)",
+            s.peak_contact_force_bed_damper_n
+        );
+    }
+    println!("  peaks over the run (exact, on the continuous solution):");
+    for p in &s.peaks {
+        println!(
+            "    {:<34} {:>14.6e} {:<5} at t = {:.6} ms",
+            p.label,
+            p.peak,
+            p.unit,
+            p.time_s * 1e3
+        );
+    }
     if let Some(r) = s.energy_balance_residual {
         println!("  energy-balance residual               {r:.2e} (end of collision), {:.2e} (end of run)", s.energy_balance_residual_run_end);
     }

@@ -167,6 +167,8 @@ impl Observer for Recorder<'_> {
 pub struct ChannelPeak {
     /// Channel key with its unit ([`Channel::key`]).
     pub channel: &'static str,
+    /// Human label ([`Channel::label`]).
+    pub label: &'static str,
     pub unit: &'static str,
     /// Largest magnitude.
     pub peak: f64,
@@ -190,6 +192,7 @@ pub fn channel_peaks(sys: &ImpactSystem, peaks: &Peaks) -> Vec<ChannelPeak> {
             let set = e.is_set();
             ChannelPeak {
                 channel: c.key(),
+                label: c.label(),
                 unit: c.unit(),
                 peak: v.abs(),
                 time_s: if set { t } else { 0.0 },
