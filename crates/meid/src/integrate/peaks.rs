@@ -138,10 +138,55 @@ pub(crate) fn on_poly(
     if taylor::keeps_sign(&da, 1.0, len) || taylor::keeps_sign(&da, -1.0, len) {
         return;
     }
+    // A monotone slope (its derivative `p''` keeps its sign) has at most one root, where its
+    // end values differ in sign: safeguarded Newton on it, without the general search.
+    let mut d2a = [0.0; taylor::ORDER + 1];
+    for (k, d) in d2a.iter_mut().take(taylor::ORDER).enumerate() {
+        *d = (k + 1) as f64 * da[k + 1];
+    }
+    if taylor::keeps_sign(&d2a, 1.0, len) || taylor::keeps_sign(&d2a, -1.0, len) {
+        let (g0, g1) = (da[0], taylor::eval(&da, len));
+        if g0 * g1 < 0.0 {
+            let s = monotone_root(&da, &d2a, len, g0, EXTREMUM_SEARCH.tolerance * period);
+            ext.offer(taylor::eval(a, s), t0 + s);
+        }
+        return;
+    }
     let slope = Poly::new(&da, tau, period);
     for_each_extremum(&slope, 0.0, len, EXTREMUM_SEARCH, |s, _| {
         ext.offer(taylor::eval(a, s), t0 + s)
     });
+}
+
+/// The root of `g = Σ g_k s^k` (slope `dg`) on `[0, len]`, given that `g` is monotone there and
+/// `g(0) = g0` and `g(len)` differ in sign: Newton steps kept inside the bracket (bisection when
+/// one leaves it or does not halve the bracket), to `tol` (s).
+fn monotone_root(g: &Coefficients, dg: &Coefficients, len: f64, g0: f64, tol: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0, len);
+    let side = g0.signum();
+    let mut s = 0.5 * len;
+    for _ in 0..100 {
+        let v = taylor::eval(g, s);
+        if v == 0.0 {
+            return s;
+        }
+        if v.signum() == side {
+            lo = s;
+        } else {
+            hi = s;
+        }
+        if hi - lo <= tol.max(4.0 * f64::EPSILON * hi) {
+            break;
+        }
+        let d = taylor::eval(dg, s);
+        let newton = s - v / d;
+        s = if d != 0.0 && newton > lo && newton < hi && (newton - s).abs() < 0.5 * (hi - lo) {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+    }
+    s
 }
 
 /// Extremes of `ℓᵀX(s)` on `[0, len]` of a closed-form segment starting at time `t0`, offered
