@@ -23,6 +23,13 @@
 //! 4. `md/mb = r`: `m_d = r m_b`;
 //! 5. if a ratio in 3 or 4 was given: `K_d = m_d w_d w_d` (so `md/mb` keeps `w_d`).
 //!
+//! Field values are written as TOML literals of the field's kind ([`field_kind`]): a
+//! whole-number field (`structure.fem.machine.elements_per_side`) gets an integer literal and
+//! refuses a non-integral value, naming the field. A varied `simulation.*` field sets that
+//! point's integration options ([`point_options`]); a varied `simulation.duration` runs the
+//! point for its duration instead of stopping at the end of the collision. m_b is
+//! [`Sweep::with_bed_mass`]'s mass if given, else [`Model::bed_mass`] (see there for the rule).
+//!
 //! # Cost and reproducibility
 //!
 //! The model file is parsed once. Derived ratios and non-structural fields are set on a clone

@@ -1,7 +1,7 @@
 //! Model files: TOML in, a validated [`Model`] out.
 //!
-//! A model names a structure, the slider, an impact damper or an added mass (or neither),
-//! the two contacts and the simulation settings. See `docs/model-format.md` for the full
+//! A model names a structure, the slider, an impact damper and/or an added mass at a named
+//! point (or neither), the two contacts and the simulation settings. See `docs/model-format.md` for the full
 //! reference and `examples/paper-lumped.toml` for a complete file.
 //!
 //! # Units (SI throughout; field names carry no suffix except `frequencies_hz`)
