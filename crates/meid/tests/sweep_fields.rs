@@ -263,11 +263,12 @@ fn fe_bed_mass_is_the_bed_plate() {
     // md/mb on the FE model with the derived m_b: m_d = r m_b, K_d keeps w_d.
     let c = base.spec.contact.bed_damper.as_ref().unwrap().stiffness;
     let m = base.spec.damper.as_ref().unwrap().mass;
+    let m_b_model = base.bed_mass().unwrap();
     let sweep = Sweep::new(base, vec![Vary::parse("md/mb=0.35,0.7").unwrap()]).unwrap();
     for (i, r) in [0.35, 0.7].into_iter().enumerate() {
         let pm = sweep.point_model(i).unwrap();
         let d = pm.model.spec.damper.as_ref().unwrap().mass;
-        assert_eq!(d, r * sweep.bed_mass_kg.unwrap());
+        assert_eq!(d, r * m_b_model);
         let k = pm.model.spec.contact.bed_damper.as_ref().unwrap().stiffness;
         assert!(((k / d) / (c / m) - 1.0).abs() < 1e-14);
     }
@@ -405,5 +406,36 @@ fn montecarlo_draws_simulation_fields_per_sample() {
     let whole = single(&lumped(&[]), true).energy_ratio.unwrap();
     for s in &long.samples {
         assert_eq!(s.metrics.unwrap()[0].to_bits(), whole.to_bits());
+    }
+}
+
+#[test]
+fn derived_bed_mass_follows_the_point() {
+    // m_b = the point's bed mass: varying the lumped bed mass carries m_d = r m_b with it.
+    let vary = || {
+        vec![
+            Vary::parse("structure.lumped.masses[0].mass=10,20").unwrap(),
+            Vary::parse("md/mb=0.5").unwrap(),
+        ]
+    };
+    let sweep = Sweep::new(lumped(&[]), vary()).unwrap();
+    assert_eq!(sweep.point_model(0).unwrap().derived[2], 5.0);
+    assert_eq!(sweep.point_model(1).unwrap().derived[2], 10.0);
+    // A given m_b is fixed.
+    let sweep = Sweep::with_bed_mass(lumped(&[]), vary(), Some(10.0)).unwrap();
+    assert_eq!(sweep.point_model(1).unwrap().derived[2], 5.0);
+    // The same on the FE machine: a thicker bed plate is a heavier bed.
+    let sweep = Sweep::new(
+        fe(&[]),
+        vec![
+            Vary::parse("structure.fem.machine.bed.thickness=0.01095,0.0219").unwrap(),
+            Vary::parse("md/mb=0.35").unwrap(),
+        ],
+    )
+    .unwrap();
+    let m_b = 7850.0 * 0.432 * 0.2693 * 0.01095;
+    for (i, t) in [1.0, 2.0].into_iter().enumerate() {
+        let d = sweep.point_model(i).unwrap().derived[2];
+        assert!((d / (0.35 * t * m_b) - 1.0).abs() < 1e-14, "{d}");
     }
 }

@@ -89,6 +89,7 @@ pub struct OptimizeStudy {
     pub variables: Vec<Variable>,
     pub objective: Objective,
     pub options: Options,
+    /// m_b (kg) for `md/mb`, when given; `None`: each point's [`Model::bed_mass`].
     pub bed_mass_kg: Option<f64>,
     /// Evaluation budget.
     pub max_simulations: usize,
@@ -167,9 +168,10 @@ impl OptimizeStudy {
         if over.is_empty() {
             return Err(Error::invalid("over", "give at least one variable"));
         }
-        let bed_mass_kg = check_bed_mass(bed_mass_kg)?.or_else(|| model.bed_mass());
+        let bed_mass_kg = check_bed_mass(bed_mass_kg)?;
+        let m_b = bed_mass_kg.or_else(|| model.bed_mass());
         let qs: Vec<&Quantity> = over.iter().map(|(q, _)| q).collect();
-        check_quantities(&model, &qs, bed_mass_kg)?;
+        check_quantities(&model, &qs, m_b)?;
         for q in &qs {
             if let Quantity::Field(p) = q {
                 let kind = field_kind(&model, p).map_err(|e| match e {
@@ -207,7 +209,7 @@ impl OptimizeStudy {
                     } else {
                         5.0
                     };
-                    match current_value(&model, q, bed_mass_kg) {
+                    match current_value(&model, q, m_b) {
                         Some(v) if v > 0.0 && v.is_finite() => (v / f, v * f),
                         _ => {
                             return Err(Error::invalid(
@@ -336,7 +338,8 @@ impl OptimizeStudy {
             let x0: Vec<f64> = (0..n)
                 .map(|k| {
                     let v = &self.variables[k];
-                    let c = current_value(&self.model, &v.quantity, self.bed_mass_kg)
+                    let m_b = self.bed_mass_kg.or_else(|| self.model.bed_mass());
+                    let c = current_value(&self.model, &v.quantity, m_b)
                         .filter(|c| c.is_finite() && *c > v.lower && *c < v.upper);
                     match c {
                         Some(c) => self.value_to_search(k, c),

@@ -13,8 +13,9 @@
 //! `contact.slider_bed.stiffness`, ...), set as `--set PATH=VALUE` would.
 //!
 //! With `w_s = sqrt(K_s/m_s)` (slider contact), `w_d = sqrt(K_d/m_d)` (damper contact),
-//! `w_ref` = [`Model::reference_omega`] and `m_b` = [`Model::bed_mass`] (or
-//! [`Sweep::bed_mass_kg`]), a point is built in this fixed order:
+//! `w_ref` = [`Model::reference_omega`] and `m_b` = [`Sweep::bed_mass_kg`] if given, else
+//! [`Model::bed_mass`] of the point's model (after step 1, so a varied bed mass or bed plate
+//! carries m_b with it), a point is built in this fixed order:
 //!
 //! 1. field paths, in the order given;
 //! 2. `ws/w_ref = r`: `w_s = r w_ref`, `K_s = m_s w_s w_s`;
@@ -27,8 +28,7 @@
 //! whole-number field (`structure.fem.machine.elements_per_side`) gets an integer literal and
 //! refuses a non-integral value, naming the field. A varied `simulation.*` field sets that
 //! point's integration options ([`point_options`]); a varied `simulation.duration` runs the
-//! point for its duration instead of stopping at the end of the collision. m_b is
-//! [`Sweep::with_bed_mass`]'s mass if given, else [`Model::bed_mass`] (see there for the rule).
+//! point for its duration instead of stopping at the end of the collision.
 //!
 //! # Cost and reproducibility
 //!
@@ -379,7 +379,8 @@ pub struct Sweep {
     /// `stop_at_collision_end = true` (the sample rate then only serves the peak bed
     /// acceleration and floor force during the collision).
     pub options: Options,
-    /// m_b (kg) for `md/mb`; default [`Model::bed_mass`].
+    /// m_b (kg) for `md/mb`, when given (`--bed-mass`); `None`: each point's
+    /// [`Model::bed_mass`].
     pub bed_mass_kg: Option<f64>,
 }
 
@@ -398,6 +399,8 @@ pub struct SweepSpec {
     pub overrides: Vec<String>,
     pub vary: Vec<Vary>,
     pub method: &'static str,
+    /// The options every point starts from; a varied `simulation.*` column overrides its
+    /// setting per point (a varied duration also clears `stop_at_collision_end`).
     pub duration_s: f64,
     pub stop_at_collision_end: bool,
     pub sample_rate_hz: Option<f64>,
@@ -409,17 +412,17 @@ pub struct SweepSpec {
 impl Sweep {
     /// A sweep of `model` over the grid of `vary` (checked: quantities distinct, w_ref / m_b /
     /// damper available where the ratios need them, field paths numeric, whole-number fields
-    /// given whole numbers). m_b is [`Model::bed_mass`].
+    /// given whole numbers). m_b is each point's [`Model::bed_mass`].
     pub fn new(model: Model, vary: Vec<Vary>) -> Result<Self> {
         Self::with_bed_mass(model, vary, None)
     }
 
-    /// [`Sweep::new`] with the bed mass m_b (kg) for `md/mb` given (`None`: [`Model::bed_mass`]).
-    /// The given mass is checked before the quantities are.
+    /// [`Sweep::new`] with the bed mass m_b (kg) for `md/mb` given (`None`: each point's
+    /// [`Model::bed_mass`]). The given mass is applied before the quantities are checked.
     pub fn with_bed_mass(model: Model, vary: Vec<Vary>, bed_mass_kg: Option<f64>) -> Result<Self> {
         let mut options = model.options();
         options.stop_at_collision_end = true;
-        let bed_mass_kg = check_bed_mass(bed_mass_kg)?.or_else(|| model.bed_mass());
+        let bed_mass_kg = check_bed_mass(bed_mass_kg)?;
         let s = Sweep {
             model,
             vary,
@@ -449,7 +452,8 @@ impl Sweep {
             }
         }
         let qs: Vec<&Quantity> = self.vary.iter().map(|v| &v.quantity).collect();
-        check_quantities(&self.model, &qs, self.bed_mass_kg)?;
+        let m_b = self.bed_mass_kg.or_else(|| self.model.bed_mass());
+        check_quantities(&self.model, &qs, m_b)?;
         let table = spec_table(&self.model)?;
         for v in &self.vary {
             if let Quantity::Field(p) = &v.quantity {
@@ -612,10 +616,14 @@ impl Sweep {
                 Method::Dopri5 => "dopri5",
             },
             duration_s: self.options.duration,
-            stop_at_collision_end: self.options.stop_at_collision_end,
+            stop_at_collision_end: self.options.stop_at_collision_end
+                && !self
+                    .vary
+                    .iter()
+                    .any(|v| v.quantity == Quantity::Field("simulation.duration".into())),
             sample_rate_hz: self.options.sample_rate,
             reference_omega_rad_per_s: self.model.reference_omega(),
-            bed_mass_kg: self.bed_mass_kg,
+            bed_mass_kg: self.bed_mass_kg.or_else(|| self.model.bed_mass()),
             columns: self.columns(),
         }
     }
@@ -1070,6 +1078,7 @@ pub fn point_model(
     }
     let get = |q: Quantity| quantities.iter().position(|x| **x == q).map(|i| values[i]);
     let w_ref = model.reference_omega();
+    let m_b = bed_mass_kg.or_else(|| model.bed_mass());
     let spec = &mut model.spec;
     let m_s = spec.slider.mass;
     // 2. w_s.
@@ -1098,7 +1107,9 @@ pub fn point_model(
             None => (c.stiffness / d.mass).sqrt(),
         };
         if let Some(r) = md_ratio {
-            let m_b = bed_mass_kg.ok_or_else(|| Error::invalid("vary", "md/mb needs m_b"))?;
+            let m_b = m_b.ok_or_else(|| {
+                Error::invalid("vary", "md/mb needs the bed mass m_b: give --bed-mass KG")
+            })?;
             d.mass = r * m_b;
         }
         c.stiffness = d.mass * w_d * w_d;
