@@ -38,6 +38,10 @@ pub struct OptimizeArgs {
     /// Print the report as JSON on stdout.
     #[arg(long)]
     json: bool,
+    /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, or the
+    /// FE machine's bed plate; see docs/studies.md).
+    #[arg(long, value_name = "KG")]
+    bed_mass: Option<f64>,
 }
 
 fn parse_bounds(s: &str) -> Result<(Quantity, (f64, f64))> {
@@ -82,7 +86,13 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
             (q, b)
         })
         .collect();
-    let mut study = OptimizeStudy::new(model, vars, Objective::parse(&a.objective)?)?;
+    if let Some(m) = a.bed_mass {
+        if !(m.is_finite() && m > 0.0) {
+            bail!("--bed-mass must be > 0 kg (got {m})");
+        }
+    }
+    let mut study =
+        OptimizeStudy::with_bed_mass(model, vars, Objective::parse(&a.objective)?, a.bed_mass)?;
     study.max_simulations = a.max_simulations;
     let t0 = std::time::Instant::now();
     let rep = study.run()?;

@@ -42,7 +42,8 @@ pub struct SweepArgs {
     /// Run every point for S seconds instead of stopping at the end of the collision.
     #[arg(long, value_name = "S")]
     duration: Option<f64>,
-    /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point).
+    /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, or the
+    /// FE machine's bed plate; see docs/studies.md).
     #[arg(long, value_name = "KG")]
     bed_mass: Option<f64>,
 }
@@ -61,13 +62,12 @@ pub fn run(a: SweepArgs) -> Result<()> {
         .iter()
         .map(|s| Vary::parse(s))
         .collect::<meid::Result<Vec<_>>>()?;
-    let mut sweep = Sweep::new(model, vary.clone())?;
     if let Some(m) = a.bed_mass {
         if !(m.is_finite() && m > 0.0) {
             bail!("--bed-mass must be > 0 kg (got {m})");
         }
-        sweep.bed_mass_kg = Some(m);
     }
+    let mut sweep = Sweep::with_bed_mass(model, vary.clone(), a.bed_mass)?;
     if a.duration.is_some() {
         sweep.options.stop_at_collision_end = false;
     }
@@ -102,6 +102,10 @@ pub fn run(a: SweepArgs) -> Result<()> {
     bar.finish_and_clear();
     let elapsed = t0.elapsed().as_secs_f64();
     result.write(&a.output)?;
+    if let Some(e) = sweep.all_failed_error(&result) {
+        // The results (every row with its error) are written; the run is that error.
+        return Err(e.into());
+    }
     let pictures = draw(&sweep, &result, &a.metric, &a.output)?;
     if !a.quiet {
         summarise(&sweep, &result, &a.metric, elapsed, &a.output, &pictures);
@@ -135,7 +139,7 @@ fn summarise(
                     .collect();
                 println!("  min {m:<32} {:.6e}  at {}", p.metric(m), at.join(", "));
             }
-            None => println!("  min {m:<32} — (no point succeeded)"),
+            None => println!("  min {m:<32} — (undefined at every point; no picture)"),
         }
         if metric == "energy_ratio" {
             break;
@@ -229,6 +233,11 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
         r.points[index].metric(metric)
     };
     let stem = metric.replace('/', "_");
+    // No picture of a metric undefined at every point (e.g. the energy ratio when no run
+    // reached the end of the collision); the summary says so.
+    if !r.points.iter().any(|p| p.metric(metric).is_finite()) {
+        return Ok(out);
+    }
     match vary.len() {
         1 => {
             let Some(ix) = increasing(vary[0]) else {

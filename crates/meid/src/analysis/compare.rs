@@ -1,7 +1,10 @@
 //! The paper's comparison (section 4, Figs. 10, 11, 13, 14, 18, 19): one machine, one blow
-//! (or a train of blows), three cases — no damper, the impact damper, the damper's mass fixed
-//! to the bed — and by how many dB each case lowers the bed acceleration at B and the force
-//! to the floor.
+//! (or a train of blows), three cases — no damper, the impact damper, a rigid added mass — and
+//! by how many dB each case lowers the bed acceleration at B and the force to the floor.
+//!
+//! The added mass is [`Model::added_mass`]: `added_mass.mass` (default: the damper's mass m_d)
+//! fixed at `added_mass.point` (default: the bed contact point O_b; the paper's Figs. 10-11 also
+//! put it on the floating base, `point = "O_f"` or the lumped model's `"base"`).
 //!
 //! # Formulation
 //!
@@ -223,6 +226,8 @@ pub struct Reduction {
 #[derive(Debug, Clone)]
 pub struct ComparisonResult {
     pub sample_rate_hz: f64,
+    /// The added-mass case's mass (kg) and point, when that case ran.
+    pub added_mass: Option<(f64, String)>,
     pub window: Window,
     pub acceleration_reference_m_per_s2: f64,
     pub cases: Vec<CaseResult>,
@@ -248,7 +253,8 @@ impl Comparison {
     }
 
     /// The cases this model can run: always no damper; the damper when the model has one;
-    /// the added mass when it has a damper (its mass) or an `[added_mass]`.
+    /// the added mass ([`Model::added_mass`]) when it has a damper (its mass) or an
+    /// `[added_mass]`.
     pub fn cases(&self) -> Vec<CaseName> {
         let s = &self.model.spec;
         let mut c = vec![CaseName::NoDamper];
@@ -391,8 +397,14 @@ impl Comparison {
             cases.push(self.analyse(c, &sys, history, energy_ratio, peaks, &specs, fs)?);
         }
         let reductions = reductions(&cases);
+        let added_mass = if cases.iter().any(|c| c.case == CaseName::AddedMass) {
+            self.model.added_mass()
+        } else {
+            None
+        };
         Ok(ComparisonResult {
             sample_rate_hz: fs,
+            added_mass,
             window: o.window,
             acceleration_reference_m_per_s2: o.acceleration_reference_m_per_s2,
             cases,
@@ -531,6 +543,9 @@ impl ComparisonResult {
                 r.reduction_db
             ));
         }
+        if let Some((m, p)) = &self.added_mass {
+            s.push_str(&format!("added mass: {m} kg fixed at point {p}\n"));
+        }
         s.push_str("paper's figures:\n");
         for p in PAPER_FIGURES {
             s.push_str(&format!("  {:<70} {:>5.1} dB\n", p.what, p.reduction_db));
@@ -568,6 +583,8 @@ impl ComparisonResult {
     pub fn summary(&self) -> ComparisonSummary {
         ComparisonSummary {
             sample_rate_hz: self.sample_rate_hz,
+            added_mass_kg: self.added_mass.as_ref().map(|a| a.0),
+            added_mass_point: self.added_mass.as_ref().map(|a| a.1.clone()),
             window: self.window.name(),
             acceleration_reference_m_per_s2: self.acceleration_reference_m_per_s2,
             cases: self
@@ -638,6 +655,9 @@ pub struct CaseSummary {
 #[derive(Debug, Clone, Serialize)]
 pub struct ComparisonSummary {
     pub sample_rate_hz: f64,
+    /// The added-mass case's mass (kg) and point (`added_mass.point`, default O_b).
+    pub added_mass_kg: Option<f64>,
+    pub added_mass_point: Option<String>,
     pub window: &'static str,
     pub acceleration_reference_m_per_s2: f64,
     pub cases: Vec<CaseSummary>,

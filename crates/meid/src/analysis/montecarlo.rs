@@ -17,7 +17,13 @@
 //! summary's energy ratio E_p+/E_s−, peak bed acceleration at B, peak floor force and peak
 //! contact forces. Statistics over the successful samples: mean, sample standard deviation
 //! (`n − 1`), and the 5th, 50th and 95th percentiles by linear interpolation between order
-//! statistics (Hyndman & Fan 1996, definition 7). Failed samples are kept with their error.
+//! statistics (Hyndman & Fan 1996, definition 7). Failed samples are kept with their error;
+//! when every sample fails, the run is that error (the first sample's, with how many failed).
+//!
+//! Inputs must be real-valued model fields: a whole-number field (a count such as
+//! `elements_per_side`) or a non-numeric one is refused before any sample runs. A drawn
+//! `simulation.*` field (duration, sample_rate, rtol, atol) takes effect per sample, like
+//! every other field (the sample's model is re-read with it).
 //!
 //! **Reproducibility.** The generator is SplitMix64 (Steele, Lea & Flood, OOPSLA 2014),
 //! hand-written (a dozen lines; no new dependency). Sample `i` draws from its own stream
@@ -29,6 +35,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::energy::{simulate, Summary};
+use super::sweep::{field_kind, FieldKind};
 use crate::model::{Case, Model};
 use crate::{Error, Result};
 
@@ -304,26 +311,72 @@ impl MonteCarlo {
                 "give at least one uncertain input PATH=DIST(a,b)",
             ));
         }
-        let samples: Vec<Sample> = (0..self.samples)
+        for u in &self.inputs {
+            let kind = field_kind(&self.model, &u.path).map_err(|e| match e {
+                Error::Input { message, .. } => Error::Input {
+                    location: format!("--vary {}", u.path),
+                    message,
+                },
+                other => other,
+            })?;
+            if kind == FieldKind::Whole {
+                return Err(Error::Input {
+                    location: format!("--vary {}", u.path),
+                    message: format!(
+                        "{} takes a whole number (a count or an index); a distribution draws real values",
+                        u.path
+                    ),
+                });
+            }
+        }
+        let runs: Vec<(Sample, Option<Error>)> = (0..self.samples)
             .into_par_iter()
             .map(|i| {
                 let inputs = self.draw(i);
                 match self.run_sample(&inputs) {
-                    Ok(m) => Sample {
-                        index: i,
-                        inputs,
-                        metrics: Some(m),
-                        error: None,
-                    },
-                    Err(e) => Sample {
-                        index: i,
-                        inputs,
-                        metrics: None,
-                        error: Some(e.to_string()),
-                    },
+                    Ok(m) => (
+                        Sample {
+                            index: i,
+                            inputs,
+                            metrics: Some(m),
+                            error: None,
+                        },
+                        None,
+                    ),
+                    Err(e) => (
+                        Sample {
+                            index: i,
+                            inputs,
+                            metrics: None,
+                            error: Some(e.to_string()),
+                        },
+                        Some(e),
+                    ),
                 }
             })
             .collect();
+        let n = runs.len();
+        if runs.iter().all(|(_, e)| e.is_some()) {
+            let first = runs.into_iter().next().and_then(|(_, e)| e);
+            let tag = format!("all {n} samples failed; this is sample 0's error");
+            return Err(match first {
+                Some(Error::Input { location, message }) => Error::Input {
+                    location,
+                    message: format!("{message} ({tag})"),
+                },
+                Some(Error::InvalidValue { field, message }) => Error::InvalidValue {
+                    field,
+                    message: format!("{message} ({tag})"),
+                },
+                Some(Error::Numerical { context, message }) => Error::Numerical {
+                    context,
+                    message: format!("{message} ({tag})"),
+                },
+                Some(e) => e,
+                None => Error::numerical("montecarlo", tag),
+            });
+        }
+        let samples: Vec<Sample> = runs.into_iter().map(|(s, _)| s).collect();
         let input_stats = self
             .inputs
             .iter()

@@ -25,7 +25,10 @@
 use serde::Serialize;
 
 use super::optimize::{brent_minimize, minimize_box, BrentOptions, NelderMeadOptions};
-use super::sweep::{check_quantities, evaluate, PointResult, Quantity};
+use super::sweep::{
+    check_bed_mass, check_quantities, evaluate, failure_error, field_kind, FieldKind, PointResult,
+    Quantity,
+};
 use crate::integrate::Options;
 use crate::model::Model;
 use crate::{Error, Result};
@@ -86,6 +89,7 @@ pub struct OptimizeStudy {
     pub variables: Vec<Variable>,
     pub objective: Objective,
     pub options: Options,
+    /// m_b (kg) for `md/mb`, when given; `None`: each point's [`Model::bed_mass`].
     pub bed_mass_kg: Option<f64>,
     /// Evaluation budget.
     pub max_simulations: usize,
@@ -143,18 +147,50 @@ pub fn current_value(model: &Model, q: &Quantity, bed_mass_kg: Option<f64>) -> O
 impl OptimizeStudy {
     /// A study over `over` with optional bounds per variable. Default bounds: `wd/ws`
     /// 0.2..5, `md/mb` 0.05..2, other quantities a factor 5 (ratios) or 10 (fields) either
-    /// side of the model's value.
+    /// side of the model's value. m_b for `md/mb` is [`Model::bed_mass`].
     pub fn new(
         model: Model,
         over: Vec<(Quantity, Option<(f64, f64)>)>,
         objective: Objective,
     ) -> Result<Self> {
+        Self::with_bed_mass(model, over, objective, None)
+    }
+
+    /// [`OptimizeStudy::new`] with the bed mass m_b (kg) for `md/mb` given (`None`:
+    /// [`Model::bed_mass`]). Model fields must be real numbers: a whole-number field (a count
+    /// such as `elements_per_side`) cannot be searched continuously; sweep its values instead.
+    pub fn with_bed_mass(
+        model: Model,
+        over: Vec<(Quantity, Option<(f64, f64)>)>,
+        objective: Objective,
+        bed_mass_kg: Option<f64>,
+    ) -> Result<Self> {
         if over.is_empty() {
             return Err(Error::invalid("over", "give at least one variable"));
         }
-        let bed_mass_kg = model.bed_mass();
+        let bed_mass_kg = check_bed_mass(bed_mass_kg)?;
+        let m_b = bed_mass_kg.or_else(|| model.bed_mass());
         let qs: Vec<&Quantity> = over.iter().map(|(q, _)| q).collect();
-        check_quantities(&model, &qs, bed_mass_kg)?;
+        check_quantities(&model, &qs, m_b)?;
+        for q in &qs {
+            if let Quantity::Field(p) = q {
+                let kind = field_kind(&model, p).map_err(|e| match e {
+                    Error::Input { message, .. } => Error::Input {
+                        location: format!("--over {p}"),
+                        message,
+                    },
+                    other => other,
+                })?;
+                if kind == FieldKind::Whole {
+                    return Err(Error::Input {
+                        location: format!("--over {p}"),
+                        message: format!(
+                            "{p} takes a whole number (a count or an index) and cannot be optimised continuously; sweep its values instead (meid sweep --vary {p}=LIST)"
+                        ),
+                    });
+                }
+            }
+        }
         let mut variables = Vec::new();
         for (i, (q, b)) in over.iter().enumerate() {
             if over[..i].iter().any(|(p, _)| p == q) {
@@ -173,7 +209,7 @@ impl OptimizeStudy {
                     } else {
                         5.0
                     };
-                    match current_value(&model, q, bed_mass_kg) {
+                    match current_value(&model, q, m_b) {
                         Some(v) if v > 0.0 && v.is_finite() => (v / f, v * f),
                         _ => {
                             return Err(Error::invalid(
@@ -233,6 +269,21 @@ impl OptimizeStudy {
         evaluate(&self.model, &qs, x, self.bed_mass_kg, &self.options, 0)
     }
 
+    /// The error of the failed point `x` (with its kind, see [`failure_error`]).
+    fn failure(&self, x: &[f64], note: &str, which: &str) -> Error {
+        let qs: Vec<&Quantity> = self.variables.iter().map(|v| &v.quantity).collect();
+        let p = self.evaluate(x);
+        failure_error(
+            &self.model,
+            &qs,
+            x,
+            self.bed_mass_kg,
+            p.error.as_deref().unwrap_or("objective undefined"),
+            note,
+            which,
+        )
+    }
+
     /// Runs the search (see the module docs).
     pub fn run(&self) -> Result<OptimizeReport> {
         let metric = self.objective.metric();
@@ -254,12 +305,16 @@ impl OptimizeStudy {
                 .collect();
             let vals: Vec<f64> = grid.iter().map(|&u| f(&[u])).collect();
             let scan_fail = vals.iter().filter(|v| !v.is_finite()).count();
-            let ib = (0..m)
+            let Some(ib) = (0..m)
                 .filter(|&i| vals[i].is_finite())
                 .min_by(|&a, &b| vals[a].total_cmp(&vals[b]))
-                .ok_or_else(|| {
-                    Error::numerical("optimize", "every point of the initial scan failed")
-                })?;
+            else {
+                return Err(self.failure(
+                    &[self.search_to_value(0, grid[0])],
+                    &format!("all {m} points of the initial scan failed"),
+                    "the first scan point",
+                ));
+            };
             let a = grid[ib.saturating_sub(1)];
             let b = grid[(ib + 1).min(m - 1)];
             let opts = BrentOptions {
@@ -283,7 +338,8 @@ impl OptimizeStudy {
             let x0: Vec<f64> = (0..n)
                 .map(|k| {
                     let v = &self.variables[k];
-                    let c = current_value(&self.model, &v.quantity, self.bed_mass_kg)
+                    let m_b = self.bed_mass_kg.or_else(|| self.model.bed_mass());
+                    let c = current_value(&self.model, &v.quantity, m_b)
                         .filter(|c| c.is_finite() && *c > v.lower && *c < v.upper);
                     match c {
                         Some(c) => self.value_to_search(k, c),
@@ -308,12 +364,16 @@ impl OptimizeStudy {
         let point = self.evaluate(&optimum);
         let objective_value = point.metric(metric);
         if !objective_value.is_finite() {
+            if point.error.is_some() {
+                return Err(self.failure(
+                    &optimum,
+                    &format!("no valid design found in {} simulations", simulations + 1),
+                    "the last point",
+                ));
+            }
             return Err(Error::numerical(
                 "optimize",
-                format!(
-                    "no valid design found: {}",
-                    point.error.as_deref().unwrap_or("objective undefined")
-                ),
+                format!("no valid design found: {metric} is undefined at the best point"),
             ));
         }
         // The paper's rule at the optimum's other variables.

@@ -13,8 +13,9 @@
 //! `contact.slider_bed.stiffness`, ...), set as `--set PATH=VALUE` would.
 //!
 //! With `w_s = sqrt(K_s/m_s)` (slider contact), `w_d = sqrt(K_d/m_d)` (damper contact),
-//! `w_ref` = [`Model::reference_omega`] and `m_b` = [`Model::bed_mass`] (or
-//! [`Sweep::bed_mass_kg`]), a point is built in this fixed order:
+//! `w_ref` = [`Model::reference_omega`] and `m_b` = [`Sweep::bed_mass_kg`] if given, else
+//! [`Model::bed_mass`] of the point's model (after step 1, so a varied bed mass or bed plate
+//! carries m_b with it), a point is built in this fixed order:
 //!
 //! 1. field paths, in the order given;
 //! 2. `ws/w_ref = r`: `w_s = r w_ref`, `K_s = m_s w_s w_s`;
@@ -22,6 +23,12 @@
 //!    otherwise `w_d = sqrt(K_d/m_d)` of the point so far;
 //! 4. `md/mb = r`: `m_d = r m_b`;
 //! 5. if a ratio in 3 or 4 was given: `K_d = m_d w_d w_d` (so `md/mb` keeps `w_d`).
+//!
+//! Field values are written as TOML literals of the field's kind ([`field_kind`]): a
+//! whole-number field (`structure.fem.machine.elements_per_side`) gets an integer literal and
+//! refuses a non-integral value, naming the field. A varied `simulation.*` field sets that
+//! point's integration options ([`point_options`]); a varied `simulation.duration` runs the
+//! point for its duration instead of stopping at the end of the collision.
 //!
 //! # Cost and reproducibility
 //!
@@ -372,7 +379,8 @@ pub struct Sweep {
     /// `stop_at_collision_end = true` (the sample rate then only serves the peak bed
     /// acceleration and floor force during the collision).
     pub options: Options,
-    /// m_b (kg) for `md/mb`; default [`Model::bed_mass`].
+    /// m_b (kg) for `md/mb`, when given (`--bed-mass`); `None`: each point's
+    /// [`Model::bed_mass`].
     pub bed_mass_kg: Option<f64>,
 }
 
@@ -391,6 +399,8 @@ pub struct SweepSpec {
     pub overrides: Vec<String>,
     pub vary: Vec<Vary>,
     pub method: &'static str,
+    /// The options every point starts from; a varied `simulation.*` column overrides its
+    /// setting per point (a varied duration also clears `stop_at_collision_end`).
     pub duration_s: f64,
     pub stop_at_collision_end: bool,
     pub sample_rate_hz: Option<f64>,
@@ -401,11 +411,18 @@ pub struct SweepSpec {
 
 impl Sweep {
     /// A sweep of `model` over the grid of `vary` (checked: quantities distinct, w_ref / m_b /
-    /// damper available where the ratios need them).
+    /// damper available where the ratios need them, field paths numeric, whole-number fields
+    /// given whole numbers). m_b is each point's [`Model::bed_mass`].
     pub fn new(model: Model, vary: Vec<Vary>) -> Result<Self> {
+        Self::with_bed_mass(model, vary, None)
+    }
+
+    /// [`Sweep::new`] with the bed mass m_b (kg) for `md/mb` given (`None`: each point's
+    /// [`Model::bed_mass`]). The given mass is applied before the quantities are checked.
+    pub fn with_bed_mass(model: Model, vary: Vec<Vary>, bed_mass_kg: Option<f64>) -> Result<Self> {
         let mut options = model.options();
         options.stop_at_collision_end = true;
-        let bed_mass_kg = model.bed_mass();
+        let bed_mass_kg = check_bed_mass(bed_mass_kg)?;
         let s = Sweep {
             model,
             vary,
@@ -435,7 +452,37 @@ impl Sweep {
             }
         }
         let qs: Vec<&Quantity> = self.vary.iter().map(|v| &v.quantity).collect();
-        check_quantities(&self.model, &qs, self.bed_mass_kg)
+        let m_b = self.bed_mass_kg.or_else(|| self.model.bed_mass());
+        check_quantities(&self.model, &qs, m_b)?;
+        let table = spec_table(&self.model)?;
+        for v in &self.vary {
+            if let Quantity::Field(p) = &v.quantity {
+                let kind = kind_in(&table, p, "--vary")?;
+                for &x in &v.values {
+                    field_literal(p, x, kind, "--vary")?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// When every point of `result` failed: that failure as an error (the first point's, with
+    /// its kind: an input error stays an input error), noting how many points failed. `None`
+    /// when at least one point succeeded.
+    pub fn all_failed_error(&self, result: &SweepResult) -> Option<Error> {
+        let first = result.points.first()?;
+        if result.failures() < result.points.len() {
+            return None;
+        }
+        Some(failure_error(
+            &self.model,
+            &self.quantities(),
+            &first.values,
+            self.bed_mass_kg,
+            first.error.as_deref().unwrap_or("failed"),
+            &format!("all {} points of the sweep failed", result.points.len()),
+            &format!("point {}", first.index),
+        ))
     }
 
     /// Number of grid points.
@@ -482,6 +529,13 @@ impl Sweep {
             &self.values_at(index),
             self.bed_mass_kg,
         )
+    }
+
+    /// The integration options of grid point `index`: [`Sweep::options`] with the point's
+    /// varied `simulation.*` fields ([`point_options`]).
+    pub fn point_options(&self, index: usize) -> Result<Options> {
+        let pm = self.point_model(index)?;
+        Ok(point_options(&self.options, &self.quantities(), &pm.model))
     }
 
     /// Simulates grid point `index`; failures become a [`PointResult`] with its error.
@@ -562,10 +616,14 @@ impl Sweep {
                 Method::Dopri5 => "dopri5",
             },
             duration_s: self.options.duration,
-            stop_at_collision_end: self.options.stop_at_collision_end,
+            stop_at_collision_end: self.options.stop_at_collision_end
+                && !self
+                    .vary
+                    .iter()
+                    .any(|v| v.quantity == Quantity::Field("simulation.duration".into())),
             sample_rate_hz: self.options.sample_rate,
             reference_omega_rad_per_s: self.model.reference_omega(),
-            bed_mass_kg: self.bed_mass_kg,
+            bed_mass_kg: self.bed_mass_kg.or_else(|| self.model.bed_mass()),
             columns: self.columns(),
         }
     }
@@ -791,6 +849,51 @@ fn format_row(r: &PointResult) -> String {
     s
 }
 
+/// A given bed mass must be a finite number > 0 kg.
+pub(crate) fn check_bed_mass(m: Option<f64>) -> Result<Option<f64>> {
+    match m {
+        Some(m) if !(m.is_finite() && m > 0.0) => Err(Error::invalid(
+            "bed mass",
+            format!("m_b must be a finite number > 0 kg (got {m})"),
+        )),
+        m => Ok(m),
+    }
+}
+
+/// The error of a failed point, with its kind: the point's model and impact system are built
+/// again and their error returned (an input error stays an input error); if they build, the
+/// failure was the run's, reported as a numerical error with the `recorded` message. `note`
+/// says how many points failed, `which` names the point shown (e.g. "point 0").
+pub(crate) fn failure_error(
+    base: &Model,
+    quantities: &[&Quantity],
+    values: &[f64],
+    bed_mass_kg: Option<f64>,
+    recorded: &str,
+    note: &str,
+    which: &str,
+) -> Error {
+    let tag = format!("{note}; this is {which}'s error");
+    let built = point_model(base, quantities, values, bed_mass_kg)
+        .and_then(|pm| pm.model.impact_system(Case::AsSpecified).map(|_| ()));
+    match built {
+        Err(Error::Input { location, message }) => Error::Input {
+            location,
+            message: format!("{message} ({tag})"),
+        },
+        Err(Error::InvalidValue { field, message }) => Error::InvalidValue {
+            field,
+            message: format!("{message} ({tag})"),
+        },
+        Err(Error::Numerical { context, message }) => Error::Numerical {
+            context,
+            message: format!("{message} ({tag})"),
+        },
+        Err(e @ Error::Io { .. }) => e,
+        Ok(()) => Error::numerical("sweep", format!("{note}; {which}: {recorded}")),
+    }
+}
+
 /// Checks that the quantities can be resolved on `model`.
 pub fn check_quantities(model: &Model, qs: &[&Quantity], bed_mass_kg: Option<f64>) -> Result<()> {
     let has = |q: &Quantity| qs.contains(&q);
@@ -818,14 +921,111 @@ pub fn check_quantities(model: &Model, qs: &[&Quantity], bed_mass_kg: Option<f64
     if has(&Quantity::MdOverMb) && !bed_mass_kg.is_some_and(|m| m > 0.0) {
         return Err(Error::invalid(
             "vary",
-            "md/mb needs the bed mass: the model has no lumped mass at the bed contact point; give --bed-mass",
+            "md/mb needs the bed mass m_b, which this model cannot tell (it can for a lumped mass at points.bed_contact, or the parametric FE machine struck on its bed plate); give --bed-mass KG",
         ));
     }
     Ok(())
 }
 
+/// The TOML table of a model's spec (what `--set` paths address).
+fn spec_table(model: &Model) -> Result<toml::Table> {
+    toml::Table::try_from(&model.spec)
+        .map_err(|e| Error::numerical("sweep", format!("cannot serialise the model: {e}")))
+}
+
+/// The type of a numeric model field: a real number or a whole number (a count or an index,
+/// e.g. `structure.fem.machine.elements_per_side`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FieldKind {
+    Real,
+    Whole,
+}
+
+fn kind_in(table: &toml::Table, path: &str, flag: &str) -> Result<FieldKind> {
+    use serde::Deserialize;
+    let probe = |raw: &str| -> std::result::Result<(), String> {
+        let mut t = table.clone();
+        crate::model::source::apply_override(&mut t, &format!("{path}={raw}"))
+            .map_err(|e| e.to_string())?;
+        crate::model::ModelSpec::deserialize(toml::Value::Table(t))
+            .map(|_| ())
+            .map_err(|e| {
+                let mut m = e.message().trim().to_string();
+                if let Some(h) = crate::model::source::did_you_mean(&m) {
+                    m.push_str(&h);
+                }
+                m
+            })
+    };
+    match probe("1.5") {
+        Ok(()) => Ok(FieldKind::Real),
+        Err(real) => match probe("1") {
+            Ok(()) => Ok(FieldKind::Whole),
+            Err(_) => Err(Error::Input {
+                location: format!("{flag} {path}"),
+                message: format!("`{path}` cannot be set to a number: {real}"),
+            }),
+        },
+    }
+}
+
+/// Whether the model field `path` takes a real or a whole number; an error naming the field
+/// when it is not a numeric field of the model (unknown key, a string, a table, ...).
+pub fn field_kind(model: &Model, path: &str) -> Result<FieldKind> {
+    kind_in(&spec_table(model)?, path, "--vary")
+}
+
+/// The TOML literal of value `v` for a field of kind `kind`: real numbers in shortest
+/// round-trip form (`{:e}`), whole numbers as integer literals (`8`, not `8e0`, which a
+/// whole-number field refuses); a non-integral value for a whole-number field is an error
+/// naming the field.
+pub fn field_literal(path: &str, v: f64, kind: FieldKind, flag: &str) -> Result<String> {
+    match kind {
+        FieldKind::Real => Ok(format!("{v:e}")),
+        FieldKind::Whole => {
+            // 2^53: every integer up to it is an exact f64.
+            if v.is_finite() && v.fract() == 0.0 && v.abs() <= 9_007_199_254_740_992.0 {
+                Ok(format!("{}", v as i64))
+            } else {
+                Err(Error::Input {
+                    location: format!("{flag} {path}={v}"),
+                    message: format!(
+                        "{path} takes a whole number (a count or an index); {v} is not one"
+                    ),
+                })
+            }
+        }
+    }
+}
+
+/// The integration options of a point: `options`, with the `[simulation]` fields the point
+/// varies (`simulation.duration`, `sample_rate`, `rtol`, `atol`) taken from the point's model.
+/// A varied `simulation.duration` also runs the point for its whole duration
+/// (`stop_at_collision_end = false`), as `--duration` does.
+pub fn point_options(options: &Options, quantities: &[&Quantity], model: &Model) -> Options {
+    let sim = &model.spec.simulation;
+    let mut o = *options;
+    for q in quantities {
+        let Quantity::Field(p) = q else { continue };
+        match p.as_str() {
+            "simulation.duration" => {
+                o.duration = sim.duration;
+                o.stop_at_collision_end = false;
+            }
+            "simulation.sample_rate" => o.sample_rate = Some(sim.sample_rate),
+            "simulation.rtol" => o.rtol = sim.rtol,
+            "simulation.atol" => o.atol = sim.atol,
+            _ => {}
+        }
+    }
+    o
+}
+
 /// Builds the model of one point: `base` with `quantities = values` resolved in the order of
 /// the module docs. The structure's modes are reused unless a `structure.` field is set.
+/// Field values are written as TOML literals of the field's kind ([`field_literal`]); the
+/// point's settings are checked as a model file's are.
 pub fn point_model(
     base: &Model,
     quantities: &[&Quantity],
@@ -834,15 +1034,16 @@ pub fn point_model(
 ) -> Result<PointModel> {
     let mut model = base.clone();
     // 1. Field paths.
-    let fields: Vec<String> = quantities
-        .iter()
-        .zip(values)
-        .filter_map(|(q, v)| match q {
-            Quantity::Field(p) => Some(format!("{p}={v:e}")),
-            _ => None,
-        })
-        .collect();
-    if !fields.is_empty() {
+    let has_fields = quantities.iter().any(|q| matches!(q, Quantity::Field(_)));
+    if has_fields {
+        let mut table = spec_table(base)?;
+        let mut fields: Vec<String> = Vec::new();
+        for (q, v) in quantities.iter().zip(values) {
+            if let Quantity::Field(p) = q {
+                let kind = kind_in(&table, p, "--vary")?;
+                fields.push(format!("{p}={}", field_literal(p, *v, kind, "--vary")?));
+            }
+        }
         let structural = quantities
             .iter()
             .any(|q| matches!(q, Quantity::Field(p) if p.starts_with("structure")));
@@ -856,8 +1057,6 @@ pub fn point_model(
             ov.extend(fields);
             model = Model::from_text(&base.source.name, base.source.text.clone(), &ov)?;
         } else {
-            let mut table = toml::Table::try_from(&base.spec)
-                .map_err(|e| Error::numerical("sweep", format!("cannot serialise model: {e}")))?;
             for f in &fields {
                 let applied = crate::model::source::apply_override(&mut table, f)?;
                 model.source.overrides.push(applied);
@@ -874,10 +1073,12 @@ pub fn point_model(
                         message: e.message().trim().to_string(),
                     }
                 })?;
+            model.validate_settings()?;
         }
     }
     let get = |q: Quantity| quantities.iter().position(|x| **x == q).map(|i| values[i]);
     let w_ref = model.reference_omega();
+    let m_b = bed_mass_kg.or_else(|| model.bed_mass());
     let spec = &mut model.spec;
     let m_s = spec.slider.mass;
     // 2. w_s.
@@ -906,7 +1107,9 @@ pub fn point_model(
             None => (c.stiffness / d.mass).sqrt(),
         };
         if let Some(r) = md_ratio {
-            let m_b = bed_mass_kg.ok_or_else(|| Error::invalid("vary", "md/mb needs m_b"))?;
+            let m_b = m_b.ok_or_else(|| {
+                Error::invalid("vary", "md/mb needs the bed mass m_b: give --bed-mass KG")
+            })?;
             d.mass = r * m_b;
         }
         c.stiffness = d.mass * w_d * w_d;
@@ -947,10 +1150,11 @@ pub fn evaluate(
             }
         }
     };
+    let options = point_options(options, quantities, &pm.model);
     let run = pm
         .model
         .impact_system(Case::AsSpecified)
-        .and_then(|sys| simulate(&sys, options, false));
+        .and_then(|sys| simulate(&sys, &options, false));
     match run {
         Ok(run) => {
             let mut metrics = summary_metrics(&run.summary);

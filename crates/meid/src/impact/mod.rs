@@ -290,14 +290,15 @@ pub struct ImpactSystem {
 }
 
 /// What (if anything) is attached to the bed to reduce the blow's effect.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Absorber {
     /// Nothing: the bare machine.
     None,
     /// A momentum-exchange impact damper with its bed-damper contact.
     Damper(Damper, Contact),
-    /// A rigid mass (kg) fixed to the bed at O_b.
-    AddedMass(f64),
+    /// A rigid mass `mass_kg` (kg) fixed to the named structure point `point` (O_b, the
+    /// floating base O_f, ...), added by [`ModalModel::with_point_mass`].
+    AddedMass { mass_kg: f64, point: String },
 }
 
 impl ImpactSystem {
@@ -330,9 +331,20 @@ impl ImpactSystem {
                 check_contact("contact.bed_damper", &c)?;
                 (structure.clone(), Some(d), Some(c), 0.0)
             }
-            Absorber::AddedMass(m) => {
-                check_positive("added_mass.mass", m, "kg")?;
-                (structure.with_point_mass(bed_contact, m)?, None, None, m)
+            Absorber::AddedMass { mass_kg, point } => {
+                check_positive("added_mass.mass", mass_kg, "kg")?;
+                structure.point(&point).map_err(|e| match e {
+                    Error::InvalidValue { message, .. } => {
+                        Error::invalid("added_mass.point", message)
+                    }
+                    other => other,
+                })?;
+                (
+                    structure.with_point_mass(&point, mass_kg)?,
+                    None,
+                    None,
+                    mass_kg,
+                )
             }
         };
         let points = Points {

@@ -1,7 +1,7 @@
 //! Model files: TOML in, a validated [`Model`] out.
 //!
-//! A model names a structure, the slider, an impact damper or an added mass (or neither),
-//! the two contacts and the simulation settings. See `docs/model-format.md` for the full
+//! A model names a structure, the slider, an impact damper and/or an added mass at a named
+//! point (or neither), the two contacts and the simulation settings. See `docs/model-format.md` for the full
 //! reference and `examples/paper-lumped.toml` for a complete file.
 //!
 //! # Units (SI throughout; field names carry no suffix except `frequencies_hz`)
@@ -60,7 +60,8 @@ pub enum Case {
     NoDamper,
     /// The impact damper of the file.
     Damper,
-    /// The damper's mass (or the file's added mass) fixed to the bed.
+    /// A rigid added mass ([`Model::added_mass`]: `added_mass.mass`, else the damper's mass,
+    /// at `added_mass.point`, else the bed contact point).
     AddedMass,
 }
 
@@ -157,6 +158,15 @@ impl Model {
     }
 
     fn validate(&self) -> Result<()> {
+        self.validate_settings()?;
+        // Everything the impact system checks (masses, stiffnesses, ...), with positions.
+        self.impact_system(Case::AsSpecified).map(|_| ())
+    }
+
+    /// The checks of [`Model::from_text`] that do not build the impact system: reference mode,
+    /// `[added_mass]`, named points and `[simulation]` (used again on the models of sweep
+    /// points, whose fields are set after the file was read).
+    pub(crate) fn validate_settings(&self) -> Result<()> {
         let s = &self.spec;
         let src = &self.source;
         let n = self.structure.len();
@@ -168,11 +178,13 @@ impl Model {
                 ));
             }
         }
-        if s.damper.is_some() && s.added_mass.is_some() {
-            return Err(src.error(
-                "added_mass",
-                "give either [damper] or [added_mass], not both",
-            ));
+        if let Some(a) = &s.added_mass {
+            if a.mass.is_none() && s.damper.is_none() {
+                return Err(src.error(
+                    "added_mass",
+                    "added_mass.mass is missing: give the added mass in kg (it defaults to the damper's mass only when the model has a [damper])",
+                ));
+            }
         }
         if s.damper.is_some() && s.contact.bed_damper.is_none() {
             return Err(src.error(
@@ -184,6 +196,10 @@ impl Model {
             ("points.bed_contact", Some(&s.points.bed_contact)),
             ("points.measurement", Some(&s.points.measurement)),
             ("points.damper_anchor", s.points.damper_anchor.as_ref()),
+            (
+                "added_mass.point",
+                s.added_mass.as_ref().and_then(|a| a.point.as_ref()),
+            ),
         ] {
             let Some(name) = name else { continue };
             if role == "points.damper_anchor" && name == "ground" {
@@ -229,8 +245,7 @@ impl Model {
                 format!("simulation.atol must be > 0 (got {})", sim.atol),
             ));
         }
-        // Everything the impact system checks (masses, stiffnesses, ...), with positions.
-        self.impact_system(Case::AsSpecified).map(|_| ())
+        Ok(())
     }
 
     /// The impact system for a case.
@@ -257,15 +272,19 @@ impl Model {
             )),
             _ => None,
         };
-        let added = s
-            .added_mass
-            .as_ref()
-            .map(|a| a.mass)
-            .or(damper.map(|d| d.0.mass));
+        let added = self.added_mass();
         let absorber = match case {
             Case::AsSpecified => match (&damper, &s.added_mass) {
                 (Some((d, c)), _) => Absorber::Damper(*d, *c),
-                (None, Some(a)) => Absorber::AddedMass(a.mass),
+                (None, Some(_)) => {
+                    let (mass_kg, point) = added.ok_or_else(|| {
+                        self.source.error(
+                            "added_mass",
+                            "added_mass.mass is missing: give the added mass in kg",
+                        )
+                    })?;
+                    Absorber::AddedMass { mass_kg, point }
+                }
                 _ => Absorber::None,
             },
             Case::NoDamper => Absorber::None,
@@ -279,7 +298,7 @@ impl Model {
                 }
             },
             Case::AddedMass => match added {
-                Some(m) => Absorber::AddedMass(m),
+                Some((mass_kg, point)) => Absorber::AddedMass { mass_kg, point },
                 None => {
                     return Err(Error::invalid(
                         "added_mass",
@@ -342,15 +361,44 @@ impl Model {
             .map(|r| self.structure.omega_rad_per_s[r - 1])
     }
 
-    /// Bed mass m_b (kg) for mass ratios: the lumped mass at the bed contact point, else
-    /// `1/ψ_b²` of the reference mode (its modal mass seen at O_b).
+    /// The added mass of the "added mass" case, `(m_a (kg), point)`: `added_mass.mass`, else the
+    /// damper's mass m_d; at `added_mass.point`, else `points.bed_contact`. `None` when the
+    /// model has neither `[added_mass]` nor `[damper]`.
+    pub fn added_mass(&self) -> Option<(f64, String)> {
+        let s = &self.spec;
+        let a = s.added_mass.clone().unwrap_or_default();
+        let mass = a.mass.or(s.damper.as_ref().map(|d| d.mass))?;
+        let point = a.point.unwrap_or_else(|| s.points.bed_contact.clone());
+        Some((mass, point))
+    }
+
+    /// Bed mass m_b (kg) for the mass ratio `md/mb`, when the model can tell:
+    ///
+    /// * `[structure.lumped]`: the mass named by `points.bed_contact`;
+    /// * `[structure.fem.machine]` with `points.bed_contact` on the bed plate (`O_b` or `B`):
+    ///   the bed plate's mass `ρ L_x L_y t` (exactly the sum of its shell elements' masses)
+    ///   plus the `added_masses` on plate `"bed"`;
+    /// * otherwise (`[structure.modal]`, Gmsh meshes, a contact point elsewhere) `None`: give it
+    ///   (`--bed-mass`).
     pub fn bed_mass(&self) -> Option<f64> {
-        if let Some(l) = &self.spec.structure.lumped {
-            return l
-                .masses
+        let st = &self.spec.structure;
+        let contact = self.spec.points.bed_contact.as_str();
+        if let Some(l) = &st.lumped {
+            return l.masses.iter().find(|m| m.name == contact).map(|m| m.mass);
+        }
+        if let Some(m) = st.fem.as_ref().and_then(|f| f.machine.as_ref()) {
+            if contact != "O_b" && contact != "B" {
+                return None;
+            }
+            let spec = fem::machine_spec(m).ok()?;
+            let added: f64 = spec
+                .added_masses
                 .iter()
-                .find(|m| m.name == self.spec.points.bed_contact)
-                .map(|m| m.mass);
+                .filter(|a| a.plate == crate::structure::machine::Plate::Bed)
+                .map(|a| a.mass_kg)
+                .sum();
+            let m_b = spec.bed.mass_kg() + added;
+            return (m_b.is_finite() && m_b > 0.0).then_some(m_b);
         }
         None
     }

@@ -162,11 +162,21 @@ pub struct DamperSpec {
     pub dashpot: DashpotKindSpec,
 }
 
-#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+/// `[added_mass]`: a rigid mass fixed to a named point of the structure.
+///
+/// Without a `[damper]` it is the absorber of the model (`mass` required). With a `[damper]` it
+/// only sets the "added mass" case of comparisons (`meid compare`, `--case added-mass`):
+/// `mass` then defaults to the damper's mass m_d.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq, Default)]
 #[serde(deny_unknown_fields)]
 pub struct AddedMassSpec {
-    /// kg, fixed to the bed at the contact point.
-    pub mass: f64,
+    /// kg. Required without a `[damper]`; with one, default m_d.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mass: Option<f64>,
+    /// The named structure point the mass is fixed to (default `points.bed_contact`), e.g. the
+    /// floating base (paper Figs. 10-11: "add a mass on the bed or floating base").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point: Option<String>,
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
