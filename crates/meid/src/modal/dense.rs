@@ -2,7 +2,8 @@
 //!
 //! Hand-written because faer 0.24 has no generalised *symmetric* eigen-solver (its
 //! `generalized_eigen` is a general QZ, complex and ~10x slower); the symmetric eigen-decomposition
-//! itself is faer's. Two reductions to a standard symmetric problem:
+//! itself is faer's, called sequentially so that the result does not depend on the thread count
+//! (the products `K Φ`, `M Φ`, `Φᵀ M Φ` are parallel over fixed row chunks, `modal::kernels`). Two reductions to a standard symmetric problem:
 //!
 //! * **Diagonal M** (lumped masses): `C = M^(-1/2) K M^(-1/2)`, a diagonal similarity that loses
 //!   nothing; `φ = M^(-1/2) y`.
@@ -39,8 +40,9 @@
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
-use faer::{Mat, MatRef, Par, Side};
+use faer::{Mat, MatRef, Par};
 
+use super::kernels;
 use crate::{Error, Result};
 
 /// Mass-normalised modes of a dense symmetric pencil (K, M).
@@ -156,14 +158,8 @@ fn solve_diagonal_mass(k: MatRef<'_, f64>, m: MatRef<'_, f64>) -> Result<DenseMo
     let s: Vec<f64> = (0..n).map(|i| 1.0 / m[(i, i)].sqrt()).collect();
     let mut c = Mat::<f64>::from_fn(n, n, |i, j| s[i] * k[(i, j)] * s[j]);
     symmetrise(&mut c);
-    let evd = c.self_adjoint_eigen(Side::Lower).map_err(|e| {
-        Error::numerical(
-            "dense eigen-solver",
-            format!("symmetric eigen-decomposition failed: {e:?}"),
-        )
-    })?;
-    let eigenvalues: Vec<f64> = (0..n).map(|i| evd.S()[i]).collect();
-    let shapes = Mat::<f64>::from_fn(n, n, |i, j| s[i] * evd.U()[(i, j)]);
+    let (eigenvalues, u) = kernels::self_adjoint_eigen(c.as_ref(), "dense eigen-solver")?;
+    let shapes = Mat::<f64>::from_fn(n, n, |i, j| s[i] * u[(i, j)]);
     let lam_max = eigenvalues.iter().fold(0.0_f64, |a, &b| a.max(b.abs()));
     let mut rigid = 0;
     let mut omega = Vec::with_capacity(n);
@@ -216,31 +212,26 @@ pub fn solve_shift_invert(
         .map(|i| 1.0 / (k[(i, i)] + sigma * m[(i, i)]).sqrt())
         .collect();
     let a = Mat::<f64>::from_fn(n, n, |i, j| d[i] * (k[(i, j)] + sigma * m[(i, j)]) * d[j]);
-    let llt = a.llt(Side::Lower).map_err(|_| {
+    let l = kernels::llt_lower(a.as_ref()).ok_or_else(|| {
         Error::numerical(
             "dense eigen-solver",
             "K + σM is not positive definite: the mass matrix is not positive definite or the stiffness is not positive semi-definite",
         )
     })?;
-    let l = llt.L();
+    let l = l.as_ref();
     let mut x = Mat::<f64>::from_fn(n, n, |i, j| d[i] * m[(i, j)] * d[j]);
     solve_lower_triangular_in_place(l, x.as_mut(), Par::Seq);
     let mut c = x.transpose().to_owned();
     solve_lower_triangular_in_place(l, c.as_mut(), Par::Seq);
     symmetrise(&mut c);
-    let evd = c.self_adjoint_eigen(Side::Lower).map_err(|e| {
-        Error::numerical(
-            "dense eigen-solver",
-            format!("symmetric eigen-decomposition failed: {e:?}"),
-        )
-    })?;
-    let mu_max = evd.S()[n - 1];
+    let (mu_all, u) = kernels::self_adjoint_eigen(c.as_ref(), "dense eigen-solver")?;
+    let mu_max = mu_all[n - 1];
     // Ascending λ = descending μ.
     let mut eigenvalues = Vec::with_capacity(n);
     let mut y = Mat::<f64>::zeros(n, n);
     for col in 0..n {
         let i = n - 1 - col;
-        let mu = evd.S()[i];
+        let mu = mu_all[i];
         if mu.is_nan() || mu <= 1e-300 * mu_max.max(1e-300) {
             return Err(Error::numerical(
                 "dense eigen-solver",
@@ -250,7 +241,7 @@ pub fn solve_shift_invert(
         eigenvalues.push(1.0 / mu - sigma);
         let s = 1.0 / mu.sqrt();
         for r in 0..n {
-            y[(r, col)] = evd.U()[(r, i)] * s;
+            y[(r, col)] = u[(r, i)] * s;
         }
     }
     solve_upper_triangular_in_place(l.transpose(), y.as_mut(), Par::Seq);
@@ -285,8 +276,8 @@ fn finish(
     sigma: f64,
 ) -> DenseModes {
     let n = shapes.ncols();
-    let mm = m * &shapes;
-    let gram = shapes.transpose() * &mm;
+    let mm = kernels::mul_rows(m, shapes.as_ref());
+    let gram = kernels::mul_tn(shapes.as_ref(), mm.as_ref());
     let mut orth = 0.0_f64;
     for j in 0..n {
         for i in 0..n {
@@ -294,7 +285,7 @@ fn finish(
             orth = orth.max((gram[(i, j)] - target).abs());
         }
     }
-    let km = k * &shapes;
+    let km = kernels::mul_rows(k, shapes.as_ref());
     let max_residual = (0..n)
         .map(|j| residual(km.col(j).iter(), mm.col(j).iter(), eigenvalues[j], sigma))
         .fold(0.0_f64, f64::max);
@@ -362,12 +353,12 @@ pub fn mode_residuals(
                 format!("mode index {j} out of range (0..{})", modes.shapes.ncols()),
             ));
         }
-        let phi = modes.shapes.col(j);
-        let kphi = k * phi;
-        let mphi = m * phi;
+        let phi = modes.shapes.get(.., j..j + 1);
+        let kphi = kernels::mul(k, phi);
+        let mphi = kernels::mul(m, phi);
         out.push(residual(
-            kphi.iter(),
-            mphi.iter(),
+            kphi.col(0).iter(),
+            mphi.col(0).iter(),
             modes.eigenvalues[j],
             sigma,
         ));

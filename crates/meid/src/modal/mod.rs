@@ -14,8 +14,13 @@
 //!
 //! Submodules: [`dense`] (dense generalised symmetric eigen-solver), [`lanczos`]
 //! (sparse shift-invert block Lanczos for large models).
+//!
+//! Every result of this module is bit-identical for any number of rayon threads: faer is
+//! called with `Par::Seq` only, and the parallel parts cut their work into chunks of a fixed
+//! size and combine them in index order (`kernels`).
 
 pub mod dense;
+pub(crate) mod kernels;
 pub mod lanczos;
 
 use std::collections::BTreeMap;

@@ -299,9 +299,10 @@ pub(crate) fn block_rotation(axes: &[V3; 3], blocks: usize) -> Mat<f64> {
     t
 }
 
-/// `Tᵀ A T`, symmetrised.
+/// `Tᵀ A T`, symmetrised (sequential products: faer's `*` would follow the global parallelism).
 pub(crate) fn to_global(a: &Mat<f64>, t: &Mat<f64>) -> Mat<f64> {
-    let mut g = t.transpose() * a * t;
+    use crate::modal::kernels::mul;
+    let mut g = mul(mul(t.transpose(), a.as_ref()).as_ref(), t.as_ref());
     let n = g.nrows();
     for j in 0..n {
         for i in 0..j {

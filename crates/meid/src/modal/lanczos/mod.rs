@@ -73,19 +73,28 @@
 //! plus any further Ritz values in the gap, e.g. the rest of a multiple eigenvalue); otherwise
 //! a mode was missed and an error is returned. See `lanczos/shifted.rs` for how D is read from
 //! faer's factor (faer 0.24 has no accessor for it).
+//!
+//! # Threads
+//! The result is bit-identical for any number of rayon threads. The factorisations, solves and
+//! small dense eigen-problems run sequentially (`Par::Seq`); the sparse products parallelise
+//! over rows, each row summed by one task in storage order; the tall products with the basis
+//! (`V Y`, `(M V)ᵀ W`, `W - V C`, `Xᵀ K X`) are cut into row chunks of a fixed size and their
+//! reductions summed in chunk order (`modal::kernels`). Before, faer's parallel kernels split
+//! their reductions by the thread count and the iteration amplified the last-bit differences to
+//! 1e-9 in the paper machine's lowest frequency.
 
 mod block;
 mod shifted;
 
-use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
 use faer::sparse::SparseColMatRef;
-use faer::{Accum, Mat, MatRef, Par, Side};
+use faer::{Accum, Mat, Par};
 
 use std::time::Instant;
 
+use super::kernels::{self, mul, mul_rows, mul_rows_into, mul_tn};
 use crate::rng::SplitMix64;
 use crate::{Error, Result};
 use block::{fill_random, m_norm, norm2, project_column, sym_matmul};
@@ -279,7 +288,9 @@ pub fn lowest_modes(
         ));
     }
 
-    let par = faer::get_global_parallelism();
+    // Sequential factorisations: faer's parallel supernodal kernels split their reductions by the
+    // thread count (the results' last bits would change with it, see `modal::kernels`).
+    let par = Par::Seq;
     let mut stats = LanczosStats {
         basis_size: basis,
         ..Default::default()
@@ -301,7 +312,7 @@ pub fn lowest_modes(
         for c in 0..b {
             w.col_mut(c).copy_from(fill_random(&mut rng, n));
         }
-        st.append_block(w, m, &mut rng, &mut stats, false, Par::Seq)?;
+        st.append_block(w, m, &mut rng, &mut stats, false)?;
     }
 
     let mut tol_op = opts.tol;
@@ -317,7 +328,7 @@ pub fn lowest_modes(
             stats.block_steps += 1;
             stats.solve_s += clock.elapsed().as_secs_f64();
             let clock = Instant::now();
-            st.append_block(w, m, &mut rng, &mut stats, true, Par::Seq)?;
+            st.append_block(w, m, &mut rng, &mut stats, true)?;
             stats.orthogonalise_s += clock.elapsed().as_secs_f64();
         }
         stats.cycles += 1;
@@ -325,7 +336,7 @@ pub fn lowest_modes(
 
         // Rayleigh-Ritz on the projected operator.
         let (theta, y) = st.ritz()?;
-        let coupling = st.h.get(basis..basis + b, ..basis) * &y; // b × basis
+        let coupling = mul(st.h.get(basis..basis + b, ..basis), y.as_ref()); // b × basis
         let res: Vec<f64> = (0..basis).map(|i| norm2(coupling.col(i))).collect();
         let n_conv = (0..want)
             .take_while(|&i| res[i] <= tol_op * theta[i])
@@ -333,7 +344,7 @@ pub fn lowest_modes(
         best_converged = best_converged.max(n_conv);
 
         if n_conv == want {
-            let x = mul(st.v.get(.., ..basis), y.get(.., ..want));
+            let x = mul_rows(st.v.get(.., ..basis), y.get(.., ..want));
             let fin = finalize(k, m, x, s_ref, &mut stats)?;
             stats.ritz_s += clock.elapsed().as_secs_f64();
             clock = Instant::now();
@@ -382,14 +393,14 @@ pub fn lowest_modes(
             stats.factorizations += 1;
             stats.reshifts += 1;
             // New start block: the Ritz vectors folded into b columns.
-            let x = mul(st.v.get(.., ..basis), y.get(.., ..basis.min(want + b)));
+            let x = mul_rows(st.v.get(.., ..basis), y.get(.., ..basis.min(want + b)));
             let mut w = Mat::<f64>::zeros(n, b);
             for i in 0..x.ncols() {
                 let mut col = w.col_mut(i % b);
                 col += x.col(i);
             }
             st.reset();
-            st.append_block(w, m, &mut rng, &mut stats, false, Par::Seq)?;
+            st.append_block(w, m, &mut rng, &mut stats, false)?;
             continue;
         }
 
@@ -585,7 +596,6 @@ impl Basis {
         rng: &mut SplitMix64,
         stats: &mut LanczosStats,
         is_image: bool,
-        par: Par,
     ) -> Result<()> {
         let n = w.nrows();
         let b = self.b;
@@ -593,23 +603,15 @@ impl Basis {
         let mut coef_v = Mat::<f64>::zeros(nv, b);
         let mut norm2_removed = vec![0.0; b];
         if nv > 0 {
-            let mut c = Mat::<f64>::zeros(nv, b);
             for _pass in 0..2 {
-                matmul(
-                    c.as_mut(),
-                    Accum::Replace,
-                    self.mv.get(.., ..nv).transpose(),
-                    w.as_ref(),
-                    1.0,
-                    par,
-                );
-                matmul(
+                // C = (M V)ᵀ W, W -= V C: row chunks of fixed size, thread-count independent.
+                let c = mul_tn(self.mv.get(.., ..nv), w.as_ref());
+                mul_rows_into(
                     w.as_mut(),
                     Accum::Add,
                     self.v.get(.., ..nv),
                     c.as_ref(),
                     -1.0,
-                    par,
                 );
                 coef_v += &c;
             }
@@ -725,14 +727,9 @@ impl Basis {
                 t[(j, i)] = s;
             }
         }
-        let evd = t.self_adjoint_eigen(Side::Lower).map_err(|e| {
-            Error::numerical(
-                "sparse eigen-solver",
-                format!("eigen-decomposition of the projected matrix failed: {e:?}"),
-            )
-        })?;
-        let theta: Vec<f64> = (0..m).rev().map(|i| evd.S()[i]).collect();
-        let u = evd.U();
+        let (s, u) =
+            kernels::self_adjoint_eigen(t.as_ref(), "sparse eigen-solver (projected matrix)")?;
+        let theta: Vec<f64> = (0..m).rev().map(|i| s[i]).collect();
         let y = Mat::from_fn(m, m, |i, j| u[(i, m - 1 - j)]);
         Ok((theta, y))
     }
@@ -750,8 +747,8 @@ impl Basis {
         let q = ((m - want) / (2 * b)).max(1);
         let l = m - q * b;
         let yl = y.get(.., ..l);
-        let nv_new = mul(self.v.get(.., ..m), yl);
-        let nmv_new = mul(self.mv.get(.., ..m), yl);
+        let nv_new = mul_rows(self.v.get(.., ..m), yl);
+        let nmv_new = mul_rows(self.mv.get(.., ..m), yl);
         self.v.get_mut(.., ..l).copy_from(&nv_new);
         self.mv.get_mut(.., ..l).copy_from(&nmv_new);
         let res_v = self.v.get(.., m..m + b).to_owned();
@@ -794,34 +791,28 @@ fn finalize(
     sym_matmul(k, x.as_ref(), kx.as_mut());
     sym_matmul(m, x.as_ref(), mx.as_mut());
     stats.matvec_columns += 2 * p;
-    let a = symmetrised(mul(x.transpose(), kx.as_ref()));
-    let bm = symmetrised(mul(x.transpose(), mx.as_ref()));
-    let llt = bm.llt(Side::Lower).map_err(|_| {
+    let a = symmetrised(mul_tn(x.as_ref(), kx.as_ref()));
+    let bm = symmetrised(mul_tn(x.as_ref(), mx.as_ref()));
+    let l = kernels::llt_lower(bm.as_ref()).ok_or_else(|| {
         Error::numerical(
             "sparse eigen-solver",
             "Ritz vectors are not M-independent (lost orthogonality)",
         )
     })?;
-    let l = llt.L();
+    let l = l.as_ref();
     let mut t = a.clone();
     solve_lower_triangular_in_place(l, t.as_mut(), Par::Seq);
     let mut c = t.transpose().to_owned();
     solve_lower_triangular_in_place(l, c.as_mut(), Par::Seq);
     let c = symmetrised(c);
-    let evd = c.self_adjoint_eigen(Side::Lower).map_err(|e| {
-        Error::numerical(
-            "sparse eigen-solver",
-            format!("Rayleigh-Ritz eigen-decomposition failed: {e:?}"),
-        )
-    })?;
-    let eigenvalues: Vec<f64> = (0..p).map(|i| evd.S()[i]).collect();
-    let mut g = evd.U().to_owned();
+    let (eigenvalues, mut g) =
+        kernels::self_adjoint_eigen(c.as_ref(), "sparse eigen-solver (Rayleigh-Ritz)")?;
     solve_upper_triangular_in_place(l.transpose(), g.as_mut(), Par::Seq);
-    let shapes = mul(x.as_ref(), g.as_ref());
+    let shapes = mul_rows(x.as_ref(), g.as_ref());
     sym_matmul(k, shapes.as_ref(), kx.as_mut());
     sym_matmul(m, shapes.as_ref(), mx.as_mut());
     stats.matvec_columns += 2 * p;
-    let gram = mul(shapes.transpose(), mx.as_ref());
+    let gram = mul_tn(shapes.as_ref(), mx.as_ref());
     let mut orth = 0.0_f64;
     for j in 0..p {
         for i in 0..p {
@@ -853,13 +844,6 @@ fn finalize(
         residuals,
         orthonormality_error: orth,
     })
-}
-
-/// `a b` with a sequential kernel (faer's parallel GEMM stalls on a loaded 2-core machine).
-fn mul(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
-    let mut c = Mat::<f64>::zeros(a.nrows(), b.ncols());
-    matmul(c.as_mut(), Accum::Replace, a, b, 1.0, Par::Seq);
-    c
 }
 
 fn symmetrised(mut a: Mat<f64>) -> Mat<f64> {

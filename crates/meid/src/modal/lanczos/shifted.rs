@@ -119,7 +119,9 @@ impl ShiftedPencil {
             .collect()
     }
 
-    /// Cholesky factorisation of `K - σ M` (parallel as `par`; its solves are sequential).
+    /// Cholesky factorisation of `K - σ M` (parallel as `par`; its solves are sequential). The
+    /// solver passes `Par::Seq`: faer's parallel supernodal kernels make the factor's last bits
+    /// depend on the thread count.
     /// Fails if the matrix is not numerically positive definite.
     pub(crate) fn factor_llt(&self, sigma: f64, par: Par) -> Result<ShiftedLlt<'_>> {
         let values = self.shifted_values(sigma);
