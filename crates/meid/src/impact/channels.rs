@@ -172,58 +172,81 @@ impl ChannelMap {
     /// zero in `mode` (an open contact's force, the dashpot while it does not act) gets the
     /// zero vector.
     pub fn vectors(&self, sys: &ImpactSystem, mode: Mode) -> Option<[Vec<f64>; N_CHANNELS]> {
+        let m = 2 * sys.dofs();
+        let mut flat = vec![0.0; N_CHANNELS * m];
+        self.vectors_into(sys, mode, &mut flat)?;
+        let mut rows = flat.chunks_exact(m).map(<[f64]>::to_vec);
+        Some(std::array::from_fn(|_| rows.next().unwrap_or_default()))
+    }
+
+    /// [`Self::vectors`] without allocating: channel `c`'s vector into
+    /// `out[c·2·dofs .. (c+1)·2·dofs]` (`out` of length `N_CHANNELS · 2 · dofs`, overwritten).
+    /// `None` (with `out` partly written) when a closed contact of `mode` is non-linear.
+    ///
+    /// # Panics
+    /// When `out` has the wrong length.
+    pub fn vectors_into(&self, sys: &ImpactSystem, mode: Mode, out: &mut [f64]) -> Option<()> {
         let n = sys.n_modes();
         let nd = sys.dofs();
-        let zero = || vec![0.0; 2 * nd];
+        let m = 2 * nd;
+        assert_eq!(out.len(), N_CHANNELS * m, "channel vector buffer");
+        out.fill(0.0);
+        let row = |c: Channel| c.index() * m;
         // f = K aᵀx + C aᵀẋ of a closed linear contact.
-        let contact = |s: Switch| -> Option<Vec<f64>> {
-            let mut l = zero();
+        for (s, c) in [
+            (Switch::SliderBed, Channel::ContactSliderBed),
+            (Switch::BedDamper, Channel::ContactBedDamper),
+        ] {
             if s == Switch::BedDamper && sys.damper.is_none() || !mode.on(s) {
-                return Some(l);
+                continue;
             }
             let ContactLaw::Linear { stiffness, damping } = sys.contact(s).law else {
                 return None;
             };
             let a = sys.relative_vector(s);
+            let l = &mut out[row(c)..row(c) + m];
             for i in 0..nd {
                 l[i] = stiffness * a[i];
                 l[nd + i] = damping * a[i];
             }
-            Some(l)
-        };
-        let fbs = contact(Switch::SliderBed)?;
-        let fbd = contact(Switch::BedDamper)?;
-        let (mut spring, mut dashpot) = (zero(), zero());
+        }
         if let Some(d) = &sys.damper {
             let a = sys.relative_vector(Switch::Dashpot);
             let on = d.dashpot == DashpotKind::TwoWay || mode.on(Switch::Dashpot);
+            let (rs, rd) = (row(Channel::DamperSpring), row(Channel::DamperDashpot));
             for i in 0..nd {
-                spring[i] = d.stiffness * a[i];
+                out[rs + i] = d.stiffness * a[i];
                 if on {
-                    dashpot[nd + i] = d.damping * a[i];
+                    out[rd + nd + i] = d.damping * a[i];
                 }
             }
         }
-        let ffd: Vec<f64> = spring.iter().zip(&dashpot).map(|(a, b)| a + b).collect();
         let phi = &sys.points.measurement;
-        let mut disp = zero();
-        let mut vel = zero();
-        let mut acc = zero();
-        let mut floor = zero();
-        disp[..n].copy_from_slice(phi);
-        vel[nd..nd + n].copy_from_slice(phi);
-        acc[..n].copy_from_slice(&self.acc_q);
-        acc[nd..nd + n].copy_from_slice(&self.acc_v);
-        floor[..n].copy_from_slice(&sys.floor.stiffness);
-        floor[nd..nd + n].copy_from_slice(&sys.floor.damping);
+        let (rx, rv, ra, rf) = (
+            row(Channel::BedDisplacement),
+            row(Channel::BedVelocity),
+            row(Channel::BedAcceleration),
+            row(Channel::FloorForce),
+        );
+        out[rx..rx + n].copy_from_slice(phi);
+        out[rv + nd..rv + nd + n].copy_from_slice(phi);
+        out[ra..ra + n].copy_from_slice(&self.acc_q);
+        out[ra + nd..ra + nd + n].copy_from_slice(&self.acc_v);
+        out[rf..rf + n].copy_from_slice(&sys.floor.stiffness);
+        out[rf + nd..rf + nd + n].copy_from_slice(&sys.floor.damping);
         let anchored_to_ground = sys.damper.is_some() && sys.points.damper_anchor.is_none();
-        for i in 0..2 * nd {
-            acc[i] +=
-                self.acc_contact * (fbs[i] - fbd[i]) + self.acc_damper * (spring[i] + dashpot[i]);
+        let (rbs, rbd) = (
+            row(Channel::ContactSliderBed),
+            row(Channel::ContactBedDamper),
+        );
+        let (rs, rd) = (row(Channel::DamperSpring), row(Channel::DamperDashpot));
+        for i in 0..m {
+            let ffd = out[rs + i] + out[rd + i];
+            out[ra + i] += self.acc_contact * (out[rbs + i] - out[rbd + i]) + self.acc_damper * ffd;
             if anchored_to_ground {
-                floor[i] += ffd[i];
+                out[rf + i] += ffd;
             }
         }
-        Some([disp, vel, acc, floor, fbs, fbd, spring, dashpot])
+        Some(())
     }
 }

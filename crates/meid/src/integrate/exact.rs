@@ -37,7 +37,7 @@ use super::roots::{Scalar, Search, SearchOptions};
 use super::switching::{ModeSelector, MODES};
 use super::taylor::{self, Poly, TaylorMatrix};
 use super::{CollisionEnd, Event, Grid, Observer, Options, PathPoint, Solution, Totals};
-use crate::impact::{ChannelMap, ImpactSystem, Mode, Switch, CHANNELS};
+use crate::impact::{ChannelMap, ImpactSystem, Mode, Switch, CHANNELS, N_CHANNELS};
 use crate::{Error, Result};
 
 struct ModeData {
@@ -121,6 +121,7 @@ pub fn solve_from(
     let map = ChannelMap::new(sys);
     let mut channels: [Option<ModeChannels>; MODES] = Default::default();
     let mut chan_poly = [0.0; taylor::ORDER + 1];
+    let mut chan_buf = Vec::new();
     let mut path = vec![PathPoint {
         t: 0.0,
         mode,
@@ -184,12 +185,20 @@ pub fn solve_from(
                     totals.closed_time[ci] += s_end;
                 }
             }
-            let mc = mode_channels(&mut channels, &map, sys, &mut selector, mode, false)?;
+            let mc = mode_channels(
+                &mut channels,
+                &map,
+                sys,
+                &mut selector,
+                mode,
+                false,
+                &mut chan_buf,
+            )?;
             for &c in &mc.zero {
                 totals.peaks.0[c].offer(0.0, t);
             }
-            for (&c, proj) in mc.index.iter().zip(&mc.proj) {
-                proj.apply(&coef, &mut chan_poly);
+            for (r, &c) in mc.index.iter().enumerate() {
+                mc.project(r, &coef, &mut chan_poly);
                 peaks::on_poly(&chan_poly, tau, period, t, s_end, &mut totals.peaks.0[c]);
             }
             totals.dissipated += tm
@@ -246,11 +255,24 @@ pub fn solve_from(
                     totals.closed_time[ci] += s_end;
                 }
             }
-            let mc = mode_channels(&mut channels, &map, sys, &mut selector, mode, true)?;
+            let mc = mode_channels(
+                &mut channels,
+                &map,
+                sys,
+                &mut selector,
+                mode,
+                true,
+                &mut chan_buf,
+            )?;
             for &c in &mc.zero {
                 totals.peaks.0[c].offer(0.0, t);
             }
-            for ((&c, l), la) in mc.index.iter().zip(&mc.vecs).zip(&mc.slopes) {
+            for ((&c, l), la) in mc
+                .index
+                .iter()
+                .zip(mc.dense.chunks_exact(n))
+                .zip(mc.slopes.chunks_exact(n))
+            {
                 peaks::on_segment(&seg, l, la, t, s_end, &mut totals.peaks.0[c]);
             }
             totals.dissipated += dissipated(&seg, &md.damping, nd, s_end);
@@ -456,18 +478,37 @@ fn first_switch<F: Scalar>(searches: &mut [Search<F>], period: f64, horizon: f64
     }
 }
 
-/// The response channels of one mode: those that move (their vectors `ℓ_σ`, the Taylor
-/// projectors and the slope vectors `ℓ_σᵀA_σ`), and those identically zero in it.
+/// The response channels of one mode: those that move (their vectors `ℓ_σ`, dense and as
+/// non-zeros for the Taylor projections, and the slope vectors `ℓ_σᵀA_σ`), and those
+/// identically zero in it. Rows of `n = 2·dofs` in flat buffers (a few allocations per mode).
 struct ModeChannels {
     index: Vec<usize>,
-    vecs: Vec<Vec<f64>>,
-    proj: Vec<taylor::Projector>,
+    dense: Vec<f64>,
+    /// Row `r`'s non-zeros are `nz_idx/nz_val[nz_off[r] .. nz_off[r + 1]]`.
+    nz_off: Vec<usize>,
+    nz_idx: Vec<usize>,
+    nz_val: Vec<f64>,
     /// Built when a closed-form segment first needs them.
-    slopes: Vec<Vec<f64>>,
+    slopes: Vec<f64>,
     zero: Vec<usize>,
 }
 
+impl ModeChannels {
+    /// The coefficients `ℓ_rᵀc_k`, k = 0..=P, of moving channel `r` on a Taylor step (`coef`:
+    /// rows of `n`).
+    fn project(&self, r: usize, coef: &[f64], out: &mut taylor::Coefficients) {
+        let (a, b) = (self.nz_off[r], self.nz_off[r + 1]);
+        let (idx, val) = (&self.nz_idx[a..b], &self.nz_val[a..b]);
+        let n = coef.len() / out.len();
+        for (o, ck) in out.iter_mut().zip(coef.chunks_exact(n)) {
+            *o = idx.iter().zip(val).map(|(&i, v)| v * ck[i]).sum();
+        }
+    }
+}
+
 /// The channels of `mode`, built on first use (with their slope vectors when `need_slopes`).
+/// `buf` is scratch space for [`ChannelMap::vectors_into`].
+#[allow(clippy::too_many_arguments)]
 fn mode_channels<'c>(
     cache: &'c mut [Option<ModeChannels>; MODES],
     map: &ChannelMap,
@@ -475,20 +516,24 @@ fn mode_channels<'c>(
     selector: &mut ModeSelector,
     mode: Mode,
     need_slopes: bool,
+    buf: &mut Vec<f64>,
 ) -> Result<&'c ModeChannels> {
     let mi = usize::from(mode.0) % MODES;
+    let n = 2 * sys.dofs();
     if cache[mi].is_none() {
-        let vecs = map
-            .vectors(sys, mode)
+        buf.resize(N_CHANNELS * n, 0.0);
+        map.vectors_into(sys, mode, buf)
             .ok_or_else(|| Error::numerical("exact", "a closed contact has a non-linear law"))?;
         let mut mc = ModeChannels {
-            index: Vec::new(),
-            vecs: Vec::new(),
-            proj: Vec::new(),
+            index: Vec::with_capacity(N_CHANNELS),
+            dense: Vec::with_capacity(N_CHANNELS * n),
+            nz_off: vec![0],
+            nz_idx: Vec::new(),
+            nz_val: Vec::new(),
             slopes: Vec::new(),
             zero: Vec::new(),
         };
-        for (c, l) in CHANNELS.into_iter().zip(vecs) {
+        for (c, l) in CHANNELS.into_iter().zip(buf.chunks_exact(n)) {
             if c.needs_damper() && sys.damper.is_none() {
                 continue;
             }
@@ -497,29 +542,32 @@ fn mode_channels<'c>(
                 continue;
             }
             mc.index.push(c.index());
-            mc.proj.push(taylor::Projector::new(&l));
-            mc.vecs.push(l);
+            mc.dense.extend_from_slice(l);
+            for (i, &v) in l.iter().enumerate() {
+                if v != 0.0 {
+                    mc.nz_idx.push(i);
+                    mc.nz_val.push(v);
+                }
+            }
+            mc.nz_off.push(mc.nz_idx.len());
         }
         cache[mi] = Some(mc);
     }
     if need_slopes {
         if let Some(mc) = cache[mi].as_mut().filter(|mc| mc.slopes.is_empty()) {
             // ℓᵀA with A column-major: (ℓᵀA)_j = Σ_i ℓ_i A_ij.
-            let n = 2 * sys.dofs();
             let a = selector.matrix(mode);
             mc.slopes = mc
-                .vecs
-                .iter()
-                .map(|l| {
-                    (0..n)
-                        .map(|j| {
-                            a[j * n..(j + 1) * n]
-                                .iter()
-                                .zip(l)
-                                .map(|(x, y)| x * y)
-                                .sum()
-                        })
-                        .collect()
+                .dense
+                .chunks_exact(n)
+                .flat_map(|l| {
+                    (0..n).map(move |j| {
+                        a[j * n..(j + 1) * n]
+                            .iter()
+                            .zip(l)
+                            .map(|(x, y)| x * y)
+                            .sum()
+                    })
                 })
                 .collect();
         }
