@@ -8,11 +8,38 @@
 //! (see shared/notes/stack.md).
 //!
 //! The mode (which contacts are closed) is frozen within a step, so the right-hand side is
-//! smooth there; after each accepted step every indicator is checked on the dense output with
-//! the same crossing search as the exact propagator (sampled at 16 points per step with a
-//! Hermite dip test for grazing), the step is cut at the first crossing and the run restarts
-//! from the interpolated state in the new mode. The dissipated energy is integrated as an
-//! extra state component (not under error control).
+//! smooth there; after each accepted step every indicator (all are affine in the state,
+//! `g = ℓᵀX + c`) is checked on the dense output with the same crossing search as the exact
+//! propagator (values and slopes at the step ends with a Hermite dip test first; the search
+//! lifts `g` by its zero band so that a start within it is on its selected side), the step is
+//! cut at the first crossing and the run restarts from the interpolated state in the new mode.
+//!
+//! **Mode selection** (at t = 0 and at each switch, for every contact law): an indicator's
+//! side is the sign of its value beyond a zero band (`rtol/10` of its terms, round-off at
+//! least), else that of its first non-vanishing time derivative `ℓᵀ y_k`, `y_1 = f_σ(X)`,
+//! `y_{k+1} = J_σ(X) y_k` with `J_σ` the Jacobian of the right-hand side (exact for linear
+//! laws, where it is `A_σ`, and for the first two derivatives with any law); candidate modes
+//! are iterated to a consistent one. An indicator still zero to all orders (a Hertz contact at
+//! zero overlap moves with fractional powers of time) is settled by the motion: if the next
+//! step leaves it beyond its band on the side its mode excludes, it left zero at once, and the
+//! step is redone from its start in the mode that side implies.
+//!
+//! **Energy**: the dissipated energy is integrated as an extra state component (not under
+//! error control): `ẋᵀC_σẋ` with the modal damping, the dashpots and the rate-dependent part
+//! `(f − f_elastic) δ̇` of each closed contact; a contact released by the force rule at a
+//! positive overlap takes its elastic energy with it ([`contact_energy_jump`]).
+//!
+//! **Peaks**: every channel ([`Channel`]) is followed on the dense output: its values and
+//! slopes at the step ends, and the root of its slope where it changes sign (or where the
+//! cubic Hermite interpolant of the ends has critical points), so the extremes and their times
+//! do not depend on the output samples. Both one-sided values are offered at each switch.
+//!
+//! **Path**: [`Solution::path`] has a knot at t = 0, at each mode change, and at each accepted
+//! step while a closed contact has a non-linear law.
+//!
+//! **Guards**: 1000 consecutive rejected steps, 1000 consecutive switches that do not advance
+//! time, a step below 16 ulps of `t`, or more than [`MAX_STEPS`] steps end the run with an
+//! error naming the time, the mode and the likely cause.
 
 use super::peaks::Peaks;
 use super::roots::{first_crossing, hermite_dip, Scalar, SearchOptions};
@@ -927,6 +954,11 @@ fn slope_root(
 /// Consecutive rejected steps, or switches that do not advance time, before a run gives up.
 const MAX_STALLED: usize = 1000;
 
+/// Steps (accepted and rejected) a run may take: 60 s of the paper's machines take 2e5 to 3e5;
+/// a contact so stiff that the explicit method's stability limit needs more gives up with an
+/// error instead of running for hours.
+const MAX_STEPS: usize = 100_000_000;
+
 /// Runs Dormand-Prince 5(4). See the module documentation.
 pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Result<Solution> {
     solve_from(sys, &sys.initial_state(), opts, obs)
@@ -1076,6 +1108,13 @@ pub fn solve_from(
         h = h.min(t_end - t);
         if !(h > 16.0 * f64::EPSILON * t.abs()) {
             return Err(stalled("step size underflow", t, mode));
+        }
+        if steps + rejected > MAX_STEPS {
+            return Err(stalled(
+                &format!("{MAX_STEPS} steps taken, the last of {h:.3e} s"),
+                t,
+                mode,
+            ));
         }
         // Stages: `out = y + h Σ c_j k_j`, one contiguous pass per term.
         let (k0, rest) = k.split_at_mut(1);
@@ -1495,5 +1534,226 @@ fn combo(out: &mut [f64], y: &[f64], h: f64, terms: &[(f64, &Vec<f64>)]) {
         for (o, &v) in out.iter_mut().zip(kj.iter()) {
             *o += hc * v;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::impact::{Absorber, Contact, Damper, Release, Slider};
+    use crate::integrate::{Method, NoOutput};
+    use crate::modal::ModalModel;
+
+    /// A two-mode structure with the damper anchored to it: every term of the right-hand side
+    /// and of the channels is present.
+    fn system(sb: ContactLaw, bd: ContactLaw, dashpot: DashpotKind) -> ImpactSystem {
+        let w = vec![
+            2.0 * std::f64::consts::PI * 6.35,
+            2.0 * std::f64::consts::PI * 283.0,
+        ];
+        let mut s = ModalModel::with_damping_ratios(w, &[0.01, 0.02]).unwrap();
+        s.points.insert("b".into(), vec![0.14, -0.29]);
+        s.points.insert("f".into(), vec![0.15, 0.05]);
+        let c = |law| Contact {
+            law,
+            release: Release::Force,
+        };
+        ImpactSystem::new(
+            &s,
+            "b",
+            Some("f"),
+            "b",
+            Slider {
+                mass: 1.2,
+                velocity: 1.2,
+            },
+            c(sb),
+            Absorber::Damper(
+                Damper {
+                    mass: 3.5,
+                    stiffness: 1.8e3,
+                    damping: 700.0,
+                    dashpot,
+                },
+                c(bd),
+            ),
+        )
+        .unwrap()
+    }
+
+    const LINEAR: ContactLaw = ContactLaw::Linear {
+        stiffness: 4.3e7,
+        damping: 300.0,
+    };
+    const HERTZ: ContactLaw = ContactLaw::Hertz { stiffness: 1.7e10 };
+    const HUNT_CROSSLEY: ContactLaw = ContactLaw::HuntCrossley {
+        stiffness: 5e10,
+        exponent: 1.5,
+        alpha: 0.2,
+    };
+
+    /// A state with every contact overlapping (so that non-linear laws act) and moving.
+    fn state(sys: &ImpactSystem) -> Vec<f64> {
+        let nd = sys.dofs();
+        let mut y = vec![0.0; 2 * nd + 1];
+        y[0] = 2e-6;
+        y[1] = -1e-6;
+        y[sys.slider_index()] = 5e-6;
+        y[sys.damper_index()] = -3e-6;
+        for (i, v) in [0.3, -0.2, 0.7, -0.4].iter().enumerate() {
+            y[nd + i] = *v;
+        }
+        y
+    }
+
+    /// For linear laws `J_σ w = A_σ w` in every mode.
+    #[test]
+    fn jvp_is_the_first_order_matrix_for_linear_laws() {
+        let sys = system(LINEAR, LINEAR, DashpotKind::OneWay);
+        let rhs = Rhs::new(&sys);
+        let y = state(&sys);
+        let n = 2 * sys.dofs();
+        let w: Vec<f64> = (0..n).map(|i| 1.0 + 0.37 * i as f64).collect();
+        let mut out = vec![0.0; n];
+        for bits in 0..8u8 {
+            let mode = Mode(bits);
+            rhs.jvp(mode, &y, &w, &mut out);
+            let a = sys.first_order(mode);
+            for i in 0..n {
+                let e: f64 = (0..n).map(|j| a[(i, j)] * w[j]).sum();
+                assert!((out[i] - e).abs() <= 1e-12 * e.abs().max(1.0), "{bits} {i}");
+            }
+        }
+    }
+
+    /// For non-linear laws `J_σ w` is the derivative of `f_σ` along `w` (central differences,
+    /// truncation `~h²`, relative step 1e-6).
+    #[test]
+    fn jvp_is_the_derivative_of_the_right_hand_side() {
+        for (sb, bd) in [(HERTZ, HUNT_CROSSLEY), (HUNT_CROSSLEY, LINEAR)] {
+            let sys = system(sb, bd, DashpotKind::OneWay);
+            let rhs = Rhs::new(&sys);
+            let y = state(&sys);
+            let n = 2 * sys.dofs();
+            let w: Vec<f64> = (0..n).map(|i| y[i] * (0.5 + 0.1 * i as f64)).collect();
+            let eps = 1e-6;
+            let (mut yp, mut ym) = (y.clone(), y.clone());
+            for i in 0..n {
+                yp[i] += eps * w[i];
+                ym[i] -= eps * w[i];
+            }
+            let (mut fp, mut fm, mut out) = (vec![0.0; n + 1], vec![0.0; n + 1], vec![0.0; n]);
+            for bits in [3u8, 7] {
+                let mode = Mode(bits);
+                rhs.eval(mode, &yp, &mut fp);
+                rhs.eval(mode, &ym, &mut fm);
+                rhs.jvp(mode, &y, &w, &mut out);
+                for i in 0..n {
+                    let fd = (fp[i] - fm[i]) / (2.0 * eps);
+                    assert!(
+                        (out[i] - fd).abs() <= 1e-6 * fd.abs() + 1e-9,
+                        "{sb:?} {bits} {i}: {} vs {fd}",
+                        out[i]
+                    );
+                }
+            }
+        }
+    }
+
+    /// `Channels::at` gives [`ChannelMap::values`] in every mode for every law, and slopes
+    /// equal to the derivative of the values along the state's derivative (central
+    /// differences).
+    #[test]
+    fn channels_on_the_dense_output_are_the_channel_map() {
+        for (sb, bd, dashpot) in [
+            (LINEAR, LINEAR, DashpotKind::OneWay),
+            (HERTZ, HUNT_CROSSLEY, DashpotKind::OneWay),
+            (HUNT_CROSSLEY, HERTZ, DashpotKind::TwoWay),
+        ] {
+            let sys = system(sb, bd, dashpot);
+            let map = ChannelMap::new(&sys);
+            let mut ch = Channels::new(&sys);
+            let rhs = Rhs::new(&sys);
+            let y = state(&sys);
+            let n = 2 * sys.dofs();
+            let mut yd = vec![0.0; n + 1];
+            for bits in 0..8u8 {
+                let mode = Mode(bits);
+                ch.prepare(&sys, &map, mode);
+                rhs.eval(mode, &y, &mut yd);
+                let (mut v, mut d) = ([0.0; N_CHANNELS], [0.0; N_CHANNELS]);
+                ch.at(mode, &y, &yd, &mut v, &mut d);
+                let e = map.values(&sys, mode, &y[..n]);
+                let eps = 1e-7;
+                let yp: Vec<f64> = (0..n).map(|i| y[i] + eps * yd[i]).collect();
+                let ym: Vec<f64> = (0..n).map(|i| y[i] - eps * yd[i]).collect();
+                let (ep, em) = (map.values(&sys, mode, &yp), map.values(&sys, mode, &ym));
+                for c in 0..N_CHANNELS {
+                    assert!(
+                        (v[c] - e[c]).abs() <= 1e-12 * e[c].abs().max(1e-9),
+                        "{sb:?} {bits} {c}: {} vs {}",
+                        v[c],
+                        e[c]
+                    );
+                    let fd = (ep[c] - em[c]) / (2.0 * eps);
+                    assert!(
+                        (d[c] - fd).abs() <= 1e-5 * fd.abs() + 1e-6,
+                        "{sb:?} {bits} {c}: slope {} vs {fd}",
+                        d[c]
+                    );
+                }
+            }
+        }
+    }
+
+    /// A contact let go by the force rule at `δ > 0` takes `½ K δ²` with it; closing at
+    /// `δ > 0` brings it back; the dashpot switch and open-open changes take nothing.
+    #[test]
+    fn released_contact_takes_its_elastic_energy() {
+        let sys = system(LINEAR, HERTZ, DashpotKind::OneWay);
+        let y = state(&sys);
+        let n = 2 * sys.dofs();
+        let (d, _) = sys.relative_motion(Switch::SliderBed, &y[..n]);
+        let e = 0.5 * 4.3e7 * d * d;
+        assert!(d > 0.0);
+        let j = contact_energy_jump(&sys, Mode(1), Mode(0), &y[..n]);
+        assert!((j - e).abs() <= 1e-15 * e, "{j} vs {e}");
+        assert_eq!(contact_energy_jump(&sys, Mode(0), Mode(1), &y[..n]), -j);
+        assert_eq!(contact_energy_jump(&sys, Mode(1), Mode(5), &y[..n]), 0.0);
+        let (dd, _) = sys.relative_motion(Switch::BedDamper, &y[..n]);
+        let eh = HERTZ.potential_energy(dd);
+        let jh = contact_energy_jump(&sys, Mode(2), Mode(0), &y[..n]);
+        assert!(eh > 0.0 && (jh - eh).abs() <= 1e-15 * eh);
+    }
+
+    #[test]
+    fn hermite_critical_points_and_slope_roots() {
+        // p(u) = u³ − u² + …: the Hermite cubic of g(s) = s (s − 1)(s − 0.5) on [0, 1]
+        // (g' = 3s² − 3s + 0.5): critical points (3 ∓ √3)/6.
+        let g = |s: f64| s * (s - 1.0) * (s - 0.5);
+        let dg = |s: f64| 3.0 * s * s - 3.0 * s + 0.5;
+        let c = hermite_critical_points(g(0.0), dg(0.0), g(1.0), dg(1.0), 1.0);
+        let r = 3f64.sqrt() / 6.0;
+        assert!((c[0] - (0.5 - r)).abs() < 1e-14 && (c[1] - (0.5 + r)).abs() < 1e-14);
+        let c = hermite_critical_points(0.0, 1.0, 2.0, 1.0, 2.0);
+        assert!(c[0].is_nan() && c[1].is_nan());
+        let root = slope_root(dg, 0.0, 0.5, dg(0.0), dg(0.5), 1e-15);
+        assert!((root - (0.5 - r)).abs() < 1e-14, "{root}");
+    }
+
+    /// A run whose right-hand side is not finite (a slider mass of NaN, past the checks) stops
+    /// with an error naming the time instead of halving its step forever.
+    #[test]
+    fn a_run_without_progress_is_an_error() {
+        let mut sys = system(LINEAR, LINEAR, DashpotKind::OneWay);
+        sys.slider.mass = f64::NAN;
+        let opts = Options {
+            method: Method::Dopri5,
+            duration: 0.01,
+            sample_rate: None,
+            ..Options::default()
+        };
+        let e = solve(&sys, &opts, &mut NoOutput).unwrap_err().to_string();
+        assert!(e.contains("no progress at t = 0"), "{e}");
     }
 }
