@@ -1106,7 +1106,7 @@ pub fn solve_from(
             break;
         }
         h = h.min(t_end - t);
-        if !(h > 16.0 * f64::EPSILON * t.abs()) {
+        if h.is_nan() || h <= 16.0 * f64::EPSILON * t.abs() {
             return Err(stalled("step size underflow", t, mode));
         }
         if steps + rejected > MAX_STEPS {
