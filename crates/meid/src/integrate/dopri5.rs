@@ -8,18 +8,47 @@
 //! (see shared/notes/stack.md).
 //!
 //! The mode (which contacts are closed) is frozen within a step, so the right-hand side is
-//! smooth there; after each accepted step every indicator is checked on the dense output with
-//! the same crossing search as the exact propagator (sampled at 16 points per step with a
-//! Hermite dip test for grazing), the step is cut at the first crossing and the run restarts
-//! from the interpolated state in the new mode. The dissipated energy is integrated as an
-//! extra state component (not under error control).
+//! smooth there; after each accepted step every indicator (all are affine in the state,
+//! `g = ℓᵀX + c`) is checked on the dense output with the same crossing search as the exact
+//! propagator (values and slopes at the step ends with a Hermite dip test first; the search
+//! lifts `g` by its zero band so that a start within it is on its selected side), the step is
+//! cut at the first crossing and the run restarts from the interpolated state in the new mode.
+//!
+//! **Mode selection** (at t = 0 and at each switch, for every contact law): an indicator's
+//! side is the sign of its value beyond a zero band (`rtol/10` of its terms, round-off at
+//! least), else that of its first non-vanishing time derivative `ℓᵀ y_k`, `y_1 = f_σ(X)`,
+//! `y_{k+1} = J_σ(X) y_k` with `J_σ` the Jacobian of the right-hand side (exact for linear
+//! laws, where it is `A_σ`, and for the first two derivatives with any law); candidate modes
+//! are iterated to a consistent one. An indicator still zero to all orders (a Hertz contact at
+//! zero overlap moves with fractional powers of time) is settled by the motion: if the next
+//! step leaves it beyond its band on the side its mode excludes, it left zero at once, and the
+//! step is redone from its start in the mode that side implies.
+//!
+//! **Energy**: the dissipated energy is integrated as an extra state component (not under
+//! error control): `ẋᵀC_σẋ` with the modal damping, the dashpots and the rate-dependent part
+//! `(f − f_elastic) δ̇` of each closed contact; a contact released by the force rule at a
+//! positive overlap takes its elastic energy with it ([`contact_energy_jump`]).
+//!
+//! **Peaks**: every channel ([`Channel`]) is followed on the dense output: its values and
+//! slopes at the step ends, and the root of its slope where it changes sign (or where the
+//! cubic Hermite interpolant of the ends has critical points), so the extremes and their times
+//! do not depend on the output samples. Both one-sided values are offered at each switch.
+//!
+//! **Path**: [`Solution::path`] has a knot at t = 0, at each mode change, and at each accepted
+//! step while a closed contact has a non-linear law.
+//!
+//! **Guards**: 1000 consecutive rejected steps, 1000 consecutive switches that do not advance
+//! time, a step below 16 ulps of `t`, or more than [`MAX_STEPS`] steps end the run with an
+//! error naming the time, the mode and the likely cause.
 
+use super::peaks::Peaks;
 use super::roots::{first_crossing, hermite_dip, Scalar, SearchOptions};
 use super::switching::{implied_mode, ModeSelector};
 use super::{CollisionEnd, Event, Grid, Observer, Options, PathPoint, Solution, Totals};
 use crate::impact::SparseVec;
 use crate::impact::{
     dot, Channel, ChannelMap, ContactLaw, DashpotKind, ImpactSystem, Indicator, Mode, Switch,
+    N_CHANNELS,
 };
 use crate::{Error, Result};
 
@@ -215,6 +244,51 @@ impl<'a> Rhs<'a> {
     }
 }
 
+impl Rhs<'_> {
+    /// `out = J_σ(y) w` over positions and velocities (`2·dofs` entries): the derivative of
+    /// `f_σ` at `y` in the direction `w`, a non-linear law by its partial derivatives
+    /// `∂f/∂δ`, `∂f/∂δ̇` ([`ContactLaw::partials`]) at `y`. For linear laws this is `A_σ w`.
+    fn jvp(&self, mode: Mode, y: &[f64], w: &[f64], out: &mut [f64]) {
+        let (n, nd) = (self.n, self.nd);
+        let (x, v) = (&y[..nd], &y[nd..2 * nd]);
+        let (wx, wv) = (&w[..nd], &w[nd..2 * nd]);
+        out[..nd].copy_from_slice(wv);
+        let acc = &mut out[nd..2 * nd];
+        for i in 0..n {
+            let c = if self.damping_diagonal {
+                self.damping[i * n + i] * wv[i]
+            } else {
+                dot(&self.damping[i * n..(i + 1) * n], wv)
+            };
+            acc[i] = -self.omega2[i] * wx[i] - c;
+        }
+        for a in acc[n..].iter_mut() {
+            *a = 0.0;
+        }
+        for (s, a) in [
+            (Switch::SliderBed, &self.a_s),
+            (Switch::BedDamper, &self.a_d),
+        ] {
+            if !mode.on(s) || (s == Switch::BedDamper && self.sys.damper.is_none()) {
+                continue;
+            }
+            let (d, r) = a.dots(x, v);
+            let (fd, fr) = self.sys.contact(s).law.partials(d, r);
+            let (dw, rw) = a.dots(wx, wv);
+            a.sub_scaled(fd * dw + fr * rw, acc);
+        }
+        if let Some(dmp) = &self.sys.damper {
+            let (dw, rw) = self.a_f.dots(wx, wv);
+            let c_on = dmp.dashpot == DashpotKind::TwoWay || mode.on(Switch::Dashpot);
+            let cd = if c_on { dmp.damping } else { 0.0 };
+            self.a_f.sub_scaled(dmp.stiffness * dw + cd * rw, acc);
+        }
+        for i in n..nd {
+            acc[i] /= self.masses[i];
+        }
+    }
+}
+
 /// [`Rhs::eval`] for linear laws with `ND` degrees of freedom: `ẋ` copied, `ẍ = A₂₁x + A₂₂ẋ`
 /// from the rows of `A_σ`'s lower half, the dissipated power `−Σ m_i ẋ_i (A₂₂ẋ)_i`.
 fn linear_small<const ND: usize>(rows: &[f64], masses: &[f64], y: &[f64], dy: &mut [f64]) {
@@ -243,7 +317,9 @@ fn elastic(law: &ContactLaw, d: f64) -> f64 {
     }
 }
 
-/// Dense output of one step: `y(θ) = r1 + θ(r2 + θ₁(r3 + θ(r4 + θ₁ r5)))`, θ = s/h.
+/// Dense output of one step: `y(θ) = r1 + θ(r2 + θ₁(r3 + θ(r4 + θ₁ r5)))`, θ = s/h, θ₁ = 1 − θ
+/// (Hairer, Nørsett & Wanner's `contd5`): a quartic in θ that matches `y`, `y_new` and the
+/// slopes `f(y)`, `f(y_new)` at the ends of the step.
 struct Dense {
     r: [Vec<f64>; 5],
     h: f64,
@@ -259,56 +335,306 @@ impl Dense {
                     + th1 * (self.r[2][i] + th * (self.r[3][i] + th1 * self.r[4][i])));
         }
     }
-    /// `ℓᵀy(s)` and its time derivative.
-    fn functional(&self, l: &[f64], s: f64) -> (f64, f64) {
+
+    /// The state `y(s)` and its time derivative `ẏ(s)` (the derivative of the quartic).
+    fn eval_with_slope(&self, s: f64, out: &mut [f64], slope: &mut [f64]) {
         let th = s / self.h;
         let th1 = 1.0 - th;
+        for (i, (o, d)) in out.iter_mut().zip(slope.iter_mut()).enumerate() {
+            let (v, dv) = self.component(i, th, th1);
+            *o = v;
+            *d = dv;
+        }
+    }
+
+    /// Component `i` and its derivative with respect to time at `θ`.
+    #[inline]
+    fn component(&self, i: usize, th: f64, th1: f64) -> (f64, f64) {
+        let (r1, r2, r3, r4, r5) = (
+            self.r[0][i],
+            self.r[1][i],
+            self.r[2][i],
+            self.r[3][i],
+            self.r[4][i],
+        );
+        let q = r4 + th1 * r5;
+        let rr = r3 + th * q;
+        let ss = r2 + th1 * rr;
+        let drr = q - th * r5;
+        let dss = -rr + th1 * drr;
+        (r1 + th * ss, (ss + th * dss) / self.h)
+    }
+
+    /// `ℓᵀy(s)` and its time derivative, `ℓ` given by its non-zeros.
+    fn functional(&self, l: &SparseVec, s: f64) -> (f64, f64) {
+        let th = s / self.h;
+        let th1 = 1.0 - th;
+        let (idx, val) = l.parts();
         let (mut v, mut d) = (0.0, 0.0);
-        for (i, &li) in l.iter().enumerate() {
-            if li == 0.0 {
-                continue;
-            }
-            let (r1, r2, r3, r4, r5) = (
-                self.r[0][i],
-                self.r[1][i],
-                self.r[2][i],
-                self.r[3][i],
-                self.r[4][i],
-            );
-            let q = r4 + th1 * r5;
-            let rr = r3 + th * q;
-            let ss = r2 + th1 * rr;
-            v += li * (r1 + th * ss);
-            let dq = -r5;
-            let drr = q + th * dq;
-            let dss = -rr + th1 * drr;
-            d += li * (ss + th * dss) / self.h;
+        for (&i, &li) in idx.iter().zip(val) {
+            let (a, b) = self.component(i, th, th1);
+            v += li * a;
+            d += li * b;
         }
         (v, d)
     }
 }
 
-/// An indicator on the dense output of a step (non-linear indicators via state evaluation).
+/// An indicator as the affine function of the state that it is: `g = ℓᵀX + c`. Overlaps,
+/// the dashpot velocity and the force-sign functions of the linear and Hertz laws are linear
+/// (`c = 0`); Hunt-Crossley's is `1 + 3/2 α δ̇` (`c = 1`).
+struct Affine {
+    ind: Indicator,
+    l: SparseVec,
+    c: f64,
+    /// `‖ℓ‖` over the positions and over the velocities.
+    norm_x: f64,
+    norm_v: f64,
+}
+
+impl Affine {
+    fn new(sys: &ImpactSystem, ind: Indicator) -> Self {
+        let l = sys.indicator_vector(ind);
+        let c = sys.indicator_value(ind, &vec![0.0; l.len()]);
+        let nd = l.len() / 2;
+        Affine {
+            ind,
+            norm_x: norm2(&l[..nd]),
+            norm_v: norm2(&l[nd..]),
+            l: SparseVec::new(&l),
+            c,
+        }
+    }
+
+    #[inline]
+    fn value(&self, x: &[f64]) -> f64 {
+        self.l.dot(x) + self.c
+    }
+
+    /// The band around zero within which the value at the state `X = [x; ẋ]` (with norms
+    /// `(‖x‖, ‖ẋ‖)`) is taken as zero: `rel (Σ|ℓ_i X_i| + |c|)` with `rel` the larger of
+    /// `64 ε` (round-off) and a tenth of the run's `rtol` (the integration's own accuracy: an
+    /// overlap of 1e-12 m between bodies 3 mm from their start that separate at 1e-8 m/s is
+    /// zero to the run), and at least `1e-12 (‖ℓ_x‖ ‖x‖ + ‖ℓ_v‖ ‖ẋ‖)` (a quantity whose terms
+    /// are all physically zero, such as the relative velocity of bodies at rest, carries
+    /// round-off only), as the lexicographic signs of [`super::switching`] do, unit by unit.
+    fn noise(&self, x: &[f64], norms: (f64, f64), rel: f64) -> f64 {
+        let (_, scale) = self.l.dot_abs(x);
+        (rel * (scale + self.c.abs())).max(1e-12 * (self.norm_x * norms.0 + self.norm_v * norms.1))
+    }
+}
+
+/// Highest derivative order the mode selection consults (as [`super::switching`]).
+const K_MAX: usize = 8;
+
+/// The side of an indicator that `mode` implies: `+1` for a closed contact's overlap and
+/// force, `−1` for an open one's; `−1` for the dashpot velocity while the dashpot acts.
+fn mode_side(ind: Indicator, mode: Mode) -> f64 {
+    match ind {
+        Indicator::Overlap(s) | Indicator::Force(s) => {
+            if mode.on(s) {
+                1.0
+            } else {
+                -1.0
+            }
+        }
+        Indicator::DashpotVelocity => {
+            if mode.on(Switch::Dashpot) {
+                -1.0
+            } else {
+                1.0
+            }
+        }
+    }
+}
+
+/// The indicators' sides at a restart point (the start of the run or a switch).
+struct Sides {
+    /// `+1` or `−1`: the side each indicator is on just after the point under the selected
+    /// mode (a provisional one carries the side its mode implies).
+    signs: Vec<f64>,
+    /// True for an indicator that is zero with all its derivatives up to [`K_MAX`]
+    /// (Hertz-type laws at zero overlap grow with fractional powers of time): its side is
+    /// settled by the motion itself, at the end of the next step.
+    provisional: Vec<bool>,
+    /// [`Affine::noise`] at the point: the crossing search lifts `g` by it.
+    noise: Vec<f64>,
+    /// Signs imposed at this point (`0` for none): provisional indicators found on the other
+    /// side after a step.
+    forced: Vec<f64>,
+}
+
+/// Mode selection for any contact law: the mode `σ` at a state `X` is consistent when each
+/// indicator moves, under `σ`'s dynamics, to the side that implies `σ`. An indicator's side is
+/// the sign of its value where that is beyond round-off ([`Affine::noise`]); at zero it is the
+/// sign of its first non-vanishing time derivative `g⁽ᵏ⁾ = ℓᵀ y_k` with `y_1 = f_σ(X)` and
+/// `y_{k+1} = J_σ(X) y_k` ([`Rhs::jvp`]): exact for linear laws (`J_σ = A_σ`, the lexicographic
+/// signs of [`super::switching`]) and for `k ≤ 2` with any law; beyond that a non-linear law
+/// enters by its local linearisation. Candidate modes are iterated to a fixed point.
+struct Selector<'a> {
+    sys: &'a ImpactSystem,
+    /// The relative width of the zero band ([`Affine::noise`]).
+    rel: f64,
+    inds: Vec<Affine>,
+    /// Derivative vectors (length `ny`) and the state padded to `ny`.
+    work: [Vec<f64>; 2],
+    pad: Vec<f64>,
+}
+
+fn norm2(v: &[f64]) -> f64 {
+    v.iter().map(|a| a * a).sum::<f64>().sqrt()
+}
+
+/// `(‖x‖, ‖ẋ‖)` of a state `X = [x; ẋ]` (length `2·dofs`).
+fn norms(x: &[f64]) -> (f64, f64) {
+    let nd = x.len() / 2;
+    (norm2(&x[..nd]), norm2(&x[nd..]))
+}
+
+impl<'a> Selector<'a> {
+    fn new(sys: &'a ImpactSystem, ny: usize, rtol: f64) -> Self {
+        Selector {
+            sys,
+            rel: (64.0 * f64::EPSILON).max(0.1 * rtol),
+            inds: sys
+                .indicators()
+                .into_iter()
+                .map(|i| Affine::new(sys, i))
+                .collect(),
+            work: [vec![0.0; ny], vec![0.0; ny]],
+            pad: vec![0.0; ny],
+        }
+    }
+
+    /// The signs of the indicators just after `x` (positions and velocities) under `mode`'s
+    /// dynamics into `sides.signs` (`0` where undecided to order [`K_MAX`]), their noise into
+    /// `sides.noise`; forced signs are taken as they are.
+    fn signs(&mut self, rhs: &Rhs<'_>, mode: Mode, x: &[f64], sides: &mut Sides) {
+        let nx = x.len();
+        let x_norms = norms(x);
+        let mut open = 0;
+        for (i, a) in self.inds.iter().enumerate() {
+            sides.noise[i] = a.noise(x, x_norms, self.rel);
+            sides.signs[i] = if sides.forced[i] != 0.0 {
+                sides.forced[i]
+            } else {
+                let g = a.value(x);
+                if g.abs() > sides.noise[i] {
+                    g.signum()
+                } else {
+                    open += 1;
+                    0.0
+                }
+            };
+        }
+        if open == 0 {
+            return;
+        }
+        self.pad[..nx].copy_from_slice(x);
+        self.pad[nx] = 0.0;
+        rhs.eval(mode, &self.pad, &mut self.work[0]);
+        for k in 1..=K_MAX {
+            let y = &self.work[0][..nx];
+            let y_norm = norms(y);
+            for (a, o) in self.inds.iter().zip(sides.signs.iter_mut()) {
+                if *o != 0.0 {
+                    continue;
+                }
+                let (val, scale) = a.l.dot_abs(y);
+                let floor = 1e-12 * (a.norm_x * y_norm.0 + a.norm_v * y_norm.1);
+                if val.abs() > 1e-11 * scale && val.abs() > floor {
+                    *o = val.signum();
+                    open -= 1;
+                }
+            }
+            if open == 0 || k == K_MAX {
+                break;
+            }
+            let (w0, w1) = self.work.split_at_mut(1);
+            rhs.jvp(mode, x, &w0[0], &mut w1[0]);
+            self.work.swap(0, 1);
+        }
+    }
+
+    /// The mode the signs imply (an undecided indicator leaves its contact open and its
+    /// dashpot off, [`implied_mode`]).
+    fn implied(&self, signs: &[f64]) -> Mode {
+        let sign_of = |ind: Indicator| {
+            self.inds
+                .iter()
+                .position(|a| a.ind == ind)
+                .map_or(0.0, |p| signs[p])
+        };
+        implied_mode(self.sys, &sign_of)
+    }
+
+    /// Selects a consistent mode at `x` starting from `start`, and the sides of the
+    /// indicators under it. Without a consistent mode the last candidate is taken (the search
+    /// then finds the switch at once, and the progress guard of [`solve_from`] stops a loop).
+    fn select(&mut self, rhs: &Rhs<'_>, x: &[f64], start: Mode, sides: &mut Sides) -> Mode {
+        let mut cand = start;
+        let mut seen = 0u32;
+        let mut found = None;
+        for _ in 0..16 {
+            self.signs(rhs, cand, x, sides);
+            let next = self.implied(&sides.signs);
+            if next == cand {
+                found = Some(cand);
+                break;
+            }
+            if seen & (1 << (next.0 & 7)) != 0 {
+                break;
+            }
+            seen |= 1 << (cand.0 & 7);
+            cand = next;
+        }
+        let mode = match found {
+            Some(m) => m,
+            None => {
+                let allowed = self
+                    .sys
+                    .switches()
+                    .iter()
+                    .fold(0u8, |a, &s| a | Mode::bit(s));
+                let mut pick = None;
+                for bits in 0..8u8 {
+                    let m = Mode(bits);
+                    if m.0 & !allowed == 0 {
+                        self.signs(rhs, m, x, sides);
+                        if self.implied(&sides.signs) == m {
+                            pick = Some(m);
+                            break;
+                        }
+                    }
+                }
+                pick.unwrap_or_else(|| {
+                    self.signs(rhs, cand, x, sides);
+                    cand
+                })
+            }
+        };
+        for (i, a) in self.inds.iter().enumerate() {
+            sides.provisional[i] = sides.signs[i] == 0.0;
+            if sides.provisional[i] {
+                sides.signs[i] = mode_side(a.ind, mode);
+            }
+        }
+        mode
+    }
+}
+
+/// An indicator on the dense output of a step, lifted by its noise so that a start within
+/// round-off of zero is on the side the selection gave it.
 struct OnStep<'a> {
     dense: &'a Dense,
-    sys: &'a ImpactSystem,
-    ind: Indicator,
-    linear: Option<&'a [f64]>,
-    scratch: &'a std::cell::RefCell<Vec<f64>>,
+    ind: &'a Affine,
+    noise: f64,
 }
 
 impl Scalar for OnStep<'_> {
     fn value_slope(&self, s: f64) -> (f64, f64) {
-        if let Some(l) = self.linear {
-            return self.dense.functional(l, s);
-        }
-        let mut y = self.scratch.borrow_mut();
-        let eps = 1e-7 * self.dense.h;
-        self.dense.eval(s, &mut y);
-        let g0 = self.sys.indicator_value(self.ind, &y);
-        self.dense.eval(s + eps, &mut y);
-        let g1 = self.sys.indicator_value(self.ind, &y);
-        (g0, (g1 - g0) / eps)
+        let (v, d) = self.dense.functional(&self.ind.l, s);
+        (v + self.ind.c, d)
     }
     fn curvature_bound(&self, _a: f64, _b: f64) -> f64 {
         f64::INFINITY
@@ -319,7 +645,319 @@ impl Scalar for OnStep<'_> {
     fn fastest_period(&self) -> f64 {
         8.0 * self.dense.h
     }
+    fn noise(&self) -> f64 {
+        self.noise
+    }
 }
+
+/// The response channels ([`Channel`]) along the dense output, as `c = V_σᵀX + N_σ(X)`:
+/// `V_σ` the channel's vector ([`ChannelMap::vectors`]) in `σ` with its non-linear contacts
+/// taken out, `N_σ` the forces of the closed non-linear contacts (the contact-force channels)
+/// and their share `φ_Bᵀψ_b (f_bs − f_bd)` of the bed acceleration. The slope is
+/// `V_σᵀẊ + ∂N/∂δ δ̇ + ∂N/∂δ̇ δ̈`.
+struct Channels {
+    /// Per mode, built on first use: the non-zero vectors `V_σ`.
+    lin: Vec<Option<[Option<SparseVec>; N_CHANNELS]>>,
+    /// `φ_Bᵀψ_b`.
+    w_c: f64,
+    /// The contacts' relative vectors and their laws when non-linear.
+    contacts: [(Switch, SparseVec, Option<ContactLaw>); 2],
+    nd: usize,
+}
+
+/// The channel index of each contact's force.
+const CONTACT_CHANNEL: [usize; 2] = [4, 5];
+
+impl Channels {
+    fn new(sys: &ImpactSystem) -> Self {
+        let contact = |s: Switch| {
+            let present = s == Switch::SliderBed || sys.damper.is_some();
+            let law = sys.contact(s).law;
+            (
+                s,
+                SparseVec::new(if present { sys.relative_vector(s) } else { &[] }),
+                (present && !law.is_linear()).then_some(law),
+            )
+        };
+        debug_assert_eq!(
+            CONTACT_CHANNEL,
+            [
+                Channel::ContactSliderBed.index(),
+                Channel::ContactBedDamper.index()
+            ]
+        );
+        Channels {
+            lin: vec![None; 8],
+            w_c: dot(&sys.points.measurement, &sys.points.bed_contact),
+            contacts: [contact(Switch::SliderBed), contact(Switch::BedDamper)],
+            nd: sys.dofs(),
+        }
+    }
+
+    /// True when `mode` closes a contact with a non-linear law.
+    fn nonlinear(&self, mode: Mode) -> bool {
+        self.contacts
+            .iter()
+            .any(|(s, _, law)| law.is_some() && mode.on(*s))
+    }
+
+    /// Builds `mode`'s vectors.
+    fn prepare(&mut self, sys: &ImpactSystem, map: &ChannelMap, mode: Mode) {
+        let k = usize::from(mode.0 & 7);
+        if self.lin[k].is_some() {
+            return;
+        }
+        let mut m = mode;
+        for (s, _, law) in &self.contacts {
+            if law.is_some() {
+                m = m.with(*s, false);
+            }
+        }
+        let vecs = map.vectors(sys, m);
+        self.lin[k] = Some(std::array::from_fn(|c| {
+            vecs.as_ref()
+                .map(|v| SparseVec::new(&v[c]))
+                .filter(|v| !v.parts().0.is_empty())
+        }));
+    }
+
+    fn vectors(&self, mode: Mode) -> &[Option<SparseVec>; N_CHANNELS] {
+        const NONE: [Option<SparseVec>; N_CHANNELS] =
+            [None, None, None, None, None, None, None, None];
+        self.lin[usize::from(mode.0 & 7)].as_ref().unwrap_or(&NONE)
+    }
+
+    /// Does channel `c` have a non-linear part in `mode`?
+    fn has_nonlinear(&self, mode: Mode, c: usize) -> bool {
+        (c == Channel::BedAcceleration.index() || CONTACT_CHANNEL.contains(&c))
+            && self.contacts.iter().enumerate().any(|(ci, (s, _, law))| {
+                law.is_some()
+                    && mode.on(*s)
+                    && (c == CONTACT_CHANNEL[ci] || c == Channel::BedAcceleration.index())
+            })
+    }
+
+    /// All channels' values and slopes at the state `x` with derivative `xd` in `mode`
+    /// (prepared).
+    fn at(
+        &self,
+        mode: Mode,
+        x: &[f64],
+        xd: &[f64],
+        v: &mut [f64; N_CHANNELS],
+        d: &mut [f64; N_CHANNELS],
+    ) {
+        let nd = self.nd;
+        for (c, l) in self.vectors(mode).iter().enumerate() {
+            (v[c], d[c]) = match l {
+                Some(l) => (l.dot(x), l.dot(xd)),
+                None => (0.0, 0.0),
+            };
+        }
+        for (ci, (s, a, law)) in self.contacts.iter().enumerate() {
+            let Some(law) = law else { continue };
+            if !mode.on(*s) {
+                continue;
+            }
+            let (del, rate) = a.dots(&x[..nd], &x[nd..2 * nd]);
+            let (_, acc) = a.dots(&xd[..nd], &xd[nd..2 * nd]);
+            let f = law.force(del, rate);
+            let (fd, fr) = law.partials(del, rate);
+            let fdot = fd * rate + fr * acc;
+            let sign = if ci == 0 { 1.0 } else { -1.0 };
+            let cc = CONTACT_CHANNEL[ci];
+            v[cc] += f;
+            d[cc] += fdot;
+            let ab = Channel::BedAcceleration.index();
+            v[ab] += sign * self.w_c * f;
+            d[ab] += sign * self.w_c * fdot;
+        }
+    }
+
+    /// Channel `c`'s value and slope at `s` on the dense output (`buf`, `bufd`: scratch of
+    /// length `ny`).
+    fn on_dense(
+        &self,
+        mode: Mode,
+        c: usize,
+        dense: &Dense,
+        s: f64,
+        buf: &mut [f64],
+        bufd: &mut [f64],
+    ) -> (f64, f64) {
+        if !self.has_nonlinear(mode, c) {
+            return match &self.vectors(mode)[c] {
+                Some(l) => dense.functional(l, s),
+                None => (0.0, 0.0),
+            };
+        }
+        dense.eval_with_slope(s, buf, bufd);
+        let (mut v, mut d) = ([0.0; N_CHANNELS], [0.0; N_CHANNELS]);
+        self.at(mode, buf, bufd, &mut v, &mut d);
+        (v[c], d[c])
+    }
+}
+
+/// The extremes of every channel on `[0, len]` of a step (in `mode`, starting at time `t`),
+/// offered to `peaks`: the end value (the start was offered as the previous end), and each
+/// interior extremum where the slope changes sign. Values and slopes at the ends (`v0`, `d0`,
+/// `v1`, `d1`) come from the states and stages; only where the slopes differ in sign, or the
+/// cubic Hermite interpolant of the ends has critical points inside (then the slope is
+/// sampled between them), is the slope's root located on the dense output (Illinois
+/// regula falsi to `1e-12` of the step): a step without an interior extremum costs the end
+/// values only.
+#[allow(clippy::too_many_arguments)]
+fn step_extremes(
+    ch: &Channels,
+    mode: Mode,
+    dense: &Dense,
+    t: f64,
+    len: f64,
+    ends: (
+        &[f64; N_CHANNELS],
+        &[f64; N_CHANNELS],
+        &[f64; N_CHANNELS],
+        &[f64; N_CHANNELS],
+    ),
+    peaks: &mut Peaks,
+    buf: &mut [f64],
+    bufd: &mut [f64],
+) {
+    let (v0, d0, v1, d1) = ends;
+    for c in 0..N_CHANNELS {
+        peaks.0[c].offer(v1[c], t + len);
+        if len <= 0.0 {
+            continue;
+        }
+        let mut extremum = |a: f64, b: f64, da: f64, db: f64, buf: &mut [f64], bufd: &mut [f64]| {
+            let s = slope_root(
+                |s| ch.on_dense(mode, c, dense, s, buf, bufd).1,
+                a,
+                b,
+                da,
+                db,
+                1e-12 * len,
+            );
+            let (v, _) = ch.on_dense(mode, c, dense, s, buf, bufd);
+            peaks.0[c].offer(v, t + s);
+        };
+        if d0[c] * d1[c] < 0.0 {
+            extremum(0.0, len, d0[c], d1[c], buf, bufd);
+            continue;
+        }
+        // Critical points of the Hermite cubic through the ends (u ∈ (0, 1)): the slope is
+        // sampled between them, where the cubic's slope has the other sign.
+        let crit = hermite_critical_points(v0[c], d0[c], v1[c], d1[c], len);
+        if crit[0].is_nan() {
+            continue;
+        }
+        let mut knots = [0.0; 4];
+        let mut nk = 1;
+        for u in crit.into_iter().filter(|u| !u.is_nan()) {
+            knots[nk] = u;
+            nk += 1;
+        }
+        knots[nk] = 1.0;
+        let (mut sa, mut da) = (0.0, d0[c]);
+        for k in 0..nk {
+            let sm = 0.5 * (knots[k] + knots[k + 1]) * len;
+            let dm = ch.on_dense(mode, c, dense, sm, buf, bufd).1;
+            if da * dm < 0.0 {
+                extremum(sa, sm, da, dm, buf, bufd);
+            }
+            if dm != 0.0 {
+                (sa, da) = (sm, dm);
+            }
+        }
+        if da * d1[c] < 0.0 {
+            extremum(sa, len, da, d1[c], buf, bufd);
+        }
+    }
+}
+
+/// The critical points `u ∈ (0, 1)` (ascending, `NaN` for none) of the cubic Hermite
+/// interpolant through `(0, ga, da)`, `(len, gb, db)` in `u = s/len`.
+fn hermite_critical_points(ga: f64, da: f64, gb: f64, db: f64, len: f64) -> [f64; 2] {
+    let c2 = 3.0 * (2.0 * ga + len * da - 2.0 * gb + len * db);
+    let c1 = 2.0 * (-3.0 * ga - 2.0 * len * da + 3.0 * gb - len * db);
+    let c0 = len * da;
+    let mut r = [f64::NAN; 2];
+    let mut roots = [f64::NAN; 2];
+    if c2.abs() > 1e-300 {
+        let disc = c1 * c1 - 4.0 * c2 * c0;
+        if disc >= 0.0 {
+            let q = -0.5 * (c1 + c1.signum() * disc.sqrt());
+            roots = [q / c2, if q != 0.0 { c0 / q } else { f64::NAN }];
+        }
+    } else if c1.abs() > 1e-300 {
+        roots[0] = -c0 / c1;
+    }
+    let mut k = 0;
+    for u in roots {
+        if u > 0.0 && u < 1.0 {
+            r[k] = u;
+            k += 1;
+        }
+    }
+    if k == 2 && r[0] > r[1] {
+        r.swap(0, 1);
+    }
+    r
+}
+
+/// A root of `f` in `[a, b]` with `f(a) = fa`, `f(b) = fb` of opposite signs, by the Illinois
+/// variant of regula falsi, to `tol`.
+fn slope_root(
+    mut f: impl FnMut(f64) -> f64,
+    mut a: f64,
+    mut b: f64,
+    mut fa: f64,
+    mut fb: f64,
+    tol: f64,
+) -> f64 {
+    let mut side = 0;
+    for _ in 0..100 {
+        if b - a <= tol {
+            break;
+        }
+        let mut m = (a * fb - b * fa) / (fb - fa);
+        if !(m > a && m < b) {
+            m = 0.5 * (a + b);
+        }
+        let fm = f(m);
+        if fm == 0.0 {
+            return m;
+        }
+        if (fm > 0.0) == (fa > 0.0) {
+            a = m;
+            fa = fm;
+            if side == -1 {
+                fb *= 0.5;
+            }
+            side = -1;
+        } else {
+            b = m;
+            fb = fm;
+            if side == 1 {
+                fa *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    if fa.abs() < fb.abs() {
+        a
+    } else {
+        b
+    }
+}
+
+/// Consecutive rejected steps, or switches that do not advance time, before a run gives up.
+const MAX_STALLED: usize = 1000;
+
+/// Steps (accepted and rejected) a run may take: 60 s of the paper's machines take 2e5 to 3e5;
+/// a contact so stiff that the explicit method's stability limit needs more gives up with an
+/// error instead of running for hours.
+const MAX_STEPS: usize = 100_000_000;
 
 /// Runs Dormand-Prince 5(4). See the module documentation.
 pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Result<Solution> {
@@ -347,55 +985,24 @@ pub fn solve_from(
     let nd = sys.dofs();
     let nx = 2 * nd;
     let ny = nx + 1;
-    let all_linear = [Switch::SliderBed, Switch::BedDamper].iter().all(|&s| {
-        (s == Switch::BedDamper && sys.damper.is_none()) || sys.contact(s).law.is_linear()
-    });
-    let inds = sys.indicators();
-    let linear_vecs: Vec<Option<Vec<f64>>> = inds
-        .iter()
-        .map(|&i| {
-            let nonlinear = match i {
-                Indicator::Overlap(_) | Indicator::DashpotVelocity => false,
-                Indicator::Force(s) => !sys.contact(s).law.is_linear(),
-            };
-            if nonlinear {
-                None
-            } else {
-                Some(sys.indicator_vector(i))
-            }
-        })
-        .collect();
-
-    // The linear indicators by their non-zero entries (the per-step pre-check).
-    let linear_sparse: Vec<SparseVec> = linear_vecs
-        .iter()
-        .map(|l| SparseVec::new(l.as_deref().unwrap_or(&[])))
-        .collect();
-    let mut selector = ModeSelector::new(sys);
-    // The signs the mode selection works with (the step's own are `signs`, below).
-    let mut selected_signs = vec![0.0; inds.len()];
-    // `δ` and `δ̇` of each contact as functionals of the dense output.
-    let peak_vecs: Vec<(Vec<f64>, Vec<f64>)> = [Switch::SliderBed, Switch::BedDamper]
-        .into_iter()
-        .map(|s| {
-            let (mut lx, mut lv) = (vec![0.0; ny], vec![0.0; ny]);
-            if s == Switch::SliderBed || sys.damper.is_some() {
-                let a = sys.relative_vector(s);
-                lx[..nd].copy_from_slice(&a[..nd]);
-                lv[nd..2 * nd].copy_from_slice(&a[..nd]);
-            }
-            (lx, lv)
-        })
-        .collect();
+    let all_linear = rhs.linear_rows.is_some();
+    // The first-order matrices of linear modes (the right-hand side's rows).
+    let mut matrices = ModeSelector::new(sys);
+    let mut selector = Selector::new(sys, ny, opts.rtol);
+    let m = selector.inds.len();
+    let mut sides = Sides {
+        signs: vec![0.0; m],
+        provisional: vec![false; m],
+        noise: vec![0.0; m],
+        forced: vec![0.0; m],
+    };
+    let map = ChannelMap::new(sys);
+    let mut channels = Channels::new(sys);
     let mut y = vec![0.0; ny];
     y[..nx].copy_from_slice(x0);
     let mut t = 0.0;
     let t_end = opts.duration;
-    let mut mode = if all_linear {
-        selector.select(&y[..nx], Mode(0), &mut selected_signs).0
-    } else {
-        initial_mode_numeric(sys, &y[..nx])
-    };
+    let mut mode = selector.select(&rhs, &y[..nx], Mode(0), &mut sides);
     let mut grid = Grid::new(opts.sample_rate);
     let mut k: [Vec<f64>; 7] = std::array::from_fn(|_| vec![0.0; ny]);
     let mut ytmp = vec![0.0; ny];
@@ -405,22 +1012,25 @@ pub fn solve_from(
         h: 1.0,
     };
     let mut ybuf = vec![0.0; ny];
+    let mut ydot = vec![0.0; ny];
+    let (mut buf, mut bufd) = (vec![0.0; ny], vec![0.0; ny]);
     let mut events = Vec::new();
-    let map = ChannelMap::new(sys);
     let mut path = vec![PathPoint {
         t: 0.0,
         mode,
         x: y[..nx].to_vec(),
     }];
     let mut totals = Totals::default();
-    // Interim: channel values at the start and at every step end and switch (both sides).
     totals
         .peaks
         .offer_all(&map.values(sys, mode, &y[..nx]), 0.0);
     let mut collision_end = None;
     let (mut steps, mut rejected) = (0usize, 0usize);
-    let mut signs = vec![0.0; inds.len()];
-    let scratch = std::cell::RefCell::new(vec![0.0; ny]);
+    // Consecutive rejected steps and switches without progress (the guards).
+    let (mut stalled_rejects, mut stalled_switches) = (0usize, 0usize);
+    // Channel values and slopes at the start of the step.
+    let (mut cv0, mut cd0) = ([0.0; N_CHANNELS], [0.0; N_CHANNELS]);
+    let (mut cv1, mut cd1) = ([0.0; N_CHANNELS], [0.0; N_CHANNELS]);
 
     let sc = |a: f64, b: f64| opts.atol + opts.rtol * a.abs().max(b.abs());
     let err_norm = |y0: &[f64], y1: &[f64], e: &[f64]| -> f64 {
@@ -430,6 +1040,33 @@ pub fn solve_from(
             s += r * r;
         }
         (s / nx as f64).sqrt()
+    };
+    let stalled = |what: &str, t: f64, mode: Mode| {
+        Error::numerical(
+            "dopri5",
+            format!(
+                "no progress at t = {t:.9e} s ({what}, mode: slider-bed {}, bed-damper {}, \
+                 dashpot {}). Likely cause: a contact stiffness too high for the tolerance \
+                 (rtol {:e}, atol {:e}) or contacts that chatter",
+                if mode.on(Switch::SliderBed) {
+                    "closed"
+                } else {
+                    "open"
+                },
+                if mode.on(Switch::BedDamper) {
+                    "closed"
+                } else {
+                    "open"
+                },
+                if mode.on(Switch::Dashpot) {
+                    "on"
+                } else {
+                    "off"
+                },
+                opts.rtol,
+                opts.atol
+            ),
+        )
     };
 
     // Emit t = 0.
@@ -444,19 +1081,12 @@ pub fn solve_from(
     'outer: loop {
         if need_k1 {
             if all_linear {
-                // The mode's first-order matrix, shared with the mode selection.
-                rhs.set_lower_rows(mode, selector.matrix(mode));
+                // The mode's first-order matrix: its rows are the right-hand side.
+                rhs.set_lower_rows(mode, matrices.matrix(mode));
             }
+            channels.prepare(sys, &map, mode);
             rhs.eval(mode, &y, &mut k[0]);
-            // Indicator sides at the (re)start.
-            if all_linear {
-                // Lexicographic signs under the mode's dynamics (`switching::lex_signs`).
-                selector.signs(mode, &y[..nx], &mut signs);
-            } else {
-                for (i, &ind) in inds.iter().enumerate() {
-                    signs[i] = start_sign(sys, ind, mode, &y[..nx]);
-                }
-            }
+            channels.at(mode, &y, &k[0], &mut cv0, &mut cd0);
             if h == 0.0 {
                 let (k0, k1) = k.split_at_mut(1);
                 h = initial_step(
@@ -464,7 +1094,6 @@ pub fn solve_from(
                     mode,
                     &y,
                     &k0[0],
-                    opts,
                     t_end - t,
                     &mut ytmp,
                     &mut k1[0],
@@ -477,10 +1106,14 @@ pub fn solve_from(
             break;
         }
         h = h.min(t_end - t);
-        if h < 1e-15 * t.max(1e-9) * 1e-3 {
-            return Err(Error::numerical(
-                "dopri5",
-                format!("step size underflow at t = {t:.9e} s"),
+        if h.is_nan() || h <= 16.0 * f64::EPSILON * t.abs() {
+            return Err(stalled("step size underflow", t, mode));
+        }
+        if steps + rejected > MAX_STEPS {
+            return Err(stalled(
+                &format!("{MAX_STEPS} steps taken, the last of {h:.3e} s"),
+                t,
+                mode,
             ));
         }
         // Stages: `out = y + h Σ c_j k_j`, one contiguous pass per term.
@@ -545,6 +1178,14 @@ pub fn solve_from(
         let fac11 = err.powf(expo1);
         if err > 1.0 || !err.is_finite() {
             rejected += 1;
+            stalled_rejects += 1;
+            if stalled_rejects > MAX_STALLED {
+                return Err(stalled(
+                    &format!("{MAX_STALLED} consecutive rejected steps, last h = {h:.3e} s"),
+                    t,
+                    mode,
+                ));
+            }
             let f = if err.is_finite() {
                 (fac11 / 0.9).min(5.0)
             } else {
@@ -553,6 +1194,52 @@ pub fn solve_from(
             h /= f.max(1.0);
             last_reject = true;
             continue;
+        }
+        stalled_rejects = 0;
+        // Provisional indicators (zero to all orders at the restart): settled by where the
+        // step took them. One that left zero towards the other side of its mode did so at
+        // once: the mode it implies holds from the step's start, which is redone in it.
+        let mut redo = None;
+        for i in 0..m {
+            if !sides.provisional[i] {
+                continue;
+            }
+            let a = &selector.inds[i];
+            let g = a.value(&ynew[..nx]);
+            if g.abs() <= a.noise(&ynew[..nx], norms(&ynew[..nx]), selector.rel) {
+                continue;
+            }
+            sides.provisional[i] = false;
+            if g.signum() == sides.signs[i] {
+                continue;
+            }
+            sides.forced[i] = g.signum();
+            redo = Some(());
+        }
+        if redo.is_some() {
+            let start = mode;
+            let forced = sides.forced.clone();
+            let new_mode = selector.select(&rhs, &y[..nx], start, &mut sides);
+            sides.forced = forced;
+            if new_mode != mode {
+                rejected += 1;
+                y[nx] += switch_to(
+                    &map,
+                    sys,
+                    &mut totals,
+                    &mut events,
+                    &mut path,
+                    t,
+                    &y[..nx],
+                    mode,
+                    new_mode,
+                    opts.max_events,
+                )?;
+                mode = new_mode;
+                totals.dissipated = y[nx];
+                need_k1 = true;
+                continue;
+            }
         }
         // Accepted: dense output.
         steps += 1;
@@ -575,33 +1262,29 @@ pub fn solve_from(
         // Events on the step.
         let mut s_end = h;
         let mut switched = false;
-        for (i, &ind) in inds.iter().enumerate() {
-            if signs[i] == 0.0 {
+        for (i, a) in selector.inds.iter().enumerate() {
+            if sides.provisional[i] {
                 continue;
             }
-            if linear_vecs[i].is_some() {
-                // Values and slopes at the step ends come from the state and the stages
-                // (k₁ = f(y), k₇ = f(y_new)); the search on the dense output runs only where the
-                // step may hold a crossing: a sign change at the end, or a dip of the cubic
-                // Hermite interpolant in between (what its first interval would test).
-                let sg = signs[i];
-                let sl = &linear_sparse[i];
-                let ga = (sg * sl.dot(&y[..nx])).max(0.0);
-                let da = sg * sl.dot(&k[0][..nx]);
-                let gb = sg * sl.dot(&ynew[..nx]);
-                let db = sg * sl.dot(&k[6][..nx]);
-                if gb >= 0.0 && hermite_dip(ga, da, gb, db, h).is_none() {
-                    continue;
-                }
+            // Values and slopes at the step ends come from the state and the stages
+            // (k₁ = f(y), k₇ = f(y_new)); the search on the dense output runs only where the
+            // step may hold a crossing: a sign change at the end, or a dip of the cubic
+            // Hermite interpolant in between (what its first interval would test).
+            let sg = sides.signs[i];
+            let lift = sides.noise[i];
+            let ga = (sg * a.value(&y[..nx]) + lift).max(0.0);
+            let da = sg * a.l.dot(&k[0][..nx]);
+            let gb = sg * a.value(&ynew[..nx]) + lift;
+            let db = sg * a.l.dot(&k[6][..nx]);
+            if gb >= 0.0 && hermite_dip(ga, da, gb, db, h).is_none() {
+                continue;
             }
             let f = OnStep {
                 dense: &dense,
-                sys,
-                ind,
-                linear: linear_vecs[i].as_deref(),
-                scratch: &scratch,
+                ind: a,
+                noise: lift,
             };
-            if let Some(s) = first_crossing(&f, s_end, signs[i], SearchOptions::default()) {
+            if let Some(s) = first_crossing(&f, s_end, sg, SearchOptions::default()) {
                 if s < s_end || (s == s_end && !switched) {
                     s_end = s;
                     switched = true;
@@ -620,62 +1303,74 @@ pub fn solve_from(
                 g.next += 1;
             }
         }
-        // Peak contact forces and closed times on [0, s_end].
+        // The state at the step's end (cut at a switch) and its derivative.
+        if switched {
+            dense.eval_with_slope(s_end, &mut ybuf, &mut ydot);
+        } else {
+            ybuf.copy_from_slice(&ynew);
+            ydot.copy_from_slice(&k[6]);
+        }
+        // Channel extremes and closed times on [0, s_end].
+        channels.at(mode, &ybuf, &ydot, &mut cv1, &mut cd1);
+        step_extremes(
+            &channels,
+            mode,
+            &dense,
+            t,
+            s_end,
+            (&cv0, &cd0, &cv1, &cd1),
+            &mut totals.peaks,
+            &mut buf,
+            &mut bufd,
+        );
         for (ci, s) in [Switch::SliderBed, Switch::BedDamper]
             .into_iter()
             .enumerate()
         {
             if mode.on(s) && (ci == 0 || sys.damper.is_some()) {
                 totals.closed_time[ci] += s_end;
-                let law = sys.contact(s).law;
-                let rel = sys.relative_vector(s);
-                let start = force_slope_at(&law, rel, &y, &k[0], nd);
-                let end = if switched {
-                    None
-                } else {
-                    Some(force_slope_at(&law, rel, &ynew, &k[6], nd))
-                };
-                let peak = peak_on_step(&law, &peak_vecs[ci], &dense, s_end, start, end);
-                // Interim: the value of the peak (its time is the step's start).
-                totals.peaks.0[Channel::ContactSliderBed.index() + ci].offer(peak, t);
             }
         }
         if switched {
-            dense.eval(s_end, &mut ybuf);
+            let t_old = t;
             y.copy_from_slice(&ybuf);
             t += s_end;
-            totals.dissipated = y[nx];
-            let new_mode = if all_linear {
-                selector.select(&y[..nx], mode, &mut selected_signs).0
-            } else {
-                mode_after_numeric(sys, &inds, &signs, &dense, s_end, &y[..nx])
-            };
-            totals.peaks.offer_all(&map.values(sys, mode, &y[..nx]), t);
-            totals
-                .peaks
-                .offer_all(&map.values(sys, new_mode, &y[..nx]), t);
-            if new_mode != mode {
-                path.push(PathPoint {
-                    t,
-                    mode: new_mode,
-                    x: y[..nx].to_vec(),
-                });
-                events.push(Event {
-                    t,
-                    from: mode,
-                    to: new_mode,
-                });
-                if events.len() > opts.max_events {
-                    return Err(Error::numerical(
-                        "dopri5",
-                        format!(
-                            "more than {} switching events before t = {t:.6} s",
-                            opts.max_events
-                        ),
+            if t - t_old <= 16.0 * f64::EPSILON * t.abs() {
+                stalled_switches += 1;
+                if stalled_switches > MAX_STALLED {
+                    return Err(stalled(
+                        &format!("{MAX_STALLED} consecutive switches without time advancing"),
+                        t,
+                        mode,
                     ));
                 }
+            } else {
+                stalled_switches = 0;
+            }
+            sides.forced.iter_mut().for_each(|f| *f = 0.0);
+            let new_mode = selector.select(&rhs, &y[..nx], mode, &mut sides);
+            if new_mode != mode {
+                y[nx] += switch_to(
+                    &map,
+                    sys,
+                    &mut totals,
+                    &mut events,
+                    &mut path,
+                    t,
+                    &y[..nx],
+                    mode,
+                    new_mode,
+                    opts.max_events,
+                )?;
+            } else if channels.nonlinear(mode) {
+                path.push(PathPoint {
+                    t,
+                    mode,
+                    x: y[..nx].to_vec(),
+                });
             }
             mode = new_mode;
+            totals.dissipated = y[nx];
             need_k1 = true;
             if collision_end.is_none() && !mode.on(Switch::SliderBed) && !mode.on(Switch::BedDamper)
             {
@@ -694,8 +1389,16 @@ pub fn solve_from(
         y.copy_from_slice(&ynew);
         k.swap(0, 6);
         t += h;
-        totals.peaks.offer_all(&map.values(sys, mode, &y[..nx]), t);
+        (cv0, cd0) = (cv1, cd1);
         totals.dissipated = y[nx];
+        if channels.nonlinear(mode) {
+            // A knot of the non-linear stretch (see `PathPoint`).
+            path.push(PathPoint {
+                t,
+                mode,
+                x: y[..nx].to_vec(),
+            });
+        }
         // PI control.
         let mut fac = fac11 / facold.powf(0.04);
         fac = (fac / 0.9).clamp(0.1, 5.0);
@@ -723,13 +1426,65 @@ pub fn solve_from(
     })
 }
 
+/// A mode change at `t`: the channels on both sides of the switch, the event and the path point.
+#[allow(clippy::too_many_arguments)]
+fn switch_to(
+    map: &ChannelMap,
+    sys: &ImpactSystem,
+    totals: &mut Totals,
+    events: &mut Vec<Event>,
+    path: &mut Vec<PathPoint>,
+    t: f64,
+    x: &[f64],
+    from: Mode,
+    to: Mode,
+    max_events: usize,
+) -> Result<f64> {
+    totals.peaks.offer_all(&map.values(sys, from, x), t);
+    totals.peaks.offer_all(&map.values(sys, to, x), t);
+    path.push(PathPoint {
+        t,
+        mode: to,
+        x: x.to_vec(),
+    });
+    events.push(Event { t, from, to });
+    if events.len() > max_events {
+        return Err(Error::numerical(
+            "dopri5",
+            format!("more than {max_events} switching events before t = {t:.6} s"),
+        ));
+    }
+    Ok(contact_energy_jump(sys, from, to, x))
+}
+
+/// The elastic energy (J) the contacts lose when the mode changes from `from` to `to` at the
+/// state `x`: `Σ_c [c closed in from] E_c(δ_c) − [c closed in to] E_c(δ_c)` with `E_c` the
+/// law's potential energy ([`ContactLaw::potential_energy`]). A contact released by the force
+/// rule lets go at a positive overlap (`K δ + C δ̇ = 0` with `δ̇ < 0`), and its elastic energy
+/// `E_c(δ) > 0` leaves with it: the massless contact spring holds it and nothing else takes it.
+/// It is counted as dissipated (negative when a contact closes at a positive overlap, which the
+/// force rule also allows). Zero for switches at zero overlap (the overlap rule, the dashpot).
+pub(crate) fn contact_energy_jump(sys: &ImpactSystem, from: Mode, to: Mode, x: &[f64]) -> f64 {
+    let mut jump = 0.0;
+    for s in [Switch::SliderBed, Switch::BedDamper] {
+        if s == Switch::BedDamper && sys.damper.is_none() || from.on(s) == to.on(s) {
+            continue;
+        }
+        let e = sys
+            .contact(s)
+            .law
+            .potential_energy(sys.relative_motion(s, x).0);
+        jump += if from.on(s) { e } else { -e };
+    }
+    jump
+}
+
 #[allow(clippy::too_many_arguments)]
 fn initial_step(
     rhs: &Rhs<'_>,
     mode: Mode,
     y: &[f64],
     f0: &[f64],
-    opts: &Options,
     span: f64,
     ytmp: &mut [f64],
     f1: &mut [f64],
@@ -758,88 +1513,17 @@ fn initial_step(
         ytmp[i] = y[i] + h0 * f0[i];
     }
     rhs.eval(mode, ytmp, f1);
-    let diff: Vec<f64> = f1.iter().zip(f0).map(|(a, b)| a - b).collect();
-    let d2 = norm(&diff) / h0;
+    let mut d2 = 0.0;
+    for i in 0..nx {
+        d2 += ((f1[i] - f0[i]) / sc(y[i], y[i])).powi(2);
+    }
+    let d2 = (d2 / nx as f64).sqrt() / h0;
     let h1 = if d1.max(d2) <= 1e-15 {
         (h0 * 1e-3).max(1e-6)
     } else {
         (0.01 / d1.max(d2)).powf(0.2)
     };
-    let _ = opts;
     (100.0 * h0).min(h1).min(span)
-}
-
-/// The side of indicator `ind` at `x` when a contact law is not linear: its value's sign, or at
-/// zero the side the mode implies.
-fn start_sign(sys: &ImpactSystem, ind: Indicator, mode: Mode, x: &[f64]) -> f64 {
-    let v = sys.indicator_value(ind, x);
-    if v != 0.0 {
-        return v.signum();
-    }
-    match ind {
-        Indicator::Overlap(s) | Indicator::Force(s) => {
-            if mode.on(s) {
-                1.0
-            } else {
-                -1.0
-            }
-        }
-        Indicator::DashpotVelocity => {
-            if mode.on(Switch::Dashpot) {
-                -1.0
-            } else {
-                1.0
-            }
-        }
-    }
-}
-
-fn initial_mode_numeric(sys: &ImpactSystem, x: &[f64]) -> Mode {
-    let nd = sys.dofs();
-    let sign_of = |ind: Indicator| {
-        let v = sys.indicator_value(ind, x);
-        if v != 0.0 {
-            return v.signum();
-        }
-        // At zero: the direction it is moving in.
-        match ind {
-            Indicator::Overlap(s) => {
-                dot(sys.relative_vector(s), &x[nd..]).signum()
-                    * f64::from(u8::from(dot(sys.relative_vector(s), &x[nd..]) != 0.0))
-            }
-            _ => 0.0,
-        }
-    };
-    implied_mode(sys, &sign_of)
-}
-
-fn mode_after_numeric(
-    sys: &ImpactSystem,
-    inds: &[Indicator],
-    signs: &[f64],
-    dense: &Dense,
-    s: f64,
-    x: &[f64],
-) -> Mode {
-    let y = std::cell::RefCell::new(vec![0.0; x.len() + 1]);
-    let sign_of = |ind: Indicator| {
-        let mut y = y.borrow_mut();
-        let p = inds.iter().position(|&i| i == ind).unwrap_or(0);
-        let v = sys.indicator_value(ind, x);
-        let scale = 1e-9 * (1.0 + v.abs());
-        if v.abs() > scale {
-            return v.signum();
-        }
-        // At zero: compare with the value just before the event.
-        dense.eval((s * (1.0 - 1e-6)).max(0.0), &mut y);
-        let before = sys.indicator_value(ind, &y[..x.len()]);
-        if before.signum() == signs[p] {
-            -signs[p]
-        } else {
-            signs[p]
-        }
-    };
-    implied_mode(sys, &sign_of)
 }
 
 /// `out = y + h Σ c_j k_j`.
@@ -853,67 +1537,223 @@ fn combo(out: &mut [f64], y: &[f64], h: f64, terms: &[(f64, &Vec<f64>)]) {
     }
 }
 
-/// Contact force and its time derivative from `δ`, `δ̇`, `δ̈`: `f(δ, δ̇)` and
-/// `∂f/∂δ·δ̇ + ∂f/∂δ̇·δ̈` ([`ContactLaw::partials`]).
-fn force_and_slope(law: &ContactLaw, d: f64, r: f64, acc: f64) -> (f64, f64) {
-    let (fd, fr) = law.partials(d, r);
-    (law.force(d, r), fd * r + fr * acc)
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::impact::{Absorber, Contact, Damper, Release, Slider};
+    use crate::integrate::{Method, NoOutput};
+    use crate::modal::ModalModel;
 
-/// Force and slope at a step end from the state `y` and its derivative `dy` (a stage).
-fn force_slope_at(law: &ContactLaw, a: &[f64], y: &[f64], dy: &[f64], nd: usize) -> (f64, f64) {
-    let d = dot(&a[..nd], &y[..nd]);
-    let r = dot(&a[..nd], &y[nd..2 * nd]);
-    let acc = dot(&a[..nd], &dy[nd..2 * nd]);
-    force_and_slope(law, d, r, acc)
-}
+    /// A two-mode structure with the damper anchored to it: every term of the right-hand side
+    /// and of the channels is present.
+    fn system(sb: ContactLaw, bd: ContactLaw, dashpot: DashpotKind) -> ImpactSystem {
+        let w = vec![
+            2.0 * std::f64::consts::PI * 6.35,
+            2.0 * std::f64::consts::PI * 283.0,
+        ];
+        let mut s = ModalModel::with_damping_ratios(w, &[0.01, 0.02]).unwrap();
+        s.points.insert("b".into(), vec![0.14, -0.29]);
+        s.points.insert("f".into(), vec![0.15, 0.05]);
+        let c = |law| Contact {
+            law,
+            release: Release::Force,
+        };
+        ImpactSystem::new(
+            &s,
+            "b",
+            Some("f"),
+            "b",
+            Slider {
+                mass: 1.2,
+                velocity: 1.2,
+            },
+            c(sb),
+            Absorber::Damper(
+                Damper {
+                    mass: 3.5,
+                    stiffness: 1.8e3,
+                    damping: 700.0,
+                    dashpot,
+                },
+                c(bd),
+            ),
+        )
+        .unwrap()
+    }
 
-/// Largest contact force on `[0, len]` of a step. A step is far shorter than any period of
-/// the motion (the error control sees to that), so the force has at most one interior maximum
-/// there, and only if its slope goes from positive at the start to negative at the end: then
-/// the slope's root is found by safeguarded secant steps on the dense output. Otherwise the
-/// maximum is at an end. `start` and `end` are `(f, f')` at the ends (`end` is `None` when the
-/// step was cut at an event: then it comes from the dense output).
-fn peak_on_step(
-    law: &ContactLaw,
-    vecs: &(Vec<f64>, Vec<f64>),
-    dense: &Dense,
-    len: f64,
-    start: (f64, f64),
-    end: Option<(f64, f64)>,
-) -> f64 {
-    let (lx, lv) = vecs;
-    let force_slope = |t: f64| -> (f64, f64) {
-        let (d, _) = dense.functional(lx, t);
-        let (r, dr) = dense.functional(lv, t);
-        force_and_slope(law, d, r, dr)
+    const LINEAR: ContactLaw = ContactLaw::Linear {
+        stiffness: 4.3e7,
+        damping: 300.0,
     };
-    let (f0, s0) = start;
-    let (f1, s1) = end.unwrap_or_else(|| force_slope(len));
-    let mut best = f0.max(f1);
-    if s0 > 0.0 && s1 < 0.0 {
-        let (mut lo, mut hi, mut slo, mut shi) = (0.0, len, s0, s1);
-        for _ in 0..60 {
-            if hi - lo <= 1e-12 * len {
-                break;
-            }
-            // Secant point, kept away from the ends (bisection otherwise).
-            let mut m = lo + (hi - lo) * slo / (slo - shi);
-            if !(m > lo + 0.01 * (hi - lo) && m < hi - 0.01 * (hi - lo)) {
-                m = 0.5 * (lo + hi);
-            }
-            let (fm, sm) = force_slope(m);
-            best = best.max(fm);
-            if sm > 0.0 {
-                lo = m;
-                slo = sm;
-            } else if sm < 0.0 {
-                hi = m;
-                shi = sm;
-            } else {
-                break;
+    const HERTZ: ContactLaw = ContactLaw::Hertz { stiffness: 1.7e10 };
+    const HUNT_CROSSLEY: ContactLaw = ContactLaw::HuntCrossley {
+        stiffness: 5e10,
+        exponent: 1.5,
+        alpha: 0.2,
+    };
+
+    /// A state with every contact overlapping (so that non-linear laws act) and moving.
+    fn state(sys: &ImpactSystem) -> Vec<f64> {
+        let nd = sys.dofs();
+        let mut y = vec![0.0; 2 * nd + 1];
+        y[0] = 2e-6;
+        y[1] = -1e-6;
+        y[sys.slider_index()] = 5e-6;
+        y[sys.damper_index()] = -3e-6;
+        for (i, v) in [0.3, -0.2, 0.7, -0.4].iter().enumerate() {
+            y[nd + i] = *v;
+        }
+        y
+    }
+
+    /// For linear laws `J_σ w = A_σ w` in every mode.
+    #[test]
+    fn jvp_is_the_first_order_matrix_for_linear_laws() {
+        let sys = system(LINEAR, LINEAR, DashpotKind::OneWay);
+        let rhs = Rhs::new(&sys);
+        let y = state(&sys);
+        let n = 2 * sys.dofs();
+        let w: Vec<f64> = (0..n).map(|i| 1.0 + 0.37 * i as f64).collect();
+        let mut out = vec![0.0; n];
+        for bits in 0..8u8 {
+            let mode = Mode(bits);
+            rhs.jvp(mode, &y, &w, &mut out);
+            let a = sys.first_order(mode);
+            for i in 0..n {
+                let e: f64 = (0..n).map(|j| a[(i, j)] * w[j]).sum();
+                assert!((out[i] - e).abs() <= 1e-12 * e.abs().max(1.0), "{bits} {i}");
             }
         }
     }
-    best
+
+    /// For non-linear laws `J_σ w` is the derivative of `f_σ` along `w` (central differences,
+    /// truncation `~h²`, relative step 1e-6).
+    #[test]
+    fn jvp_is_the_derivative_of_the_right_hand_side() {
+        for (sb, bd) in [(HERTZ, HUNT_CROSSLEY), (HUNT_CROSSLEY, LINEAR)] {
+            let sys = system(sb, bd, DashpotKind::OneWay);
+            let rhs = Rhs::new(&sys);
+            let y = state(&sys);
+            let n = 2 * sys.dofs();
+            let w: Vec<f64> = (0..n).map(|i| y[i] * (0.5 + 0.1 * i as f64)).collect();
+            let eps = 1e-6;
+            let (mut yp, mut ym) = (y.clone(), y.clone());
+            for i in 0..n {
+                yp[i] += eps * w[i];
+                ym[i] -= eps * w[i];
+            }
+            let (mut fp, mut fm, mut out) = (vec![0.0; n + 1], vec![0.0; n + 1], vec![0.0; n]);
+            for bits in [3u8, 7] {
+                let mode = Mode(bits);
+                rhs.eval(mode, &yp, &mut fp);
+                rhs.eval(mode, &ym, &mut fm);
+                rhs.jvp(mode, &y, &w, &mut out);
+                for i in 0..n {
+                    let fd = (fp[i] - fm[i]) / (2.0 * eps);
+                    assert!(
+                        (out[i] - fd).abs() <= 1e-6 * fd.abs() + 1e-9,
+                        "{sb:?} {bits} {i}: {} vs {fd}",
+                        out[i]
+                    );
+                }
+            }
+        }
+    }
+
+    /// `Channels::at` gives [`ChannelMap::values`] in every mode for every law, and slopes
+    /// equal to the derivative of the values along the state's derivative (central
+    /// differences).
+    #[test]
+    fn channels_on_the_dense_output_are_the_channel_map() {
+        for (sb, bd, dashpot) in [
+            (LINEAR, LINEAR, DashpotKind::OneWay),
+            (HERTZ, HUNT_CROSSLEY, DashpotKind::OneWay),
+            (HUNT_CROSSLEY, HERTZ, DashpotKind::TwoWay),
+        ] {
+            let sys = system(sb, bd, dashpot);
+            let map = ChannelMap::new(&sys);
+            let mut ch = Channels::new(&sys);
+            let rhs = Rhs::new(&sys);
+            let y = state(&sys);
+            let n = 2 * sys.dofs();
+            let mut yd = vec![0.0; n + 1];
+            for bits in 0..8u8 {
+                let mode = Mode(bits);
+                ch.prepare(&sys, &map, mode);
+                rhs.eval(mode, &y, &mut yd);
+                let (mut v, mut d) = ([0.0; N_CHANNELS], [0.0; N_CHANNELS]);
+                ch.at(mode, &y, &yd, &mut v, &mut d);
+                let e = map.values(&sys, mode, &y[..n]);
+                let eps = 1e-7;
+                let yp: Vec<f64> = (0..n).map(|i| y[i] + eps * yd[i]).collect();
+                let ym: Vec<f64> = (0..n).map(|i| y[i] - eps * yd[i]).collect();
+                let (ep, em) = (map.values(&sys, mode, &yp), map.values(&sys, mode, &ym));
+                for c in 0..N_CHANNELS {
+                    assert!(
+                        (v[c] - e[c]).abs() <= 1e-12 * e[c].abs().max(1e-9),
+                        "{sb:?} {bits} {c}: {} vs {}",
+                        v[c],
+                        e[c]
+                    );
+                    let fd = (ep[c] - em[c]) / (2.0 * eps);
+                    assert!(
+                        (d[c] - fd).abs() <= 1e-5 * fd.abs() + 1e-6,
+                        "{sb:?} {bits} {c}: slope {} vs {fd}",
+                        d[c]
+                    );
+                }
+            }
+        }
+    }
+
+    /// A contact let go by the force rule at `δ > 0` takes `½ K δ²` with it; closing at
+    /// `δ > 0` brings it back; the dashpot switch and open-open changes take nothing.
+    #[test]
+    fn released_contact_takes_its_elastic_energy() {
+        let sys = system(LINEAR, HERTZ, DashpotKind::OneWay);
+        let y = state(&sys);
+        let n = 2 * sys.dofs();
+        let (d, _) = sys.relative_motion(Switch::SliderBed, &y[..n]);
+        let e = 0.5 * 4.3e7 * d * d;
+        assert!(d > 0.0);
+        let j = contact_energy_jump(&sys, Mode(1), Mode(0), &y[..n]);
+        assert!((j - e).abs() <= 1e-15 * e, "{j} vs {e}");
+        assert_eq!(contact_energy_jump(&sys, Mode(0), Mode(1), &y[..n]), -j);
+        assert_eq!(contact_energy_jump(&sys, Mode(1), Mode(5), &y[..n]), 0.0);
+        let (dd, _) = sys.relative_motion(Switch::BedDamper, &y[..n]);
+        let eh = HERTZ.potential_energy(dd);
+        let jh = contact_energy_jump(&sys, Mode(2), Mode(0), &y[..n]);
+        assert!(eh > 0.0 && (jh - eh).abs() <= 1e-15 * eh);
+    }
+
+    #[test]
+    fn hermite_critical_points_and_slope_roots() {
+        // p(u) = u³ − u² + …: the Hermite cubic of g(s) = s (s − 1)(s − 0.5) on [0, 1]
+        // (g' = 3s² − 3s + 0.5): critical points (3 ∓ √3)/6.
+        let g = |s: f64| s * (s - 1.0) * (s - 0.5);
+        let dg = |s: f64| 3.0 * s * s - 3.0 * s + 0.5;
+        let c = hermite_critical_points(g(0.0), dg(0.0), g(1.0), dg(1.0), 1.0);
+        let r = 3f64.sqrt() / 6.0;
+        assert!((c[0] - (0.5 - r)).abs() < 1e-14 && (c[1] - (0.5 + r)).abs() < 1e-14);
+        let c = hermite_critical_points(0.0, 1.0, 2.0, 1.0, 2.0);
+        assert!(c[0].is_nan() && c[1].is_nan());
+        let root = slope_root(dg, 0.0, 0.5, dg(0.0), dg(0.5), 1e-15);
+        assert!((root - (0.5 - r)).abs() < 1e-14, "{root}");
+    }
+
+    /// A run whose right-hand side is not finite (a slider mass of NaN, past the checks) stops
+    /// with an error naming the time instead of halving its step forever.
+    #[test]
+    fn a_run_without_progress_is_an_error() {
+        let mut sys = system(LINEAR, LINEAR, DashpotKind::OneWay);
+        sys.slider.mass = f64::NAN;
+        let opts = Options {
+            method: Method::Dopri5,
+            duration: 0.01,
+            sample_rate: None,
+            ..Options::default()
+        };
+        let e = solve(&sys, &opts, &mut NoOutput).unwrap_err().to_string();
+        assert!(e.contains("no progress at t = 0"), "{e}");
+    }
 }

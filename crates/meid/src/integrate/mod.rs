@@ -137,9 +137,14 @@ impl Totals {
 /// A point of the run's path: from time `t` on, the system is in `mode`, starting from state
 /// `x = [x; ẋ]` there. A run's [`Solution::path`] has one at t = 0 and one at each mode change,
 /// so that each stretch between two of them is a linear time-invariant motion for linear
-/// contact laws: the exact spectrum ([`crate::analysis::spectrum`]) is built from them. Where a
-/// closed contact has a non-linear law, `dopri5` adds one at each accepted step (knots of its
-/// dense output) with the same mode.
+/// contact laws: the exact spectrum ([`crate::analysis::spectrum`]) is built from them.
+///
+/// Where a closed contact of the current mode has a non-linear law (Hertz, Hunt-Crossley), the
+/// motion between switches is not LTI: `dopri5` then also adds a point at the end of each
+/// accepted step, with the same mode. Those knots are the ends of its steps, which its error
+/// control keeps short against the motion, and between two of them the state is represented by
+/// the cubic Hermite interpolant of the knots' states and derivatives
+/// `Ẋ = [ẋ; ẍ]` (`ẍ` from [`ImpactSystem::accelerations`] in the knot's mode).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PathPoint {
     pub t: f64,
