@@ -75,7 +75,7 @@
 //! faer's factor (faer 0.24 has no accessor for it).
 
 mod block;
-mod shifted;
+pub(crate) mod shifted;
 
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
