@@ -224,7 +224,7 @@ mod tests {
             body_mass: 3.5,
             psi: Some(vec![0.14, 0.3]),
         };
-        let f = propagator_findings(&omega, &[], &[c.clone()], 0.5);
+        let f = propagator_findings(&omega, &[], std::slice::from_ref(&c), 0.5);
         assert!(f.errors.is_empty());
         assert_eq!(f.warnings.len(), 1);
         assert!(f.warnings[0].1.contains("structure mode 1"), "{f:?}");

@@ -4,8 +4,7 @@
 //!
 //! ```toml
 //! [structure.fem]
-//! select = "auto"            # or [6, 10] (1-based mode numbers) or { band_hz = [1, 400] }
-//! auto_count = 2             # modes kept by "auto"
+//! select = "auto"            # or "participation", [6, 10] (1-based mode numbers), { band_hz = [1, 400] }
 //! damping_ratios = 0.01      # one value, or one per selected mode; or rayleigh = [alpha, beta]
 //! solver = "dense"           # or "lanczos" (default: dense below 1000 DOF)
 //! count = 30                 # modes computed (table length; Lanczos k)
@@ -26,13 +25,29 @@
 //! force (`g · φ_i`, along d) that [`FeModel::modal_model`] returns are already along the impact
 //! engine's +z (the slider's direction): no further flip is needed.
 //!
-//! **Automatic mode selection.** An impulse `P` at point A puts the energy `P² ψ_i(A)²/2` into
-//! mass-normalised mode i, so the participation of mode i at the contact points is
-//! `s_i = Σ_A ψ_i(A)²` (A = O_b and O_f, those that exist; `contact_points` to change). `auto`
-//! keeps the `auto_count` modes with the largest `s_i` among those up to `auto_max_hz`, in
-//! ascending frequency. [`FemAnalysis`] carries the scores so `meid modes` can show why.
+//! **Automatic mode selection** (`select = "auto"`, the default). The named points are those
+//! with a role, O_b, O_f and B (`contact_points` adds or replaces them). "auto" keeps
 //!
-//! **Rayleigh damping** `C = αM + βK` gives the modal damping `D_ii = α + β ω_i²`.
+//! 1. every mode up to the cutoff `f_c = 3 ω_c / 2π` (`auto_max_hz` to override) that moves a
+//!    named point (`ψ_i(P)² > 1e-12 max_j ψ_j(P)²` at some P; a mode that moves none is never
+//!    excited by the contact forces nor seen at B). `ω_c` is the highest contact frequency,
+//!    `sqrt(K_s/m_s)` and `sqrt(K_d/m_d)` for linear contacts ([`contact_omega`] for Hertz and
+//!    Hunt-Crossley). A contact of duration `T = π/ω_c` is a half-sine force pulse whose
+//!    spectrum has its main lobe up to `3/(2T)` Hz = `3 ω_c/2π` (first zero of
+//!    `|F(f)| ∝ |cos(π f T)/(1 − (2 f T)²)|` beyond the peak): modes below respond dynamically
+//!    to the blow, modes above it mostly statically;
+//! 2. then, above the cutoff, the modes with the largest share `ψ_i(P)²/(ω_i² G_PP)` of some
+//!    point's static flexibility (see [`crate::modal::truncation`]), one at a time, until every
+//!    named point's captured share reaches 95 % (at most `auto_count` of them; default no limit).
+//!
+//! So a low mode is never dropped in favour of a higher one, and a soft mode carrying a point's
+//! flexibility (a plate's bounce on its springs) is always kept. `select = "participation"` is
+//! the rule "auto" had before: the `auto_count` (default 2) modes with the largest
+//! participation score `s_i = Σ_A ψ_i(A)²` (A = `contact_points`, default the named points)
+//! among those up to `auto_max_hz` — it can drop a low mode; the truncation table then shows
+//! what it lost. [`FemAnalysis`] carries the scores so `meid modes` can show why.
+//!
+//! //! **Rayleigh damping** `C = αM + βK` gives the modal damping `D_ii = α + β ω_i²`.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -154,16 +169,19 @@ pub struct FemSpec {
     /// A Gmsh `.msh` 4.1 quad mesh.
     #[serde(default)]
     pub mesh: Option<MeshFileSpec>,
-    /// Mode selection: "auto" (default), a list of 1-based mode numbers, or `{ band_hz = [lo, hi] }`.
+    /// Mode selection: "auto" (default, module docs), "participation", a list of 1-based mode
+    /// numbers, or `{ band_hz = [lo, hi] }`.
     #[serde(default)]
     pub select: Option<SelectSpec>,
-    /// Modes kept by "auto" (default 2).
+    /// "auto": most modes added above the cutoff (default no limit); "participation": modes
+    /// kept (default 2).
     #[serde(default)]
     pub auto_count: Option<usize>,
-    /// Highest frequency "auto" considers (Hz); default: all computed modes.
+    /// "auto": the cutoff (Hz; default 3 × the highest contact frequency); "participation":
+    /// the highest frequency considered (default: all computed modes).
     #[serde(default)]
     pub auto_max_hz: Option<f64>,
-    /// Points whose motion ranks modes for "auto" (default: O_b and O_f, those that exist).
+    /// Points whose motion ranks modes (default: the model's O_b, O_f and B, those in the mesh).
     #[serde(default)]
     pub contact_points: Option<Vec<String>>,
     /// Modal damping ratio, one value or one per selected mode (default 0).

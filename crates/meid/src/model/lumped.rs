@@ -537,20 +537,14 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
                 .iter()
                 .filter_map(|e| sys.element_frequency2(&part, e).map(|f| (e, f)))
                 .max_by(|x, y| x.1.total_cmp(&y.1));
-            let others = springs
-                .iter()
-                .filter(|e| sys.element_frequency2(&part, e).is_some())
-                .map(|e| e.value)
-                .fold(Vec::new(), |mut v, k| {
-                    v.push(k);
-                    v
-                });
             let (field, advice) = match stiff {
                 Some((e, _)) => {
-                    let rest = others
+                    // The stiffest of the other springs between moving groups.
+                    let rest = springs
                         .iter()
-                        .copied()
-                        .filter(|k| *k != e.value)
+                        .filter(|o| !std::ptr::eq(*o, e))
+                        .filter(|o| sys.element_frequency2(&part, o).is_some())
+                        .map(|o| o.value)
                         .fold(0.0_f64, f64::max);
                     let hint = if rest > 0.0 {
                         format!(
