@@ -265,6 +265,14 @@ duration = {duration}
     assert!(e.starts_with("tab.toml:2:"), "{e}");
     let m = Model::from_text("tab.toml", text(1e-6), &[]).unwrap();
     assert!(m.diagnostics().warnings.is_empty());
+    // dopri5 has no null tolerance: no error.
+    let m = Model::from_text(
+        "tab.toml",
+        text(0.5).replace("[simulation]", "[simulation]\nmethod = \"dopri5\""),
+        &[],
+    )
+    .unwrap();
+    assert!(m.diagnostics().warnings.is_empty());
 }
 
 /// A damper spring of 1e-6 N/m next to a 283 Hz structure is below the propagator's resolution:

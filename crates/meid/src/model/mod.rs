@@ -453,10 +453,14 @@ impl Model {
     }
 
     /// The damper spring (always acting) and the linear contacts (acting while closed) against
-    /// the structure's modes.
+    /// the structure's modes, for the exact method's closed-form propagator (dopri5 has no
+    /// null tolerance: a wide spread only makes its steps small).
     fn propagator_findings(&self) -> crate::modal::conditioning::Findings {
-        use crate::modal::conditioning::{propagator_findings, Link};
+        use crate::modal::conditioning::{propagator_findings, Findings, Link};
         let s = &self.spec;
+        if s.simulation.method != MethodSpec::Exact {
+            return Findings::default();
+        }
         let psi = |name: &str| self.structure.points.get(name).cloned();
         let mut persistent = Vec::new();
         let mut contacts = Vec::new();
