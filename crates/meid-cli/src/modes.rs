@@ -12,8 +12,8 @@ use meid::model::fem;
 pub struct ModesArgs {
     /// Model file (TOML).
     model: PathBuf,
-    /// Write modes.csv, modes.json, modes.vtu + modes.pvd and mode_<n>.png/.svg of the selected
-    /// modes (FE models) into DIR.
+    /// Write modes.csv, modes.json, truncation.csv, modes.vtu + modes.pvd and mode_<n>.png/.svg
+    /// of the selected modes (FE models) into DIR.
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
     /// Print the table as JSON on stdout.
@@ -42,7 +42,11 @@ pub fn run(a: ModesArgs) -> Result<()> {
     let report = match &analysis {
         Some(an) => an.report()?,
         None => fem::report_from_modal(&model.structure),
-    };
+    }
+    .with_diagnostics(model.diagnostics());
+    for w in &report.warnings {
+        eprintln!("warning: {w}");
+    }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
@@ -50,6 +54,10 @@ pub fn run(a: ModesArgs) -> Result<()> {
     }
     if let Some(dir) = &a.output {
         io::write_atomic(&dir.join("modes.csv"), report.to_csv().as_bytes())?;
+        io::write_atomic(
+            &dir.join("truncation.csv"),
+            meid::modal::truncation::to_csv(&report.truncation).as_bytes(),
+        )?;
         io::write_json(&dir.join("modes.json"), &report)?;
         if let Some(an) = &analysis {
             let which: Vec<usize> = (0..an.modes.omega_rad_per_s.len()).collect();

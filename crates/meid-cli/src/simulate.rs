@@ -14,7 +14,8 @@ use crate::args::{CaseArg, PrintArgs, RunArgs};
 pub struct SimulateArgs {
     /// Model file (TOML).
     model: PathBuf,
-    /// Write time histories (history.csv) and the summary (summary.json) into DIR.
+    /// Write time histories (history.csv), the summary (summary.json, with the truncation table,
+    /// notes and warnings) and truncation.csv into DIR.
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
     /// Simulated time (s).
@@ -35,16 +36,37 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     let record = a.output.is_some();
     let run = analysis::simulate(&sys, &opts, record).context("simulation failed")?;
     let s = &run.summary;
+    let diag = model.diagnostics();
+    if !a.print.quiet {
+        for w in &diag.warnings {
+            eprintln!("warning: {w}");
+        }
+    }
+    // The summary's fields, then `truncation`, `notes` and `warnings`.
+    let mut out = serde_json::to_value(s)?;
+    if let (serde_json::Value::Object(o), serde_json::Value::Object(d)) =
+        (&mut out, serde_json::to_value(&diag)?)
+    {
+        o.extend(d);
+    }
     if let Some(dir) = &a.output {
         if let Some(h) = &run.history {
             meid::io::write_atomic(&dir.join("history.csv"), &meid::io::history_csv(h)?)?;
         }
-        meid::io::write_json(&dir.join("summary.json"), s)?;
+        meid::io::write_json(&dir.join("summary.json"), &out)?;
+        meid::io::write_atomic(
+            &dir.join("truncation.csv"),
+            meid::modal::truncation::to_csv(&diag.truncation).as_bytes(),
+        )?;
     }
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(s)?);
+        println!("{}", serde_json::to_string_pretty(&out)?);
     } else if a.print.human() {
         print_summary(&model, s, a.output.as_deref());
+        print!("{}", meid::modal::truncation::to_text(&diag.truncation));
+        for n in &diag.notes {
+            println!("note: {n}");
+        }
     }
     Ok(())
 }
@@ -140,6 +162,9 @@ fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>) {
         s.switching_events, s.steps, s.simulated_time_s
     );
     if let Some(dir) = out {
-        println!("  wrote {}/history.csv and summary.json", dir.display());
+        println!(
+            "  wrote {}/history.csv, summary.json and truncation.csv",
+            dir.display()
+        );
     }
 }

@@ -98,7 +98,7 @@ fn simulate_gives_energy_ratio_between_zero_and_one() {
 fn rigid_body_mode_signs_follow_the_impact_direction() {
     let m = load("paper-soft-base.toml");
     let fem_spec = m.spec.structure.fem.as_ref().unwrap();
-    let a = fem::analyse(fem_spec, &m.source).unwrap();
+    let a = fem::analyse(fem_spec, &m.source, &fem::ReductionContext::of(&m.spec)).unwrap();
     let s = &a.modal;
     let ob = s.point("O_b").unwrap()[0];
     let of = s.point("O_f").unwrap()[0];

@@ -443,6 +443,42 @@ mod tests {
         assert!(err.contains("not positive definite"), "{err}");
     }
 
+    /// A non-diagonal mass matrix with a positive diagonal but a negative eigenvalue
+    /// (M = [1 2; 2 1], eigenvalues 3 and -1) is rejected by the shift-invert route: K + σM is
+    /// still positive definite for this K, but the shift-inverted problem has a negative μ.
+    #[test]
+    fn indefinite_consistent_mass_is_an_error() {
+        let k = Mat::<f64>::from_fn(2, 2, |i, j| if i == j { 1e3 } else { 0.0 });
+        let m = Mat::<f64>::from_fn(2, 2, |i, j| if i == j { 1.0 } else { 2.0 });
+        let err = solve(k.as_ref(), m.as_ref()).unwrap_err().to_string();
+        assert!(
+            err.contains("mass matrix is not positive definite"),
+            "{err}"
+        );
+        // So is one that makes K + σM indefinite (σ = 1e-4 tr K/tr M is large for a light M).
+        let m = Mat::<f64>::from_fn(2, 2, |i, j| if i == j { 1e-3 } else { -1.0 });
+        let err = solve(k.as_ref(), m.as_ref()).unwrap_err().to_string();
+        assert!(err.contains("not positive definite"), "{err}");
+    }
+
+    /// A badly conditioned diagonal M (masses 1 kg and 1e-12 kg on one spring to the ground
+    /// each, k = 1): the diagonal route is a similarity and resolves both modes, ω² = 1 and 1e12,
+    /// to round-off (the spread 1e12 costs the *coupled* case accuracy: see
+    /// `modal::conditioning`).
+    #[test]
+    fn badly_scaled_diagonal_mass_is_resolved_exactly_when_uncoupled() {
+        let k = Mat::<f64>::identity(2, 2);
+        let m = Mat::<f64>::from_fn(2, 2, |i, j| match (i, j) {
+            (0, 0) => 1.0,
+            (1, 1) => 1e-12,
+            _ => 0.0,
+        });
+        let modes = solve(k.as_ref(), m.as_ref()).unwrap();
+        assert!((modes.eigenvalues[0] - 1.0).abs() <= 1e-15);
+        assert!((modes.eigenvalues[1] - 1e12).abs() <= 1e-15 * 1e12);
+        assert!(modes.orthonormality_error < 1e-15);
+    }
+
     /// One consistent-mass bar element, free-free: K = k[1 -1; -1 1], M = m/6 [2 1; 1 2]
     /// (non-diagonal, so the shift-invert route): λ = 0 and λ = 12 k/m exactly.
     #[test]

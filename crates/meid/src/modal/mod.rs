@@ -13,15 +13,19 @@
 //! finite-element model and a user's table of measured or imported modes all end here.
 //!
 //! Submodules: [`dense`] (dense generalised symmetric eigen-solver), [`lanczos`]
-//! (sparse shift-invert block Lanczos for large models).
+//! (sparse shift-invert block Lanczos for large models), [`truncation`] (the static flexibility
+//! a set of retained modes captures at the named points), [`conditioning`] (spreads double
+//! precision cannot carry).
 //!
 //! Every result of this module is bit-identical for any number of rayon threads: faer is
 //! called with `Par::Seq` only, and the parallel parts cut their work into chunks of a fixed
 //! size and combine them in index order (`kernels`).
 
+pub mod conditioning;
 pub mod dense;
 pub(crate) mod kernels;
 pub mod lanczos;
+pub mod truncation;
 
 use std::collections::BTreeMap;
 
@@ -52,6 +56,15 @@ pub struct ModalModel {
     pub floor_force: Option<FloorForce>,
     /// A label per mode for tables and plots, e.g. "mode 6".
     pub labels: Vec<String>,
+    /// Static flexibility of the full (unreduced) structure along z at named points (m/N), over
+    /// its elastic modes: `G_PP = Σ_{all elastic modes} ψ_i(P)²/ω_i²`, computed from the
+    /// stiffness matrix (see [`truncation`]). Empty when unknown (tabulated modes).
+    pub static_flexibility: BTreeMap<String, f64>,
+    /// What building the structure did that a user should know (e.g. a spring treated as rigid).
+    pub notes: Vec<String>,
+    /// What building the structure found doubtful (ill-conditioning, modes missing below the
+    /// selection cutoff). Each names the model field concerned.
+    pub warnings: Vec<String>,
 }
 
 impl ModalModel {
@@ -75,6 +88,9 @@ impl ModalModel {
             points: BTreeMap::new(),
             floor_force: None,
             labels,
+            static_flexibility: BTreeMap::new(),
+            notes: Vec::new(),
+            warnings: Vec::new(),
         })
     }
 
@@ -156,6 +172,17 @@ impl ModalModel {
             points,
             floor_force,
             labels: (1..=n).map(|i| format!("mode {i}")).collect(),
+            // A rigid mass changes no stiffness: without rigid-body modes G_PP is that of the
+            // bare structure, and the Ritz basis keeps ψᵀΩ⁻²ψ (Y Ω'⁻² Yᵀ = Ω⁻² for
+            // YᵀΩ²Y = Ω'²), so shares carry over. With rigid-body modes the elastic
+            // (inertia-relief) flexibility depends on the mass distribution: unknown here.
+            static_flexibility: if self.omega_rad_per_s.iter().all(|w| *w > 0.0) {
+                self.static_flexibility.clone()
+            } else {
+                BTreeMap::new()
+            },
+            notes: self.notes.clone(),
+            warnings: self.warnings.clone(),
         })
     }
 

@@ -4,8 +4,7 @@
 //!
 //! ```toml
 //! [structure.fem]
-//! select = "auto"            # or [6, 10] (1-based mode numbers) or { band_hz = [1, 400] }
-//! auto_count = 2             # modes kept by "auto"
+//! select = "auto"            # or "participation", [6, 10] (1-based mode numbers), { band_hz = [1, 400] }
 //! damping_ratios = 0.01      # one value, or one per selected mode; or rayleigh = [alpha, beta]
 //! solver = "dense"           # or "lanczos" (default: dense below 1000 DOF)
 //! count = 30                 # modes computed (table length; Lanczos k)
@@ -26,27 +25,135 @@
 //! force (`g · φ_i`, along d) that [`FeModel::modal_model`] returns are already along the impact
 //! engine's +z (the slider's direction): no further flip is needed.
 //!
-//! **Automatic mode selection.** An impulse `P` at point A puts the energy `P² ψ_i(A)²/2` into
-//! mass-normalised mode i, so the participation of mode i at the contact points is
-//! `s_i = Σ_A ψ_i(A)²` (A = O_b and O_f, those that exist; `contact_points` to change). `auto`
-//! keeps the `auto_count` modes with the largest `s_i` among those up to `auto_max_hz`, in
-//! ascending frequency. [`FemAnalysis`] carries the scores so `meid modes` can show why.
+//! **Automatic mode selection** (`select = "auto"`, the default). The named points are those
+//! with a role, O_b, O_f and B (`contact_points` adds or replaces them). "auto" keeps
 //!
-//! **Rayleigh damping** `C = αM + βK` gives the modal damping `D_ii = α + β ω_i²`.
+//! 1. every mode up to the cutoff `f_c = 3 ω_c / 2π` (`auto_max_hz` to override) that moves a
+//!    named point (`ψ_i(P)² > 1e-12 max_j ψ_j(P)²` at some P; a mode that moves none is never
+//!    excited by the contact forces nor seen at B). `ω_c` is the highest contact frequency,
+//!    `sqrt(K_s/m_s)` and `sqrt(K_d/m_d)` for linear contacts ([`contact_omega`] for Hertz and
+//!    Hunt-Crossley). A contact of duration `T = π/ω_c` is a half-sine force pulse whose
+//!    spectrum has its main lobe up to `3/(2T)` Hz = `3 ω_c/2π` (first zero of
+//!    `|F(f)| ∝ |cos(π f T)/(1 − (2 f T)²)|` beyond the peak): modes below respond dynamically
+//!    to the blow, modes above it mostly statically;
+//! 2. then, above the cutoff, the modes with the largest share `ψ_i(P)²/(ω_i² G_PP)` of some
+//!    point's static flexibility (see [`crate::modal::truncation`]), one at a time, until every
+//!    named point's captured share reaches 95 % (at most `auto_count` of them; default no limit).
+//!
+//! So a low mode is never dropped in favour of a higher one, and a soft mode carrying a point's
+//! flexibility (a plate's bounce on its springs) is always kept. `select = "participation"` is
+//! the rule "auto" had before: the `auto_count` (default 2) modes with the largest
+//! participation score `s_i = Σ_A ψ_i(A)²` (A = `contact_points`, default the named points)
+//! among those up to `auto_max_hz` — it can drop a low mode; the truncation table then shows
+//! what it lost. [`FemAnalysis`] carries the scores so `meid modes` can show why.
+//!
+//! //! **Rayleigh damping** `C = αM + βK` gives the modal damping `D_ii = α + β ω_i²`.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::spec::Ratios;
+use super::spec::{ContactSpec, LawSpec, ModelSpec, Ratios};
 use super::{Model, Source};
 use crate::modal::dense::{DenseModes, DEFAULT_RELATIVE_SHIFT};
 use crate::modal::lanczos::{self, LanczosOptions};
-use crate::modal::ModalModel;
+use crate::modal::{truncation, ModalModel};
 use crate::structure::machine::{AddedMass, Plate, PlateSpec};
 use crate::structure::{FeModel, MachineSpec, Material, Mesh, ModeTable, Section, Support};
 use crate::{Error, Result};
+
+/// What reducing a structure to modes needs from the rest of the model: the contact frequencies
+/// (for the "auto" selection's cutoff and the rigid-limit test of lumped springs) and the points
+/// with a role (for the selection and the truncation table).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ReductionContext {
+    /// The highest contact frequency ω_c (rad/s) of the slider-bed and bed-damper contacts
+    /// ([`contact_omega`]); 0 when none is known.
+    pub contact_omega_rad_per_s: f64,
+    /// The named points with a role: (name, roles) for O_b (`bed_contact`), O_f
+    /// (`damper_anchor`, unless "ground") and B (`measurement`), in that order, merged by name.
+    pub role_points: Vec<(String, Vec<String>)>,
+}
+
+impl ReductionContext {
+    /// The context of a model spec. Invalid masses or stiffnesses give no contact frequency
+    /// (validation reports them later).
+    pub fn of(spec: &ModelSpec) -> Self {
+        let mut role_points: Vec<(String, Vec<String>)> = Vec::new();
+        let mut add = |name: &str, role: &str| match role_points.iter_mut().find(|(n, _)| n == name)
+        {
+            Some((_, r)) => r.push(role.to_string()),
+            None => role_points.push((name.to_string(), vec![role.to_string()])),
+        };
+        add(&spec.points.bed_contact, "bed_contact");
+        if let Some(a) = spec.points.damper_anchor.as_deref() {
+            if a != "ground" {
+                add(a, "damper_anchor");
+            }
+        }
+        add(&spec.points.measurement, "measurement");
+        let v = spec.slider.velocity.abs();
+        let mut w = contact_omega(&spec.contact.slider_bed, spec.slider.mass, v).unwrap_or(0.0);
+        if let (Some(d), Some(c)) = (&spec.damper, &spec.contact.bed_damper) {
+            // The bed hits the damper at most at about 2 v_s (an elastic blow on a bed at rest).
+            w = w.max(contact_omega(c, d.mass, 2.0 * v).unwrap_or(0.0));
+        }
+        Self {
+            contact_omega_rad_per_s: w,
+            role_points,
+        }
+    }
+}
+
+/// `∫₀¹ dx / sqrt(1 − x^p)` (p > 0): with `x = 1 − u²` the integrand `2u / sqrt(1 − (1 − u²)^p)`
+/// is bounded (→ 2/√p at u = 0); composite Simpson with 4000 panels. `p = 2` gives π/2; in
+/// general `√π Γ(1 + 1/p) / Γ(1/2 + 1/p)`.
+fn half_period_integral(p: f64) -> f64 {
+    let f = |u: f64| {
+        if u == 0.0 {
+            2.0 / p.sqrt()
+        } else {
+            2.0 * u / (1.0 - (1.0 - u * u).powf(p)).sqrt()
+        }
+    };
+    let n = 4000;
+    let h = 1.0 / n as f64;
+    let mut s = f(0.0) + f(1.0);
+    for i in 1..n {
+        s += if i % 2 == 1 { 4.0 } else { 2.0 } * f(i as f64 * h);
+    }
+    s * h / 3.0
+}
+
+/// The contact frequency `ω_c = π / T_c` (rad/s) of a body of mass `m` (kg) striking a rigid
+/// wall at speed `v` (m/s) through the contact law `F = K δ^n`: `T_c` is the contact duration,
+///
+/// ```text
+/// T_c = 2 (δ_max / v) ∫₀¹ dx / sqrt(1 − x^(n+1)),   δ_max = ((n + 1) m v² / (2K))^(1/(n+1)),
+/// ```
+///
+/// which for the linear law (n = 1) is `π sqrt(m/K)`, so `ω_c = sqrt(K/m)` whatever v; for Hertz
+/// (n = 1.5) it is `2.9432 δ_max / v`. Damping (C, α) is ignored. `None` for invalid inputs or a
+/// nonlinear law at v = 0.
+pub fn contact_omega(c: &ContactSpec, m: f64, v: f64) -> Option<f64> {
+    let k = c.stiffness;
+    if !(k.is_finite() && k > 0.0 && m.is_finite() && m > 0.0) {
+        return None;
+    }
+    let n = match c.law {
+        LawSpec::Linear => return Some((k / m).sqrt()),
+        LawSpec::Hertz => 1.5,
+        LawSpec::HuntCrossley => c.exponent.unwrap_or(1.5),
+    };
+    if !(n.is_finite() && n > 0.0 && v.is_finite() && v > 0.0) {
+        return None;
+    }
+    let p = n + 1.0;
+    let d_max = (p * m * v * v / (2.0 * k)).powf(1.0 / p);
+    let t = 2.0 * d_max / v * half_period_integral(p);
+    Some(std::f64::consts::PI / t)
+}
 
 /// Below this many DOFs the default solver is the dense one (measured: the dense solver takes
 /// ~3 s at 1,500 DOFs, the Lanczos solver 0.3-0.7 s for 30 modes up to 5,000 DOFs).
@@ -62,16 +169,19 @@ pub struct FemSpec {
     /// A Gmsh `.msh` 4.1 quad mesh.
     #[serde(default)]
     pub mesh: Option<MeshFileSpec>,
-    /// Mode selection: "auto" (default), a list of 1-based mode numbers, or `{ band_hz = [lo, hi] }`.
+    /// Mode selection: "auto" (default, module docs), "participation", a list of 1-based mode
+    /// numbers, or `{ band_hz = [lo, hi] }`.
     #[serde(default)]
     pub select: Option<SelectSpec>,
-    /// Modes kept by "auto" (default 2).
+    /// "auto": most modes added above the cutoff (default no limit); "participation": modes
+    /// kept (default 2).
     #[serde(default)]
     pub auto_count: Option<usize>,
-    /// Highest frequency "auto" considers (Hz); default: all computed modes.
+    /// "auto": the cutoff (Hz; default 3 × the highest contact frequency); "participation":
+    /// the highest frequency considered (default: all computed modes).
     #[serde(default)]
     pub auto_max_hz: Option<f64>,
-    /// Points whose motion ranks modes for "auto" (default: O_b and O_f, those that exist).
+    /// Points whose motion ranks modes (default: the model's O_b, O_f and B, those in the mesh).
     #[serde(default)]
     pub contact_points: Option<Vec<String>>,
     /// Modal damping ratio, one value or one per selected mode (default 0).
@@ -288,7 +398,17 @@ pub struct GroupSpringSpec {
 pub enum Selection {
     Indices,
     Band([f64; 2]),
-    Auto { count: usize, points: Vec<String> },
+    /// Every participating mode up to `cutoff_hz`, plus `extra` modes above it.
+    Auto {
+        cutoff_hz: f64,
+        extra: usize,
+        points: Vec<String>,
+    },
+    /// The `count` modes with the largest participation score.
+    Participation {
+        count: usize,
+        points: Vec<String>,
+    },
 }
 
 /// Everything `meid modes` shows: the model, all computed modes, the table and the selection.
@@ -582,8 +702,18 @@ pub fn solve_modes(
     }
 }
 
-/// Builds, solves, selects and reduces: the full analysis behind `[structure.fem]`.
-pub fn analyse(spec: &FemSpec, src: &Source) -> Result<FemAnalysis> {
+/// The "auto" selection keeps every participating mode up to this multiple of the highest
+/// contact frequency (see the module docs: the main lobe of a half-sine contact pulse).
+pub const AUTO_CUTOFF_FACTOR: f64 = 3.0;
+/// Modes whose participation score is below this fraction of the largest are not moved by any
+/// named point's force and are left out by "auto" (they are never excited).
+pub const NEGLIGIBLE_SCORE: f64 = 1e-12;
+/// Selected modes with a relative residual above this are warned about.
+pub const RESIDUAL_WARNING: f64 = 1e-6;
+
+/// Builds, solves, selects and reduces: the full analysis behind `[structure.fem]`. `ctx`
+/// gives the contact frequency (for the "auto" cutoff) and the model's named points.
+pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<FemAnalysis> {
     let base = "structure.fem";
     let model = build_model(spec, src)?;
     let count = spec.count.unwrap_or(30);
@@ -596,8 +726,9 @@ pub fn analyse(spec: &FemSpec, src: &Source) -> Result<FemAnalysis> {
     let (modes, solver) = solve_modes(&model, spec.solver, count)?;
     let table = model.mode_table(&modes)?;
     let nm = modes.omega_rad_per_s.len();
+    let mut warnings = Vec::new();
 
-    // Participation at the contact points.
+    // The points that rank modes: `contact_points`, else the model's named points with a role.
     let score_points: Vec<String> = match &spec.contact_points {
         Some(v) => {
             for (i, p) in v.iter().enumerate() {
@@ -614,31 +745,91 @@ pub fn analyse(spec: &FemSpec, src: &Source) -> Result<FemAnalysis> {
             }
             v.clone()
         }
-        None => ["O_b", "O_f"]
+        None => ctx
+            .role_points
             .iter()
-            .filter(|p| model.mesh.points.contains_key(**p))
-            .map(|s| s.to_string())
+            .map(|(p, _)| p.clone())
+            .filter(|p| model.mesh.points.contains_key(p))
             .collect(),
     };
+    let mut psi: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    let mut functionals = Vec::new();
+    for p in score_points
+        .iter()
+        .chain(ctx.role_points.iter().map(|(p, _)| p))
+    {
+        if psi.contains_key(p) || !model.mesh.points.contains_key(p) {
+            continue;
+        }
+        let f = model.point_functional(p)?;
+        let v: Vec<f64> = (0..nm)
+            .map(|i| (0..f.len()).map(|j| f[j] * modes.shapes[(j, i)]).sum())
+            .collect();
+        psi.insert(p.clone(), v);
+        functionals.push((p.clone(), f));
+    }
     let mut scores = vec![0.0; nm];
     for p in &score_points {
-        let f = model.point_functional(p)?;
-        for (i, s) in scores.iter_mut().enumerate() {
-            let v: f64 = (0..f.len()).map(|j| f[j] * modes.shapes[(j, i)]).sum();
+        for (s, v) in scores.iter_mut().zip(&psi[p]) {
             *s += v * v;
         }
     }
 
+    // Static flexibility of the full model at those points (elastic part, module docs).
+    let rigid: Vec<Vec<f64>> = (0..nm)
+        .filter(|&i| modes.omega_rad_per_s[i] == 0.0)
+        .map(|i| modes.shapes.col(i).iter().copied().collect())
+        .collect();
+    let lowest_elastic = modes
+        .omega_rad_per_s
+        .iter()
+        .find(|w| **w > 0.0)
+        .map(|w| w * w);
+    let fvecs: Vec<Vec<f64>> = functionals.iter().map(|(_, f)| f.clone()).collect();
+    let static_flexibility: BTreeMap<String, f64> = match truncation::static_flexibility(
+        model.stiffness.as_ref(),
+        model.mass.as_ref(),
+        &fvecs,
+        &rigid,
+        lowest_elastic,
+    ) {
+        Ok(g) => functionals.iter().map(|(p, _)| p.clone()).zip(g).collect(),
+        Err(e) => {
+            warnings.push(format!(
+                "{base}: the static flexibility could not be computed, so modes are selected \
+                 without it and there is no truncation table: {e}"
+            ));
+            BTreeMap::new()
+        }
+    };
+
     let freq = &table.frequency_hz;
+    let auto = |warnings: &mut Vec<String>| {
+        auto_select(
+            spec,
+            src,
+            ctx,
+            &AutoInput {
+                scores: &scores,
+                freq,
+                omega: &modes.omega_rad_per_s,
+                points: &score_points,
+                psi: &psi,
+                static_flexibility: &static_flexibility,
+            },
+            warnings,
+        )
+    };
     let (mut selected, selection) = match spec.select.clone() {
-        None => auto_select(spec, src, &scores, freq, &score_points)?,
-        Some(SelectSpec::Keyword(k)) if k == "auto" => {
-            auto_select(spec, src, &scores, freq, &score_points)?
+        None => auto(&mut warnings)?,
+        Some(SelectSpec::Keyword(k)) if k == "auto" => auto(&mut warnings)?,
+        Some(SelectSpec::Keyword(k)) if k == "participation" => {
+            participation_select(spec, src, &scores, freq, &score_points)?
         }
         Some(SelectSpec::Keyword(k)) => {
             return Err(src.error(
                 &format!("{base}.select"),
-                format!("{base}.select: unknown keyword '{k}'; give \"auto\", a list of 1-based mode numbers, or {{ band_hz = [lo, hi] }}"),
+                format!("{base}.select: unknown keyword '{k}'; give \"auto\", \"participation\", a list of 1-based mode numbers, or {{ band_hz = [lo, hi] }}"),
             ))
         }
         Some(SelectSpec::Indices(v)) => {
@@ -719,6 +910,20 @@ pub fn analyse(spec: &FemSpec, src: &Source) -> Result<FemAnalysis> {
         }
     }
     let selected_residuals = sparse_residuals(&model, &modes, &selected);
+    for (&i, r) in selected.iter().zip(&selected_residuals) {
+        if *r > RESIDUAL_WARNING {
+            warnings.push(format!(
+                "{base}: mode {} ({:.4} Hz) has a relative residual {r:.1e} > {RESIDUAL_WARNING:.0e}: \
+                 the eigen-solution is inaccurate, as when stiffnesses or masses span more than \
+                 double precision carries (a very stiff spring: give a rigid link instead, or \
+                 lower it to ~1e3 times the structure's stiffness)",
+                i + 1,
+                freq[i]
+            ));
+        }
+    }
+    modal.static_flexibility = static_flexibility;
+    modal.warnings = warnings;
     Ok(FemAnalysis {
         model,
         modes,
@@ -778,7 +983,138 @@ fn sparse_residuals(model: &FeModel, modes: &DenseModes, which: &[usize]) -> Vec
         .collect()
 }
 
+/// What [`auto_select`] ranks modes by.
+struct AutoInput<'a> {
+    scores: &'a [f64],
+    freq: &'a [f64],
+    omega: &'a [f64],
+    points: &'a [String],
+    psi: &'a BTreeMap<String, Vec<f64>>,
+    static_flexibility: &'a BTreeMap<String, f64>,
+}
+
+/// `select = "auto"` (module docs): every participating mode up to the cutoff, then, above it,
+/// the modes carrying the largest share of a point's static flexibility until every point
+/// holds [`truncation::SHARE_WARNING`] (at most `auto_count` of them).
 fn auto_select(
+    spec: &FemSpec,
+    src: &Source,
+    ctx: &ReductionContext,
+    a: &AutoInput<'_>,
+    warnings: &mut Vec<String>,
+) -> Result<(Vec<usize>, Selection)> {
+    let base = "structure.fem";
+    if a.points.is_empty() {
+        return Err(src.error(
+            &format!("{base}.select"),
+            format!("{base}.select = \"auto\" needs the model's named points (O_b, O_f, B) in the mesh, or `contact_points`"),
+        ));
+    }
+    let cutoff_hz = match spec.auto_max_hz {
+        Some(f) if f.is_finite() && f > 0.0 => f,
+        Some(f) => {
+            return Err(src.error(
+                &format!("{base}.auto_max_hz"),
+                format!("{base}.auto_max_hz must be a finite number > 0 Hz (got {f})"),
+            ))
+        }
+        None if ctx.contact_omega_rad_per_s > 0.0 => {
+            AUTO_CUTOFF_FACTOR * ctx.contact_omega_rad_per_s / (2.0 * std::f64::consts::PI)
+        }
+        None => {
+            return Err(src.error(
+                &format!("{base}.auto_max_hz"),
+                format!("{base}: select = \"auto\" needs a contact frequency (a linear contact, or a nonlinear one with slider.velocity != 0) or `auto_max_hz`"),
+            ))
+        }
+    };
+    let nm = a.scores.len();
+    // A mode that moves none of the points (score points and role points) is never excited
+    // by the impact forces and never seen at B.
+    let peak: BTreeMap<&String, f64> = a
+        .psi
+        .iter()
+        .map(|(p, v)| (p, v.iter().fold(0.0_f64, |x, y| x.max(y * y))))
+        .collect();
+    let moves = |i: usize| {
+        a.psi
+            .iter()
+            .any(|(p, v)| v[i] * v[i] > NEGLIGIBLE_SCORE * peak[p])
+    };
+    // Shares are checked at every point of the truncation table (the role points) and at the
+    // score points.
+    let share_points: Vec<&String> = a.psi.keys().collect();
+    let mut selected: Vec<usize> = (0..nm)
+        .filter(|&i| a.freq[i] <= cutoff_hz && moves(i))
+        .collect();
+    if nm > 0 && a.freq[nm - 1] < cutoff_hz {
+        warnings.push(format!(
+            "{base}.count: the {nm} computed modes stop at {:.4} Hz, below the \"auto\" cutoff \
+             {cutoff_hz:.4} Hz ({AUTO_CUTOFF_FACTOR} times the highest contact frequency): \
+             modes in between may be missing; raise {base}.count",
+            a.freq[nm - 1]
+        ));
+    }
+    // Above the cutoff: largest share of some point's static flexibility first.
+    let share = |sel: &[usize], p: &str| -> Option<f64> {
+        let g = *a.static_flexibility.get(p)?;
+        if g <= 0.0 {
+            return None;
+        }
+        let v = a.psi.get(p)?;
+        let m: f64 = sel
+            .iter()
+            .filter(|&&i| a.omega[i] > 0.0)
+            .map(|&i| v[i] * v[i] / (a.omega[i] * a.omega[i]))
+            .sum();
+        Some(m / g)
+    };
+    let contribution = |i: usize| -> f64 {
+        share_points
+            .iter()
+            .filter_map(|p| {
+                let g = *a.static_flexibility.get(p.as_str())?;
+                let v = a.psi.get(p.as_str())?;
+                (g > 0.0 && a.omega[i] > 0.0).then(|| v[i] * v[i] / (a.omega[i] * a.omega[i] * g))
+            })
+            .fold(0.0, f64::max)
+    };
+    let mut extra: Vec<usize> = (0..nm)
+        .filter(|&i| a.freq[i] > cutoff_hz && moves(i))
+        .collect();
+    extra.sort_by(|&x, &y| contribution(y).total_cmp(&contribution(x)));
+    let limit = spec.auto_count.unwrap_or(usize::MAX);
+    let mut added = 0;
+    for i in extra {
+        let short = share_points
+            .iter()
+            .any(|p| share(&selected, p).is_some_and(|s| s < truncation::SHARE_WARNING));
+        if !short || added >= limit {
+            break;
+        }
+        selected.push(i);
+        added += 1;
+    }
+    if selected.is_empty() {
+        return Err(src.error(
+            &format!("{base}.select"),
+            format!("{base}: no computed mode moves the points {} (up to {cutoff_hz:.4} Hz and above): check the points and `count`", a.points.join(", ")),
+        ));
+    }
+    Ok((
+        selected,
+        Selection::Auto {
+            cutoff_hz,
+            extra: added,
+            points: share_points.iter().map(|p| p.to_string()).collect(),
+        },
+    ))
+}
+
+/// `select = "participation"`: the `auto_count` modes (default 2) with the largest participation
+/// score up to `auto_max_hz` (the rule "auto" had before; it can drop a low mode that carries
+/// a point's flexibility, which the truncation table then shows).
+fn participation_select(
     spec: &FemSpec,
     src: &Source,
     scores: &[f64],
@@ -789,14 +1125,14 @@ fn auto_select(
     if points.is_empty() {
         return Err(src.error(
             &format!("{base}.select"),
-            format!("{base}.select = \"auto\" needs contact points (O_b/O_f) in the model or `contact_points`"),
+            format!("{base}.select = \"participation\" needs the model's named points in the mesh, or `contact_points`"),
         ));
     }
     let count = spec.auto_count.unwrap_or(2);
     if count == 0 {
         return Err(src.error(
             &format!("{base}.auto_count"),
-            format!("{base}.auto_count must be >= 1"),
+            format!("{base}.auto_count must be >= 1 with select = \"participation\""),
         ));
     }
     let max_hz = spec.auto_max_hz.unwrap_or(f64::INFINITY);
@@ -811,7 +1147,7 @@ fn auto_select(
     }
     Ok((
         cand,
-        Selection::Auto {
+        Selection::Participation {
             count,
             points: points.to_vec(),
         },
@@ -819,8 +1155,8 @@ fn auto_select(
 }
 
 /// Builds, solves and reduces the finite-element structure.
-pub fn modal_model(spec: &FemSpec, src: &Source) -> Result<ModalModel> {
-    Ok(analyse(spec, src)?.modal)
+pub fn modal_model(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<ModalModel> {
+    Ok(analyse(spec, src, ctx)?.modal)
 }
 
 /// Reads a model file like [`Model::from_file`] and, when its structure is `[structure.fem]`,
@@ -845,7 +1181,7 @@ pub fn from_file_with_analysis(
                 if count.is_some() {
                     f.count = count;
                 }
-                let an = analyse(&f, src)?;
+                let an = analyse(&f, src, &ReductionContext::of(spec))?;
                 let modal = an.modal.clone();
                 analysis = Some(an);
                 Ok(modal)
@@ -904,6 +1240,12 @@ pub struct ModeReport {
     pub selected_residuals: Vec<f64>,
     /// max |Φᵀ M Φ − I| over the computed modes.
     pub orthonormality_error: Option<f64>,
+    /// Captured share of the static flexibility at the named points with a role.
+    pub truncation: Vec<truncation::TruncationRow>,
+    /// What building the structure did (e.g. springs treated as rigid).
+    pub notes: Vec<String>,
+    /// Doubtful findings, each naming the model field concerned.
+    pub warnings: Vec<String>,
 }
 
 fn eff(a: [f64; 6]) -> EffectiveMass {
@@ -950,8 +1292,16 @@ impl FemAnalysis {
         let selection = match &self.selection {
             Selection::Indices => "by index (select = [...])".to_string(),
             Selection::Band(b) => format!("by frequency band {} to {} Hz", b[0], b[1]),
-            Selection::Auto { count, points } => format!(
-                "auto: the {count} modes with the largest participation score sum of psi(P)^2 at {}",
+            Selection::Auto {
+                cutoff_hz,
+                extra,
+                points,
+            } => format!(
+                "auto: every mode moving {} up to {cutoff_hz:.1} Hz ({AUTO_CUTOFF_FACTOR} x the highest contact frequency, or auto_max_hz), plus {extra} above it by share of static flexibility",
+                points.join(", ")
+            ),
+            Selection::Participation { count, points } => format!(
+                "participation: the {count} modes with the largest participation score sum of psi(P)^2 at {}",
                 points.join(", ")
             ),
         };
@@ -964,6 +1314,9 @@ impl FemAnalysis {
             total_mass: Some(eff(self.table.total_mass)),
             selected_residuals: self.selected_residuals.clone(),
             orthonormality_error: Some(self.modes.orthonormality_error),
+            truncation: Vec::new(),
+            notes: Vec::new(),
+            warnings: Vec::new(),
         })
     }
 }
@@ -994,11 +1347,23 @@ pub fn report_from_modal(m: &ModalModel) -> ModeReport {
         total_mass: None,
         selected_residuals: Vec::new(),
         orthonormality_error: None,
+        truncation: Vec::new(),
+        notes: Vec::new(),
+        warnings: Vec::new(),
     }
 }
 
 impl ModeReport {
-    /// A fixed-width text table (one line per mode) followed by the selection.
+    /// The report with a model's truncation table, notes and warnings ([`Model::diagnostics`]).
+    pub fn with_diagnostics(mut self, d: super::Diagnostics) -> Self {
+        self.truncation = d.truncation;
+        self.notes = d.notes;
+        self.warnings = d.warnings;
+        self
+    }
+
+    /// A fixed-width text table (one line per mode) followed by the selection, the truncation
+    /// table and the notes (warnings are left to the caller, for stderr).
     pub fn to_text(&self) -> String {
         use std::fmt::Write;
         let points: Vec<String> = self
@@ -1053,6 +1418,10 @@ impl ModeReport {
                     .map(|r| format!("{r:.1e}"))
                     .collect::<Vec<_>>()
             );
+        }
+        s.push_str(&truncation::to_text(&self.truncation));
+        for n in &self.notes {
+            let _ = writeln!(s, "note: {n}");
         }
         s
     }

@@ -245,7 +245,13 @@ impl Model {
                 format!("simulation.atol must be > 0 (got {})", sim.atol),
             ));
         }
-        Ok(())
+        // Everything the impact system checks (masses, stiffnesses, ...), with positions.
+        self.impact_system(Case::AsSpecified)?;
+        // Frequency spreads the closed-form propagator cannot carry (meaningless results).
+        match self.propagator_findings().errors.into_iter().next() {
+            Some((field, message)) => Err(src.error(&field, message)),
+            None => Ok(()),
+        }
     }
 
     /// The impact system for a case.
@@ -443,17 +449,107 @@ fn build_structure(spec: &ModelSpec, src: &Source) -> Result<ModalModel> {
             "give one of [structure.lumped], [structure.modal] or [structure.fem], not several",
         ));
     }
+    let ctx = fem::ReductionContext::of(spec);
     if let Some(l) = &st.lumped {
-        return lumped::modal_model(l, src);
+        return lumped::modal_model(l, src, &ctx);
     }
     if let Some(m) = &st.modal {
         return lumped::from_modal_spec(m, src);
     }
     if let Some(f) = &st.fem {
-        return fem::modal_model(f, src);
+        return fem::modal_model(f, src, &ctx);
     }
     Err(src.error(
         "structure",
         "the structure is missing: add [structure.lumped] (masses, springs), [structure.modal] (frequencies_hz, shapes) or [structure.fem]",
     ))
+}
+
+/// What a report shows beside a model's results: how much of the structure the retained modes
+/// keep, what building it did, and what looks doubtful.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct Diagnostics {
+    /// Captured share of the static flexibility at each named point with a role.
+    pub truncation: Vec<crate::modal::truncation::TruncationRow>,
+    /// E.g. a spring treated as rigid.
+    pub notes: Vec<String>,
+    /// Each names the model field concerned.
+    pub warnings: Vec<String>,
+}
+
+impl Model {
+    /// The truncation table of the role points (O_b, O_f, B), the structure's notes, and the
+    /// warnings: the structure's own, captured shares below 95 %
+    /// ([`crate::modal::truncation::SHARE_WARNING`]), and frequency spreads the closed-form
+    /// propagator resolves only approximately ([`crate::modal::conditioning`]).
+    pub fn diagnostics(&self) -> Diagnostics {
+        let ctx = fem::ReductionContext::of(&self.spec);
+        let truncation = self.structure.truncation(&ctx.role_points);
+        let mut warnings = self.structure.warnings.clone();
+        warnings.extend(
+            truncation
+                .iter()
+                .filter_map(crate::modal::truncation::share_warning),
+        );
+        for (field, message) in self.propagator_findings().warnings {
+            warnings.push(format!("{}: {message}", self.source.locate(&field)));
+        }
+        Diagnostics {
+            truncation,
+            notes: self.structure.notes.clone(),
+            warnings,
+        }
+    }
+
+    /// The damper spring (always acting) and the linear contacts (acting while closed) against
+    /// the structure's modes, for the exact method's closed-form propagator (dopri5 has no
+    /// null tolerance: a wide spread only makes its steps small).
+    fn propagator_findings(&self) -> crate::modal::conditioning::Findings {
+        use crate::modal::conditioning::{propagator_findings, Findings, Link};
+        let s = &self.spec;
+        if s.simulation.method != MethodSpec::Exact {
+            return Findings::default();
+        }
+        let psi = |name: &str| self.structure.points.get(name).cloned();
+        let mut persistent = Vec::new();
+        let mut contacts = Vec::new();
+        let linear = |c: &ContactSpec| c.law == LawSpec::Linear && c.stiffness > 0.0;
+        if linear(&s.contact.slider_bed) {
+            contacts.push(Link {
+                field: "contact.slider_bed.stiffness".into(),
+                stiffness: s.contact.slider_bed.stiffness,
+                body_mass: s.slider.mass,
+                psi: psi(&s.points.bed_contact),
+            });
+        }
+        if let Some(d) = &s.damper {
+            if d.stiffness > 0.0 {
+                persistent.push(Link {
+                    field: "damper.stiffness".into(),
+                    stiffness: d.stiffness,
+                    body_mass: d.mass,
+                    psi: s
+                        .points
+                        .damper_anchor
+                        .as_deref()
+                        .filter(|a| *a != "ground")
+                        .and_then(psi),
+                });
+            }
+            if let Some(c) = s.contact.bed_damper.as_ref().filter(|c| linear(c)) {
+                contacts.push(Link {
+                    field: "contact.bed_damper.stiffness".into(),
+                    stiffness: c.stiffness,
+                    body_mass: d.mass,
+                    psi: psi(&s.points.bed_contact),
+                });
+            }
+        }
+        propagator_findings(
+            &self.structure.omega_rad_per_s,
+            &persistent,
+            &contacts,
+            s.simulation.duration,
+        )
+    }
 }

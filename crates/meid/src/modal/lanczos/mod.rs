@@ -84,7 +84,7 @@
 //! 1e-9 in the paper machine's lowest frequency.
 
 mod block;
-mod shifted;
+pub(crate) mod shifted;
 
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,

@@ -1,0 +1,405 @@
+//! Mode selection and truncation: the static flexibility the retained modes capture at the named
+//! points, the "auto" rule that keeps every mode up to a cutoff, and the bounce-mode defect (a
+//! plate on four corner springs whose 14 Hz bounce mode the old rule dropped).
+
+use std::fmt::Write;
+use std::path::PathBuf;
+
+use meid::model::fem::{self, contact_omega, ReductionContext};
+use meid::model::{ContactSpec, LawSpec, Model, ReleaseSpec};
+
+/// A structured nx × ny quad mesh of [0, a] × [0, b] in Gmsh 4.1 ASCII with physical groups
+/// "plate" (surface), "corners" (the four corner points) and "centre" (a point).
+fn plate_msh(nx: usize, ny: usize, a: f64, b: f64) -> String {
+    assert!(nx % 2 == 0 && ny % 2 == 0);
+    let tag = |i: usize, j: usize| 1 + j * (nx + 1) + i;
+    let mut s = String::new();
+    s.push_str("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n");
+    s.push_str(
+        "$PhysicalNames\n3\n0 1 \"corners\"\n0 2 \"centre\"\n2 3 \"plate\"\n$EndPhysicalNames\n",
+    );
+    // 5 points (4 corners + centre), 0 curves, 1 surface.
+    s.push_str("$Entities\n5 0 1 0\n");
+    let corners = [(0, 0), (nx, 0), (nx, ny), (0, ny)];
+    for (k, &(i, j)) in corners.iter().enumerate() {
+        let (x, y) = (a * i as f64 / nx as f64, b * j as f64 / ny as f64);
+        writeln!(s, "{} {x} {y} 0 1 1", k + 1).unwrap();
+    }
+    writeln!(s, "5 {} {} 0 1 2", a / 2.0, b / 2.0).unwrap();
+    writeln!(s, "1 0 0 0 {a} {b} 0 1 3 0").unwrap();
+    s.push_str("$EndEntities\n");
+    let total = (nx + 1) * (ny + 1);
+    writeln!(s, "$Nodes\n1 {total} 1 {total}\n2 1 0 {total}").unwrap();
+    for t in 1..=total {
+        writeln!(s, "{t}").unwrap();
+    }
+    for j in 0..=ny {
+        for i in 0..=nx {
+            writeln!(
+                s,
+                "{:e} {:e} 0",
+                a * i as f64 / nx as f64,
+                b * j as f64 / ny as f64
+            )
+            .unwrap();
+        }
+    }
+    s.push_str("$EndNodes\n");
+    let mut blocks = Vec::new();
+    let mut et = 1;
+    for (k, &(i, j)) in corners.iter().enumerate() {
+        blocks.push(format!("0 {} 15 1\n{et} {}\n", k + 1, tag(i, j)));
+        et += 1;
+    }
+    blocks.push(format!("0 5 15 1\n{et} {}\n", tag(nx / 2, ny / 2)));
+    et += 1;
+    let mut q = format!("2 1 3 {}\n", nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            writeln!(
+                q,
+                "{et} {} {} {} {}",
+                tag(i, j),
+                tag(i + 1, j),
+                tag(i + 1, j + 1),
+                tag(i, j + 1)
+            )
+            .unwrap();
+            et += 1;
+        }
+    }
+    blocks.push(q);
+    writeln!(s, "$Elements\n{} {} 1 {}", blocks.len(), et - 1, et - 1).unwrap();
+    for b in blocks {
+        s.push_str(&b);
+    }
+    s.push_str("$EndElements\n");
+    s
+}
+
+const A: f64 = 0.40;
+const B: f64 = 0.30;
+const H: f64 = 0.010;
+/// Steel plate mass ρ a b h (kg).
+fn plate_mass() -> f64 {
+    7850.0 * A * B * H
+}
+/// Vertical stiffness per corner spring giving a 14 Hz bounce: k = m (2π·14)² / 4.
+fn corner_kz() -> f64 {
+    plate_mass() * (2.0 * std::f64::consts::PI * 14.0).powi(2) / 4.0
+}
+
+/// A plate on four corner springs (x, y, z), struck at its centre by a 1.2 kg slider through a
+/// 4.3e7 N/m contact (ω_s = 5985 rad/s, 952.5 Hz): `select` and extra `[structure.fem]` lines.
+fn bounce_model(tag: &str, fem_extra: &str) -> (PathBuf, String) {
+    let dir = std::env::temp_dir().join(format!("meid-bounce-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("plate.msh"), plate_msh(8, 6, A, B)).unwrap();
+    let kz = corner_kz();
+    let text = format!(
+        r#"
+[structure.fem]
+damping_ratios = 0.01
+count = 30
+{fem_extra}
+
+[structure.fem.mesh]
+file = "plate.msh"
+thickness = {H}
+points = {{ O_b = "centre", B = "centre" }}
+springs = [{{ group = "corners", stiffness = [{kxy}, {kxy}, {kz}] }}]
+
+[points]
+bed_contact = "O_b"
+measurement = "B"
+
+[slider]
+mass = 1.2
+velocity = 1.2
+
+[contact.slider_bed]
+law = "linear"
+stiffness = 4.3e7
+
+[simulation]
+duration = 0.02
+"#,
+        kxy = 0.2 * kz
+    );
+    (dir.join("model.toml"), text)
+}
+
+fn load(tag: &str, fem_extra: &str) -> Model {
+    let (path, text) = bounce_model(tag, fem_extra);
+    Model::from_text(&path.display().to_string(), text, &[]).unwrap()
+}
+
+/// The defect: the old rule (now `select = "participation"`, 2 modes by ψ(O_b)²) keeps two
+/// plate-bending modes and drops the 14 Hz bounce mode, which carries almost all of the contact
+/// point's static flexibility (the springs are ~100 times softer than the plate). The new
+/// default keeps it, captures ≥ 95 % at O_b, and the old selection reports its loss.
+#[test]
+fn auto_keeps_the_bounce_mode_the_old_rule_dropped() {
+    let old = load("old", "select = \"participation\"\nauto_count = 2");
+    let f0 = old.structure.omega_rad_per_s[0] / (2.0 * std::f64::consts::PI);
+    assert!(
+        f0 > 100.0,
+        "the old rule kept a {f0} Hz mode: the defect is not reproduced"
+    );
+    let d_old = old.diagnostics();
+    let ob_old = d_old.truncation.iter().find(|r| r.point == "O_b").unwrap();
+    assert!(ob_old.captured_share < 0.05, "{ob_old:?}");
+    assert!(
+        d_old
+            .warnings
+            .iter()
+            .any(|w| w.contains("'O_b'") && w.contains("static flexibility")),
+        "{:?}",
+        d_old.warnings
+    );
+
+    let new = load("new", "");
+    let f: Vec<f64> = new
+        .structure
+        .omega_rad_per_s
+        .iter()
+        .map(|w| w / (2.0 * std::f64::consts::PI))
+        .collect();
+    // The bounce: a rigid plate on 4 kz: sqrt(4 kz / m)/2π = 14 Hz (the plate's bending lowers
+    // it a little).
+    let bounce = f.iter().position(|&x| (x - 14.0).abs() < 0.3);
+    assert!(bounce.is_some(), "no bounce mode kept: {f:?}");
+    let d = new.diagnostics();
+    let ob = d.truncation.iter().find(|r| r.point == "O_b").unwrap();
+    eprintln!(
+        "old rule: {:?} Hz, share {:.4}; auto: {} modes {:.2}..{:.2} Hz, share {:.6}",
+        old.structure
+            .omega_rad_per_s
+            .iter()
+            .map(|w| w / (2.0 * std::f64::consts::PI))
+            .collect::<Vec<_>>(),
+        ob_old.captured_share,
+        f.len(),
+        f[0],
+        f[f.len() - 1],
+        ob.captured_share
+    );
+    assert!(ob.captured_share >= 0.95, "{ob:?}");
+    assert!(ob.captured_share <= 1.0 + 1e-12, "{ob:?}");
+    assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+    // G_PP is the springs in series with the plate: at least the four springs in parallel.
+    assert!(ob.static_flexibility_m_per_n > 1.0 / (4.0 * corner_kz()));
+    assert!(ob.static_flexibility_m_per_n < 1.1 / (4.0 * corner_kz()));
+}
+
+/// "Auto" never drops a low mode in favour of a higher one: every kept mode above the cutoff
+/// comes after all participating modes below it, and the cutoff is 3 ω_s / 2π.
+#[test]
+fn auto_keeps_every_participating_mode_below_the_cutoff() {
+    let (path, text) = bounce_model("cutoff", "");
+    let spec: meid::model::ModelSpec = toml::from_str(&text).unwrap();
+    let ctx = ReductionContext::of(&spec);
+    let ws = (4.3e7_f64 / 1.2).sqrt();
+    assert!((ctx.contact_omega_rad_per_s - ws).abs() <= 1e-12 * ws);
+    let src = meid::model::Source {
+        name: path.display().to_string(),
+        text: text.clone(),
+        overrides: Vec::new(),
+    };
+    let a = fem::analyse(spec.structure.fem.as_ref().unwrap(), &src, &ctx).unwrap();
+    let cutoff = 3.0 * ws / (2.0 * std::f64::consts::PI);
+    let fmax_kept_below = a
+        .selected
+        .iter()
+        .map(|&i| a.table.frequency_hz[i])
+        .filter(|&f| f <= cutoff)
+        .fold(0.0, f64::max);
+    for i in 0..a.table.frequency_hz.len() {
+        let f = a.table.frequency_hz[i];
+        let moves = a.scores[i] > 1e-12 * a.scores.iter().fold(0.0_f64, |x, &y| x.max(y));
+        if f <= cutoff && moves {
+            assert!(a.selected.contains(&i), "mode {} ({f} Hz) dropped", i + 1);
+        }
+        if !a.selected.contains(&i) && moves {
+            assert!(
+                f > fmax_kept_below,
+                "mode {} ({f} Hz) dropped below a kept one",
+                i + 1
+            );
+        }
+    }
+}
+
+/// A deliberately truncated selection (only the 6th mode, a plate mode) keeps a small share and
+/// is warned about, in the diagnostics and on the CLI's stderr.
+#[test]
+fn truncated_selection_reports_a_small_share_and_a_warning() {
+    let m = load("trunc", "select = [7]");
+    let d = m.diagnostics();
+    // O_b and B name the same node: two rows, two warnings.
+    assert_eq!(d.truncation.len(), 2);
+    for (r, (point, role)) in d
+        .truncation
+        .iter()
+        .zip([("O_b", "bed_contact"), ("B", "measurement")])
+    {
+        assert_eq!(
+            (r.point.as_str(), r.roles.clone()),
+            (point, vec![role.to_string()])
+        );
+        assert!(r.captured_share < 0.95, "{r:?}");
+    }
+    assert_eq!(d.warnings.len(), 2, "{:?}", d.warnings);
+    for w in &d.warnings {
+        assert!(w.contains("static flexibility at point"), "{w}");
+    }
+}
+
+/// A lumped model keeps all its modes: the share is 1 to 1e-12 at every point (the static
+/// flexibility comes from the Cholesky factor of K, the modal sum from the eigenvectors).
+/// Here a free-free three-mass chain (one rigid-body mode: the elastic convention) and the
+/// paper's grounded two-mass model.
+#[test]
+fn lumped_models_capture_everything() {
+    let free = r#"
+[structure.lumped]
+masses = [ { name = "a", mass = 2.0 }, { name = "b", mass = 5.0 }, { name = "c", mass = 1.5 } ]
+springs = [ { nodes = ["a", "b"], stiffness = 3.0e5 }, { nodes = ["b", "c"], stiffness = 8.0e4 } ]
+[points]
+bed_contact = "a"
+damper_anchor = "b"
+measurement = "c"
+[slider]
+mass = 0.5
+velocity = 1.0
+[contact.slider_bed]
+stiffness = 1e7
+"#;
+    let m = Model::from_text("free.toml", free.to_string(), &[]).unwrap();
+    assert_eq!(m.structure.omega_rad_per_s[0], 0.0);
+    let d = m.diagnostics();
+    assert_eq!(d.truncation.len(), 3);
+    for r in &d.truncation {
+        assert!((r.captured_share - 1.0).abs() <= 1e-12, "{r:?}");
+    }
+    // Closed form at the free end c of a free chain: with the load made self-equilibrated, the
+    // elastic flexibility is Σ over springs of (share of the total mass beyond the spring,
+    // seen from c)² / k: spring b-c carries (m_a + m_b)/M of the load, a-b carries m_a/M.
+    let mt: f64 = 8.5;
+    let gc = ((2.0 + 5.0) / mt).powi(2) / 8.0e4 + (2.0 / mt).powi(2) / 3.0e5;
+    let rc = d.truncation.iter().find(|r| r.point == "c").unwrap();
+    assert!(
+        (rc.static_flexibility_m_per_n - gc).abs() <= 1e-12 * gc,
+        "{} vs {gc}",
+        rc.static_flexibility_m_per_n
+    );
+
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/paper-lumped.toml"
+    );
+    let m = Model::from_file(std::path::Path::new(path), &[]).unwrap();
+    let d = m.diagnostics();
+    for r in &d.truncation {
+        assert!((r.captured_share - 1.0).abs() <= 1e-12, "{r:?}");
+    }
+    // Grounded chain: G(base) = 1/k_f, G(bed) = 1/k_f + 1/k_c.
+    let (kc, kf) = (2.5415164e7, 8.1195270e4);
+    let bed = d.truncation.iter().find(|r| r.point == "bed").unwrap();
+    let base = d.truncation.iter().find(|r| r.point == "base").unwrap();
+    assert!((bed.static_flexibility_m_per_n - (1.0 / kf + 1.0 / kc)).abs() <= 1e-13 / kf);
+    assert!((base.static_flexibility_m_per_n - 1.0 / kf).abs() <= 1e-13 / kf);
+    assert!(d.warnings.is_empty() && d.notes.is_empty(), "{d:?}");
+}
+
+/// Contact frequencies: linear √(K/m) whatever v; Hertz T_c = 2.9432 δ_max / v (the classical
+/// constant, 2 √π Γ(7/5)/Γ(9/10)), so ω_c = π v / (2.9432 δ_max).
+#[test]
+fn contact_frequencies_match_closed_forms() {
+    let mut c = ContactSpec {
+        law: LawSpec::Linear,
+        stiffness: 4.3e7,
+        damping: 0.0,
+        exponent: None,
+        alpha: 0.0,
+        release: ReleaseSpec::Force,
+    };
+    let w = contact_omega(&c, 1.2, 3.0).unwrap();
+    assert!((w - (4.3e7_f64 / 1.2).sqrt()).abs() <= 1e-12 * w);
+    c.law = LawSpec::Hertz;
+    c.stiffness = 1.0e10;
+    let (m, v) = (1.2, 1.5);
+    let d_max = (5.0 * m * v * v / (4.0 * c.stiffness)).powf(0.4);
+    // 2 √π Γ(1.4) / Γ(0.9) with Γ(1.4) = 0.887263817503075, Γ(0.9) = 1.068628702119319.
+    let k = 2.0 * std::f64::consts::PI.sqrt() * 0.887263817503075 / 1.068628702119319;
+    let exact = std::f64::consts::PI * v / (k * d_max);
+    let got = contact_omega(&c, m, v).unwrap();
+    assert!((got - exact).abs() <= 1e-9 * exact, "{got} vs {exact}");
+    assert!((k - 2.9432).abs() < 1e-4, "{k}");
+    assert!(contact_omega(&c, m, 0.0).is_none());
+}
+
+/// The elastic (inertia-relief) convention on a structure with rigid-body modes, checked against
+/// an independent computation. A free plate (no springs: six rigid-body modes, three of which
+/// move the centre and the corners along z) with every mode kept: the modal sum over all
+/// elastic modes of the dense eigen-decomposition must equal the static flexibility from the
+/// factorisation of K + σM with the rigid-body projection, at the centre and at the corners.
+/// And on the plate on z-only springs (three in-plane rigid-body modes that do not move the
+/// points along z) G_PP equals that with in-plane springs (flat shells: in-plane and bending
+/// decouple).
+#[test]
+fn elastic_convention_matches_the_full_modal_sum() {
+    let (path, text) = bounce_model("free", "select = { band_hz = [0.0, 1e12] }\ncount = 1000");
+    let text = text
+        .replace("count = 30\n", "")
+        .replace(
+            "springs = [{ group = \"corners\", stiffness",
+            "#springs = [{ group = \"corners\", stiffness",
+        )
+        .replace(
+            "points = { O_b = \"centre\", B = \"centre\" }",
+            "points = { O_b = \"centre\", B = \"corners\" }",
+        );
+    let spec: meid::model::ModelSpec = toml::from_str(&text).unwrap();
+    let src = meid::model::Source {
+        name: path.display().to_string(),
+        text: text.clone(),
+        overrides: Vec::new(),
+    };
+    let ctx = ReductionContext::of(&spec);
+    let a = fem::analyse(spec.structure.fem.as_ref().unwrap(), &src, &ctx).unwrap();
+    assert_eq!(a.modes.rigid_body_modes, 6);
+    assert_eq!(a.selected.len(), a.model.n_dofs());
+    let rows = a.modal.truncation(&ctx.role_points);
+    assert_eq!(rows.len(), 2);
+    for r in &rows {
+        eprintln!("{r:?}");
+        // Measured: 1.7e-13.
+        assert!((r.captured_share - 1.0).abs() <= 1e-11, "{r:?}");
+    }
+
+    // z-only springs: three in-plane rigid-body modes, same G_PP as with in-plane springs.
+    let g = |fem_extra: &str, kxy: &str| {
+        let (path, text) = bounce_model("zonly", fem_extra);
+        let text = text.replace(
+            &format!("stiffness = [{}, {}", 0.2 * corner_kz(), 0.2 * corner_kz()),
+            &format!("stiffness = [{kxy}, {kxy}"),
+        );
+        assert!(
+            text.contains(&format!("stiffness = [{kxy}, {kxy}, ")),
+            "{text}"
+        );
+        let spec: meid::model::ModelSpec = toml::from_str(&text).unwrap();
+        let src = meid::model::Source {
+            name: path.display().to_string(),
+            text: text.clone(),
+            overrides: Vec::new(),
+        };
+        let ctx = ReductionContext::of(&spec);
+        let a = fem::analyse(spec.structure.fem.as_ref().unwrap(), &src, &ctx).unwrap();
+        (a.modes.rigid_body_modes, a.modal.static_flexibility["O_b"])
+    };
+    let ((r0, g0), (r1, g1)) = (g("", "0.0"), g("", &format!("{}", 0.2 * corner_kz())));
+    assert_eq!((r0, r1), (3, 0));
+    assert!((g0 - g1).abs() <= 1e-10 * g1, "{g0} vs {g1}");
+}
