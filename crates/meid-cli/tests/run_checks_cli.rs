@@ -48,3 +48,26 @@ fn peaks_and_their_times_are_in_the_json_summary() {
         assert!(p["peak"].as_f64().unwrap().is_finite());
     }
 }
+
+/// A time scale far beyond what the run can step through is refused up front with the field
+/// responsible (a 1e20 N/m contact ran for more than 9 minutes; a 1e-9 kg damper too).
+#[test]
+fn an_unaffordable_time_scale_is_refused_up_front() {
+    for (set, field) in [
+        (
+            "contact.bed_damper.stiffness=1e20",
+            "contact.bed_damper.stiffness",
+        ),
+        ("damper.mass=1e-9", "damper.mass"),
+    ] {
+        let o = meid()
+            .arg("simulate")
+            .arg(paper_example())
+            .args(["--set", set])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{set}");
+        let e = stderr(&o);
+        assert!(e.contains(field) && e.contains("periods"), "{set}: {e}");
+    }
+}

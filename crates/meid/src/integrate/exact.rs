@@ -307,6 +307,8 @@ pub fn solve_from(
         // taken when no mode is consistent).
         let (new_mode, _) = selector.select(&x, mode, &mut signs);
         if new_mode != mode {
+            // A contact released by the force rule takes its elastic energy with it.
+            totals.dissipated += super::dopri5::contact_energy_jump(sys, mode, new_mode, &x);
             path.push(PathPoint {
                 t,
                 mode: new_mode,

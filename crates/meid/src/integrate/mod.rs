@@ -229,10 +229,88 @@ pub fn solve_from(
             ));
         }
     }
+    check_cost(sys, opts)?;
     match opts.method {
         Method::Exact => exact::solve_from(sys, x0, opts, obs),
         Method::Dopri5 => dopri5::solve_from(sys, x0, opts, obs),
     }
+}
+
+/// The most periods of its fastest time scale a run may span ([`check_cost`]).
+pub const MAX_PERIODS: f64 = 1e7;
+
+/// Bounds a run's cost before it starts: the number of periods of the system's fastest time
+/// scale over `opts.duration` must stay below [`MAX_PERIODS`]. The rates considered are the
+/// structure's highest frequency, each linear contact's `√(K/m)` (m the lighter body it
+/// touches) and `C/m`, and the damper's `√(k_d/m_d)` and `c_d/m_d`. Switch searches and
+/// integration steps cannot be fewer than a few per such period, so a run beyond the limit
+/// would take hours (a 1e20 N/m contact on a 3.5 kg damper is a 1.2 ns period: 4e8 of them in
+/// 0.5 s); it is refused with the field responsible.
+pub fn check_cost(sys: &ImpactSystem, opts: &Options) -> Result<()> {
+    let mut rates: Vec<(f64, String)> = Vec::new();
+    let w_max = sys
+        .structure
+        .omega_rad_per_s
+        .iter()
+        .copied()
+        .fold(0.0, f64::max);
+    rates.push((w_max, "the structure's highest retained mode".into()));
+    let ms = sys.slider.mass;
+    let md = sys.damper.map(|d| d.mass);
+    let law = |c: &crate::impact::Contact, m: f64, field: &str, rates: &mut Vec<(f64, String)>| {
+        if let crate::impact::ContactLaw::Linear { stiffness, damping } = c.law {
+            rates.push((
+                (stiffness / m).sqrt(),
+                format!("{field}.stiffness = {stiffness:e} N/m on {m:e} kg"),
+            ));
+            rates.push((
+                damping / m,
+                format!("{field}.damping = {damping:e} N·s/m on {m:e} kg"),
+            ));
+        }
+    };
+    law(&sys.slider_bed, ms, "contact.slider_bed", &mut rates);
+    if let (Some(c), Some(m)) = (&sys.bed_damper, md) {
+        law(c, m, "contact.bed_damper", &mut rates);
+    }
+    if let Some(d) = &sys.damper {
+        rates.push((
+            (d.stiffness / d.mass).sqrt(),
+            format!(
+                "damper.stiffness = {:e} N/m on damper.mass = {:e} kg",
+                d.stiffness, d.mass
+            ),
+        ));
+        rates.push((
+            d.damping / d.mass,
+            format!(
+                "damper.damping = {:e} N·s/m on damper.mass = {:e} kg",
+                d.damping, d.mass
+            ),
+        ));
+    }
+    let Some((rate, what)) = rates
+        .into_iter()
+        .filter(|(r, _)| r.is_finite())
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+    else {
+        return Ok(());
+    };
+    let periods = opts.duration * rate / (2.0 * std::f64::consts::PI);
+    if periods > MAX_PERIODS {
+        return Err(Error::invalid(
+            "simulation.duration",
+            format!(
+                "the run would span {periods:.2e} periods of its fastest time scale \
+                 (2π/{rate:.3e} s, set by {what}); the limit is {MAX_PERIODS:e}. Lower that \
+                 stiffness or damping (a contact 1e3 times stiffer than the structure already \
+                 acts as rigid), raise the mass, or shorten simulation.duration \
+                 ({:e} s)",
+                opts.duration
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Output grid helper: sample `j` is at `j / rate`.
