@@ -68,8 +68,13 @@ fn sdof_trajectory(wn: f64, zeta: f64, t_end: f64) -> Trajectory {
     }
 }
 
+/// `|got − want| ≤ tol·max(|want|, floor)`.
+fn close_to(got: c64, want: c64, tol: f64, floor: f64) -> bool {
+    (got - want).norm() <= tol * want.norm().max(floor)
+}
+
 fn close(got: c64, want: c64, tol: f64) -> bool {
-    (got - want).norm() <= tol * want.norm()
+    close_to(got, want, tol, 0.0)
 }
 
 /// `X(ω) = 1/(ω_n² − ω² + 2iζω_nω)` for the impulse response, with `iωX` for the velocity and
@@ -92,6 +97,9 @@ fn sdof_impulse_response_matches_closed_form() {
     let rec = b.build(&traj, false).unwrap();
     let end = sdof_state(wn, zeta, t_end);
     let mut worst = 0.0_f64;
+    // Each channel's |G| at the resonance: the scale of "relative" where G vanishes (the
+    // velocity at 0 Hz).
+    let peak = full.transform(10.0);
     for f in [
         0.0, 1e-6, 1e-3, 0.5, 9.9, 9.98, 9.995_999, 10.0, 10.02, 37.0, 1e3, 1e5,
     ] {
@@ -107,10 +115,10 @@ fn sdof_impulse_response_matches_closed_form() {
             iw * (x - decay) + end[0] * c64::new(0.0, -w * t_end).exp(),
         ];
         for k in 0..3 {
-            let e = (g[k] - want[k]).norm() / want[k].norm();
+            let e = (g[k] - want[k]).norm() / want[k].norm().max(peak[k].norm());
             worst = worst.max(e);
             assert!(
-                close(g[k], want[k], 1e-9),
+                close_to(g[k], want[k], 1e-9, 1e-3 * peak[k].norm()),
                 "f = {f} Hz, {:?}: {} vs {}",
                 ch[k],
                 g[k],
@@ -120,7 +128,7 @@ fn sdof_impulse_response_matches_closed_form() {
         let gr = rec.transform(f);
         for k in 0..2 {
             assert!(
-                close(gr[k], want_rec[k], 1e-9),
+                close_to(gr[k], want_rec[k], 1e-9, 1e-3 * peak[k].norm()),
                 "record only, f = {f} Hz, {:?}: {} vs {}",
                 ch[k],
                 gr[k],
@@ -263,8 +271,10 @@ impl Observer for Simpson<'_> {
 /// 2. Parseval for the exact path: `∫₀^∞ E(f) df` (adaptive Gauss-Kronrod) equals the energy
 ///    `∫g²dt` computed in the time domain, to 1e-7;
 /// 3. over a record `[0, T]`, that energy equals Simpson's rule on the response sampled at
-///    1 MHz (independent of the transform), to 1e-6, and the transform equals Simpson's rule
-///    for `∫g e^{−iωt}dt` at 5 frequencies, to 1e-6.
+///    1 MHz (independent of the transform), and the transform equals Simpson's rule for
+///    `∫g e^{−iωt}dt` at 5 frequencies, to 1e-5: Simpson's rule is O(h²) across the jumps of
+///    slope at the switches (a contact closing at `δ̇ ≠ 0` steps `ḟ` by `K δ̇`), about 1e-6
+///    relative at h = 1 µs here (measured: 8e-7 for the energy of the bed acceleration).
 #[test]
 fn impact_run_parseval_and_sampled_quadrature() {
     let path = concat!(
@@ -331,11 +341,17 @@ fn impact_run_parseval_and_sampled_quadrature() {
     for (k, c) in ch.iter().enumerate() {
         let e = rec.energy()[k];
         eprintln!("{c:?}: sampled ∫g² = {:.12e}, exact {e:.12e}", e_samp[k]);
-        assert!(((e_samp[k] - e) / e).abs() < 1e-6, "{c:?}");
+        assert!(((e_samp[k] - e) / e).abs() < 1e-5, "{c:?}");
+        // Simpson's errors at the slope jumps are absolute (~2e-7 m/s²·s here at every
+        // frequency): relative to the largest |G| among the frequencies checked.
+        let scale = freqs
+            .iter()
+            .map(|f| rec.transform(*f)[k].norm())
+            .fold(0.0, f64::max);
         for (j, f) in freqs.iter().enumerate() {
             let g = rec.transform(*f)[k];
             eprintln!("  {f} Hz: {g:.9e} vs sampled {:.9e}", g_samp[k][j]);
-            assert!((g - g_samp[k][j]).norm() < 1e-6 * g.norm(), "{c:?} {f} Hz");
+            assert!((g - g_samp[k][j]).norm() < 1e-5 * scale, "{c:?} {f} Hz");
         }
     }
 }

@@ -997,6 +997,10 @@ impl<'a> SpectrumBuilder<'a> {
                     ),
                 ));
             }
+            // Continue by at most the time simulated so far (at least 1 s): the prediction from
+            // the slowest decay rate of the current mode overshoots when a switch (the dashpot
+            // acting again) speeds up the decay.
+            let chunk = chunk.min(t_end.max(1.0));
             let o = Options {
                 duration: (chunk * shrink)
                     .clamp(MIN_CHUNK, rule.max_continuation_s - done + MIN_CHUNK),
