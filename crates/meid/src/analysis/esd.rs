@@ -822,6 +822,22 @@ pub struct Continuation {
 /// Shortest continuation step (s).
 const MIN_CHUNK: f64 = 1e-3;
 
+/// Band energies are computed to their relative tolerance or to this share of the channel's
+/// energy `∫g²dt`, whichever is larger ([`ExactSpectrum::band_energy`]).
+pub const ENERGY_FLOOR: f64 = 1e-13;
+
+/// Knots per contact episode of a non-linear contact ([`SpectrumBuilder::refine_nonlinear`]).
+pub const NONLINEAR_SUBDIVISIONS: usize = 48;
+
+/// Records the states on the output grid.
+struct States(Vec<(f64, Vec<f64>)>);
+
+impl integrate::Observer for States {
+    fn sample(&mut self, t: f64, x: &[f64], _mode: Mode) {
+        self.0.push((t, x.to_vec()));
+    }
+}
+
 /// Builds exact spectra of the response channels of one system: decomposes each mode met once
 /// and reuses it for the continuation's checks and the transform.
 pub struct SpectrumBuilder<'a> {
@@ -1048,6 +1064,86 @@ impl<'a> SpectrumBuilder<'a> {
         }
     }
 
+    /// Subdivides the stretches with a non-linear contact closed, whose states are known only
+    /// at their ends (path points): each contact episode (consecutive such stretches of one
+    /// mode) gets about [`NONLINEAR_SUBDIVISIONS`] knots, the states there from the same
+    /// integrator (`opts`: method and tolerances) run again from the stretch's start with
+    /// output samples at the knots. The cubic Hermite interpolant between knots then has an
+    /// error of order `(h/T_c)⁴` of the pulse (`h` the knot spacing, `T_c` the contact
+    /// duration). Returns the number of knots added. Linear stretches are left as they are.
+    pub fn refine_nonlinear(&mut self, opts: &Options, traj: &mut Trajectory) -> Result<usize> {
+        let n = traj.stretches.len();
+        let mut out = Vec::with_capacity(n);
+        let mut added = 0;
+        let mut i = 0;
+        while i < n {
+            let s = &traj.stretches[i];
+            let mi = self.model(s.mode)?;
+            if self.models[mi].lin.is_some() {
+                out.push(s.clone());
+                i += 1;
+                continue;
+            }
+            let mut j = i;
+            while j + 1 < n
+                && traj.stretches[j + 1].mode == s.mode
+                && traj.stretches[j + 1].t0 == traj.stretches[j].t1
+            {
+                j += 1;
+            }
+            let total = traj.stretches[j].t1 - s.t0;
+            for st in &traj.stretches[i..=j] {
+                let len = st.t1 - st.t0;
+                let k = ((NONLINEAR_SUBDIVISIONS as f64 * len / total).ceil() as usize).max(1);
+                if k == 1 {
+                    out.push(st.clone());
+                    continue;
+                }
+                let o = Options {
+                    duration: len,
+                    sample_rate: Some(k as f64 / len),
+                    stop_at_collision_end: false,
+                    ..*opts
+                };
+                let mut rec = States(Vec::new());
+                integrate::solve_from(self.sys, &st.x0, &o, &mut rec).map_err(|e| {
+                    Error::numerical(
+                        "exact spectrum",
+                        format!(
+                            "re-integrating the non-linear contact stretch at t = {:.6e} s for its knots: {e}",
+                            st.t0
+                        ),
+                    )
+                })?;
+                let mut prev = (st.t0, st.x0.clone());
+                for (t, x) in rec.0 {
+                    if t > 0.0 && t < len * (1.0 - 1e-9) && x.iter().all(|v| v.is_finite()) {
+                        let t = st.t0 + t;
+                        out.push(Stretch {
+                            t0: prev.0,
+                            t1: t,
+                            mode: st.mode,
+                            x0: prev.1,
+                            x1: x.clone(),
+                        });
+                        prev = (t, x);
+                        added += 1;
+                    }
+                }
+                out.push(Stretch {
+                    t0: prev.0,
+                    t1: st.t1,
+                    mode: st.mode,
+                    x0: prev.1,
+                    x1: st.x1.clone(),
+                });
+            }
+            i = j + 1;
+        }
+        traj.stretches = out;
+        Ok(added)
+    }
+
     /// The exact transform of `traj`'s channels: over the trajectory only (`free_decay` false,
     /// the record `[t₀, T]` as if the response stopped at T), or with the final mode's free decay
     /// to ∞ (`free_decay` true; an error when a channel does not decay, see the module docs).
@@ -1166,14 +1262,24 @@ impl<'a> SpectrumBuilder<'a> {
                 }
             }
         }
+        // The damped natural frequencies where the density can have a narrow peak: lightly
+        // damped poles (ζ < 0.3) of modes the response stays in for ten of their periods (or
+        // decays freely in); within 1e-3 of each other they count once. They start the band
+        // integrations' subdivisions and the peak searches' candidates.
         let mut poles = Vec::new();
         for m in &modes {
-            if let Part::Spectral { lam, .. } = &m.part {
-                poles.extend(lam.iter().filter(|l| l.im > 0.0).map(|l| l.im / (2.0 * PI)));
-            }
+            let Part::Spectral { lam, .. } = &m.part else {
+                continue;
+            };
+            let longest = m.stretches.iter().map(|s| s.1).fold(0.0, f64::max);
+            poles.extend(
+                lam.iter()
+                    .filter(|l| l.im > 0.0 && -l.re < 0.3 * l.norm() && longest * l.im > 20.0 * PI)
+                    .map(|l| l.im / (2.0 * PI)),
+            );
         }
         poles.sort_by(f64::total_cmp);
-        poles.dedup();
+        poles.dedup_by(|a, b| (*a - *b).abs() <= 1e-3 * b.abs());
         Ok(ExactSpectrum {
             channels: self.channels.clone(),
             times,
@@ -1194,10 +1300,16 @@ impl<'a> SpectrumBuilder<'a> {
 struct ModeTerms {
     mode: Mode,
     part: Part,
+    /// The columns kept: a pole (spectral) or a coordinate (dense), with the index of its
+    /// complex-conjugate partner when it has one (spectral: `w_k̄ = conj(w_k)`, so the partner's
+    /// sums follow from the same products).
+    cols: Vec<(usize, Option<usize>)>,
     /// Time index of each entry.
     entry_t: Vec<usize>,
-    /// Spectral: `±w_kᵀX` per entry (row-major, `m` per entry); dense: `±P X` (real parts).
-    y: Vec<c64>,
+    /// `±w_kᵀX` (spectral) or `±P X` (dense) per entry and kept column (row-major). Real and
+    /// imaginary parts apart, so that the accumulation over entries vectorises.
+    yr: Vec<f64>,
+    yi: Vec<f64>,
     /// Stretches: (index of the start entry, length; ∞ for the free decay).
     stretches: Vec<(usize, f64)>,
     /// Longest finite stretch (s).
@@ -1206,34 +1318,53 @@ struct ModeTerms {
 
 impl ModeTerms {
     fn new(mode: Mode, lin: &Linear) -> Self {
+        let cols = match &lin.part {
+            Part::Spectral { lam, .. } => {
+                let mut c = Vec::new();
+                let mut k = 0;
+                while k < lam.len() {
+                    if lam[k].im > 0.0 && k + 1 < lam.len() && lam[k + 1] == lam[k].conj() {
+                        c.push((k, Some(k + 1)));
+                        k += 2;
+                    } else {
+                        c.push((k, None));
+                        k += 1;
+                    }
+                }
+                c
+            }
+            Part::Dense { p, .. } => (0..p.len()).map(|j| (j, None)).collect(),
+        };
         Self {
             mode,
             part: lin.part.clone(),
+            cols,
             entry_t: Vec::new(),
-            y: Vec::new(),
+            yr: Vec::new(),
+            yi: Vec::new(),
             stretches: Vec::new(),
             lmax: 0.0,
         }
     }
 
     fn width(&self) -> usize {
-        match &self.part {
-            Part::Spectral { lam, .. } => lam.len(),
-            Part::Dense { p, .. } => p.len(),
-        }
+        self.cols.len()
     }
 
     fn push(&mut self, ti: usize, x: &[f64], sign: f64) -> usize {
         self.entry_t.push(ti);
         match &self.part {
             Part::Spectral { w, .. } => {
-                for wk in w {
-                    self.y.push(cdot(wk, x) * sign);
+                for &(k, _) in &self.cols {
+                    let v = cdot(&w[k], x) * sign;
+                    self.yr.push(v.re);
+                    self.yi.push(v.im);
                 }
             }
             Part::Dense { p, .. } => {
                 for r in p {
-                    self.y.push(c64::new(dot(r, x) * sign, 0.0));
+                    self.yr.push(dot(r, x) * sign);
+                    self.yi.push(0.0);
                 }
             }
         }
@@ -1299,6 +1430,14 @@ impl ExactSpectrum {
         !self.hermite.is_empty()
     }
 
+    /// Modes evaluated by the dense fallback (ill-conditioned eigenvectors, see the module docs).
+    pub fn fallback_modes(&self) -> usize {
+        self.modes
+            .iter()
+            .filter(|m| matches!(m.part, Part::Dense { .. }))
+            .count()
+    }
+
     /// True when the free decay after the last simulated instant is included.
     pub fn includes_free_decay(&self) -> bool {
         self.free_decay
@@ -1333,29 +1472,56 @@ impl ExactSpectrum {
                 c64::new(c, -s)
             })
             .collect();
+        // Σ_e (c + is)(y_r + iy_i) and, for a conjugate partner, Σ_e (c + is) conj(y) =
+        // conj(Σ_e (c − is) y), from the four real sums Σcy_r, Σsy_i, Σcy_i, Σsy_r.
+        let mut sums = [Vec::new(), Vec::new(), Vec::new(), Vec::new()];
         let mut acc: Vec<c64> = Vec::new();
         for mt in &self.modes {
             let m = mt.width();
-            acc.clear();
-            acc.resize(m, c64::new(0.0, 0.0));
+            for v in sums.iter_mut() {
+                v.clear();
+                v.resize(m, 0.0);
+            }
+            let [p1, p2, p3, p4] = &mut sums;
             for (e, &ti) in mt.entry_t.iter().enumerate() {
-                let ph = phases[ti];
-                for (a, y) in acc.iter_mut().zip(&mt.y[e * m..(e + 1) * m]) {
-                    *a += ph * y;
+                let (c, sn) = (phases[ti].re, phases[ti].im);
+                let yr = &mt.yr[e * m..(e + 1) * m];
+                let yi = &mt.yi[e * m..(e + 1) * m];
+                for ((((a1, a2), a3), a4), (r, i)) in p1
+                    .iter_mut()
+                    .zip(p2.iter_mut())
+                    .zip(p3.iter_mut())
+                    .zip(p4.iter_mut())
+                    .zip(yr.iter().zip(yi))
+                {
+                    *a1 += c * r;
+                    *a2 += sn * i;
+                    *a3 += c * i;
+                    *a4 += sn * r;
                 }
             }
             match &mt.part {
                 Part::Spectral { lam, h, .. } => {
-                    for k in 0..m {
+                    // (pole, sums, conjugated y?)
+                    let mut poles: Vec<(usize, c64, usize, bool)> = Vec::with_capacity(2 * m);
+                    for (j, &(k, partner)) in mt.cols.iter().enumerate() {
+                        poles.push((k, c64::new(p1[j] - p2[j], p3[j] + p4[j]), j, false));
+                        if let Some(kp) = partner {
+                            poles.push((kp, c64::new(p1[j] + p2[j], p4[j] - p3[j]), j, true));
+                        }
+                    }
+                    for (k, a, j, conj) in poles {
                         let z = lam[k] - iw;
                         let s = if z.norm() * mt.lmax >= PER_STRETCH {
-                            acc[k] / z
+                            a / z
                         } else {
                             // One stretch at a time: ∫₀^L (w·X₀) e^{zs} ds e^{−iωt₀}.
                             let mut s = c64::new(0.0, 0.0);
                             let mut p = [c64::new(0.0, 0.0)];
                             for &(e, len) in &mt.stretches {
-                                let y0 = -mt.y[e * m + k] * phases[mt.entry_t[e]];
+                                let y = c64::new(mt.yr[e * m + j], mt.yi[e * m + j]);
+                                let y = if conj { y.conj() } else { y };
+                                let y0 = -y * phases[mt.entry_t[e]];
                                 if len.is_infinite() {
                                     s += y0 * (-1.0 / z);
                                 } else {
@@ -1376,6 +1542,8 @@ impl ExactSpectrum {
                     for i in 0..n {
                         mat[(i, i)] -= iw;
                     }
+                    acc.clear();
+                    acc.extend((0..m).map(|j| c64::new(p1[j] - p2[j], p3[j] + p4[j])));
                     let v = solve_complex(mat, &acc);
                     for (o, lc) in out.iter_mut().zip(l) {
                         *o += v
@@ -1479,8 +1647,9 @@ impl ExactSpectrum {
     }
 
     /// `∫_{f_lo}^{f_hi} E(f) df` of channel `ch` (unit²·s) by adaptive Gauss-Kronrod with the
-    /// damped natural frequencies as breakpoints, to `rtol` (the result carries its error
-    /// estimate).
+    /// damped natural frequencies as breakpoints, to `rtol` or to [`ENERGY_FLOOR`] of the
+    /// channel's energy `∫g²dt`, whichever is larger (below that the density is round-off of
+    /// the boundary sums); the result carries its error estimate.
     pub fn band_energy(&self, ch: usize, f_lo: f64, f_hi: f64, rtol: f64) -> Quadrature {
         let mut buf = vec![c64::new(0.0, 0.0); self.channels.len()];
         quadrature::integrate(
@@ -1490,7 +1659,7 @@ impl ExactSpectrum {
             &self.pole_hz,
             Tolerance {
                 rtol,
-                atol: 1e-300,
+                atol: ENERGY_FLOOR * self.energy[ch],
                 max_evaluations: 200_000,
             },
         )
@@ -1499,11 +1668,17 @@ impl ExactSpectrum {
     /// `∫_{f_lo}^{f_hi} E(f) df` of every channel at once (see [`Self::band_energy`]).
     pub fn band_energies(&self, f_lo: f64, f_hi: f64, rtol: f64) -> Vec<Quadrature> {
         let mut buf = vec![c64::new(0.0, 0.0); self.channels.len()];
-        quadrature::integrate_many(
+        // Each channel in units of its energy, so that one absolute floor fits all.
+        let scale: Vec<f64> = self
+            .energy
+            .iter()
+            .map(|e| if *e > 0.0 { 1.0 / e } else { 1.0 })
+            .collect();
+        let mut q = quadrature::integrate_many(
             |f, out| {
                 self.transform_into(f, &mut buf);
-                for (o, g) in out.iter_mut().zip(&buf) {
-                    *o = 2.0 * g.norm_sqr();
+                for ((o, g), s) in out.iter_mut().zip(&buf).zip(&scale) {
+                    *o = 2.0 * g.norm_sqr() * s;
                 }
             },
             self.channels.len(),
@@ -1512,10 +1687,15 @@ impl ExactSpectrum {
             &self.pole_hz,
             Tolerance {
                 rtol,
-                atol: 1e-300,
+                atol: ENERGY_FLOOR,
                 max_evaluations: 200_000,
             },
-        )
+        );
+        for (qi, s) in q.iter_mut().zip(&scale) {
+            qi.value /= s;
+            qi.error /= s;
+        }
+        q
     }
 
     /// `∫₀^∞ E(f) df` of channel `ch` (Parseval: equals [`Self::energy`]), by adaptive
@@ -1538,7 +1718,7 @@ impl ExactSpectrum {
             &breaks,
             Tolerance {
                 rtol,
-                atol: 1e-300,
+                atol: 0.1 * ENERGY_FLOOR * self.energy[ch],
                 max_evaluations: 400_000,
             },
         )
