@@ -513,14 +513,10 @@ fn nonlinear_contact_stretches_are_an_estimate() {
     assert!(added > 0);
     let spec = b.build(&traj, true).unwrap();
     assert!(spec.is_estimate() && coarse.is_estimate());
-    for k in 0..2 {
+    for (k, c) in ch.iter().enumerate() {
         let q = spec.esd_integral(k, 1e-10);
         let e = spec.energy()[k];
-        assert!(
-            ((q.value - e) / e).abs() < 1e-7,
-            "{:?}: {q:?} vs {e}",
-            ch[k]
-        );
+        assert!(((q.value - e) / e).abs() < 1e-7, "{c:?}: {q:?} vs {e}");
     }
     let fs = 1.0e6;
     let n = 20_000;

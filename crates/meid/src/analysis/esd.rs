@@ -24,8 +24,9 @@
 //! space of `M^{-½}KM^{-½}` and `M^{-½}CM^{-½}`: the slider in flight) is split off exactly as in
 //! the exact propagator ([`crate::integrate::propagator`]), and the rest `A_r = V Λ V⁻¹` (balanced
 //! form, all eigenvalues kept). Then `ℓᵀ(A − iω)⁻¹X = Σ_k (ℓᵀv_k)(w_kᵀX)/(λ_k − iω)`, with
-//! `w_kᵀX` computed once per switch: a frequency costs one `e^{−iωt}` per switch and one complex
-//! multiply-add per pole and switch, whatever the sample rate. Where `|λ_k − iω|·L` is small
+//! `w_kᵀX` computed once per switch: a frequency costs one `e^{−iωt}` per switch and four real
+//! multiply-adds per switch and pair of conjugate poles (the pair shares its sums), whatever the
+//! sample rate. Where `|λ_k − iω|·L` is small
 //! (ω → 0 on a slow pole) the pole's stretches are integrated one by one with
 //! `∫₀^L e^{zs} ds = L ψ₀(zL)` (no cancellation); the rigid part, a polynomial `c₀ + c₁s` in time,
 //! likewise. When the eigenvectors are ill-conditioned (`‖V‖‖V⁻¹‖ > 1e6`, near-critical damping)
@@ -35,18 +36,25 @@
 //! **Non-linear contacts** (Hertz, Hunt-Crossley; `dopri5` runs) have no `ℓ_σ`: consecutive
 //! path points of such a mode are joined by the cubic Hermite interpolant of the state (`X`, `Ẋ`
 //! from [`ImpactSystem::accelerations`]), the channel is evaluated on it at five Chebyshev points
-//! and its interpolating quartic transformed exactly. Those parts are **estimates**
-//! ([`ExactSpectrum::is_estimate`]); their accuracy is that of the interpolation between knots.
+//! and its interpolating quartic transformed exactly. [`SpectrumBuilder::refine_nonlinear`] first
+//! gives each contact [`NONLINEAR_SUBDIVISIONS`] knots (the integrator run again from the
+//! stretch's start with output at the knots). Those parts are **estimates**
+//! ([`ExactSpectrum::is_estimate`]); with the knots their error on a Hertz blow is 4e-8 of the
+//! pulse's spectrum (test `nonlinear_contact_stretches_are_an_estimate`).
 //!
 //! # The length of the run
 //! Switches after `T` (the one-way dashpot rectifying the base's vibration, the damper returning
 //! to the bed) change the tail, so the spectrum is computed from a run continued, without output
 //! samples, until the free decay of every channel from the current state carries at most
 //! `DecayRule::tail_energy_fraction` (default 1e-12) of the channel's total energy
-//! ([`SpectrumBuilder::continue_until_decayed`]). The switches it then ignores could change
-//! `|G|` by about the square root of that fraction near the tail's own frequencies (1e-6,
-//! 1e-5 dB), far below the printed digits; the continuation is bounded by
-//! `DecayRule::max_continuation_s` (default 600 s) and fails with a clear error beyond it.
+//! ([`SpectrumBuilder::continue_until_decayed`]). The switches it then ignores act on at most
+//! that energy and can change `|G|` by about its square root (1e-6, 1e-5 dB) near the tail's own
+//! frequencies, far below the printed digits. The continuation is bounded by
+//! `DecayRule::max_continuation_s` (default 600 s) and fails with a clear error beyond it. When
+//! the integrator cannot go on (contacts chattering without time advancing as the damper comes
+//! to rest against the bed), the continuation creeps up on that instant with shorter runs and
+//! stops there if the decay left carries at most `DecayRule::accept_energy_fraction` (1e-8,
+//! about 0.002 dB) of each channel's energy, saying so in [`Continuation::stopped_early`].
 //!
 //! The energies `∫g²dt` are computed in the time domain, independently of the transform: on a
 //! linear stretch `g(s) = c₀ + c₁s + Σ_k a_k e^{λ_k s}` is integrated in closed form
@@ -401,7 +409,7 @@ impl Linear {
                         continue;
                     }
                     if lk.re >= -1e-12 * lmax {
-                        persist = Some(*lk);
+                        persist = Some(c64::new(lk.re, lk.im.abs()));
                     } else {
                         rate = rate.min(-lk.re);
                     }
@@ -449,7 +457,7 @@ impl Linear {
                     };
                 }
                 if worst.re >= -1e-12 * lmax {
-                    Some(worst)
+                    Some(c64::new(worst.re, worst.im.abs()))
                 } else if c0.abs() + c1.abs() > SEEN * (scale + seen) {
                     Some(c64::new(0.0, 0.0))
                 } else {
@@ -923,8 +931,19 @@ impl<'a> SpectrumBuilder<'a> {
                 format!("must lie in (0, 1) (got {})", rule.tail_energy_fraction),
             ));
         }
-        if !(rule.max_continuation_s >= 0.0) {
+        if rule.max_continuation_s.is_nan() || rule.max_continuation_s < 0.0 {
             return Err(Error::invalid("max_continuation_s", "must be ≥ 0 s"));
+        }
+        if !(rule.accept_energy_fraction >= rule.tail_energy_fraction
+            && rule.accept_energy_fraction < 1.0)
+        {
+            return Err(Error::invalid(
+                "accept_energy_fraction",
+                format!(
+                    "must lie in [tail_energy_fraction, 1) (got {})",
+                    rule.accept_energy_fraction
+                ),
+            ));
         }
         let record_end = traj.end_time();
         let nch = self.channels.len();
@@ -1008,8 +1027,7 @@ impl<'a> SpectrumBuilder<'a> {
                 return Err(Error::numerical(
                     "exact spectrum",
                     format!(
-                        "{what} {:.1} s after the record's end; the exact spectrum would depend on the record length. Add damping, or use the windowed FFT of the record (--spectrum fft)",
-                        done
+                        "{what} (the run was continued {done:.1} s past the record); the exact spectrum would depend on the record length. Add damping, or use the windowed FFT of the record (--spectrum fft)"
                     ),
                 ));
             }

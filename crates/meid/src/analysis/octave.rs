@@ -77,7 +77,7 @@ mod tests {
         let b = Band::new(0);
         assert_eq!(b.nominal_hz, 1000.0);
         assert!(
-            (b.lower_hz - 891.250_938).abs() < 1e-5 && (b.upper_hz - 1122.018_454).abs() < 1e-5
+            (b.lower_hz - 891.250_938).abs() < 1e-5 && (b.upper_hz - 1_122.018_454).abs() < 1e-5
         );
         // Neighbours share edges, ten bands a decade.
         assert!((Band::new(1).lower_hz - b.upper_hz).abs() < 1e-9);
