@@ -4,9 +4,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use meid::analysis::compare::{CompareOptions, Comparison, ComparisonResult};
+use meid::analysis::compare::{CompareOptions, Comparison, ComparisonResult, SpectrumMethod};
+use meid::analysis::esd::esd_level_db;
 use meid::analysis::spectrum::{
-    Window, REF_ACCELERATION_ISO1683_M_PER_S2, REF_ACCELERATION_M_PER_S2, REF_FORCE_N,
+    TransientWindow, REF_ACCELERATION_ISO1683_M_PER_S2, REF_ACCELERATION_M_PER_S2,
 };
 use meid::plot::{self, LinePlot, Series, SpectrumPlot};
 
@@ -16,10 +17,11 @@ use crate::args::{PrintArgs, RunArgs};
 pub struct CompareArgs {
     /// Model file (TOML) with a [damper] (or an [added_mass]).
     model: PathBuf,
-    /// Write histories, spectra, the reduction table and pictures into DIR.
+    /// Write histories, spectra, band tables, the reduction table and pictures into DIR.
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
-    /// Record length (s) of a single blow.
+    /// Record length (s) of a single blow: the time histories written (the exact spectrum
+    /// does not depend on it).
     #[arg(long, value_name = "S", default_value_t = 2.0)]
     duration: f64,
     /// Number of blows (the record is then N · 60/rate s).
@@ -28,12 +30,20 @@ pub struct CompareArgs {
     /// Stroke rate for --blows (blows per minute).
     #[arg(long, value_name = "R", default_value_t = 60.0)]
     rate_bpm: f64,
-    /// Acceleration level reference: 1 m/s² (default) or ISO 1683's 1e-6 m/s².
+    /// Acceleration level reference: 1 m/s² (default) or ISO 1683's 1e-6 m/s² (ESD levels are
+    /// re its square·s/Hz).
     #[arg(long, value_parser = ["1", "iso1683"], default_value = "1")]
     reference: String,
-    /// Spectral window over the whole record (rect suits a transient that starts at t = 0).
-    #[arg(long, value_parser = ["hann", "rect", "flattop"], default_value = "rect")]
+    /// Spectra: the exact transform of the simulated response (independent of rate and
+    /// record length), or the windowed FFT of the sampled record (test-lab path).
+    #[arg(long, value_parser = ["exact", "fft"], default_value = "exact")]
+    spectrum: String,
+    /// Window of the FFT path on the responses (the blow's force gets the force window).
+    #[arg(long, value_parser = ["rect", "hann", "exponential"], default_value = "rect")]
     window: String,
+    /// Time constant (s) of the exponential window (default: the record length / 5).
+    #[arg(long, value_name = "S")]
+    tau: Option<f64>,
     /// Read mode levels at these frequencies (Hz) instead of the model's dominant modes.
     #[arg(long, value_name = "HZ", value_delimiter = ',')]
     frequencies: Vec<f64>,
@@ -45,15 +55,29 @@ pub struct CompareArgs {
 
 pub fn run(a: CompareArgs) -> Result<()> {
     let model = a.run.load(&a.model, None)?;
+    let spectrum: SpectrumMethod = a.spectrum.parse()?;
+    if spectrum == SpectrumMethod::Exact && (a.window != "rect" || a.tau.is_some()) {
+        anyhow::bail!(
+            "--window and --tau shape the FFT of the record; add --spectrum fft (the exact spectrum needs no window)"
+        );
+    }
+    let record = if a.blows > 1 {
+        a.blows as f64 * 60.0 / a.rate_bpm
+    } else {
+        a.duration
+    };
     let window = match a.window.as_str() {
-        "hann" => Window::Hann,
-        "flattop" => Window::FlatTop,
-        _ => Window::Rectangular,
+        "hann" => TransientWindow::Hann,
+        "exponential" => TransientWindow::Exponential {
+            tau_s: a.tau.unwrap_or(record / 5.0),
+        },
+        _ => TransientWindow::Rectangular,
     };
     let options = CompareOptions {
         duration_s: a.duration,
         blows: a.blows,
         rate_bpm: a.rate_bpm,
+        spectrum,
         window,
         acceleration_reference_m_per_s2: if a.reference == "iso1683" {
             REF_ACCELERATION_ISO1683_M_PER_S2
@@ -76,7 +100,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
         print!("{}", result.table_text());
         if let Some(dir) = &a.output {
             println!(
-                "wrote histories, spectra, reductions and pictures to {}",
+                "wrote histories, spectra, bands, reductions and pictures to {}",
                 dir.display()
             );
         }
@@ -92,11 +116,12 @@ fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
         )?;
     }
     meid::io::write_atomic(&dir.join("spectra.csv"), &r.spectra_csv()?)?;
+    meid::io::write_atomic(&dir.join("bands.csv"), &r.bands_csv()?)?;
     meid::io::write_atomic(&dir.join("reductions.txt"), r.table_text().as_bytes())?;
     meid::io::write_atomic(&dir.join("reductions.csv"), &r.table_csv()?)?;
     meid::io::write_json(&dir.join("reductions.json"), &r.summary())?;
 
-    // Time histories (paper Figs. 10/11, 13/14, 18/19).
+    // Time histories (paper Figs. 10/11, 13/14, 18/19): the output samples.
     let time = |title: &str, y_label: &str, pick: &dyn Fn(&meid::analysis::History) -> Vec<f64>| {
         LinePlot {
             title: title.into(),
@@ -128,70 +153,109 @@ fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
         }),
     )?;
 
-    // Spectra in dB, log frequency from 1/T to the highest mode read × 4 (≤ Nyquist).
-    let top = r
-        .cases
-        .iter()
-        .flat_map(|c| c.modes.iter().map(|m| m.band_hz[1]))
-        .fold(0.0_f64, f64::max);
-    let f_max = (4.0 * top).min(r.sample_rate_hz / 2.0);
-    let spec = |title: &str, y_label: &str, acc: bool| -> Result<SpectrumPlot> {
-        let mut series = Vec::new();
-        for c in &r.cases {
-            let s = if acc {
-                &c.acceleration_spectrum
-            } else {
-                &c.floor_force_spectrum
-            };
-            let reference = if acc {
-                r.acceleration_reference_m_per_s2
-            } else {
-                REF_FORCE_N
-            };
-            let levels = s.levels_db(reference)?;
-            let (x, y): (Vec<f64>, Vec<f64>) = s
-                .frequency_hz
-                .iter()
-                .zip(levels)
-                .filter(|(f, _)| **f > 0.0 && **f <= f_max)
-                .map(|(f, l)| (*f, l))
-                .unzip();
-            series.push(Series {
-                label: c.case.label().into(),
-                x,
-                y,
-            });
-        }
-        Ok(SpectrumPlot {
+    // Energy spectral densities in dB, log frequency, with the refined peaks (exact path).
+    let (ea, ef) = r.esd_references();
+    let a2 = r.acceleration_reference_m_per_s2.powi(2);
+    let what = match r.spectrum {
+        SpectrumMethod::Exact => "exact ESD".to_string(),
+        SpectrumMethod::Fft => format!("FFT ESD, {} window", r.window.name()),
+    };
+    let spec = |ch: usize, title: &str, reference: f64, label: String| -> SpectrumPlot {
+        let series = r
+            .cases
+            .iter()
+            .map(|c| {
+                let s = &c.spectra[ch];
+                let mut pts: Vec<(f64, f64)> = r
+                    .frequency_hz
+                    .iter()
+                    .zip(&s.esd)
+                    .map(|(f, e)| (*f, *e))
+                    .chain(s.peaks.iter().copied())
+                    .filter(|(f, _)| *f > 0.0)
+                    .collect();
+                pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let (x, y) = pts
+                    .into_iter()
+                    .map(|(f, e)| (f, esd_level_db(e, reference)))
+                    .unzip();
+                Series {
+                    label: c.case.label().into(),
+                    x,
+                    y,
+                }
+            })
+            .collect();
+        SpectrumPlot {
             title: title.into(),
-            y_label: y_label.into(),
+            y_label: label,
             x_log: true,
             series,
-        })
-    };
-    let acc_label = if r.acceleration_reference_m_per_s2 == REF_ACCELERATION_M_PER_S2 {
-        "acceleration level (dB re 1 m/s², RMS)".to_string()
-    } else {
-        "acceleration level (dB re 1e-6 m/s², RMS)".to_string()
+        }
     };
     plot::spectrum_plot(
         dir.join("acceleration-spectrum"),
         &spec(
-            &format!(
-                "bed acceleration at B, spectrum ({} window)",
-                r.window.name()
-            ),
-            &acc_label,
-            true,
-        )?,
+            0,
+            &format!("bed acceleration at B, energy spectral density ({what})"),
+            a2,
+            format!("ESD level (dB re {ea})"),
+        ),
     )?;
     plot::spectrum_plot(
         dir.join("floor-force-spectrum"),
         &spec(
-            &format!("force to the floor, spectrum ({} window)", r.window.name()),
-            "force level (dB re 1 N, RMS)",
-            false,
-        )?,
+            1,
+            &format!("force to the floor, energy spectral density ({what})"),
+            1.0,
+            format!("ESD level (dB re {ef})"),
+        ),
+    )?;
+    // One-third-octave band levels as steps over each band.
+    let bands = |ch: usize, title: &str, reference: f64, label: String| -> SpectrumPlot {
+        let series = r
+            .cases
+            .iter()
+            .map(|c| {
+                let mut x = Vec::new();
+                let mut y = Vec::new();
+                for (b, e) in r.bands.iter().zip(&c.spectra[ch].band_energy) {
+                    let l = esd_level_db(*e, reference);
+                    x.extend([b.lower_hz, b.upper_hz]);
+                    y.extend([l, l]);
+                }
+                Series {
+                    label: c.case.label().into(),
+                    x,
+                    y,
+                }
+            })
+            .collect();
+        SpectrumPlot {
+            title: title.into(),
+            y_label: label,
+            x_log: true,
+            series,
+        }
+    };
+    let band_ref = |s: &str| s.trim_end_matches("/Hz").to_string();
+    plot::spectrum_plot(
+        dir.join("acceleration-bands"),
+        &bands(
+            0,
+            &format!("bed acceleration at B, one-third-octave band energy ({what})"),
+            a2,
+            format!("band level (dB re {})", band_ref(&ea)),
+        ),
+    )?;
+    plot::spectrum_plot(
+        dir.join("floor-force-bands"),
+        &bands(
+            1,
+            &format!("force to the floor, one-third-octave band energy ({what})"),
+            1.0,
+            format!("band level (dB re {})", band_ref(&ef)),
+        ),
     )?;
     Ok(())
 }

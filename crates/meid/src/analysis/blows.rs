@@ -40,7 +40,7 @@ use serde::Serialize;
 
 use super::energy::{check_run, EnergyTerms, History, Recorder};
 use crate::impact::{dot, Channel, ImpactSystem, Mode, Switch};
-use crate::integrate::{self, Options};
+use crate::integrate::{self, Options, Solution};
 use crate::{Error, Result};
 
 /// Settings of a blow train.
@@ -122,6 +122,9 @@ pub struct BlowsRun {
     /// Concatenated histories on one uniform grid (when recorded); `dissipated_j` is the
     /// energy dissipated since t = 0.
     pub history: Option<History>,
+    /// Each blow's run (times relative to its strike at `blows[k].start_s`): the paths the
+    /// exact spectrum of the train is built from ([`super::esd::Trajectory::append`]).
+    pub solutions: Vec<Solution>,
 }
 
 /// The blow interval for a stroke rate, rounded to whole output samples when sampling.
@@ -193,6 +196,7 @@ pub fn run_blows(
     let mut reports = Vec::with_capacity(blow.blows);
     let mut history = record.then(History::default);
     let mut dissipated_before = 0.0;
+    let mut solutions = Vec::with_capacity(blow.blows);
     for k in 0..blow.blows {
         let t0 = k as f64 * interval;
         // Energies at the strike, in the mode the contacts are in (overlap > 0 = closed).
@@ -253,7 +257,8 @@ pub fn run_blows(
         }
         dissipated_before += sol.totals.dissipated;
         // The next strike: same structure and damper state, a fresh slider touching the bed.
-        x0 = sol.x_final;
+        x0 = sol.x_final.clone();
+        solutions.push(sol);
         let phi_b = &sys.points.bed_contact;
         x0[sys.slider_index()] = dot(phi_b, &x0[..n]);
         x0[nd + sys.slider_index()] = sys.slider.velocity;
@@ -265,6 +270,7 @@ pub fn run_blows(
         steady,
         damper_gap_at_next_strike_m: damper_gap(&x0),
         history,
+        solutions,
     })
 }
 

@@ -6,40 +6,50 @@
 //! fixed at `added_mass.point` (default: the bed contact point O_b; the paper's Figs. 10-11 also
 //! put it on the floating base, `point = "O_f"` or the lumped model's `"base"`).
 //!
-//! # Formulation
+//! # Measures
 //!
-//! Each case is simulated over the same record (default 2 s, sampled at the model's rate).
-//! Levels are taken two ways:
+//! Each case is simulated over the same record (default 2 s, sampled at the model's rate: the
+//! samples are the time histories written and plotted, nothing else). Every reduction says which
+//! measure it is ([`Measure`]); with the default exact spectrum none depends on the sample rate
+//! or on the record length:
 //!
-//! * **Time-domain peaks** `max |a_B(t)|`, `max |F_floor(t)|`, as dB ratios
-//!   `20 log10(peak_case / peak_none)`.
-//! * **Spectral peaks at the dominant modes**: the whole record's one-sided amplitude spectrum
-//!   ([`super::spectrum::amplitude_spectrum_padded`], zero-padded to 4× the record length,
-//!   which interpolates the spectrum between the `1/T` bins) with a chosen window and its
-//!   coherent-gain correction, `A_k = 2|X_k|/Σw`, so a sinusoid of peak amplitude `A` reads
-//!   `A` (within the window's scalloping loss: rectangular 3.92 dB, Hann 1.42 dB, flat-top
-//!   0.004 dB at most — with 4× padding the worst case shrinks to ~0.2 dB rectangular,
-//!   0.1 dB Hann). Levels are RMS, `L = 20 log10((A/√2)/A_ref)` dB re 1 m/s² (or ISO 1683's
-//!   1e-6 m/s²) and re 1 N (Heinzel et al. 2002; ISO 1683:2015). The default is the
-//!   **rectangular** window: the blow's transient starts at t = 0, where a Hann or flat-top
-//!   taper is zero, so those windows weight the response by where it sits in the record
-//!   (on the paper example Hann reads the 283 Hz bed mode, which decays in ~0.06 s, 30 dB
-//!   low). Rectangular is exact for a transient that has decayed inside the record; for a
-//!   lightly damped mode that still rings at the end of the record it leaks, and Hann or
-//!   flat-top (which reads steady sinusoids best) can be chosen.
+//! * **time peak** `20 log10(peak_none / peak_case)` of `max |a_B(t)|`, `max |F_floor(t)|`,
+//!   located on the continuous solution ([`crate::integrate::peaks`]);
+//! * **ESD peak** at each dominant mode: the maximum of the exact energy spectral density
+//!   `E(f) = 2|G(f)|²` ([`super::esd`]) within ±10 % of **that case's own** mode frequency,
+//!   located by refinement (Brent) rather than on a grid; `10 log10(E_none/E_case)`. Levels are
+//!   dB re 1 (m/s²)²·s/Hz (or re (1e-6 m/s²)²·s/Hz, ISO 1683's reference squared) and
+//!   re 1 N²·s/Hz;
+//! * **band level**: the energy `∫E df` of the one-third-octave band (IEC 61260-1, base 10,
+//!   [`super::octave`]) that contains that ESD peak, integrated by adaptive Gauss-Kronrod to
+//!   1e-6 (4e-6 dB); dB re 1 (m/s²)²·s and re 1 N²·s;
+//! * **signal energy** `∫g² dt` over the whole response (time domain, exact);
+//! * **energy ratio**: `10 log10(η_none/η_case)` with `η = E_p+/E_s−` (paper Eq. 10), the share
+//!   of the blow's energy left in the machine, which the paper calls vibration power.
+//!
+//! The exact spectrum is the Fourier transform of the simulated response including its free
+//! decay after the record: the run is continued without samples until the decay left carries
+//! less than [`DecayRule::tail_energy_fraction`] of each channel's energy (module docs of
+//! [`super::esd`]). A model whose response does not decay (no damping) has no such spectrum:
+//! the comparison says so; the windowed FFT of the record remains available.
+//!
+//! **Test-lab path** ([`SpectrumMethod::Fft`]): the windowed FFT of the sampled record,
+//! [`super::spectrum::esd_fft`], zero-padded to 4× the record, with a rectangular, Hann or
+//! exponential window on the responses (and the force window on the blow's force), as a
+//! laboratory would process measurements. Its levels depend on the record, the window and the
+//! rate, as a measurement's do; the reductions then carry the `fft-` measures.
 //!
 //! The dominant modes are the model's reference mode (the rigid-body mode, the paper's ω_6)
 //! and, among the other modes with ω > 0, the one with the largest `|ψ(O_b)|·|ψ(B)|` (struck
 //! at the bed and seen at B: the paper's first bed mode, 283 Hz), or frequencies the user
-//! names. Each level is the largest spectral line within ±10 % of **that case's own** mode
-//! frequency: the added mass lowers the modes (Rayleigh-Ritz on the retained modes,
-//! [`crate::modal::ModalModel::with_point_mass`]), so the band follows it. For user-named
-//! frequencies the band is ±10 % around the named value in every case.
+//! names (the band is then ±10 % around the named value in every case). The added mass lowers
+//! the modes (Rayleigh-Ritz on the retained modes,
+//! [`crate::modal::ModalModel::with_point_mass`]), so the band follows it.
 //!
 //! **Reductions** are `ΔL = L_none − L_case` dB: positive means the case is quieter. For a
 //! spring-mounted mass `M` hit by an impulse `J` the peak spring force is `J √(k/M)`
 //! (`= v √(kM)` with `v = J/M`), so a rigid added mass `m` gives `ΔL = 10 log10(1 + m/M)`
-//! (0.79 dB for 20 %, 3.01 dB for 100 %) — the baseline the damper must beat.
+//! (0.79 dB for 20 %, 3.01 dB for 100 %) in the time peak — the baseline the damper must beat.
 //!
 //! The paper's own figures are carried as [`PAPER_FIGURES`] to print beside ours.
 //!
@@ -52,7 +62,7 @@
 //! let model = Model::from_file("examples/paper-lumped.toml".as_ref(), &[])?;
 //! let result = Comparison::new(model, CompareOptions::default()).run()?;
 //! for row in &result.reductions {
-//!     println!("{} {}: {:.2} dB", row.case, row.metric, row.reduction_db);
+//!     println!("{} {} ({:?}): {:.2} dB", row.case, row.metric, row.measure, row.reduction_db);
 //! }
 //! # Ok::<(), meid::Error>(())
 //! ```
@@ -61,11 +71,14 @@ use serde::Serialize;
 
 use super::blows::{run_blows, BlowOptions};
 use super::energy::{simulate, History};
+use super::esd::{esd_level_db, Continuation, DecayRule, SpectrumBuilder, Trajectory};
+use super::octave::{bands_covering, Band};
 use super::spectrum::{
-    amplitude_spectrum_padded, level_db, Padding, Spectrum, Window, REF_ACCELERATION_M_PER_S2,
-    REF_FORCE_N,
+    amplitude_spectrum_padded, esd_fft, Esd, Padding, Spectrum, TransientWindow, Window,
+    REF_ACCELERATION_M_PER_S2,
 };
-use crate::impact::ImpactSystem;
+use crate::impact::{Channel, ImpactSystem};
+use crate::integrate::Options;
 use crate::model::{Case, Model};
 use crate::{Error, Result};
 
@@ -104,6 +117,31 @@ pub const PAPER_FIGURES: [PaperFigure; 6] = [
     },
 ];
 
+/// How the comparison's spectra are computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SpectrumMethod {
+    /// The exact transform of the simulated response with its free decay ([`super::esd`]).
+    #[default]
+    Exact,
+    /// The windowed FFT of the sampled record (test-lab path).
+    Fft,
+}
+
+impl std::str::FromStr for SpectrumMethod {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "exact" => Ok(SpectrumMethod::Exact),
+            "fft" => Ok(SpectrumMethod::Fft),
+            _ => Err(Error::invalid(
+                "spectrum",
+                format!("unknown spectrum '{s}'; valid: exact, fft"),
+            )),
+        }
+    }
+}
+
 /// Settings of a comparison.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CompareOptions {
@@ -113,14 +151,22 @@ pub struct CompareOptions {
     pub blows: usize,
     /// Stroke rate (blows per minute) when `blows > 1`; the record is then `blows · 60/rate`.
     pub rate_bpm: f64,
-    /// Window of the spectra (default rectangular, see the module docs).
-    pub window: Window,
-    /// Reference for acceleration levels (m/s²): 1 (default) or 1e-6 (ISO 1683).
+    /// Exact spectrum (default) or the windowed FFT of the record.
+    pub spectrum: SpectrumMethod,
+    /// Window of the FFT path on the responses (default rectangular); the blow's force gets the
+    /// force window over the slider's contact.
+    pub window: TransientWindow,
+    /// Reference for acceleration levels (m/s²): 1 (default) or 1e-6 (ISO 1683); ESD levels
+    /// are re its square·s/Hz.
     pub acceleration_reference_m_per_s2: f64,
     /// Mode frequencies (Hz) to read levels at instead of the model's dominant modes.
     pub mode_frequencies_hz: Option<Vec<f64>>,
     /// Half-width of the search band as a fraction of the mode frequency (default 0.10).
     pub band_fraction: f64,
+    /// How long runs are continued for the exact spectrum.
+    pub decay: DecayRule,
+    /// Points of the exact ESD curve written and plotted (log-spaced; default 1500).
+    pub curve_points: usize,
 }
 
 impl Default for CompareOptions {
@@ -129,10 +175,13 @@ impl Default for CompareOptions {
             duration_s: 2.0,
             blows: 1,
             rate_bpm: 60.0,
-            window: Window::Rectangular,
+            spectrum: SpectrumMethod::Exact,
+            window: TransientWindow::Rectangular,
             acceleration_reference_m_per_s2: REF_ACCELERATION_M_PER_S2,
             mode_frequencies_hz: None,
             band_fraction: 0.10,
+            decay: DecayRule::default(),
+            curve_points: 1500,
         }
     }
 }
@@ -178,6 +227,14 @@ impl std::fmt::Display for CaseName {
     }
 }
 
+/// The channels whose spectra a comparison computes: the bed acceleration at B, the force to
+/// the floor, and the blow itself (the slider-bed contact force).
+pub const SPECTRUM_CHANNELS: [Channel; 3] = [
+    Channel::BedAcceleration,
+    Channel::FloorForce,
+    Channel::ContactSliderBed,
+];
+
 /// The level at one dominant mode in one case.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ModeLevel {
@@ -186,13 +243,37 @@ pub struct ModeLevel {
     /// Centre of the search band in this case (Hz).
     pub centre_hz: f64,
     pub band_hz: [f64; 2],
-    /// Where the acceleration / force peaks were found (Hz).
+    /// Where the acceleration / force ESD peaks are (Hz).
     pub acceleration_peak_hz: f64,
     pub floor_force_peak_hz: f64,
-    /// dB re the acceleration reference (RMS).
+    /// ESD level at the peak, dB re (acceleration reference)²·s/Hz.
     pub acceleration_level_db: f64,
-    /// dB re 1 N (RMS).
+    /// ESD level at the peak, dB re 1 N²·s/Hz.
     pub floor_force_level_db: f64,
+    /// The one-third-octave band containing the acceleration peak and its level
+    /// (dB re (acceleration reference)²·s).
+    pub acceleration_band: Band,
+    pub acceleration_band_level_db: f64,
+    /// The band containing the force peak and its level (dB re 1 N²·s).
+    pub floor_force_band: Band,
+    pub floor_force_band_level_db: f64,
+    /// True when a maximum lies on the edge of the search band (no interior peak there).
+    pub peak_at_band_edge: bool,
+}
+
+/// The spectrum of one channel in one case.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChannelSpectrum {
+    pub channel: Channel,
+    /// ESD on the comparison's frequencies ([`ComparisonResult::frequency_hz`]), unit²·s/Hz.
+    pub esd: Vec<f64>,
+    /// Energy of each band of [`ComparisonResult::bands`] (unit²·s).
+    pub band_energy: Vec<f64>,
+    /// `∫ g² dt` (unit²·s): exact over the response with its free decay (exact path), or the
+    /// windowed record's (FFT path).
+    pub energy: f64,
+    /// Exact path: the refined ESD peaks `(f, E)` at the dominant modes, for plots.
+    pub peaks: Vec<(f64, f64)>,
 }
 
 /// The results of one case.
@@ -200,24 +281,71 @@ pub struct ModeLevel {
 pub struct CaseResult {
     pub case: CaseName,
     pub history: History,
-    pub acceleration_spectrum: Spectrum,
-    pub floor_force_spectrum: Spectrum,
     pub peak_bed_acceleration_m_per_s2: f64,
     pub peak_floor_force_n: f64,
     pub modes: Vec<ModeLevel>,
     /// E_p+/E_s− of the (first) blow.
     pub energy_ratio: Option<f64>,
+    /// In the order of [`SPECTRUM_CHANNELS`].
+    pub spectra: Vec<ChannelSpectrum>,
+    /// Exact path: how the run was continued for the spectrum.
+    pub continuation: Option<Continuation>,
+    /// True when part of the exact spectrum is interpolated between knots (non-linear contact
+    /// laws): an estimate.
+    pub spectrum_is_estimate: bool,
+}
+
+/// Which measure a reduction is (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Measure {
+    /// Peak of the time history on the continuous solution, `20 log10`.
+    TimePeak,
+    /// Maximum of the exact ESD near the case's mode, `10 log10`.
+    EsdPeak,
+    /// Exact one-third-octave band energy, `10 log10`.
+    BandLevel,
+    /// `∫g² dt` of the whole response, `10 log10`.
+    SignalEnergy,
+    /// `E_p+/E_s−` (the paper's vibration power), `10 log10`.
+    EnergyRatio,
+    /// Largest bin of the windowed FFT ESD of the record.
+    FftEsdPeak,
+    /// One-third-octave band energy from the bins of the windowed FFT.
+    FftBandLevel,
+    /// Energy of the windowed record.
+    FftSignalEnergy,
+}
+
+impl Measure {
+    /// Short name (as in JSON).
+    pub fn name(self) -> &'static str {
+        match self {
+            Measure::TimePeak => "time-peak",
+            Measure::EsdPeak => "esd-peak",
+            Measure::BandLevel => "band-level",
+            Measure::SignalEnergy => "signal-energy",
+            Measure::EnergyRatio => "energy-ratio",
+            Measure::FftEsdPeak => "fft-esd-peak",
+            Measure::FftBandLevel => "fft-band-level",
+            Measure::FftSignalEnergy => "fft-signal-energy",
+        }
+    }
 }
 
 /// One row of the reduction table.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Reduction {
     pub case: CaseName,
-    /// e.g. "peak bed acceleration", "floor force at mode 1 (reference)".
+    /// e.g. "peak bed acceleration (time)", "floor force ESD at mode 1 (reference)".
     pub metric: String,
-    /// dB re the metric's reference: time peaks as `20 log10(peak/ref)`, spectral as RMS levels.
+    /// Which measure it is.
+    pub measure: Measure,
+    /// Level in dB re `reference`.
     pub level_db: f64,
     pub no_damper_level_db: f64,
+    /// The level's reference, e.g. "1 (m/s²)²·s/Hz".
+    pub reference: String,
     /// `L_none − L_case` (positive: quieter than without damper).
     pub reduction_db: f64,
 }
@@ -228,8 +356,14 @@ pub struct ComparisonResult {
     pub sample_rate_hz: f64,
     /// The added-mass case's mass (kg) and point, when that case ran.
     pub added_mass: Option<(f64, String)>,
-    pub window: Window,
+    pub spectrum: SpectrumMethod,
+    /// The FFT path's window on the responses.
+    pub window: TransientWindow,
     pub acceleration_reference_m_per_s2: f64,
+    /// Frequencies of the ESD curves (Hz): log-spaced (exact) or the FFT bins in range.
+    pub frequency_hz: Vec<f64>,
+    /// The one-third-octave bands of the band table.
+    pub bands: Vec<Band>,
     pub cases: Vec<CaseResult>,
     pub reductions: Vec<Reduction>,
 }
@@ -350,6 +484,12 @@ impl Comparison {
     pub fn run(&self) -> Result<ComparisonResult> {
         let fs = self.check()?;
         let o = &self.options;
+        if o.curve_points < 2 {
+            return Err(Error::invalid(
+                "curve_points",
+                format!("needs at least 2 points (got {})", o.curve_points),
+            ));
+        }
         if self.cases().len() < 2 {
             return Err(Error::invalid(
                 "damper",
@@ -367,17 +507,43 @@ impl Comparison {
         let mut opts = self.model.options();
         opts.duration = o.duration_s;
         opts.sample_rate = Some(fs);
+        let systems = self
+            .cases()
+            .into_iter()
+            .map(|c| Ok((c, self.model.impact_system(c.case())?)))
+            .collect::<Result<Vec<_>>>()?;
+        let centres: Vec<Vec<(String, f64)>> = systems
+            .iter()
+            .map(|(_, sys)| mode_centres(sys, &specs))
+            .collect();
+        let all = centres.iter().flatten().map(|c| c.1);
+        let f_min = all.clone().fold(f64::INFINITY, f64::min);
+        let f_max = all.fold(0.0, f64::max);
+        let mut bands = bands_covering(0.5 * f_min, 4.0 * f_max);
+        if o.spectrum == SpectrumMethod::Fft {
+            bands.retain(|b| b.upper_hz <= 0.5 * fs);
+        }
+        let (Some(first), Some(last)) = (bands.first(), bands.last()) else {
+            return Err(Error::invalid(
+                "simulation.sample_rate",
+                format!("no one-third-octave band around {f_min}-{f_max} Hz lies below the Nyquist frequency {} Hz", 0.5 * fs),
+            ));
+        };
+        let (f_lo, f_hi) = (first.lower_hz, last.upper_hz);
+        let mut grid: Vec<f64> = (0..o.curve_points)
+            .map(|i| f_lo * (f_hi / f_lo).powf(i as f64 / (o.curve_points - 1) as f64))
+            .collect();
         let mut cases = Vec::new();
-        for c in self.cases() {
-            let sys = self.model.impact_system(c.case())?;
+        for ((c, sys), centres) in systems.iter().zip(&centres) {
+            let c = *c;
             // Peaks on the continuous solution (not the samples): (bed acceleration, floor force).
-            let (history, energy_ratio, peaks) = if o.blows > 1 {
+            let (history, energy_ratio, peaks, traj) = if o.blows > 1 {
                 let b = BlowOptions {
                     blows: o.blows,
                     rate_bpm: o.rate_bpm,
                     ..BlowOptions::default()
                 };
-                let r = run_blows(&sys, &opts, &b, true)?;
+                let r = run_blows(sys, &opts, &b, true)?;
                 let e = r.blows.first().and_then(|b| b.energy_ratio);
                 let peaks = r.blows.iter().fold((0.0_f64, 0.0_f64), |p, b| {
                     (
@@ -385,18 +551,47 @@ impl Comparison {
                         p.1.max(b.peak_floor_force_n),
                     )
                 });
-                (r.history, e, peaks)
+                let mut traj = Trajectory::default();
+                for (rep, sol) in r.blows.iter().zip(&r.solutions) {
+                    traj.append(sol, rep.start_s);
+                }
+                (r.history, e, peaks, traj)
             } else {
-                let r = simulate(&sys, &opts, true)?;
+                let r = simulate(sys, &opts, true)?;
                 let s = &r.summary;
                 let peaks = (s.peak_bed_acceleration_m_per_s2, s.peak_floor_force_n);
-                (r.history, s.energy_ratio, peaks)
+                let traj = Trajectory::from_solution(&r.solution);
+                (r.history, s.energy_ratio, peaks, traj)
             };
             let history = history
                 .ok_or_else(|| Error::numerical("compare", "the run recorded no history"))?;
-            cases.push(self.analyse(c, &sys, history, energy_ratio, peaks, &specs, fs)?);
+            let case = match o.spectrum {
+                SpectrumMethod::Exact => {
+                    self.analyse_exact(c, sys, traj, &opts, centres, &grid, &bands)
+                }
+                SpectrumMethod::Fft => {
+                    let (case, bins) =
+                        self.analyse_fft(c, &history, fs, centres, &bands, f_lo, f_hi)?;
+                    grid = bins;
+                    Ok(case)
+                }
+            }
+            .map_err(|e| match e {
+                Error::Numerical { context, message } => Error::Numerical {
+                    context,
+                    message: format!("{} case: {message}", c.label()),
+                },
+                other => other,
+            })?;
+            cases.push(CaseResult {
+                energy_ratio,
+                peak_bed_acceleration_m_per_s2: peaks.0,
+                peak_floor_force_n: peaks.1,
+                history,
+                ..case
+            });
         }
-        let reductions = reductions(&cases);
+        let reductions = reductions(&cases, o.spectrum, o.acceleration_reference_m_per_s2);
         let added_mass = if cases.iter().any(|c| c.case == CaseName::AddedMass) {
             self.model.added_mass()
         } else {
@@ -405,111 +600,351 @@ impl Comparison {
         Ok(ComparisonResult {
             sample_rate_hz: fs,
             added_mass,
+            spectrum: o.spectrum,
             window: o.window,
             acceleration_reference_m_per_s2: o.acceleration_reference_m_per_s2,
+            frequency_hz: grid,
+            bands,
             cases,
             reductions,
         })
     }
 
-    fn analyse(
+    /// The exact spectra of one case: the run continued until its free decay is negligible,
+    /// the transform with the free decay, levels at the modes, band energies.
+    #[allow(clippy::too_many_arguments)]
+    fn analyse_exact(
         &self,
         case: CaseName,
         sys: &ImpactSystem,
-        history: History,
-        energy_ratio: Option<f64>,
-        peaks: (f64, f64),
-        specs: &[ModeSpec],
-        fs: f64,
+        mut traj: Trajectory,
+        opts: &Options,
+        centres: &[(String, f64)],
+        grid: &[f64],
+        bands: &[Band],
     ) -> Result<CaseResult> {
         let o = &self.options;
-        let a = &history.bed_acceleration_m_per_s2;
-        let f = &history.floor_force_n;
-        let acc = record_spectrum(a, fs, o.window)?;
-        let force = record_spectrum(f, fs, o.window)?;
-        let mut modes = Vec::new();
-        for s in specs {
-            let (name, centre) = match s {
-                ModeSpec::Index(i, name) => (
-                    name.clone(),
-                    sys.structure.omega_rad_per_s[*i] / (2.0 * std::f64::consts::PI),
-                ),
-                ModeSpec::Frequency(v) => (format!("{v} Hz (named)"), *v),
+        let mut builder = SpectrumBuilder::new(sys, &SPECTRUM_CHANNELS);
+        let cont = builder.continue_until_decayed(opts, &mut traj, &o.decay)?;
+        builder.refine_nonlinear(opts, &mut traj)?;
+        let spec = builder.build(&traj, true)?;
+        let nch = SPECTRUM_CHANNELS.len();
+        let mut esd = vec![Vec::with_capacity(grid.len()); nch];
+        for &f in grid {
+            for (v, e) in esd.iter_mut().zip(spec.esd(f)) {
+                v.push(e);
+            }
+        }
+        let mut band_energy = vec![Vec::with_capacity(bands.len()); nch];
+        for b in bands {
+            for (v, q) in band_energy
+                .iter_mut()
+                .zip(spec.band_energies(b.lower_hz, b.upper_hz, BAND_RTOL))
+            {
+                v.push(q.value);
+            }
+        }
+        let band_level = |ch: usize, f: f64, reference: f64| -> (Band, f64) {
+            let b = Band::containing(f);
+            let e = match bands.iter().position(|x| x.index == b.index) {
+                Some(i) => band_energy[ch][i],
+                None => spec.band_energies(b.lower_hz, b.upper_hz, BAND_RTOL)[ch].value,
             };
+            (b, esd_level_db(e, reference))
+        };
+        let a2 = o.acceleration_reference_m_per_s2.powi(2);
+        let mut modes = Vec::new();
+        let mut peaks = vec![Vec::new(); nch];
+        for (name, centre) in centres {
             let lo = centre * (1.0 - o.band_fraction);
             let hi = centre * (1.0 + o.band_fraction);
-            let pa = acc.peak_in_band(lo, hi)?;
-            let pf = force.peak_in_band(lo, hi)?;
+            let pa = spec.peak(0, lo, hi)?;
+            let pf = spec.peak(1, lo, hi)?;
+            peaks[0].push((pa.frequency_hz, pa.esd));
+            peaks[1].push((pf.frequency_hz, pf.esd));
+            let (ab, al) = band_level(0, pa.frequency_hz, a2);
+            let (fb, fl) = band_level(1, pf.frequency_hz, 1.0);
             modes.push(ModeLevel {
-                name,
-                centre_hz: centre,
+                name: name.clone(),
+                centre_hz: *centre,
                 band_hz: [lo, hi],
                 acceleration_peak_hz: pa.frequency_hz,
                 floor_force_peak_hz: pf.frequency_hz,
-                acceleration_level_db: level_db(pa.value, o.acceleration_reference_m_per_s2)?,
-                floor_force_level_db: level_db(pf.value, REF_FORCE_N)?,
+                acceleration_level_db: esd_level_db(pa.esd, a2),
+                floor_force_level_db: esd_level_db(pf.esd, 1.0),
+                acceleration_band: ab,
+                acceleration_band_level_db: al,
+                floor_force_band: fb,
+                floor_force_band_level_db: fl,
+                peak_at_band_edge: pa.at_band_edge || pf.at_band_edge,
             });
         }
+        let spectra = (0..nch)
+            .map(|ch| ChannelSpectrum {
+                channel: SPECTRUM_CHANNELS[ch],
+                esd: std::mem::take(&mut esd[ch]),
+                band_energy: std::mem::take(&mut band_energy[ch]),
+                energy: spec.energy()[ch],
+                peaks: std::mem::take(&mut peaks[ch]),
+            })
+            .collect();
         Ok(CaseResult {
             case,
-            peak_bed_acceleration_m_per_s2: peaks.0,
-            peak_floor_force_n: peaks.1,
-            acceleration_spectrum: acc,
-            floor_force_spectrum: force,
-            history,
+            history: History::default(),
+            peak_bed_acceleration_m_per_s2: 0.0,
+            peak_floor_force_n: 0.0,
             modes,
-            energy_ratio,
+            energy_ratio: None,
+            spectra,
+            continuation: Some(cont),
+            spectrum_is_estimate: spec.is_estimate(),
         })
+    }
+
+    /// The test-lab spectra of one case: windowed FFT ESDs of the record, zero-padded to 4×
+    /// its length; returns the case and the bins in `[f_lo, f_hi]`.
+    #[allow(clippy::too_many_arguments)]
+    fn analyse_fft(
+        &self,
+        case: CaseName,
+        history: &History,
+        fs: f64,
+        centres: &[(String, f64)],
+        bands: &[Band],
+        f_lo: f64,
+        f_hi: f64,
+    ) -> Result<(CaseResult, Vec<f64>)> {
+        let o = &self.options;
+        let n = history.time_s.len();
+        let pad = Padding::Length(n.saturating_mul(4));
+        // The blow's force: force window over the first contact (rectangular for a train).
+        let f = &history.contact_force_slider_bed_n;
+        let blow_window = match f.iter().position(|v| *v > 0.0) {
+            Some(i0) if o.blows == 1 => {
+                let i1 = (i0..n).find(|&i| f[i] <= 0.0).unwrap_or(n);
+                let pulse = i1 as f64 / fs;
+                TransientWindow::Force {
+                    pulse_s: pulse,
+                    taper_s: 0.5 * pulse,
+                }
+            }
+            _ => TransientWindow::Rectangular,
+        };
+        let esds: Vec<Esd> = vec![
+            esd_fft(&history.bed_acceleration_m_per_s2, fs, o.window, pad)?,
+            esd_fft(&history.floor_force_n, fs, o.window, pad)?,
+            esd_fft(f, fs, blow_window, pad)?,
+        ];
+        let keep: Vec<usize> = (0..esds[0].frequency_hz.len())
+            .filter(|&k| {
+                let v = esds[0].frequency_hz[k];
+                v >= f_lo && v <= f_hi
+            })
+            .collect();
+        let bins: Vec<f64> = keep.iter().map(|&k| esds[0].frequency_hz[k]).collect();
+        let a2 = o.acceleration_reference_m_per_s2.powi(2);
+        let mut modes = Vec::new();
+        for (name, centre) in centres {
+            let lo = centre * (1.0 - o.band_fraction);
+            let hi = centre * (1.0 + o.band_fraction);
+            let pa = esds[0].peak_in_band(lo, hi)?;
+            let pf = esds[1].peak_in_band(lo, hi)?;
+            let (ab, fb) = (
+                Band::containing(pa.frequency_hz),
+                Band::containing(pf.frequency_hz),
+            );
+            modes.push(ModeLevel {
+                name: name.clone(),
+                centre_hz: *centre,
+                band_hz: [lo, hi],
+                acceleration_peak_hz: pa.frequency_hz,
+                floor_force_peak_hz: pf.frequency_hz,
+                acceleration_level_db: esd_level_db(pa.value, a2),
+                floor_force_level_db: esd_level_db(pf.value, 1.0),
+                acceleration_band: ab,
+                acceleration_band_level_db: esd_level_db(
+                    esds[0].band_energy(ab.lower_hz, ab.upper_hz),
+                    a2,
+                ),
+                floor_force_band: fb,
+                floor_force_band_level_db: esd_level_db(
+                    esds[1].band_energy(fb.lower_hz, fb.upper_hz),
+                    1.0,
+                ),
+                peak_at_band_edge: false,
+            });
+        }
+        let spectra = esds
+            .iter()
+            .zip(SPECTRUM_CHANNELS)
+            .map(|(e, channel)| ChannelSpectrum {
+                channel,
+                esd: keep.iter().map(|&k| e.density[k]).collect(),
+                band_energy: bands
+                    .iter()
+                    .map(|b| e.band_energy(b.lower_hz, b.upper_hz))
+                    .collect(),
+                energy: e.energy(),
+                peaks: Vec::new(),
+            })
+            .collect();
+        Ok((
+            CaseResult {
+                case,
+                history: History::default(),
+                peak_bed_acceleration_m_per_s2: 0.0,
+                peak_floor_force_n: 0.0,
+                modes,
+                energy_ratio: None,
+                spectra,
+                continuation: None,
+                spectrum_is_estimate: false,
+            },
+            bins,
+        ))
     }
 }
 
-/// The spectrum the comparison reads levels from: the whole record, windowed, zero-padded to
-/// exactly 4× its length (so the record's own bins `k/T` stay bins, and three interpolated
-/// lines lie between them), amplitude-corrected by the window's coherent gain
-/// (`A_k = 2|X_k|/Σw`, see [`super::spectrum`]).
+/// Relative accuracy of the band energies (adaptive Gauss-Kronrod, see [`super::quadrature`]):
+/// 1e-6, 4e-6 dB.
+pub const BAND_RTOL: f64 = 1e-6;
+
+/// Each mode spec's name and band centre in one case's system.
+fn mode_centres(sys: &ImpactSystem, specs: &[ModeSpec]) -> Vec<(String, f64)> {
+    specs
+        .iter()
+        .map(|s| match s {
+            ModeSpec::Index(i, name) => (
+                name.clone(),
+                sys.structure.omega_rad_per_s[*i] / (2.0 * std::f64::consts::PI),
+            ),
+            ModeSpec::Frequency(v) => (format!("{v} Hz (named)"), *v),
+        })
+        .collect()
+}
+
+/// The spectrum the former comparison read levels from: the whole record, windowed,
+/// zero-padded to exactly 4× its length, amplitude-corrected by the window's coherent gain
+/// (`A_k = 2|X_k|/Σw`, see [`super::spectrum`]). Kept for amplitude readings of sampled records.
 pub fn record_spectrum(x: &[f64], sample_rate_hz: f64, window: Window) -> Result<Spectrum> {
     let pad = Padding::Length(x.len().saturating_mul(4));
     amplitude_spectrum_padded(x, sample_rate_hz, window, pad)
 }
 
-/// `20 log10(x)`, `-inf` for 0.
-fn db20(x: f64) -> f64 {
-    20.0 * x.log10()
+/// `20 log10(x/r)`.
+fn db20(x: f64, r: f64) -> f64 {
+    20.0 * (x / r).log10()
 }
 
-fn reductions(cases: &[CaseResult]) -> Vec<Reduction> {
-    let metrics = |c: &CaseResult| -> Vec<(String, f64)> {
-        let mut m = vec![
-            (
-                "peak bed acceleration (time)".to_string(),
-                db20(c.peak_bed_acceleration_m_per_s2),
-            ),
-            (
-                "peak floor force (time)".to_string(),
-                db20(c.peak_floor_force_n),
-            ),
-        ];
-        for l in &c.modes {
-            m.push((
-                format!("bed acceleration at {}", l.name),
-                l.acceleration_level_db,
-            ));
-            m.push((format!("floor force at {}", l.name), l.floor_force_level_db));
-        }
-        m
+/// "1 m/s²" or "1e-6 m/s²".
+fn acc_ref_text(a_ref: f64) -> String {
+    if a_ref == 1.0 {
+        "1 m/s²".into()
+    } else {
+        format!("{a_ref:e} m/s²")
+    }
+}
+
+fn reductions(cases: &[CaseResult], method: SpectrumMethod, a_ref: f64) -> Vec<Reduction> {
+    let a2 = a_ref * a_ref;
+    let ar = acc_ref_text(a_ref);
+    let (esd_m, band_m, energy_m) = match method {
+        SpectrumMethod::Exact => (Measure::EsdPeak, Measure::BandLevel, Measure::SignalEnergy),
+        SpectrumMethod::Fft => (
+            Measure::FftEsdPeak,
+            Measure::FftBandLevel,
+            Measure::FftSignalEnergy,
+        ),
     };
     let Some(none) = cases.iter().find(|c| c.case == CaseName::NoDamper) else {
         return Vec::new();
     };
+    let floor = none.spectra.get(1).is_some_and(|s| s.energy > 0.0);
+    let metrics = |c: &CaseResult| -> Vec<(String, Measure, f64, String)> {
+        let mut m = vec![(
+            "peak bed acceleration (time)".to_string(),
+            Measure::TimePeak,
+            db20(c.peak_bed_acceleration_m_per_s2, a_ref),
+            ar.clone(),
+        )];
+        if floor {
+            m.push((
+                "peak floor force (time)".to_string(),
+                Measure::TimePeak,
+                db20(c.peak_floor_force_n, 1.0),
+                "1 N".into(),
+            ));
+        }
+        for l in &c.modes {
+            m.push((
+                format!("bed acceleration ESD at {}", l.name),
+                esd_m,
+                l.acceleration_level_db,
+                format!("({ar})²·s/Hz"),
+            ));
+            if floor {
+                m.push((
+                    format!("floor force ESD at {}", l.name),
+                    esd_m,
+                    l.floor_force_level_db,
+                    "1 N²·s/Hz".into(),
+                ));
+            }
+            m.push((
+                format!("bed acceleration 1/3-octave band at {}", l.name),
+                band_m,
+                l.acceleration_band_level_db,
+                format!("({ar})²·s"),
+            ));
+            if floor {
+                m.push((
+                    format!("floor force 1/3-octave band at {}", l.name),
+                    band_m,
+                    l.floor_force_band_level_db,
+                    "1 N²·s".into(),
+                ));
+            }
+        }
+        if let Some(s) = c.spectra.first() {
+            m.push((
+                "bed acceleration energy ∫a²dt".to_string(),
+                energy_m,
+                esd_level_db(s.energy, a2),
+                format!("({ar})²·s"),
+            ));
+        }
+        if let (true, Some(s)) = (floor, c.spectra.get(1)) {
+            m.push((
+                "floor force energy ∫F²dt".to_string(),
+                energy_m,
+                esd_level_db(s.energy, 1.0),
+                "1 N²·s".into(),
+            ));
+        }
+        if let Some(e) = c.energy_ratio {
+            m.push((
+                "energy left in the machine E_p+/E_s− (vibration power)".to_string(),
+                Measure::EnergyRatio,
+                10.0 * e.log10(),
+                "1".into(),
+            ));
+        }
+        m
+    };
     let base = metrics(none);
     let mut out = Vec::new();
     for c in cases {
-        for ((metric, l), (_, l0)) in metrics(c).into_iter().zip(&base) {
+        for (metric, measure, l, reference) in metrics(c) {
+            let Some((_, _, l0, _)) = base.iter().find(|b| b.0 == metric && b.1 == measure) else {
+                continue;
+            };
             out.push(Reduction {
                 case: c.case,
                 metric,
+                measure,
                 level_db: l,
                 no_damper_level_db: *l0,
+                reference,
                 reduction_db: l0 - l,
             });
         }
@@ -518,25 +953,68 @@ fn reductions(cases: &[CaseResult]) -> Vec<Reduction> {
 }
 
 impl ComparisonResult {
-    /// The reduction table as aligned text, with the paper's figures beside it.
+    /// The ESD references as text: (acceleration, force).
+    pub fn esd_references(&self) -> (String, String) {
+        (
+            format!(
+                "({})²·s/Hz",
+                acc_ref_text(self.acceleration_reference_m_per_s2)
+            ),
+            "1 N²·s/Hz".into(),
+        )
+    }
+
+    /// What the spectra are, in one line.
+    pub fn spectrum_text(&self) -> String {
+        match self.spectrum {
+            SpectrumMethod::Exact => {
+                let ends: Vec<f64> = self
+                    .cases
+                    .iter()
+                    .filter_map(|c| c.continuation.as_ref().map(|k| k.end_s))
+                    .collect();
+                let (lo, hi) = ends
+                    .iter()
+                    .fold((f64::INFINITY, 0.0_f64), |(a, b), &v| (a.min(v), b.max(v)));
+                let estimate = if self.cases.iter().any(|c| c.spectrum_is_estimate) {
+                    "; ESTIMATE: stretches with a non-linear contact closed are interpolated between knots"
+                } else {
+                    ""
+                };
+                format!(
+                    "spectrum: exact Fourier transform of the simulated response and its free decay (runs continued to {lo:.2}-{hi:.2} s until the decay left carries < {:e} of each channel's energy); independent of the sample rate and the record length{estimate}",
+                    DecayRule::default().tail_energy_fraction
+                )
+            }
+            SpectrumMethod::Fft => format!(
+                "spectrum: windowed FFT of the sampled record ({} window on the responses, zero-padded 4x): a test-lab estimate that depends on the record, the window and the rate",
+                self.window.name()
+            ),
+        }
+    }
+
+    /// The reduction table as aligned text, with the paper's figures and the band table.
     pub fn table_text(&self) -> String {
+        let (ea, ef) = self.esd_references();
         let mut s = String::new();
+        s.push_str(&self.spectrum_text());
+        s.push('\n');
         s.push_str(&format!(
-            "window {}, levels dB re {} m/s² and re 1 N (RMS); reduction = L(no damper) − L(case), positive = quieter\n",
-            self.window.name(),
-            self.acceleration_reference_m_per_s2
+            "ESD levels dB re {ea} and re {ef}; band levels and energies dB re {} and re 1 N²·s; reduction = L(no damper) − L(case), positive = quieter\n",
+            ea.trim_end_matches("/Hz")
         ));
         s.push_str(&format!(
-            "{:<12} {:<44} {:>10} {:>12} {:>11}\n",
-            "case", "metric", "level dB", "no damper dB", "reduction"
+            "{:<11} {:<17} {:<54} {:>9} {:>12} {:>11}\n",
+            "case", "measure", "metric", "level dB", "no damper dB", "reduction"
         ));
         for r in &self.reductions {
             if r.case == CaseName::NoDamper {
                 continue;
             }
             s.push_str(&format!(
-                "{:<12} {:<44} {:>10.2} {:>12.2} {:>8.2} dB\n",
+                "{:<11} {:<17} {:<54} {:>9.2} {:>12.2} {:>8.2} dB\n",
                 r.case.name(),
+                r.measure.name(),
                 r.metric,
                 r.level_db,
                 r.no_damper_level_db,
@@ -549,6 +1027,34 @@ impl ComparisonResult {
         s.push_str("paper's figures:\n");
         for p in PAPER_FIGURES {
             s.push_str(&format!("  {:<70} {:>5.1} dB\n", p.what, p.reduction_db));
+        }
+        s.push_str(&format!(
+            "one-third-octave bands (IEC 61260-1, base 10): band energy levels, bed acceleration dB re {} / floor force dB re 1 N²·s\n",
+            ea.trim_end_matches("/Hz")
+        ));
+        s.push_str(&format!("{:>9} {:>19}", "band", "edges (Hz)"));
+        for c in &self.cases {
+            s.push_str(&format!(" {:>21}", c.case.name()));
+        }
+        s.push('\n');
+        let a2 = self.acceleration_reference_m_per_s2.powi(2);
+        for (i, b) in self.bands.iter().enumerate() {
+            s.push_str(&format!(
+                "{:>9} {:>8.1}-{:<10.1}",
+                b.label(),
+                b.lower_hz,
+                b.upper_hz
+            ));
+            for c in &self.cases {
+                let l = |ch: usize, r: f64| {
+                    c.spectra
+                        .get(ch)
+                        .and_then(|s| s.band_energy.get(i))
+                        .map_or(f64::NAN, |e| esd_level_db(*e, r))
+                };
+                s.push_str(&format!(" {:>10.2} {:>10.2}", l(0, a2), l(1, 1.0)));
+            }
+            s.push('\n');
         }
         s
     }
@@ -563,6 +1069,8 @@ impl ComparisonResult {
             "level_db",
             "no_damper_level_db",
             "reduction_db",
+            "measure",
+            "reference",
         ])
         .map_err(err)?;
         for r in &self.reductions {
@@ -572,6 +1080,8 @@ impl ComparisonResult {
                 format!("{:.6}", r.level_db),
                 format!("{:.6}", r.no_damper_level_db),
                 format!("{:.6}", r.reduction_db),
+                r.measure.name().to_string(),
+                r.reference.clone(),
             ])
             .map_err(err)?;
         }
@@ -579,14 +1089,21 @@ impl ComparisonResult {
             .map_err(|e| Error::numerical("csv", e.to_string()))
     }
 
-    /// A JSON-ready summary: settings, per-case peaks and mode levels, reductions, paper.
+    /// A JSON-ready summary: settings, per-case peaks, mode levels and energies, the band
+    /// table, reductions, paper.
     pub fn summary(&self) -> ComparisonSummary {
+        let (ea, ef) = self.esd_references();
+        let a2 = self.acceleration_reference_m_per_s2.powi(2);
         ComparisonSummary {
             sample_rate_hz: self.sample_rate_hz,
             added_mass_kg: self.added_mass.as_ref().map(|a| a.0),
             added_mass_point: self.added_mass.as_ref().map(|a| a.1.clone()),
+            spectrum: self.spectrum,
+            spectrum_description: self.spectrum_text(),
             window: self.window.name(),
             acceleration_reference_m_per_s2: self.acceleration_reference_m_per_s2,
+            acceleration_esd_reference: ea,
+            force_esd_reference: ef,
             cases: self
                 .cases
                 .iter()
@@ -595,7 +1112,37 @@ impl ComparisonResult {
                     energy_ratio: c.energy_ratio,
                     peak_bed_acceleration_m_per_s2: c.peak_bed_acceleration_m_per_s2,
                     peak_floor_force_n: c.peak_floor_force_n,
+                    bed_acceleration_energy_m2_per_s3: c.spectra.first().map_or(0.0, |s| s.energy),
+                    floor_force_energy_n2_s: c.spectra.get(1).map_or(0.0, |s| s.energy),
                     modes: c.modes.clone(),
+                    continuation: c.continuation.clone(),
+                    spectrum_is_estimate: c.spectrum_is_estimate,
+                })
+                .collect(),
+            bands: self
+                .bands
+                .iter()
+                .enumerate()
+                .map(|(i, b)| BandRow {
+                    band: *b,
+                    levels: self
+                        .cases
+                        .iter()
+                        .map(|c| {
+                            let e = |ch: usize| {
+                                c.spectra
+                                    .get(ch)
+                                    .and_then(|s| s.band_energy.get(i))
+                                    .copied()
+                                    .unwrap_or(f64::NAN)
+                            };
+                            CaseBand {
+                                case: c.case,
+                                bed_acceleration_db: esd_level_db(e(0), a2),
+                                floor_force_db: esd_level_db(e(1), 1.0),
+                            }
+                        })
+                        .collect(),
                 })
                 .collect(),
             reductions: self.reductions.clone(),
@@ -603,36 +1150,82 @@ impl ComparisonResult {
         }
     }
 
-    /// Spectra of every case as CSV: `frequency_hz` then, per case, acceleration and force
-    /// levels (dB) — all cases share the bins (same record length).
+    /// ESDs of every case as CSV: `frequency_hz`, then per case the bed acceleration, floor
+    /// force and blow (slider-bed contact force) ESD levels in dB, the reference in the header.
     pub fn spectra_csv(&self) -> Result<Vec<u8>> {
         let mut w = csv::Writer::from_writer(Vec::new());
         let err = |e: csv::Error| Error::numerical("csv", e.to_string());
+        let ar = if self.acceleration_reference_m_per_s2 == 1.0 {
+            "1_(m/s^2)^2*s/Hz".to_string()
+        } else {
+            format!("({:e}_m/s^2)^2*s/Hz", self.acceleration_reference_m_per_s2)
+        };
         let mut head = vec!["frequency_hz".to_string()];
         for c in &self.cases {
-            head.push(format!("{}_acceleration_db", c.case.name()));
-            head.push(format!("{}_floor_force_db", c.case.name()));
+            head.push(format!("{}_bed_acceleration_esd_db_re_{ar}", c.case.name()));
+            head.push(format!(
+                "{}_floor_force_esd_db_re_1_N^2*s/Hz",
+                c.case.name()
+            ));
+            head.push(format!("{}_blow_force_esd_db_re_1_N^2*s/Hz", c.case.name()));
         }
         w.write_record(&head).map_err(err)?;
-        let Some(first) = self.cases.first() else {
-            return Ok(Vec::new());
-        };
-        let levels: Vec<(Vec<f64>, Vec<f64>)> = self
-            .cases
-            .iter()
-            .map(|c| {
-                Ok((
-                    c.acceleration_spectrum
-                        .levels_db(self.acceleration_reference_m_per_s2)?,
-                    c.floor_force_spectrum.levels_db(REF_FORCE_N)?,
-                ))
-            })
-            .collect::<Result<_>>()?;
-        for (k, f) in first.acceleration_spectrum.frequency_hz.iter().enumerate() {
+        let a2 = self.acceleration_reference_m_per_s2.powi(2);
+        for (k, f) in self.frequency_hz.iter().enumerate() {
             let mut row = vec![format!("{f:.6e}")];
-            for (a, fl) in &levels {
-                row.push(format!("{:.6}", a.get(k).copied().unwrap_or(f64::NAN)));
-                row.push(format!("{:.6}", fl.get(k).copied().unwrap_or(f64::NAN)));
+            for c in &self.cases {
+                for (ch, r) in [(0, a2), (1, 1.0), (2, 1.0)] {
+                    let v = c
+                        .spectra
+                        .get(ch)
+                        .and_then(|s| s.esd.get(k))
+                        .map_or(f64::NAN, |e| esd_level_db(*e, r));
+                    row.push(format!("{v:.6}"));
+                }
+            }
+            w.write_record(&row).map_err(err)?;
+        }
+        w.into_inner()
+            .map_err(|e| Error::numerical("csv", e.to_string()))
+    }
+
+    /// The one-third-octave band table as CSV: the band, then per case the band energies
+    /// ((m/s²)²·s, N²·s) and levels (dB re the acceleration reference²·s and re 1 N²·s).
+    pub fn bands_csv(&self) -> Result<Vec<u8>> {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let err = |e: csv::Error| Error::numerical("csv", e.to_string());
+        let mut head: Vec<String> = ["band", "nominal_hz", "centre_hz", "lower_hz", "upper_hz"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        for c in &self.cases {
+            let n = c.case.name();
+            head.push(format!("{n}_bed_acceleration_energy_m2_per_s3"));
+            head.push(format!("{n}_bed_acceleration_db"));
+            head.push(format!("{n}_floor_force_energy_n2_s"));
+            head.push(format!("{n}_floor_force_db"));
+        }
+        w.write_record(&head).map_err(err)?;
+        let a2 = self.acceleration_reference_m_per_s2.powi(2);
+        for (i, b) in self.bands.iter().enumerate() {
+            let mut row = vec![
+                b.index.to_string(),
+                format!("{}", b.nominal_hz),
+                format!("{:.6}", b.centre_hz),
+                format!("{:.6}", b.lower_hz),
+                format!("{:.6}", b.upper_hz),
+            ];
+            for c in &self.cases {
+                for (ch, r) in [(0, a2), (1, 1.0)] {
+                    let e = c
+                        .spectra
+                        .get(ch)
+                        .and_then(|s| s.band_energy.get(i))
+                        .copied()
+                        .unwrap_or(f64::NAN);
+                    row.push(format!("{e:.9e}"));
+                    row.push(format!("{:.6}", esd_level_db(e, r)));
+                }
             }
             w.write_record(&row).map_err(err)?;
         }
@@ -648,7 +1241,28 @@ pub struct CaseSummary {
     pub energy_ratio: Option<f64>,
     pub peak_bed_acceleration_m_per_s2: f64,
     pub peak_floor_force_n: f64,
+    /// `∫a²dt`, (m/s²)²·s = m²/s³.
+    pub bed_acceleration_energy_m2_per_s3: f64,
+    /// `∫F²dt`, N²·s.
+    pub floor_force_energy_n2_s: f64,
     pub modes: Vec<ModeLevel>,
+    pub continuation: Option<Continuation>,
+    pub spectrum_is_estimate: bool,
+}
+
+/// One band's levels in one case (dB re the acceleration reference²·s, re 1 N²·s).
+#[derive(Debug, Clone, Serialize)]
+pub struct CaseBand {
+    pub case: CaseName,
+    pub bed_acceleration_db: f64,
+    pub floor_force_db: f64,
+}
+
+/// One row of the band table.
+#[derive(Debug, Clone, Serialize)]
+pub struct BandRow {
+    pub band: Band,
+    pub levels: Vec<CaseBand>,
 }
 
 /// The comparison for JSON output.
@@ -658,9 +1272,14 @@ pub struct ComparisonSummary {
     /// The added-mass case's mass (kg) and point (`added_mass.point`, default O_b).
     pub added_mass_kg: Option<f64>,
     pub added_mass_point: Option<String>,
-    pub window: &'static str,
+    pub spectrum: SpectrumMethod,
+    pub spectrum_description: String,
+    pub window: String,
     pub acceleration_reference_m_per_s2: f64,
+    pub acceleration_esd_reference: String,
+    pub force_esd_reference: String,
     pub cases: Vec<CaseSummary>,
+    pub bands: Vec<BandRow>,
     pub reductions: Vec<Reduction>,
     pub paper: Vec<PaperFigure>,
 }

@@ -3,8 +3,11 @@
 pub mod blows;
 pub mod compare;
 pub mod energy;
+pub mod esd;
 pub mod montecarlo;
+pub mod octave;
 pub mod optimize;
+pub mod quadrature;
 pub mod spectrum;
 pub mod study;
 pub mod sweep;

@@ -545,3 +545,175 @@ impl Psd {
             .collect()
     }
 }
+
+// ---------------------------------------------------------------- transient (energy) records
+
+/// Windows for transient records: the test-lab practice for impact tests, kept for comparing
+/// simulated and measured spectra like for like (the exact spectrum of a simulated response,
+/// [`super::esd`], needs no window).
+///
+/// * **Exponential** `w(t) = e^{−t/τ}` (t from the first sample) forces a lightly damped
+///   response to decay inside the record, at a known cost: it multiplies a mode
+///   `e^{−ζωt}` by `e^{−t/τ}`, i.e. it adds `1/τ` to the decay rate `σ = ζω`. A damping ratio
+///   identified from the windowed spectrum is therefore `ζ_m = ζ + 1/(τω)` (for `ζ ≪ 1`), and the
+///   structure's own is `ζ = ζ_m − 1/(τω)` ([`exponential_window_correction`]).
+/// * **Force** window for the excitation record (a hammer's or the slider's force): 1 over the
+///   pulse `[0, T_p]`, a half-cosine taper `½(1 + cos(π(t − T_p)/T_c))` over `[T_p, T_p + T_c]`,
+///   0 after, so that the noise after the pulse does not enter the force spectrum.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TransientWindow {
+    /// `w = 1` over the record.
+    Rectangular,
+    /// Hann over the record (periodic form): zero at the start, where a blow's transient is.
+    Hann,
+    /// `w(t) = e^{−t/τ}`.
+    Exponential { tau_s: f64 },
+    /// 1 over the pulse, cosine taper, 0 after.
+    Force { pulse_s: f64, taper_s: f64 },
+}
+
+impl TransientWindow {
+    /// The window's value at each of `n` samples at `t_j = j/f_s`.
+    pub fn coefficients(&self, n: usize, sample_rate_hz: f64) -> Result<Vec<f64>> {
+        let dt = 1.0 / sample_rate_hz;
+        Ok(match *self {
+            TransientWindow::Rectangular => vec![1.0; n],
+            TransientWindow::Hann => Window::Hann.coefficients(n),
+            TransientWindow::Exponential { tau_s } => {
+                if !(tau_s.is_finite() && tau_s > 0.0) {
+                    return Err(Error::invalid(
+                        "window.tau_s",
+                        format!(
+                            "the exponential window's time constant must be > 0 s (got {tau_s})"
+                        ),
+                    ));
+                }
+                (0..n).map(|j| (-(j as f64) * dt / tau_s).exp()).collect()
+            }
+            TransientWindow::Force { pulse_s, taper_s } => {
+                if !(pulse_s.is_finite() && pulse_s > 0.0 && taper_s.is_finite() && taper_s >= 0.0)
+                {
+                    return Err(Error::invalid(
+                        "window",
+                        format!(
+                            "the force window needs a pulse > 0 s and a taper ≥ 0 s (got {pulse_s}, {taper_s})"
+                        ),
+                    ));
+                }
+                (0..n)
+                    .map(|j| {
+                        let t = j as f64 * dt;
+                        if t <= pulse_s {
+                            1.0
+                        } else if t < pulse_s + taper_s {
+                            0.5 * (1.0 + (std::f64::consts::PI * (t - pulse_s) / taper_s).cos())
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect()
+            }
+        })
+    }
+
+    /// A short name for labels.
+    pub fn name(&self) -> String {
+        match *self {
+            TransientWindow::Rectangular => "rectangular".into(),
+            TransientWindow::Hann => "hann".into(),
+            TransientWindow::Exponential { tau_s } => format!("exponential (τ = {tau_s} s)"),
+            TransientWindow::Force { pulse_s, taper_s } => {
+                format!("force (pulse {pulse_s} s, taper {taper_s} s)")
+            }
+        }
+    }
+}
+
+/// The damping ratio of a mode from the one identified through an exponential window
+/// `e^{−t/τ}`: `ζ = ζ_m − 1/(τω)` (the window adds `1/τ` to the decay rate `ζω`).
+pub fn exponential_window_correction(zeta_measured: f64, tau_s: f64, omega_rad_per_s: f64) -> f64 {
+    zeta_measured - 1.0 / (tau_s * omega_rad_per_s)
+}
+
+/// A one-sided energy spectral density of a windowed record.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Esd {
+    /// Bin frequencies `k f_s / N_fft` (Hz).
+    pub frequency_hz: Vec<f64>,
+    /// `E_k` (unit²·s/Hz).
+    pub density: Vec<f64>,
+}
+
+/// One-sided energy spectral density of a windowed transient record:
+/// `E_k = 2|Δt Σ_n w_n x_n e^{−2πikn/N_fft}|²` (unit²·s/Hz; not doubled at DC and at the Nyquist
+/// bin), the discrete form of `E(f) = 2|G(f)|²` of [`super::esd`] for the windowed record
+/// `w(t)x(t)`. Parseval holds exactly, with or without zero padding:
+/// `Σ_k E_k Δf = Δt Σ_n (w_n x_n)²`, `Δf = f_s/N_fft` ([`Esd::energy`]). For a stationary
+/// signal the PSD is the ESD divided by the record's `Δt Σ w_n²` (cf. [`welch_psd`]).
+pub fn esd_fft(
+    x: &[f64],
+    sample_rate_hz: f64,
+    window: TransientWindow,
+    padding: Padding,
+) -> Result<Esd> {
+    check_record(x, sample_rate_hz)?;
+    let n = x.len();
+    let n_fft = padding.fft_length(n)?;
+    let w = window.coefficients(n, sample_rate_hz)?;
+    let xw: Vec<f64> = x.iter().zip(&w).map(|(a, b)| a * b).collect();
+    let bins = real_fft(&xw, n_fft)?;
+    let dt = 1.0 / sample_rate_hz;
+    let nyquist = if n_fft % 2 == 0 {
+        Some(n_fft / 2)
+    } else {
+        None
+    };
+    let density = bins
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            let one_sided = if k == 0 || Some(k) == nyquist {
+                1.0
+            } else {
+                2.0
+            };
+            one_sided * c.norm_sqr() * dt * dt
+        })
+        .collect();
+    Ok(Esd {
+        frequency_hz: bin_frequencies(bins.len(), n_fft, sample_rate_hz),
+        density,
+    })
+}
+
+impl Esd {
+    /// Bin spacing `Δf` (Hz).
+    pub fn bin_width_hz(&self) -> f64 {
+        if self.frequency_hz.len() > 1 {
+            self.frequency_hz[1] - self.frequency_hz[0]
+        } else {
+            0.0
+        }
+    }
+
+    /// `Σ_k E_k Δf` (unit²·s): the windowed record's energy `Δt Σ (w x)²`.
+    pub fn energy(&self) -> f64 {
+        self.density.iter().sum::<f64>() * self.bin_width_hz()
+    }
+
+    /// `Σ E_k Δf` over the bins in `[f_lo, f_hi)` (unit²·s): a band energy on the bins.
+    pub fn band_energy(&self, f_lo: f64, f_hi: f64) -> f64 {
+        self.frequency_hz
+            .iter()
+            .zip(&self.density)
+            .filter(|(f, _)| **f >= f_lo && **f < f_hi)
+            .map(|(_, e)| e)
+            .sum::<f64>()
+            * self.bin_width_hz()
+    }
+
+    /// The largest bin in `[f_lo, f_hi]`.
+    pub fn peak_in_band(&self, f_lo: f64, f_hi: f64) -> Result<Peak> {
+        peak_in_band(&self.frequency_hz, &self.density, f_lo, f_hi)
+    }
+}
