@@ -1046,8 +1046,10 @@ impl<'a> SpectrumBuilder<'a> {
                 Ok(sol) if sol.x_final.iter().all(|v| v.is_finite()) => sol,
                 failed => {
                     let why = match failed {
-                        Err(e) => e.to_string(),
-                        Ok(_) => "the state became non-finite".to_string(),
+                        Err(e) => format!("continuing from t = {t_end:.9e} s: {e}"),
+                        Ok(_) => format!(
+                            "continuing from t = {t_end:.9e} s: the state became non-finite"
+                        ),
                     };
                     // The integrator cannot go on (e.g. the damper coming to rest against the
                     // bed: contacts chattering without time advancing). Creep up on that instant
@@ -1070,7 +1072,7 @@ impl<'a> SpectrumBuilder<'a> {
                     return Err(Error::numerical(
                         "exact spectrum",
                         format!(
-                            "continuing the run after t = {t_end:.6e} s for its spectrum: {why}; the free decay from there still carries {worst:.3e} of a channel's energy (> {:e} accepted)",
+                            "{why} (for the spectrum); the free decay from there still carries {worst:.3e} of a channel's energy (> {:e} accepted)",
                             rule.accept_energy_fraction
                         ),
                     ));
