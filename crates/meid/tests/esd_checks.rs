@@ -556,15 +556,17 @@ fn nonlinear_contact_stretches_are_an_estimate() {
         worst_coarse = worst_coarse.max(err_coarse);
     }
     assert!(worst < 1e-6, "{worst}");
-    assert!(worst_coarse > 0.1, "{worst_coarse}");
+    // dopri5 itself now leaves a knot at every accepted step of a non-linear contact
+    // (`PathPoint`), so the path before refinement is already accurate.
+    assert!(worst_coarse < 1e-6, "{worst_coarse}");
 }
 
-/// The damper coming to rest against the bed without preload makes grazing contacts chatter
-/// (the exact integrator stops: "switches chatter … without time advancing"). Asked for a decay
-/// it cannot reach (1e-30 of the energy), the continuation creeps up on that instant and stops
-/// there, the decay left being below the accepted 1e-8, and says why.
+/// The damper settling against the bed without preload (where the exact integrator used to stop
+/// at 23.77 s with "switches chatter"): asked for a decay of 1e-30 of the energy, the
+/// continuation now runs through it, some 760 switches, and reaches that decay well within its
+/// limit, and the spectrum is the same as with the regular rule to 1e-6 dB.
 #[test]
-fn continuation_stops_at_a_resting_contact_with_a_negligible_tail() {
+fn continuation_runs_through_the_settling_damper() {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../examples/paper-lumped.toml"
@@ -584,9 +586,12 @@ fn continuation_stops_at_a_resting_contact_with_a_negligible_tail() {
     };
     let cont = b.continue_until_decayed(&opts, &mut traj, &rule).unwrap();
     eprintln!("{cont:?}");
-    let why = cont.stopped_early.as_deref().unwrap_or("");
-    assert!(why.contains("chatter"), "{cont:?}");
-    assert!(cont.end_s < 120.0 && cont.tail_energy_fraction.iter().all(|f| *f <= 1e-8));
+    assert!(cont.stopped_early.is_none(), "{cont:?}");
+    assert!(cont.end_s > 23.77 && cont.end_s < 120.0, "{cont:?}");
+    assert!(
+        cont.tail_energy_fraction.iter().all(|f| *f <= 1e-30),
+        "{cont:?}"
+    );
     // The spectrum from there is the same as from the regular rule's end, to 1e-6 dB.
     let spec = b.build(&traj, true).unwrap();
     let mut t2 = Trajectory::from_solution(&sol);
