@@ -1,5 +1,5 @@
 //! Checks of `analysis::compare` and `analysis::blows` against closed forms
-//! (`/work/shared/notes/closed-forms.md`) and the paper's lumped example.
+//! (spring-mounted mass closed forms) and the paper's lumped example.
 
 use meid::analysis::blows::{run_blows, BlowOptions};
 use std::f64::consts::PI;

@@ -3,7 +3,7 @@
 //! * Kirchhoff thin square plate (a/h = 100): f = λ/(2π a²) sqrt(D/(ρh)), D = E h³/(12(1-ν²));
 //!   simply supported λ = π²(m² + n²) (exact), clamped λ = 35.985 (doubly symmetric),
 //!   73.394 (antisymmetric-symmetric), 108.22 (doubly antisymmetric) (Leissa, *Vibration of
-//!   Plates*, NASA SP-160, 1969, Table 4.23; /work/shared/notes/closed-forms.md).
+//!   Plates*, NASA SP-160, 1969, Table 4.23).
 //!   Tolerance 1 % on the fine mesh (brief).
 //! * Mindlin thick plate (a/h = 10), hard simple supports, shear factor κ = π²/12: for mode (m, n)
 //!   with k² = (m² + n²) π²/a² the flexural frequency is the smaller root of

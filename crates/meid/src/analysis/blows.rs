@@ -346,7 +346,7 @@ fn steady_state(r: &[BlowReport], tol: f64) -> Steady {
 
 #[cfg(test)]
 mod tests {
-    //! Checks of the blow chaining against closed forms (`/work/shared/notes/closed-forms.md`)
+    //! Checks of the blow chaining against closed forms (two-body impact and spring-mounted mass closed forms)
     //! and against single runs.
 
     use super::*;
