@@ -67,11 +67,10 @@ use serde::Serialize;
 
 use super::quadrature::{self, Quadrature, Tolerance};
 use crate::impact::{Channel, ChannelMap, ImpactSystem, Mode, Switch};
+use crate::integrate::propagator::{self, Reduced};
 use crate::integrate::{self, expm::expm, small, NoOutput, Options, Solution};
 use crate::{Error, Result};
 
-/// Relative size under which an eigenvalue of K̃ (or C̃) is taken as zero (as the propagator).
-const NULL_TOL: f64 = 1e-11;
 /// Largest eigenvector condition number for the pole-sum form.
 const MAX_COND: f64 = 1e6;
 /// `|λ − iω|·L` below which a pole's stretches are integrated one by one.
@@ -545,68 +544,17 @@ fn decompose(
     let ls: Vec<&Vec<f64>> = channels.iter().map(|c| &vecs[c.index()]).collect();
     let nd = sys.dofs();
     let (k, c) = sys.matrices(mode);
-    let m = sys.mass_diag();
-    let sq: Vec<f64> = m.iter().map(|x| x.sqrt()).collect();
-    let kt = Mat::<f64>::from_fn(nd, nd, |i, j| k[(i, j)] / (sq[i] * sq[j]));
-    let ct = Mat::<f64>::from_fn(nd, nd, |i, j| c[(i, j)] / (sq[i] * sq[j]));
-    let (ek, uk) = small::sym_eigen(&kt)?;
-    let kmax = ek.iter().map(|v| v.abs()).fold(0.0, f64::max);
-    let null: Vec<usize> = (0..nd)
-        .filter(|&i| ek[i].abs() <= NULL_TOL * kmax.max(f64::MIN_POSITIVE))
-        .collect();
-    let mut q_cols: Vec<Vec<f64>> = (0..nd)
-        .filter(|i| !null.contains(i))
-        .map(|j| (0..nd).map(|i| uk[(i, j)]).collect())
-        .collect();
-    let mut kappa: Vec<f64> = (0..nd)
-        .filter(|i| !null.contains(i))
-        .map(|j| ek[j])
-        .collect();
-    let mut r_cols: Vec<Vec<f64>> = Vec::new();
-    if !null.is_empty() {
-        let n0 = null.len();
-        let u0 = Mat::<f64>::from_fn(nd, n0, |i, j| uk[(i, null[j])]);
-        let c0 = small::at_b_c(&u0, &ct, &u0);
-        let c0 = Mat::<f64>::from_fn(n0, n0, |i, j| 0.5 * (c0[(i, j)] + c0[(j, i)]));
-        let (ec, ecu) = small::sym_eigen(&c0)?;
-        let cmax = (0..nd).map(|i| ct[(i, i)].abs()).fold(0.0, f64::max);
-        let wv = small::mul(&u0, &ecu);
-        for j in 0..n0 {
-            let col: Vec<f64> = (0..nd).map(|i| wv[(i, j)]).collect();
-            if ec[j].abs() <= NULL_TOL * cmax.max(f64::MIN_POSITIVE) {
-                r_cols.push(col);
-            } else {
-                q_cols.push(col);
-                kappa.push(0.0);
-            }
-        }
-    }
-    let mr = q_cols.len();
-    let q = Mat::<f64>::from_fn(nd, mr, |i, j| q_cols[j][i]);
-    let cr = small::at_b_c(&q, &ct, &q);
+    // Rigid directions and the balanced reduced form ζ = [S y; ẏ], as the propagator.
+    let Reduced {
+        sq,
+        q,
+        scale,
+        r_cols,
+        ar,
+        ..
+    } = propagator::reduce(&k, &c, &sys.mass_diag())?;
+    let mr = q.ncols();
     let n2 = 2 * mr;
-    // Balanced reduced form ζ = [S y; ẏ], S = diag(√κ) (1 where κ = 0), as the propagator.
-    let scale: Vec<f64> = kappa
-        .iter()
-        .map(|&k| if k > 0.0 { k.sqrt() } else { 1.0 })
-        .collect();
-    let ar = Mat::<f64>::from_fn(n2, n2, |i, j| {
-        if i < mr {
-            if j == mr + i {
-                scale[i]
-            } else {
-                0.0
-            }
-        } else if j < mr {
-            if j == i - mr {
-                -kappa[j].max(0.0) / scale[j]
-            } else {
-                0.0
-            }
-        } else {
-            -0.5 * (cr[(i - mr, j - mr)] + cr[(j - mr, i - mr)])
-        }
-    });
     // Projection rows (ζ = P X) and the channels in ζ (ℓᵀX_Q = l_ζᵀζ).
     let mut p = vec![vec![0.0; 2 * nd]; n2];
     for j in 0..mr {

@@ -535,7 +535,28 @@ impl Scalar for Functional<'_> {
     }
 }
 
-fn spectral(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Spectral> {
+/// The split of a mode's `(K, C, M)` that the spectral form is built on: in mass-scaled
+/// coordinates `x̃ = M^{½}x`, the directions `R̃` without stiffness and damping (free rigid
+/// motion, `rx = M^{-½}r`, integrated as `p₀ + p₁s`) and the rest `Q̃` (columns of `q`, with
+/// stiffness `κ`), and the balanced first-order matrix on `Q̃`: `Z = [S y; ẏ]` with
+/// `S = diag(√κ)` (1 where κ = 0), so that `A_r = [[0, S], [−diag(κ/S), −C_r]]` has entries of
+/// size ω rather than ω² and is skew-symmetric without damping (well-conditioned eigenvectors).
+/// Shared by the propagator and the exact spectrum ([`crate::analysis::esd`]).
+pub(crate) struct Reduced {
+    /// `√m_i`.
+    pub sq: Vec<f64>,
+    /// `Q̃` (`nd × mr`).
+    pub q: Mat<f64>,
+    /// `S`'s diagonal.
+    pub scale: Vec<f64>,
+    /// The `R̃` columns (scaled coordinates).
+    pub r_cols: Vec<Vec<f64>>,
+    /// `A_r` (`2mr × 2mr`).
+    pub ar: Mat<f64>,
+}
+
+/// [`Reduced`] of `(k, c, m)` (`m` the diagonal masses).
+pub(crate) fn reduce(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Reduced> {
     let nd = m.len();
     let sq: Vec<f64> = m.iter().map(|x| x.sqrt()).collect();
     let kt = Mat::<f64>::from_fn(nd, nd, |i, j| k[(i, j)] / (sq[i] * sq[j]));
@@ -600,6 +621,27 @@ fn spectral(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Spectral> {
             -0.5 * (cr[(i - mr, j - mr)] + cr[(j - mr, i - mr)])
         }
     });
+    Ok(Reduced {
+        sq,
+        q,
+        scale,
+        r_cols,
+        ar,
+    })
+}
+
+fn spectral(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Spectral> {
+    let Reduced {
+        sq,
+        q,
+        scale,
+        mut r_cols,
+        ar,
+        ..
+    } = reduce(k, c, m)?;
+    let nd = m.len();
+    let mr = q.ncols();
+    let n2 = 2 * mr;
     let (lam_all, v) = if n2 > 0 {
         small::real_eigen(&ar)?
     } else {
@@ -678,7 +720,6 @@ fn spectral(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Spectral> {
         .collect();
     let lam_max = lam.iter().map(|l| l.norm()).fold(0.0, f64::max);
     r_cols.clear();
-    q_cols.clear();
     Ok(Spectral {
         rx,
         rproj,
