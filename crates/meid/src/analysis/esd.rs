@@ -65,6 +65,7 @@ use std::f64::consts::PI;
 use faer::{c64, Mat};
 use serde::Serialize;
 
+use super::optimize::{brent_minimize_from, BrentOptions};
 use super::quadrature::{self, Quadrature, Tolerance};
 use crate::impact::{Channel, ChannelMap, ImpactSystem, Mode, Switch};
 use crate::integrate::propagator::{self, Reduced};
@@ -1603,10 +1604,9 @@ impl ExactSpectrum {
         let (f, v) = brent_max(
             |f| self.esd_one(ch, f, &mut buf),
             cand[ib - 1],
-            cand[ib],
+            (cand[ib], vals[ib]),
             cand[ib + 1],
-            vals[ib],
-        );
+        )?;
         Ok(EsdPeak {
             frequency_hz: f,
             esd: v,
@@ -1737,86 +1737,22 @@ fn solve_complex(mut a: Mat<c64>, b: &[c64]) -> Vec<c64> {
     v
 }
 
-/// Brent's maximisation (parabolic interpolation with golden-section safeguard, R. P. Brent,
-/// *Algorithms for Minimization without Derivatives*, 1973, ch. 5) of `f` on `[a, b]` from the
-/// interior point `x` with value `fx`, to `1e-10·x`.
-fn brent_max(mut f: impl FnMut(f64) -> f64, a: f64, x: f64, b: f64, fx: f64) -> (f64, f64) {
-    let g = 0.5 * (3.0 - 5f64.sqrt());
-    let (mut a, mut b) = (a, b);
-    let (mut x, mut w, mut v) = (x, x, x);
-    let (mut fx, mut fw, mut fv) = (-fx, -fx, -fx);
-    let mut d: f64 = 0.0;
-    let mut e: f64 = 0.0;
-    for _ in 0..200 {
-        let m = 0.5 * (a + b);
-        let tol = 1e-10 * x.abs() + 1e-300;
-        let t2 = 2.0 * tol;
-        if (x - m).abs() <= t2 - 0.5 * (b - a) {
-            break;
-        }
-        let mut golden = true;
-        if e.abs() > tol {
-            let r = (x - w) * (fx - fv);
-            let mut q = (x - v) * (fx - fw);
-            let mut p = (x - v) * q - (x - w) * r;
-            q = 2.0 * (q - r);
-            if q > 0.0 {
-                p = -p;
-            }
-            q = q.abs();
-            let r = e;
-            e = d;
-            if p.abs() < (0.5 * q * r).abs() && p > q * (a - x) && p < q * (b - x) {
-                d = p / q;
-                let u = x + d;
-                if u - a < t2 || b - u < t2 {
-                    d = if x < m { tol } else { -tol };
-                }
-                golden = false;
-            }
-        }
-        if golden {
-            e = if x < m { b - x } else { a - x };
-            d = g * e;
-        }
-        let u = if d.abs() >= tol {
-            x + d
-        } else if d > 0.0 {
-            x + tol
-        } else {
-            x - tol
-        };
-        let fu = -f(u);
-        if fu <= fx {
-            if u < x {
-                b = x;
-            } else {
-                a = x;
-            }
-            v = w;
-            fv = fw;
-            w = x;
-            fw = fx;
-            x = u;
-            fx = fu;
-        } else {
-            if u < x {
-                a = u;
-            } else {
-                b = u;
-            }
-            if fu <= fw || w == x {
-                v = w;
-                fv = fw;
-                w = u;
-                fw = fu;
-            } else if fu <= fv || v == x || v == w {
-                v = u;
-                fv = fu;
-            }
-        }
-    }
-    (x, -fx)
+/// The maximum of `f` on `[a, b]` bracketed by the interior point `x` with value `fx`
+/// (`f(x) ≥ f(a), f(b)`), by Brent's method ([`crate::analysis::optimize`]) on `−f`, to
+/// `1e-10·|x|`.
+fn brent_max(
+    mut f: impl FnMut(f64) -> f64,
+    a: f64,
+    (x, fx): (f64, f64),
+    b: f64,
+) -> Result<(f64, f64)> {
+    let options = BrentOptions {
+        x_tolerance: 1e-300,
+        relative_tolerance: 1e-10,
+        max_evaluations: 200,
+    };
+    let m = brent_minimize_from(|u| -f(u), a, (x, -fx), b, &options)?;
+    Ok((m.x, -m.f))
 }
 
 /// `10·log10(E/E_ref)` dB (−∞ for 0).
@@ -1865,7 +1801,7 @@ mod tests {
     #[test]
     fn brent_finds_a_lorentzian_peak() {
         let f = |x: f64| 1.0 / ((x - 3.123_456_789).powi(2) + 1e-6);
-        let (x, v) = brent_max(f, 3.0, 3.1, 3.2, f(3.1));
+        let (x, v) = brent_max(f, 3.0, (3.1, f(3.1)), 3.2).unwrap();
         assert!((x - 3.123_456_789).abs() < 1e-8, "{x}");
         assert!((v - 1e6).abs() < 1e-3, "{v}");
     }

@@ -97,7 +97,37 @@ pub struct Minimum1d {
 /// minimum of the parabola through the three best points whenever that step falls inside
 /// the bracket and is less than half the step before last. Finds a local minimum; on a
 /// unimodal function, the global one. Failed evaluations (`+∞`) force golden-section steps.
-pub fn brent_minimize<F, R>(mut f: F, a: f64, b: f64, options: &BrentOptions) -> Result<Minimum1d>
+pub fn brent_minimize<F, R>(f: F, a: f64, b: f64, options: &BrentOptions) -> Result<Minimum1d>
+where
+    F: FnMut(f64) -> R,
+    R: ObjectiveValue,
+{
+    brent_search(f, a, None, b, options)
+}
+
+/// [`brent_minimize`] started from an interior point `x ∈ (a, b)` whose value `fx` is already
+/// known (a bracket `f(x) ≤ f(a), f(b)` from a scan), which saves the first evaluation.
+pub(crate) fn brent_minimize_from<F, R>(
+    f: F,
+    a: f64,
+    start: (f64, f64),
+    b: f64,
+    options: &BrentOptions,
+) -> Result<Minimum1d>
+where
+    F: FnMut(f64) -> R,
+    R: ObjectiveValue,
+{
+    brent_search(f, a, Some(start), b, options)
+}
+
+fn brent_search<F, R>(
+    mut f: F,
+    a: f64,
+    start: Option<(f64, f64)>,
+    b: f64,
+    options: &BrentOptions,
+) -> Result<Minimum1d>
 where
     F: FnMut(f64) -> R,
     R: ObjectiveValue,
@@ -141,9 +171,24 @@ where
 
     let golden = 0.5 * (3.0 - 5.0_f64.sqrt());
     let (mut lo, mut hi) = (a, b);
-    let mut x = lo + golden * (hi - lo);
+    let (mut x, mut fx) = match start {
+        Some((x, fx)) if x > a && x < b => {
+            let fx = fx.into_value().unwrap_or(f64::INFINITY);
+            history.push((x, fx));
+            (x, fx)
+        }
+        Some((x, _)) => {
+            return Err(Error::invalid(
+                "start",
+                format!("must lie inside ({a}, {b}), got {x}"),
+            ))
+        }
+        None => {
+            let x = lo + golden * (hi - lo);
+            (x, eval(x, &mut history, &mut failures))
+        }
+    };
     let (mut w, mut v) = (x, x);
-    let mut fx = eval(x, &mut history, &mut failures);
     let (mut fw, mut fv) = (fx, fx);
     let (mut d, mut e) = (0.0_f64, 0.0_f64);
     let mut converged = false;
