@@ -52,7 +52,9 @@ pub fn run(a: ModesArgs) -> Result<()> {
     } else {
         print!("{}", report.to_text());
     }
-    if let Some(dir) = &a.output {
+    if let Some(out) = &a.output {
+        let set = crate::outputs::begin(out)?;
+        let dir = set.staging();
         io::write_atomic(&dir.join("modes.csv"), report.to_csv().as_bytes())?;
         io::write_atomic(
             &dir.join("truncation.csv"),
@@ -89,8 +91,9 @@ pub fn run(a: ModesArgs) -> Result<()> {
         } else if a.export_matrices {
             anyhow::bail!("--export-matrices needs a [structure.fem] model");
         }
+        set.commit("modes")?;
         if !a.json {
-            println!("wrote {}", dir.display());
+            println!("wrote {}", out.display());
         }
     }
     Ok(())
