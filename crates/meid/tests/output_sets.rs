@@ -109,6 +109,21 @@ fn an_output_set_is_replaced_whole_and_a_failed_one_leaves_the_old() {
 }
 
 #[test]
+fn staging_left_by_a_killed_run_is_removed_by_the_next() {
+    if !Path::new("/proc/self").exists() {
+        return; // the liveness check needs /proc
+    }
+    let d = tmpdir("stale");
+    // PID 4294967295 cannot exist (Linux PIDs are at most 2^22); PID 1 always does.
+    std::fs::create_dir_all(d.join(".meid-staging.4294967295.0/x")).unwrap();
+    std::fs::create_dir_all(d.join(".meid-staging.1.0")).unwrap();
+    let s = OutputSet::begin(&d).unwrap();
+    io::write_atomic(&s.path("a.csv"), b"1\n").unwrap();
+    s.commit("simulate").unwrap();
+    assert_eq!(names(&d), [".meid-staging.1.0", "a.csv", MANIFEST]);
+}
+
+#[test]
 fn an_output_directory_that_is_a_file_is_named() {
     let d = tmpdir("notdir");
     let f = d.join("out");

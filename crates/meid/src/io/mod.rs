@@ -264,6 +264,7 @@ impl OutputSet {
             });
         }
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        remove_dead_staging(dir);
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
         let staging = dir.join(format!(".meid-staging.{}.{n}", std::process::id()));
         std::fs::create_dir(&staging).map_err(|e| Error::io(&staging, e))?;
@@ -302,6 +303,30 @@ impl Drop for OutputSet {
     fn drop(&mut self) {
         if !self.staging.as_os_str().is_empty() {
             let _ = std::fs::remove_dir_all(&self.staging);
+        }
+    }
+}
+
+/// Removes the staging directories `.meid-staging.PID.N` in `dir` left by killed runs: those
+/// whose process is gone (Linux: no `/proc/PID`). Elsewhere, or for a live process, nothing is
+/// removed.
+fn remove_dead_staging(dir: &Path) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().to_string();
+        let Some(rest) = name.strip_prefix(".meid-staging.") else {
+            continue;
+        };
+        let Some(pid) = rest.split('.').next().and_then(|p| p.parse::<u32>().ok()) else {
+            continue;
+        };
+        if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = std::fs::remove_dir_all(e.path());
         }
     }
 }
