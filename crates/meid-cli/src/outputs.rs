@@ -31,7 +31,7 @@ pub fn available_bytes(dir: &Path) -> Option<u64> {
 /// the run would fail with a full disk after all its work.
 pub fn check_disk(dir: &Path, what: &str, bytes: f64, reduce: &str) -> Result<()> {
     if let Some(free) = available_bytes(dir) {
-        if !(bytes <= free as f64) {
+        if bytes.is_nan() || bytes > free as f64 {
             bail!(
                 "{what} would take about {} on disk, more than the {} free in {}. Reduce {reduce}",
                 format_bytes(bytes),

@@ -219,6 +219,9 @@ pub fn train_bytes(sys: &ImpactSystem, blows: usize, keep_solutions: bool) -> f6
     blows as f64 * per_blow
 }
 
+/// Receives the samples of each blow of a train ([`run_blows_with`]).
+pub type HistorySink<'a> = dyn FnMut(&History) -> Result<()> + 'a;
+
 /// [`run_blows`] handing each blow's samples (times from the train's start, the first sample
 /// of a later blow dropped, `dissipated_j` since t = 0) to `on_history` as soon as the blow is
 /// done, instead of holding the train's history: with a sink that writes them to a file, a
@@ -229,7 +232,7 @@ pub fn run_blows_with(
     sys: &ImpactSystem,
     opts: &Options,
     blow: &BlowOptions,
-    mut on_history: Option<&mut dyn FnMut(&History) -> Result<()>>,
+    mut on_history: Option<&mut HistorySink<'_>>,
     keep_solutions: bool,
 ) -> Result<BlowsRun> {
     let record = on_history.is_some();
