@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use meid::analysis::blows::{run_blows, BlowOptions};
+use meid::analysis::blows::{run_blows_with, BlowOptions};
 use meid::plot::{self, LinePlot, Series};
 
 use crate::args::{CaseArg, PrintArgs, RunArgs};
@@ -41,14 +41,60 @@ pub fn run(a: BlowsArgs) -> Result<()> {
         rate_bpm: a.rate_bpm,
         steady_tolerance: a.tolerance,
     };
-    let r = run_blows(&sys, &opts, &b, a.output.is_some()).context("blow train failed")?;
+    // With -o: history.csv is streamed blow by blow into the output set; only the three
+    // pictured series (time, bed acceleration, floor force) are held.
+    let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
+    let mut pictured: [Vec<f64>; 3] = Default::default();
+    let r = match &set {
+        Some(set) => {
+            let interval = meid::analysis::blows::blow_interval_s(a.rate_bpm, opts.sample_rate)?;
+            let rows =
+                a.blows as f64 * meid::analysis::energy::sample_count(interval, opts.sample_rate);
+            meid::limits::check_memory(
+                &format!(
+                    "the pictured series of {} blows ({rows:.3e} samples × 48 B)",
+                    a.blows
+                ),
+                48.0 * rows,
+                "blows",
+                "the number of blows (--blows) or simulation.sample_rate (--rate)",
+            )?;
+            crate::outputs::check_disk(
+                set.dir(),
+                &format!("history.csv ({rows:.3e} samples)"),
+                rows * meid::io::HISTORY_ROW_BYTES as f64,
+                "the number of blows (--blows) or simulation.sample_rate (--rate)",
+            )?;
+            let path = set.path("history.csv");
+            let file = std::fs::File::create(&path)
+                .with_context(|| format!("cannot create {}", path.display()))?;
+            let mut w = meid::io::HistoryWriter::new(std::io::BufWriter::new(file))
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            let mut sink = |h: &meid::analysis::History| -> meid::Result<()> {
+                for i in 0..h.time_s.len() {
+                    w.row(&h.row(i)).map_err(|e| meid::Error::io(&path, e))?;
+                }
+                pictured[0].extend_from_slice(&h.time_s);
+                pictured[1].extend_from_slice(&h.bed_acceleration_m_per_s2);
+                pictured[2].extend_from_slice(&h.floor_force_n);
+                Ok(())
+            };
+            let r = run_blows_with(&sys, &opts, &b, Some(&mut sink), false)
+                .context("blow train failed")?;
+            w.into_inner()
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            r
+        }
+        None => run_blows_with(&sys, &opts, &b, None, false).context("blow train failed")?,
+    };
     let out = serde_json::json!({
         "interval_s": r.interval_s,
         "blows": r.blows,
         "steady": r.steady,
         "damper_gap_at_next_strike_m": r.damper_gap_at_next_strike_m,
     });
-    if let Some(dir) = &a.output {
+    if let Some(set) = &set {
+        let dir = set.staging();
         let mut w = String::from("blow,start_s,energy_ratio,machine_energy_at_strike_j,damper_energy_at_strike_j,peak_bed_acceleration_m_per_s2,peak_floor_force_n,peak_contact_force_slider_bed_n,damper_gap_at_strike_m,damper_contact_time_s\n");
         let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.9e}"));
         for x in &r.blows {
@@ -68,37 +114,30 @@ pub fn run(a: BlowsArgs) -> Result<()> {
         }
         meid::io::write_atomic(&dir.join("blows.csv"), w.as_bytes())?;
         meid::io::write_json(&dir.join("blows.json"), &out)?;
-        if let Some(h) = &r.history {
-            meid::io::write_atomic(&dir.join("history.csv"), &meid::io::history_csv(h)?)?;
-            for (stem, title, label, y) in [
-                (
-                    "acceleration-time",
-                    "bed acceleration at B",
-                    "acceleration (m/s²)",
-                    &h.bed_acceleration_m_per_s2,
-                ),
-                (
-                    "floor-force-time",
-                    "force to the floor",
-                    "force (N)",
-                    &h.floor_force_n,
-                ),
-            ] {
-                plot::line_plot(
-                    dir.join(stem),
-                    &LinePlot {
-                        title: format!("{title}, {} blows at {} /min", a.blows, a.rate_bpm),
-                        x_label: "time (s)".into(),
-                        y_label: label.into(),
-                        series: vec![Series {
-                            label: String::new(),
-                            x: h.time_s.clone(),
-                            y: y.clone(),
-                        }],
-                        ..LinePlot::default()
-                    },
-                )?;
-            }
+        let [time_s, accel, floor] = std::mem::take(&mut pictured);
+        for (stem, title, label, y) in [
+            (
+                "acceleration-time",
+                "bed acceleration at B",
+                "acceleration (m/s²)",
+                accel,
+            ),
+            ("floor-force-time", "force to the floor", "force (N)", floor),
+        ] {
+            plot::line_plot(
+                dir.join(stem),
+                &LinePlot {
+                    title: format!("{title}, {} blows at {} /min", a.blows, a.rate_bpm),
+                    x_label: "time (s)".into(),
+                    y_label: label.into(),
+                    series: vec![Series {
+                        label: String::new(),
+                        x: time_s.clone(),
+                        y,
+                    }],
+                    ..LinePlot::default()
+                },
+            )?;
         }
         let n: Vec<f64> = r.blows.iter().map(|x| x.blow as f64).collect();
         let first_f = r.blows.first().map_or(1.0, |x| x.peak_floor_force_n);
@@ -133,6 +172,9 @@ pub fn run(a: BlowsArgs) -> Result<()> {
                 ..LinePlot::default()
             },
         )?;
+    }
+    if let Some(set) = set {
+        set.commit("blows")?;
     }
     if a.print.json {
         println!("{}", serde_json::to_string_pretty(&out)?);

@@ -87,11 +87,13 @@ pub fn run(a: CompareArgs) -> Result<()> {
         mode_frequencies_hz: (!a.frequencies.is_empty()).then(|| a.frequencies.clone()),
         ..CompareOptions::default()
     };
+    let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
     let result = Comparison::new(model, options)
         .run()
         .context("comparison failed")?;
-    if let Some(dir) = &a.output {
-        write_outputs(dir, &result)?;
+    if let Some(set) = set {
+        write_outputs(set.staging(), &result)?;
+        set.commit("compare")?;
     }
     if a.print.json {
         println!("{}", serde_json::to_string_pretty(&result.summary())?);
@@ -110,9 +112,9 @@ pub fn run(a: CompareArgs) -> Result<()> {
 
 fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
     for c in &r.cases {
-        meid::io::write_atomic(
+        meid::io::write_history_csv(
             &dir.join(format!("history-{}.csv", c.case.name())),
-            &meid::io::history_csv(&c.history)?,
+            &c.history,
         )?;
     }
     meid::io::write_atomic(&dir.join("spectra.csv"), &r.spectra_csv()?)?;

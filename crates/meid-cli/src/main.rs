@@ -15,6 +15,7 @@ mod compare;
 mod modes;
 mod montecarlo;
 mod optimize;
+mod outputs;
 mod simulate;
 mod sweep;
 
@@ -25,6 +26,10 @@ mod sweep;
     about = "Momentum-exchange impact dampers for impact machines"
 )]
 struct Cli {
+    /// Memory a run may use, e.g. 2GiB, 512MiB or bytes (default: half the physical memory).
+    /// Runs estimated above it are refused before they allocate, naming the input to reduce.
+    #[arg(long, global = true, value_name = "BYTES|MiB|GiB")]
+    max_memory: Option<String>,
     #[command(subcommand)]
     command: Command,
 }
@@ -49,6 +54,15 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(m) = &cli.max_memory {
+        match meid::limits::parse_bytes(m) {
+            Ok(b) => meid::limits::set_max_memory(b),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(2);
+            }
+        }
+    }
     let result = match cli.command {
         Command::Simulate(a) => simulate::run(a),
         Command::Modes(a) => modes::run(a),
@@ -61,10 +75,27 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_chain(&e));
             ExitCode::from(2)
         }
     }
+}
+
+/// The error and its causes, `: `-separated, each cause left out when the text so far already
+/// ends with it (an `Io` error displays its OS error and also returns it as its source: printed
+/// once, not "… (os error 2): … (os error 2)").
+pub(crate) fn error_chain(e: &anyhow::Error) -> String {
+    let mut out = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if out.is_empty() {
+            out = text;
+        } else if !out.ends_with(&text) {
+            out.push_str(": ");
+            out.push_str(&text);
+        }
+    }
+    out
 }
 
 /// Loads a model with `--set` overrides and the common run options folded in as overrides.

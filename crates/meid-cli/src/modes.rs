@@ -37,6 +37,8 @@ pub fn run(a: ModesArgs) -> Result<()> {
     if a.export_matrices && a.output.is_none() {
         anyhow::bail!("--export-matrices needs an output directory (-o DIR)");
     }
+    // The output set first: `-o FILE` is refused before the solve.
+    let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
     // One build and one solve: the analysis the model's modes came from.
     let (model, analysis) = fem::from_file_with_analysis(&a.model, &a.set, a.count)?;
     let report = match &analysis {
@@ -52,7 +54,8 @@ pub fn run(a: ModesArgs) -> Result<()> {
     } else {
         print!("{}", report.to_text());
     }
-    if let Some(dir) = &a.output {
+    if let (Some(out), Some(set)) = (&a.output, set) {
+        let dir = set.staging();
         io::write_atomic(&dir.join("modes.csv"), report.to_csv().as_bytes())?;
         io::write_atomic(
             &dir.join("truncation.csv"),
@@ -89,8 +92,9 @@ pub fn run(a: ModesArgs) -> Result<()> {
         } else if a.export_matrices {
             anyhow::bail!("--export-matrices needs a [structure.fem] model");
         }
+        set.commit("modes")?;
         if !a.json {
-            println!("wrote {}", dir.display());
+            println!("wrote {}", out.display());
         }
     }
     Ok(())

@@ -68,6 +68,7 @@ pub fn run(a: MonteCarloArgs) -> Result<()> {
         pool = pool.num_threads(t);
     }
     let pool = pool.build().context("thread pool")?;
+    let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
     let r = pool.install(|| study.run()).context("Monte Carlo failed")?;
     let stats = serde_json::json!({
         "seed": r.seed,
@@ -77,7 +78,8 @@ pub fn run(a: MonteCarloArgs) -> Result<()> {
         "input_stats": r.input_stats,
         "metric_stats": r.metric_stats,
     });
-    if let Some(dir) = &a.output {
+    if let Some(set) = set {
+        let dir = set.staging();
         meid::io::write_atomic(&dir.join("samples.csv"), &r.samples_csv()?)?;
         meid::io::write_json(&dir.join("stats.json"), &stats)?;
         let values = r.metric(&a.metric)?;
@@ -104,6 +106,7 @@ pub fn run(a: MonteCarloArgs) -> Result<()> {
                 },
             )?;
         }
+        set.commit("montecarlo")?;
     }
     if a.print.json {
         println!("{}", serde_json::to_string_pretty(&stats)?);

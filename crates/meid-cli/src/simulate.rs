@@ -33,9 +33,36 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     let model = a.run.load(&a.model, a.duration)?;
     let sys = model.impact_system(a.case.parse()?)?;
     let opts = model.options();
-    let record = a.output.is_some();
-    let run = analysis::simulate(&sys, &opts, record).context("simulation failed")?;
-    let s = &run.summary;
+    // With -o, the history is streamed into the output set's history.csv (constant memory);
+    // without, no sample is computed at all. Peaks come from the continuous solution either way.
+    let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
+    let (s, _solution) = match &set {
+        Some(set) => {
+            let rows = analysis::energy::sample_count(opts.duration, opts.sample_rate);
+            crate::outputs::check_disk(
+                set.dir(),
+                &format!("history.csv ({rows:.3e} samples)"),
+                rows * meid::io::HISTORY_ROW_BYTES as f64,
+                "simulation.duration (--duration) or simulation.sample_rate (--rate)",
+            )?;
+            let path = set.path("history.csv");
+            let file = std::fs::File::create(&path)
+                .with_context(|| format!("cannot create {}", path.display()))?;
+            let mut rec =
+                analysis::energy::StreamRecorder::new(&sys, std::io::BufWriter::new(file))
+                    .with_context(|| format!("cannot write {}", path.display()))?;
+            let r = analysis::energy::simulate_observed(&sys, &opts, Some(&mut rec))
+                .context("simulation failed")?;
+            rec.finish()
+                .and_then(|mut w| std::io::Write::flush(&mut w))
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            r
+        }
+        None => {
+            analysis::energy::simulate_observed(&sys, &opts, None).context("simulation failed")?
+        }
+    };
+    let s = &s;
     let diag = model.diagnostics();
     if !a.print.quiet {
         for w in &diag.warnings {
@@ -49,15 +76,13 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     {
         o.extend(d);
     }
-    if let Some(dir) = &a.output {
-        if let Some(h) = &run.history {
-            meid::io::write_atomic(&dir.join("history.csv"), &meid::io::history_csv(h)?)?;
-        }
-        meid::io::write_json(&dir.join("summary.json"), &out)?;
+    if let Some(set) = set {
+        meid::io::write_json(&set.path("summary.json"), &out)?;
         meid::io::write_atomic(
-            &dir.join("truncation.csv"),
+            &set.path("truncation.csv"),
             meid::modal::truncation::to_csv(&diag.truncation).as_bytes(),
         )?;
+        set.commit("simulate")?;
     }
     if a.print.json {
         println!("{}", serde_json::to_string_pretty(&out)?);

@@ -22,12 +22,17 @@ pub struct SweepArgs {
     /// model field path (repeatable; the grid is their Cartesian product, last fastest).
     #[arg(long = "vary", value_name = "SPEC", required = true)]
     vary: Vec<String>,
-    /// Output directory (sweep.csv, sweep.json, pictures, the journal sweep.partial.csv).
-    #[arg(short, long, value_name = "DIR", default_value = "sweep-out")]
-    output: PathBuf,
+    /// Output directory (sweep.csv, sweep.json, pictures, manifest.json, and the journal
+    /// sweep.partial.csv). Without it, nothing is written: the summary and the table of every
+    /// point (sweep.csv's content) go to stdout.
+    #[arg(short, long, value_name = "DIR")]
+    output: Option<PathBuf>,
     /// Reuse the finished points of an interrupted sweep (DIR/sweep.partial.csv).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "force")]
     resume: bool,
+    /// Discard the journal of an earlier sweep in DIR and start over.
+    #[arg(long)]
+    force: bool,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
@@ -86,7 +91,23 @@ pub fn run(a: SweepArgs) -> Result<()> {
         ProgressBar::hidden()
     };
     let progress = |done: usize, _total: usize| bar.set_position(done as u64);
-    let journal = a.output.join("sweep.partial.csv");
+    if a.resume && a.output.is_none() {
+        bail!("--resume needs -o DIR: the journal of the sweep is DIR/sweep.partial.csv");
+    }
+    let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
+    if let Some(dir) = &a.output {
+        let journal = dir.join("sweep.partial.csv");
+        if !a.resume && !a.force {
+            let rows = journal_rows(&journal);
+            if rows > 0 {
+                bail!(
+                    "{} holds {rows} finished point(s) of an earlier sweep; add --resume to reuse \
+                     them (a different sweep's journal is refused), or --force to discard them",
+                    journal.display()
+                );
+            }
+        }
+    }
     let pool = {
         let mut b = rayon::ThreadPoolBuilder::new();
         if let Some(n) = a.threads {
@@ -98,29 +119,49 @@ pub fn run(a: SweepArgs) -> Result<()> {
         b.build().context("cannot start the worker threads")?
     };
     let t0 = std::time::Instant::now();
-    let result = pool.install(|| sweep.run_resumable(&journal, a.resume, &progress))?;
+    let result = match &a.output {
+        Some(dir) => {
+            let journal = dir.join("sweep.partial.csv");
+            pool.install(|| sweep.run_resumable(&journal, a.resume, &progress))?
+        }
+        None => pool.install(|| sweep.run(&progress)),
+    };
     bar.finish_and_clear();
     let elapsed = t0.elapsed().as_secs_f64();
-    result.write(&a.output)?;
+    let Some(set) = set else {
+        if let Some(e) = sweep.all_failed_error(&result) {
+            return Err(e.into());
+        }
+        if !a.quiet {
+            summarise(&sweep, &result, &a.metric, elapsed, &[]);
+            println!();
+            print!("{}", result.csv());
+        }
+        return Ok(());
+    };
+    result.write(set.staging())?;
     if let Some(e) = sweep.all_failed_error(&result) {
         // The results (every row with its error) are written; the run is that error.
+        set.commit("sweep")?;
         return Err(e.into());
     }
-    let pictures = draw(&sweep, &result, &a.metric, &a.output)?;
+    draw(&sweep, &result, &a.metric, set.staging())?;
+    let files = set.commit("sweep")?;
     if !a.quiet {
-        summarise(&sweep, &result, &a.metric, elapsed, &a.output, &pictures);
+        summarise(&sweep, &result, &a.metric, elapsed, &files);
     }
     Ok(())
 }
 
-fn summarise(
-    sweep: &Sweep,
-    r: &SweepResult,
-    metric: &str,
-    elapsed: f64,
-    dir: &Path,
-    pictures: &[PathBuf],
-) {
+/// Finished points in a sweep journal: its complete lines after the journal line and the
+/// header (0 for a missing, empty or header-only journal).
+fn journal_rows(path: &Path) -> usize {
+    std::fs::read(path).map_or(0, |b| {
+        b.iter().filter(|c| **c == b'\n').count().saturating_sub(2)
+    })
+}
+
+fn summarise(sweep: &Sweep, r: &SweepResult, metric: &str, elapsed: f64, files: &[PathBuf]) {
     println!(
         "meid sweep — {} points in {:.2} s ({} failed)",
         r.points.len(),
@@ -152,9 +193,7 @@ fn summarise(
             p.error.as_deref().unwrap_or("")
         );
     }
-    println!("  wrote {}", dir.join("sweep.csv").display());
-    println!("  wrote {}", dir.join("sweep.json").display());
-    for p in pictures {
+    for p in files {
         println!("  wrote {}", p.display());
     }
 }

@@ -156,12 +156,86 @@ fn relative_change(a: f64, b: f64) -> f64 {
 
 /// Runs `blow.blows` blows of `sys` every `60 / blow.rate_bpm` s. `opts.duration` is ignored
 /// (the blow interval is the duration of each run); `opts.sample_rate` is the output grid.
+/// With `record`, the concatenated history is held in memory ([`BlowsRun::history`]); the
+/// estimate of that and of the kept per-blow solutions is checked against
+/// [`crate::limits::max_memory`] before the first blow.
 pub fn run_blows(
     sys: &ImpactSystem,
     opts: &Options,
     blow: &BlowOptions,
     record: bool,
 ) -> Result<BlowsRun> {
+    if record {
+        let interval = blow_interval_s(blow.rate_bpm, opts.sample_rate)?;
+        let n = blow.blows as f64 * super::energy::sample_count(interval, opts.sample_rate);
+        crate::limits::check_memory(
+            &format!(
+                "the history of {} blows ({n:.3e} samples × {} B)",
+                blow.blows,
+                super::energy::HISTORY_SAMPLE_BYTES
+            ),
+            History::bytes_for(n),
+            "blows",
+            "the number of blows (--blows) or simulation.sample_rate (--rate)",
+        )?;
+    }
+    let mut history = record.then(History::default);
+    if let Some(h) = history.as_mut() {
+        let interval = blow_interval_s(blow.rate_bpm, opts.sample_rate)?;
+        let n = blow.blows as f64 * super::energy::sample_count(interval, opts.sample_rate);
+        h.reserve(n as usize + 2);
+    }
+    let mut sink = |b: &History| -> Result<()> {
+        if let Some(h) = history.as_mut() {
+            extend(h, b);
+        }
+        Ok(())
+    };
+    let mut run = run_blows_with(
+        sys,
+        opts,
+        blow,
+        if record { Some(&mut sink) } else { None },
+        true,
+    )?;
+    run.history = history;
+    Ok(run)
+}
+
+/// Memory (bytes) a blow train holds besides the samples: one [`BlowReport`] per blow, and one
+/// [`Solution`] per blow when kept (its path and events counted at their minimum, the strike
+/// and the end of the blow).
+pub fn train_bytes(sys: &ImpactSystem, blows: usize, keep_solutions: bool) -> f64 {
+    let per_blow = std::mem::size_of::<BlowReport>() as f64
+        + if keep_solutions {
+            let state = (2 * sys.dofs() * 8) as f64;
+            (std::mem::size_of::<Solution>()
+                + 2 * std::mem::size_of::<integrate::PathPoint>()
+                + std::mem::size_of::<integrate::CollisionEnd>()) as f64
+                + 4.0 * state
+        } else {
+            0.0
+        };
+    blows as f64 * per_blow
+}
+
+/// Receives the samples of each blow of a train ([`run_blows_with`]).
+pub type HistorySink<'a> = dyn FnMut(&History) -> Result<()> + 'a;
+
+/// [`run_blows`] handing each blow's samples (times from the train's start, the first sample
+/// of a later blow dropped, `dissipated_j` since t = 0) to `on_history` as soon as the blow is
+/// done, instead of holding the train's history: with a sink that writes them to a file, a
+/// train of any length is recorded in the memory of one blow. `keep_solutions` keeps each
+/// blow's [`Solution`] ([`BlowsRun::solutions`], for the exact spectrum of the train);
+/// without it that list is empty. [`BlowsRun::history`] is `None`.
+pub fn run_blows_with(
+    sys: &ImpactSystem,
+    opts: &Options,
+    blow: &BlowOptions,
+    mut on_history: Option<&mut HistorySink<'_>>,
+    keep_solutions: bool,
+) -> Result<BlowsRun> {
+    let record = on_history.is_some();
     if blow.blows == 0 {
         return Err(Error::invalid("blows", "needs at least one blow"));
     }
@@ -172,6 +246,47 @@ pub fn run_blows(
         ));
     }
     let interval = blow_interval_s(blow.rate_bpm, opts.sample_rate)?;
+    // The train is one run chained: the same time bound as a single run
+    // ([`integrate::check_cost`]) over its whole simulated time `N · T`.
+    if let Some((rate, what)) = integrate::fastest_rate(sys) {
+        let periods = blow.blows as f64 * interval * rate / (2.0 * std::f64::consts::PI);
+        if periods > integrate::MAX_PERIODS {
+            return Err(Error::invalid(
+                "blows",
+                format!(
+                    "{} blows of {interval} s would span {periods:.2e} periods of the fastest \
+                     time scale (2π/{rate:.3e} s, set by {what}); the limit is {:e}. Reduce the \
+                     number of blows (--blows) to at most {}",
+                    blow.blows,
+                    integrate::MAX_PERIODS,
+                    (integrate::MAX_PERIODS * 2.0 * std::f64::consts::PI / (rate * interval))
+                        .floor()
+                ),
+            ));
+        }
+    }
+    {
+        let per_blow_samples = if record {
+            super::energy::sample_count(interval, opts.sample_rate)
+        } else {
+            0.0
+        };
+        crate::limits::check_memory(
+            &format!(
+                "a train of {} blows ({} B per blow{})",
+                blow.blows,
+                train_bytes(sys, 1, keep_solutions),
+                if record {
+                    format!(", and the history of one blow: {per_blow_samples:.3e} samples")
+                } else {
+                    String::new()
+                }
+            ),
+            train_bytes(sys, blow.blows, keep_solutions) + History::bytes_for(per_blow_samples),
+            "blows",
+            "the number of blows (--blows)",
+        )?;
+    }
     let mut o = *opts;
     o.duration = interval;
     let n = sys.n_modes();
@@ -194,9 +309,8 @@ pub fn run_blows(
     };
     let mut x0 = sys.initial_state();
     let mut reports = Vec::with_capacity(blow.blows);
-    let mut history = record.then(History::default);
     let mut dissipated_before = 0.0;
-    let mut solutions = Vec::with_capacity(blow.blows);
+    let mut solutions = Vec::with_capacity(if keep_solutions { blow.blows } else { 0 });
     for k in 0..blow.blows {
         let t0 = k as f64 * interval;
         // Energies at the strike, in the mode the contacts are in (overlap > 0 = closed).
@@ -249,16 +363,20 @@ pub fn run_blows(
             peak_contact_force_slider_bed_n: end
                 .map_or(sol.totals.peak_force(0), |c| c.totals.peak_force(0)),
         });
-        if let Some(h) = history.as_mut() {
+        if let Some(sink) = on_history.as_mut() {
             // The recorder counts dissipation as E_s− − Σ stored; add what was stored at the
             // strike besides the fresh slider, and what earlier blows dissipated.
             let offset = e0.total() - e_s + dissipated_before;
-            append(h, rec.history, t0, k > 0, offset);
+            let mut h = History::default();
+            append(&mut h, std::mem::take(&mut rec.history), t0, k > 0, offset);
+            sink(&h)?;
         }
         dissipated_before += sol.totals.dissipated;
         // The next strike: same structure and damper state, a fresh slider touching the bed.
         x0 = sol.x_final.clone();
-        solutions.push(sol);
+        if keep_solutions {
+            solutions.push(sol);
+        }
         let phi_b = &sys.points.bed_contact;
         x0[sys.slider_index()] = dot(phi_b, &x0[..n]);
         x0[nd + sys.slider_index()] = sys.slider.velocity;
@@ -269,9 +387,16 @@ pub fn run_blows(
         blows: reports,
         steady,
         damper_gap_at_next_strike_m: damper_gap(&x0),
-        history,
+        history: None,
         solutions,
     })
+}
+
+/// Appends the samples of `b` (already shifted) to `h`.
+fn extend(h: &mut History, b: &History) {
+    for i in 0..b.time_s.len() {
+        h.push_row(&b.row(i));
+    }
 }
 
 /// Appends the samples of one blow, shifted by `t0`; the first sample of a later blow

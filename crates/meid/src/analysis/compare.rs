@@ -441,6 +441,35 @@ impl Comparison {
         Ok(fs)
     }
 
+    /// Refuses a comparison whose histories would not fit [`crate::limits::max_memory`]:
+    /// every case holds its record, `samples = ⌊T_record · f_s⌋ + 1` samples of
+    /// [`super::energy::HISTORY_SAMPLE_BYTES`] (`T_record = duration_s`, or `blows · 60/rate`),
+    /// plus, on the FFT path, the zero-padded complex transforms of two channels (≤ 4 × 16 B
+    /// per sample each).
+    fn check_memory(&self, fs: f64) -> Result<()> {
+        let o = &self.options;
+        let record_s = if o.blows > 1 {
+            o.blows as f64 * 60.0 / o.rate_bpm
+        } else {
+            o.duration_s
+        };
+        let samples = super::energy::sample_count(record_s, Some(fs));
+        let per_sample = super::energy::HISTORY_SAMPLE_BYTES
+            + if o.spectrum == SpectrumMethod::Fft {
+                2.0 * 4.0 * 16.0
+            } else {
+                0.0
+            };
+        let cases = self.cases().len();
+        crate::limits::check_memory(
+            &format!("the records of {cases} cases ({samples:.3e} samples × {per_sample} B each)"),
+            cases as f64 * samples * per_sample,
+            if o.blows > 1 { "blows" } else { "duration" },
+            "the record length (--duration, or --blows at --rate-bpm) or \
+             simulation.sample_rate (--rate)",
+        )
+    }
+
     /// The modes levels are read at: the reference mode and the elastic mode with the largest
     /// `|ψ(O_b)|·|ψ(B)|`, or the user's frequencies.
     fn mode_specs(&self, bare: &ImpactSystem) -> Vec<ModeSpec> {
@@ -496,6 +525,7 @@ impl Comparison {
                 "the model has neither [damper] nor [added_mass]: nothing to compare with",
             ));
         }
+        self.check_memory(fs)?;
         let bare = self.model.impact_system(Case::NoDamper)?;
         let specs = self.mode_specs(&bare);
         if specs.is_empty() {

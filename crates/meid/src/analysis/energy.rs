@@ -106,58 +106,222 @@ pub struct History {
     pub dissipated_j: Vec<f64>,
 }
 
+impl History {
+    /// Sample `i` in [`crate::io::HISTORY_COLUMNS`] order (the last value is Eq. (24),
+    /// `KE_p + PE_p + dissipated`).
+    pub fn row(&self, i: usize) -> [f64; 21] {
+        let e = &self.energy[i];
+        [
+            self.time_s[i],
+            self.bed_displacement_m[i],
+            self.bed_velocity_m_per_s[i],
+            self.bed_acceleration_m_per_s2[i],
+            self.floor_force_n[i],
+            self.contact_force_slider_bed_n[i],
+            self.contact_force_bed_damper_n[i],
+            self.damper_force_n[i],
+            self.slider_displacement_m[i],
+            self.slider_velocity_m_per_s[i],
+            self.damper_displacement_m[i],
+            self.damper_velocity_m_per_s[i],
+            e.ke_slider,
+            e.pe_slider_contact,
+            e.ke_machine,
+            e.pe_machine,
+            e.ke_damper,
+            e.pe_damper_spring,
+            e.pe_damper_contact,
+            self.dissipated_j[i],
+            e.ke_machine + e.pe_machine + self.dissipated_j[i],
+        ]
+    }
+
+    /// Reserves room for `samples` more samples in every series.
+    pub fn reserve(&mut self, samples: usize) {
+        for v in [
+            &mut self.time_s,
+            &mut self.bed_displacement_m,
+            &mut self.bed_velocity_m_per_s,
+            &mut self.bed_acceleration_m_per_s2,
+            &mut self.floor_force_n,
+            &mut self.contact_force_slider_bed_n,
+            &mut self.contact_force_bed_damper_n,
+            &mut self.damper_force_n,
+            &mut self.slider_displacement_m,
+            &mut self.slider_velocity_m_per_s,
+            &mut self.damper_displacement_m,
+            &mut self.damper_velocity_m_per_s,
+            &mut self.dissipated_j,
+        ] {
+            v.reserve(samples);
+        }
+        self.energy.reserve(samples);
+    }
+
+    /// Appends one sample given as [`Self::row`] returns it.
+    pub fn push_row(&mut self, r: &[f64; 21]) {
+        self.time_s.push(r[0]);
+        self.bed_displacement_m.push(r[1]);
+        self.bed_velocity_m_per_s.push(r[2]);
+        self.bed_acceleration_m_per_s2.push(r[3]);
+        self.floor_force_n.push(r[4]);
+        self.contact_force_slider_bed_n.push(r[5]);
+        self.contact_force_bed_damper_n.push(r[6]);
+        self.damper_force_n.push(r[7]);
+        self.slider_displacement_m.push(r[8]);
+        self.slider_velocity_m_per_s.push(r[9]);
+        self.damper_displacement_m.push(r[10]);
+        self.damper_velocity_m_per_s.push(r[11]);
+        self.energy.push(EnergyTerms {
+            ke_slider: r[12],
+            pe_slider_contact: r[13],
+            ke_machine: r[14],
+            pe_machine: r[15],
+            ke_damper: r[16],
+            pe_damper_spring: r[17],
+            pe_damper_contact: r[18],
+        });
+        self.dissipated_j.push(r[19]);
+    }
+
+    /// Bytes a history of `samples` samples holds in memory (20 `f64` per sample), for
+    /// estimates ([`crate::limits`]).
+    pub fn bytes_for(samples: f64) -> f64 {
+        samples * HISTORY_SAMPLE_BYTES
+    }
+}
+
+/// Memory of one sample of a [`History`]: 13 `f64` series and the 7 energy terms.
+pub const HISTORY_SAMPLE_BYTES: f64 = 20.0 * 8.0;
+
+/// The samples a run of `duration` s at `rate` Hz records: `⌊duration · rate⌋ + 1`.
+pub fn sample_count(duration_s: f64, rate_hz: Option<f64>) -> f64 {
+    match rate_hz {
+        Some(r) => (duration_s * r).floor() + 1.0,
+        None => 0.0,
+    }
+}
+
+/// Evaluates the history's quantities of one sample (see [`History::row`]).
+struct Sampler<'a> {
+    sys: &'a ImpactSystem,
+    map: ChannelMap,
+    e_in: f64,
+}
+
+impl<'a> Sampler<'a> {
+    fn new(sys: &'a ImpactSystem) -> Self {
+        Sampler {
+            sys,
+            map: ChannelMap::new(sys),
+            e_in: 0.5 * sys.slider.mass * sys.slider.velocity.powi(2),
+        }
+    }
+
+    fn row(&self, t: f64, x: &[f64], mode: Mode) -> [f64; 21] {
+        let sys = self.sys;
+        let nd = sys.dofs();
+        let v = self.map.values(sys, mode, x);
+        let ch = |c: Channel| v[c.index()];
+        let (zd, vd) = if sys.damper.is_some() {
+            (x[sys.damper_index()], x[nd + sys.damper_index()])
+        } else {
+            (0.0, 0.0)
+        };
+        let e = EnergyTerms::at(sys, mode, x);
+        let dissipated = self.e_in - e.total();
+        [
+            t,
+            ch(Channel::BedDisplacement),
+            ch(Channel::BedVelocity),
+            ch(Channel::BedAcceleration),
+            ch(Channel::FloorForce),
+            ch(Channel::ContactSliderBed),
+            ch(Channel::ContactBedDamper),
+            ch(Channel::DamperSpring) + ch(Channel::DamperDashpot),
+            x[sys.slider_index()],
+            x[nd + sys.slider_index()],
+            zd,
+            vd,
+            e.ke_slider,
+            e.pe_slider_contact,
+            e.ke_machine,
+            e.pe_machine,
+            e.ke_damper,
+            e.pe_damper_spring,
+            e.pe_damper_contact,
+            dissipated,
+            e.ke_machine + e.pe_machine + dissipated,
+        ]
+    }
+}
+
 /// Observer that records the histories on the output grid. Peaks do not come from here: the
 /// integrators locate them on the continuous solution ([`crate::integrate::peaks`]).
 pub struct Recorder<'a> {
-    sys: &'a ImpactSystem,
-    map: ChannelMap,
+    sampler: Sampler<'a>,
     pub history: History,
-    e_in: f64,
 }
 
 impl<'a> Recorder<'a> {
     pub fn new(sys: &'a ImpactSystem) -> Self {
-        let e_in = 0.5 * sys.slider.mass * sys.slider.velocity.powi(2);
         Recorder {
-            sys,
-            map: ChannelMap::new(sys),
+            sampler: Sampler::new(sys),
             history: History::default(),
-            e_in,
         }
     }
 }
 
 impl Observer for Recorder<'_> {
     fn sample(&mut self, t: f64, x: &[f64], mode: Mode) {
-        let sys = self.sys;
-        let nd = sys.dofs();
-        let v = self.map.values(sys, mode, x);
-        let ch = |c: Channel| v[c.index()];
-        let h = &mut self.history;
-        h.time_s.push(t);
-        h.bed_displacement_m.push(ch(Channel::BedDisplacement));
-        h.bed_velocity_m_per_s.push(ch(Channel::BedVelocity));
-        h.bed_acceleration_m_per_s2
-            .push(ch(Channel::BedAcceleration));
-        h.floor_force_n.push(ch(Channel::FloorForce));
-        h.contact_force_slider_bed_n
-            .push(ch(Channel::ContactSliderBed));
-        h.contact_force_bed_damper_n
-            .push(ch(Channel::ContactBedDamper));
-        h.damper_force_n
-            .push(ch(Channel::DamperSpring) + ch(Channel::DamperDashpot));
-        h.slider_displacement_m.push(x[sys.slider_index()]);
-        h.slider_velocity_m_per_s.push(x[nd + sys.slider_index()]);
-        let (zd, vd) = if sys.damper.is_some() {
-            (x[sys.damper_index()], x[nd + sys.damper_index()])
-        } else {
-            (0.0, 0.0)
-        };
-        h.damper_displacement_m.push(zd);
-        h.damper_velocity_m_per_s.push(vd);
-        let e = EnergyTerms::at(sys, mode, x);
-        h.dissipated_j.push(self.e_in - e.total());
-        h.energy.push(e);
+        let r = self.sampler.row(t, x, mode);
+        self.history.push_row(&r);
+    }
+}
+
+/// Observer that writes each sample straight to a CSV writer ([`crate::io::HistoryWriter`]):
+/// a history of any length in constant memory, byte for byte what
+/// [`crate::io::history_csv`] of the recorded [`History`] would be. The first write error
+/// stops the writing and is returned by [`Self::finish`].
+pub struct StreamRecorder<'a, W: std::io::Write> {
+    sampler: Sampler<'a>,
+    out: crate::io::HistoryWriter<W>,
+    error: Option<std::io::Error>,
+}
+
+impl<'a, W: std::io::Write> StreamRecorder<'a, W> {
+    /// Writes the header to `out`.
+    pub fn new(sys: &'a ImpactSystem, out: W) -> std::io::Result<Self> {
+        Ok(StreamRecorder {
+            sampler: Sampler::new(sys),
+            out: crate::io::HistoryWriter::new(out)?,
+            error: None,
+        })
+    }
+
+    /// Rows written.
+    pub fn rows(&self) -> u64 {
+        self.out.rows()
+    }
+
+    /// The writer back, or the first write error.
+    pub fn finish(self) -> std::io::Result<W> {
+        match self.error {
+            Some(e) => Err(e),
+            None => self.out.into_inner(),
+        }
+    }
+}
+
+impl<W: std::io::Write> Observer for StreamRecorder<'_, W> {
+    fn sample(&mut self, t: f64, x: &[f64], mode: Mode) {
+        if self.error.is_some() {
+            return;
+        }
+        let r = self.sampler.row(t, x, mode);
+        if let Err(e) = self.out.row(&r) {
+            self.error = Some(e);
+        }
     }
 }
 
@@ -349,20 +513,53 @@ pub struct Run {
     pub solution: Solution,
 }
 
-/// Simulates `sys`, records histories when `record` is true, and summarises.
+/// Simulates `sys`, records histories when `record` is true, and summarises. The history is
+/// held in memory: its estimate (`samples ×` [`HISTORY_SAMPLE_BYTES`]) is checked against
+/// [`crate::limits::max_memory`] first. To write a long history to a file, use
+/// [`simulate_observed`] with a [`StreamRecorder`].
 pub fn simulate(sys: &ImpactSystem, opts: &Options, record: bool) -> Result<Run> {
     let mut rec = Recorder::new(sys);
-    let sol = if record {
-        integrate::solve(sys, opts, &mut rec)?
-    } else {
-        integrate::solve(
+    if record {
+        let n = sample_count(opts.duration, opts.sample_rate);
+        crate::limits::check_memory(
+            &format!("the history ({n:.3e} samples × {HISTORY_SAMPLE_BYTES} B)"),
+            History::bytes_for(n),
+            "simulation.duration",
+            "simulation.duration (--duration) or simulation.sample_rate (--rate), or write the \
+             history to a file (simulate -o streams it)",
+        )?;
+    }
+    if record {
+        // Exactly the estimate checked above: no doubling growth of the series.
+        rec.history
+            .reserve(sample_count(opts.duration, opts.sample_rate) as usize + 2);
+    }
+    let (summary, solution) = simulate_observed(sys, opts, record.then_some(&mut rec as _))?;
+    let history = if record { Some(rec.history) } else { None };
+    Ok(Run {
+        summary,
+        history,
+        solution,
+    })
+}
+
+/// Simulates `sys` and summarises; `obs` (when given) receives the samples of
+/// `opts.sample_rate` (without it, no sample is computed).
+pub fn simulate_observed(
+    sys: &ImpactSystem,
+    opts: &Options,
+    obs: Option<&mut dyn Observer>,
+) -> Result<(Summary, Solution)> {
+    let sol = match obs {
+        Some(o) => integrate::solve(sys, opts, o)?,
+        None => integrate::solve(
             sys,
             &Options {
                 sample_rate: None,
                 ..*opts
             },
-            &mut rec,
-        )?
+            &mut integrate::NoOutput,
+        )?,
     };
     let nd = sys.dofs();
     let e_in = 0.5 * sys.slider.mass * sys.slider.velocity.powi(2);
@@ -418,10 +615,5 @@ pub fn simulate(sys: &ImpactSystem, opts: &Options, record: bool) -> Result<Run>
         switching_events: sol.events.len(),
         steps: sol.steps,
     };
-    let history = if record { Some(rec.history) } else { None };
-    Ok(Run {
-        summary,
-        history,
-        solution: sol,
-    })
+    Ok((summary, sol))
 }

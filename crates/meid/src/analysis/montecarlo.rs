@@ -300,6 +300,17 @@ impl MonteCarlo {
         Ok(metrics_of(&run.summary))
     }
 
+    /// Memory one sample takes in the study and its outputs (bytes): the result record with
+    /// its drawn inputs, a copy of each value for the statistics (sorted), and its row of
+    /// `samples.csv` (≤ 24 characters per value).
+    pub fn bytes_per_sample(&self) -> f64 {
+        let values = (self.inputs.len() + METRICS.len()) as f64;
+        std::mem::size_of::<(Sample, Option<Error>)>() as f64
+            + 8.0 * self.inputs.len() as f64
+            + 16.0
+            + 24.0 * values
+    }
+
     /// Runs every sample in parallel on the current rayon pool; results in sample order.
     pub fn run(&self) -> Result<MonteCarloResult> {
         if self.samples == 0 {
@@ -329,6 +340,16 @@ impl MonteCarlo {
                 });
             }
         }
+        crate::limits::check_memory(
+            &format!(
+                "{} Monte Carlo samples ({} B each)",
+                self.samples,
+                self.bytes_per_sample()
+            ),
+            self.samples as f64 * self.bytes_per_sample(),
+            "samples",
+            "the number of samples (--samples)",
+        )?;
         let runs: Vec<(Sample, Option<Error>)> = (0..self.samples)
             .into_par_iter()
             .map(|i| {

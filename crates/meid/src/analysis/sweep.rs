@@ -233,6 +233,12 @@ impl Vary {
                     format!("`{spec}`: a log range needs A > 0 (got {a})"),
                 ));
             }
+            crate::limits::check_memory(
+                &format!("`{spec}`: {n} values (8 B each)"),
+                8.0 * n as f64,
+                "vary",
+                "the count N of the range",
+            )?;
             let values: Vec<f64> = (0..n)
                 .map(|i| {
                     let t = i as f64 / (n - 1) as f64;
@@ -451,6 +457,14 @@ impl Sweep {
                 ));
             }
         }
+        let points: f64 = self.vary.iter().map(|v| v.values.len() as f64).product();
+        let per_point = self.bytes_per_point();
+        crate::limits::check_memory(
+            &format!("the grid of {points:.3e} points ({per_point} B each)"),
+            points * per_point,
+            "vary",
+            "the counts of the --vary ranges",
+        )?;
         let qs: Vec<&Quantity> = self.vary.iter().map(|v| &v.quantity).collect();
         let m_b = self.bed_mass_kg.or_else(|| self.model.bed_mass());
         check_quantities(&self.model, &qs, m_b)?;
@@ -483,6 +497,16 @@ impl Sweep {
             &format!("all {} points of the sweep failed", result.points.len()),
             &format!("point {}", first.index),
         ))
+    }
+
+    /// Memory one grid point takes (bytes): its [`PointResult`] (values, derived quantities,
+    /// metrics) and its text in `sweep.csv` and `sweep.json`, each ≤ 24 characters per column.
+    pub fn bytes_per_point(&self) -> f64 {
+        let columns = (self.vary.len() + DERIVED.len() + METRICS.len() + 2) as f64;
+        std::mem::size_of::<PointResult>() as f64
+            + 8.0 * (self.vary.len() + DERIVED.len()) as f64
+            + 16.0 * METRICS.len() as f64
+            + 2.0 * 24.0 * columns
     }
 
     /// Number of grid points.
@@ -675,7 +699,19 @@ impl Sweep {
         if resume {
             if let Ok(bytes) = std::fs::read(journal) {
                 let text = String::from_utf8_lossy(&bytes);
-                if !text.starts_with(&first) {
+                // A journal without a finished point (empty, or cut within its first two
+                // lines, whichever sweep wrote them) holds nothing to resume: start afresh.
+                let lines = text
+                    .split_inclusive('\n')
+                    .filter(|l| l.ends_with('\n'))
+                    .count();
+                let nothing = lines <= 2
+                    && (text.is_empty()
+                        || text.starts_with("# meid sweep journal")
+                        || format!("{first}{header}").starts_with(&*text));
+                if nothing {
+                    // Falls through with valid_prefix = 0: a fresh journal.
+                } else if !text.starts_with(&first) {
                     return Err(Error::invalid(
                         "resume",
                         format!(
@@ -683,27 +719,28 @@ impl Sweep {
                             journal.display()
                         ),
                     ));
-                }
-                let mut offset = first.len();
-                let body = &text[first.len()..];
-                for line in body.split_inclusive('\n') {
-                    if !line.ends_with('\n') {
-                        break; // truncated by an interruption
-                    }
-                    if line == header {
-                        offset += line.len();
-                        continue;
-                    }
-                    match self.parse_row(line.trim_end_matches('\n')) {
-                        Some(r) if r.index < total => {
-                            let i = r.index;
-                            known[i] = Some(r);
+                } else {
+                    let mut offset = first.len();
+                    let body = &text[first.len()..];
+                    for line in body.split_inclusive('\n') {
+                        if !line.ends_with('\n') {
+                            break; // truncated by an interruption
                         }
-                        _ => break,
+                        if line == header {
+                            offset += line.len();
+                            continue;
+                        }
+                        match self.parse_row(line.trim_end_matches('\n')) {
+                            Some(r) if r.index < total => {
+                                let i = r.index;
+                                known[i] = Some(r);
+                            }
+                            _ => break,
+                        }
+                        offset += line.len();
                     }
-                    offset += line.len();
+                    valid_prefix = offset;
                 }
-                valid_prefix = offset;
             }
         }
         // (Re)write the journal: the kept prefix, or a fresh header.

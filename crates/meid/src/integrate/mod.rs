@@ -247,6 +247,29 @@ pub const MAX_PERIODS: f64 = 1e7;
 /// would take hours (a 1e20 N/m contact on a 3.5 kg damper is a 1.2 ns period: 4e8 of them in
 /// 0.5 s); it is refused with the field responsible.
 pub fn check_cost(sys: &ImpactSystem, opts: &Options) -> Result<()> {
+    let Some((rate, what)) = fastest_rate(sys) else {
+        return Ok(());
+    };
+    let periods = opts.duration * rate / (2.0 * std::f64::consts::PI);
+    if periods > MAX_PERIODS {
+        return Err(Error::invalid(
+            "simulation.duration",
+            format!(
+                "the run would span {periods:.2e} periods of its fastest time scale \
+                 (2π/{rate:.3e} s, set by {what}); the limit is {MAX_PERIODS:e}. Lower that \
+                 stiffness or damping (a contact 1e3 times stiffer than the structure already \
+                 acts as rigid), raise the mass, or shorten simulation.duration \
+                 ({:e} s)",
+                opts.duration
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The fastest time scale of `sys` (rad/s) and what sets it (see [`check_cost`]); `None` when
+/// no rate is finite.
+pub fn fastest_rate(sys: &ImpactSystem) -> Option<(f64, String)> {
     let mut rates: Vec<(f64, String)> = Vec::new();
     let w_max = sys
         .structure
@@ -289,28 +312,10 @@ pub fn check_cost(sys: &ImpactSystem, opts: &Options) -> Result<()> {
             ),
         ));
     }
-    let Some((rate, what)) = rates
+    rates
         .into_iter()
         .filter(|(r, _)| r.is_finite())
         .max_by(|a, b| a.0.total_cmp(&b.0))
-    else {
-        return Ok(());
-    };
-    let periods = opts.duration * rate / (2.0 * std::f64::consts::PI);
-    if periods > MAX_PERIODS {
-        return Err(Error::invalid(
-            "simulation.duration",
-            format!(
-                "the run would span {periods:.2e} periods of its fastest time scale \
-                 (2π/{rate:.3e} s, set by {what}); the limit is {MAX_PERIODS:e}. Lower that \
-                 stiffness or damping (a contact 1e3 times stiffer than the structure already \
-                 acts as rigid), raise the mass, or shorten simulation.duration \
-                 ({:e} s)",
-                opts.duration
-            ),
-        ));
-    }
-    Ok(())
 }
 
 /// Output grid helper: sample `j` is at `j / rate`.

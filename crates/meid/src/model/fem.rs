@@ -683,6 +683,14 @@ pub fn solve_modes(
     });
     match solver {
         SolverSpec::Dense => {
+            // K, M, the shift-inverted product, its eigenvectors and the shapes: five dense
+            // n × n matrices of f64.
+            crate::limits::check_memory(
+                &format!("the dense eigen-solver ({n} DOFs: 5 × {n}² × 8 B)"),
+                5.0 * 8.0 * (n as f64).powi(2),
+                "structure.fem.solver",
+                "the mesh, or use solver = \"lanczos\" (the lowest modes only)",
+            )?;
             let mut modes = model.solve_dense()?;
             let keep = count.min(n);
             modes.eigenvalues.truncate(keep);
