@@ -27,10 +27,9 @@ pub mod fem;
 mod lumped;
 pub mod source;
 pub mod spec;
+pub mod strict;
 
 use std::path::Path;
-
-use serde::Deserialize;
 
 pub use source::Source;
 pub use spec::*;
@@ -41,6 +40,10 @@ use crate::impact::{
 use crate::integrate::{Method, Options};
 use crate::modal::ModalModel;
 use crate::{Error, Result};
+
+/// The largest blow energy `½ m_s v_s²` (J) a model may have (see [`Model::from_text`]'s
+/// checks): far above any forging machine's (~1e6 J), far below double precision's 1.8e308.
+pub const MAX_BLOW_ENERGY_J: f64 = 1e100;
 
 /// A validated model: the spec, the structure reduced to modes, and where it came from.
 #[derive(Debug, Clone)]
@@ -104,8 +107,7 @@ impl Model {
         // 1. The file as written: syntax, unknown keys and types, with positions.
         let mut table: toml::Table =
             toml::from_str(&text).map_err(|e| source::toml_error(name, &text, &e))?;
-        let from_file: ModelSpec =
-            toml::from_str(&text).map_err(|e| source::toml_error(name, &text, &e))?;
+        let from_file: ModelSpec = spec_from_text(name, &text)?;
         let mut src = Source {
             name: name.to_string(),
             text,
@@ -119,21 +121,7 @@ impl Model {
                 let applied = source::apply_override(&mut table, o)?;
                 src.overrides.push(applied);
             }
-            ModelSpec::deserialize(toml::Value::Table(table)).map_err(|e| {
-                let list: Vec<String> = src
-                    .overrides
-                    .iter()
-                    .map(|(p, v)| format!("--set {p}={v}"))
-                    .collect();
-                let mut message = e.message().trim().to_string();
-                if let Some(h) = source::did_you_mean(&message) {
-                    message.push_str(&h);
-                }
-                Error::Input {
-                    location: list.join(" "),
-                    message,
-                }
-            })?
+            spec_from_table(table, &src)?
         };
         // 3. Values.
         let structure = build(&spec, &src)?;
@@ -220,6 +208,16 @@ impl Model {
                     ),
                 ));
             }
+        }
+        let (m_s, v_s) = (s.slider.mass, s.slider.velocity);
+        let e_s = 0.5 * m_s * v_s * v_s;
+        if m_s.is_finite() && v_s.is_finite() && m_s > 0.0 && !(e_s <= MAX_BLOW_ENERGY_J) {
+            return Err(src.error(
+                "slider.velocity",
+                format!(
+                    "slider.mass = {m_s} kg and slider.velocity = {v_s} m/s strike with ½ m_s v_s² = {e_s:e} J; meid takes at most {MAX_BLOW_ENERGY_J:e} J (the largest forging hammers strike with ~1e6 J), so that the energies, powers and their products in the energy balance stay far from double precision's limit 1.8e308"
+                ),
+            ));
         }
         let sim = &s.simulation;
         for (field, v, unit) in [
@@ -408,6 +406,41 @@ impl Model {
         }
         None
     }
+}
+
+/// Reads a model file's text strictly ([`strict`]): errors name the file, line, column and
+/// field, in the model's terms.
+pub fn spec_from_text(name: &str, text: &str) -> Result<ModelSpec> {
+    let de = toml::de::Deserializer::parse(text).map_err(|e| source::toml_error(name, text, &e))?;
+    strict::deserialize(de).map_err(|(e, track)| {
+        source::toml_error_message(name, text, &e, strict::message(e.message(), &track))
+    })
+}
+
+/// Reads a model table (the file with `--set` overrides applied) strictly ([`strict`]):
+/// errors name the `--set` that set the failing field (all of them when none did) and the
+/// field.
+pub fn spec_from_table(table: toml::Table, src: &Source) -> Result<ModelSpec> {
+    strict::deserialize(toml::Value::Table(table)).map_err(|(e, track)| {
+        let message = strict::message(e.message(), &track);
+        let path = track.path.unwrap_or_default();
+        let own: Vec<String> = src
+            .overrides
+            .iter()
+            .filter(|(p, _)| source::path_within(&path, p) || source::path_within(p, &path))
+            .map(|(p, v)| format!("--set {p}={v}"))
+            .collect();
+        let location = if own.is_empty() {
+            src.overrides
+                .iter()
+                .map(|(p, v)| format!("--set {p}={v}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        } else {
+            own.join(" ")
+        };
+        Error::Input { location, message }
+    })
 }
 
 fn contact(c: &ContactSpec) -> Result<Contact> {
