@@ -436,9 +436,12 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
                 }
                 let matches: Vec<_> = grounded.iter().filter(|g| &g.0.name == name).collect();
                 if matches.is_empty() {
-                    let known: Vec<&str> = grounded.iter().map(|g| g.0.name.as_str()).collect();
+                    let known: Vec<String> = grounded
+                        .iter()
+                        .map(|g| format!("'{}' ({})", g.0.name, g.0.path))
+                        .collect();
                     let path = format!("{base}.floor[{fi}]");
-                    return Err(src.error(&path, format!("{path}: '{name}' is not a spring or dashpot attached to ground; valid: {}", known.join(", "))));
+                    return Err(src.error(&path, format!("{path}: '{name}' is not a spring or dashpot attached to ground; valid: {} (an element without `name` is called springs[i] or dashpots[i])", known.join(", "))));
                 }
                 out.extend(matches);
             }

@@ -45,6 +45,65 @@ use crate::{Error, Result};
 /// checks): far above any forging machine's (~1e6 J), far below double precision's 1.8e308.
 pub const MAX_BLOW_ENERGY_J: f64 = 1e100;
 
+/// The magnitudes a model's real numbers may have: 0, or between [`MIN_MAGNITUDE`] and
+/// [`MAX_MAGNITUDE`] (SI units). meid multiplies inputs together (a stiffness by a squared
+/// length, E t³, m v², k/m ...): with every input inside 1e-100..1e100, products of up to three
+/// of them stay inside double precision's normal range 2.2e-308..1.8e308; a mass or a
+/// thickness of 1e-308, or a length of 1e308, would not.
+pub const MAX_MAGNITUDE: f64 = 1e100;
+/// See [`MAX_MAGNITUDE`].
+pub const MIN_MAGNITUDE: f64 = 1e-100;
+
+/// Every finite real number of the model (file and overrides) is 0 or within
+/// [`MIN_MAGNITUDE`]..=[`MAX_MAGNITUDE`] in magnitude; the first that is not is an error
+/// naming its field. NaN and infinities are left to each field's own check (which says what
+/// the field takes).
+fn check_magnitudes(spec: &ModelSpec, src: &Source) -> Result<()> {
+    fn walk(v: &toml::Value, path: &str, out: &mut Option<(String, f64)>) {
+        if out.is_some() {
+            return;
+        }
+        match v {
+            toml::Value::Float(x) => {
+                let a = x.abs();
+                if x.is_finite() && a != 0.0 && !(MIN_MAGNITUDE..=MAX_MAGNITUDE).contains(&a) {
+                    *out = Some((path.to_string(), *x));
+                }
+            }
+            toml::Value::Array(items) => {
+                for (i, item) in items.iter().enumerate() {
+                    walk(item, &format!("{path}[{i}]"), out);
+                }
+            }
+            toml::Value::Table(t) => {
+                for (k, item) in t {
+                    let p = if path.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{path}.{k}")
+                    };
+                    walk(item, &p, out);
+                }
+            }
+            _ => {}
+        }
+    }
+    let Ok(table) = toml::Table::try_from(spec) else {
+        return Ok(());
+    };
+    let mut found = None;
+    walk(&toml::Value::Table(table), "", &mut found);
+    match found {
+        Some((path, x)) => Err(src.error(
+            &path,
+            format!(
+                "{path} = {x:e} is out of the range meid computes with: give 0 or a magnitude between {MIN_MAGNITUDE:e} and {MAX_MAGNITUDE:e} (SI units; products of a few inputs must stay inside double precision, 2.2e-308 to 1.8e308)"
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// A validated model: the spec, the structure reduced to modes, and where it came from.
 #[derive(Debug, Clone)]
 pub struct Model {
@@ -124,6 +183,7 @@ impl Model {
             spec_from_table(table, &src)?
         };
         // 3. Values.
+        check_magnitudes(&spec, &src)?;
         let structure = build(&spec, &src)?;
         let model = Model {
             spec,
@@ -209,6 +269,7 @@ impl Model {
                 ));
             }
         }
+        check_magnitudes(s, src)?;
         let (m_s, v_s) = (s.slider.mass, s.slider.velocity);
         let e_s = 0.5 * m_s * v_s * v_s;
         if m_s.is_finite() && v_s.is_finite() && m_s > 0.0 && !(e_s <= MAX_BLOW_ENERGY_J) {

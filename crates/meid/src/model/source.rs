@@ -24,7 +24,7 @@ impl Source {
             .overrides
             .iter()
             .rev()
-            .find(|(p, _)| path == p || path.starts_with(&format!("{p}.")))
+            .find(|(p, _)| path_within(path, p))
         {
             return format!("--set {p}={v}");
         }
