@@ -7,7 +7,7 @@
 //! a message that does not name the field, a run longer than [`TIMEOUT`]) is a defect.
 //!
 //! By default (CI) a deterministic sample runs: every mutation whose index is a multiple of
-//! [`STRIDE`] (offset 0), about a fifth of the whole. `MEID_MUTATIONS=all` runs them all.
+//! [`STRIDE`] (offset 0), half of the whole (≈ 20 s on 2 cores; the whole suite, 841 mutations, ≈ 40 s). `MEID_MUTATIONS=all` runs them all.
 //! Each mutant's simulated time is cut to [`DURATION_S`] (unless the mutation is to
 //! `simulation.duration` itself), so the run's cost is the model's build, not its length.
 //!
@@ -29,7 +29,7 @@ use toml::{Table, Value};
 /// Simulated time of every mutant (s).
 const DURATION_S: f64 = 0.01;
 /// The default sample: every STRIDE-th mutation.
-const STRIDE: usize = 5;
+const STRIDE: usize = 2;
 /// A mutant running longer than this is a defect (a hang).
 const TIMEOUT: Duration = Duration::from_secs(120);
 
