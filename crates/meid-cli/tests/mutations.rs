@@ -99,20 +99,20 @@ fn number_values() -> Vec<Value> {
 }
 
 /// Every mutation of `v` at `segs` and below.
-fn walk(example: &'static str, v: &Value, segs: &mut Vec<Seg>, out: &mut Vec<(Vec<Seg>, Change)>) {
+fn walk(v: &Value, segs: &mut Vec<Seg>, out: &mut Vec<(Vec<Seg>, Change)>) {
     match v {
         Value::Table(t) => {
             for (k, child) in t {
                 segs.push(Seg::Key(k.clone()));
                 out.push((segs.clone(), Change::Delete));
-                walk(example, child, segs, out);
+                walk(child, segs, out);
                 segs.pop();
             }
         }
         Value::Array(a) => {
             for (i, child) in a.iter().enumerate() {
                 segs.push(Seg::Index(i));
-                walk(example, child, segs, out);
+                walk(child, segs, out);
                 segs.pop();
             }
         }
@@ -135,7 +135,7 @@ fn all_mutations() -> Vec<(Mutation, Vec<Seg>)> {
     for example in EXAMPLES {
         let table = base_table(example);
         let mut found = Vec::new();
-        walk(example, &Value::Table(table), &mut Vec::new(), &mut found);
+        walk(&Value::Table(table), &mut Vec::new(), &mut found);
         for (segs, change) in found {
             all.push((
                 Mutation {

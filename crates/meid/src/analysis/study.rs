@@ -118,10 +118,10 @@ pub struct OptimizeReport {
     pub point: PointResult,
 }
 
-/// A given bound must lie in its quantity's valid domain: a ratio (`wd/ws`, `md/mb` ...) is
-/// > 0 (a negative w_d/w_s would give the same stiffness m_d w_d² as its opposite); a model
-/// field's bounds must each give a valid model (the model's own checks at LO and at HI, e.g.
-/// `damper.mass` > 0 kg).
+/// A given bound must lie in its quantity's valid domain: a ratio (`wd/ws`, `md/mb` ...) must
+/// be positive (a negative w_d/w_s would give the same stiffness m_d w_d² as its opposite); a
+/// model field's bounds must each give a valid model (the model's own checks at LO and at HI,
+/// e.g. a positive `damper.mass`).
 fn check_bound_domain(
     model: &Model,
     q: &Quantity,

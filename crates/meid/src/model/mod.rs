@@ -272,7 +272,11 @@ impl Model {
         check_magnitudes(s, src)?;
         let (m_s, v_s) = (s.slider.mass, s.slider.velocity);
         let e_s = 0.5 * m_s * v_s * v_s;
-        if m_s.is_finite() && v_s.is_finite() && m_s > 0.0 && !(e_s <= MAX_BLOW_ENERGY_J) {
+        if m_s.is_finite()
+            && v_s.is_finite()
+            && m_s > 0.0
+            && (e_s.is_nan() || e_s > MAX_BLOW_ENERGY_J)
+        {
             return Err(src.error(
                 "slider.velocity",
                 format!(
