@@ -32,7 +32,9 @@ pub struct OptimizeArgs {
     bounds: Vec<String>,
     #[command(flatten)]
     set: SetArgs,
-    /// Simulation budget.
+    /// Simulation budget: at most this many simulations run (the optimum's own run and the
+    /// w_d = w_s comparison included); refused below the method's minimum (12 for one
+    /// variable: a 9-point scan, one Brent step and those two; n + 3 for n variables).
     #[arg(long, value_name = "N", default_value_t = 400)]
     max_simulations: usize,
     /// Print the report as JSON on stdout.
@@ -74,15 +76,21 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
         .iter()
         .map(|s| parse_bounds(s))
         .collect::<Result<Vec<_>>>()?;
-    for (q, _) in &bounds {
+    for (i, (q, _)) in bounds.iter().enumerate() {
         if !over.contains(q) {
             bail!("--bounds for {} which is not in --over", q.name());
+        }
+        if bounds[..i].iter().any(|(p, _)| p == q) {
+            bail!(
+                "--bounds {}: given twice; give each variable's bounds once",
+                q.name()
+            );
         }
     }
     let vars = over
         .into_iter()
         .map(|q| {
-            let b = bounds.iter().rev().find(|(p, _)| *p == q).map(|(_, b)| *b);
+            let b = bounds.iter().find(|(p, _)| *p == q).map(|(_, b)| *b);
             (q, b)
         })
         .collect();

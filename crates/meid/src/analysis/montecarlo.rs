@@ -322,7 +322,13 @@ impl MonteCarlo {
                 "give at least one uncertain input PATH=DIST(a,b)",
             ));
         }
-        for u in &self.inputs {
+        for (i, u) in self.inputs.iter().enumerate() {
+            if self.inputs[..i].iter().any(|w| w.path == u.path) {
+                return Err(Error::Input {
+                    location: format!("--vary {}", u.path),
+                    message: format!("{} is given twice; give each uncertain input once", u.path),
+                });
+            }
             let kind = field_kind(&self.model, &u.path).map_err(|e| match e {
                 Error::Input { message, .. } => Error::Input {
                     location: format!("--vary {}", u.path),

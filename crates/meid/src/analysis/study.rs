@@ -105,7 +105,8 @@ pub struct OptimizeReport {
     pub optimum: Vec<f64>,
     /// The objective there.
     pub objective_value: f64,
-    /// Simulations run (including failed ones).
+    /// Simulations run (including failed ones): the search's, the optimum's own run and the
+    /// w_d = w_s comparison; never more than [`OptimizeStudy::max_simulations`].
     pub simulations: usize,
     pub failures: usize,
     pub converged: bool,
@@ -115,6 +116,53 @@ pub struct OptimizeReport {
     pub objective_at_wd_equal_ws: f64,
     /// The whole point at the optimum (every metric).
     pub point: PointResult,
+}
+
+/// A given bound must lie in its quantity's valid domain: a ratio (`wd/ws`, `md/mb` ...) must
+/// be positive (a negative w_d/w_s would give the same stiffness m_d w_d² as its opposite); a
+/// model field's bounds must each give a valid model (the model's own checks at LO and at HI,
+/// e.g. a positive `damper.mass`).
+fn check_bound_domain(
+    model: &Model,
+    q: &Quantity,
+    lower: f64,
+    upper: f64,
+    bed_mass_kg: Option<f64>,
+) -> Result<()> {
+    let location = format!("--bounds {}={lower}..{upper}", q.name());
+    if !matches!(q, Quantity::Field(_)) {
+        if lower <= 0.0 {
+            return Err(Error::Input {
+                location,
+                message: format!(
+                    "the lower bound {lower} lies outside the domain of the ratio {}: it must be > 0",
+                    q.name()
+                ),
+            });
+        }
+        return Ok(());
+    }
+    for (which, x) in [("lower", lower), ("upper", upper)] {
+        let built = super::sweep::point_model(model, &[q], &[x], bed_mass_kg).and_then(|pm| {
+            pm.model
+                .impact_system(crate::model::Case::AsSpecified)
+                .map(|_| ())
+        });
+        if let Err(e) = built {
+            let why = match e {
+                Error::Input { message, .. } => message,
+                other => other.to_string(),
+            };
+            return Err(Error::Input {
+                location,
+                message: format!(
+                    "the {which} bound {x} lies outside the valid domain of {}: {why}",
+                    q.name()
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The value of a numeric field path (`a.b.c`) of the model spec, if any.
@@ -230,6 +278,9 @@ impl OptimizeStudy {
                     format!("{}: needs finite LO < HI, got {lower}..{upper}", q.name()),
                 ));
             }
+            if b.is_some() {
+                check_bound_domain(&model, q, lower, upper, bed_mass_kg)?;
+            }
             variables.push(Variable {
                 quantity: q.clone(),
                 lower,
@@ -247,6 +298,15 @@ impl OptimizeStudy {
             bed_mass_kg,
             max_simulations: 400,
         })
+    }
+
+    /// The fewest simulations [`OptimizeStudy::run`] can work with: for one variable the
+    /// [`SCAN_POINTS`]-point scan and one Brent step, for n variables one simplex (n + 1
+    /// points); plus, always, the optimum's own run and the w_d = w_s comparison.
+    pub fn min_simulations(&self) -> usize {
+        let n = self.variables.len();
+        let search = if n == 1 { SCAN_POINTS + 1 } else { n + 1 };
+        search + 2
     }
 
     fn value_to_search(&self, k: usize, x: f64) -> f64 {
@@ -288,6 +348,24 @@ impl OptimizeStudy {
     pub fn run(&self) -> Result<OptimizeReport> {
         let metric = self.objective.metric();
         let n = self.variables.len();
+        let min = self.min_simulations();
+        if self.max_simulations < min {
+            return Err(Error::Input {
+                location: format!("--max-simulations {}", self.max_simulations),
+                message: format!(
+                    "{} simulations are too few: with {n} variable{} the search needs at least {min} ({}, the optimum's own run and the w_d = w_s comparison)",
+                    self.max_simulations,
+                    if n == 1 { "" } else { "s" },
+                    if n == 1 {
+                        format!("a {SCAN_POINTS}-point scan and one Brent step")
+                    } else {
+                        format!("one simplex of {} points", n + 1)
+                    }
+                ),
+            });
+        }
+        // The search's share of the budget: the optimum's run and the comparison come after.
+        let search_budget = self.max_simulations - 2;
         let f = |u: &[f64]| -> f64 {
             let x: Vec<f64> = (0..n).map(|k| self.search_to_value(k, u[k])).collect();
             self.evaluate(&x).metric(metric)
@@ -320,7 +398,7 @@ impl OptimizeStudy {
             let opts = BrentOptions {
                 x_tolerance: 1e-6 * (hi[0] - lo[0]),
                 relative_tolerance: 1e-8,
-                max_evaluations: self.max_simulations.saturating_sub(m).max(10),
+                max_evaluations: search_budget - m,
             };
             let r = brent_minimize(|u| f(&[u]), a, b, &opts)?;
             let (u, _) = if r.f <= vals[ib] {
@@ -351,7 +429,7 @@ impl OptimizeStudy {
                 initial_step: 0.2,
                 x_tolerance: 1e-5,
                 f_tolerance: 1e-9,
-                max_evaluations: self.max_simulations,
+                max_evaluations: search_budget,
                 max_restarts: 5,
                 random_starts: 2,
                 seed: 4,
@@ -390,10 +468,12 @@ impl OptimizeStudy {
         let wd = Quantity::WdOverWs;
         qs.push(&wd);
         vals.push(1.0);
-        let rule = if self.model.spec.damper.is_some() {
-            evaluate(&self.model, &qs, &vals, self.bed_mass_kg, &self.options, 0).metric(metric)
+        let (rule, rule_runs) = if self.model.spec.damper.is_some() {
+            let r = evaluate(&self.model, &qs, &vals, self.bed_mass_kg, &self.options, 0)
+                .metric(metric);
+            (r, 1)
         } else {
-            f64::NAN
+            (f64::NAN, 0)
         };
         Ok(OptimizeReport {
             objective: self.objective,
@@ -401,7 +481,7 @@ impl OptimizeStudy {
             variables: self.variables.clone(),
             optimum,
             objective_value,
-            simulations: simulations + 1,
+            simulations: simulations + 1 + rule_runs,
             failures,
             converged,
             wd_over_ws_at_optimum: point.metric("wd_over_ws"),

@@ -980,20 +980,13 @@ pub enum FieldKind {
 }
 
 fn kind_in(table: &toml::Table, path: &str, flag: &str) -> Result<FieldKind> {
-    use serde::Deserialize;
     let probe = |raw: &str| -> std::result::Result<(), String> {
         let mut t = table.clone();
         crate::model::source::apply_override(&mut t, &format!("{path}={raw}"))
             .map_err(|e| e.to_string())?;
-        crate::model::ModelSpec::deserialize(toml::Value::Table(t))
+        crate::model::strict::deserialize::<crate::model::ModelSpec, _>(toml::Value::Table(t))
             .map(|_| ())
-            .map_err(|e| {
-                let mut m = e.message().trim().to_string();
-                if let Some(h) = crate::model::source::did_you_mean(&m) {
-                    m.push_str(&h);
-                }
-                m
-            })
+            .map_err(|(e, track)| crate::model::strict::message(e.message(), &track))
     };
     match probe("1.5") {
         Ok(()) => Ok(FieldKind::Real),
@@ -1098,18 +1091,16 @@ pub fn point_model(
                 let applied = crate::model::source::apply_override(&mut table, f)?;
                 model.source.overrides.push(applied);
             }
-            use serde::Deserialize;
-            model.spec =
-                crate::model::ModelSpec::deserialize(toml::Value::Table(table)).map_err(|e| {
-                    Error::Input {
-                        location: fields
-                            .iter()
-                            .map(|f| format!("--vary {f}"))
-                            .collect::<Vec<_>>()
-                            .join(" "),
-                        message: e.message().trim().to_string(),
-                    }
-                })?;
+            model.spec = crate::model::strict::deserialize(toml::Value::Table(table)).map_err(
+                |(e, track)| Error::Input {
+                    location: fields
+                        .iter()
+                        .map(|f| format!("--vary {f}"))
+                        .collect::<Vec<_>>()
+                        .join(" "),
+                    message: crate::model::strict::message(e.message(), &track),
+                },
+            )?;
             model.validate_settings()?;
         }
     }

@@ -199,7 +199,7 @@ pub struct FemSpec {
 }
 
 /// Mode selection.
-#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum SelectSpec {
     /// "auto".
@@ -272,12 +272,90 @@ pub struct SectionFileSpec {
     pub j: Option<f64>,
 }
 
+impl<'de> Deserialize<'de> for SelectSpec {
+    /// A keyword, a list of mode numbers or `{ band_hz = [lo, hi] }`; anything else is refused
+    /// naming the three forms.
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = SelectSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(
+                    "\"auto\", \"participation\", a list of 1-based mode numbers (e.g. [6, 10]) or { band_hz = [lo, hi] }",
+                )
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<SelectSpec, E> {
+                Ok(SelectSpec::Keyword(v.to_string()))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<SelectSpec, A::Error> {
+                let mut out = Vec::new();
+                while let Some(i) = seq.next_element::<usize>()? {
+                    out.push(i);
+                }
+                Ok(SelectSpec::Indices(out))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                map: A,
+            ) -> Result<SelectSpec, A::Error> {
+                #[derive(Deserialize)]
+                #[serde(deny_unknown_fields)]
+                struct Band {
+                    band_hz: [f64; 2],
+                }
+                let b = Band::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+                Ok(SelectSpec::Band { band_hz: b.band_hz })
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
 /// One value for x, y, z or three.
-#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum PerDirection {
     All(f64),
     Xyz([f64; 3]),
+}
+
+impl<'de> Deserialize<'de> for PerDirection {
+    /// A number or `[x, y, z]` (exactly three numbers).
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = PerDirection;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a number (the same for x, y and z) or [x, y, z] (three numbers)")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<PerDirection, E> {
+                Ok(PerDirection::All(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<PerDirection, E> {
+                Ok(PerDirection::All(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<PerDirection, E> {
+                Ok(PerDirection::All(v as f64))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                seq: A,
+            ) -> Result<PerDirection, A::Error> {
+                let v = super::spec::numbers(seq)?;
+                match v[..] {
+                    [x, y, z] => Ok(PerDirection::Xyz([x, y, z])),
+                    _ => Err(serde::de::Error::invalid_length(
+                        v.len(),
+                        &"[x, y, z] (exactly three numbers)",
+                    )),
+                }
+            }
+        }
+        d.deserialize_any(V)
+    }
 }
 
 impl PerDirection {
@@ -461,6 +539,51 @@ fn section(s: &SectionFileSpec) -> Result<Section> {
     }
 }
 
+/// A plate whose sizes are valid one by one can still leave double precision: its mass
+/// `ρ L_x L_y t` or its bending rigidity `D = E t³ / (12 (1 − ν²))` overflowing or underflowing
+/// (a thickness of 1e-308 m gives D = 0, a length of 1e308 m an infinite mass). Refused naming
+/// the plate's length or thickness (`key` is `bed` or `base`); sizes that are not finite and
+/// > 0 are left to the structure library's own message.
+fn check_plate_scale(p: &PlateSpec, key: &str) -> Result<()> {
+    let sizes = [p.length_x_m, p.length_y_m, p.thickness_m];
+    let mat = &p.material;
+    if sizes.iter().any(|v| !(v.is_finite() && *v > 0.0))
+        || !(mat.density_kg_per_m3.is_finite() && mat.density_kg_per_m3 > 0.0)
+        || !(mat.youngs_modulus_pa.is_finite() && mat.youngs_modulus_pa > 0.0)
+        || !(mat.poisson_ratio > -1.0 && mat.poisson_ratio < 0.5)
+    {
+        return Ok(());
+    }
+    let mass = mat.density_kg_per_m3 * p.length_x_m * p.length_y_m * p.thickness_m;
+    let t = p.thickness_m;
+    let d =
+        mat.youngs_modulus_pa * t * t * t / (12.0 * (1.0 - mat.poisson_ratio * mat.poisson_ratio));
+    if !d.is_normal() {
+        return Err(Error::invalid(
+            format!("{key}.thickness"),
+            format!(
+                "t = {t} m gives the plate a bending rigidity E t³/(12(1−ν²)) = {d:e} N·m that double precision cannot carry (it must be a normal number, between {:e} and {:e}); give a plate thickness in metres",
+                f64::MIN_POSITIVE,
+                f64::MAX
+            ),
+        ));
+    }
+    if !mass.is_normal() {
+        let (field, v) = if p.length_x_m >= p.length_y_m {
+            ("length_x", p.length_x_m)
+        } else {
+            ("length_y", p.length_y_m)
+        };
+        return Err(Error::invalid(
+            format!("{key}.{field}"),
+            format!(
+                "{v} m gives the plate a mass ρ L_x L_y t = {mass:e} kg that double precision cannot carry; give the plate's sides in metres"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// The [`MachineSpec`] a `[structure.fem.machine]` table describes.
 pub fn machine_spec(m: &MachineFileSpec) -> Result<MachineSpec> {
     let mut spec = MachineSpec::default();
@@ -528,6 +651,10 @@ pub fn machine_spec(m: &MachineFileSpec) -> Result<MachineSpec> {
             }
         }
     }
+    check_plate_scale(&spec.bed, "bed")?;
+    if let Support::FloatingBase { base, .. } = &spec.support {
+        check_plate_scale(base, "base")?;
+    }
     for (i, a) in m.added_masses.iter().enumerate() {
         let plate = match a.plate.as_str() {
             "bed" => Plate::Bed,
@@ -544,6 +671,25 @@ pub fn machine_spec(m: &MachineFileSpec) -> Result<MachineSpec> {
                 format!("added_masses[{i}].mass"),
                 format!("must be > 0 kg (got {})", a.mass),
             ));
+        }
+        if !a.offset.iter().all(|v| v.is_finite()) {
+            return Err(Error::invalid(
+                format!("added_masses[{i}].offset"),
+                format!(
+                    "must be two finite numbers [x, y] m from the plate centre (got {:?})",
+                    a.offset
+                ),
+            ));
+        }
+        if let Some(inertia) = a.inertia {
+            if !inertia.iter().all(|v| v.is_finite() && *v >= 0.0) {
+                return Err(Error::invalid(
+                    format!("added_masses[{i}].inertia"),
+                    format!(
+                        "must be three finite numbers >= 0 kg·m² [Ixx, Iyy, Izz] (got {inertia:?})"
+                    ),
+                ));
+            }
         }
         spec.added_masses.push(AddedMass {
             plate,
@@ -628,10 +774,10 @@ pub fn build_model(spec: &FemSpec, src: &Source) -> Result<FeModel> {
     match (&spec.machine, &spec.mesh) {
         (Some(m), None) => {
             let field = "structure.fem.machine";
-            let ms = machine_spec(m).map_err(|e| locate(e, field, src))?;
+            let ms = machine_spec(m).map_err(|e| locate(e, field, src, Some(m)))?;
             ms.build()
                 .map(|mach| mach.model)
-                .map_err(|e| locate(e, field, src))
+                .map_err(|e| locate(e, field, src, Some(m)))
         }
         (None, Some(ms)) => mesh_model(ms, src),
         _ => Err(src.error(
@@ -641,18 +787,139 @@ pub fn build_model(spec: &FemSpec, src: &Source) -> Result<FeModel> {
     }
 }
 
-/// An `InvalidValue` from the structure library, placed at `base.field` when the field exists.
-fn locate(e: Error, base: &str, src: &Source) -> Error {
-    match e {
-        Error::InvalidValue { field, message } => {
-            let key = field.replace(' ', "_");
-            let path = format!("{base}.{key}");
-            let loc = src.locate(&path);
-            Error::Input {
-                location: loc,
-                message: format!("{base}: {field}: {message}"),
+/// The `[structure.fem.machine]` key (relative path) of a field named by the structure library
+/// ([`crate::structure::machine`], [`Material`], [`Section`]): "bed thickness" is
+/// `bed.thickness`, "column: density" is `column_material.density` (or `material.density`
+/// when the file gives no column material), ... `None` when the library's name has no key.
+fn machine_key(field: &str, m: Option<&MachineFileSpec>) -> Option<String> {
+    let plate_key = |what: &str| match what {
+        "bed" => Some("bed"),
+        "floating base" => Some("base"),
+        _ => None,
+    };
+    // Plate sizes: "bed length x", "floating base thickness".
+    for what in ["bed", "floating base"] {
+        if let Some(rest) = field.strip_prefix(what).and_then(|r| r.strip_prefix(' ')) {
+            let key = match rest {
+                "length x" => "length_x",
+                "length y" => "length_y",
+                "thickness" => "thickness",
+                _ => continue,
+            };
+            return Some(format!("{}.{key}", plate_key(what)?));
+        }
+    }
+    // Materials: "bed: Young's modulus", "floating base: density", "column: Poisson's ratio".
+    if let Some((what, prop)) = field.split_once(": ") {
+        let key = match prop {
+            "Young's modulus" => Some("youngs_modulus"),
+            "density" => Some("density"),
+            "Poisson's ratio" => Some("poisson_ratio"),
+            _ => None,
+        };
+        if let Some(key) = key {
+            let own = match what {
+                "bed" => m
+                    .and_then(|m| m.bed.as_ref())
+                    .and_then(|b| b.material.as_ref())
+                    .map(|_| "bed.material"),
+                "floating base" => m
+                    .and_then(|m| m.base.as_ref())
+                    .and_then(|b| b.material.as_ref())
+                    .map(|_| "base.material"),
+                "column" => m
+                    .and_then(|m| m.column_material.as_ref())
+                    .map(|_| "column_material"),
+                _ => return None,
+            };
+            return Some(format!("{}.{key}", own.unwrap_or("material")));
+        }
+        // Sections derived from sizes: the sizes the file gives.
+        if what == "section" {
+            let c = m.and_then(|m| m.column.as_ref());
+            let given = c.map(|c| {
+                [
+                    ("diameter", c.diameter),
+                    ("wall", c.wall),
+                    ("width", c.width),
+                    ("depth", c.depth),
+                    ("area", c.area),
+                ]
+                .iter()
+                .filter(|(_, v)| v.is_some())
+                .map(|(k, _)| format!("column.{k}"))
+                .collect::<Vec<_>>()
+            });
+            return Some(match given {
+                Some(g) if !g.is_empty() => g.join(" / structure.fem.machine."),
+                _ => "column".to_string(),
+            });
+        }
+        // Sections: "column section: area A (m^2)".
+        if what == "column section" {
+            let key = match prop.split(' ').next() {
+                Some("area") => "area",
+                Some("Iy") => "iy",
+                Some("Iz") => "iz",
+                Some("torsion") => "j",
+                _ => return None,
+            };
+            return Some(format!("column.{key}"));
+        }
+    }
+    let key = match field {
+        "column length" => "column_length",
+        "column inset" => "column_inset",
+        "spring inset" => "spring_inset",
+        "spider half-size" => "spider_half_size",
+        "spring stiffness" => "spring_stiffness",
+        "spring damping" => "spring_damping",
+        "tube wall" | "rectangular tube wall" => "column.wall",
+        "tube outer diameter" | "circle diameter" => "column.diameter",
+        "rectangle width" | "rectangular tube width" => "column.width",
+        "rectangle depth" | "rectangular tube depth" => "column.depth",
+        "column" => "column",
+        f if f.starts_with("frame element") => "column_length",
+        "support" => "support",
+        "point B" => "b_offset",
+        "added mass on the bed" | "added mass on the base" | "added mass" => "added_masses",
+        "mesh density" => {
+            let eps = m.and_then(|m| m.elements_per_side).unwrap_or(8);
+            if (2..=400).contains(&eps) {
+                "column_elements"
+            } else {
+                "elements_per_side"
             }
         }
+        f if f.starts_with("added_masses[") || f.starts_with("bed.") || f.starts_with("base.") => {
+            return Some(f.to_string())
+        }
+        _ => return None,
+    };
+    Some(key.to_string())
+}
+
+/// An `InvalidValue` from the structure library, placed at its `[structure.fem.machine]` key
+/// ([`machine_key`]) when it has one, else at `base.field`.
+fn locate(e: Error, base: &str, src: &Source, m: Option<&MachineFileSpec>) -> Error {
+    match e {
+        Error::InvalidValue { field, message } => match machine_key(&field, m) {
+            Some(key) => {
+                let path = format!("{base}.{key}");
+                Error::Input {
+                    location: src.locate(&path),
+                    message: format!("{path}: {message}"),
+                }
+            }
+            None => {
+                let key = field.replace(' ', "_");
+                let path = format!("{base}.{key}");
+                Error::Input {
+                    location: src.locate(&path),
+                    message: format!("{base}: {field}: {message}"),
+                }
+            }
+        },
         other => other,
     }
 }
@@ -710,6 +977,30 @@ pub fn solve_modes(
     }
 }
 
+/// The most modes the block Lanczos solver computes on `n` degrees of freedom with blocks of
+/// `block` vectors: its basis, a multiple of `block` leaving one block spare
+/// (`⌊(n − b)/b⌋ b`), must hold the wanted modes plus one block.
+pub fn lanczos_max_modes(n: usize, block: usize) -> usize {
+    if block == 0 {
+        return 0;
+    }
+    (n.saturating_sub(block) / block * block).saturating_sub(block)
+}
+
+/// A failed eigen-solution of a finite-element structure, in the model's terms: the matrices
+/// the solver refused come from the plates' and columns' sizes, materials and masses.
+fn unsolvable(e: Error, src: &Source) -> Error {
+    match e {
+        e @ (Error::InvalidValue { .. } | Error::Numerical { .. }) => src.error(
+            "structure.fem",
+            format!(
+                "structure.fem: the finite-element model cannot be solved ({e}). Check the thicknesses, lengths, densities, Young's moduli and masses of [structure.fem]: a value so small that the element masses or stiffnesses underflow (e.g. 1e-308) or so large that they overflow does this"
+            ),
+        ),
+        other => other,
+    }
+}
+
 /// The "auto" selection keeps every participating mode up to this multiple of the highest
 /// contact frequency (see the module docs: the main lobe of a half-sine contact pulse).
 pub const AUTO_CUTOFF_FACTOR: f64 = 3.0;
@@ -723,6 +1014,14 @@ pub const RESIDUAL_WARNING: f64 = 1e-6;
 /// gives the contact frequency (for the "auto" cutoff) and the model's named points.
 pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<FemAnalysis> {
     let base = "structure.fem";
+    if let Some(f) = spec.auto_max_hz {
+        if !(f.is_finite() && f > 0.0) {
+            return Err(src.error(
+                &format!("{base}.auto_max_hz"),
+                format!("{base}.auto_max_hz must be a finite number > 0 Hz (got {f})"),
+            ));
+        }
+    }
     let model = build_model(spec, src)?;
     let count = spec.count.unwrap_or(30);
     if count == 0 {
@@ -731,7 +1030,26 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             format!("{base}.count must be >= 1"),
         ));
     }
-    let (modes, solver) = solve_modes(&model, spec.solver, count)?;
+    let n_dofs = model.n_dofs();
+    let lanczos = spec.solver.unwrap_or(if n_dofs < DENSE_LIMIT_DOFS {
+        SolverSpec::Dense
+    } else {
+        SolverSpec::Lanczos
+    }) == SolverSpec::Lanczos;
+    if lanczos {
+        let block = LanczosOptions::default().block_size;
+        let max = lanczos_max_modes(n_dofs, block);
+        if count.min(n_dofs) > max {
+            return Err(src.error(
+                &format!("{base}.count"),
+                format!(
+                    "{base}.count = {count}: the model has {n_dofs} degrees of freedom, of which the Lanczos solver computes at most {max} modes; lower {base}.count to {max} or less, or set {base}.solver = \"dense\" (all {n_dofs} modes; slow above ~{DENSE_LIMIT_DOFS} degrees of freedom)"
+                ),
+            ));
+        }
+    }
+    let (modes, solver) =
+        solve_modes(&model, spec.solver, count).map_err(|e| unsolvable(e, src))?;
     let table = model.mode_table(&modes)?;
     let nm = modes.omega_rad_per_s.len();
     let mut warnings = Vec::new();

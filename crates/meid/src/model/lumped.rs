@@ -427,11 +427,21 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
         Some(names) => {
             let mut out = Vec::new();
             for (fi, name) in names.iter().enumerate() {
+                if let Some(first) = names[..fi].iter().position(|n| n == name) {
+                    let path = format!("{base}.floor[{fi}]");
+                    return Err(src.error(
+                        &path,
+                        format!("{path}: '{name}' is already listed as {base}.floor[{first}]; list each spring or dashpot once (a duplicate would count its force twice)"),
+                    ));
+                }
                 let matches: Vec<_> = grounded.iter().filter(|g| &g.0.name == name).collect();
                 if matches.is_empty() {
-                    let known: Vec<&str> = grounded.iter().map(|g| g.0.name.as_str()).collect();
+                    let known: Vec<String> = grounded
+                        .iter()
+                        .map(|g| format!("'{}' ({})", g.0.name, g.0.path))
+                        .collect();
                     let path = format!("{base}.floor[{fi}]");
-                    return Err(src.error(&path, format!("{path}: '{name}' is not a spring or dashpot attached to ground; valid: {}", known.join(", "))));
+                    return Err(src.error(&path, format!("{path}: '{name}' is not a spring or dashpot attached to ground; valid: {} (an element without `name` is called springs[i] or dashpots[i])", known.join(", "))));
                 }
                 out.extend(matches);
             }
@@ -628,6 +638,20 @@ pub fn from_modal_spec(s: &ModalSpec, src: &Source) -> Result<ModalModel> {
                 &path,
                 format!("{path}: needs {n} stiffness (and damping) values, one per mode"),
             ));
+        }
+        for (field, values, unit) in [
+            ("stiffness", &fl.stiffness, "N"),
+            ("damping", &damping, "N·s"),
+        ] {
+            if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                let at = format!("{path}.{field}[{i}]");
+                return Err(src.error(
+                    &at,
+                    format!(
+                        "{at} must be a finite number ({unit} per unit modal coordinate; got {v})"
+                    ),
+                ));
+            }
         }
         model.floor_force = Some(FloorForce {
             stiffness: fl.stiffness.clone(),

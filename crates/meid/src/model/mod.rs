@@ -27,10 +27,9 @@ pub mod fem;
 mod lumped;
 pub mod source;
 pub mod spec;
+pub mod strict;
 
 use std::path::Path;
-
-use serde::Deserialize;
 
 pub use source::Source;
 pub use spec::*;
@@ -41,6 +40,69 @@ use crate::impact::{
 use crate::integrate::{Method, Options};
 use crate::modal::ModalModel;
 use crate::{Error, Result};
+
+/// The largest blow energy `½ m_s v_s²` (J) a model may have (see [`Model::from_text`]'s
+/// checks): far above any forging machine's (~1e6 J), far below double precision's 1.8e308.
+pub const MAX_BLOW_ENERGY_J: f64 = 1e100;
+
+/// The magnitudes a model's real numbers may have: 0, or between [`MIN_MAGNITUDE`] and
+/// [`MAX_MAGNITUDE`] (SI units). meid multiplies inputs together (a stiffness by a squared
+/// length, E t³, m v², k/m ...): with every input inside 1e-100..1e100, products of up to three
+/// of them stay inside double precision's normal range 2.2e-308..1.8e308; a mass or a
+/// thickness of 1e-308, or a length of 1e308, would not.
+pub const MAX_MAGNITUDE: f64 = 1e100;
+/// See [`MAX_MAGNITUDE`].
+pub const MIN_MAGNITUDE: f64 = 1e-100;
+
+/// Every finite real number of the model (file and overrides) is 0 or within
+/// [`MIN_MAGNITUDE`]..=[`MAX_MAGNITUDE`] in magnitude; the first that is not is an error
+/// naming its field. NaN and infinities are left to each field's own check (which says what
+/// the field takes).
+fn check_magnitudes(spec: &ModelSpec, src: &Source) -> Result<()> {
+    fn walk(v: &toml::Value, path: &str, out: &mut Option<(String, f64)>) {
+        if out.is_some() {
+            return;
+        }
+        match v {
+            toml::Value::Float(x) => {
+                let a = x.abs();
+                if x.is_finite() && a != 0.0 && !(MIN_MAGNITUDE..=MAX_MAGNITUDE).contains(&a) {
+                    *out = Some((path.to_string(), *x));
+                }
+            }
+            toml::Value::Array(items) => {
+                for (i, item) in items.iter().enumerate() {
+                    walk(item, &format!("{path}[{i}]"), out);
+                }
+            }
+            toml::Value::Table(t) => {
+                for (k, item) in t {
+                    let p = if path.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{path}.{k}")
+                    };
+                    walk(item, &p, out);
+                }
+            }
+            _ => {}
+        }
+    }
+    let Ok(table) = toml::Table::try_from(spec) else {
+        return Ok(());
+    };
+    let mut found = None;
+    walk(&toml::Value::Table(table), "", &mut found);
+    match found {
+        Some((path, x)) => Err(src.error(
+            &path,
+            format!(
+                "{path} = {x:e} is out of the range meid computes with: give 0 or a magnitude between {MIN_MAGNITUDE:e} and {MAX_MAGNITUDE:e} (SI units; products of a few inputs must stay inside double precision, 2.2e-308 to 1.8e308)"
+            ),
+        )),
+        None => Ok(()),
+    }
+}
 
 /// A validated model: the spec, the structure reduced to modes, and where it came from.
 #[derive(Debug, Clone)]
@@ -104,8 +166,7 @@ impl Model {
         // 1. The file as written: syntax, unknown keys and types, with positions.
         let mut table: toml::Table =
             toml::from_str(&text).map_err(|e| source::toml_error(name, &text, &e))?;
-        let from_file: ModelSpec =
-            toml::from_str(&text).map_err(|e| source::toml_error(name, &text, &e))?;
+        let from_file: ModelSpec = spec_from_text(name, &text)?;
         let mut src = Source {
             name: name.to_string(),
             text,
@@ -119,23 +180,10 @@ impl Model {
                 let applied = source::apply_override(&mut table, o)?;
                 src.overrides.push(applied);
             }
-            ModelSpec::deserialize(toml::Value::Table(table)).map_err(|e| {
-                let list: Vec<String> = src
-                    .overrides
-                    .iter()
-                    .map(|(p, v)| format!("--set {p}={v}"))
-                    .collect();
-                let mut message = e.message().trim().to_string();
-                if let Some(h) = source::did_you_mean(&message) {
-                    message.push_str(&h);
-                }
-                Error::Input {
-                    location: list.join(" "),
-                    message,
-                }
-            })?
+            spec_from_table(table, &src)?
         };
         // 3. Values.
+        check_magnitudes(&spec, &src)?;
         let structure = build(&spec, &src)?;
         let model = Model {
             spec,
@@ -220,6 +268,21 @@ impl Model {
                     ),
                 ));
             }
+        }
+        check_magnitudes(s, src)?;
+        let (m_s, v_s) = (s.slider.mass, s.slider.velocity);
+        let e_s = 0.5 * m_s * v_s * v_s;
+        if m_s.is_finite()
+            && v_s.is_finite()
+            && m_s > 0.0
+            && (e_s.is_nan() || e_s > MAX_BLOW_ENERGY_J)
+        {
+            return Err(src.error(
+                "slider.velocity",
+                format!(
+                    "slider.mass = {m_s} kg and slider.velocity = {v_s} m/s strike with ½ m_s v_s² = {e_s:e} J; meid takes at most {MAX_BLOW_ENERGY_J:e} J (the largest forging hammers strike with ~1e6 J), so that the energies, powers and their products in the energy balance stay far from double precision's limit 1.8e308"
+                ),
+            ));
         }
         let sim = &s.simulation;
         for (field, v, unit) in [
@@ -408,6 +471,41 @@ impl Model {
         }
         None
     }
+}
+
+/// Reads a model file's text strictly ([`strict`]): errors name the file, line, column and
+/// field, in the model's terms.
+pub fn spec_from_text(name: &str, text: &str) -> Result<ModelSpec> {
+    let de = toml::de::Deserializer::parse(text).map_err(|e| source::toml_error(name, text, &e))?;
+    strict::deserialize(de).map_err(|(e, track)| {
+        source::toml_error_message(name, text, &e, strict::message(e.message(), &track))
+    })
+}
+
+/// Reads a model table (the file with `--set` overrides applied) strictly ([`strict`]):
+/// errors name the `--set` that set the failing field (all of them when none did) and the
+/// field.
+pub fn spec_from_table(table: toml::Table, src: &Source) -> Result<ModelSpec> {
+    strict::deserialize(toml::Value::Table(table)).map_err(|(e, track)| {
+        let message = strict::message(e.message(), &track);
+        let path = track.path.unwrap_or_default();
+        let own: Vec<String> = src
+            .overrides
+            .iter()
+            .filter(|(p, _)| source::path_within(&path, p) || source::path_within(p, &path))
+            .map(|(p, v)| format!("--set {p}={v}"))
+            .collect();
+        let location = if own.is_empty() {
+            src.overrides
+                .iter()
+                .map(|(p, v)| format!("--set {p}={v}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        } else {
+            own.join(" ")
+        };
+        Error::Input { location, message }
+    })
 }
 
 fn contact(c: &ContactSpec) -> Result<Contact> {

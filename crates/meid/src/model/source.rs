@@ -24,7 +24,7 @@ impl Source {
             .overrides
             .iter()
             .rev()
-            .find(|(p, _)| path == p || path.starts_with(&format!("{p}.")))
+            .find(|(p, _)| path_within(path, p))
         {
             return format!("--set {p}={v}");
         }
@@ -79,6 +79,18 @@ impl Source {
     }
 }
 
+/// True when the dotted path `path` is `within` or inside it (`a.b[1].c` is within `a.b`,
+/// `a.b[1]` and itself).
+pub fn path_within(path: &str, within: &str) -> bool {
+    if within.is_empty() {
+        return true;
+    }
+    path == within
+        || path
+            .strip_prefix(within)
+            .is_some_and(|rest| rest.starts_with('.') || rest.starts_with('['))
+}
+
 /// `a.b[2].c` → [("a",None),("b",Some(2)),("c",None)].
 fn split_path(path: &str) -> Vec<(&str, Option<usize>)> {
     path.split('.')
@@ -99,6 +111,16 @@ pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
 
 /// Turns a toml/serde error into a positioned message with a did-you-mean for unknown keys.
 pub fn toml_error(name: &str, text: &str, e: &toml::de::Error) -> Error {
+    let mut message = e.message().trim().to_string();
+    if let Some(hint) = did_you_mean(&message) {
+        message.push_str(&hint);
+    }
+    toml_error_message(name, text, e, message)
+}
+
+/// [`toml_error`] with the message given (the error supplies the position).
+pub fn toml_error_message(name: &str, text: &str, e: &toml::de::Error, message: String) -> Error {
+    let mut message = message;
     let location = match e.span() {
         Some(s) => {
             let (l, c) = line_col(text, s.start);
@@ -106,10 +128,6 @@ pub fn toml_error(name: &str, text: &str, e: &toml::de::Error) -> Error {
         }
         None => name.to_string(),
     };
-    let mut message = e.message().trim().to_string();
-    if let Some(hint) = did_you_mean(&message) {
-        message.push_str(&hint);
-    }
     if let Some(s) = e.span() {
         let (l, _) = line_col(text, s.start);
         if let Some(line) = text.lines().nth(l - 1) {
@@ -154,16 +172,54 @@ pub fn apply_override(table: &mut toml::Table, spec: &str) -> Result<(String, St
             .unwrap_or(toml::Value::String(raw.to_string())),
         Err(_) => toml::Value::String(raw.to_string()),
     };
-    let segs = split_path(path);
-    set_path(table, &segs, value, spec)?;
+    let segs = split_set_path(path).map_err(|message| Error::Input {
+        location: format!("--set {spec}"),
+        message,
+    })?;
+    set_path(table, &segs, value, spec, "")?;
     Ok((path.to_string(), raw.to_string()))
+}
+
+/// A `--set` path split strictly: `a.b[2].c` → [("a", None), ("b", Some("2")), ("c", None)].
+/// Each segment is a key, optionally followed by one `[index]` and nothing after it.
+fn split_set_path(path: &str) -> std::result::Result<Vec<(&str, Option<&str>)>, String> {
+    let form = "give PATH as dotted keys with optional [index] after a key, e.g. structure.lumped.masses[1].mass";
+    path.split('.')
+        .map(|seg| {
+            let (key, index) = match seg.find('[') {
+                Some(i) => {
+                    let rest = &seg[i + 1..];
+                    let Some(close) = rest.find(']') else {
+                        return Err(format!("`{seg}` has an unclosed `[`; {form}"));
+                    };
+                    if close + 1 != rest.len() {
+                        return Err(format!(
+                            "`{seg}`: nothing may follow `[{}]` (found `{}`); {form}",
+                            &rest[..close],
+                            &rest[close + 1..]
+                        ));
+                    }
+                    (&seg[..i], Some(&rest[..close]))
+                }
+                None => (seg, None),
+            };
+            if key.is_empty() {
+                return Err(format!("empty key in `{path}`; {form}"));
+            }
+            if key.contains(']') {
+                return Err(format!("`{seg}` has a `]` without `[`; {form}"));
+            }
+            Ok((key, index))
+        })
+        .collect()
 }
 
 fn set_path(
     table: &mut toml::Table,
-    segs: &[(&str, Option<usize>)],
+    segs: &[(&str, Option<&str>)],
     value: toml::Value,
     spec: &str,
+    parent: &str,
 ) -> Result<()> {
     let err = |message: String| Error::Input {
         location: format!("--set {spec}"),
@@ -171,6 +227,11 @@ fn set_path(
     };
     let Some(((key, index), rest)) = segs.split_first() else {
         return Ok(());
+    };
+    let here = if parent.is_empty() {
+        key.to_string()
+    } else {
+        format!("{parent}.{key}")
     };
     match index {
         None if rest.is_empty() => {
@@ -181,30 +242,52 @@ fn set_path(
             let entry = table
                 .entry(key.to_string())
                 .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-            let sub = entry
-                .as_table_mut()
-                .ok_or_else(|| err(format!("`{key}` is not a table")))?;
-            set_path(sub, rest, value, spec)
+            let sub = entry.as_table_mut().ok_or_else(|| {
+                err(format!(
+                    "{here}: is not a table, so `{here}.{}` cannot be set",
+                    rest[0].0
+                ))
+            })?;
+            set_path(sub, rest, value, spec, &here)
         }
-        Some(idx) => {
+        Some(raw) => {
             let arr = table
                 .get_mut(*key)
                 .and_then(|v| v.as_array_mut())
-                .ok_or_else(|| err(format!("`{key}` is not an array in the model")))?;
+                .ok_or_else(|| {
+                    err(format!(
+                        "{here}: is not an array in the model, so `{here}[{raw}]` cannot be set; set the whole value instead (--set '{here}=...')"
+                    ))
+                })?;
             let len = arr.len();
-            let item = arr.get_mut(*idx).ok_or_else(|| {
+            let valid = if len == 0 {
+                "the array is empty: set the whole array instead".to_string()
+            } else {
+                format!(
+                    "valid indices are 0 to {} (the array has {len} entries)",
+                    len - 1
+                )
+            };
+            let idx: usize = raw.trim().parse().map_err(|_| {
                 err(format!(
-                    "index {idx} out of range: `{key}` has {len} entries (0-based)"
+                    "{here}: index `{raw}` is not a whole number >= 0; {valid}"
                 ))
             })?;
+            let item = arr
+                .get_mut(idx)
+                .ok_or_else(|| err(format!("{here}: index {idx} is out of range; {valid}")))?;
+            let here = format!("{here}[{idx}]");
             if rest.is_empty() {
                 *item = value;
                 Ok(())
             } else {
-                let sub = item
-                    .as_table_mut()
-                    .ok_or_else(|| err(format!("`{key}[{idx}]` is not a table")))?;
-                set_path(sub, rest, value, spec)
+                let sub = item.as_table_mut().ok_or_else(|| {
+                    err(format!(
+                        "{here}: is not a table, so `{here}.{}` cannot be set",
+                        rest[0].0
+                    ))
+                })?;
+                set_path(sub, rest, value, spec, &here)
             }
         }
     }

@@ -57,11 +57,76 @@ pub struct LumpedSpec {
 }
 
 /// One value or one per mode.
-#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum Ratios {
     All(f64),
     PerMode(Vec<f64>),
+}
+
+impl<'de> Deserialize<'de> for Ratios {
+    /// A number or an array of numbers; anything else is refused in the model's terms
+    /// ("expected a number (fraction of critical, e.g. 0.02) or a list of numbers, one per
+    /// mode").
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = Ratios;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(
+                    "a number (fraction of critical, e.g. 0.02) or a list of numbers, one per mode",
+                )
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Ratios, E> {
+                Ok(Ratios::All(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Ratios, E> {
+                Ok(Ratios::All(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Ratios, E> {
+                Ok(Ratios::All(v as f64))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Ratios, A::Error> {
+                numbers(seq).map(Ratios::PerMode)
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// A number (a float or an integer, read as f64).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Number(pub f64);
+
+impl<'de> Deserialize<'de> for Number {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = Number;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a number")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Number, E> {
+                Ok(Number(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Number, E> {
+                Ok(Number(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Number, E> {
+                Ok(Number(v as f64))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// The numbers of an array (each element a number; see [`Number`]).
+pub(crate) fn numbers<'de, A: serde::de::SeqAccess<'de>>(mut seq: A) -> Result<Vec<f64>, A::Error> {
+    let mut out = Vec::new();
+    while let Some(Number(x)) = seq.next_element()? {
+        out.push(x);
+    }
+    Ok(out)
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
