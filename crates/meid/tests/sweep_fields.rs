@@ -361,16 +361,22 @@ fn an_error_at_every_point_is_that_error() {
     let r = sweep.run(&|_, _| {});
     assert_eq!(r.failures(), 1);
     assert!(sweep.all_failed_error(&r).is_none());
-    // Optimisation: every scan point failing is that error.
-    let st = OptimizeStudy::new(
+    // Optimisation: bounds outside the field's domain are that error before any point runs
+    // (issue 15: they used to run the scan, whose every point failed).
+    let e = OptimizeStudy::new(
         lumped(&[]),
         vec![(Quantity::Field("damper.mass".into()), Some((-2.0, -1.0)))],
         Objective::Energy,
     )
-    .unwrap();
-    let e = st.run().unwrap_err();
+    .unwrap_err();
     assert!(matches!(e, Error::Input { .. }), "{e:?}");
-    assert!(e.to_string().contains("damper.mass"), "{e}");
+    let t = e.to_string();
+    assert!(
+        t.contains("--bounds damper.mass=-2..-1")
+            && t.contains("the lower bound -2 lies outside the valid domain of damper.mass")
+            && t.contains("> 0 kg"),
+        "{t}"
+    );
     // Monte Carlo: every sample failing is that error.
     let mc = MonteCarlo {
         model: lumped(&[]),
