@@ -247,54 +247,71 @@ pub const MAX_PERIODS: f64 = 1e7;
 /// would take hours (a 1e20 N/m contact on a 3.5 kg damper is a 1.2 ns period: 4e8 of them in
 /// 0.5 s); it is refused with the field responsible.
 pub fn check_cost(sys: &ImpactSystem, opts: &Options) -> Result<()> {
-    let mut rates: Vec<(f64, String)> = Vec::new();
+    // The rates, each with what sets it; the description is written only for an error (the
+    // check runs before every run, a few formatted numbers would cost more than a collision's
+    // exact integration).
+    #[derive(Clone, Copy)]
+    enum Source {
+        Structure,
+        ContactStiffness(&'static str, f64, f64),
+        ContactDamping(&'static str, f64, f64),
+        DamperStiffness(f64, f64),
+        DamperDamping(f64, f64),
+    }
+    let mut rates: [(f64, Source); 7] = [(f64::NAN, Source::Structure); 7];
+    let mut count = 0;
+    let mut push = |r: f64, s: Source| {
+        rates[count] = (r, s);
+        count += 1;
+    };
     let w_max = sys
         .structure
         .omega_rad_per_s
         .iter()
         .copied()
         .fold(0.0, f64::max);
-    rates.push((w_max, "the structure's highest retained mode".into()));
+    push(w_max, Source::Structure);
     let ms = sys.slider.mass;
     let md = sys.damper.map(|d| d.mass);
-    let law = |c: &crate::impact::Contact, m: f64, field: &str, rates: &mut Vec<(f64, String)>| {
+    let mut law = |c: &crate::impact::Contact, m: f64, field: &'static str| {
         if let crate::impact::ContactLaw::Linear { stiffness, damping } = c.law {
-            rates.push((
+            push(
                 (stiffness / m).sqrt(),
-                format!("{field}.stiffness = {stiffness:e} N/m on {m:e} kg"),
-            ));
-            rates.push((
-                damping / m,
-                format!("{field}.damping = {damping:e} N·s/m on {m:e} kg"),
-            ));
+                Source::ContactStiffness(field, stiffness, m),
+            );
+            push(damping / m, Source::ContactDamping(field, damping, m));
         }
     };
-    law(&sys.slider_bed, ms, "contact.slider_bed", &mut rates);
+    law(&sys.slider_bed, ms, "contact.slider_bed");
     if let (Some(c), Some(m)) = (&sys.bed_damper, md) {
-        law(c, m, "contact.bed_damper", &mut rates);
+        law(c, m, "contact.bed_damper");
     }
     if let Some(d) = &sys.damper {
-        rates.push((
+        push(
             (d.stiffness / d.mass).sqrt(),
-            format!(
-                "damper.stiffness = {:e} N/m on damper.mass = {:e} kg",
-                d.stiffness, d.mass
-            ),
-        ));
-        rates.push((
-            d.damping / d.mass,
-            format!(
-                "damper.damping = {:e} N·s/m on damper.mass = {:e} kg",
-                d.damping, d.mass
-            ),
-        ));
+            Source::DamperStiffness(d.stiffness, d.mass),
+        );
+        push(d.damping / d.mass, Source::DamperDamping(d.damping, d.mass));
     }
-    let Some((rate, what)) = rates
+    let Some((rate, source)) = rates
         .into_iter()
         .filter(|(r, _)| r.is_finite())
         .max_by(|a, b| a.0.total_cmp(&b.0))
     else {
         return Ok(());
+    };
+    let describe = || match source {
+        Source::Structure => "the structure's highest retained mode".to_string(),
+        Source::ContactStiffness(field, k, m) => {
+            format!("{field}.stiffness = {k:e} N/m on {m:e} kg")
+        }
+        Source::ContactDamping(field, c, m) => format!("{field}.damping = {c:e} N·s/m on {m:e} kg"),
+        Source::DamperStiffness(k, m) => {
+            format!("damper.stiffness = {k:e} N/m on damper.mass = {m:e} kg")
+        }
+        Source::DamperDamping(c, m) => {
+            format!("damper.damping = {c:e} N·s/m on damper.mass = {m:e} kg")
+        }
     };
     let periods = opts.duration * rate / (2.0 * std::f64::consts::PI);
     if periods > MAX_PERIODS {
@@ -302,10 +319,11 @@ pub fn check_cost(sys: &ImpactSystem, opts: &Options) -> Result<()> {
             "simulation.duration",
             format!(
                 "the run would span {periods:.2e} periods of its fastest time scale \
-                 (2π/{rate:.3e} s, set by {what}); the limit is {MAX_PERIODS:e}. Lower that \
+                 (2π/{rate:.3e} s, set by {}); the limit is {MAX_PERIODS:e}. Lower that \
                  stiffness or damping (a contact 1e3 times stiffer than the structure already \
                  acts as rigid), raise the mass, or shorten simulation.duration \
                  ({:e} s)",
+                describe(),
                 opts.duration
             ),
         ));

@@ -121,6 +121,7 @@ impl Peaks {
 
 /// Extremes of `p(s) = Σ a_k s^k` on `[0, len]` (a Taylor step of validity `tau` starting at
 /// time `t0`), offered to `ext`.
+#[inline(never)]
 pub(crate) fn on_poly(
     a: &Coefficients,
     tau: f64,
@@ -155,7 +156,8 @@ pub(crate) fn on_poly(
     if taylor::keeps_sign(&d2a, 1.0, len) || taylor::keeps_sign(&d2a, -1.0, len) {
         let (g0, g1) = (da[0], taylor::eval(&da, len));
         if g0 * g1 < 0.0 {
-            let s = monotone_root(&da, &d2a, len, g0, EXTREMUM_SEARCH.tolerance * period);
+            let tol = EXTREMUM_SEARCH.tolerance * period;
+            let s = monotone_root(&da, &d2a, len, (g0, g1), tol);
             ext.offer(taylor::eval(a, s), t0 + s);
         }
         return;
@@ -167,12 +169,25 @@ pub(crate) fn on_poly(
 }
 
 /// The root of `g = Σ g_k s^k` (slope `dg`) on `[0, len]`, given that `g` is monotone there and
-/// `g(0) = g0` and `g(len)` differ in sign: Newton steps kept inside the bracket (bisection when
-/// one leaves it or does not halve the bracket), to `tol` (s).
-fn monotone_root(g: &Coefficients, dg: &Coefficients, len: f64, g0: f64, tol: f64) -> f64 {
+/// `g(0) = g0` and `g(len) = g1` differ in sign: Newton steps from the secant point, kept inside
+/// the bracket (bisection when one leaves it or does not halve the bracket), to `tol` (s): the
+/// search ends when the bracket is that narrow or a Newton step is shorter than `tol/4`
+/// (Newton's error is then of the order of the step squared over the slope's scale, far
+/// below `tol`; a step that no longer moves `s` ends it too).
+fn monotone_root(
+    g: &Coefficients,
+    dg: &Coefficients,
+    len: f64,
+    (g0, g1): (f64, f64),
+    tol: f64,
+) -> f64 {
     let (mut lo, mut hi) = (0.0, len);
     let side = g0.signum();
-    let mut s = 0.5 * len;
+    let mut s = (len * g0 / (g0 - g1)).clamp(0.0, len);
+    if !(s > 0.0 && s < len) {
+        s = 0.5 * len;
+    }
+    let mut last_step = f64::INFINITY;
     for _ in 0..100 {
         let v = taylor::eval(g, s);
         if v == 0.0 {
@@ -183,16 +198,22 @@ fn monotone_root(g: &Coefficients, dg: &Coefficients, len: f64, g0: f64, tol: f6
         } else {
             hi = s;
         }
-        if hi - lo <= tol.max(4.0 * f64::EPSILON * hi) {
+        if hi - lo <= tol.max(4.0 * f64::EPSILON * hi) || last_step < 0.25 * tol {
             break;
         }
         let d = taylor::eval(dg, s);
         let newton = s - v / d;
-        s = if d != 0.0 && newton > lo && newton < hi && (newton - s).abs() < 0.5 * (hi - lo) {
-            newton
+        let step = (newton - s).abs();
+        if d != 0.0 && newton > lo && newton < hi && step < 0.5 * (hi - lo) {
+            if newton == s {
+                break;
+            }
+            s = newton;
+            last_step = step;
         } else {
-            0.5 * (lo + hi)
-        };
+            s = 0.5 * (lo + hi);
+            last_step = f64::INFINITY;
+        }
     }
     s
 }
@@ -200,6 +221,7 @@ fn monotone_root(g: &Coefficients, dg: &Coefficients, len: f64, g0: f64, tol: f6
 /// Extremes of `ℓᵀX(s)` on `[0, len]` of a closed-form segment starting at time `t0`, offered
 /// to `ext`; `la = ℓᵀA` is the functional of the slope. A sum of exponentials is searched by
 /// [`exp_extremes`]; the matrix-exponential fallback by one search over the whole segment.
+#[inline(never)]
 pub(crate) fn on_segment(
     seg: &Segment<'_>,
     l: &[f64],
@@ -266,6 +288,7 @@ const BOUND_PAD: f64 = 1e-12;
 ///
 /// The bounds carry an allowance for round-off (`1e-12` of the functional's size, plus its
 /// noise), so a window or cell is skipped only when its values cannot beat the extremes.
+#[inline(never)]
 fn exp_extremes(e: &ExpSum, dg: &Functional<'_>, t0: f64, len: f64, ext: &mut Extremes) {
     let value = |s: f64| e.derivative(0, s);
     let period = e.fastest_period();
