@@ -510,6 +510,7 @@ impl ModeChannels {
     }
     /// The coefficients `ℓ_rᵀc_k`, k = 0..=P, of moving channel `r` on a Taylor step (`coef`:
     /// rows of `n`).
+    #[inline(never)]
     fn project(&self, r: usize, coef: &[f64], out: &mut taylor::Coefficients) {
         let nz = &self.nz[self.nz_off[r]..self.nz_off[r + 1]];
         let n = coef.len() / out.len();

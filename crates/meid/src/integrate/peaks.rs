@@ -324,60 +324,90 @@ fn exp_extremes(e: &ExpSum, dg: &Functional<'_>, t0: f64, len: f64, ext: &mut Ex
     let w4 = w.powi(4) / 384.0;
     let resolved: Vec<bool> = l4.iter().map(|l| l * w4 < 1.0).collect();
 
-    // 1. Window bounds, and the best boundaries as seeds.
-    let step: Vec<c64> = e.lam.iter().map(|l| (l * w).exp()).collect();
-    let decay: Vec<f64> = e.lam.iter().map(|l| (l.re * w).exp()).collect();
-    let mut z = e.amp.clone();
-    let mut env = mags.clone();
-    let (mut lo, mut hi) = (vec![0.0; n_win], vec![0.0; n_win]);
-    let sums = |z: &[c64], s: f64| {
-        let (mut gs, mut ds, mut gf) = (e.p0 + e.p1 * s, e.p1, 0.0);
-        for ((zk, l), r) in z.iter().zip(&e.lam).zip(&resolved) {
-            if *r {
-                gs += zk.re;
-                ds += (zk * l).re;
-            } else {
-                gf += zk.re;
-            }
+    // 1. Window bounds, and the best boundaries as seeds. The resolved terms are advanced as
+    //    exponentials `z_k = A_k e^{λ_k a}`, the others only as envelopes `|A_k| e^{Re λ_k a}`;
+    //    a decaying envelope below 1e-3 of the round-off allowance leaves the loop, its bound
+    //    at that time kept as a constant (it only decreases afterwards).
+    let mut slow: Vec<(c64, c64, c64, f64, f64, c64, f64)> = Vec::with_capacity(k);
+    let mut fast: Vec<(f64, f64, f64, f64)> = Vec::with_capacity(k);
+    for j in 0..k {
+        let (amp, lam, mag) = (e.amp[j], e.lam[j], mags[j]);
+        let decay = (lam.re * w).exp();
+        if resolved[j] {
+            // (A, λ, e^{λw}, e^{Re λ w}, l4·max(1, e^{Re λ w}), z, env)
+            slow.push((
+                amp,
+                lam,
+                (lam * w).exp(),
+                decay,
+                l4[j] * decay.max(1.0),
+                amp,
+                mag,
+            ));
+        } else {
+            // (|A|, Re λ, e^{Re λ w}, env)
+            fast.push((mag, lam.re, decay, mag));
         }
-        (gs, ds, gf)
+    }
+    let mut dropped = 0.0;
+    let drop_below = 1e-3 * pad;
+    let (mut lo, mut hi) = (vec![0.0; n_win], vec![0.0; n_win]);
+    let sums = |slow: &[(c64, c64, c64, f64, f64, c64, f64)], s: f64| {
+        let (mut g, mut d) = (e.p0 + e.p1 * s, e.p1);
+        for t in slow {
+            g += t.5.re;
+            d += (t.5 * t.1).re;
+        }
+        (g, d)
     };
-    let (mut gs0, mut ds0, _) = sums(&z, 0.0);
+    let (mut gs0, mut ds0) = sums(&slow, 0.0);
     let (mut best_max, mut best_min) = ((f64::NEG_INFINITY, 0.0), (f64::INFINITY, 0.0));
     for i in 0..n_win {
         let b = win_end(i);
-        let (mut m4, mut far) = (0.0, 0.0);
-        for j in 0..k {
-            let top = env[j] * decay[j].max(1.0);
-            if resolved[j] {
-                m4 += top * l4[j];
+        let reseed = (i + 1) % RESEED == 0 || i + 1 == n_win;
+        let mut m4 = 0.0;
+        for t in slow.iter_mut() {
+            m4 += t.6 * t.4;
+            if reseed {
+                t.5 = t.0 * (t.1 * b).exp();
+                t.6 = t.5.norm();
             } else {
-                far += top;
+                t.5 *= t.2;
+                t.6 *= t.3;
             }
         }
-        if (i + 1) % RESEED == 0 || i + 1 == n_win {
-            for j in 0..k {
-                z[j] = e.amp[j] * (e.lam[j] * b).exp();
-                env[j] = mags[j] * (e.lam[j].re * b).exp();
-            }
-        } else {
-            for j in 0..k {
-                z[j] *= step[j];
-                env[j] *= decay[j];
+        let mut far = dropped;
+        let mut j = 0;
+        while j < fast.len() {
+            let t = &mut fast[j];
+            let top = t.3 * t.2.max(1.0);
+            far += top;
+            t.3 = if reseed {
+                t.0 * (t.1 * b).exp()
+            } else {
+                t.3 * t.2
+            };
+            if t.2 < 1.0 && top < drop_below {
+                dropped += top;
+                fast.swap_remove(j);
+            } else {
+                j += 1;
             }
         }
-        let (gs1, ds1, gf1) = sums(&z, b);
-        let (hlo, hhi) = hermite_range(gs0, ds0, gs1, ds1, b - i as f64 * w);
-        let rem = m4 * (b - i as f64 * w).powi(4) / 384.0 + far + pad;
+        let (gs1, ds1) = sums(&slow, b);
+        let h = b - i as f64 * w;
+        let (hlo, hhi) = hermite_range(gs0, ds0, gs1, ds1, h);
+        let rem = m4 * h.powi(4) / 384.0 + far + pad;
         lo[i] = hlo - rem;
         hi[i] = hhi + rem;
+        // Seeds: the boundaries where the resolved part is largest and smallest (the rest is
+        // within `far` of zero there).
         if i + 1 < n_win {
-            let g1 = gs1 + gf1;
-            if g1 > best_max.0 {
-                best_max = (g1, b);
+            if gs1 > best_max.0 {
+                best_max = (gs1, b);
             }
-            if g1 < best_min.0 {
-                best_min = (g1, b);
+            if gs1 < best_min.0 {
+                best_min = (gs1, b);
             }
         }
         (gs0, ds0) = (gs1, ds1);
@@ -387,6 +417,8 @@ fn exp_extremes(e: &ExpSum, dg: &Functional<'_>, t0: f64, len: f64, ext: &mut Ex
             ext.offer(value(s), t0 + s);
         }
     }
+    let mut z = vec![c64::new(0.0, 0.0); k];
+    let mut env = vec![0.0; k];
 
     // 2. The windows that can beat the extremes, cell by cell.
     let cell_step: Vec<c64> = e.lam.iter().map(|l| (l * hc).exp()).collect();
