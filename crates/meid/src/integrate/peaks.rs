@@ -8,9 +8,10 @@
 //! `g'` changes sign; those roots are located by the same bracketing search as the switches
 //! ([`super::roots`]) to `1e-9` of the fastest period, which leaves the value off by about
 //! `½|g''|δ² ≈ 2e-17 |g|max` for a channel oscillating at up to that frequency (an estimate, not
-//! a bound). A stretch (or a window of a long segment) whose bound `max|g| ≤ Σ|a_k|L^k`
-//! (polynomial) or `|p₀| + |p₁|L + Σ|A_k| e^{Re λ_k s}` (exponentials) cannot beat the extremes
-//! found so far is not searched: the result is the same, only cheaper.
+//! a bound). A Taylor step whose bound `max|g| ≤ Σ|a_k|L^k` cannot beat the extremes found so
+//! far is not searched, nor is a window or cell of a closed-form segment whose range bound (a
+//! cubic Hermite interpolant plus its remainder, envelopes for the fast terms:
+//! `exp_extremes`) cannot: the result is the same, only cheaper.
 
 use faer::c64;
 
