@@ -37,7 +37,7 @@ use super::roots::{Scalar, Search, SearchOptions};
 use super::switching::{ModeSelector, MODES};
 use super::taylor::{self, Poly, TaylorMatrix};
 use super::{CollisionEnd, Event, Grid, Observer, Options, PathPoint, Solution, Totals};
-use crate::impact::{ChannelMap, ImpactSystem, Mode, Switch, CHANNELS, N_CHANNELS};
+use crate::impact::{Channel, ChannelMap, ImpactSystem, Mode, Switch, CHANNELS, N_CHANNELS};
 use crate::{Error, Result};
 
 struct ModeData {
@@ -194,10 +194,10 @@ pub fn solve_from(
                 false,
                 &mut chan_buf,
             )?;
-            for &c in &mc.zero {
+            for &c in mc.zeros() {
                 totals.peaks.0[c].offer(0.0, t);
             }
-            for (r, &c) in mc.index.iter().enumerate() {
+            for (r, &c) in mc.moving().iter().enumerate() {
                 mc.project(r, &coef, &mut chan_poly);
                 peaks::on_poly(&chan_poly, tau, period, t, s_end, &mut totals.peaks.0[c]);
             }
@@ -264,11 +264,11 @@ pub fn solve_from(
                 true,
                 &mut chan_buf,
             )?;
-            for &c in &mc.zero {
+            for &c in mc.zeros() {
                 totals.peaks.0[c].offer(0.0, t);
             }
             for ((&c, l), la) in mc
-                .index
+                .moving()
                 .iter()
                 .zip(mc.dense.chunks_exact(n))
                 .zip(mc.slopes.chunks_exact(n))
@@ -480,36 +480,53 @@ fn first_switch<F: Scalar>(searches: &mut [Search<F>], period: f64, horizon: f64
     }
 }
 
-/// The response channels of one mode: those that move (their vectors `ℓ_σ`, dense and as
-/// non-zeros for the Taylor projections, and the slope vectors `ℓ_σᵀA_σ`), and those
-/// identically zero in it. Rows of `n = 2·dofs` in flat buffers (a few allocations per mode).
+/// The response channels of one mode: those that move (their vectors `ℓ_σ` as non-zeros for
+/// the Taylor projections and, once a closed-form segment needs them, dense with the slope
+/// vectors `ℓ_σᵀA_σ`), and those identically zero in it. One allocation per mode met (two more
+/// for a mode with a closed form).
 struct ModeChannels {
-    index: Vec<usize>,
+    /// Channel indices of the moving channels (`moving` of them), then of the zero ones.
+    index: [usize; N_CHANNELS],
+    moving: usize,
+    zero: [usize; N_CHANNELS],
+    n_zero: usize,
+    /// Row `r`'s non-zeros `(i, ℓ_i)` are `nz[nz_off[r] .. nz_off[r + 1]]`.
+    nz_off: [usize; N_CHANNELS + 1],
+    nz: Vec<(usize, f64)>,
+    /// Rows of `n` (built with the slopes).
     dense: Vec<f64>,
-    /// Row `r`'s non-zeros are `nz_idx/nz_val[nz_off[r] .. nz_off[r + 1]]`.
-    nz_off: Vec<usize>,
-    nz_idx: Vec<usize>,
-    nz_val: Vec<f64>,
     /// Built when a closed-form segment first needs them.
     slopes: Vec<f64>,
-    zero: Vec<usize>,
 }
 
 impl ModeChannels {
+    /// Channel indices of the moving channels.
+    fn moving(&self) -> &[usize] {
+        &self.index[..self.moving]
+    }
+    /// Channel indices of the channels identically zero in the mode.
+    fn zeros(&self) -> &[usize] {
+        &self.zero[..self.n_zero]
+    }
     /// The coefficients `ℓ_rᵀc_k`, k = 0..=P, of moving channel `r` on a Taylor step (`coef`:
     /// rows of `n`).
+    #[inline(never)]
     fn project(&self, r: usize, coef: &[f64], out: &mut taylor::Coefficients) {
-        let (a, b) = (self.nz_off[r], self.nz_off[r + 1]);
-        let (idx, val) = (&self.nz_idx[a..b], &self.nz_val[a..b]);
+        let nz = &self.nz[self.nz_off[r]..self.nz_off[r + 1]];
         let n = coef.len() / out.len();
-        for (o, ck) in out.iter_mut().zip(coef.chunks_exact(n)) {
-            *o = idx.iter().zip(val).map(|(&i, v)| v * ck[i]).sum();
+        out.fill(0.0);
+        for &(i, v) in nz {
+            if i < n {
+                for (o, ck) in out.iter_mut().zip(coef.chunks_exact(n)) {
+                    *o += v * ck[i];
+                }
+            }
         }
     }
 }
 
-/// The channels of `mode`, built on first use (with their slope vectors when `need_slopes`).
-/// `buf` is scratch space for [`ChannelMap::vectors_into`].
+/// The channels of `mode`, built on first use (with their dense and slope vectors when
+/// `need_slopes`). `buf` is scratch space for [`ChannelMap::vectors_into`].
 #[allow(clippy::too_many_arguments)]
 fn mode_channels<'c>(
     cache: &'c mut [Option<ModeChannels>; MODES],
@@ -522,41 +539,54 @@ fn mode_channels<'c>(
 ) -> Result<&'c ModeChannels> {
     let mi = usize::from(mode.0) % MODES;
     let n = 2 * sys.dofs();
-    if cache[mi].is_none() {
+    let vectors = |buf: &mut Vec<f64>| {
         buf.resize(N_CHANNELS * n, 0.0);
         map.vectors_into(sys, mode, buf)
-            .ok_or_else(|| Error::numerical("exact", "a closed contact has a non-linear law"))?;
+            .ok_or_else(|| Error::numerical("exact", "a closed contact has a non-linear law"))
+    };
+    let kept = |c: Channel| !(c.needs_damper() && sys.damper.is_none());
+    if cache[mi].is_none() {
+        vectors(buf)?;
         let mut mc = ModeChannels {
-            index: Vec::with_capacity(N_CHANNELS),
-            dense: Vec::with_capacity(N_CHANNELS * n),
-            nz_off: vec![0],
-            nz_idx: Vec::new(),
-            nz_val: Vec::new(),
+            index: [0; N_CHANNELS],
+            moving: 0,
+            zero: [0; N_CHANNELS],
+            n_zero: 0,
+            nz_off: [0; N_CHANNELS + 1],
+            nz: Vec::with_capacity(buf.iter().filter(|v| **v != 0.0).count()),
+            dense: Vec::new(),
             slopes: Vec::new(),
-            zero: Vec::new(),
         };
         for (c, l) in CHANNELS.into_iter().zip(buf.chunks_exact(n)) {
-            if c.needs_damper() && sys.damper.is_none() {
+            if !kept(c) {
                 continue;
             }
             if l.iter().all(|v| *v == 0.0) {
-                mc.zero.push(c.index());
+                mc.zero[mc.n_zero] = c.index();
+                mc.n_zero += 1;
                 continue;
             }
-            mc.index.push(c.index());
-            mc.dense.extend_from_slice(l);
-            for (i, &v) in l.iter().enumerate() {
-                if v != 0.0 {
-                    mc.nz_idx.push(i);
-                    mc.nz_val.push(v);
-                }
-            }
-            mc.nz_off.push(mc.nz_idx.len());
+            mc.index[mc.moving] = c.index();
+            mc.nz.extend(
+                l.iter()
+                    .enumerate()
+                    .filter(|(_, v)| **v != 0.0)
+                    .map(|(i, v)| (i, *v)),
+            );
+            mc.moving += 1;
+            mc.nz_off[mc.moving] = mc.nz.len();
         }
         cache[mi] = Some(mc);
     }
     if need_slopes {
         if let Some(mc) = cache[mi].as_mut().filter(|mc| mc.slopes.is_empty()) {
+            vectors(buf)?;
+            mc.dense = CHANNELS
+                .into_iter()
+                .zip(buf.chunks_exact(n))
+                .filter(|(c, _)| kept(*c) && mc.index[..mc.moving].contains(&c.index()))
+                .flat_map(|(_, l)| l.iter().copied())
+                .collect();
             // ℓᵀA with A column-major: (ℓᵀA)_j = Σ_i ℓ_i A_ij.
             let a = selector.matrix(mode);
             mc.slopes = mc

@@ -247,7 +247,7 @@ pub const MAX_PERIODS: f64 = 1e7;
 /// would take hours (a 1e20 N/m contact on a 3.5 kg damper is a 1.2 ns period: 4e8 of them in
 /// 0.5 s); it is refused with the field responsible.
 pub fn check_cost(sys: &ImpactSystem, opts: &Options) -> Result<()> {
-    let Some((rate, what)) = fastest_rate(sys) else {
+    let Some((rate, source)) = fastest_rate(sys) else {
         return Ok(());
     };
     let periods = opts.duration * rate / (2.0 * std::f64::consts::PI);
@@ -256,7 +256,7 @@ pub fn check_cost(sys: &ImpactSystem, opts: &Options) -> Result<()> {
             "simulation.duration",
             format!(
                 "the run would span {periods:.2e} periods of its fastest time scale \
-                 (2π/{rate:.3e} s, set by {what}); the limit is {MAX_PERIODS:e}. Lower that \
+                 (2π/{rate:.3e} s, set by {source}); the limit is {MAX_PERIODS:e}. Lower that \
                  stiffness or damping (a contact 1e3 times stiffer than the structure already \
                  acts as rigid), raise the mass, or shorten simulation.duration \
                  ({:e} s)",
@@ -267,50 +267,83 @@ pub fn check_cost(sys: &ImpactSystem, opts: &Options) -> Result<()> {
     Ok(())
 }
 
+/// What sets a system's fastest time scale ([`fastest_rate`]); its `Display` names the field.
+/// Kept as numbers and formatted only for a message: the check runs before every run, and a
+/// few formatted numbers would cost more than a collision's exact integration.
+#[derive(Debug, Clone, Copy)]
+pub enum RateSource {
+    /// The structure's highest retained mode.
+    Structure,
+    /// A linear contact's stiffness (field, N/m, kg).
+    ContactStiffness(&'static str, f64, f64),
+    /// A linear contact's damping (field, N·s/m, kg).
+    ContactDamping(&'static str, f64, f64),
+    /// The damper spring (N/m, kg).
+    DamperStiffness(f64, f64),
+    /// The damper dashpot (N·s/m, kg).
+    DamperDamping(f64, f64),
+}
+
+impl std::fmt::Display for RateSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            RateSource::Structure => write!(f, "the structure's highest retained mode"),
+            RateSource::ContactStiffness(field, k, m) => {
+                write!(f, "{field}.stiffness = {k:e} N/m on {m:e} kg")
+            }
+            RateSource::ContactDamping(field, c, m) => {
+                write!(f, "{field}.damping = {c:e} N·s/m on {m:e} kg")
+            }
+            RateSource::DamperStiffness(k, m) => {
+                write!(f, "damper.stiffness = {k:e} N/m on damper.mass = {m:e} kg")
+            }
+            RateSource::DamperDamping(c, m) => {
+                write!(f, "damper.damping = {c:e} N·s/m on damper.mass = {m:e} kg")
+            }
+        }
+    }
+}
+
 /// The fastest time scale of `sys` (rad/s) and what sets it (see [`check_cost`]); `None` when
 /// no rate is finite.
-pub fn fastest_rate(sys: &ImpactSystem) -> Option<(f64, String)> {
-    let mut rates: Vec<(f64, String)> = Vec::new();
+pub fn fastest_rate(sys: &ImpactSystem) -> Option<(f64, RateSource)> {
+    let mut rates: [(f64, RateSource); 7] = [(f64::NAN, RateSource::Structure); 7];
+    let mut count = 0;
+    let mut push = |r: f64, s: RateSource| {
+        rates[count] = (r, s);
+        count += 1;
+    };
     let w_max = sys
         .structure
         .omega_rad_per_s
         .iter()
         .copied()
         .fold(0.0, f64::max);
-    rates.push((w_max, "the structure's highest retained mode".into()));
+    push(w_max, RateSource::Structure);
     let ms = sys.slider.mass;
     let md = sys.damper.map(|d| d.mass);
-    let law = |c: &crate::impact::Contact, m: f64, field: &str, rates: &mut Vec<(f64, String)>| {
+    let mut law = |c: &crate::impact::Contact, m: f64, field: &'static str| {
         if let crate::impact::ContactLaw::Linear { stiffness, damping } = c.law {
-            rates.push((
+            push(
                 (stiffness / m).sqrt(),
-                format!("{field}.stiffness = {stiffness:e} N/m on {m:e} kg"),
-            ));
-            rates.push((
-                damping / m,
-                format!("{field}.damping = {damping:e} N·s/m on {m:e} kg"),
-            ));
+                RateSource::ContactStiffness(field, stiffness, m),
+            );
+            push(damping / m, RateSource::ContactDamping(field, damping, m));
         }
     };
-    law(&sys.slider_bed, ms, "contact.slider_bed", &mut rates);
+    law(&sys.slider_bed, ms, "contact.slider_bed");
     if let (Some(c), Some(m)) = (&sys.bed_damper, md) {
-        law(c, m, "contact.bed_damper", &mut rates);
+        law(c, m, "contact.bed_damper");
     }
     if let Some(d) = &sys.damper {
-        rates.push((
+        push(
             (d.stiffness / d.mass).sqrt(),
-            format!(
-                "damper.stiffness = {:e} N/m on damper.mass = {:e} kg",
-                d.stiffness, d.mass
-            ),
-        ));
-        rates.push((
+            RateSource::DamperStiffness(d.stiffness, d.mass),
+        );
+        push(
             d.damping / d.mass,
-            format!(
-                "damper.damping = {:e} N·s/m on damper.mass = {:e} kg",
-                d.damping, d.mass
-            ),
-        ));
+            RateSource::DamperDamping(d.damping, d.mass),
+        );
     }
     rates
         .into_iter()

@@ -8,9 +8,12 @@
 //! `g'` changes sign; those roots are located by the same bracketing search as the switches
 //! ([`super::roots`]) to `1e-9` of the fastest period, which leaves the value off by about
 //! `½|g''|δ² ≈ 2e-17 |g|max` for a channel oscillating at up to that frequency (an estimate, not
-//! a bound). A stretch (or a window of a long segment) whose bound `max|g| ≤ Σ|a_k|L^k`
-//! (polynomial) or `|p₀| + |p₁|L + Σ|A_k| e^{Re λ_k s}` (exponentials) cannot beat the extremes
-//! found so far is not searched: the result is the same, only cheaper.
+//! a bound). A Taylor step whose bound `max|g| ≤ Σ|a_k|L^k` cannot beat the extremes found so
+//! far is not searched, nor is a window or cell of a closed-form segment whose range bound (a
+//! cubic Hermite interpolant plus its remainder, envelopes for the fast terms:
+//! `exp_extremes`) cannot: the result is the same, only cheaper.
+
+use faer::c64;
 
 use super::propagator::{ExpSum, Functional, Segment};
 use super::roots::{for_each_extremum, Scalar, SearchOptions};
@@ -45,15 +48,16 @@ impl Default for Extremes {
 }
 
 impl Extremes {
-    /// Takes the value `v` at time `t` (the earliest of equal extremes is kept). A NaN is kept
+    /// Takes the value `v` at time `t` (the earliest of equal extremes is kept, in whatever
+    /// order they are offered). A NaN is kept
     /// as the maximum so that [`Extremes::is_finite`] reports it.
     #[inline]
     pub fn offer(&mut self, v: f64, t: f64) {
-        if v > self.max || v.is_nan() {
+        if v > self.max || v.is_nan() || (v == self.max && t < self.t_max) {
             self.max = v;
             self.t_max = t;
         }
-        if v < self.min {
+        if v < self.min || (v == self.min && t < self.t_min) {
             self.min = v;
             self.t_min = t;
         }
@@ -84,7 +88,12 @@ impl Extremes {
     /// Could a value within `±bound` change these extremes?
     #[inline]
     fn could_improve(&self, bound: f64) -> bool {
-        !(bound <= self.max && -bound >= self.min)
+        self.could_improve_range(-bound, bound)
+    }
+    /// Could a value within `[lo, hi]` change these extremes? (True when either is NaN.)
+    #[inline]
+    fn could_improve_range(&self, lo: f64, hi: f64) -> bool {
+        !(hi <= self.max && lo >= self.min)
     }
 }
 
@@ -113,6 +122,7 @@ impl Peaks {
 
 /// Extremes of `p(s) = Σ a_k s^k` on `[0, len]` (a Taylor step of validity `tau` starting at
 /// time `t0`), offered to `ext`.
+#[inline(never)]
 pub(crate) fn on_poly(
     a: &Coefficients,
     tau: f64,
@@ -147,7 +157,8 @@ pub(crate) fn on_poly(
     if taylor::keeps_sign(&d2a, 1.0, len) || taylor::keeps_sign(&d2a, -1.0, len) {
         let (g0, g1) = (da[0], taylor::eval(&da, len));
         if g0 * g1 < 0.0 {
-            let s = monotone_root(&da, &d2a, len, g0, EXTREMUM_SEARCH.tolerance * period);
+            let tol = EXTREMUM_SEARCH.tolerance * period;
+            let s = monotone_root(&da, &d2a, len, (g0, g1), tol);
             ext.offer(taylor::eval(a, s), t0 + s);
         }
         return;
@@ -159,12 +170,25 @@ pub(crate) fn on_poly(
 }
 
 /// The root of `g = Σ g_k s^k` (slope `dg`) on `[0, len]`, given that `g` is monotone there and
-/// `g(0) = g0` and `g(len)` differ in sign: Newton steps kept inside the bracket (bisection when
-/// one leaves it or does not halve the bracket), to `tol` (s).
-fn monotone_root(g: &Coefficients, dg: &Coefficients, len: f64, g0: f64, tol: f64) -> f64 {
+/// `g(0) = g0` and `g(len) = g1` differ in sign: Newton steps from the secant point, kept inside
+/// the bracket (bisection when one leaves it or does not halve the bracket), to `tol` (s): the
+/// search ends when the bracket is that narrow or a Newton step is shorter than `tol/4`
+/// (Newton's error is then of the order of the step squared over the slope's scale, far
+/// below `tol`; a step that no longer moves `s` ends it too).
+fn monotone_root(
+    g: &Coefficients,
+    dg: &Coefficients,
+    len: f64,
+    (g0, g1): (f64, f64),
+    tol: f64,
+) -> f64 {
     let (mut lo, mut hi) = (0.0, len);
     let side = g0.signum();
-    let mut s = 0.5 * len;
+    let mut s = (len * g0 / (g0 - g1)).clamp(0.0, len);
+    if !(s > 0.0 && s < len) {
+        s = 0.5 * len;
+    }
+    let mut last_step = f64::INFINITY;
     for _ in 0..100 {
         let v = taylor::eval(g, s);
         if v == 0.0 {
@@ -175,24 +199,30 @@ fn monotone_root(g: &Coefficients, dg: &Coefficients, len: f64, g0: f64, tol: f6
         } else {
             hi = s;
         }
-        if hi - lo <= tol.max(4.0 * f64::EPSILON * hi) {
+        if hi - lo <= tol.max(4.0 * f64::EPSILON * hi) || last_step < 0.25 * tol {
             break;
         }
         let d = taylor::eval(dg, s);
         let newton = s - v / d;
-        s = if d != 0.0 && newton > lo && newton < hi && (newton - s).abs() < 0.5 * (hi - lo) {
-            newton
+        let step = (newton - s).abs();
+        if d != 0.0 && newton > lo && newton < hi && step < 0.5 * (hi - lo) {
+            if newton == s {
+                break;
+            }
+            s = newton;
+            last_step = step;
         } else {
-            0.5 * (lo + hi)
-        };
+            s = 0.5 * (lo + hi);
+            last_step = f64::INFINITY;
+        }
     }
     s
 }
 
 /// Extremes of `ℓᵀX(s)` on `[0, len]` of a closed-form segment starting at time `t0`, offered
-/// to `ext`; `la = ℓᵀA` is the functional of the slope. Long segments are searched window by
-/// window (four of the functional's fastest periods each), skipping windows whose bound
-/// cannot beat the extremes found so far.
+/// to `ext`; `la = ℓᵀA` is the functional of the slope. A sum of exponentials is searched by
+/// [`exp_extremes`]; the matrix-exponential fallback by one search over the whole segment.
+#[inline(never)]
 pub(crate) fn on_segment(
     seg: &Segment<'_>,
     l: &[f64],
@@ -212,47 +242,277 @@ pub(crate) fn on_segment(
     }
     ext.offer(value(len), t0 + len);
     let df = seg.functional(la);
-    let Functional::Exp(e) = &f else {
-        for_each_extremum(&df, 0.0, len, EXTREMUM_SEARCH, |s, _| {
+    match &f {
+        Functional::Exp(e) => exp_extremes(e, &df, t0, len, ext),
+        _ => for_each_extremum(&df, 0.0, len, EXTREMUM_SEARCH, |s, _| {
             ext.offer(value(s), t0 + s)
-        });
-        return;
-    };
-    let period = e.fastest_period();
-    let window = if period.is_finite() && period > 0.0 {
-        4.0 * period
-    } else {
-        len
-    };
-    let mut a = 0.0;
-    while a < len {
-        let b = if len - a <= 1.5 * window {
-            len
-        } else {
-            a + window
-        };
-        if ext.could_improve(exp_bound(e, a, b)) {
-            ext.offer(value(a), t0 + a);
-            for_each_extremum(&df, a, b, EXTREMUM_SEARCH, |s, _| {
-                ext.offer(value(s), t0 + s)
-            });
-        }
-        a = b;
+        }),
     }
 }
 
-/// A bound of `|g(s)|` on `[a, b]` for `g = p₀ + p₁s + Re Σ A_k e^{λ_k s}`.
-fn exp_bound(e: &ExpSum, a: f64, b: f64) -> f64 {
-    let lin = (e.p0 + e.p1 * a).abs().max((e.p0 + e.p1 * b).abs());
-    lin + e
-        .amp
+/// Windows of [`exp_extremes`] are about this many of the functional's fastest periods long.
+const WINDOW_PERIODS: f64 = 4.0;
+/// Cells of a window are at most an eighth of the fastest period long.
+const CELLS_PER_PERIOD: f64 = 8.0;
+/// The exponentials of the bounds are advanced by one complex product per window (per cell
+/// inside a window), and recomputed directly every this many windows.
+const RESEED: usize = 32;
+/// Relative round-off allowance of the bounds (a multiple of the functional's size).
+const BOUND_PAD: f64 = 1e-12;
+
+/// Extremes on `[0, len]` (value and time, offered to `ext`, the ends already offered) of
+/// `g(s) = p₀ + p₁s + Re Σ_k A_k e^{λ_k s}`, whose slope is `dg`.
+///
+/// The segment is cut into `N` equal windows of about four fastest periods and each window
+/// into cells of at most an eighth of the fastest period. Only the cells whose range bound
+/// can beat the extremes found so far are searched for the roots of `g'`
+/// ([`for_each_extremum`]); the result is that of searching everything, only cheaper.
+///
+/// Range bound of `g` on `[a, b]`, `h = b − a`: split the terms into a resolved part `g_S`
+/// (with `p₀ + p₁s`) and the rest `g_F`. With `H` the cubic Hermite interpolant of `g_S` from
+/// `g_S(a), g_S'(a), g_S(b), g_S'(b)`, `|g_S − H| ≤ M₄ (s−a)²(b−s)²/4! ≤ M₄h⁴/384` where
+/// `M₄ = Σ_S |A_k| |λ_k|⁴ max(e^{Re λ_k a}, e^{Re λ_k b})`, and `|g_F| ≤ Σ_F |A_k|
+/// max(e^{Re λ_k a}, e^{Re λ_k b})`; so
+///
+/// `min H − M₄h⁴/384 − F ≤ g(s) ≤ max H + M₄h⁴/384 + F` on `[a, b]`,
+///
+/// and each term goes to the side where it counts less: into `S` when `(|λ_k|h)⁴ < 384`.
+/// On a cell (`|λ_k|h ≤ π/4`) every term is resolved and the bound is within
+/// `(π/4)⁴/384 ≈ 1e-3` of each term's size from the true range.
+///
+/// 1. Every window gets its bound (values of the exponentials advanced by one complex
+///    product per window), and the window boundaries with the largest and smallest values
+///    are evaluated exactly and offered: the extremes found so far are then close to the
+///    segment's own before any search, wherever in the segment they sit.
+/// 2. The windows, in time order, whose bound can beat the extremes so far are cut into cells
+///    with their own bounds; each cell that can beat them is searched.
+///
+/// The bounds carry an allowance for round-off (`1e-12` of the functional's size, plus its
+/// noise), so a window or cell is skipped only when its values cannot beat the extremes.
+#[inline(never)]
+fn exp_extremes(e: &ExpSum, dg: &Functional<'_>, t0: f64, len: f64, ext: &mut Extremes) {
+    let value = |s: f64| e.derivative(0, s);
+    let period = e.fastest_period();
+    if !(period.is_finite() && period > 0.0) || e.amp.is_empty() {
+        for_each_extremum(dg, 0.0, len, EXTREMUM_SEARCH, |s, _| {
+            ext.offer(value(s), t0 + s)
+        });
+        return;
+    }
+    let n_win = ((len / (WINDOW_PERIODS * period)).round() as usize).max(1);
+    let w = len / n_win as f64;
+    let n_cell = ((w * CELLS_PER_PERIOD / period).ceil() as usize).max(1);
+    let hc = w / n_cell as f64;
+    let win_end = |i: usize| {
+        if i + 1 == n_win {
+            len
+        } else {
+            (i + 1) as f64 * w
+        }
+    };
+    let k = e.amp.len();
+    let mags: Vec<f64> = e.amp.iter().map(|a| a.norm()).collect();
+    let pad = BOUND_PAD
+        * (e.p0.abs()
+            + e.p1.abs() * len
+            + mags
+                .iter()
+                .zip(&e.lam)
+                .map(|(m, l)| m * (l.re * len).exp().max(1.0))
+                .sum::<f64>())
+        + e.noise();
+    let l4: Vec<f64> = e.lam.iter().map(|l| l.norm_sqr() * l.norm_sqr()).collect();
+    let w4 = w.powi(4) / 384.0;
+    let resolved: Vec<bool> = l4.iter().map(|l| l * w4 < 1.0).collect();
+
+    // 1. Window bounds, and the best boundaries as seeds. The resolved terms are advanced as
+    //    exponentials `z_k = A_k e^{λ_k a}`, the others only as envelopes `|A_k| e^{Re λ_k a}`;
+    //    a decaying envelope below 1e-3 of the round-off allowance leaves the loop, its bound
+    //    at that time kept as a constant (it only decreases afterwards).
+    let mut slow: Vec<(c64, c64, c64, f64, f64, c64, f64)> = Vec::with_capacity(k);
+    let mut fast: Vec<(f64, f64, f64, f64)> = Vec::with_capacity(k);
+    for j in 0..k {
+        let (amp, lam, mag) = (e.amp[j], e.lam[j], mags[j]);
+        let decay = (lam.re * w).exp();
+        if resolved[j] {
+            // (A, λ, e^{λw}, e^{Re λ w}, l4·max(1, e^{Re λ w}), z, env)
+            slow.push((
+                amp,
+                lam,
+                (lam * w).exp(),
+                decay,
+                l4[j] * decay.max(1.0),
+                amp,
+                mag,
+            ));
+        } else {
+            // (|A|, Re λ, e^{Re λ w}, env)
+            fast.push((mag, lam.re, decay, mag));
+        }
+    }
+    let mut dropped = 0.0;
+    let drop_below = 1e-3 * pad;
+    let (mut lo, mut hi) = (vec![0.0; n_win], vec![0.0; n_win]);
+    let sums = |slow: &[(c64, c64, c64, f64, f64, c64, f64)], s: f64| {
+        let (mut g, mut d) = (e.p0 + e.p1 * s, e.p1);
+        for t in slow {
+            g += t.5.re;
+            d += (t.5 * t.1).re;
+        }
+        (g, d)
+    };
+    let (mut gs0, mut ds0) = sums(&slow, 0.0);
+    let (mut best_max, mut best_min) = ((f64::NEG_INFINITY, 0.0), (f64::INFINITY, 0.0));
+    for i in 0..n_win {
+        let b = win_end(i);
+        let reseed = (i + 1) % RESEED == 0 || i + 1 == n_win;
+        let mut m4 = 0.0;
+        for t in slow.iter_mut() {
+            m4 += t.6 * t.4;
+            if reseed {
+                t.5 = t.0 * (t.1 * b).exp();
+                t.6 = t.5.norm();
+            } else {
+                t.5 *= t.2;
+                t.6 *= t.3;
+            }
+        }
+        let mut far = dropped;
+        let mut j = 0;
+        while j < fast.len() {
+            let t = &mut fast[j];
+            let top = t.3 * t.2.max(1.0);
+            far += top;
+            t.3 = if reseed {
+                t.0 * (t.1 * b).exp()
+            } else {
+                t.3 * t.2
+            };
+            if t.2 < 1.0 && top < drop_below {
+                dropped += top;
+                fast.swap_remove(j);
+            } else {
+                j += 1;
+            }
+        }
+        let (gs1, ds1) = sums(&slow, b);
+        let h = b - i as f64 * w;
+        let (hlo, hhi) = hermite_range(gs0, ds0, gs1, ds1, h);
+        let rem = m4 * h.powi(4) / 384.0 + far + pad;
+        lo[i] = hlo - rem;
+        hi[i] = hhi + rem;
+        // Seeds: the boundaries where the resolved part is largest and smallest (the rest is
+        // within `far` of zero there).
+        if i + 1 < n_win {
+            if gs1 > best_max.0 {
+                best_max = (gs1, b);
+            }
+            if gs1 < best_min.0 {
+                best_min = (gs1, b);
+            }
+        }
+        (gs0, ds0) = (gs1, ds1);
+    }
+    for (g, s) in [best_max, best_min] {
+        if g.is_finite() {
+            ext.offer(value(s), t0 + s);
+        }
+    }
+    let mut z = vec![c64::new(0.0, 0.0); k];
+    let mut env = vec![0.0; k];
+
+    // 2. The windows that can beat the extremes, cell by cell.
+    let cell_step: Vec<c64> = e.lam.iter().map(|l| (l * hc).exp()).collect();
+    let cell_decay: Vec<f64> = e.lam.iter().map(|l| (l.re * hc).exp()).collect();
+    let cell_top: Vec<f64> = cell_decay
         .iter()
-        .zip(&e.lam)
-        .map(|(amp, l)| {
-            let s = if l.re < 0.0 { a } else { b };
-            amp.norm() * (l.re * s).exp()
-        })
-        .sum::<f64>()
+        .zip(&l4)
+        .map(|(d, l4)| d.max(1.0) * l4)
+        .collect();
+    let full = |z: &[c64], s: f64| {
+        let (mut g, mut d) = (e.p0 + e.p1 * s, e.p1);
+        for (zk, l) in z.iter().zip(&e.lam) {
+            g += zk.re;
+            d += (zk * l).re;
+        }
+        (g, d)
+    };
+    for i in 0..n_win {
+        if !ext.could_improve_range(lo[i], hi[i]) {
+            continue;
+        }
+        let a = i as f64 * w;
+        let b = win_end(i);
+        for j in 0..k {
+            z[j] = e.amp[j] * (e.lam[j] * a).exp();
+            env[j] = mags[j] * (e.lam[j].re * a).exp();
+        }
+        let (mut g0, mut d0) = full(&z, a);
+        for c in 0..n_cell {
+            let ca = a + c as f64 * hc;
+            let cb = if c + 1 == n_cell { b } else { ca + hc };
+            let mut m4 = 0.0;
+            for j in 0..k {
+                m4 += env[j] * cell_top[j];
+                z[j] *= cell_step[j];
+                env[j] *= cell_decay[j];
+            }
+            let (g1, d1) = full(&z, cb);
+            let (hlo, hhi) = hermite_range(g0, d0, g1, d1, cb - ca);
+            let rem = m4 * (cb - ca).powi(4) / 384.0 + pad;
+            if ext.could_improve_range(hlo - rem, hhi + rem) {
+                ext.offer(value(ca), t0 + ca);
+                for_each_extremum(dg, ca, cb, EXTREMUM_SEARCH, |s, _| {
+                    ext.offer(value(s), t0 + s)
+                });
+            }
+            (g0, d0) = (g1, d1);
+        }
+    }
+}
+
+/// The range `(min, max)` on `[0, h]` of the cubic Hermite interpolant with values `g0`, `g1`
+/// and slopes `d0`, `d1` at the ends.
+fn hermite_range(g0: f64, d0: f64, g1: f64, d1: f64, h: f64) -> (f64, f64) {
+    let (mut lo, mut hi) = (g0.min(g1), g0.max(g1));
+    // p(u) = h00 g0 + h10 h d0 + h01 g1 + h11 h d1 on u ∈ [0, 1]; p'(u) = c2 u² + c1 u + c0.
+    let p = |u: f64| {
+        let u2 = u * u;
+        let u3 = u2 * u;
+        (2.0 * u3 - 3.0 * u2 + 1.0) * g0
+            + (u3 - 2.0 * u2 + u) * h * d0
+            + (-2.0 * u3 + 3.0 * u2) * g1
+            + (u3 - u2) * h * d1
+    };
+    let c2 = 3.0 * (2.0 * g0 + h * d0 - 2.0 * g1 + h * d1);
+    let c1 = 2.0 * (-3.0 * g0 - 2.0 * h * d0 + 3.0 * g1 - h * d1);
+    let c0 = h * d0;
+    let mut take = |u: f64| {
+        if u > 0.0 && u < 1.0 {
+            let v = p(u);
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    };
+    if c2 != 0.0 {
+        let disc = c1 * c1 - 4.0 * c2 * c0;
+        if disc >= 0.0 {
+            // Roots without cancellation.
+            let q = -0.5 * (c1 + c1.signum() * disc.sqrt());
+            if q != 0.0 {
+                take(q / c2);
+                take(c0 / q);
+            } else {
+                take(0.0);
+            }
+        }
+    } else if c1 != 0.0 {
+        take(-c0 / c1);
+    }
+    if g0.is_nan() || g1.is_nan() || d0.is_nan() || d1.is_nan() {
+        return (f64::NAN, f64::NAN);
+    }
+    (lo, hi)
 }
 
 #[cfg(test)]
@@ -290,5 +550,177 @@ mod tests {
         f.offer(0.15, 0.0);
         on_poly(&a, 2.0, 1.0, 3.0, 1.0, &mut f);
         assert!((f.max - 0.2).abs() < 1e-15 && f.t_max == 4.0);
+    }
+
+    /// The Hermite cubic's range against dense evaluation.
+    #[test]
+    fn hermite_range_is_the_cubics_range() {
+        for (g0, d0, g1, d1, h) in [
+            (0.0, 1.0, 0.0, -1.0, 2.0),
+            (1.0, -3.0, 0.5, 2.0, 1.0),
+            (0.0, 0.0, 1.0, 0.0, 0.5),
+            (2.0, 5.0, -1.0, 5.0, 1.5),
+        ] {
+            let (lo, hi) = hermite_range(g0, d0, g1, d1, h);
+            let (mut dlo, mut dhi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for i in 0..=100_000 {
+                let u = i as f64 / 100_000.0;
+                let v = (2.0 * u.powi(3) - 3.0 * u * u + 1.0) * g0
+                    + (u.powi(3) - 2.0 * u * u + u) * h * d0
+                    + (-2.0 * u.powi(3) + 3.0 * u * u) * g1
+                    + (u.powi(3) - u * u) * h * d1;
+                dlo = dlo.min(v);
+                dhi = dhi.max(v);
+            }
+            assert!(lo <= dlo + 1e-14 && lo >= dlo - 1e-8, "{lo} vs {dlo}");
+            assert!(hi >= dhi - 1e-14 && hi <= dhi + 1e-8, "{hi} vs {dhi}");
+        }
+        assert!(hermite_range(f64::NAN, 0.0, 1.0, 0.0, 1.0).0.is_nan());
+    }
+
+    /// Uncoupled unit-mass oscillators `(f Hz, ζ)`, started from `x0 = [x; ẋ]`: the segment's
+    /// extremes of `ℓᵀX` by [`on_segment`] (windows and cells skipped by their bounds), by one
+    /// search over the whole segment without any skipping, and by dense evaluation; then
+    /// [`on_segment`] again, given beforehand extremes `1e-9` inside the exhaustive ones (at
+    /// t = −1 s), which leaves the bounds almost no room: it must still find the true ones.
+    fn segment_extremes(
+        modes: &[(f64, f64)],
+        x0: &[f64],
+        l: &[f64],
+        len: f64,
+    ) -> (Extremes, Extremes, Extremes, f64) {
+        use super::super::propagator::Propagator;
+        use faer::Mat;
+        let n = modes.len();
+        let w: Vec<f64> = modes
+            .iter()
+            .map(|(f, _)| 2.0 * std::f64::consts::PI * f)
+            .collect();
+        let k = Mat::from_fn(n, n, |i, j| if i == j { w[i] * w[i] } else { 0.0 });
+        let c = Mat::from_fn(
+            n,
+            n,
+            |i, j| {
+                if i == j {
+                    2.0 * modes[i].1 * w[i]
+                } else {
+                    0.0
+                }
+            },
+        );
+        let a = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+            (true, false) => f64::from(u8::from(j - n == i)),
+            (false, true) => -k[(i - n, j)],
+            (false, false) => -c[(i - n, j - n)],
+            _ => 0.0,
+        });
+        let la: Vec<f64> = (0..2 * n)
+            .map(|j| (0..2 * n).map(|i| l[i] * a[(i, j)]).sum())
+            .collect();
+        let p = Propagator::new(&k, &c, &vec![1.0; n], a).unwrap();
+        let seg = p.segment(x0);
+        let mut pruned = Extremes::default();
+        on_segment(&seg, l, &la, 0.0, len, &mut pruned);
+        let Functional::Exp(e) = seg.functional(l) else {
+            panic!("spectral form expected")
+        };
+        let df = seg.functional(&la);
+        let mut all = Extremes::default();
+        all.offer(e.derivative(0, 0.0), 0.0);
+        all.offer(e.derivative(0, len), len);
+        for_each_extremum(&df, 0.0, len, EXTREMUM_SEARCH, |s, _| {
+            all.offer(e.derivative(0, s), s)
+        });
+        let mut dense = Extremes::default();
+        let h = e.fastest_period() / 256.0;
+        let steps = (len / h).ceil() as usize;
+        for i in 0..=steps {
+            let s = (i as f64 * h).min(len);
+            dense.offer(e.derivative(0, s), s);
+        }
+        // Largest curvature, for how far the dense grid may fall short: ½ max|g''| h².
+        let gap = 0.5 * e.curvature_bound(0.0, len) * h * h;
+        let margin = 1e-9 * all.max.abs().max(all.min.abs());
+        let mut tight = Extremes::default();
+        tight.offer(all.max - margin, -1.0);
+        tight.offer(all.min + margin, -1.0);
+        on_segment(&seg, l, &la, 0.0, len, &mut tight);
+        assert_eq!((tight.max, tight.min), (pruned.max, pruned.min));
+        assert_eq!((tight.t_max, tight.t_min), (pruned.t_max, pruned.t_min));
+        (pruned, all, dense, gap)
+    }
+
+    fn assert_same(pruned: &Extremes, all: &Extremes, dense: &Extremes, gap: f64, scale: f64) {
+        for (p, a, d) in [
+            (pruned.max, all.max, dense.max),
+            (-pruned.min, -all.min, -dense.min),
+        ] {
+            assert!(
+                (p - a).abs() <= 1e-14 * scale,
+                "pruned {p} vs exhaustive {a}"
+            );
+            assert!(p >= d - 1e-14 * scale, "dense {d} above {p}");
+            assert!(p <= d + gap + 1e-14 * scale, "{p} beyond dense {d} + {gap}");
+        }
+        assert!(
+            (pruned.t_max - all.t_max).abs() < 1e-9,
+            "{pruned:?} {all:?}"
+        );
+        assert!(
+            (pruned.t_min - all.t_min).abs() < 1e-9,
+            "{pruned:?} {all:?}"
+        );
+    }
+
+    /// A slow mode peaking late (25 ms) under a fast one that starts almost as large and
+    /// decays: the early windows' bounds are close to the late maximum, which must still be
+    /// found (and the minimum at 75 ms).
+    #[test]
+    fn late_slow_peak_under_a_decaying_fast_mode() {
+        let modes = [(10.0, 0.005), (3000.0, 0.02), (300.0, 0.01)];
+        let ws = 2.0 * std::f64::consts::PI * 10.0;
+        // Slow: from rest at 0 with velocity, amplitude 1 mm; fast: 0.97 mm; middle: 0.02 mm.
+        let x0 = [0.0, 0.97e-3, 0.02e-3, 1e-3 * ws, 0.0, 0.0];
+        let l = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0];
+        let (p, a, d, gap) = segment_extremes(&modes, &x0, &l, 0.2);
+        assert!((p.t_max - 0.025).abs() < 2e-3, "{p:?}");
+        assert!((p.t_min - 0.075).abs() < 2e-3, "{p:?}");
+        assert_same(&p, &a, &d, gap, 1e-3);
+    }
+
+    /// Random sums of damped oscillations (a fixed pseudo-random sequence): every extreme the
+    /// pruned search reports is the exhaustive search's, and no dense sample beats it.
+    #[test]
+    fn pruned_extremes_match_exhaustive_search() {
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..24 {
+            let n = 2 + (rnd() * 3.0) as usize;
+            let modes: Vec<(f64, f64)> = (0..n)
+                .map(|_| (10f64.powf(1.0 + 2.7 * rnd()), 0.002 + 0.05 * rnd()))
+                .collect();
+            let x0: Vec<f64> = (0..2 * n)
+                .map(|i| {
+                    let v = rnd() - 0.5;
+                    if i < n {
+                        v
+                    } else {
+                        v * 2.0 * std::f64::consts::PI * modes[i - n].0
+                    }
+                })
+                .collect();
+            let l: Vec<f64> = (0..2 * n)
+                .map(|i| (rnd() - 0.5) * if i < n { 1.0 } else { 1e-3 })
+                .collect();
+            let len = 0.01 + 0.3 * rnd();
+            let (p, a, d, gap) = segment_extremes(&modes, &x0, &l, len);
+            let scale = a.max.abs().max(a.min.abs());
+            assert_same(&p, &a, &d, gap, scale);
+        }
     }
 }
