@@ -241,9 +241,9 @@ pub(crate) fn on_segment(
     }
 }
 
-/// A bound of `|g(s)|` on `[a, b]` for `g = p₀ + p₁s + Re Σ A_k e^{λ_k s}`.
+/// A bound of `|g(s)|` on `[a, b]` for `g = p₀ + p₁s + p₂s² + Re Σ A_k e^{λ_k s}`.
 fn exp_bound(e: &ExpSum, a: f64, b: f64) -> f64 {
-    let lin = (e.p0 + e.p1 * a).abs().max((e.p0 + e.p1 * b).abs());
+    let lin = (e.p0 + e.p1 * a).abs().max((e.p0 + e.p1 * b).abs()) + e.p2.abs() * b * b;
     lin + e
         .amp
         .iter()
