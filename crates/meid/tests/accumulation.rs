@@ -333,3 +333,34 @@ stiffness = 1e7
         .to_string();
     assert!(e.contains("slider.force"), "{e}");
 }
+
+/// The lumped example under a 100 N slider force runs 60 s with both methods: no chatter stop,
+/// no zero-length loop, the energy balance (with the force's work) within its bound.
+#[test]
+fn sixty_seconds_of_the_lumped_example_under_a_force() {
+    let path = format!(
+        "{}/../../examples/paper-lumped.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let m = Model::from_file(path.as_ref(), &["slider.force=100".to_string()]).expect("example");
+    let sys = m.impact_system(Case::Damper).expect("system");
+    for method in [Method::Exact, Method::Dopri5] {
+        let mut o = m.options();
+        o.method = method;
+        o.duration = 60.0;
+        o.sample_rate = None;
+        let run = simulate(&sys, &o, false).unwrap_or_else(|e| panic!("{method:?}: {e}"));
+        let s = &run.summary;
+        assert!((s.simulated_time_s - 60.0).abs() < 1e-9, "{method:?}");
+        let bound = if method == Method::Exact { 1e-9 } else { 1e-6 };
+        assert!(
+            s.energy_balance_residual_run_end <= bound,
+            "{method:?}: residual {}",
+            s.energy_balance_residual_run_end
+        );
+        println!(
+            "{method:?}: {} events, residual {:.2e}, W_F = {:.6} J",
+            s.switching_events, s.energy_balance_residual_run_end, s.force_work_run_end_j
+        );
+    }
+}
