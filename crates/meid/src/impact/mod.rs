@@ -415,7 +415,7 @@ impl ImpactSystem {
                 .structure
                 .omega_rad_per_s
                 .iter()
-                .position(|w| !(*w > 0.0))
+                .position(|w| w.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
             {
                 return Err(Error::invalid(
                     "slider.force",
