@@ -121,6 +121,14 @@ fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>) {
                 "  end of collision                      {}",
                 opt(s.collision_end_s, "ms", 1e3)
             );
+            if s.slider_force_n != 0.0 {
+                println!(
+                    "  slider force F, its work W_F+         {:.6} N, {} (the ratio is E_p+/(E_s- + W_F+) = E_p+/{})",
+                    s.slider_force_n,
+                    opt(s.force_work_after_j, "J", 1.0),
+                    opt(s.energy_input_j, "J", 1.0)
+                );
+            }
             println!(
                 "  slider energy before / after          {:.6} J / {}",
                 s.slider_energy_before_j,

@@ -38,7 +38,7 @@
 
 use serde::Serialize;
 
-use super::energy::{check_run, EnergyTerms, History, Recorder};
+use super::energy::{balance_residual, check_run, EnergyTerms, History, Recorder};
 use crate::impact::{dot, Channel, ImpactSystem, Mode, Switch};
 use crate::integrate::{self, Options, Solution};
 use crate::{Error, Result};
@@ -324,7 +324,7 @@ pub fn run_blows_with(
         }
         let e0 = EnergyTerms::at(sys, mode0, &x0);
         let ed0 = damper_energy(&x0);
-        let mut rec = Recorder::new(sys);
+        let mut rec = Recorder::new(sys).starting_at(&x0);
         let o_blow = if record {
             o
         } else {
@@ -337,13 +337,22 @@ pub fn run_blows_with(
         // The blow's energy balance: what was stored at the strike = what is stored at its
         // end + what it dissipated.
         let e_end = EnergyTerms::at(sys, sol.mode_final, &sol.x_final);
-        let residual = (e0.total() - e_end.total() - sol.totals.dissipated).abs() / e0.total();
+        // (With a constant slider force, plus its work W_F = F (z_s − z_s0).)
+        let residual = balance_residual(
+            e0.total(),
+            sys.force_work(&x0, &sol.x_final),
+            e_end.total(),
+            sol.totals.dissipated,
+        );
         check_run(sys, &o_blow, &sol, residual)?;
         let end = sol.collision_end.as_ref();
         let energy_ratio = end.map(|c| {
             let vs = c.x[nd + sys.slider_index()];
             let es_after = 0.5 * sys.slider.mass * vs * vs;
-            (e_s - es_after - (damper_energy(&c.x) - ed0)) / e_s
+            // The slider force's work during the collision counts as energy put in (as in
+            // `energy::simulate`); 0 without a force.
+            let w = sys.force_work(&x0, &c.x);
+            (e_s + w - es_after - (damper_energy(&c.x) - ed0)) / (e_s + w)
         });
         reports.push(BlowReport {
             blow: k + 1,

@@ -17,6 +17,27 @@
 //!
 //! Independently, the integrators integrate the dissipated power `ẋᵀC_σẋ` (exactly for
 //! `exact`); the **energy-balance residual** `|E_s− − Σ stored − ∫P dt| / E_s−` checks both.
+//!
+//! # A constant slider force F
+//! With `slider.force = F > 0` ([`ImpactSystem::slider_force`]) the force puts in the work
+//!
+//! ```text
+//! W_F(t) = ∫₀ᵗ F ż_s dt = F (z_s(t) − z_s(0))
+//! ```
+//!
+//! (negative while the slider is above its starting point). The balance is
+//! `E_s− + W_F = Σ stored + ∫P dt`, its residual `|E_s− + W_F − Σ stored − ∫P dt| /
+//! (E_s− + |W_F|)`. The energy ratio keeps the paper's meaning, the share of the energy put in
+//! during the collision that the machine keeps: with `W_F+` the work up to the end of the
+//! collision,
+//!
+//! ```text
+//! E_p+ = E_s− + W_F+ − E_s+ − E_d+,   ratio = E_p+ / (E_s− + W_F+)
+//! ```
+//!
+//! which is Eq. (10)/(11) for F = 0. The summary reports `W_F+`, the denominator
+//! (`energy_input_j`) and `W_F` at the end of the run beside it. (Stored energies are measured
+//! from the unloaded state x = 0, not from the static state under F.)
 
 use serde::Serialize;
 
@@ -102,7 +123,8 @@ pub struct History {
     pub damper_displacement_m: Vec<f64>,
     pub damper_velocity_m_per_s: Vec<f64>,
     pub energy: Vec<EnergyTerms>,
-    /// Eq. (23): `E_s− − Σ stored` (J).
+    /// Eq. (23): `E_s− − Σ stored` (J); with a constant slider force F,
+    /// `E_s− + F (z_s − z_s0) − Σ stored`.
     pub dissipated_j: Vec<f64>,
 }
 
@@ -207,6 +229,8 @@ struct Sampler<'a> {
     sys: &'a ImpactSystem,
     map: ChannelMap,
     e_in: f64,
+    /// z_s at the start of the run (for the constant force's work, `F (z_s − z_s0)`).
+    z0: f64,
 }
 
 impl<'a> Sampler<'a> {
@@ -215,6 +239,7 @@ impl<'a> Sampler<'a> {
             sys,
             map: ChannelMap::new(sys),
             e_in: 0.5 * sys.slider.mass * sys.slider.velocity.powi(2),
+            z0: 0.0,
         }
     }
 
@@ -229,7 +254,8 @@ impl<'a> Sampler<'a> {
             (0.0, 0.0)
         };
         let e = EnergyTerms::at(sys, mode, x);
-        let dissipated = self.e_in - e.total();
+        let w_f = sys.slider_force() * (x[sys.slider_index()] - self.z0);
+        let dissipated = self.e_in + w_f - e.total();
         [
             t,
             ch(Channel::BedDisplacement),
@@ -269,6 +295,13 @@ impl<'a> Recorder<'a> {
             sampler: Sampler::new(sys),
             history: History::default(),
         }
+    }
+
+    /// The recorder of a run starting from `x0` (chained blows): the constant slider force's
+    /// work is counted from `x0`'s slider position.
+    pub fn starting_at(mut self, x0: &[f64]) -> Self {
+        self.sampler.z0 = x0[self.sampler.sys.slider_index()];
+        self
     }
 }
 
@@ -469,7 +502,18 @@ pub fn check_run(sys: &ImpactSystem, opts: &Options, sol: &Solution, residual: f
 pub struct Summary {
     pub method: &'static str,
     /// E_p+ / E_s− (Eq. 10 over Eq. 11); `None` if the collision did not end within the run.
+    /// With a constant slider force F: `E_p+ / (E_s− + W_F+)`, `E_p+ = E_s− + W_F+ − E_s+ −
+    /// E_d+` (see the module documentation).
     pub energy_ratio: Option<f64>,
+    /// F (N), the constant force on the slider (0 without one).
+    pub slider_force_n: f64,
+    /// W_F+ = F (z_s − z_s0) at the end of the collision (J): the work of the slider force
+    /// during the collision; `None` if the collision did not end.
+    pub force_work_after_j: Option<f64>,
+    /// The energy ratio's denominator `E_s− + W_F+` (J; `E_s−` when F = 0).
+    pub energy_input_j: Option<f64>,
+    /// W_F at the end of the run (J).
+    pub force_work_run_end_j: f64,
     pub collision_end_s: Option<f64>,
     pub slider_energy_before_j: f64,
     pub slider_energy_after_j: Option<f64>,
@@ -496,13 +540,26 @@ pub struct Summary {
     pub peak_floor_force_time_s: f64,
     /// The exact peaks of every channel over the run.
     pub peaks: Vec<ChannelPeak>,
-    /// |E_s− − Σ stored − ∫ P_diss dt| / E_s− at the end of the collision.
+    /// |E_s− − Σ stored − ∫ P_diss dt| / E_s− at the end of the collision; with a constant
+    /// slider force `|E_s− + W_F − Σ stored − ∫ P_diss dt| / (E_s− + |W_F|)`.
     pub energy_balance_residual: Option<f64>,
     /// The same at the end of the run.
     pub energy_balance_residual_run_end: f64,
     pub simulated_time_s: f64,
     pub switching_events: usize,
     pub steps: usize,
+}
+
+/// The energy-balance residual `|E_in + W_F − stored − dissipated| / (E_in + |W_F|)`: the
+/// energy put in (`E_in`, and the constant slider force's work `W_F`, 0 without one) against
+/// what is stored and what was dissipated, relative to the energy that went through the system.
+/// For `W_F = 0` this is `|E_in − stored − dissipated| / E_in`, bit for bit.
+pub fn balance_residual(e_in: f64, w_f: f64, stored: f64, dissipated: f64) -> f64 {
+    if w_f == 0.0 {
+        (e_in - stored - dissipated).abs() / e_in
+    } else {
+        (e_in + w_f - stored - dissipated).abs() / (e_in + w_f.abs())
+    }
 }
 
 /// A finished run.
@@ -576,22 +633,31 @@ pub fn simulate_observed(
         (e, vs, vd, c)
     });
     let e_final = EnergyTerms::at(sys, sol.mode_final, &sol.x_final);
-    let residual_run_end = (e_in - e_final.total() - sol.totals.dissipated).abs() / e_in;
+    let x0 = sys.initial_state();
+    let w_end = sys.force_work(&x0, &sol.x_final);
+    let residual_run_end = balance_residual(e_in, w_end, e_final.total(), sol.totals.dissipated);
     check_run(sys, opts, &sol, residual_run_end)?;
+    let w_ce = end.map(|c| sys.force_work(&x0, &c.x));
     let pk = |c: Channel| sol.totals.peaks.get(c).peak();
     let summary = Summary {
         method: match opts.method {
             Method::Exact => "exact",
             Method::Dopri5 => "dopri5",
         },
-        energy_ratio: at_end
-            .map(|(e, ..)| (e_in - e.ke_slider - e.ke_damper - e.pe_damper_spring) / e_in),
+        energy_ratio: at_end.zip(w_ce).map(|((e, ..), w)| {
+            (e_in + w - e.ke_slider - e.ke_damper - e.pe_damper_spring) / (e_in + w)
+        }),
+        slider_force_n: sys.slider_force(),
+        force_work_after_j: w_ce,
+        energy_input_j: w_ce.map(|w| e_in + w),
+        force_work_run_end_j: w_end,
         collision_end_s: end.map(|c| c.t),
         slider_energy_before_j: e_in,
         slider_energy_after_j: at_end.map(|(e, ..)| e.ke_slider),
         damper_energy_after_j: at_end.map(|(e, ..)| e.ke_damper + e.pe_damper_spring),
         machine_energy_after_j: at_end
-            .map(|(e, ..)| e_in - e.ke_slider - e.ke_damper - e.pe_damper_spring),
+            .zip(w_ce)
+            .map(|((e, ..), w)| e_in + w - e.ke_slider - e.ke_damper - e.pe_damper_spring),
         machine_kinetic_energy_after_j: at_end.map(|(e, ..)| e.ke_machine),
         machine_potential_energy_after_j: at_end.map(|(e, ..)| e.pe_machine),
         dissipated_energy_after_j: at_end.map(|(.., c)| c.totals.dissipated),
@@ -609,7 +675,8 @@ pub fn simulate_observed(
         peak_floor_force_time_s: pk(Channel::FloorForce).1,
         peaks: channel_peaks(sys, &sol.totals.peaks),
         energy_balance_residual: at_end
-            .map(|(e, .., c)| (e_in - e.total() - c.totals.dissipated).abs() / e_in),
+            .zip(w_ce)
+            .map(|((e, .., c), w)| balance_residual(e_in, w, e.total(), c.totals.dissipated)),
         energy_balance_residual_run_end: residual_run_end,
         simulated_time_s: sol.t_final,
         switching_events: sol.events.len(),

@@ -804,6 +804,23 @@ pub struct SpectrumBuilder<'a> {
     models: Vec<ModeModel>,
 }
 
+/// The exact spectrum assumes a response that decays to zero: refuse a constant slider force,
+/// naming the field.
+pub fn check_unforced(sys: &ImpactSystem) -> Result<()> {
+    if sys.slider_force() != 0.0 {
+        return Err(crate::Error::invalid(
+            "slider.force",
+            format!(
+                "the exact spectrum (ESD) needs a response that decays to zero; with a constant \
+                 slider force ({:e} N) it settles at a static state instead. Set \
+                 slider.force = 0 for spectra and comparisons, or use the time histories",
+                sys.slider_force()
+            ),
+        ));
+    }
+    Ok(())
+}
+
 impl<'a> SpectrumBuilder<'a> {
     pub fn new(sys: &'a ImpactSystem, channels: &[Channel]) -> Self {
         Self {
@@ -1116,7 +1133,12 @@ impl<'a> SpectrumBuilder<'a> {
     /// The exact transform of `traj`'s channels: over the trajectory only (`free_decay` false,
     /// the record `[t₀, T]` as if the response stopped at T), or with the final mode's free decay
     /// to ∞ (`free_decay` true; an error when a channel does not decay, see the module docs).
+    ///
+    /// A system with a constant slider force (`slider.force > 0`) is refused: its response
+    /// tends to a static state, not to zero, so the transform of the transient does not exist
+    /// as defined here (the error names the field).
     pub fn build(&mut self, traj: &Trajectory, free_decay: bool) -> Result<ExactSpectrum> {
+        check_unforced(self.sys)?;
         let nd = self.sys.dofs();
         let nch = self.channels.len();
         // Merge consecutive linear stretches of one mode (knots, restarts): one LTI motion.

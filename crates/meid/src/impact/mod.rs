@@ -11,8 +11,13 @@
 //! `q_i` are the modal coordinates of the structure (mass-normalised modes, paper Eq. 9),
 //! `u_P = Σ_i Ψ_i(P) q_i` the displacement of structure point `P`. All start at rest at 0,
 //! with the slider touching the bed (`z_s = u_b = 0`) at `v_s`, and the damper touching the bed
-//! from the other side (`u_b = z_d = 0`) without preload (gravity and static preloads are
-//! equilibrium offsets and drop out of the linear dynamics).
+//! from the other side (`u_b = z_d = 0`) without preload (gravity and static preloads of the
+//! structure are equilibrium offsets and drop out of the linear dynamics).
+//!
+//! A constant force `F ≥ 0` on the slider (its weight on a vertical hammer, a drive pressure:
+//! [`ImpactSystem::with_slider_force`], model field `slider.force`) acts from t = 0; it does not
+//! drop out, because the slider leaves the bed and comes back. With it the equations are
+//! `M ẍ + C_σ ẋ + K_σ x = F e_s`: affine, `Ẋ = A_σ X + b`.
 //!
 //! Forces (paper Eqs. 5-8), each a spring-dashpot acting on a relative displacement `δ = aᵀx`:
 //!
@@ -22,7 +27,7 @@
 //! | bed-damper contact (K_d, C_d) | `u_b − z_d` (overlap) | `f_bd = K_d δ + C_d δ̇` while closed | `−f_bd` on the bed, `+f_bd` on the damper |
 //! | damper spring + dashpot (k_d, c_d) | `z_d − u_f` | `f_fd = k_d δ + c_d δ̇` | `−f_fd` on the damper, `+f_fd` on the base at O_f |
 //!
-//! so that `M ẍ + C_σ ẋ + K_σ x = 0`, with `M = diag(1,…,1, m_s, m_d)` and `K_σ`, `C_σ`
+//! so that `M ẍ + C_σ ẋ + K_σ x = F e_s` (`F = 0` unless set), with `M = diag(1,…,1, m_s, m_d)` and `K_σ`, `C_σ`
 //! depending on the *mode* `σ`: which contacts are closed and whether the one-way dashpot acts.
 //!
 //! # Switching rules
@@ -287,6 +292,9 @@ pub struct ImpactSystem {
     rel_nz: [SparseVec; 3],
     /// True when the modal damping matrix is diagonal (modal damping ratios only).
     damping_diagonal: bool,
+    /// F (N): constant force on the slider, positive towards the bed
+    /// ([`ImpactSystem::with_slider_force`]); 0 by default.
+    slider_force: f64,
 }
 
 /// What (if anything) is attached to the bed to reduce the blow's effect.
@@ -379,6 +387,7 @@ impl ImpactSystem {
             rel: Default::default(),
             rel_nz: Default::default(),
             damping_diagonal: false,
+            slider_force: 0.0,
         };
         let nm = sys.structure.len();
         let d = &sys.structure.damping;
@@ -390,6 +399,69 @@ impl ImpactSystem {
         ];
         sys.rel_nz = [0, 1, 2].map(|k| SparseVec::new(&sys.rel[k]));
         Ok(sys)
+    }
+
+    /// This system with a constant force `F` (N) on the slider from t = 0, positive towards the
+    /// bed (its weight on a vertical hammer, a drive or air pressure): the slider's equation
+    /// becomes `m_s z̈_s = F − f_bs`, so the dynamics of every mode are affine,
+    /// `Ẋ = A_σ X + b` with `b = (F/m_s) e_{ż_s}`. `F` must be finite and ≥ 0, and with
+    /// `F > 0` every structural mode must have a stiffness (ω > 0): a structure free to move as
+    /// a rigid body would be pushed away for ever (`slider.force`, `structure` named in the
+    /// error).
+    pub fn with_slider_force(mut self, force_n: f64) -> Result<Self> {
+        check_non_negative("slider.force", force_n, "N (towards the bed)")?;
+        if force_n > 0.0 {
+            if let Some(i) = self
+                .structure
+                .omega_rad_per_s
+                .iter()
+                .position(|w| w.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
+            {
+                return Err(Error::invalid(
+                    "slider.force",
+                    format!(
+                        "a constant force ({force_n:e} N) needs a structure held by springs: \
+                         retained mode {} is a rigid-body mode (0 Hz), which the force would \
+                         push away for ever; support the structure or set slider.force = 0",
+                        i + 1
+                    ),
+                ));
+            }
+        }
+        self.slider_force = force_n;
+        Ok(self)
+    }
+
+    /// F (N): the constant force on the slider, positive towards the bed (0 unless set with
+    /// [`Self::with_slider_force`]).
+    #[inline]
+    pub fn slider_force(&self) -> f64 {
+        self.slider_force
+    }
+
+    /// The constant part `b` of the affine dynamics `Ẋ = A_σ X + b` (length `2·dofs`, the
+    /// same in every mode): `F/m_s` in the slider's velocity row, zero elsewhere; `None` when
+    /// `F = 0` (the dynamics are linear, `Ẋ = A_σ X`).
+    pub fn forcing(&self) -> Option<Vec<f64>> {
+        if self.slider_force == 0.0 {
+            return None;
+        }
+        let nd = self.dofs();
+        let mut b = vec![0.0; 2 * nd];
+        b[nd + self.slider_index()] = self.slider_force / self.slider.mass;
+        Some(b)
+    }
+
+    /// The work done by the constant slider force between the states `x0` and `x`:
+    /// `W_F = ∫ F ż_s dt = F (z_s − z_s0)` (J), energy put into the system (negative while the
+    /// slider is above its starting point).
+    #[inline]
+    pub fn force_work(&self, x0: &[f64], x: &[f64]) -> f64 {
+        if self.slider_force == 0.0 {
+            return 0.0;
+        }
+        let i = self.slider_index();
+        self.slider_force * (x[i] - x0[i])
     }
 
     /// Number of structural modes n.
@@ -813,7 +885,8 @@ impl ImpactSystem {
 impl ImpactSystem {
     /// Generalised accelerations `ẍ` at state `X` in `mode` (any contact law), written to `out`
     /// (length `dofs`): `q̈ = −Ω²q − D q̇ + ψ_b f_bs − ψ_b f_bd + ψ_f f_fd`,
-    /// `z̈_s = −f_bs/m_s`, `z̈_d = (f_bd − f_fd)/m_d`.
+    /// `z̈_s = (F − f_bs)/m_s` (F the constant slider force, [`Self::slider_force`]),
+    /// `z̈_d = (f_bd − f_fd)/m_d`.
     pub fn accelerations(&self, mode: Mode, x: &[f64], out: &mut [f64]) {
         self.accelerations_with(x, self.element_forces(mode, x), out);
     }
@@ -845,7 +918,11 @@ impl ImpactSystem {
                 *o += fi * ffd;
             }
         }
-        out[self.slider_index()] = -fbs / self.slider.mass;
+        out[self.slider_index()] = if self.slider_force != 0.0 {
+            (self.slider_force - fbs) / self.slider.mass
+        } else {
+            -fbs / self.slider.mass
+        };
         if let Some(dm) = &self.damper {
             out[self.damper_index()] = (fbd - ffd) / dm.mass;
         }

@@ -101,6 +101,9 @@ struct Rhs<'a> {
     /// Linear contact laws only: per mode, the lower half of `A_σ` (`nd` rows of `2·nd`), built
     /// on first use; then `f(y) = A_σ y` and the dissipated power is `−Σ m_i ẋ_i (A₂₂ ẋ)_i`.
     linear_rows: Option<[std::cell::OnceCell<Vec<f64>>; 8]>,
+    /// `F/m_s` (m/s²), the constant slider force's acceleration, added to `z̈_s`
+    /// ([`ImpactSystem::slider_force`]); 0 without a force.
+    force_acc: f64,
 }
 
 impl<'a> Rhs<'a> {
@@ -140,6 +143,7 @@ impl<'a> Rhs<'a> {
                         || sys.contact(s).law.is_linear()
                 })
                 .then(Default::default),
+            force_acc: sys.slider_force() / sys.slider.mass,
         }
     }
 
@@ -173,8 +177,19 @@ impl<'a> Rhs<'a> {
             .map(|r| &r[..])
     }
 
-    /// `dy = f(y)`, `y = [x; ẋ; E_diss]`.
+    /// `dy = f(y)`, `y = [x; ẋ; E_diss]`: `ẍ = M⁻¹(−K_σx − C_σẋ − contact forces) + b` with
+    /// `b = (F/m_s) e_s` the constant slider force ([`ImpactSystem::forcing`]; it does no
+    /// dissipation: its work is `F (z_s − z_s0)`, [`ImpactSystem::force_work`]).
+    #[inline]
     fn eval(&self, mode: Mode, y: &[f64], dy: &mut [f64]) {
+        self.eval_unforced(mode, y, dy);
+        if self.force_acc != 0.0 {
+            dy[self.nd + self.n] += self.force_acc;
+        }
+    }
+
+    /// [`Rhs::eval`] without the constant slider force.
+    fn eval_unforced(&self, mode: Mode, y: &[f64], dy: &mut [f64]) {
         let (n, nd) = (self.n, self.nd);
         let (x, v) = (&y[..nd], &y[nd..2 * nd]);
         dy[..nd].copy_from_slice(v);

@@ -102,6 +102,15 @@ pub fn solve_from(
     let mut buf = vec![0.0; n];
     let mut buf2 = vec![0.0; n];
     let mut taylor_steps = [0usize; MODES];
+    // A constant slider force: `Ẋ = A_σ X + b` (`b` first-order, `f` second-order), and per
+    // mode the Taylor coefficients of the forced response from rest (built on first use).
+    let forcing = sys.forcing();
+    let force_2nd: Option<Vec<f64>> = forcing.as_ref().map(|b| b[nd..].to_vec());
+    let force_2nd: Option<Vec<f64>> = force_2nd.map(|mut f| {
+        f.iter_mut().zip(&masses).for_each(|(fi, mi)| *fi *= mi);
+        f
+    });
+    let mut forced_coef: [Option<Vec<f64>>; MODES] = Default::default();
 
     // Taylor-step workspace: the first-order matrices prepared per mode, the coefficients
     // c_0 … c_P of the current step, the polynomials of the indicators, and the searches' buffer (reused
@@ -109,7 +118,7 @@ pub fn solve_from(
     let mut tmats: [Option<TaylorMatrix>; MODES] = Default::default();
     let mut coef = vec![0.0; (taylor::ORDER + 1) * n];
     let mut ind_polys = vec![[0.0; taylor::ORDER + 1]; n_ind];
-    let mut searches: Vec<Search<Poly>> = Vec::with_capacity(n_ind);
+    let mut searches: Vec<Search<Lifted<Poly>>> = Vec::with_capacity(n_ind);
     let ind_proj: Vec<taylor::Projector> = selector
         .vectors()
         .iter()
@@ -155,6 +164,16 @@ pub fn solve_from(
                 }
             };
             tm.expand(&x, &mut coef);
+            if let Some(b) = &forcing {
+                let fc = forced_coef[mi].get_or_insert_with(|| {
+                    let mut fc = vec![0.0; (taylor::ORDER + 1) * n];
+                    tm.forced_coefficients(b, &mut fc);
+                    fc
+                });
+                for (c, f) in coef.iter_mut().zip(fc.iter()) {
+                    *c += f;
+                }
+            }
             let tau = tm.validity();
             period = tm.period();
             // 1-2: the first switch, within the step's validity.
@@ -167,7 +186,8 @@ pub fn solve_from(
             searches.clear();
             for (p, &sign) in ind_polys.iter().zip(&signs) {
                 if sign != 0.0 && !taylor::keeps_sign(p, sign, reach) {
-                    searches.push(Search::new(Poly::new(p, tau, period), sign, search));
+                    let f = Lifted::new(Poly::new(p, tau, period), p[0], sign);
+                    searches.push(Search::new(f, sign, search));
                 }
             }
             let found = first_switch(&mut searches, period, reach);
@@ -210,7 +230,7 @@ pub fn solve_from(
                 let (k, c) = sys.matrices(mode);
                 let am = selector.matrix(mode);
                 let a = Mat::from_fn(n, n, |i, j| am[j * n + i]);
-                let prop = Propagator::shared(&k, &c, &masses, a)?;
+                let prop = Propagator::shared_forced(&k, &c, &masses, a, force_2nd.as_deref())?;
                 cache[mi] = Some(ModeData {
                     prop,
                     damping: c,
@@ -220,7 +240,9 @@ pub fn solve_from(
             let md = cache[mi]
                 .as_mut()
                 .ok_or_else(|| Error::numerical("exact", "mode cache"))?;
-            if let (Some(g), None) = (&grid, &md.step) {
+            // (With a forcing the samples are evaluated one by one: the transition matrix
+            // propagates the deviation from the particular solution only.)
+            if let (Some(g), None, false) = (&grid, &md.step, md.prop.is_forced()) {
                 md.step = Some(md.prop.transition(g.dt));
             }
             let md = &*md;
@@ -233,11 +255,15 @@ pub fn solve_from(
                 .iter()
                 .map(|l| seg.functional(l))
                 .collect();
-            let mut closed_searches: Vec<Search<&Functional<'_>>> = funcs
+            let mut closed_searches: Vec<Search<Lifted<&Functional<'_>>>> = funcs
                 .iter()
                 .zip(&signs)
-                .filter(|(_, s)| **s != 0.0)
-                .map(|(f, s)| Search::new(f, *s, search))
+                .zip(selector.vectors())
+                .filter(|((_, s), _)| **s != 0.0)
+                .map(|((f, s), l)| {
+                    let v = l.iter().zip(&x).map(|(a, b)| a * b).sum();
+                    Search::new(Lifted::new(f, v, *s), *s, search)
+                })
                 .collect();
             let found = first_switch(&mut closed_searches, period, horizon);
             (s_end, switched) = stretch_end(found, horizon, true);
@@ -267,11 +293,12 @@ pub fn solve_from(
             for &c in mc.zeros() {
                 totals.peaks.0[c].offer(0.0, t);
             }
+            let slope_len = n + usize::from(forcing.is_some());
             for ((&c, l), la) in mc
                 .moving()
                 .iter()
                 .zip(mc.dense.chunks_exact(n))
-                .zip(mc.slopes.chunks_exact(n))
+                .zip(mc.slopes.chunks_exact(slope_len))
             {
                 peaks::on_segment(&seg, l, la, t, s_end, &mut totals.peaks.0[c]);
             }
@@ -281,6 +308,7 @@ pub fn solve_from(
         }
 
         // Advance.
+        let t_before = t;
         t += s_end;
         if run_ends {
             break;
@@ -289,7 +317,10 @@ pub fn solve_from(
             // End of a Taylor step: the same mode goes on, the indicators on the same sides.
             continue;
         }
-        if s_end <= 1e-14 * period.min(t_end) {
+        // No progress: a stretch shorter than round-off of the time scale, or one that does not
+        // move `t` at all (2.5e-17 s at t = 3.7 s).
+        let no_progress = s_end <= 1e-14 * period.min(t_end) || t == t_before;
+        if no_progress {
             zero_length += 1;
             if zero_length > 50 {
                 return Err(Error::numerical(
@@ -306,6 +337,19 @@ pub fn solve_from(
         // 5: the new mode, and the indicators' sides under its dynamics (those of the mode
         // taken when no mode is consistent).
         let (new_mode, _) = selector.select(&x, mode, &mut signs);
+        if no_progress && new_mode == mode && forcing.is_some() {
+            // Resting contact under a constant force: an indicator that "crossed" without time
+            // advancing and without changing the mode is at zero within round-off (a dashpot's
+            // relative velocity at rest against static forces of 1e5 N/m·mm). It is not
+            // searched (sign 0) until the next switch that changes the mode, so the run
+            // progresses instead of re-finding the same crossing.
+            for (sg, l) in signs.iter_mut().zip(selector.vectors()) {
+                let v: f64 = l.iter().zip(&x).map(|(a, b)| a * b).sum();
+                if *sg * v <= 0.0 {
+                    *sg = 0.0;
+                }
+            }
+        }
         if new_mode != mode {
             // A contact released by the force rule takes its elastic energy with it.
             totals.dissipated += super::dopri5::contact_energy_jump(sys, mode, new_mode, &x);
@@ -369,6 +413,49 @@ pub fn solve_from(
         rejected: 0,
         fallback_modes,
     })
+}
+
+/// An indicator searched from the side the mode selection gave it. The selection decides an
+/// indicator within its zero band (`1e-9` of its terms, `switching::lex_signs`) by its
+/// derivatives; when the value `v` itself is then on the other side (a contact overlapping by
+/// 6e-13 m at a static preload of 1e-3 m, moving apart), that start is taken as zero: the
+/// noise is raised to `|v|` plus the function's own, so the search does not report the start
+/// as a crossing (a zero-length stretch, again and again), and reports a real return across
+/// zero. Otherwise the function is unchanged.
+struct Lifted<F> {
+    f: F,
+    noise: f64,
+}
+
+impl<F: Scalar> Lifted<F> {
+    fn new(f: F, value: f64, sign: f64) -> Self {
+        let own = f.noise();
+        let noise = if value * sign < 0.0 {
+            own + value.abs()
+        } else {
+            own
+        };
+        Self { f, noise }
+    }
+}
+
+impl<F: Scalar> Scalar for Lifted<F> {
+    #[inline]
+    fn value_slope(&self, s: f64) -> (f64, f64) {
+        self.f.value_slope(s)
+    }
+    #[inline]
+    fn curvature_bound(&self, a: f64, b: f64) -> f64 {
+        self.f.curvature_bound(a, b)
+    }
+    #[inline]
+    fn fastest_period(&self) -> f64 {
+        self.f.fastest_period()
+    }
+    #[inline]
+    fn noise(&self) -> f64 {
+        self.noise
+    }
 }
 
 /// Where a stretch ends: at the first switch `found` if it comes before `reach`, else at
@@ -587,19 +674,27 @@ fn mode_channels<'c>(
                 .filter(|(c, _)| kept(*c) && mc.index[..mc.moving].contains(&c.index()))
                 .flat_map(|(_, l)| l.iter().copied())
                 .collect();
-            // ℓᵀA with A column-major: (ℓᵀA)_j = Σ_i ℓ_i A_ij.
+            // ℓᵀA with A column-major: (ℓᵀA)_j = Σ_i ℓ_i A_ij; with a constant forcing b the
+            // slope is the affine ℓᵀA X + ℓᵀb, ℓᵀb appended (an augmented-state functional,
+            // `Segment::functional`).
+            let b = sys.forcing();
             let a = selector.matrix(mode);
             mc.slopes = mc
                 .dense
                 .chunks_exact(n)
                 .flat_map(|l| {
-                    (0..n).map(move |j| {
-                        a[j * n..(j + 1) * n]
-                            .iter()
-                            .zip(l)
-                            .map(|(x, y)| x * y)
-                            .sum()
-                    })
+                    let lb = b
+                        .as_ref()
+                        .map(|b| b.iter().zip(l).map(|(x, y)| x * y).sum());
+                    (0..n)
+                        .map(move |j| {
+                            a[j * n..(j + 1) * n]
+                                .iter()
+                                .zip(l)
+                                .map(|(x, y)| x * y)
+                                .sum()
+                        })
+                        .chain(lb)
                 })
                 .collect();
         }
@@ -632,7 +727,25 @@ fn dissipated(seg: &Segment<'_>, c: &Mat<f64>, nd: usize, len: f64) -> f64 {
         return 0.0;
     }
     if let Some((beta, lam)) = seg.velocity_terms() {
-        // ẋᵀCẋ = ½ Σ_kl Re[(β_kᵀCβ_l) e^{(λ_k+λ_l)s} + (β_kᵀCβ̄_l) e^{(λ_k+λ̄_l)s}].
+        // ẋᵀCẋ = ½ Σ_kl Re[(β_kᵀCβ_l) e^{(λ_k+λ_l)s} + (β_kᵀCβ̄_l) e^{(λ_k+λ̄_l)s}]; with a
+        // forcing, ẋ also has the particular x_1 + x_2 s (C x_2 = 0: x_2 is rigid motion), so
+        // + 2 Re Σ_k (x_1ᵀCβ_k) e^{λ_k s} + x_1ᵀCx_1.
+        let mut extra = 0.0;
+        if let Some((x1, _)) = seg.particular_velocity() {
+            if x1.iter().any(|v| *v != 0.0) {
+                let cx1: Vec<f64> = (0..nd)
+                    .map(|i| (0..nd).map(|j| c[(i, j)] * x1[j]).sum())
+                    .collect();
+                extra += len * x1.iter().zip(&cx1).map(|(a, b)| a * b).sum::<f64>();
+                for (b, l) in beta.iter().zip(&lam) {
+                    let p = b
+                        .iter()
+                        .zip(&cx1)
+                        .fold(c64::new(0.0, 0.0), |acc, (bi, ci)| acc + bi * ci);
+                    extra += 2.0 * (p * exp_integral(*l, len)).re;
+                }
+            }
+        }
         let kk = beta.len();
         let cb: Vec<Vec<c64>> = beta
             .iter()
@@ -655,7 +768,7 @@ fn dissipated(seg: &Segment<'_>, c: &Mat<f64>, nd: usize, len: f64) -> f64 {
                 total += 0.5 * (q * exp_integral(lam[k] + lam[l].conj(), len)).re;
             }
         }
-        return total;
+        return total + extra;
     }
     // Quadrature fallback.
     let pieces = ((len / (seg_period(seg) / 4.0)).ceil() as usize).clamp(1, 1_000_000);

@@ -261,7 +261,8 @@ const RESEED: usize = 32;
 const BOUND_PAD: f64 = 1e-12;
 
 /// Extremes on `[0, len]` (value and time, offered to `ext`, the ends already offered) of
-/// `g(s) = p₀ + p₁s + Re Σ_k A_k e^{λ_k s}`, whose slope is `dg`.
+/// `g(s) = p₀ + p₁s + p₂s² + Re Σ_k A_k e^{λ_k s}`, whose slope is `dg` (`p₂ ≠ 0` only for
+/// the slider in flight under a constant force).
 ///
 /// The segment is cut into `N` equal windows of about four fastest periods and each window
 /// into cells of at most an eighth of the fastest period. Only the cells whose range bound
@@ -269,7 +270,7 @@ const BOUND_PAD: f64 = 1e-12;
 /// ([`for_each_extremum`]); the result is that of searching everything, only cheaper.
 ///
 /// Range bound of `g` on `[a, b]`, `h = b − a`: split the terms into a resolved part `g_S`
-/// (with `p₀ + p₁s`) and the rest `g_F`. With `H` the cubic Hermite interpolant of `g_S` from
+/// (with `p₀ + p₁s + p₂s²`, which the cubic interpolates exactly) and the rest `g_F`. With `H` the cubic Hermite interpolant of `g_S` from
 /// `g_S(a), g_S'(a), g_S(b), g_S'(b)`, `|g_S − H| ≤ M₄ (s−a)²(b−s)²/4! ≤ M₄h⁴/384` where
 /// `M₄ = Σ_S |A_k| |λ_k|⁴ max(e^{Re λ_k a}, e^{Re λ_k b})`, and `|g_F| ≤ Σ_F |A_k|
 /// max(e^{Re λ_k a}, e^{Re λ_k b})`; so
@@ -315,6 +316,7 @@ fn exp_extremes(e: &ExpSum, dg: &Functional<'_>, t0: f64, len: f64, ext: &mut Ex
     let pad = BOUND_PAD
         * (e.p0.abs()
             + e.p1.abs() * len
+            + e.p2.abs() * len * len
             + mags
                 .iter()
                 .zip(&e.lam)
@@ -354,7 +356,7 @@ fn exp_extremes(e: &ExpSum, dg: &Functional<'_>, t0: f64, len: f64, ext: &mut Ex
     let drop_below = 1e-3 * pad;
     let (mut lo, mut hi) = (vec![0.0; n_win], vec![0.0; n_win]);
     let sums = |slow: &[(c64, c64, c64, f64, f64, c64, f64)], s: f64| {
-        let (mut g, mut d) = (e.p0 + e.p1 * s, e.p1);
+        let (mut g, mut d) = (e.p0 + (e.p1 + e.p2 * s) * s, e.p1 + 2.0 * e.p2 * s);
         for t in slow {
             g += t.5.re;
             d += (t.5 * t.1).re;
@@ -430,7 +432,7 @@ fn exp_extremes(e: &ExpSum, dg: &Functional<'_>, t0: f64, len: f64, ext: &mut Ex
         .map(|(d, l4)| d.max(1.0) * l4)
         .collect();
     let full = |z: &[c64], s: f64| {
-        let (mut g, mut d) = (e.p0 + e.p1 * s, e.p1);
+        let (mut g, mut d) = (e.p0 + (e.p1 + e.p2 * s) * s, e.p1 + 2.0 * e.p2 * s);
         for (zk, l) in z.iter().zip(&e.lam) {
             g += zk.re;
             d += (zk * l).re;

@@ -23,6 +23,23 @@
 //! a sum of exponentials evaluated in O(number of modes), with exact derivatives and a
 //! rigorous bound on its curvature for the event search ([`super::roots`]).
 //!
+//! # Constant forcing (affine dynamics)
+//! With a constant force vector `f` (the slider force, [`crate::impact::ImpactSystem::forcing`])
+//! the mode is `M ẍ + C ẋ + K x = f`, i.e. `Ẋ = A X + b`. [`Propagator::shared_forced`] adds a
+//! particular solution built on the same split:
+//!
+//! ```text
+//! x_p(s) = x_c + x_1 s + x_2 s²/2,   M x_2 = R R⁺ f (rigid directions accelerate),
+//! K x_1 = 0, C x_1 + K x_c = f − M x_2 (damped null directions drift, the rest deflects),
+//! ```
+//!
+//! (`x_2 = M^{-½}R̃R̃ᵀM^{-½}f`, `x_1` on the damped null columns of `Q̃`, `x_c` on the stiff
+//! ones, refined once against the residual of the constant terms), and propagates the
+//! deviation `X − X_p(s)` with the homogeneous closed form: `X(s) = X_p(s) + Φ(s)(X₀ − X_p(0))`.
+//! A functional then gains `ℓᵀX_p(s)`, a polynomial of degree 2 ([`ExpSum::p2`]). The slider in
+//! flight under F is the parabola `z_s = z_s0 + ż_s0 s + F s²/(2 m_s)`; at rest on the bed the
+//! deviation decays and `X → X_p = [K⁻¹f; 0]`, the static state.
+//!
 //! # Fallback
 //! When `‖V‖‖V⁻¹‖ > 1e8` (near-critical damping, clustered non-symmetric eigenvalues) the mode
 //! falls back to the matrix exponential ([`super::expm`]), evaluated on demand.
@@ -50,6 +67,55 @@ pub struct Propagator {
     pub a: Mat<f64>,
     dofs: usize,
     kind: Kind,
+    /// The particular solution of a constant forcing, `None` without one.
+    part: Option<Particular>,
+}
+
+/// A particular solution `x_p(s) = x_c + x_1 s + x_2 s²/2` of `M ẍ + C ẋ + K x = f` (see the
+/// module documentation).
+#[derive(Debug, Clone)]
+struct Particular {
+    xc: Vec<f64>,
+    x1: Vec<f64>,
+    x2: Vec<f64>,
+}
+
+impl Particular {
+    /// `X_p(s) = [x_c + x_1 s + x_2 s²/2; x_1 + x_2 s]` added to `out`.
+    fn add_state(&self, s: f64, out: &mut [f64]) {
+        let nd = self.xc.len();
+        for i in 0..nd {
+            out[i] += self.xc[i] + self.x1[i] * s + 0.5 * self.x2[i] * s * s;
+            out[nd + i] += self.x1[i] + self.x2[i] * s;
+        }
+    }
+
+    /// `Σ_i |ℓ_i X_p,i(0)|`: the size of the terms of `ℓᵀX_p(0)` (its round-off scale).
+    fn scale(&self, l: &[f64]) -> f64 {
+        let nd = self.xc.len();
+        let a: f64 = l[..nd]
+            .iter()
+            .zip(&self.xc)
+            .map(|(a, b)| (a * b).abs())
+            .sum();
+        let b: f64 = l[nd..2 * nd]
+            .iter()
+            .zip(&self.x1)
+            .map(|(a, b)| (a * b).abs())
+            .sum();
+        a + b
+    }
+
+    /// `ℓᵀX_p(s) = q₀ + q₁ s + q₂ s²` as `[q₀, q₁, q₂]`.
+    fn functional(&self, l: &[f64]) -> [f64; 3] {
+        let nd = self.xc.len();
+        let (lx, lv) = (&l[..nd], &l[nd..2 * nd]);
+        [
+            dot(lx, &self.xc) + dot(lv, &self.x1),
+            dot(lx, &self.x1) + dot(lv, &self.x2),
+            0.5 * dot(lx, &self.x2),
+        ]
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -94,13 +160,18 @@ pub struct Segment<'p> {
     coef: Vec<c64>,
     /// Fallback only: states at multiples of the grid step, filled on demand.
     grid: RefCell<Vec<Vec<f64>>>,
+    /// Forced modes only: the segment's initial state `X₀` itself (`grid[0]` holds the
+    /// deviation `X₀ − X_p(0)`), for the round-off estimate of functionals.
+    start: Option<Vec<f64>>,
 }
 
-/// A linear functional of the state along a segment: `p₀ + p₁ s + Re Σ amp_k e^{λ_k s}`.
+/// A linear functional of the state along a segment: `p₀ + p₁ s + p₂ s² + Re Σ amp_k e^{λ_k s}`
+/// (`p₂ ≠ 0` only for a forced rigid direction: the slider in flight under a constant force).
 #[derive(Debug, Clone)]
 pub struct ExpSum {
     pub p0: f64,
     pub p1: f64,
+    pub p2: f64,
     pub amp: Vec<c64>,
     pub lam: Vec<c64>,
     period: f64,
@@ -129,9 +200,25 @@ impl Propagator {
     /// slider off the bed depend on K_d alone) reuse the closed form instead of rebuilding it.
     /// The result is the same bit for bit either way: the build is deterministic in its inputs.
     pub fn shared(k: &Mat<f64>, c: &Mat<f64>, m: &[f64], a: Mat<f64>) -> Result<Rc<Self>> {
+        Self::shared_forced(k, c, m, a, None)
+    }
+
+    /// [`Propagator::shared`] of the forced mode `M ẍ + C ẋ + K x = f` (`f` of length
+    /// `dofs`; `None` is [`Propagator::shared`]): the cache key includes `f`.
+    pub fn shared_forced(
+        k: &Mat<f64>,
+        c: &Mat<f64>,
+        m: &[f64],
+        a: Mat<f64>,
+        f: Option<&[f64]>,
+    ) -> Result<Rc<Self>> {
         let nd = m.len();
-        let mut key = Vec::with_capacity(2 * nd * nd + nd + 1);
+        let mut key = Vec::with_capacity(2 * nd * nd + 2 * nd + 2);
         key.push(nd as u64);
+        if let Some(f) = f {
+            key.push(u64::MAX);
+            key.extend(f.iter().map(|v| v.to_bits()));
+        }
         for j in 0..nd {
             for i in 0..nd {
                 key.push(k[(i, j)].to_bits());
@@ -150,7 +237,11 @@ impl Propagator {
         if let Some(p) = hit {
             return Ok(p);
         }
-        let p = Rc::new(Self::new(k, c, m, a)?);
+        let mut p = Self::new(k, c, m, a)?;
+        if let Some(f) = f {
+            p.part = Some(particular(k, c, m, f)?);
+        }
+        let p = Rc::new(p);
         CACHE.with(|cache| {
             let mut cache = cache.borrow_mut();
             cache.insert(0, (key, p.clone()));
@@ -167,6 +258,7 @@ impl Propagator {
                 a,
                 dofs,
                 kind: Kind::Spectral(s),
+                part: None,
             }),
             Err(_) => {
                 let d = super::expm::balance(&a);
@@ -179,9 +271,15 @@ impl Propagator {
                     a,
                     dofs,
                     kind: Kind::Expm { norm_f, h, e, d, b },
+                    part: None,
                 })
             }
         }
+    }
+
+    /// True when the mode has a constant forcing (an affine `Ẋ = A X + b`).
+    pub fn is_forced(&self) -> bool {
+        self.part.is_some()
     }
 
     /// True when this mode uses the spectral (not the matrix-exponential) form.
@@ -202,9 +300,21 @@ impl Propagator {
         }
     }
 
-    /// Starts a segment at state `x0`.
+    /// Starts a segment at state `x0` (with a forcing: the deviation `x0 − X_p(0)` is
+    /// propagated by the homogeneous closed form, [`Segment::state`] adds `X_p(s)`).
     pub fn segment(&self, x0: &[f64]) -> Segment<'_> {
         let nd = self.dofs;
+        let start = self.part.as_ref().map(|_| x0.to_vec());
+        let dev;
+        let x0 = match &self.part {
+            Some(p) => {
+                let mut y = vec![0.0; 2 * nd];
+                p.add_state(0.0, &mut y);
+                dev = x0.iter().zip(&y).map(|(a, b)| a - b).collect::<Vec<f64>>();
+                &dev[..]
+            }
+            None => x0,
+        };
         let (alpha0, alpha_dot, coef) = match &self.kind {
             Kind::Spectral(s) => {
                 let alpha0 = s.rproj.iter().map(|r| dot(r, &x0[..nd])).collect();
@@ -227,10 +337,12 @@ impl Propagator {
             alpha_dot,
             coef,
             grid: RefCell::new(vec![x0.to_vec()]),
+            start,
         }
     }
 
-    /// Real transition matrix `E = exp(A h)`.
+    /// Real transition matrix `E = exp(A h)` (of the homogeneous part: with a forcing,
+    /// `X(s + h) − X_p(s + h) = E (X(s) − X_p(s))`).
     pub fn transition(&self, h: f64) -> Mat<f64> {
         let n = 2 * self.dofs;
         match &self.kind {
@@ -289,8 +401,22 @@ impl<'p> Segment<'p> {
         }
     }
 
+    /// The velocity `x_1 + x_2 s` of the particular solution of a forced mode as `(x_1, x_2)`
+    /// (`None` without a forcing): `ẋ = Re Σ β_k e^{λ_k s} + rigid + x_1 + x_2 s`.
+    pub fn particular_velocity(&self) -> Option<(&[f64], &[f64])> {
+        self.p.part.as_ref().map(|p| (&p.x1[..], &p.x2[..]))
+    }
+
     /// State at time `s` after the segment start, written into `out`.
     pub fn state(&self, s: f64, out: &mut [f64]) {
+        self.homogeneous_state(s, out);
+        if let Some(p) = &self.p.part {
+            p.add_state(s, out);
+        }
+    }
+
+    /// The homogeneous part of [`Segment::state`] (all of it without a forcing).
+    fn homogeneous_state(&self, s: f64, out: &mut [f64]) {
         let nd = self.p.dofs;
         match &self.p.kind {
             Kind::Expm { h, e, .. } => {
@@ -344,8 +470,42 @@ impl<'p> Segment<'p> {
         }
     }
 
-    /// The functional `ℓᵀX(s)` along this segment.
+    /// The functional `ℓᵀX(s)` along this segment. `l` has `2·dofs` entries, or one more for
+    /// an affine functional `ℓᵀX + l_last` (of the augmented state `[X; 1]`: the slope
+    /// `ℓᵀ(A X + b)` of a channel in a forced mode).
     pub fn functional(&self, l: &[f64]) -> Functional<'_> {
+        let n = 2 * self.p.dofs;
+        let (mut extra, scale) = match &self.p.part {
+            Some(p) => (p.functional(l), p.scale(l)),
+            None => ([0.0; 3], 0.0),
+        };
+        if l.len() > n {
+            extra[0] += l[n];
+        }
+        let mut f = self.functional_homogeneous(&l[..n]);
+        if extra != [0.0; 3] {
+            match &mut f {
+                Functional::Exp(e) => {
+                    e.p0 += extra[0];
+                    e.p1 += extra[1];
+                    e.p2 += extra[2];
+                    // Round-off: of the particular terms, and the discrepancy between
+                    // ℓᵀX_p(0) + ℓᵀ(X₀ − X_p(0)) and ℓᵀX₀ computed directly (the particular
+                    // solution may be far larger than the value: a contact's overlap at rest
+                    // is a small difference of two static deflections).
+                    let direct = self.start.as_ref().map_or(0.0, |x0| {
+                        dot(&l[..n], x0) + if l.len() > n { l[n] } else { 0.0 }
+                    });
+                    e.noise += 64.0 * f64::EPSILON * (scale + extra[0].abs())
+                        + 4.0 * (e.value_slope(0.0).0 - direct).abs();
+                }
+                Functional::Expm { poly, .. } => *poly = extra,
+            }
+        }
+        f
+    }
+
+    fn functional_homogeneous(&self, l: &[f64]) -> Functional<'_> {
         let nd = self.p.dofs;
         match &self.p.kind {
             Kind::Spectral(sp) => {
@@ -386,6 +546,7 @@ impl<'p> Segment<'p> {
                 let mut e = ExpSum {
                     p0,
                     p1,
+                    p2: 0.0,
                     amp,
                     lam: sp.lam.clone(),
                     period,
@@ -413,6 +574,7 @@ impl<'p> Segment<'p> {
                     la,
                     la2_norm: norm(&ldb2),
                     norm_a: *norm_f,
+                    poly: [0.0; 3],
                 }
             }
         }
@@ -428,6 +590,8 @@ pub enum Functional<'s> {
         la: Vec<f64>,
         la2_norm: f64,
         norm_a: f64,
+        /// `ℓᵀX_p(s) = poly₀ + poly₁ s + poly₂ s²` of a forced mode (zeros without a forcing).
+        poly: [f64; 3],
     },
 }
 
@@ -439,6 +603,14 @@ impl ExpSum {
             1 => self.p1,
             _ => 0.0,
         };
+        if self.p2 != 0.0 {
+            v += match j {
+                0 => self.p2 * s * s,
+                1 => 2.0 * self.p2 * s,
+                2 => 2.0 * self.p2,
+                _ => 0.0,
+            };
+        }
         for (a, l) in self.amp.iter().zip(&self.lam) {
             v += (a * l.powu(j) * (l * s).exp()).re;
         }
@@ -450,6 +622,10 @@ impl Scalar for ExpSum {
     fn value_slope(&self, s: f64) -> (f64, f64) {
         let mut g = self.p0 + self.p1 * s;
         let mut d = self.p1;
+        if self.p2 != 0.0 {
+            g += self.p2 * s * s;
+            d += 2.0 * self.p2 * s;
+        }
         for (a, l) in self.amp.iter().zip(&self.lam) {
             let t = a * (l * s).exp();
             g += t.re;
@@ -457,19 +633,21 @@ impl Scalar for ExpSum {
         }
         (g, d)
     }
-    /// `Σ |amp_k| |λ_k|² max(e^{Re λ_k a}, e^{Re λ_k b})`.
+    /// `2|p₂| + Σ |amp_k| |λ_k|² max(e^{Re λ_k a}, e^{Re λ_k b})`.
     fn curvature_bound(&self, a: f64, b: f64) -> f64 {
-        self.curv
-            .iter()
-            .zip(&self.lam)
-            .map(|(c, l)| {
-                if l.re == 0.0 {
-                    *c
-                } else {
-                    c * (l.re * if l.re < 0.0 { a } else { b }).exp()
-                }
-            })
-            .sum()
+        2.0 * self.p2.abs()
+            + self
+                .curv
+                .iter()
+                .zip(&self.lam)
+                .map(|(c, l)| {
+                    if l.re == 0.0 {
+                        *c
+                    } else {
+                        c * (l.re * if l.re < 0.0 { a } else { b }).exp()
+                    }
+                })
+                .sum::<f64>()
     }
     fn fastest_period(&self) -> f64 {
         self.period
@@ -483,10 +661,15 @@ impl Scalar for Functional<'_> {
     fn value_slope(&self, s: f64) -> (f64, f64) {
         match self {
             Functional::Exp(e) => e.value_slope(s),
-            Functional::Expm { seg, l, la, .. } => {
+            Functional::Expm {
+                seg, l, la, poly, ..
+            } => {
                 let mut x = vec![0.0; l.len()];
-                seg.state(s, &mut x);
-                (dot(l, &x), dot(la, &x))
+                seg.homogeneous_state(s, &mut x);
+                (
+                    dot(l, &x) + poly[0] + (poly[1] + poly[2] * s) * s,
+                    dot(la, &x) + poly[1] + 2.0 * poly[2] * s,
+                )
             }
         }
     }
@@ -498,10 +681,11 @@ impl Scalar for Functional<'_> {
                 la2_norm,
                 norm_a,
                 l,
+                poly,
                 ..
             } => {
                 let mut x = vec![0.0; l.len()];
-                seg.state(a, &mut x);
+                seg.homogeneous_state(a, &mut x);
                 let dinv_x = match &seg.p.kind {
                     Kind::Expm { d, .. } => x
                         .iter()
@@ -511,7 +695,7 @@ impl Scalar for Functional<'_> {
                         .sqrt(),
                     Kind::Spectral(_) => norm(&x),
                 };
-                la2_norm * dinv_x * (norm_a * (b - a)).exp()
+                la2_norm * dinv_x * (norm_a * (b - a)).exp() + 2.0 * poly[2].abs()
             }
         }
     }
@@ -628,6 +812,91 @@ pub(crate) fn reduce(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Reduced> {
         r_cols,
         ar,
     })
+}
+
+/// The particular solution of `M ẍ + C ẋ + K x = f` on the split of [`reduce`] (see the
+/// module documentation), with one step of refinement of the constant terms: the residual
+/// `r = f − M x_2 − C x_1 − K x_c` is solved the same way and added.
+fn particular(k: &Mat<f64>, c: &Mat<f64>, m: &[f64], f: &[f64]) -> Result<Particular> {
+    let nd = m.len();
+    let red = reduce(k, c, m)?;
+    let kt = Mat::<f64>::from_fn(nd, nd, |i, j| k[(i, j)] / (red.sq[i] * red.sq[j]));
+    let ct = Mat::<f64>::from_fn(nd, nd, |i, j| c[(i, j)] / (red.sq[i] * red.sq[j]));
+    let kr = small::at_b_c(&red.q, &kt, &red.q);
+    let cr = small::at_b_c(&red.q, &ct, &red.q);
+    let mr = red.q.ncols();
+    let kappa: Vec<f64> = (0..mr).map(|j| kr[(j, j)]).collect();
+    let kmax = kappa.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    let stiff: Vec<bool> = kappa
+        .iter()
+        .map(|v| v.abs() > NULL_TOL * kmax.max(f64::MIN_POSITIVE))
+        .collect();
+    let solve = |f: &[f64]| -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let ft: Vec<f64> = (0..nd).map(|i| f[i] / red.sq[i]).collect();
+        let fnorm = norm(&ft);
+        let mut x2 = vec![0.0; nd];
+        for r in &red.r_cols {
+            let g = dot(r, &ft);
+            // A rigid direction (nearly) orthogonal to the force gets none.
+            if g.abs() > 1e-12 * fnorm {
+                for i in 0..nd {
+                    x2[i] += r[i] * g / red.sq[i];
+                }
+            }
+        }
+        let h: Vec<f64> = (0..mr)
+            .map(|j| (0..nd).map(|i| red.q[(i, j)] * ft[i]).sum())
+            .collect();
+        // Damped null directions drift at v (C_r is diagonal on them, by construction).
+        let v: Vec<f64> = (0..mr)
+            .map(|j| {
+                if stiff[j] || cr[(j, j)] == 0.0 {
+                    0.0
+                } else {
+                    h[j] / cr[(j, j)]
+                }
+            })
+            .collect();
+        let y: Vec<f64> = (0..mr)
+            .map(|j| {
+                if stiff[j] {
+                    let cv: f64 = (0..mr).map(|l| cr[(j, l)] * v[l]).sum();
+                    (h[j] - cv) / kappa[j]
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let back = |z: &[f64]| -> Vec<f64> {
+            (0..nd)
+                .map(|i| (0..mr).map(|j| red.q[(i, j)] * z[j]).sum::<f64>() / red.sq[i])
+                .collect()
+        };
+        (back(&y), back(&v), x2)
+    };
+    let (mut xc, mut x1, mut x2) = solve(f);
+    let r: Vec<f64> = (0..nd)
+        .map(|i| {
+            let mut ri = f[i] - m[i] * x2[i];
+            for j in 0..nd {
+                ri -= c[(i, j)] * x1[j] + k[(i, j)] * xc[j];
+            }
+            ri
+        })
+        .collect();
+    let (dc, d1, d2) = solve(&r);
+    for i in 0..nd {
+        xc[i] += dc[i];
+        x1[i] += d1[i];
+        x2[i] += d2[i];
+    }
+    if !xc.iter().chain(&x1).chain(&x2).all(|v| v.is_finite()) {
+        return Err(Error::numerical(
+            "propagator",
+            "the particular solution of the constant force is not finite",
+        ));
+    }
+    Ok(Particular { xc, x1, x2 })
 }
 
 fn spectral(k: &Mat<f64>, c: &Mat<f64>, m: &[f64]) -> Result<Spectral> {

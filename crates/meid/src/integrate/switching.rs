@@ -51,16 +51,19 @@ impl Linear {
 /// its own, uncoupled): the slider flying away after the blow (metres, m/s) must not make the
 /// micrometre motion of the damper against the bed seconds later look like round-off.
 ///
-/// `a` is `A` column-major (`n × n`, `n = x.len()`); `work` is scratch space (reused between
-/// calls).
+/// `a` is `A` column-major (`n × n`, `n = x.len()`), `b` the constant forcing of affine
+/// dynamics `Ẋ = A X + b` (then `Ẋ = A X + b` and `X⁽ᵏ⁾ = A^{k−1}Ẋ`); `work` is scratch space
+/// (reused between calls).
 ///
 /// # Panics
 /// When `a.len() != x.len()²`.
+#[allow(clippy::too_many_arguments)]
 fn lex_signs(
     ls: &[Linear],
     skip: &[bool],
     skip_idx: &[usize],
     a: &[f64],
+    b: Option<&[f64]>,
     x: &[f64],
     out: &mut [f64],
     work: &mut Vec<f64>,
@@ -73,6 +76,18 @@ fn lex_signs(
     if work.len() < 2 * n {
         work.resize(2 * n, 0.0);
     }
+    // With a forcing, the sizes of the terms of each derivative: `T₀ = |X|`,
+    // `T₁ = |A| T₀ + |b|`, `T_{k+1} = |A| T_k` (elementwise). At rest under a constant force
+    // `A X + b = 0` is a cancellation of terms of the size of the static forces, so a
+    // derivative counts as zero below `1e-11 Σ|ℓ_i| T_k,i` (its round-off band), not only
+    // relative to its own (round-off) entries.
+    let mut terms = b.map(|_| {
+        let mut t = vec![0.0; 2 * n];
+        for (ti, xi) in t.iter_mut().zip(x) {
+            *ti = xi.abs();
+        }
+        t
+    });
     let (y, next) = work[..2 * n].split_at_mut(n);
     y.copy_from_slice(x);
     let (mut y, mut next) = (y, next);
@@ -100,7 +115,19 @@ fn lex_signs(
                 } else {
                     *y_norm.get_or_insert_with(|| y.iter().map(|v| v * v).sum::<f64>().sqrt())
                 };
-                if val.abs() > 1e-12 * l.norm * y_norm {
+                let band = match &terms {
+                    Some(t) if k > 0 => {
+                        let (idx, lv) = l.v.parts();
+                        1e-11
+                            * idx
+                                .iter()
+                                .zip(lv)
+                                .map(|(&j, v)| v.abs() * t[j])
+                                .sum::<f64>()
+                    }
+                    _ => 0.0,
+                };
+                if val.abs() > 1e-12 * l.norm * y_norm && val.abs() > band {
                     *o = val.signum();
                     open -= 1;
                 }
@@ -110,6 +137,29 @@ fn lex_signs(
             break;
         }
         mat_vec(a, y, next);
+        if let (0, Some(b)) = (k, b) {
+            // Affine dynamics: Ẋ = A X + b, and X⁽ᵏ⁺¹⁾ = A X⁽ᵏ⁾ from there on.
+            for (v, bi) in next.iter_mut().zip(b) {
+                *v += bi;
+            }
+        }
+        if let Some(t) = terms.as_mut() {
+            let (tk, tn) = t.split_at_mut(n);
+            tn.fill(0.0);
+            for (j, &tj) in tk.iter().enumerate() {
+                if tj != 0.0 {
+                    for (o, aij) in tn.iter_mut().zip(&a[j * n..(j + 1) * n]) {
+                        *o += aij.abs() * tj;
+                    }
+                }
+            }
+            if let (0, Some(b)) = (k, b) {
+                for (o, bi) in tn.iter_mut().zip(b) {
+                    *o += bi.abs();
+                }
+            }
+            tk.copy_from_slice(tn);
+        }
         std::mem::swap(&mut y, &mut next);
     }
 }
@@ -195,6 +245,8 @@ pub struct ModeSelector<'s> {
     no_slider: Vec<bool>,
     /// The slider's coordinates `z_s`, `ż_s` in the state.
     slider_idx: [usize; 2],
+    /// The constant forcing `b` of `Ẋ = A_σ X + b` ([`ImpactSystem::forcing`]).
+    forcing: Option<Vec<f64>>,
 }
 
 impl<'s> ModeSelector<'s> {
@@ -215,6 +267,7 @@ impl<'s> ModeSelector<'s> {
             mats: Default::default(),
             no_slider: vecs_ref_no_slider,
             slider_idx: [sys.slider_index(), sys.dofs() + sys.slider_index()],
+            forcing: sys.forcing(),
         }
     }
 
@@ -255,6 +308,7 @@ impl<'s> ModeSelector<'s> {
             free,
             &self.slider_idx,
             &self.mats[mi],
+            self.forcing.as_deref(),
             x,
             out,
             &mut self.work,

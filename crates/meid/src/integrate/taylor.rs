@@ -1,4 +1,5 @@
-//! Taylor steps of one mode, `Ẋ = A X`: the truncated series
+//! Taylor steps of one mode, `Ẋ = A X` (or `Ẋ = A X + b` with a constant forcing, by adding
+//! [`TaylorMatrix::forced_coefficients`]): the truncated series
 //!
 //! ```text
 //! X(s) = Σ_{k≤P} c_k s^k,   c_k = A^k X₀ / k! = A c_{k−1} / k,   P = 24,
@@ -206,6 +207,32 @@ impl TaylorMatrix {
 }
 
 impl TaylorMatrix {
+    /// The coefficients of the forced response from rest, `X_b(s) = ∫₀^s e^{Au} b du =
+    /// Σ_{k≥1} A^{k−1} b s^k / k!`, written as `c_0 … c_P` (`c_0 = 0`) into `coef`. With a
+    /// constant forcing (`Ẋ = A X + b`) a step's coefficients are [`TaylorMatrix::expand`]'s
+    /// plus these (the response is linear in `(X₀, b)`); they depend on the mode only, so a
+    /// run computes them once per mode. The remainder beyond `P` on `[0, τ]` is below
+    /// `2.6e-17 ‖D⁻¹b‖_∞/ρ` (the bound of the homogeneous series applied to `A^{k−1}b`).
+    ///
+    /// # Panics
+    /// When `b.len() != n` or `coef.len() != (P + 1)·n`.
+    pub fn forced_coefficients(&self, b: &[f64], coef: &mut [f64]) {
+        let n = self.n;
+        // `expand(b)` gives d_k = A^k b / k!; c_k = d_{k−1} / k.
+        let mut d = vec![0.0; (ORDER + 1) * n];
+        self.expand(b, &mut d);
+        coef[..n].fill(0.0);
+        for k in 1..=ORDER {
+            let inv = 1.0 / k as f64;
+            for (c, dv) in coef[k * n..(k + 1) * n]
+                .iter_mut()
+                .zip(&d[(k - 1) * n..k * n])
+            {
+                *c = dv * inv;
+            }
+        }
+    }
+
     /// [`TaylorMatrix::expand`] for the structured form with `ND` degrees of freedom
     /// (`N = 2·ND`), on arrays of fixed size.
     fn expand_small<const ND: usize, const N: usize>(&self, x0: &[f64], coef: &mut [f64]) {

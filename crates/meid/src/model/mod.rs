@@ -389,6 +389,7 @@ impl Model {
             slider_bed,
             absorber,
         )
+        .and_then(|sys| sys.with_slider_force(s.slider.force))
         .map_err(|e| self.locate_error(e))
     }
 

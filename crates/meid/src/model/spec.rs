@@ -202,6 +202,14 @@ pub struct SliderSpec {
     pub mass: f64,
     /// v_s (m/s), towards the bed.
     pub velocity: f64,
+    /// F (N): a constant force on the slider from t = 0, positive towards the bed (its weight
+    /// on a vertical hammer, a drive or air pressure). Default 0; must be finite and ≥ 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub force: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 #[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq, Default)]
