@@ -7,7 +7,7 @@ use anyhow::{bail, Context, Result};
 use meid::analysis::study::{Objective, OptimizeStudy};
 use meid::analysis::sweep::Quantity;
 
-use crate::args::SetArgs;
+use crate::args::{PrintArgs, SetArgs};
 use crate::load;
 
 #[derive(clap::Args)]
@@ -35,13 +35,15 @@ pub struct OptimizeArgs {
     /// Simulation budget.
     #[arg(long, value_name = "N", default_value_t = 400)]
     max_simulations: usize,
-    /// Print the report as JSON on stdout.
-    #[arg(long)]
-    json: bool,
     /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, or the
     /// FE machine's bed plate; see docs/studies.md).
     #[arg(long, value_name = "KG")]
     bed_mass: Option<f64>,
+    /// Write the report (optimize.json: variables, bounds, optimum, objective values) into DIR.
+    #[arg(short, long, value_name = "DIR")]
+    output: Option<PathBuf>,
+    #[command(flatten)]
+    print: PrintArgs,
 }
 
 fn parse_bounds(s: &str) -> Result<(Quantity, (f64, f64))> {
@@ -97,8 +99,13 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
     let t0 = std::time::Instant::now();
     let rep = study.run()?;
     let elapsed = t0.elapsed().as_secs_f64();
-    if a.json {
+    if let Some(dir) = &a.output {
+        meid::io::write_json(&dir.join("optimize.json"), &rep)?;
+    }
+    if a.print.json {
         println!("{}", serde_json::to_string_pretty(&rep)?);
+    }
+    if !a.print.human() {
         return Ok(());
     }
     let method = if rep.variables.len() == 1 {
@@ -140,6 +147,9 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
     );
     if rep.failures > 0 {
         println!("  failed simulations                {}", rep.failures);
+    }
+    if let Some(dir) = &a.output {
+        println!("  wrote {}", dir.join("optimize.json").display());
     }
     Ok(())
 }
