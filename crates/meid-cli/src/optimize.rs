@@ -2,9 +2,9 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 
-use meid::analysis::study::{Objective, OptimizeStudy};
+use meid::analysis::study::{parse_bounds, Objective, OptimizeStudy};
 use meid::analysis::sweep::Quantity;
 
 use crate::args::{PrintArgs, SetArgs};
@@ -46,24 +46,6 @@ pub struct OptimizeArgs {
     print: PrintArgs,
 }
 
-fn parse_bounds(s: &str) -> Result<(Quantity, (f64, f64))> {
-    let (name, range) = s
-        .split_once('=')
-        .with_context(|| format!("--bounds `{s}`: expected PATH=LO..HI"))?;
-    let (lo, hi) = range
-        .split_once("..")
-        .with_context(|| format!("--bounds `{s}`: expected PATH=LO..HI"))?;
-    let lo: f64 = lo
-        .trim()
-        .parse()
-        .with_context(|| format!("--bounds `{s}`: `{lo}` is not a number"))?;
-    let hi: f64 = hi
-        .trim()
-        .parse()
-        .with_context(|| format!("--bounds `{s}`: `{hi}` is not a number"))?;
-    Ok((Quantity::parse(name)?, (lo, hi)))
-}
-
 pub fn run(a: OptimizeArgs) -> Result<()> {
     let model = load(&a.model, &a.set.set, None, None, None)?;
     let over: Vec<Quantity> = a
@@ -75,7 +57,7 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
         .bounds
         .iter()
         .map(|s| parse_bounds(s))
-        .collect::<Result<Vec<_>>>()?;
+        .collect::<meid::Result<Vec<_>>>()?;
     for (q, _) in &bounds {
         if !over.contains(q) {
             bail!("--bounds for {} which is not in --over", q.name());
