@@ -30,7 +30,11 @@ fn main() {
         .filter(|c| !c.is_empty())
     {
         c
-    } else if let Some(hash) = git(&manifest, &["rev-parse", "--short", "HEAD"]) {
+    } else if let Some(hash) = git(&manifest, &["ls-files", "--error-unmatch", "build.rs"])
+        // The repository must be meid's own (this file tracked in it), not one that merely
+        // contains the unpacked package (a home directory under git, a vendoring project).
+        .and_then(|_| git(&manifest, &["rev-parse", "--short", "HEAD"]))
+    {
         // Rerun when HEAD moves (a commit, a checkout) or the index changes (a staged edit).
         // The git directory of a worktree is not `.git/` itself: ask git where things are.
         let mut watched = Vec::new();
