@@ -316,7 +316,7 @@ fn edits_give_both_errors_and_valid_models() {
     for v in ["nan", "\"x\""] {
         let text = apply(LUMPED, &[Edit::ReplaceValue(velocity, 0, value(v))]);
         assert!(text.contains(&format!("velocity = {v}")), "{text}");
-        let e = load(&text).err().expect("refused");
+        let e = load(&text).expect_err("refused");
         assert!(e.to_string().contains("velocity"), "{e}");
     }
     // Insertions keep the text UTF-8 and land where asked.
