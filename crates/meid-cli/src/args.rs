@@ -47,13 +47,17 @@ impl RunArgs {
     }
 }
 
-/// `--json` and `--quiet`: what goes to stdout.
+/// `--json` and `--quiet`: what goes to stdout. Every analysis subcommand has them, with
+/// `-o/--output DIR` (declared by each, naming the files it writes), and they mean the same
+/// everywhere: `-o DIR` writes the run's files into DIR, `--json` prints the result as JSON on
+/// stdout (and nothing else there), `-q` prints nothing but errors. `--json` and `-q` exclude
+/// each other.
 #[derive(clap::Args, Debug, Clone, Copy, Default)]
 pub struct PrintArgs {
     /// Print the result as JSON on stdout.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "quiet")]
     pub json: bool,
-    /// Print nothing but errors.
+    /// Print nothing but errors (no report, warnings or progress).
     #[arg(short, long)]
     pub quiet: bool,
 }

@@ -5,9 +5,28 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::Result;
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 use meid::model::Model;
+
+// Standard output and error go through `ui` (a closed pipe ends quietly, never a panic): these
+// shadow the standard macros in every module declared below.
+macro_rules! print {
+    ($($arg:tt)*) => { $crate::ui::write_stdout(format_args!($($arg)*), false) };
+}
+macro_rules! println {
+    () => { $crate::ui::write_stdout(format_args!(""), true) };
+    ($($arg:tt)*) => { $crate::ui::write_stdout(format_args!($($arg)*), true) };
+}
+#[allow(unused_macros)]
+macro_rules! eprint {
+    ($($arg:tt)*) => { $crate::ui::write_stderr(format_args!($($arg)*), false) };
+}
+#[allow(unused_macros)]
+macro_rules! eprintln {
+    () => { $crate::ui::write_stderr(format_args!(""), true) };
+    ($($arg:tt)*) => { $crate::ui::write_stderr(format_args!($($arg)*), true) };
+}
 
 mod args;
 mod blows;
@@ -16,20 +35,26 @@ mod modes;
 mod montecarlo;
 mod optimize;
 mod outputs;
+mod shell;
 mod simulate;
 mod sweep;
+mod ui;
 
 #[derive(Parser)]
 #[command(
     name = "meid",
-    version,
+    version = concat!(env!("CARGO_PKG_VERSION"), " (commit ", env!("MEID_GIT_COMMIT"), ")"),
     about = "Momentum-exchange impact dampers for impact machines"
 )]
-struct Cli {
+pub(crate) struct Cli {
     /// Memory a run may use, e.g. 2GiB, 512MiB or bytes (default: half the physical memory).
     /// Runs estimated above it are refused before they allocate, naming the input to reduce.
     #[arg(long, global = true, value_name = "BYTES|MiB|GiB")]
     max_memory: Option<String>,
+    /// Colour `error:`/`warning:` and emphasis: auto (a terminal, unless NO_COLOR is set),
+    /// always or never.
+    #[arg(long, global = true, value_enum, default_value_t = ui::ColorChoice::Auto)]
+    color: ui::ColorChoice,
     #[command(subcommand)]
     command: Command,
 }
@@ -50,15 +75,29 @@ enum Command {
     Blows(blows::BlowsArgs),
     /// Monte Carlo over uncertain inputs (seeded): mean, percentiles, histogram.
     Montecarlo(montecarlo::MonteCarloArgs),
+    /// Shell completion script for bash, zsh, fish, elvish or powershell, on stdout.
+    Completions(shell::CompletionsArgs),
+    /// The manual page (roff) on stdout, or every page into a directory with -o.
+    Man(shell::ManArgs),
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    // `--color` is read before clap so that clap's own messages follow it.
+    let color = ui::ColorChoice::from_args(std::env::args_os());
+    ui::init_color(color);
+    let matches = Cli::command().color(color.to_clap()).get_matches();
+    let cli = match Cli::from_arg_matches(&matches) {
+        Ok(c) => c,
+        Err(e) => e.exit(),
+    };
+    if cli.color != color {
+        ui::init_color(cli.color);
+    }
     if let Some(m) = &cli.max_memory {
         match meid::limits::parse_bytes(m) {
             Ok(b) => meid::limits::set_max_memory(b),
             Err(e) => {
-                eprintln!("error: {e}");
+                ui::error(format_args!("{e}"));
                 return ExitCode::from(2);
             }
         }
@@ -71,11 +110,16 @@ fn main() -> ExitCode {
         Command::Optimize(a) => optimize::run(a),
         Command::Blows(a) => blows::run(a),
         Command::Montecarlo(a) => montecarlo::run(a),
+        Command::Completions(a) => shell::completions(a),
+        Command::Man(a) => shell::man(a),
     };
+    let result = result.and_then(|()| {
+        ui::finish_stdout().map_err(|e| anyhow::anyhow!("cannot write to standard output: {e}"))
+    });
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", error_chain(&e));
+            ui::error(format_args!("{}", error_chain(&e)));
             ExitCode::from(2)
         }
     }

@@ -8,6 +8,8 @@ use anyhow::Result;
 use meid::io;
 use meid::model::fem;
 
+use crate::args::PrintArgs;
+
 #[derive(clap::Args)]
 pub struct ModesArgs {
     /// Model file (TOML).
@@ -16,9 +18,6 @@ pub struct ModesArgs {
     /// of the selected modes (FE models) into DIR.
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
-    /// Print the table as JSON on stdout.
-    #[arg(long)]
-    json: bool,
     /// Number of lowest modes to compute and show (FE models).
     #[arg(long, value_name = "N")]
     count: Option<usize>,
@@ -28,6 +27,8 @@ pub struct ModesArgs {
     /// Override a model field, e.g. --set structure.fem.machine.elements_per_side=12 (repeatable).
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
+    #[command(flatten)]
+    print: PrintArgs,
 }
 
 pub fn run(a: ModesArgs) -> Result<()> {
@@ -46,12 +47,14 @@ pub fn run(a: ModesArgs) -> Result<()> {
         None => fem::report_from_modal(&model.structure),
     }
     .with_diagnostics(model.diagnostics());
-    for w in &report.warnings {
-        eprintln!("warning: {w}");
+    if !a.print.quiet {
+        for w in &report.warnings {
+            crate::ui::warning(w);
+        }
     }
-    if a.json {
+    if a.print.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
+    } else if a.print.human() {
         print!("{}", report.to_text());
     }
     if let (Some(out), Some(set)) = (&a.output, set) {
@@ -93,7 +96,7 @@ pub fn run(a: ModesArgs) -> Result<()> {
             anyhow::bail!("--export-matrices needs a [structure.fem] model");
         }
         set.commit("modes")?;
-        if !a.json {
+        if a.print.human() {
             println!("wrote {}", out.display());
         }
     }

@@ -2,12 +2,12 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 
-use meid::analysis::study::{Objective, OptimizeStudy};
+use meid::analysis::study::{parse_bounds, Objective, OptimizeStudy};
 use meid::analysis::sweep::Quantity;
 
-use crate::args::SetArgs;
+use crate::args::{PrintArgs, SetArgs};
 use crate::load;
 
 #[derive(clap::Args)]
@@ -37,31 +37,15 @@ pub struct OptimizeArgs {
     /// variable: a 9-point scan, one Brent step and those two; n + 3 for n variables).
     #[arg(long, value_name = "N", default_value_t = 400)]
     max_simulations: usize,
-    /// Print the report as JSON on stdout.
-    #[arg(long)]
-    json: bool,
     /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, or the
     /// FE machine's bed plate; see docs/studies.md).
     #[arg(long, value_name = "KG")]
     bed_mass: Option<f64>,
-}
-
-fn parse_bounds(s: &str) -> Result<(Quantity, (f64, f64))> {
-    let (name, range) = s
-        .split_once('=')
-        .with_context(|| format!("--bounds `{s}`: expected PATH=LO..HI"))?;
-    let (lo, hi) = range
-        .split_once("..")
-        .with_context(|| format!("--bounds `{s}`: expected PATH=LO..HI"))?;
-    let lo: f64 = lo
-        .trim()
-        .parse()
-        .with_context(|| format!("--bounds `{s}`: `{lo}` is not a number"))?;
-    let hi: f64 = hi
-        .trim()
-        .parse()
-        .with_context(|| format!("--bounds `{s}`: `{hi}` is not a number"))?;
-    Ok((Quantity::parse(name)?, (lo, hi)))
+    /// Write the report (optimize.json: variables, bounds, optimum, objective values) into DIR.
+    #[arg(short, long, value_name = "DIR")]
+    output: Option<PathBuf>,
+    #[command(flatten)]
+    print: PrintArgs,
 }
 
 pub fn run(a: OptimizeArgs) -> Result<()> {
@@ -75,7 +59,7 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
         .bounds
         .iter()
         .map(|s| parse_bounds(s))
-        .collect::<Result<Vec<_>>>()?;
+        .collect::<meid::Result<Vec<_>>>()?;
     for (i, (q, _)) in bounds.iter().enumerate() {
         if !over.contains(q) {
             bail!("--bounds for {} which is not in --over", q.name());
@@ -99,14 +83,22 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
             bail!("--bed-mass must be > 0 kg (got {m})");
         }
     }
+    // The output set first: `-o FILE` is refused before the search.
+    let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
     let mut study =
         OptimizeStudy::with_bed_mass(model, vars, Objective::parse(&a.objective)?, a.bed_mass)?;
     study.max_simulations = a.max_simulations;
     let t0 = std::time::Instant::now();
     let rep = study.run()?;
     let elapsed = t0.elapsed().as_secs_f64();
-    if a.json {
+    if let Some(set) = set {
+        meid::io::write_json(&set.staging().join("optimize.json"), &rep)?;
+        set.commit("optimize")?;
+    }
+    if a.print.json {
         println!("{}", serde_json::to_string_pretty(&rep)?);
+    }
+    if !a.print.human() {
         return Ok(());
     }
     let method = if rep.variables.len() == 1 {
@@ -148,6 +140,9 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
     );
     if rep.failures > 0 {
         println!("  failed simulations                {}", rep.failures);
+    }
+    if let Some(dir) = &a.output {
+        println!("  wrote {}", dir.join("optimize.json").display());
     }
     Ok(())
 }

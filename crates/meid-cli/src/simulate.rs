@@ -1,6 +1,5 @@
 //! `meid simulate`: one blow.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
@@ -66,7 +65,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     let diag = model.diagnostics();
     if !a.print.quiet {
         for w in &diag.warnings {
-            eprintln!("warning: {w}");
+            crate::ui::warning(w);
         }
     }
     // The summary's fields, then `truncation`, `notes` and `warnings`.
@@ -102,14 +101,7 @@ fn opt(v: Option<f64>, unit: &str, scale: f64) -> String {
 
 fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>) {
     let name = model.spec.name.as_deref().unwrap_or("model");
-    let color = std::io::stdout().is_terminal();
-    let bold = |t: &str| {
-        if color {
-            format!("\x1b[1m{t}\x1b[0m")
-        } else {
-            t.to_string()
-        }
-    };
+    let bold = crate::ui::bold;
     println!("{} — {} ({} method)", bold("meid simulate"), name, s.method);
     match s.energy_ratio {
         Some(r) => {

@@ -11,7 +11,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use meid::analysis::sweep::{Quantity, Spacing, Sweep, SweepResult, Vary, DERIVED, METRICS};
 use meid::plot::{heat_map, line_plot, HeatMap, LinePlot, Series};
 
-use crate::args::SetArgs;
+use crate::args::{PrintArgs, SetArgs};
 use crate::load;
 
 #[derive(clap::Args)]
@@ -36,9 +36,6 @@ pub struct SweepArgs {
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
-    /// No progress bar or summary.
-    #[arg(short, long)]
-    quiet: bool,
     #[command(flatten)]
     set: SetArgs,
     /// Metric drawn in the pictures and summarised (a sweep.csv column).
@@ -51,6 +48,9 @@ pub struct SweepArgs {
     /// FE machine's bed plate; see docs/studies.md).
     #[arg(long, value_name = "KG")]
     bed_mass: Option<f64>,
+    // --json prints the result (sweep.json's content); -q: no progress bar or summary either.
+    #[command(flatten)]
+    print: PrintArgs,
 }
 
 pub fn run(a: SweepArgs) -> Result<()> {
@@ -77,7 +77,7 @@ pub fn run(a: SweepArgs) -> Result<()> {
         sweep.options.stop_at_collision_end = false;
     }
     let total = sweep.len();
-    let show = !a.quiet && std::io::stderr().is_terminal();
+    let show = !a.print.quiet && std::io::stderr().is_terminal();
     let bar = if show {
         let b = ProgressBar::new(total as u64);
         b.set_style(
@@ -132,7 +132,9 @@ pub fn run(a: SweepArgs) -> Result<()> {
         if let Some(e) = sweep.all_failed_error(&result) {
             return Err(e.into());
         }
-        if !a.quiet {
+        if a.print.json {
+            println!("{}", serde_json::to_string_pretty(&result)?);
+        } else if a.print.human() {
             summarise(&sweep, &result, &a.metric, elapsed, &[]);
             println!();
             print!("{}", result.csv());
@@ -147,7 +149,9 @@ pub fn run(a: SweepArgs) -> Result<()> {
     }
     draw(&sweep, &result, &a.metric, set.staging())?;
     let files = set.commit("sweep")?;
-    if !a.quiet {
+    if a.print.json {
+        println!("{}", serde_json::to_string_pretty(&result)?);
+    } else if a.print.human() {
         summarise(&sweep, &result, &a.metric, elapsed, &files);
     }
     Ok(())

@@ -95,22 +95,44 @@ impl Distribution {
         Ok(d)
     }
 
+    /// Checks the parameters: σ ≥ 0, lognormal mean > 0 and cov ≥ 0, low ≤ high, and every
+    /// value [`Distribution::sample`] can draw finite. The standard normal deviate z of
+    /// [`SplitMix64::next_normal`] (Box-Muller on 53-bit uniforms) has |z| ≤ √(106 ln 2) < 9, so
+    /// a normal draws within μ ± 9σ; a lognormal draws exp(μ_ln + s z) with s² = ln(1 + cov²)
+    /// and μ_ln = ln(mean) − s²/2, at most exp(μ_ln + 9 s); a uniform spans high − low.
     fn validate(&self) -> Result<()> {
-        let ok = match *self {
-            Distribution::Normal { std, .. } => std >= 0.0,
-            Distribution::LogNormal { mean, cov } => mean > 0.0 && cov >= 0.0,
-            Distribution::Uniform { low, high } => low <= high,
+        const Z_MAX: f64 = 9.0;
+        let (ok, finite) = match *self {
+            Distribution::Normal { mean, std } => {
+                (std >= 0.0, (mean.abs() + Z_MAX * std).is_finite())
+            }
+            Distribution::LogNormal { mean, cov } => {
+                let s2 = (1.0 + cov * cov).ln();
+                let largest = mean.ln() - 0.5 * s2 + Z_MAX * s2.sqrt();
+                (
+                    mean > 0.0 && cov >= 0.0,
+                    (mean * cov).is_finite() && largest.exp().is_finite(),
+                )
+            }
+            Distribution::Uniform { low, high } => (low <= high, (high - low).is_finite()),
         };
-        if ok {
-            Ok(())
-        } else {
-            Err(Error::invalid(
+        if !ok {
+            return Err(Error::invalid(
                 "distribution",
                 format!(
                     "{self:?}: needs std ≥ 0, lognormal mean > 0 and cov ≥ 0, uniform low ≤ high"
                 ),
-            ))
+            ));
         }
+        if !finite {
+            return Err(Error::invalid(
+                "distribution",
+                format!(
+                    "{self:?}: draws values beyond the range of numbers (±1.8e308): needs |mean| + 9 std, lognormal mean·cov and exp(ln(mean) − s²/2 + 9 s) with s² = ln(1 + cov²), uniform high − low finite"
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// Draws one value.
@@ -130,7 +152,8 @@ impl Distribution {
     pub fn mean(&self) -> f64 {
         match *self {
             Distribution::Normal { mean, .. } | Distribution::LogNormal { mean, .. } => mean,
-            Distribution::Uniform { low, high } => 0.5 * (low + high),
+            // Halves first: (low + high)/2 overflows near ±1.8e308.
+            Distribution::Uniform { low, high } => 0.5 * low + 0.5 * high,
         }
     }
 

@@ -72,6 +72,25 @@ impl Objective {
     }
 }
 
+/// Parses one bound of an optimisation variable, `PATH=LO..HI` (`meid optimize --bounds`):
+/// the quantity ([`Quantity::parse`]) and `(LO, HI)` as written (the study checks them).
+pub fn parse_bounds(spec: &str) -> Result<(Quantity, (f64, f64))> {
+    let bad = |what: String| Error::invalid("--bounds", format!("`{spec}`: {what}"));
+    let (name, range) = spec
+        .split_once('=')
+        .ok_or_else(|| bad("expected PATH=LO..HI".into()))?;
+    let (lo, hi) = range
+        .split_once("..")
+        .ok_or_else(|| bad("expected PATH=LO..HI".into()))?;
+    let number = |t: &str| -> Result<f64> {
+        t.trim()
+            .parse()
+            .map_err(|_| bad(format!("`{}` is not a number", t.trim())))
+    };
+    let (lo, hi) = (number(lo)?, number(hi)?);
+    Ok((Quantity::parse(name)?, (lo, hi)))
+}
+
 /// One variable of an optimisation.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Variable {
