@@ -66,8 +66,10 @@ fn files_in(dir: &Path) -> Vec<PathBuf> {
 fn closed_pipe_ends_quietly_on_every_subcommand() {
     let d = tmpdir("conv", "pipe");
     for (name, args) in subcommands() {
-        let out_dir = d.join(name);
         for extra in [&[][..], &["--json"][..]] {
+            // A directory per run: a second sweep into the first one's directory would be
+            // refused (its journal needs --resume or --force).
+            let out_dir = d.join(format!("{name}{}", extra.len()));
             let mut child = in_dir(&d, &args)
                 .args(extra)
                 .arg("-o")
