@@ -16,7 +16,7 @@
 use faer::c64;
 
 use super::propagator::{ExpSum, Functional, Segment};
-use super::roots::{for_each_extremum, Scalar, SearchOptions};
+use super::roots::{for_each_extremum, HermiteCubic, Scalar, SearchOptions};
 use super::taylor::{self, Coefficients, Poly};
 use crate::impact::{Channel, CHANNELS, N_CHANNELS};
 
@@ -477,18 +477,9 @@ fn exp_extremes(e: &ExpSum, dg: &Functional<'_>, t0: f64, len: f64, ext: &mut Ex
 /// and slopes `d0`, `d1` at the ends.
 fn hermite_range(g0: f64, d0: f64, g1: f64, d1: f64, h: f64) -> (f64, f64) {
     let (mut lo, mut hi) = (g0.min(g1), g0.max(g1));
-    // p(u) = h00 g0 + h10 h d0 + h01 g1 + h11 h d1 on u ∈ [0, 1]; p'(u) = c2 u² + c1 u + c0.
-    let p = |u: f64| {
-        let u2 = u * u;
-        let u3 = u2 * u;
-        (2.0 * u3 - 3.0 * u2 + 1.0) * g0
-            + (u3 - 2.0 * u2 + u) * h * d0
-            + (-2.0 * u3 + 3.0 * u2) * g1
-            + (u3 - u2) * h * d1
-    };
-    let c2 = 3.0 * (2.0 * g0 + h * d0 - 2.0 * g1 + h * d1);
-    let c1 = 2.0 * (-3.0 * g0 - 2.0 * h * d0 + 3.0 * g1 - h * d1);
-    let c0 = h * d0;
+    let cubic = HermiteCubic { g0, d0, g1, d1, h };
+    let p = |u: f64| cubic.value(u);
+    let (c2, c1, c0) = cubic.slope_coefficients();
     let mut take = |u: f64| {
         if u > 0.0 && u < 1.0 {
             let v = p(u);

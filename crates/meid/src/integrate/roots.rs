@@ -424,22 +424,56 @@ fn proved_positive(ga: f64, da: f64, gb: f64, db: f64, m2: f64, len: f64) -> boo
     from_a + from_b > len
 }
 
+/// The cubic Hermite interpolant on `[0, h]` with values `g0`, `g1` and slopes `d0`, `d1` at
+/// the ends, in `u = s/h ∈ [0, 1]`:
+///
+/// `p(u) = (2u³ − 3u² + 1) g0 + (u³ − 2u² + u) h d0 + (−2u³ + 3u²) g1 + (u³ − u²) h d1`,
+/// `p'(u) = c2 u² + c1 u + c0` ([`HermiteCubic::slope_coefficients`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct HermiteCubic {
+    pub g0: f64,
+    pub d0: f64,
+    pub g1: f64,
+    pub d1: f64,
+    pub h: f64,
+}
+
+impl HermiteCubic {
+    /// `p(u)`.
+    pub(crate) fn value(&self, u: f64) -> f64 {
+        let HermiteCubic { g0, d0, g1, d1, h } = *self;
+        let u2 = u * u;
+        let u3 = u2 * u;
+        (2.0 * u3 - 3.0 * u2 + 1.0) * g0
+            + (u3 - 2.0 * u2 + u) * h * d0
+            + (-2.0 * u3 + 3.0 * u2) * g1
+            + (u3 - u2) * h * d1
+    }
+
+    /// `(c2, c1, c0)` of `p'(u) = c2 u² + c1 u + c0`.
+    pub(crate) fn slope_coefficients(&self) -> (f64, f64, f64) {
+        let HermiteCubic { g0, d0, g1, d1, h } = *self;
+        (
+            3.0 * (2.0 * g0 + h * d0 - 2.0 * g1 + h * d1),
+            2.0 * (-3.0 * g0 - 2.0 * h * d0 + 3.0 * g1 - h * d1),
+            h * d0,
+        )
+    }
+}
+
 /// If the cubic Hermite interpolant through (0, ga, da), (len, gb, db) dips to ≤ 0 inside,
 /// returns where (relative to the interval start).
 pub(crate) fn hermite_dip(ga: f64, da: f64, gb: f64, db: f64, len: f64) -> Option<f64> {
-    // p(u) on u in [0,1]: h00 ga + h10 len da + h01 gb + h11 len db.
-    let p = |u: f64| {
-        let u2 = u * u;
-        let u3 = u2 * u;
-        (2.0 * u3 - 3.0 * u2 + 1.0) * ga
-            + (u3 - 2.0 * u2 + u) * len * da
-            + (-2.0 * u3 + 3.0 * u2) * gb
-            + (u3 - u2) * len * db
+    let cubic = HermiteCubic {
+        g0: ga,
+        d0: da,
+        g1: gb,
+        d1: db,
+        h: len,
     };
+    let p = |u: f64| cubic.value(u);
     // p'(u) = 0 is a quadratic: find its roots in (0,1).
-    let c2 = 3.0 * (2.0 * ga + len * da - 2.0 * gb + len * db);
-    let c1 = 2.0 * (-3.0 * ga - 2.0 * len * da + 3.0 * gb - len * db);
-    let c0 = len * da;
+    let (c2, c1, c0) = cubic.slope_coefficients();
     let mut cands = [0.5_f64, f64::NAN, f64::NAN];
     if c2.abs() > 1e-300 {
         let disc = c1 * c1 - 4.0 * c2 * c0;
