@@ -259,6 +259,17 @@ fn real_fft(x: &[f64], n_fft: usize) -> Result<Vec<Complex<f64>>> {
     Ok(output)
 }
 
+/// The one-sided weight of bin `k` of an `n_fft`-point real FFT: bins `1..n_fft/2` (the
+/// Nyquist bin of an even length excluded) stand for themselves and their mirror image (2),
+/// the DC and Nyquist bins for themselves only (1).
+fn one_sided_factor(k: usize, n_fft: usize) -> f64 {
+    if k == 0 || (n_fft % 2 == 0 && k == n_fft / 2) {
+        1.0
+    } else {
+        2.0
+    }
+}
+
 fn bin_frequencies(n_bins: usize, n_fft: usize, sample_rate_hz: f64) -> Vec<f64> {
     (0..n_bins)
         .map(|k| k as f64 * sample_rate_hz / n_fft as f64)
@@ -288,20 +299,11 @@ pub fn amplitude_spectrum_padded(
     let sum_w: f64 = w.iter().sum();
     let xw: Vec<f64> = x.iter().zip(&w).map(|(a, b)| a * b).collect();
     let bins = real_fft(&xw, n_fft)?;
-    let nyquist = if n_fft % 2 == 0 {
-        Some(n_fft / 2)
-    } else {
-        None
-    };
     let amplitude = bins
         .iter()
         .enumerate()
         .map(|(k, c)| {
-            let one_sided = if k == 0 || Some(k) == nyquist {
-                1.0
-            } else {
-                2.0
-            };
+            let one_sided = one_sided_factor(k, n_fft);
             one_sided * c.norm() / sum_w
         })
         .collect();
@@ -345,7 +347,6 @@ pub fn welch_psd(x: &[f64], sample_rate_hz: f64, options: &WelchOptions) -> Resu
     let w = options.window.coefficients(l);
     let sum_w2: f64 = w.iter().map(|v| v * v).sum();
     let sum_w: f64 = w.iter().sum();
-    let nyquist = if l % 2 == 0 { Some(l / 2) } else { None };
 
     let mut planner = RealFftPlanner::<f64>::new();
     let r2c = planner.plan_fft_forward(l);
@@ -377,11 +378,7 @@ pub fn welch_psd(x: &[f64], sample_rate_hz: f64, options: &WelchOptions) -> Resu
         .iter()
         .enumerate()
         .map(|(k, a)| {
-            let one_sided = if k == 0 || Some(k) == nyquist {
-                1.0
-            } else {
-                2.0
-            };
+            let one_sided = one_sided_factor(k, l);
             one_sided * a * scale
         })
         .collect();
@@ -402,17 +399,11 @@ pub fn parseval_energy(x: &[f64], sample_rate_hz: f64) -> Result<Parseval> {
     let dt = 1.0 / sample_rate_hz;
     let df = sample_rate_hz / n as f64;
     let bins = real_fft(x, n)?;
-    let nyquist = if n % 2 == 0 { Some(n / 2) } else { None };
     let frequency_domain: f64 = bins
         .iter()
         .enumerate()
         .map(|(k, c)| {
-            // Bins 1..N/2 (excluding Nyquist) stand for themselves and their mirror image.
-            let count = if k == 0 || Some(k) == nyquist {
-                1.0
-            } else {
-                2.0
-            };
+            let count = one_sided_factor(k, n);
             count * c.norm_sqr() * dt * dt * df
         })
         .sum();
@@ -663,20 +654,11 @@ pub fn esd_fft(
     let xw: Vec<f64> = x.iter().zip(&w).map(|(a, b)| a * b).collect();
     let bins = real_fft(&xw, n_fft)?;
     let dt = 1.0 / sample_rate_hz;
-    let nyquist = if n_fft % 2 == 0 {
-        Some(n_fft / 2)
-    } else {
-        None
-    };
     let density = bins
         .iter()
         .enumerate()
         .map(|(k, c)| {
-            let one_sided = if k == 0 || Some(k) == nyquist {
-                1.0
-            } else {
-                2.0
-            };
+            let one_sided = one_sided_factor(k, n_fft);
             one_sided * c.norm_sqr() * dt * dt
         })
         .collect();
