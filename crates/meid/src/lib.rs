@@ -11,6 +11,7 @@
 //! | time | [`integrate`] | exact event-driven propagation; Dormand-Prince 5(4) with event location |
 //! | studies | [`analysis`] | energies (Eqs. 10-24), spectra, sweeps, optimisation, comparisons |
 //! | output | [`io`], [`plot`] | CSV/JSON/VTK files written atomically, PNG/SVG pictures |
+//! | reports | [`report`] | self-contained HTML pages (figures with captions, tables) |
 //! | limits | [`limits`] | memory estimated and checked before a run allocates |
 //!
 //! Units are SI throughout (m, kg, s, N, rad/s unless a name says Hz).
@@ -28,6 +29,7 @@ pub mod limits;
 pub mod modal;
 pub mod model;
 pub mod plot;
+pub mod report;
 pub mod rng;
 pub mod structure;
 
