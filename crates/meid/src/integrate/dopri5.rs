@@ -1464,10 +1464,7 @@ fn switch_to(
     });
     events.push(Event { t, from, to });
     if events.len() > max_events {
-        return Err(Error::numerical(
-            "dopri5",
-            format!("more than {max_events} switching events before t = {t:.6} s"),
-        ));
+        return Err(super::too_many_events("dopri5", events, max_events, t));
     }
     Ok(contact_energy_jump(sys, from, to, x))
 }

@@ -99,6 +99,9 @@ pub fn solve_from(
     let mut collision_end: Option<CollisionEnd> = None;
     let mut segments = 0usize;
     let mut zero_length = 0usize;
+    let mut micro_stretches = 0usize;
+    let mut searched_signs = vec![0.0; n_ind];
+    let mut moved = vec![false; n_ind];
     let mut buf = vec![0.0; n];
     let mut buf2 = vec![0.0; n];
     let mut taylor_steps = [0usize; MODES];
@@ -334,9 +337,56 @@ pub fn solve_from(
         } else {
             zero_length = 0;
         }
+        // A stretch far shorter than the time scale that ended without changing the mode: the
+        // search saw an indicator leave its side, but the selection keeps the side (a
+        // derivative within its round-off band taken as zero, a higher one of the other sign).
+        let micro = !no_progress && s_end <= MICRO_STRETCH * period.min(t_end);
+        if micro {
+            micro_stretches += 1;
+            if micro_stretches > MAX_MICRO_STRETCHES {
+                return Err(Error::numerical(
+                    "exact propagator",
+                    format!(
+                        "{MAX_MICRO_STRETCHES} stretches shorter than {MICRO_STRETCH:e} of the \
+                         time scale in a row at t = {t:.9e} s (mode {mode:?}): the switch \
+                         indicators do not settle"
+                    ),
+                ));
+            }
+        } else {
+            micro_stretches = 0;
+        }
+        searched_signs.copy_from_slice(&signs);
         // 5: the new mode, and the indicators' sides under its dynamics (those of the mode
         // taken when no mode is consistent).
-        let (new_mode, _) = selector.select(&x, mode, &mut signs);
+        let (mut new_mode, _) = selector.select(&x, mode, &mut signs);
+        if micro && new_mode == mode {
+            // The trajectory decides what the derivatives cannot: an indicator that left the
+            // side it was searched from (its value now of the other sign, where the stretch's
+            // closed form took it) takes the side it went to, and the mode follows. Without
+            // this a dashpot velocity falling at 1.02e-6 m/s² (round-off band 1.05e-6 m/s²,
+            // second derivative +2.5e-5 m/s³) is re-found 3e-15 s later, millions of times.
+            moved.fill(false);
+            for (i, l) in selector.vectors().iter().enumerate() {
+                let was = searched_signs[i];
+                let v: f64 = l.iter().zip(&x).map(|(a, b)| a * b).sum();
+                if was != 0.0 && was * v < 0.0 && signs[i] == was {
+                    signs[i] = -was;
+                    moved[i] = true;
+                }
+            }
+            if moved.iter().any(|&m| m) {
+                new_mode = selector.implied(&signs);
+                // The other indicators' sides under the new mode's dynamics.
+                let kept = signs.clone();
+                selector.signs(new_mode, &x, &mut signs);
+                for (i, sg) in signs.iter_mut().enumerate() {
+                    if moved[i] {
+                        *sg = kept[i];
+                    }
+                }
+            }
+        }
         if no_progress && new_mode == mode && forcing.is_some() {
             // Resting contact under a constant force: an indicator that "crossed" without time
             // advancing and without changing the mode is at zero within round-off (a dashpot's
@@ -364,12 +414,11 @@ pub fn solve_from(
                 to: new_mode,
             });
             if events.len() > opts.max_events {
-                return Err(Error::numerical(
+                return Err(super::too_many_events(
                     "exact propagator",
-                    format!(
-                        "more than {} switching events before t = {t:.6} s",
-                        opts.max_events
-                    ),
+                    &events,
+                    opts.max_events,
+                    t,
                 ));
             }
         }
@@ -414,6 +463,13 @@ pub fn solve_from(
         fallback_modes,
     })
 }
+
+/// A stretch that ends at a switch after at most this fraction of the fastest period, without
+/// changing the mode, is a *micro-stretch*: the trajectory, not the derivatives' signs, then
+/// decides the side of the indicator that crossed.
+const MICRO_STRETCH: f64 = 1e-9;
+/// More micro-stretches than this in a row are an error (never a hang).
+const MAX_MICRO_STRETCHES: usize = 1000;
 
 /// An indicator searched from the side the mode selection gave it. The selection decides an
 /// indicator within its zero band (`1e-9` of its terms, `switching::lex_signs`) by its

@@ -316,7 +316,7 @@ impl<'s> ModeSelector<'s> {
     }
 
     /// The mode implied by `signs` (one per indicator).
-    fn implied(&self, signs: &[f64]) -> Mode {
+    pub(crate) fn implied(&self, signs: &[f64]) -> Mode {
         let sign_of = |ind: Indicator| {
             self.inds
                 .iter()

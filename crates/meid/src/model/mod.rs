@@ -308,6 +308,16 @@ impl Model {
                 format!("simulation.atol must be > 0 (got {})", sim.atol),
             ));
         }
+        if !(1..=100_000_000).contains(&sim.max_events) {
+            return Err(src.error(
+                "simulation.max_events",
+                format!(
+                    "simulation.max_events must be between 1 and 100000000 (got {}); each \
+                     event keeps the state at the switch",
+                    sim.max_events
+                ),
+            ));
+        }
         // Everything the impact system checks (masses, stiffnesses, ...), with positions.
         self.impact_system(Case::AsSpecified)?;
         // Frequency spreads the closed-form propagator cannot carry (meaningless results).
@@ -419,6 +429,7 @@ impl Model {
             stop_at_collision_end: false,
             rtol: s.rtol,
             atol: s.atol,
+            max_events: usize::try_from(s.max_events).unwrap_or(usize::MAX),
             ..Options::default()
         }
     }

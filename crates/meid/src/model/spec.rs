@@ -322,6 +322,9 @@ pub struct SimulationSpec {
     pub rtol: f64,
     #[serde(default = "default_atol")]
     pub atol: f64,
+    /// Switching events a run may take before it stops with an error (chattering guard).
+    #[serde(default = "default_max_events")]
+    pub max_events: u64,
 }
 
 impl Default for SimulationSpec {
@@ -332,6 +335,7 @@ impl Default for SimulationSpec {
             sample_rate: default_rate(),
             rtol: default_rtol(),
             atol: default_atol(),
+            max_events: default_max_events(),
         }
     }
 }
@@ -347,4 +351,7 @@ fn default_rtol() -> f64 {
 }
 fn default_atol() -> f64 {
     1e-14
+}
+fn default_max_events() -> u64 {
+    crate::integrate::DEFAULT_MAX_EVENTS as u64
 }
