@@ -138,8 +138,10 @@ fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
                     label: c.case.label().into(),
                     x: c.history.time_s.clone(),
                     y: pick(&c.history),
+                    ..Default::default()
                 })
                 .collect(),
+            ..Default::default()
         }
     };
     plot::line_plot(
@@ -185,6 +187,7 @@ fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
                     label: c.case.label().into(),
                     x,
                     y,
+                    ..Default::default()
                 }
             })
             .collect();
@@ -193,6 +196,7 @@ fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
             y_label: label,
             x_log: true,
             series,
+            ..Default::default()
         }
     };
     plot::spectrum_plot(
@@ -230,6 +234,7 @@ fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
                     label: c.case.label().into(),
                     x,
                     y,
+                    ..Default::default()
                 }
             })
             .collect();
@@ -238,6 +243,7 @@ fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
             y_label: label,
             x_log: true,
             series,
+            ..Default::default()
         }
     };
     let band_ref = |s: &str| s.trim_end_matches("/Hz").to_string();

@@ -102,7 +102,9 @@ pub fn run(a: MonteCarloArgs) -> Result<()> {
                         label: String::new(),
                         x,
                         y,
+                        ..Default::default()
                     }],
+                    ..Default::default()
                 },
             )?;
         }

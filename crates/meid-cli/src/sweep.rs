@@ -296,7 +296,9 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                     label: String::new(),
                     x: ix.iter().map(|&i| vary[0].values[i]).collect(),
                     y: ix.iter().map(|&i| value(i, 0)).collect(),
+                    ..Default::default()
                 }],
+                ..Default::default()
             };
             let f = line_plot(dir.join(format!("{stem}_curve")), &plot)?;
             out.extend([f.png, f.svg]);
@@ -311,6 +313,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                     label: format!("{} = {}", vary[1].quantity.name(), vary[1].values[j]),
                     x: ix.iter().map(|&i| vary[0].values[i]).collect(),
                     y: ix.iter().map(|&i| value(i, j)).collect(),
+                    ..Default::default()
                 })
                 .collect();
             let plot = LinePlot {
@@ -320,6 +323,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                 x_log: vary[0].spacing == Spacing::Log,
                 y_log: false,
                 series,
+                ..Default::default()
             };
             let f = line_plot(dir.join(format!("{stem}_family")), &plot)?;
             out.extend([f.png, f.svg]);
@@ -362,6 +366,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                         label: "ω_d = ω_s".into(),
                         x: vec![a, b],
                         y: vec![a, b],
+                        ..Default::default()
                     });
                 }
             }
@@ -370,6 +375,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                     label: "ω_d = ω_s".into(),
                     x: vec![x[0], x[x.len() - 1]],
                     y: vec![1.0, 1.0],
+                    ..Default::default()
                 });
             }
             let map = HeatMap {
@@ -384,6 +390,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                 contour_levels,
                 overlay_lines,
                 colorbar_label: metric_label(metric),
+                ..Default::default()
             };
             let f = heat_map(dir.join(format!("{stem}_map")), &map)?;
             out.extend([f.png, f.svg]);
