@@ -150,7 +150,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
             dir.join("blow-levels"),
             &LinePlot {
                 title: "peak levels per blow (relative to the first blow)".into(),
-                x_label: "blow number".into(),
+                x_label: "blow number (1)".into(),
                 y_label: "peak / first blow's peak (1)".into(),
                 series: vec![
                     Series {

@@ -132,16 +132,19 @@ pub fn nice_ticks(lo: f64, hi: f64, max: usize) -> Vec<f64> {
     }
 }
 
-/// About `n` contour levels at nice values strictly inside `(lo, hi)`: the multiples of a
-/// 1-2-5 step ([`nice_ticks`] with `n + 1` ticks at most, ends excluded).
+/// At most `n` contour levels at nice values strictly inside `(lo, hi)`: the multiples of
+/// a 1-2-5 step ([`nice_ticks`] with `n + 2` ticks at most, the ends excluded; so between
+/// about `n/2` and `n` levels).
 pub fn nice_levels(lo: f64, hi: f64, n: usize) -> Vec<f64> {
     if !(lo.is_finite() && hi.is_finite()) || hi <= lo {
         return Vec::new();
     }
-    nice_ticks(lo, hi, n + 1)
+    let mut l: Vec<f64> = nice_ticks(lo, hi, n + 2)
         .into_iter()
         .filter(|v| *v > lo && *v < hi)
-        .collect()
+        .collect();
+    l.truncate(n);
+    l
 }
 
 /// A logarithmic axis over `[lo, hi]` (`0 < lo < hi`) whose labelled points are
