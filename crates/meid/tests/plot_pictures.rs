@@ -697,3 +697,71 @@ fn x_range_cuts_the_history_and_markers_label_instants() {
     bad.x_range = Some((0.2, 0.1));
     assert!(line_plot(samples().join("bad"), &bad).is_err());
 }
+
+#[test]
+fn mode_shape_names_its_mode_and_keys_both_meshes() {
+    use meid::plot::mesh::{mesh_plot, MeshPlot};
+    // A 0.4 m × 0.3 m plate of 4 × 3 cells in its first bending shape, on four posts.
+    let (nx, ny) = (5, 4);
+    let mut nodes = Vec::new();
+    let mut displacement = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            let (x, y) = (0.1 * i as f64, 0.1 * j as f64);
+            nodes.push([x, y, 0.3]);
+            displacement.push([0.0, 0.0, (PI * x / 0.4).sin() * (PI * y / 0.3).sin()]);
+        }
+    }
+    let mut edges = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            let k = j * nx + i;
+            if i + 1 < nx {
+                edges.push([k, k + 1]);
+            }
+            if j + 1 < ny {
+                edges.push([k, k + nx]);
+            }
+        }
+    }
+    for corner in [0, nx - 1, (ny - 1) * nx, ny * nx - 1] {
+        nodes.push([nodes[corner][0], nodes[corner][1], 0.0]);
+        displacement.push([0.0; 3]);
+        edges.push([corner, nodes.len() - 1]);
+    }
+    let plot = MeshPlot {
+        title: "mode 10, 285.80 Hz".into(),
+        nodes,
+        edges,
+        displacement,
+    };
+    let files = mesh_plot(samples().join("mode-shape"), &plot).unwrap();
+    let svg = read_svg(&files.svg);
+    assert!(svg.has_text("mode 10, 285.80 Hz"));
+    assert!(svg.has_text("undeformed"));
+    assert!(svg.texts.iter().any(|t| t
+        .text
+        .starts_with("mode shape, largest displacement drawn as 12 %")));
+    // Deformed (red) over undeformed (grey): every red edge comes after the last grey edge
+    // of the picture (the key's grey sample, below it, comes later).
+    let key = svg.texts_eq("undeformed")[0];
+    let last_grey = svg
+        .polys
+        .iter()
+        .rposition(|p| p.stroke == "#AAAAAA" && p.points.iter().all(|q| q.1 < key.y - 5.0))
+        .unwrap();
+    let first_red = svg
+        .polys
+        .iter()
+        .position(|p| p.stroke == "#D62728")
+        .unwrap();
+    assert!(first_red > last_grey, "red drawn before grey");
+    // The key sits below the picture.
+    let lowest_edge = svg
+        .polys
+        .iter()
+        .filter(|p| p.stroke == "#D62728" && p.points.len() == 2 && p.points[0].0 > 60.0)
+        .flat_map(|p| p.points.iter().map(|q| q.1))
+        .fold(0.0, f64::max);
+    assert!(key.y > lowest_edge, "key overlaps the picture");
+}
