@@ -359,7 +359,7 @@ where
             let frac = (px - px_lo.start) as f64 / width;
             let right = frac > 0.75;
             let dy = 6 + 20 * (k as i32 % 4);
-            let font = TextStyle::from((FONT, 15).into_font().color(&ink));
+            let font = (FONT, 15).into_font().color(&ink);
             let (w, h) = chart
                 .plotting_area()
                 .estimate_text_size(&m.label, &font)
