@@ -134,6 +134,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
                         label: String::new(),
                         x: time_s.clone(),
                         y,
+                        ..Default::default()
                     }],
                     ..LinePlot::default()
                 },
@@ -149,7 +150,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
             dir.join("blow-levels"),
             &LinePlot {
                 title: "peak levels per blow (relative to the first blow)".into(),
-                x_label: "blow number".into(),
+                x_label: "blow number (1)".into(),
                 y_label: "peak / first blow's peak (1)".into(),
                 series: vec![
                     Series {
@@ -159,6 +160,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
                             .iter()
                             .map(|x| x.peak_floor_force_n / first_f)
                             .collect(),
+                        ..Default::default()
                     },
                     Series {
                         label: "bed acceleration".into(),
@@ -167,6 +169,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
                             .iter()
                             .map(|x| x.peak_bed_acceleration_m_per_s2 / first_a)
                             .collect(),
+                        ..Default::default()
                     },
                 ],
                 ..LinePlot::default()

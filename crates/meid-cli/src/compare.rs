@@ -123,23 +123,60 @@ fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
     meid::io::write_atomic(&dir.join("reductions.csv"), &r.table_csv()?)?;
     meid::io::write_json(&dir.join("reductions.json"), &r.summary())?;
 
-    // Time histories (paper Figs. 10/11, 13/14, 18/19): the output samples.
+    // Time histories (paper Figs. 10/11, 13/14, 18/19): the output samples, one panel per
+    // case on a common scale (overlaid, the last-drawn case hid the others).
+    // The window shown: up to 1.25 × the last instant any case exceeds 2 % of the largest
+    // |value| (the rest of the record is the decayed tail), stated in the title.
     let time = |title: &str, y_label: &str, pick: &dyn Fn(&meid::analysis::History) -> Vec<f64>| {
+        let series: Vec<Series> = r
+            .cases
+            .iter()
+            .map(|c| Series {
+                label: c.case.label().into(),
+                x: c.history.time_s.clone(),
+                y: pick(&c.history),
+                ..Default::default()
+            })
+            .collect();
+        let peak = series
+            .iter()
+            .flat_map(|s| s.y.iter())
+            .filter(|v| v.is_finite())
+            .fold(0.0_f64, |m, v| m.max(v.abs()));
+        let t_end = series
+            .iter()
+            .flat_map(|s| s.x.iter())
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max);
+        let t_last = series
+            .iter()
+            .flat_map(|s| s.x.iter().zip(&s.y))
+            .filter(|(_, v)| v.abs() > 0.02 * peak)
+            .map(|(t, _)| *t)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let t0 = series
+            .first()
+            .and_then(|s| s.x.first())
+            .copied()
+            .unwrap_or(0.0);
+        let shown = 1.25 * (t_last - t0) + t0;
+        let zoom = shown.is_finite() && shown > t0 && shown < 0.8 * t_end;
         LinePlot {
-            title: title.into(),
+            title: if zoom {
+                format!(
+                    "{title}, first {} s of {} s",
+                    plot::axis::fmt_tick(&(shown - t0)),
+                    plot::axis::fmt_tick(&(t_end - t0))
+                )
+            } else {
+                title.into()
+            },
             x_label: "time (s)".into(),
             y_label: y_label.into(),
-            x_log: false,
-            y_log: false,
-            series: r
-                .cases
-                .iter()
-                .map(|c| Series {
-                    label: c.case.label().into(),
-                    x: c.history.time_s.clone(),
-                    y: pick(&c.history),
-                })
-                .collect(),
+            series,
+            panels: true,
+            x_range: zoom.then_some((t0, shown)),
+            ..Default::default()
         }
     };
     plot::line_plot(
@@ -185,6 +222,8 @@ fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
                     label: c.case.label().into(),
                     x,
                     y,
+                    style: case_style(c.case),
+                    ..Default::default()
                 }
             })
             .collect();
@@ -193,6 +232,7 @@ fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
             y_label: label,
             x_log: true,
             series,
+            ..Default::default()
         }
     };
     plot::spectrum_plot(
@@ -230,6 +270,8 @@ fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
                     label: c.case.label().into(),
                     x,
                     y,
+                    style: case_style(c.case),
+                    ..Default::default()
                 }
             })
             .collect();
@@ -238,6 +280,7 @@ fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
             y_label: label,
             x_log: true,
             series,
+            ..Default::default()
         }
     };
     let band_ref = |s: &str| s.trim_end_matches("/Hz").to_string();
@@ -260,4 +303,13 @@ fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
         ),
     )?;
     Ok(())
+}
+
+/// Stroke of a case in the overlaid spectra: the added mass dashed, so that it stays
+/// visible where it coincides with the bare machine.
+fn case_style(case: meid::analysis::compare::CaseName) -> plot::LineStyle {
+    match case {
+        meid::analysis::compare::CaseName::AddedMass => plot::LineStyle::Dashed,
+        _ => plot::LineStyle::Solid,
+    }
 }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 
 use meid::analysis::montecarlo::{histogram_outline, MonteCarlo, Uncertain, METRICS};
-use meid::plot::{self, AreaPlot, Series};
+use meid::plot::{self, AreaPlot, Marker, Series};
 
 use crate::args::{MethodArg, PrintArgs, SetArgs};
 use crate::load;
@@ -86,23 +86,47 @@ pub fn run(a: MonteCarloArgs) -> Result<()> {
         let bins = ((values.len() as f64).sqrt().ceil() as usize).clamp(5, 50);
         let (x, y) = histogram_outline(&values, bins);
         if !x.is_empty() {
+            let x_label = meid::analysis::sweep::metric_label(&a.metric);
+            // The mean and the 95th percentile of the metric, as `stats.json` gives them.
+            let fmt = meid::plot::axis::fmt_tick;
+            let markers = r
+                .metric_stats
+                .iter()
+                .find(|s| s.name == a.metric)
+                .map(|s| {
+                    vec![
+                        Marker {
+                            x: s.mean,
+                            label: format!("mean {}", fmt(&s.mean)),
+                        },
+                        Marker {
+                            x: s.p95,
+                            label: format!("P95 {}", fmt(&s.p95)),
+                        },
+                    ]
+                })
+                .unwrap_or_default();
             plot::area_plot(
                 dir.join(format!("histogram-{}", a.metric)),
                 &AreaPlot {
                     title: format!(
                         "{} over {} samples (seed {})",
-                        a.metric,
+                        x_label
+                            .rsplit_once(" (")
+                            .map_or(x_label.as_str(), |(w, _)| w),
                         values.len(),
                         a.seed
                     ),
-                    x_label: a.metric.clone(),
+                    x_label: x_label.clone(),
                     y_label: "samples per bin (1)".into(),
                     stacked: false,
                     series: vec![Series {
                         label: String::new(),
                         x,
                         y,
+                        ..Default::default()
                     }],
+                    markers,
                 },
             )?;
         }

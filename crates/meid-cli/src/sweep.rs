@@ -202,49 +202,31 @@ fn summarise(sweep: &Sweep, r: &SweepResult, metric: &str, elapsed: f64, files: 
     }
 }
 
-fn label(q: &Quantity) -> String {
-    match q {
-        Quantity::WsOverWref => "ω_s/ω_ref (1)".into(),
-        Quantity::WdOverWref => "ω_d/ω_ref (1)".into(),
-        Quantity::WdOverWs => "ω_d/ω_s (1)".into(),
-        Quantity::MdOverMb => "m_d/m_b (1)".into(),
-        Quantity::Field(p) => {
-            let unit = if p.ends_with("stiffness") {
-                " (N/m)"
-            } else if p.ends_with("mass") {
-                " (kg)"
-            } else if p.ends_with("damping") {
-                " (N·s/m)"
-            } else if p.ends_with("velocity") {
-                " (m/s)"
-            } else {
-                ""
-            };
-            format!("{p}{unit}")
-        }
+/// Axis label in the paper's terms with unit (`ω_d/ω_s (1)`, `K_s (N/m)`), ω_ref named
+/// by its mode and frequency when the reference is known.
+fn label(q: &Quantity, w_ref: Option<f64>) -> String {
+    let l = q.axis_label();
+    match (q, w_ref) {
+        (Quantity::WsOverWref | Quantity::WdOverWref, Some(w)) => format!(
+            "{l}, ω_ref = {} rad/s ({} Hz)",
+            meid::plot::axis::fmt_tick(&w),
+            meid::plot::axis::fmt_tick(&(w / (2.0 * std::f64::consts::PI)))
+        ),
+        _ => l,
     }
 }
 
 fn metric_label(m: &str) -> String {
-    // Unit by the metric's name suffix (longest suffixes first).
-    const UNITS: [(&str, &str); 7] = [
-        ("_m_per_s2", "(m/s²)"),
-        ("_m_per_s", "(m/s)"),
-        ("_n_per_m", "(N/m)"),
-        ("_kg", "(kg)"),
-        ("_j", "(J)"),
-        ("_n", "(N)"),
-        ("_s", "(s)"),
-    ];
-    let unit = if m == "energy_ratio" {
-        "E_p+/E_s− (1)"
-    } else {
-        UNITS
-            .iter()
-            .find(|(suffix, _)| m.ends_with(suffix))
-            .map_or("(1)", |(_, u)| u)
-    };
-    format!("{m} {unit}")
+    meid::analysis::sweep::metric_label(m)
+}
+
+/// The metric in words for a title: its axis label without the unit.
+fn metric_name(m: &str) -> String {
+    let l = metric_label(m);
+    match l.rfind(" (") {
+        Some(i) => l[..i].to_string(),
+        None => l,
+    }
 }
 
 /// Sorted order of a value list (pictures need increasing axes).
@@ -276,6 +258,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
         r.points[index].metric(metric)
     };
     let stem = metric.replace('/', "_");
+    let w_ref = r.spec.reference_omega_rad_per_s;
     // No picture of a metric undefined at every point (e.g. the energy ratio when no run
     // reached the end of the collision); the summary says so.
     if !r.points.iter().any(|p| p.metric(metric).is_finite()) {
@@ -287,8 +270,8 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                 return Ok(out);
             };
             let plot = LinePlot {
-                title: format!("{metric} over {}", vary[0].quantity.name()),
-                x_label: label(&vary[0].quantity),
+                title: format!("{} over {}", metric_name(metric), vary[0].quantity.symbol()),
+                x_label: label(&vary[0].quantity, w_ref),
                 y_label: metric_label(metric),
                 x_log: vary[0].spacing == Spacing::Log,
                 y_log: false,
@@ -296,7 +279,9 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                     label: String::new(),
                     x: ix.iter().map(|&i| vary[0].values[i]).collect(),
                     y: ix.iter().map(|&i| value(i, 0)).collect(),
+                    ..Default::default()
                 }],
+                ..Default::default()
             };
             let f = line_plot(dir.join(format!("{stem}_curve")), &plot)?;
             out.extend([f.png, f.svg]);
@@ -308,18 +293,20 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
             };
             let series = (0..vary[1].values.len())
                 .map(|j| Series {
-                    label: format!("{} = {}", vary[1].quantity.name(), vary[1].values[j]),
+                    label: vary[1].quantity.legend_entry(vary[1].values[j]),
                     x: ix.iter().map(|&i| vary[0].values[i]).collect(),
                     y: ix.iter().map(|&i| value(i, j)).collect(),
+                    ..Default::default()
                 })
                 .collect();
             let plot = LinePlot {
-                title: format!("{metric} over {}", vary[0].quantity.name()),
-                x_label: label(&vary[0].quantity),
+                title: format!("{} over {}", metric_name(metric), vary[0].quantity.symbol()),
+                x_label: label(&vary[0].quantity, w_ref),
                 y_label: metric_label(metric),
                 x_log: vary[0].spacing == Spacing::Log,
                 y_log: false,
                 series,
+                ..Default::default()
             };
             let f = line_plot(dir.join(format!("{stem}_family")), &plot)?;
             out.extend([f.png, f.svg]);
@@ -342,11 +329,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
                     (a.min(v), b.max(v))
                 });
-            let contour_levels: Vec<f64> = if lo < hi {
-                (1..8).map(|k| lo + (hi - lo) * k as f64 / 8.0).collect()
-            } else {
-                Vec::new()
-            };
+            let contour_levels = meid::plot::nice_levels(lo, hi, 7);
             let mut overlay_lines = Vec::new();
             let (q0, q1) = (&vary[0].quantity, &vary[1].quantity);
             let diag = matches!(
@@ -362,6 +345,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                         label: "ω_d = ω_s".into(),
                         x: vec![a, b],
                         y: vec![a, b],
+                        ..Default::default()
                     });
                 }
             }
@@ -370,12 +354,18 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                     label: "ω_d = ω_s".into(),
                     x: vec![x[0], x[x.len() - 1]],
                     y: vec![1.0, 1.0],
+                    ..Default::default()
                 });
             }
             let map = HeatMap {
-                title: format!("{metric}: {} × {}", q0.name(), q1.name()),
-                x_label: label(q0),
-                y_label: label(q1),
+                title: format!(
+                    "{} over {} and {}",
+                    metric_name(metric),
+                    q0.symbol(),
+                    q1.symbol()
+                ),
+                x_label: label(q0, w_ref),
+                y_label: label(q1, w_ref),
                 x,
                 y,
                 z,
@@ -384,6 +374,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                 contour_levels,
                 overlay_lines,
                 colorbar_label: metric_label(metric),
+                ..Default::default()
             };
             let f = heat_map(dir.join(format!("{stem}_map")), &map)?;
             out.extend([f.png, f.svg]);

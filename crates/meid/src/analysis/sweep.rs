@@ -73,8 +73,9 @@ use crate::integrate::{Method, Options};
 use crate::model::{Case, Model};
 use crate::{Error, Result};
 
-/// A quantity a sweep can vary.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+/// A quantity a sweep can vary. In JSON it is written as its [`Quantity::name`]
+/// (`"wd/ws"`, `"damper.mass"`), the name a SPEC gives it.
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Quantity {
     /// w_s / w_ref.
     WsOverWref,
@@ -128,6 +129,72 @@ impl Quantity {
         }
     }
 
+    /// The paper's symbol: `ω_s/ω_ref`, `ω_d/ω_ref`, `ω_d/ω_s`, `m_d/m_b`; for the model
+    /// fields of the paper's Fig. 1 their symbol (`K_s`, `C_s`, `K_d`, `C_d`, `m_d`, `k_d`,
+    /// `c_d`, `m_s`, `v_s`), else the field path.
+    pub fn symbol(&self) -> String {
+        match self {
+            Quantity::WsOverWref => "ω_s/ω_ref".into(),
+            Quantity::WdOverWref => "ω_d/ω_ref".into(),
+            Quantity::WdOverWs => "ω_d/ω_s".into(),
+            Quantity::MdOverMb => "m_d/m_b".into(),
+            Quantity::Field(p) => match p.as_str() {
+                "contact.slider_bed.stiffness" => "K_s",
+                "contact.slider_bed.damping" => "C_s",
+                "contact.bed_damper.stiffness" => "K_d",
+                "contact.bed_damper.damping" => "C_d",
+                "damper.mass" => "m_d",
+                "damper.stiffness" => "k_d",
+                "damper.damping" => "c_d",
+                "slider.mass" => "m_s",
+                "slider.velocity" => "v_s",
+                other => other,
+            }
+            .into(),
+        }
+    }
+
+    /// SI unit of the quantity: `1` for the ratios, by the field's last name otherwise
+    /// (`…stiffness` N/m, `…mass` kg, `…damping` N·s/m, `…velocity` m/s); `None` when
+    /// unknown.
+    pub fn unit(&self) -> Option<&'static str> {
+        match self {
+            Quantity::Field(p) => {
+                if p.ends_with("stiffness") {
+                    Some("N/m")
+                } else if p.ends_with("mass") {
+                    Some("kg")
+                } else if p.ends_with("damping") {
+                    Some("N·s/m")
+                } else if p.ends_with("velocity") {
+                    Some("m/s")
+                } else {
+                    None
+                }
+            }
+            _ => Some("1"),
+        }
+    }
+
+    /// Axis label in the paper's terms with the unit: `"ω_d/ω_s (1)"`, `"K_s (N/m)"`; a
+    /// field of unknown unit is labelled `"PATH (as in the model file)"`.
+    pub fn axis_label(&self) -> String {
+        match self.unit() {
+            Some(u) => format!("{} ({u})", self.symbol()),
+            None => format!("{} (as in the model file)", self.symbol()),
+        }
+    }
+
+    /// Legend text for one value: `"m_d/m_b = 0.35"`, `"K_s = 4.3e7 N/m"` (four
+    /// significant digits at most).
+    pub fn legend_entry(&self, value: f64) -> String {
+        let v = crate::plot::axis::fmt_tick(&value);
+        match self.unit() {
+            Some("1") | None => format!("{} = {v}", self.symbol()),
+            Some(u) => format!("{} = {v} {u}", self.symbol()),
+        }
+    }
+
     /// True for quantities naturally varied on a log scale (ratios, stiffnesses, masses).
     pub fn is_scale_like(&self) -> bool {
         match self {
@@ -135,6 +202,38 @@ impl Quantity {
             _ => true,
         }
     }
+}
+
+impl Serialize for Quantity {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(&self.name())
+    }
+}
+
+/// Axis label of a sweep metric ([`METRICS`], [`DERIVED`]) with its unit, in words:
+/// `"energy ratio E_p+/E_s− (1)"`, `"peak bed acceleration (m/s²)"`; the unit is read
+/// from the name's suffix (`_j` J, `_n` N, `_s` s, `_m_per_s2` m/s², …), `(1)` otherwise.
+pub fn metric_label(metric: &str) -> String {
+    const UNITS: [(&str, &str); 7] = [
+        ("_m_per_s2", "m/s²"),
+        ("_m_per_s", "m/s"),
+        ("_n_per_m", "N/m"),
+        ("_kg", "kg"),
+        ("_j", "J"),
+        ("_n", "N"),
+        ("_s", "s"),
+    ];
+    match metric {
+        "energy_ratio" => return "energy ratio E_p+/E_s− (1)".into(),
+        "wd_over_ws" => return "ω_d/ω_s (1)".into(),
+        "ws_over_w_ref" => return "ω_s/ω_ref (1)".into(),
+        _ => {}
+    }
+    let (stem, unit) = UNITS
+        .iter()
+        .find_map(|(suffix, u)| metric.strip_suffix(suffix).map(|s| (s, *u)))
+        .unwrap_or((metric, "1"));
+    format!("{} ({unit})", stem.replace('_', " "))
 }
 
 /// How the values of a [`Vary`] were given.

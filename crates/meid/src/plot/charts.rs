@@ -7,11 +7,15 @@ use std::path::Path;
 use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
+use super::axis::{fmt_tick, nice_ticks, LogAxis};
 use super::contour::marching_squares;
 use super::{
-    write_figure, AreaPlot, Figure, HeatMap, LinePlot, PlotFiles, Series, SpectrumPlot, FONT,
+    write_figure, AreaPlot, Figure, HeatMap, LinePlot, LineStyle, MarkedPoint, Marker, PlotFiles,
+    Series, SpectrumPlot, FONT,
 };
 use crate::{Error, Result};
 
@@ -38,36 +42,13 @@ const OVERLAY: [RGBColor; 4] = [
 /// Neutral colour of failed (non-finite) points.
 const FAILED: RGBColor = RGBColor(150, 150, 150);
 
-fn colour(i: usize) -> RGBColor {
-    PALETTE[i % PALETTE.len()]
-}
-
-/// Tick label: plain decimals for moderate magnitudes, scientific notation otherwise.
-fn fmt_tick(v: &f64) -> String {
-    let v = *v;
-    if v == 0.0 {
-        return "0".into();
-    }
-    let a = v.abs();
-    if (1e-3..1e5).contains(&a) {
-        let s = format!("{v:.4}");
-        let s = s.trim_end_matches('0').trim_end_matches('.');
-        if s == "-0" {
-            "0".into()
-        } else {
-            s.into()
-        }
-    } else {
-        let s = format!("{v:.2e}");
-        // 1.50e3 -> 1.5e3
-        match s.split_once('e') {
-            Some((m, e)) => {
-                let m = m.trim_end_matches('0').trim_end_matches('.');
-                format!("{m}e{e}")
-            }
-            None => s,
-        }
-    }
+/// The stroke of series `s` drawn at position `k`: its own colour or the palette's, its
+/// own width or 2 px.
+fn stroke(s: &Series, k: usize, palette: &[RGBColor]) -> ShapeStyle {
+    let c = s
+        .color
+        .map_or(palette[k % palette.len()], |[r, g, b]| RGBColor(r, g, b));
+    c.stroke_width(if s.width == 0 { 2 } else { s.width })
 }
 
 fn usable(v: f64, log: bool) -> bool {
@@ -85,21 +66,15 @@ fn extent(values: impl Iterator<Item = f64>, log: bool) -> Option<(f64, f64)> {
 }
 
 /// Axis range with a 4 % margin (in log space for a log axis); a single value is widened.
-/// A log axis is widened to whole decades when it would otherwise show fewer than two
-/// decade ticks (plotters labels a log axis at decades only).
 fn padded((lo, hi): (f64, f64), log: bool) -> Range<f64> {
     if log {
         let (l, h) = (lo.log10(), hi.log10());
-        let (mut l, mut h) = if h - l < 1e-12 {
+        let (l, h) = if h - l < 1e-12 {
             (l - 0.5, h + 0.5)
         } else {
             let m = 0.04 * (h - l);
             (l - m, h + m)
         };
-        if h.floor() - l.ceil() < 1.0 {
-            l = l.floor();
-            h = h.ceil().max(l + 1.0);
-        }
         10f64.powf(l)..10f64.powf(h)
     } else if hi - lo <= 1e-12 * hi.abs().max(lo.abs()) {
         let w = if lo == 0.0 { 1.0 } else { 0.1 * lo.abs() };
@@ -110,14 +85,15 @@ fn padded((lo, hi): (f64, f64), log: bool) -> Range<f64> {
     }
 }
 
-/// Calls `$f($args..., x_coord, y_coord)` with linear or logarithmic coordinates.
+/// Calls `$f($args..., x_coord, y_coord)` with linear or logarithmic (1-2-5 labelled)
+/// coordinates.
 macro_rules! with_axes {
     ($xlog:expr, $ylog:expr, $xr:expr, $yr:expr, $f:ident($($arg:expr),*)) => {
         match ($xlog, $ylog) {
             (false, false) => $f($($arg,)* RangedCoordf64::from($xr), RangedCoordf64::from($yr)),
-            (true, false) => $f($($arg,)* LogCoord::from($xr.log_scale()), RangedCoordf64::from($yr)),
-            (false, true) => $f($($arg,)* RangedCoordf64::from($xr), LogCoord::from($yr.log_scale())),
-            (true, true) => $f($($arg,)* LogCoord::from($xr.log_scale()), LogCoord::from($yr.log_scale())),
+            (true, false) => $f($($arg,)* LogAxis::new($xr), RangedCoordf64::from($yr)),
+            (false, true) => $f($($arg,)* RangedCoordf64::from($xr), LogAxis::new($yr)),
+            (true, true) => $f($($arg,)* LogAxis::new($xr), LogAxis::new($yr)),
         }
     };
 }
@@ -150,6 +126,35 @@ fn check_series(field: &str, series: &[Series]) -> Result<()> {
     Ok(())
 }
 
+fn check_markers(markers: &[Marker]) -> Result<()> {
+    if let Some(m) = markers.iter().find(|m| !m.x.is_finite()) {
+        return Err(Error::invalid(
+            "markers",
+            format!("marker '{}': x must be finite, got {}", m.label, m.x),
+        ));
+    }
+    Ok(())
+}
+
+fn check_range(field: &str, r: Option<(f64, f64)>, log: bool) -> Result<()> {
+    if let Some((a, b)) = r {
+        if !(usable(a, log) && usable(b, log) && a < b) {
+            return Err(Error::invalid(
+                field,
+                format!(
+                    "({a}, {b}) must be finite and increasing{}",
+                    if log {
+                        ", and positive on a log axis"
+                    } else {
+                        ""
+                    }
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn e2s<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
@@ -158,10 +163,13 @@ fn e2s<E: std::fmt::Display>(e: E) -> String {
 
 type Chart<'a, DB, X, Y> = ChartContext<'a, DB, Cartesian2d<X, Y>>;
 
-/// The frame every main chart shares: caption, margin and the axis label areas.
+/// The frame every main chart shares: caption (none when `title` is empty), margin and
+/// the axis label areas (`x_area` px below the frame for tick labels and description).
 fn frame<'a, DB, X, Y>(
     area: &'a DrawingArea<DB, Shift>,
     title: &str,
+    caption_size: u32,
+    x_area: u32,
     xc: X,
     yc: Y,
 ) -> std::result::Result<Chart<'a, DB, X, Y>, String>
@@ -170,10 +178,12 @@ where
     X: Ranged<ValueType = f64>,
     Y: Ranged<ValueType = f64>,
 {
-    ChartBuilder::on(area)
-        .caption(title, (FONT, 26))
-        .margin(18)
-        .x_label_area_size(58)
+    let mut b = ChartBuilder::on(area);
+    if !title.is_empty() {
+        b.caption(title, (FONT, caption_size));
+    }
+    b.margin(18)
+        .x_label_area_size(x_area)
         .y_label_area_size(88)
         .build_cartesian_2d(xc, yc)
         .map_err(e2s)
@@ -259,31 +269,182 @@ where
     Ok(())
 }
 
+/// The dash pattern a series is drawn with (`Auto` resolved to `default`).
+fn dash_of(s: &Series, default: LineStyle) -> LineStyle {
+    match s.style {
+        LineStyle::Auto => default,
+        other => other,
+    }
+}
+
+/// Draws one unbroken polyline in the given dash pattern.
+fn draw_run<'a, DB, X, Y>(
+    chart: &mut Chart<'a, DB, X, Y>,
+    run: Vec<(f64, f64)>,
+    dash: LineStyle,
+    style: ShapeStyle,
+) -> std::result::Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    match dash {
+        LineStyle::Auto | LineStyle::Solid => {
+            chart.draw_series(LineSeries::new(run, style)).map(|_| ())
+        }
+        LineStyle::Dashed => chart
+            .draw_series(DashedLineSeries::new(run, 12, 6, style))
+            .map(|_| ()),
+        LineStyle::Dotted => chart
+            .draw_series(DashedLineSeries::new(run, 3, 5, style))
+            .map(|_| ()),
+    }
+    .map_err(e2s)
+}
+
+/// The pieces `(from, to)` (px along the legend line) of a 24 px legend sample in a
+/// dash pattern: four in every case, so that every sample has one element type.
+fn legend_pieces(dash: LineStyle) -> [(i32, i32); 4] {
+    match dash {
+        LineStyle::Auto | LineStyle::Solid => [(0, 6), (6, 12), (12, 18), (18, 24)],
+        LineStyle::Dashed => [(0, 8), (12, 20), (20, 20), (20, 20)],
+        LineStyle::Dotted => [(0, 3), (7, 10), (14, 17), (21, 24)],
+    }
+}
+
+/// The legend sample of a stroke: a 24 px line in the series' dash pattern.
+macro_rules! legend_sample {
+    ($at:expr, $dash:expr, $style:expr) => {{
+        let p = legend_pieces($dash);
+        let piece = |k: usize| PathElement::new(vec![(p[k].0, 0), (p[k].1, 0)], $style);
+        EmptyElement::at($at) + piece(0) + piece(1) + piece(2) + piece(3)
+    }};
+}
+
+/// Labelled vertical lines across the frame: dark grey dashes from the bottom to the top of
+/// the y range, the label beside the top (left of the line in the right quarter of the frame),
+/// successive labels 18 px lower so that neighbours do not overwrite one another.
+fn draw_markers<'a, DB, X, Y>(
+    chart: &mut Chart<'a, DB, X, Y>,
+    markers: &[Marker],
+    with_labels: bool,
+) -> std::result::Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    if markers.is_empty() {
+        return Ok(());
+    }
+    let (xr, yr) = (chart.x_range(), chart.y_range());
+    let ink = RGBColor(60, 60, 60);
+    let (px_lo, _) = chart.plotting_area().get_pixel_range();
+    let width = (px_lo.end - px_lo.start).max(1) as f64;
+    for (k, m) in markers.iter().enumerate() {
+        if !(m.x >= xr.start.min(xr.end) && m.x <= xr.start.max(xr.end)) {
+            continue;
+        }
+        chart
+            .draw_series(std::iter::once(DashedPathElement::new(
+                vec![(m.x, yr.start), (m.x, yr.end)],
+                6,
+                4,
+                ink.stroke_width(2),
+            )))
+            .map_err(e2s)?;
+        if with_labels && !m.label.is_empty() {
+            let (px, _) = chart.backend_coord(&(m.x, yr.end));
+            let frac = (px - px_lo.start) as f64 / width;
+            let right = frac > 0.75;
+            let dy = 6 + 20 * (k as i32 % 4);
+            let font = (FONT, 15).into_font().color(&ink);
+            let (w, h) = chart
+                .plotting_area()
+                .estimate_text_size(&m.label, &font)
+                .map_err(e2s)?;
+            let (w, h) = (w as i32, h as i32);
+            // Text and its white backing box, left or right of the line.
+            let (x_text, x_box, anchor) = if right {
+                (-6, (-9 - w, -3), HPos::Right)
+            } else {
+                (6, (3, 9 + w), HPos::Left)
+            };
+            let label = EmptyElement::at((m.x, yr.end))
+                + Rectangle::new(
+                    [(x_box.0, dy - 2), (x_box.1, dy + h + 2)],
+                    WHITE.mix(0.8).filled(),
+                )
+                + Text::new(
+                    m.label.clone(),
+                    (x_text, dy),
+                    font.pos(Pos::new(anchor, VPos::Top)),
+                );
+            chart.draw_series(std::iter::once(label)).map_err(e2s)?;
+        }
+    }
+    Ok(())
+}
+
 // ---------------------------------------------------------------- line plots
 
 /// Draws a family of curves with a legend to `<path_stem>.png` and `<path_stem>.svg`.
 /// Non-finite y values break the curves and are marked by grey × at the bottom axis.
+/// With `panels`, each series gets its own panel (common x axis and y range).
 pub fn line_plot(path_stem: impl AsRef<Path>, plot: &LinePlot) -> Result<PlotFiles> {
     check_label("x_label", &plot.x_label)?;
     check_label("y_label", &plot.y_label)?;
     check_series("series", &plot.series)?;
+    check_markers(&plot.markers)?;
+    check_range("x_range", plot.x_range, plot.x_log)?;
     let drawable = |s: &Series| {
         s.x.iter()
             .zip(&s.y)
-            .any(|(x, y)| usable(*x, plot.x_log) && usable(*y, plot.y_log))
+            .any(|(x, y)| plot.in_x_range(*x) && usable(*y, plot.y_log))
     };
     if !plot.series.iter().any(drawable) {
         return Err(Error::invalid(
             "series",
-            "no drawable point (finite, and positive on a log axis)",
+            "no drawable point (finite, positive on a log axis, inside x_range)",
         ));
     }
     write_figure(path_stem.as_ref(), plot)
 }
 
+impl LinePlot {
+    fn in_x_range(&self, x: f64) -> bool {
+        usable(x, self.x_log) && self.x_range.is_none_or(|(a, b)| x >= a && x <= b)
+    }
+
+    fn panel_count(&self) -> usize {
+        if self.panels {
+            self.series.len().max(1)
+        } else {
+            1
+        }
+    }
+}
+
+/// What one frame of a line plot shows.
+struct LinesView<'a> {
+    title: &'a str,
+    caption_size: u32,
+    x_label: &'a str,
+    x_area: u32,
+    /// (palette position, series).
+    series: Vec<(usize, &'a Series)>,
+    marker_labels: bool,
+}
+
 impl Figure for LinePlot {
     fn size(&self) -> (u32, u32) {
-        (1000, 680)
+        let n = self.panel_count() as u32;
+        if n > 1 {
+            (1000, 90 + 250 * n)
+        } else {
+            (1000, 680)
+        }
     }
 
     fn draw<DB: DrawingBackend>(
@@ -295,25 +456,79 @@ impl Figure for LinePlot {
                 .iter()
                 .flat_map(|s| s.x.iter().copied().zip(s.y.iter().copied()))
         };
-        let xe = extent(
-            pts().filter(|p| usable(p.1, self.y_log)).map(|p| p.0),
-            self.x_log,
-        )
-        .ok_or("no drawable point")?;
+        let xe = match self.x_range {
+            Some(r) => r,
+            None => extent(
+                pts().filter(|p| usable(p.1, self.y_log)).map(|p| p.0),
+                self.x_log,
+            )
+            .ok_or("no drawable point")?,
+        };
         let ye = extent(
-            pts().filter(|p| usable(p.0, self.x_log)).map(|p| p.1),
+            pts().filter(|p| self.in_x_range(p.0)).map(|p| p.1),
             self.y_log,
         )
         .ok_or("no drawable point")?;
-        let xr = padded(xe, self.x_log);
+        let xr = if self.x_range.is_some() {
+            xe.0..xe.1
+        } else {
+            padded(xe, self.x_log)
+        };
         let yr = padded(ye, self.y_log);
-        with_axes!(self.x_log, self.y_log, xr, yr, draw_lines(area, self))
+        let n = self.panel_count();
+        if n == 1 {
+            let view = LinesView {
+                title: &self.title,
+                caption_size: 26,
+                x_label: &self.x_label,
+                x_area: 58,
+                series: self.series.iter().enumerate().collect(),
+                marker_labels: true,
+            };
+            return with_axes!(
+                self.x_log,
+                self.y_log,
+                xr,
+                yr,
+                draw_lines(area, self, &view)
+            );
+        }
+        let body = if self.title.is_empty() {
+            area.clone()
+        } else {
+            area.titled(&self.title, (FONT, 26)).map_err(e2s)?
+        };
+        for (k, (panel, s)) in body
+            .split_evenly((n, 1))
+            .iter()
+            .zip(&self.series)
+            .enumerate()
+        {
+            let last = k + 1 == n;
+            let view = LinesView {
+                title: &s.label,
+                caption_size: 19,
+                x_label: if last { &self.x_label } else { "" },
+                x_area: if last { 58 } else { 30 },
+                series: vec![(k, s)],
+                marker_labels: k == 0,
+            };
+            with_axes!(
+                self.x_log,
+                self.y_log,
+                xr.clone(),
+                yr.clone(),
+                draw_lines(panel, self, &view)
+            )?;
+        }
+        Ok(())
     }
 }
 
 fn draw_lines<DB, X, Y>(
     area: &DrawingArea<DB, Shift>,
     p: &LinePlot,
+    view: &LinesView<'_>,
     xc: X,
     yc: Y,
 ) -> std::result::Result<(), String>
@@ -323,22 +538,29 @@ where
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
     let y_bottom = yc.range().start;
-    let mut chart = frame(area, &p.title, xc, yc)?;
-    axes(&mut chart, &p.x_label, &p.y_label, true)?;
+    let mut chart = frame(area, view.title, view.caption_size, view.x_area, xc, yc)?;
+    axes(&mut chart, view.x_label, &p.y_label, true)?;
 
     let mut failed_x = Vec::new();
     let mut any_label = false;
-    for (k, s) in p.series.iter().enumerate() {
-        let style = colour(k).stroke_width(2);
+    for &(k, s) in &view.series {
+        let style = stroke(s, k, &PALETTE);
+        let dash = dash_of(s, LineStyle::Solid);
         // Split into runs of drawable points.
         let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
         for (&x, &y) in s.x.iter().zip(&s.y) {
-            if usable(x, p.x_log) && usable(y, p.y_log) {
+            if !p.in_x_range(x) {
+                if runs.last().is_some_and(|r| !r.is_empty()) {
+                    runs.push(Vec::new());
+                }
+                continue;
+            }
+            if usable(y, p.y_log) {
                 if let Some(run) = runs.last_mut() {
                     run.push((x, y));
                 }
             } else {
-                if usable(x, p.x_log) && !y.is_finite() {
+                if !y.is_finite() {
                     failed_x.push(x);
                 }
                 if runs.last().is_some_and(|r| !r.is_empty()) {
@@ -346,15 +568,16 @@ where
                 }
             }
         }
-        // An empty series carries the legend entry.
+        // An empty series carries the legend entry (not in panels: there the caption
+        // names the curve).
         let legend = chart
             .draw_series(LineSeries::new(Vec::<(f64, f64)>::new(), style))
             .map_err(e2s)?;
-        if !s.label.is_empty() {
+        if !s.label.is_empty() && !p.panels {
             any_label = true;
             legend
                 .label(&s.label)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], style));
+                .legend(move |c| legend_sample!(c, dash, style));
         }
         for run in runs.into_iter().filter(|r| !r.is_empty()) {
             if run.len() == 1 {
@@ -362,12 +585,11 @@ where
                     .draw_series(run.iter().map(|&q| Circle::new(q, 3, style.filled())))
                     .map_err(e2s)?;
             } else {
-                chart
-                    .draw_series(LineSeries::new(run, style))
-                    .map_err(e2s)?;
+                draw_run(&mut chart, run, dash, style)?;
             }
         }
     }
+    draw_markers(&mut chart, &p.markers, view.marker_labels)?;
     any_label |= !failed_x.is_empty();
     failed_marks(&mut chart, &failed_x, y_bottom)?;
     if any_label {
@@ -377,7 +599,7 @@ where
 }
 
 /// Spectra in dB against frequency (Hz): a [`line_plot`] with a linear level axis and a
-/// linear or logarithmic frequency axis labelled "frequency (Hz)".
+/// linear or logarithmic (1-2-5 labelled) frequency axis labelled "frequency (Hz)".
 pub fn spectrum_plot(path_stem: impl AsRef<Path>, plot: &SpectrumPlot) -> Result<PlotFiles> {
     let lines = LinePlot {
         title: plot.title.clone(),
@@ -386,6 +608,9 @@ pub fn spectrum_plot(path_stem: impl AsRef<Path>, plot: &SpectrumPlot) -> Result
         x_log: plot.x_log,
         y_log: false,
         series: plot.series.clone(),
+        markers: plot.markers.clone(),
+        panels: false,
+        x_range: plot.x_range,
     };
     line_plot(path_stem, &lines)
 }
@@ -394,11 +619,12 @@ pub fn spectrum_plot(path_stem: impl AsRef<Path>, plot: &SpectrumPlot) -> Result
 
 /// Stacked or overlaid filled histories (e.g. energies against time) to
 /// `<path_stem>.png/.svg`. Non-finite values count as 0 in the fill and are marked by a
-/// grey × at the bottom axis.
+/// grey × at the bottom axis. The legend lists the labelled series (none: no legend).
 pub fn area_plot(path_stem: impl AsRef<Path>, plot: &AreaPlot) -> Result<PlotFiles> {
     check_label("x_label", &plot.x_label)?;
     check_label("y_label", &plot.y_label)?;
     check_series("series", &plot.series)?;
+    check_markers(&plot.markers)?;
     if plot.series.is_empty() {
         return Err(Error::invalid("series", "nothing to draw"));
     }
@@ -456,8 +682,14 @@ impl Figure for AreaPlot {
         area: &DrawingArea<DB, Shift>,
     ) -> std::result::Result<(), String> {
         let bands = self.bands();
-        let xe = extent(self.series.iter().flat_map(|s| s.x.iter().copied()), false)
-            .ok_or("no x values")?;
+        let xe = extent(
+            self.series
+                .iter()
+                .flat_map(|s| s.x.iter().copied())
+                .chain(self.markers.iter().map(|m| m.x)),
+            false,
+        )
+        .ok_or("no x values")?;
         let ye = extent(
             bands
                 .iter()
@@ -466,19 +698,24 @@ impl Figure for AreaPlot {
         )
         .ok_or("no y values")?;
         let xr = xe.0..xe.1;
-        let yr = padded(ye, false);
+        // Room above the highest band for the legend and the marker labels.
+        let yr = padded((ye.0, ye.1 + 0.12 * (ye.1 - ye.0)), false);
         let y_bottom = yr.start;
         let mut chart = frame(
             area,
             &self.title,
+            26,
+            58,
             RangedCoordf64::from(xr),
             RangedCoordf64::from(yr),
         )?;
         axes(&mut chart, &self.x_label, &self.y_label, true)?;
         let fill_alpha = if self.stacked { 0.55 } else { 0.25 };
         let mut failed_x = Vec::new();
+        let mut any_label = false;
         for (k, (s, (lo, hi))) in self.series.iter().zip(&bands).enumerate() {
-            let c = colour(k);
+            let line = stroke(s, k, &PALETTE);
+            let c = line.color;
             let mut outline: Vec<(f64, f64)> =
                 s.x.iter().copied().zip(hi.iter().copied()).collect();
             let top = outline.clone();
@@ -488,13 +725,12 @@ impl Figure for AreaPlot {
                 .draw_series(std::iter::once(Polygon::new(outline, fill)))
                 .map_err(e2s)?;
             if !s.label.is_empty() {
+                any_label = true;
                 drawn
                     .label(&s.label)
                     .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], fill));
             }
-            chart
-                .draw_series(LineSeries::new(top, c.stroke_width(2)))
-                .map_err(e2s)?;
+            draw_run(&mut chart, top, dash_of(s, LineStyle::Solid), line)?;
             failed_x.extend(
                 s.x.iter()
                     .zip(&s.y)
@@ -502,8 +738,12 @@ impl Figure for AreaPlot {
                     .map(|(x, _)| *x),
             );
         }
+        draw_markers(&mut chart, &self.markers, true)?;
+        any_label |= !failed_x.is_empty();
         failed_marks(&mut chart, &failed_x, y_bottom)?;
-        legend(&mut chart, false)?;
+        if any_label {
+            legend(&mut chart, false)?;
+        }
         Ok(())
     }
 }
@@ -554,7 +794,7 @@ fn check_axis(field: &str, c: &[f64], log: bool) -> Result<()> {
     Ok(())
 }
 
-/// A heat map with colour bar, contour lines and overlay curves to
+/// A heat map with colour bar, contour lines, overlay curves and labelled points to
 /// `<path_stem>.png/.svg`. Non-finite cells are painted grey ("failed" in the legend).
 /// Contours are traced by marching squares ([`super::contour`]) in the plotted
 /// coordinates (log10 of a log axis).
@@ -582,7 +822,51 @@ pub fn heat_map(path_stem: impl AsRef<Path>, map: &HeatMap) -> Result<PlotFiles>
         ));
     }
     check_series("overlay_lines", &map.overlay_lines)?;
+    if let Some(p) = map
+        .points
+        .iter()
+        .find(|p| !usable(p.x, map.x_log) || !usable(p.y, map.y_log))
+    {
+        return Err(Error::invalid(
+            "points",
+            format!(
+                "point '{}' at ({}, {}): coordinates must be finite (and positive on a log axis)",
+                p.label, p.x, p.y
+            ),
+        ));
+    }
     write_figure(path_stem.as_ref(), map)
+}
+
+/// The legend text of the contour lines, complete (never cut off): "contours every Δ from
+/// a to b" for evenly spaced levels, the list for up to five others, else their count.
+pub(crate) fn contour_legend(levels: &[f64]) -> String {
+    let mut l: Vec<f64> = levels.to_vec();
+    l.sort_by(f64::total_cmp);
+    l.dedup();
+    match l.len() {
+        0 => String::new(),
+        1 => format!("contour at {}", fmt_tick(&l[0])),
+        n => {
+            let step = (l[n - 1] - l[0]) / (n - 1) as f64;
+            let even = n >= 3
+                && l.windows(2)
+                    .all(|w| ((w[1] - w[0]) - step).abs() <= 1e-6 * step.abs());
+            if even {
+                format!(
+                    "contours every {} from {} to {}",
+                    fmt_tick(&step),
+                    fmt_tick(&l[0]),
+                    fmt_tick(&l[n - 1])
+                )
+            } else if n <= 5 {
+                let shown: Vec<String> = l.iter().map(fmt_tick).collect();
+                format!("contours at {}", shown.join(", "))
+            } else {
+                format!("{n} contour levels (marked on the colour bar)")
+            }
+        }
+    }
 }
 
 impl HeatMap {
@@ -640,14 +924,15 @@ impl Figure for HeatMap {
         let ey = cell_edges(&self.y, self.y_log);
         let xr = ex[0]..ex[ex.len() - 1];
         let yr = ey[0]..ey[ey.len() - 1];
-        with_axes!(
+        let rows = with_axes!(
             self.x_log,
             self.y_log,
             xr,
             yr,
             draw_heat(&main, self, &ex, &ey)
         )?;
-        draw_colorbar(&bar, self)
+        let base = bar.get_base_pixel().1;
+        draw_colorbar(&bar, self, (rows.start - base)..(rows.end - base))
     }
 }
 
@@ -656,6 +941,8 @@ fn viridis(z: f64, (lo, hi): (f64, f64)) -> RGBColor {
     ViridisRGB::get_color(t)
 }
 
+/// Draws the map; returns the pixel rows (absolute) of the plotting frame, for the colour
+/// bar to match.
 fn draw_heat<DB, X, Y>(
     area: &DrawingArea<DB, Shift>,
     map: &HeatMap,
@@ -663,7 +950,7 @@ fn draw_heat<DB, X, Y>(
     ey: &[f64],
     xc: X,
     yc: Y,
-) -> std::result::Result<(), String>
+) -> std::result::Result<Range<i32>, String>
 where
     DB: DrawingBackend,
     X: Ranged<ValueType = f64> + ValueFormatter<f64>,
@@ -671,7 +958,7 @@ where
 {
     let nx = map.x.len();
     let zr = map.z_range();
-    let mut chart = frame(area, &map.title, xc, yc)?;
+    let mut chart = frame(area, &map.title, 26, 58, xc, yc)?;
     axes(&mut chart, &map.x_label, &map.y_label, false)?;
     chart
         .draw_series(map.z.iter().enumerate().map(|(k, &z)| {
@@ -695,99 +982,155 @@ where
             .legend(|(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], FAILED.filled()));
     }
     let contours = map.contours();
+    let contour_style = BLACK.stroke_width(1);
     for (k, segments) in contours.iter().enumerate() {
         let drawn = chart
             .draw_series(
                 segments
                     .iter()
-                    .map(|s| PathElement::new(vec![s[0], s[1]], BLACK.stroke_width(1))),
+                    .map(|s| PathElement::new(vec![s[0], s[1]], contour_style)),
             )
             .map_err(e2s)?;
         if k == 0 {
             any_label = true;
-            let mut text = String::from("contours at ");
-            let shown: Vec<String> = map.contour_levels.iter().take(6).map(fmt_tick).collect();
-            text.push_str(&shown.join(", "));
-            if map.contour_levels.len() > 6 {
-                text.push_str(", …");
-            }
-            drawn.label(text).legend(|(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1))
-            });
+            drawn
+                .label(contour_legend(&map.contour_levels))
+                .legend(move |c| legend_sample!(c, LineStyle::Solid, contour_style));
         }
     }
     for (k, s) in map.overlay_lines.iter().enumerate() {
-        let style = OVERLAY[k % OVERLAY.len()].stroke_width(2);
+        let style = stroke(s, k, &OVERLAY);
+        let dash = dash_of(s, LineStyle::Dashed);
         let pts: Vec<(f64, f64)> =
             s.x.iter()
                 .copied()
                 .zip(s.y.iter().copied())
                 .filter(|(x, y)| usable(*x, map.x_log) && usable(*y, map.y_log))
                 .collect();
-        let drawn = chart
-            .draw_series(DashedLineSeries::new(pts, 12, 6, style))
+        let legend_entry = chart
+            .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
             .map_err(e2s)?;
         if !s.label.is_empty() {
             any_label = true;
-            drawn
+            legend_entry
                 .label(&s.label)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+                .legend(move |c| legend_sample!(c, dash, style));
+        }
+        if pts.len() >= 2 {
+            draw_run(&mut chart, pts, dash, style)?;
         }
     }
+    draw_points(&mut chart, &map.points)?;
     if any_label {
         legend(&mut chart, true)?;
+    }
+    let (_, rows) = chart.plotting_area().get_pixel_range();
+    Ok(rows)
+}
+
+/// Labelled points: a white disc ringed in black, the label in a white box to its upper
+/// right.
+fn draw_points<'a, DB, X, Y>(
+    chart: &mut Chart<'a, DB, X, Y>,
+    points: &[MarkedPoint],
+) -> std::result::Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let font = TextStyle::from((FONT, 18).into_font());
+    for p in points {
+        let (w, h) = chart
+            .plotting_area()
+            .estimate_text_size(&p.label, &font)
+            .map_err(e2s)?;
+        let (w, h) = (w as i32, h as i32);
+        let disc = EmptyElement::at((p.x, p.y))
+            + Circle::new((0, 0), 6, WHITE.filled())
+            + Circle::new((0, 0), 6, BLACK.stroke_width(2));
+        chart.draw_series(std::iter::once(disc)).map_err(e2s)?;
+        if !p.label.is_empty() {
+            let boxed = EmptyElement::at((p.x, p.y))
+                + Rectangle::new([(9, -13 - h), (17 + w, -7)], WHITE.mix(0.92).filled())
+                + Rectangle::new([(9, -13 - h), (17 + w, -7)], BLACK.stroke_width(1))
+                + Text::new(
+                    p.label.clone(),
+                    (13, -10 - h),
+                    font.clone().pos(Pos::new(HPos::Left, VPos::Top)),
+                );
+            chart.draw_series(std::iter::once(boxed)).map_err(e2s)?;
+        }
     }
     Ok(())
 }
 
+/// The colour bar, drawn by hand in pixels so that everything sits where a reader expects:
+/// the gradient over exactly the rows of the map's frame, tick marks on its right edge,
+/// tick labels to the right of the marks (never under them), contour levels as black lines
+/// across the gradient, and the rotated label just right of the widest tick label.
 fn draw_colorbar<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     map: &HeatMap,
+    rows: Range<i32>,
 ) -> std::result::Result<(), String> {
     let (lo, hi) = map.z_range();
-    // Align with the main frame: caption (~26 px + gap) + margin on top, label area below.
-    let mut chart = ChartBuilder::on(area)
-        .margin_top(18 + 40)
-        .margin_bottom(18 + 58)
-        .margin_right(50)
-        .margin_left(4)
-        .y_label_area_size(96)
-        .build_cartesian_2d(0.0..1.0, lo..hi)
+    let (top, bottom) = (rows.start, rows.end);
+    let (x0, x1) = (14, 42);
+    let span = (bottom - top).max(1);
+    let to_px = |z: f64| bottom - ((z - lo) / (hi - lo) * span as f64).round() as i32;
+    for r in top..bottom {
+        let z = lo + (hi - lo) * ((bottom - r) as f64 - 0.5) / span as f64;
+        area.draw(&Rectangle::new(
+            [(x0, r), (x1, r + 1)],
+            viridis(z, (lo, hi)).filled(),
+        ))
         .map_err(e2s)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_desc(&map.colorbar_label)
-        .axis_desc_style((FONT, 20))
-        .label_style((FONT, 15))
-        .y_label_formatter(&fmt_tick)
-        .draw()
-        .map_err(e2s)?;
-    let steps = 256;
-    chart
-        .draw_series((0..steps).map(|k| {
-            let a = lo + (hi - lo) * k as f64 / steps as f64;
-            let b = lo + (hi - lo) * (k + 1) as f64 / steps as f64;
-            Rectangle::new(
-                [(0.0, a), (1.0, b)],
-                viridis(0.5 * (a + b), (lo, hi)).filled(),
-            )
-        }))
-        .map_err(e2s)?;
-    chart
-        .draw_series(
-            map.contour_levels
-                .iter()
-                .filter(|l| **l >= lo && **l <= hi)
-                .map(|&l| PathElement::new(vec![(0.0, l), (1.0, l)], BLACK.stroke_width(2))),
-        )
-        .map_err(e2s)?;
-    chart
-        .draw_series(std::iter::once(Rectangle::new(
-            [(0.0, lo), (1.0, hi)],
+    }
+    for &l in map.contour_levels.iter().filter(|l| **l >= lo && **l <= hi) {
+        let y = to_px(l);
+        area.draw(&PathElement::new(
+            vec![(x0, y), (x1, y)],
             BLACK.stroke_width(1),
-        )))
+        ))
         .map_err(e2s)?;
+    }
+    area.draw(&Rectangle::new(
+        [(x0, top), (x1, bottom)],
+        BLACK.stroke_width(1),
+    ))
+    .map_err(e2s)?;
+    let font = TextStyle::from((FONT, 15).into_font());
+    let mut widest = 0;
+    for t in nice_ticks(lo, hi, 7) {
+        let y = to_px(t);
+        area.draw(&PathElement::new(
+            vec![(x1, y), (x1 + COLORBAR_TICK, y)],
+            BLACK.stroke_width(1),
+        ))
+        .map_err(e2s)?;
+        let text = fmt_tick(&t);
+        let (w, _) = area.estimate_text_size(&text, &font).map_err(e2s)?;
+        widest = widest.max(w as i32);
+        area.draw(&Text::new(
+            text,
+            (x1 + COLORBAR_TICK + COLORBAR_GAP, y),
+            font.clone().pos(Pos::new(HPos::Left, VPos::Center)),
+        ))
+        .map_err(e2s)?;
+    }
+    let label_x = x1 + COLORBAR_TICK + COLORBAR_GAP + widest + 16;
+    area.draw(&Text::new(
+        map.colorbar_label.clone(),
+        (label_x, (top + bottom) / 2),
+        TextStyle::from((FONT, 20).into_font().transform(FontTransform::Rotate270))
+            .pos(Pos::new(HPos::Center, VPos::Center)),
+    ))
+    .map_err(e2s)?;
     Ok(())
 }
+
+/// Length of a colour-bar tick mark (px).
+const COLORBAR_TICK: i32 = 6;
+/// Space between a colour-bar tick mark and its label (px).
+const COLORBAR_GAP: i32 = 5;

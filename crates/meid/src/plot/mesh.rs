@@ -1,5 +1,6 @@
 //! Mode-shape pictures (the paper's Figs. 2 and 15): the undeformed mesh (grey) and the
-//! deformed mesh (red) as wireframes in an oblique parallel projection.
+//! deformed mesh (red) drawn over it as wireframes in an oblique parallel projection, with
+//! a key at the bottom naming both and the display scale.
 //!
 //! Projection (azimuth a = 35°, elevation e = 25°, z up): screen `u = −x sin a + y cos a`,
 //! `v = z cos e − (x cos a + y sin a) sin e`; the deformation is scaled so that the largest
@@ -9,6 +10,7 @@ use std::path::Path;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::{write_figure, Figure, PlotFiles, FONT};
 use crate::{Error, Result};
@@ -25,6 +27,11 @@ pub struct MeshPlot {
     /// Displacement per node (any unit; it is scaled for display).
     pub displacement: Vec<[f64; 3]>,
 }
+
+/// The largest displacement is drawn as this fraction of the mesh's largest extent.
+const DISPLAY_FRACTION: f64 = 0.12;
+/// Height of the key under the picture (px).
+const KEY_HEIGHT: i32 = 56;
 
 fn project(p: [f64; 3]) -> (f64, f64) {
     let (a, e) = (35f64.to_radians(), 25f64.to_radians());
@@ -68,7 +75,7 @@ pub fn mesh_plot(path_stem: impl AsRef<Path>, plot: &MeshPlot) -> Result<PlotFil
 
 impl Figure for MeshPlot {
     fn size(&self) -> (u32, u32) {
-        (900, 700)
+        (900, 700 + KEY_HEIGHT as u32)
     }
 
     fn draw<DB: DrawingBackend>(
@@ -92,7 +99,11 @@ impl Figure for MeshPlot {
             .iter()
             .map(|u| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt())
             .fold(0.0_f64, f64::max);
-        let scale = if umax > 0.0 { 0.12 * size / umax } else { 0.0 };
+        let scale = if umax > 0.0 {
+            DISPLAY_FRACTION * size / umax
+        } else {
+            0.0
+        };
         let undeformed: Vec<(f64, f64)> = self.nodes.iter().map(|p| project(*p)).collect();
         let deformed: Vec<(f64, f64)> = self
             .nodes
@@ -121,7 +132,7 @@ impl Figure for MeshPlot {
         // Equal scales on both axes: pad the shorter range.
         let (w, h) = self.size();
         let (du, dv) = ((uh - ul).max(1e-9), (vh - vl).max(1e-9));
-        let ratio = (w as f64 - 40.0) / (h as f64 - 80.0);
+        let ratio = (w as f64 - 40.0) / (h as f64 - 80.0 - KEY_HEIGHT as f64);
         let (du2, dv2) = if du / dv > ratio {
             (du, du / ratio)
         } else {
@@ -130,7 +141,8 @@ impl Figure for MeshPlot {
         let (uc, vc) = (0.5 * (ul + uh), 0.5 * (vl + vh));
         let xr = (uc - 0.55 * du2)..(uc + 0.55 * du2);
         let yr = (vc - 0.55 * dv2)..(vc + 0.55 * dv2);
-        let mut chart = ChartBuilder::on(area)
+        let (picture, key) = area.split_vertically(h as i32 - KEY_HEIGHT);
+        let mut chart = ChartBuilder::on(&picture)
             .caption(&self.title, (FONT, 24))
             .margin(10)
             .build_cartesian_2d(xr, yr)
@@ -144,11 +156,31 @@ impl Figure for MeshPlot {
                 )
             }))
             .map_err(|e| e.to_string())?;
+        let red = RGBColor(214, 39, 40);
         chart
             .draw_series(self.edges.iter().map(|e| {
-                PathElement::new(vec![deformed[e[0]], deformed[e[1]]], RED.stroke_width(2))
+                PathElement::new(vec![deformed[e[0]], deformed[e[1]]], red.stroke_width(2))
             }))
             .map_err(|e| e.to_string())?;
+        // The key: what grey and red are, and how much the displacement is magnified.
+        let font = TextStyle::from((FONT, 16).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
+        let rows = [
+            (grey.stroke_width(1), "undeformed".to_string()),
+            (
+                red.stroke_width(2),
+                format!(
+                    "mode shape, largest displacement drawn as {:.0} % of the largest dimension",
+                    100.0 * DISPLAY_FRACTION
+                ),
+            ),
+        ];
+        for (k, (style, text)) in rows.into_iter().enumerate() {
+            let y = 14 + 22 * k as i32;
+            key.draw(&PathElement::new(vec![(24, y), (54, y)], style))
+                .map_err(|e| e.to_string())?;
+            key.draw(&Text::new(text, (62, y), font.clone()))
+                .map_err(|e| e.to_string())?;
+        }
         Ok(())
     }
 }

@@ -13,15 +13,18 @@
 //! iso-lines are computed here by marching squares ([`contour`]).
 //!
 //! Conventions: axis labels must be given and should carry quantity and unit, e.g.
-//! `"frequency (Hz)"`. Non-finite values (failed design points) are never drawn as data:
+//! `"frequency (Hz)"`. Logarithmic axes are labelled at 1-2-5 values (1, 2, 5, 10, 20, …;
+//! [`axis::log_ticks`]), linear axes and the colour bar at multiples of a 1-2-5 step. Non-finite values (failed design points) are never drawn as data:
 //! lines break there and a grey × marks the failed abscissa at the bottom of the frame;
 //! heat-map cells are painted neutral grey and listed in the legend as "failed".
 //! Points ≤ 0 on a logarithmic axis are left out.
 
+pub mod axis;
 mod charts;
 pub mod contour;
 pub mod mesh;
 
+pub use axis::{nice_levels, nice_ticks};
 pub use charts::{area_plot, heat_map, line_plot, spectrum_plot};
 
 use std::path::{Path, PathBuf};
@@ -33,6 +36,20 @@ use plotters::prelude::*;
 
 use crate::{Error, Result};
 
+/// How a curve is stroked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LineStyle {
+    /// The chart's default: solid for curves, dashed for heat-map overlays.
+    #[default]
+    Auto,
+    /// Continuous line.
+    Solid,
+    /// Dashes of 12 px with 6 px gaps.
+    Dashed,
+    /// Dots: 3 px dashes with 5 px gaps.
+    Dotted,
+}
+
 /// One curve: `y` against `x` (same length), named in the legend by `label`
 /// (an empty label leaves the curve out of the legend).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -43,6 +60,37 @@ pub struct Series {
     pub x: Vec<f64>,
     /// Ordinates; non-finite values are failed points.
     pub y: Vec<f64>,
+    /// Stroke: solid, dashed or dotted (e.g. solid for the damper, dashed for the added
+    /// mass on one chart). Default: the chart's own.
+    pub style: LineStyle,
+    /// Colour as 8-bit RGB; `None` takes the palette colour of the series' position
+    /// (Tableau 10 on curves, red/white/orange/pink on heat maps).
+    pub color: Option<[u8; 3]>,
+    /// Stroke width in pixels; 0 takes the default (2 px).
+    pub width: u32,
+}
+
+/// A labelled vertical line at abscissa `x` (in the x axis' unit, e.g. s), drawn across
+/// the frame as a dark dashed line with `label` written beside its top, e.g.
+/// "slider leaves" or "peak PE_Kd".
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Marker {
+    /// Abscissa, in the unit of the x axis.
+    pub x: f64,
+    /// Text beside the line (empty: the line alone).
+    pub label: String,
+}
+
+/// A labelled point on a heat map (e.g. the paper's operating points P, Q, R, S, T, U):
+/// a white disc ringed in black at `(x, y)` (axis units) and `label` in a white box beside it.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct MarkedPoint {
+    /// Text beside the point, e.g. "Q".
+    pub label: String,
+    /// Abscissa, in the unit of the x axis.
+    pub x: f64,
+    /// Ordinate, in the unit of the y axis.
+    pub y: f64,
 }
 
 /// A family of curves on common axes.
@@ -60,6 +108,15 @@ pub struct LinePlot {
     pub y_log: bool,
     /// The curves, coloured in order from a ten-colour palette (Tableau 10).
     pub series: Vec<Series>,
+    /// Labelled vertical lines (e.g. the instant the slider leaves).
+    pub markers: Vec<Marker>,
+    /// One panel per series, stacked top to bottom on a common x axis and a common y
+    /// range, each named by its series label; for histories of several cases that would
+    /// hide one another when overlaid. The title is written once above the panels.
+    pub panels: bool,
+    /// Horizontal range shown, `(from, to)` in the x unit; `None` fits the data. Points
+    /// outside it are not drawn (e.g. the first 0.3 s of a 2 s history).
+    pub x_range: Option<(f64, f64)>,
 }
 
 /// A field `z(x, y)` on a rectilinear grid, drawn as coloured cells (viridis) with a colour
@@ -84,10 +141,13 @@ pub struct HeatMap {
     pub y_log: bool,
     /// Levels of black contour lines (also marked on the colour bar).
     pub contour_levels: Vec<f64>,
-    /// Curves drawn over the map, e.g. the ω_d = ω_s diagonal.
+    /// Curves drawn over the map, e.g. the ω_d = ω_s diagonal, each with its legend
+    /// entry; dashed unless the series' `style` says otherwise.
     pub overlay_lines: Vec<Series>,
     /// Colour bar label with unit.
     pub colorbar_label: String,
+    /// Labelled points drawn over the map (operating points P, Q, R …).
+    pub points: Vec<MarkedPoint>,
 }
 
 /// Several histories on a common time axis, filled, either stacked (each band is one
@@ -104,6 +164,9 @@ pub struct AreaPlot {
     pub stacked: bool,
     /// The histories, bottom band first when stacked.
     pub series: Vec<Series>,
+    /// Labelled vertical lines (e.g. "slider leaves", "peak PE_Kd", or a histogram's mean
+    /// and P95).
+    pub markers: Vec<Marker>,
 }
 
 /// Spectra in dB against frequency in Hz (a line plot with a linear dB axis).
@@ -117,6 +180,10 @@ pub struct SpectrumPlot {
     pub x_log: bool,
     /// Spectra: `x` in Hz, `y` in dB (`-inf` for empty bins is left out).
     pub series: Vec<Series>,
+    /// Labelled vertical lines at frequencies in Hz (e.g. a mode's frequency).
+    pub markers: Vec<Marker>,
+    /// Frequency range shown, `(from, to)` in Hz; `None` fits the data.
+    pub x_range: Option<(f64, f64)>,
 }
 
 /// The two files a picture was written to.
