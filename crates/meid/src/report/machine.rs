@@ -84,6 +84,8 @@ pub struct EnergyMap {
     pub design_energy_ratio: f64,
     /// The smallest E_p+/E_s− on the grid and where (axis values).
     pub minimum: Option<(f64, f64, f64)>,
+    /// The smallest value lies on the grid's edge (the true minimum may lie outside the map).
+    pub minimum_on_edge: bool,
     pub sweep: SweepResult,
 }
 
@@ -347,15 +349,21 @@ impl MachineReport {
         }
         let centre = (n / 2) * n + n / 2;
         let design_energy_ratio = result.points[centre].metric("energy_ratio");
-        let minimum = result.argmin("energy_ratio").map(|i| {
+        let best = result.argmin("energy_ratio");
+        let minimum = best.map(|i| {
             let p = &result.points[i];
             (p.values[0], p.values[1], p.metric("energy_ratio"))
+        });
+        let minimum_on_edge = best.is_some_and(|i| {
+            let (a, b) = (i / n, i % n);
+            a == 0 || b == 0 || a == n - 1 || b == n - 1
         });
         Ok(Some(EnergyMap {
             axes,
             design,
             design_energy_ratio,
             minimum,
+            minimum_on_edge,
             sweep: result,
         }))
     }
@@ -410,11 +418,12 @@ impl MachineReport {
             if let Some((x, y, e)) = m.minimum {
                 let (xn, yn) = self.map_names();
                 out.push(format!(
-                    "Energy map: E_p+/E_s− = {} % at the design; the map's smallest, {} %, is at {xn} = {}, {yn} = {} (grid value).",
+                    "Energy map: E_p+/E_s− = {} % at the design; the map's smallest, {} %, is at {xn} = {}, {yn} = {} (grid value{}).",
                     sig(100.0 * m.design_energy_ratio, 4),
                     sig(100.0 * e, 4),
                     sig(x, 4),
-                    sig(y, 4)
+                    sig(y, 4),
+                    if m.minimum_on_edge { ", on the map's edge: lower values may lie outside it" } else { "" }
                 ));
             }
         }
@@ -730,7 +739,7 @@ impl MachineReport {
                 blocks.push(Block::Figure(fig));
                 if let Some((x, y, e)) = m.minimum {
                     blocks.push(Block::Paragraph(format!(
-                        "At the design ({xn} = {}, {yn} = {}) E_p+/E_s− = {} %. The grid's smallest value is {} % at {xn} = {}, {yn} = {}: a grid value, within one grid step ({} × in each frequency) of the true minimum.",
+                        "At the design ({xn} = {}, {yn} = {}) E_p+/E_s− = {} %. The grid's smallest value is {} % at {xn} = {}, {yn} = {}: a grid value (grid step × {} in each axis){}.",
                         sig(m.design.0, 4),
                         sig(m.design.1, 4),
                         sig(100.0 * m.design_energy_ratio, 4),
@@ -741,7 +750,12 @@ impl MachineReport {
                             (if ratio { self.options.map_span } else { self.options.map_span.powi(2) })
                                 .powf(2.0 / (n - 1) as f64),
                             4
-                        )
+                        ),
+                        if m.minimum_on_edge {
+                            ", on the map's edge: the energy keeps falling outside the map (widen it with --map-span)"
+                        } else {
+                            ", within one grid step of the map's minimum"
+                        }
                     )));
                 }
             }
@@ -1103,9 +1117,9 @@ fn distribution_text(d: &crate::analysis::montecarlo::Distribution) -> String {
 
 fn objective_text(o: Objective) -> String {
     match o {
-        Objective::Energy => "energy left, E_p+/E_s− (%)".into(),
-        Objective::BedAccel => "peak bed acceleration (m/s², time peak)".into(),
-        Objective::FloorForce => "peak floor force (N, time peak)".into(),
+        Objective::Energy => "energy left E_p+/E_s−".into(),
+        Objective::BedAccel => "peak bed acceleration, time peak".into(),
+        Objective::FloorForce => "peak floor force, time peak".into(),
     }
 }
 
