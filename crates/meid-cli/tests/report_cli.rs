@@ -134,7 +134,7 @@ fn lumped_report_passes_the_page_check_and_reads_the_library_studies() {
     // The map's centre is the design. Lumped structure (examples/paper-lumped.toml): the
     // two-mode closed form ω² = (b ∓ √(b² − 4c))/2 with b = k_c/m_b + (k_c + k_f)/m_f,
     // c = k_c k_f/(m_b m_f) gives ω_1, and ω_s = √(K_s/m_s).
-    let (kc, kf, mb, mf) = (2.5415164e7, 8.1195270e4, 10.0, 41.0);
+    let (kc, kf, mb, mf): (f64, f64, f64, f64) = (2.5415164e7, 8.1195270e4, 10.0, 41.0);
     let b = kc / mb + (kc + kf) / mf;
     let c = kc * kf / (mb * mf);
     let w1 = ((b - (b * b - 4.0 * c).sqrt()) / 2.0).sqrt();
