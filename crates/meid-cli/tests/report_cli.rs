@@ -197,10 +197,19 @@ fn fe_report_passes_the_page_check() {
     let text = ok(o);
     assert!(text.contains("wrote"), "{text}");
     let html = check_report(&out, false);
-    // The FE mode table names the solver and the DOFs; the reference mode is named by its
-    // number in that table (mode 5 of the coarse-free default mesh is the 6.35 Hz bounce).
+    // The FE mode table names the solver and the DOFs, and the energy map's axes name the
+    // reference mode by its number in that table (the 6.35 Hz vertical rigid-body mode).
     let modes = section(&html, "modes");
     assert!(modes.contains("DOFs"), "{modes}");
+    let report = json(&out.join("report.json"));
+    let n = report["energy_map"]["axes"]["Ratios"]["reference_mode"]
+        .as_u64()
+        .unwrap();
+    let f = report["modes"]["modes"][(n - 1) as usize]["frequency_hz"]
+        .as_f64()
+        .unwrap();
+    assert!((f - 6.35).abs() < 0.01, "mode {n}: {f} Hz");
+    assert!(section(&html, "energy-map").contains(&format!("ω_s/ω_{n}")));
     assert!(
         section(&html, "montecarlo").contains("--vary"),
         "says how to give one"
@@ -213,6 +222,7 @@ fn bad_report_options_exit_2_naming_the_option() {
     for (args, want) in [
         (vec!["--rate-bpm", "0"], "stroke rate"),
         (vec!["--map-points", "2"], "at least 3 points"),
+        (vec!["--map-points", "100000001"], "of memory"),
         (vec!["--map-span", "1"], "span factor must be > 1"),
         (
             vec!["--vary", "contact.nosuch.stiffness=normal(1,0.1)"],

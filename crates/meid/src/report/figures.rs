@@ -26,9 +26,9 @@ use crate::plot::{self, HeatMap, LinePlot, Series, SpectrumPlot};
 use crate::{Error, Result};
 
 /// The figure block of a picture written as `<stem>.png`/`.svg`, with its data files.
-fn figure(stem: &str, alt: &str, caption: String, data: &[String]) -> Figure {
+fn figure(stem: &str, alt: &str, caption: String, data: &[&str]) -> Figure {
     let mut links = vec![format!("{stem}.svg")];
-    links.extend(data.iter().cloned());
+    links.extend(data.iter().map(|d| d.to_string()));
     Figure {
         src: format!("{stem}.png"),
         alt: alt.into(),
@@ -194,7 +194,7 @@ pub fn energy_map(dir: &Path, stem: &str, spec: &MapSpec) -> Result<Figure> {
     plot::heat_map(dir.join(stem), &map)?;
     let csv = format!("{stem}.csv");
     crate::io::write_atomic(&dir.join(&csv), sweep.csv().as_bytes())?;
-    Ok(figure(stem, &spec.title, spec.caption.clone(), &[csv]))
+    Ok(figure(stem, &spec.title, spec.caption.clone(), &[&csv]))
 }
 
 /// The reference text of the ESD levels, e.g. `1 (m/s²)²·s/Hz`, without `/Hz` for bands.
@@ -267,7 +267,7 @@ pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Res
             sig(record_s, 3),
             sig(rate, 6)
         ),
-        &[histories.clone()],
+        &[&histories],
     ));
     let stem = format!("{prefix}-floor-force-time");
     plot::line_plot(
@@ -287,7 +287,7 @@ pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Res
             "Force to the floor F (N) over the {} s record after one blow, the three cases.",
             sig(record_s, 3)
         ),
-        &[histories],
+        &[&histories],
     ));
 
     let (ea, ef) = r.esd_references();
@@ -358,7 +358,7 @@ pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Res
                 "{}: {what} in {label}, the three cases; the dominant modes' peaks are located by refinement.",
                 capitalise(what_short)
             ),
-            &[spectra.clone()],
+            &[&spectra],
         ));
         let series = r
             .cases
@@ -398,7 +398,7 @@ pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Res
                 "{}: energy in each one-third-octave band (IEC 61260-1, base 10), the integral of the ESD over the band, in dB re {reference_text}; the three cases.",
                 capitalise(what_short)
             ),
-            &[bands_csv.clone()],
+            &[&bands_csv],
         ));
     }
     Ok(out)
@@ -584,7 +584,7 @@ pub fn blow_train_figures(
                 capitalise(quantity),
                 sig(rate_bpm, 4)
             ),
-            &[csv.clone()],
+            &[&csv],
         ));
     }
     Ok(out)
@@ -648,7 +648,7 @@ pub fn histogram_figure(
         stem,
         &format!("histogram of {quantity}"),
         caption,
-        &[csv],
+        &[&csv],
     ))
 }
 

@@ -196,6 +196,14 @@ impl MachineReport {
                 format!("the record length must be > 0 s (got {})", options.record_s),
             ));
         }
+        // The map's grid is estimated before anything is allocated (a sweep point ~2 KiB).
+        let n = (options.map_points | 1) as f64;
+        crate::limits::check_memory(
+            &format!("the energy map's {n} × {n} grid (2 KiB per point)"),
+            n * n * 2048.0,
+            "map_points",
+            "the map's points per axis (--map-points)",
+        )?;
         progress(STAGES[0]);
         let (model, analysis) = fem::from_file_with_analysis(path, overrides, None)?;
         let modes = match &analysis {
