@@ -141,6 +141,7 @@ fn lumped_report_passes_the_page_check_and_reads_the_library_studies() {
     let ws = (4.2980449e7_f64 / 1.2).sqrt();
     let wd = (1.2535964e8_f64 / 3.5).sqrt();
     let map = &report["energy_map"];
+    assert_eq!(map["axes"]["kind"], "ratios");
     let design = map["design"].as_array().unwrap();
     let rel = |a: f64, b: f64| (a / b - 1.0).abs();
     // The small-root formula loses digits to cancellation (b² ≫ 4c): 1e-7 is its accuracy.
@@ -202,7 +203,7 @@ fn fe_report_passes_the_page_check() {
     let modes = section(&html, "modes");
     assert!(modes.contains("DOFs"), "{modes}");
     let report = json(&out.join("report.json"));
-    let n = report["energy_map"]["axes"]["Ratios"]["reference_mode"]
+    let n = report["energy_map"]["axes"]["reference_mode"]
         .as_u64()
         .unwrap();
     let f = report["modes"]["modes"][(n - 1) as usize]["frequency_hz"]

@@ -63,6 +63,21 @@ pub fn sig(v: f64, digits: usize) -> String {
     }
 }
 
+/// `v` with up to 6 significant digits and no trailing zeros (`60`, `62.5`, `4.3e7`).
+pub fn plain(v: f64) -> String {
+    let s = sig(v, 6);
+    let (mantissa, exponent) = match s.split_once('e') {
+        Some((m, e)) => (m, format!("e{e}")),
+        None => (s.as_str(), String::new()),
+    };
+    let mantissa = if mantissa.contains('.') {
+        mantissa.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        mantissa
+    };
+    format!("{mantissa}{exponent}")
+}
+
 /// What [`energy_map`] draws: one metric of a two-quantity sweep over its grid.
 #[derive(Debug, Clone, Default)]
 pub struct MapSpec<'a> {
@@ -568,7 +583,7 @@ pub fn blow_train_figures(
             &LinePlot {
                 title: format!(
                     "{quantity} per blow, {blows} blows at {} /min",
-                    sig(rate_bpm, 4)
+                    plain(rate_bpm)
                 ),
                 x_label: "blow number (1)".into(),
                 y_label: label.into(),
@@ -582,7 +597,7 @@ pub fn blow_train_figures(
             format!(
                 "{} of each blow (exact time peak within the blow interval, {label}) in a train of {blows} blows at {} blows/min, without damper, with the impact damper and with the added mass; each blow starts from the state the previous one left.",
                 capitalise(quantity),
-                sig(rate_bpm, 4)
+                plain(rate_bpm)
             ),
             &[&csv],
         ));
@@ -753,5 +768,9 @@ mod tests {
         assert_eq!(sig(0.0123, 2), "0.012");
         assert_eq!(sig(f64::NAN, 2), "—");
         assert_eq!(sig(0.0, 3), "0");
+        assert_eq!(super::plain(60.0), "60");
+        assert_eq!(super::plain(62.5), "62.5");
+        assert_eq!(super::plain(4.3e7), "4.3e7");
+        assert_eq!(super::plain(100.0), "100");
     }
 }

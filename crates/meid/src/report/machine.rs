@@ -65,8 +65,10 @@ impl Default for MachineOptions {
     }
 }
 
-/// The axes of the energy map.
+/// The axes of the energy map (JSON: `{"kind": "ratios", "reference_mode": 6}` or
+/// `{"kind": "stiffnesses"}`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum MapAxes {
     /// ω_s/ω_n and ω_d/ω_n, ω_n the reference mode (its number in the mode table).
     Ratios { reference_mode: usize },
@@ -453,7 +455,7 @@ impl MachineReport {
             out.push(format!(
                 "{} blows at {} /min: last blow's peak floor force {} N without damper, {} N with it ({:+.2} dB, time peak); damper gap at the next strike {}.",
                 self.options.blows,
-                sig(self.options.rate_bpm, 4),
+                figures::plain(self.options.rate_bpm),
                 sig(last(n), 4),
                 sig(last(d), 4),
                 20.0 * (last(n) / last(d)).log10(),
@@ -838,7 +840,7 @@ impl MachineReport {
             Block::Paragraph(format!(
                 "{} blows at {} blows/min (interval {} s, rounded to whole output samples); each blow starts from the state the previous one left, with a fresh slider at v_s. The model file has no stroke rate: it is the report's setting (meid report --rate-bpm). A single rate reads the rigid-body mode's comb filter as much as the damper (docs/studies.md, \"Repeated blows\"): check the neighbouring rates before concluding.",
                 self.options.blows,
-                sig(self.options.rate_bpm, 4),
+                figures::plain(self.options.rate_bpm),
                 sig(interval, 6)
             )),
             Block::Table(Table {
