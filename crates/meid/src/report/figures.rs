@@ -78,6 +78,15 @@ pub fn plain(v: f64) -> String {
     format!("{mantissa}{exponent}")
 }
 
+/// A point marked on a map, in axis values.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Mark {
+    /// Legend text (empty: unnamed).
+    pub label: String,
+    pub x: f64,
+    pub y: f64,
+}
+
 /// What [`energy_map`] draws: one metric of a two-quantity sweep over its grid.
 #[derive(Debug, Clone, Default)]
 pub struct MapSpec<'a> {
@@ -95,9 +104,9 @@ pub struct MapSpec<'a> {
     pub y_label: String,
     /// Colour-bar label with unit.
     pub colorbar_label: String,
-    /// The point to mark (the current design), in axis values, and its legend text.
-    pub design: Option<(f64, f64)>,
-    pub design_label: String,
+    /// Points to mark (the current design; the paper's operating points P … U), each drawn
+    /// as a square with a cross, named in the legend.
+    pub marks: Vec<Mark>,
     /// Draw the line x = y with this legend text (e.g. `ω_d = ω_s` on a ω_s/ω_ref × ω_d/ω_ref
     /// map); empty: no line.
     pub diagonal_label: String,
@@ -106,7 +115,7 @@ pub struct MapSpec<'a> {
 }
 
 /// A heat map of `spec.metric` over the sweep's two quantities, with contour lines, the
-/// line x = y and the design marked by a square and a cross; writes `<stem>.png/.svg` and the
+/// line x = y and the marks (each a square and a cross); writes `<stem>.png/.svg` and the
 /// sweep table `<stem>.csv`.
 pub fn energy_map(dir: &Path, stem: &str, spec: &MapSpec) -> Result<Figure> {
     let sweep = spec
@@ -162,7 +171,8 @@ pub fn energy_map(dir: &Path, stem: &str, spec: &MapSpec) -> Result<Figure> {
             });
         }
     }
-    if let Some((dx, dy)) = spec.design {
+    for mark in &spec.marks {
+        let (dx, dy) = (mark.x, mark.y);
         // Half-sizes: 2.5 % of each axis span (in log or linear measure).
         let half = |v: &[f64], log: bool, at: f64| -> (f64, f64) {
             let (a, b) = (v[0], v[v.len() - 1]);
@@ -177,7 +187,7 @@ pub fn energy_map(dir: &Path, stem: &str, spec: &MapSpec) -> Result<Figure> {
         let (x0, x1) = half(x, x_log, dx);
         let (y0, y1) = half(y, y_log, dy);
         overlay_lines.push(Series {
-            label: spec.design_label.clone(),
+            label: mark.label.clone(),
             x: vec![x0, x1, x1, x0, x0],
             y: vec![y0, y0, y1, y1, y0],
         });

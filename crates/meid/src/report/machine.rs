@@ -16,7 +16,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::figures::{self, sig, MapSpec};
+use super::figures::{self, sig, MapSpec, Mark};
 use super::html::{Block, Page, Section, Table};
 use crate::analysis::blows::{run_blows_with, BlowOptions, BlowsRun};
 use crate::analysis::compare::{CaseName, CompareOptions, Comparison, ComparisonResult};
@@ -737,11 +737,14 @@ impl MachineReport {
                         x_label: if ratio { format!("{xn} (1)") } else { xn.clone() },
                         y_label: if ratio { format!("{yn} (1)") } else { yn.clone() },
                         colorbar_label: "E_p+/E_s− (%)".into(),
-                        design: Some(m.design),
-                        design_label: format!(
-                            "current design ({} %)",
-                            sig(100.0 * m.design_energy_ratio, 3)
-                        ),
+                        marks: vec![Mark {
+                            label: format!(
+                                "current design ({} %)",
+                                sig(100.0 * m.design_energy_ratio, 3)
+                            ),
+                            x: m.design.0,
+                            y: m.design.1,
+                        }],
                         diagonal_label: if ratio { "ω_d = ω_s".into() } else { String::new() },
                         caption,
                     },
