@@ -289,8 +289,8 @@ pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Res
         format!(
             "Bed acceleration a_B (m/s²) at the measurement point B after one blow, without damper, with the impact damper and with the added mass: the first {} ms of the {} s record (output samples at {} Hz; the peaks in the tables are exact, located on the continuous solution).",
             sig(1e3 * zoom_s, 3),
-            sig(record_s, 3),
-            sig(rate, 6)
+            plain(record_s),
+            plain(rate)
         ),
         &[&histories],
     ));

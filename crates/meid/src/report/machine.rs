@@ -723,7 +723,7 @@ impl MachineReport {
                 let n = self.options.map_points;
                 let caption = format!(
                     "Energy left in the machine after one blow, E_p+/E_s− (%, paper Eq. 10, each run stopped at the end of the collision), over {xn} × {yn} on a {n} × {n} grid spanning ÷/× {} around the current design (square and cross){}.",
-                    sig(if ratio { self.options.map_span } else { self.options.map_span.powi(2) }, 3),
+                    figures::plain(if ratio { self.options.map_span } else { self.options.map_span.powi(2) }),
                     if ratio { "; the line is the paper's rule ω_d = ω_s" } else { "" }
                 );
                 let fig = figures::energy_map(
@@ -844,7 +844,7 @@ impl MachineReport {
                 "{} blows at {} blows/min (interval {} s, rounded to whole output samples); each blow starts from the state the previous one left, with a fresh slider at v_s. The model file has no stroke rate: it is the report's setting (meid report --rate-bpm). A single rate reads the rigid-body mode's comb filter as much as the damper (docs/studies.md, \"Repeated blows\"): check the neighbouring rates before concluding.",
                 self.options.blows,
                 figures::plain(self.options.rate_bpm),
-                sig(interval, 6)
+                figures::plain(interval)
             )),
             Block::Table(Table {
                 caption: "The last blow of each train".into(),
