@@ -35,6 +35,7 @@ mod modes;
 mod montecarlo;
 mod optimize;
 mod outputs;
+mod report;
 mod shell;
 mod simulate;
 mod sweep;
@@ -75,6 +76,9 @@ enum Command {
     Blows(blows::BlowsArgs),
     /// Monte Carlo over uncertain inputs (seeded): mean, percentiles, histogram.
     Montecarlo(montecarlo::MonteCarloArgs),
+    /// One page about the model's machine: modes, energy map, none/damper/added mass,
+    /// blow train, optimiser, Monte Carlo (index.html with pictures and data).
+    Report(report::ReportArgs),
     /// Shell completion script for bash, zsh, fish, elvish or powershell, on stdout.
     Completions(shell::CompletionsArgs),
     /// The manual page (roff) on stdout, or every page into a directory with -o.
@@ -110,6 +114,7 @@ fn main() -> ExitCode {
         Command::Optimize(a) => optimize::run(a),
         Command::Blows(a) => blows::run(a),
         Command::Montecarlo(a) => montecarlo::run(a),
+        Command::Report(a) => report::run(a),
         Command::Completions(a) => shell::completions(a),
         Command::Man(a) => shell::man(a),
     };

@@ -38,6 +38,18 @@ fn subcommands() -> Vec<(&'static str, Vec<String>)> {
                 "4",
             ]),
         ),
+        (
+            "report",
+            v(&[
+                "report",
+                "--map-points",
+                "5",
+                "--blows",
+                "2",
+                "--duration",
+                "0.2",
+            ]),
+        ),
     ]
 }
 
@@ -342,7 +354,7 @@ fn optimize_output_is_its_json_report() {
 // ---------------------------------------------------------------------------------------------
 // 4. Completions and manual pages.
 
-const SUBCOMMANDS: [&str; 9] = [
+const SUBCOMMANDS: [&str; 10] = [
     "simulate",
     "modes",
     "sweep",
@@ -350,6 +362,7 @@ const SUBCOMMANDS: [&str; 9] = [
     "optimize",
     "blows",
     "montecarlo",
+    "report",
     "completions",
     "man",
 ];

@@ -12,7 +12,9 @@
 //!   Distributions* vol. 1, ch. 14).
 //! * `uniform(a, b)`: `x = a + (b − a) u`, `u ~ U[0, 1)`.
 //!
-//! Sample `i` is the model re-read with the drawn values as overrides and simulated
+//! Sample `i` is the model with the drawn values set as `--set` overrides would (re-read
+//! from its text when an input lies under `structure.`; otherwise set on the parsed model,
+//! whose modes are reused, as a sweep point is) and simulated
 //! ([`super::simulate`], case as specified, the model's `[simulation]`). Metrics are the
 //! summary's energy ratio E_p+/E_s−, peak bed acceleration at B, peak floor force and peak
 //! contact forces. Statistics over the successful samples: mean, sample standard deviation
@@ -35,7 +37,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::energy::{simulate, Summary};
-use super::sweep::{field_kind, FieldKind};
+use super::sweep::{field_kind, point_model, FieldKind, Quantity};
 use crate::model::{Case, Model};
 use crate::{Error, Result};
 
@@ -303,6 +305,21 @@ impl MonteCarlo {
     }
 
     fn run_sample(&self, values: &[f64]) -> Result<[f64; 5]> {
+        // Inputs outside `structure.` leave the structure as it is: set them on the model
+        // as a sweep point does (the modes are reused: no rebuild of a finite-element model
+        // per sample; the same model `--set` would give, test `montecarlo_fast_path_*`).
+        if !self.inputs.iter().any(|u| u.path.starts_with("structure")) {
+            let qs: Vec<Quantity> = self
+                .inputs
+                .iter()
+                .map(|u| Quantity::Field(u.path.clone()))
+                .collect();
+            let refs: Vec<&Quantity> = qs.iter().collect();
+            let m = point_model(&self.model, &refs, values, None)?.model;
+            let sys = m.impact_system(Case::AsSpecified)?;
+            let run = simulate(&sys, &m.options(), false)?;
+            return Ok(metrics_of(&run.summary));
+        }
         let mut overrides: Vec<String> = self
             .model
             .source

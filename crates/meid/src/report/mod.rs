@@ -10,4 +10,6 @@
 //! Written by hand (about 300 lines) rather than with a template engine: the page has a fixed,
 //! small structure, and escaping is the only subtle part.
 
+pub mod figures;
 pub mod html;
+pub mod machine;

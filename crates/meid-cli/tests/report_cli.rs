@@ -1,0 +1,257 @@
+//! `meid report MODEL`: the page about one machine (issue 11, points 5 and 7).
+//!
+//! * The written `index.html` passes `report::html::check_page` (every `src`/`href` resolves
+//!   inside the page's directory, every figure has a caption) for the lumped and the FE
+//!   soft-base example, and holds every required section with its figures and tables.
+//! * The page's numbers are the library's own studies: the comparison in `report.json` is
+//!   `meid compare --json`'s, the blow trains are `meid blows --json`'s, bit for bit.
+//! * The energy map's centre is the design: ω_s/ω_1 of the lumped example is 150 by the
+//!   closed form of its two-mode structure (the file's comment), and E_p+/E_s− there is the
+//!   comparison's damper value.
+//! * Bad input exits with code 2 and a message naming the option.
+
+mod common;
+
+use std::path::Path;
+
+use common::{example_file, meid, ok, paper_example, stderr, tmpdir};
+use meid::report::html::check_page;
+
+const SECTIONS: [&str; 9] = [
+    "results",
+    "model",
+    "modes",
+    "energy-map",
+    "cases",
+    "blows",
+    "optimiser",
+    "montecarlo",
+    "method",
+];
+
+/// The HTML of section `id` (up to the next section).
+fn section<'a>(html: &'a str, id: &str) -> &'a str {
+    let start = html
+        .find(&format!("<section id=\"{id}\">"))
+        .unwrap_or_else(|| panic!("section {id} missing"));
+    let rest = &html[start..];
+    let end = rest.find("</section>").unwrap();
+    &rest[..end]
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn check_report(dir: &Path, with_mc: bool) -> String {
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    assert_eq!(check_page(dir, &html), vec![], "check_page");
+    for id in SECTIONS {
+        section(&html, id);
+    }
+    assert!(!html.contains("<script"), "no scripts");
+    let figures = |id: &str| section(&html, id).matches("<figure").count();
+    let tables = |id: &str| section(&html, id).matches("<table").count();
+    assert_eq!(figures("energy-map"), 1, "the energy map");
+    assert_eq!(
+        figures("cases"),
+        6,
+        "histories, spectra and 1/3-octave levels of a_B and F"
+    );
+    assert_eq!(tables("cases"), 2, "peaks and reductions");
+    assert_eq!(figures("blows"), 2);
+    assert_eq!(tables("model"), 1);
+    assert!(tables("modes") >= 2, "modes and truncation");
+    assert_eq!(tables("optimiser"), 1);
+    assert_eq!(figures("montecarlo"), if with_mc { 2 } else { 0 });
+    // Every reduction names its measure beside it.
+    let cases = section(&html, "cases");
+    for measure in [
+        "time-peak",
+        "esd-peak",
+        "band-level",
+        "signal-energy",
+        "energy-ratio",
+    ] {
+        assert!(cases.contains(&format!("<td>{measure}</td>")), "{measure}");
+    }
+    // The manifest lists index.html and every picture the page names.
+    let manifest = std::fs::read_to_string(dir.join("manifest.json")).unwrap();
+    assert!(manifest.contains("index.html") && manifest.contains("energy-map.png"));
+    html
+}
+
+#[test]
+fn lumped_report_passes_the_page_check_and_reads_the_library_studies() {
+    let d = tmpdir("report", "lumped");
+    let out = d.join("page");
+    ok(meid()
+        .arg("report")
+        .arg(paper_example())
+        .args([
+            "-q",
+            "--map-points",
+            "11",
+            "--vary",
+            "contact.slider_bed.stiffness=lognormal(4.3e7,0.2)",
+            "--samples",
+            "16",
+            "-o",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap());
+    check_report(&out, true);
+    let report = json(&out.join("report.json"));
+
+    // The comparison is `meid compare`'s (same record length), bit for bit.
+    let compare: serde_json::Value = serde_json::from_str(&ok(meid()
+        .arg("compare")
+        .arg(paper_example())
+        .args(["--json", "--duration", "2"])
+        .output()
+        .unwrap()))
+    .unwrap();
+    assert_eq!(report["comparison"], compare);
+
+    // The blow train with the damper is `meid blows`'s (10 blows at 60 /min).
+    let blows: serde_json::Value = serde_json::from_str(&ok(meid()
+        .arg("blows")
+        .arg(paper_example())
+        .args(["--json", "--case", "damper", "--blows", "10"])
+        .output()
+        .unwrap()))
+    .unwrap();
+    let damper = report["blow_trains"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|t| t["case"] == "damper")
+        .unwrap();
+    assert_eq!(damper["blows"], blows["blows"]);
+    assert_eq!(damper["steady"], blows["steady"]);
+
+    // The map's centre is the design. Lumped structure (examples/paper-lumped.toml): the
+    // two-mode closed form ω² = (b ∓ √(b² − 4c))/2 with b = k_c/m_b + (k_c + k_f)/m_f,
+    // c = k_c k_f/(m_b m_f) gives ω_1, and ω_s = √(K_s/m_s).
+    let (kc, kf, mb, mf): (f64, f64, f64, f64) = (2.5415164e7, 8.1195270e4, 10.0, 41.0);
+    let b = kc / mb + (kc + kf) / mf;
+    let c = kc * kf / (mb * mf);
+    let w1 = ((b - (b * b - 4.0 * c).sqrt()) / 2.0).sqrt();
+    let ws = (4.2980449e7_f64 / 1.2).sqrt();
+    let wd = (1.2535964e8_f64 / 3.5).sqrt();
+    let map = &report["energy_map"];
+    assert_eq!(map["axes"]["kind"], "ratios");
+    let design = map["design"].as_array().unwrap();
+    let rel = |a: f64, b: f64| (a / b - 1.0).abs();
+    // The small-root formula loses digits to cancellation (b² ≫ 4c): 1e-7 is its accuracy.
+    assert!(
+        rel(design[0].as_f64().unwrap(), ws / w1) < 1e-7,
+        "{design:?}"
+    );
+    assert!(
+        rel(design[1].as_f64().unwrap(), wd / w1) < 1e-7,
+        "{design:?}"
+    );
+    assert!((ws / w1 - 150.0).abs() < 0.01, "the file's w_s/w_6 = 150");
+    // The design point of the map is the comparison's damper run (K_s, K_d rebuilt from the
+    // ratios: equal to rounding).
+    let damper_eta = compare["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["case"] == "damper")
+        .unwrap()["energy_ratio"]
+        .as_f64()
+        .unwrap();
+    let eta = map["design_energy_ratio"].as_f64().unwrap();
+    assert!(rel(eta, damper_eta) < 1e-9, "{eta} vs {damper_eta}");
+
+    // The Monte Carlo is `meid montecarlo`'s.
+    let mc: serde_json::Value = serde_json::from_str(&ok(meid()
+        .arg("montecarlo")
+        .arg(paper_example())
+        .args([
+            "--json",
+            "--vary",
+            "contact.slider_bed.stiffness=lognormal(4.3e7,0.2)",
+            "--samples",
+            "16",
+        ])
+        .output()
+        .unwrap()))
+    .unwrap();
+    assert_eq!(report["montecarlo"]["metric_stats"], mc["metric_stats"]);
+}
+
+#[test]
+fn fe_report_passes_the_page_check() {
+    let d = tmpdir("report", "fe");
+    let out = d.join("page");
+    let o = meid()
+        .arg("report")
+        .arg(example_file("paper-soft-base.toml"))
+        .args(["--map-points", "9", "--blows", "3", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let text = ok(o);
+    assert!(text.contains("wrote"), "{text}");
+    let html = check_report(&out, false);
+    // The FE mode table names the solver and the DOFs, and the energy map's axes name the
+    // reference mode by its number in that table (the 6.35 Hz vertical rigid-body mode).
+    let modes = section(&html, "modes");
+    assert!(modes.contains("DOFs"), "{modes}");
+    let report = json(&out.join("report.json"));
+    let n = report["energy_map"]["axes"]["reference_mode"]
+        .as_u64()
+        .unwrap();
+    let f = report["modes"]["modes"][(n - 1) as usize]["frequency_hz"]
+        .as_f64()
+        .unwrap();
+    assert!((f - 6.35).abs() < 0.01, "mode {n}: {f} Hz");
+    assert!(section(&html, "energy-map").contains(&format!("ω_s/ω_{n}")));
+    assert!(
+        section(&html, "montecarlo").contains("--vary"),
+        "says how to give one"
+    );
+}
+
+#[test]
+fn bad_report_options_exit_2_naming_the_option() {
+    let d = tmpdir("report", "bad");
+    for (args, want) in [
+        (vec!["--rate-bpm", "0"], "stroke rate"),
+        (vec!["--map-points", "2"], "at least 3 points"),
+        (vec!["--map-points", "100000001"], "of memory"),
+        (vec!["--map-span", "1"], "span factor must be > 1"),
+        (
+            vec!["--vary", "contact.nosuch.stiffness=normal(1,0.1)"],
+            "contact.nosuch.stiffness",
+        ),
+        (vec!["--vary", "damper.mass"], "expected PATH=DIST"),
+    ] {
+        let o = meid()
+            .current_dir(&d)
+            .arg("report")
+            .arg(paper_example())
+            .args(&args)
+            .args(["-o", "out"])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(want), "{args:?}: {}", stderr(&o));
+        assert!(!stderr(&o).contains("panicked"));
+    }
+    // -o on an existing file.
+    std::fs::write(d.join("file"), b"x").unwrap();
+    let o = meid()
+        .current_dir(&d)
+        .arg("report")
+        .arg(paper_example())
+        .args(["-o", "file"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("not a directory"), "{}", stderr(&o));
+}

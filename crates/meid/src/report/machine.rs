@@ -1,0 +1,1159 @@
+//! One page about a user's machine (`meid report MODEL.toml`): the model, its modes and how
+//! much the retained modes keep, the energy map around the current design with the design
+//! marked, none / damper / added mass (exact time peaks, spectra, one-third-octave levels and
+//! dB reductions, each with its measure), a blow train at the stroke rate, the optimiser's
+//! damper against the paper's rule ω_d = ω_s, and a Monte Carlo study when the inputs are
+//! given a distribution.
+//!
+//! [`MachineReport::run`] does the studies (the library's own: [`crate::analysis`]);
+//! [`MachineReport::write`] writes the pictures, data and `index.html` into a directory. No
+//! number on the page depends on the output sample rate: peaks are exact on the continuous
+//! solution, spectra are the exact transforms of the response, the map and the optimiser stop
+//! each run at the end of the collision (energy) or take exact peaks (force).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use serde::Serialize;
+
+use super::figures::{self, sig, MapSpec, Mark};
+use super::html::{Block, Page, Section, Table};
+use crate::analysis::blows::{run_blows_with, BlowOptions, BlowsRun};
+use crate::analysis::compare::{CaseName, CompareOptions, Comparison, ComparisonResult};
+use crate::analysis::montecarlo::{MonteCarlo, MonteCarloResult, Uncertain};
+use crate::analysis::study::{Objective, OptimizeReport, OptimizeStudy};
+use crate::analysis::sweep::{Quantity, Spacing, Sweep, SweepResult, Vary};
+use crate::model::fem::{self, ModeReport};
+use crate::model::spec::{DashpotKindSpec, LawSpec, MethodSpec};
+use crate::model::{Case, Model};
+use crate::{Error, Result};
+
+/// Settings of a machine report.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MachineOptions {
+    /// Stroke rate of the blow train (blows per minute); the model file has no stroke rate.
+    pub rate_bpm: f64,
+    /// Blows in the train.
+    pub blows: usize,
+    /// Grid points per axis of the energy map (made odd so that the design is a grid point).
+    pub map_points: usize,
+    /// The map spans `value / span .. value · span` of each contact frequency around the
+    /// design (its square for stiffnesses).
+    pub map_span: f64,
+    /// Record length (s) of the comparison's time histories (the exact spectra and peaks do
+    /// not depend on it).
+    pub record_s: f64,
+    /// Uncertain inputs of the Monte Carlo study (none: no study).
+    pub uncertain: Vec<Uncertain>,
+    /// Monte Carlo samples and seed.
+    pub samples: usize,
+    pub seed: u64,
+}
+
+impl Default for MachineOptions {
+    fn default() -> Self {
+        Self {
+            rate_bpm: 60.0,
+            blows: 10,
+            map_points: 41,
+            map_span: 3.0,
+            record_s: 2.0,
+            uncertain: Vec::new(),
+            samples: 100,
+            seed: 1,
+        }
+    }
+}
+
+/// The axes of the energy map (JSON: `{"kind": "ratios", "reference_mode": 6}` or
+/// `{"kind": "stiffnesses"}`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum MapAxes {
+    /// ω_s/ω_n and ω_d/ω_n, ω_n the reference mode (its number in the mode table).
+    Ratios { reference_mode: usize },
+    /// K_s and K_d (non-linear contact laws, or no reference mode).
+    Stiffnesses,
+}
+
+/// The energy map around the design.
+#[derive(Debug, Clone, Serialize)]
+pub struct EnergyMap {
+    pub axes: MapAxes,
+    /// The design in axis values (the grid's centre).
+    pub design: (f64, f64),
+    /// E_p+/E_s− at the design point of the grid.
+    pub design_energy_ratio: f64,
+    /// The smallest E_p+/E_s− on the grid and where (axis values).
+    pub minimum: Option<(f64, f64, f64)>,
+    /// The smallest value lies on the grid's edge (the true minimum may lie outside the map).
+    pub minimum_on_edge: bool,
+    pub sweep: SweepResult,
+}
+
+/// Everything [`MachineReport::run`] computed.
+#[derive(Debug, Clone)]
+pub struct MachineReport {
+    /// The model file as given.
+    pub model_path: String,
+    pub model: Model,
+    pub modes: ModeReport,
+    pub options: MachineOptions,
+    pub map: Option<EnergyMap>,
+    pub comparison: ComparisonResult,
+    /// One train per case of the comparison.
+    pub blows: Vec<(CaseName, BlowsRun)>,
+    /// The optimiser over ω_d/ω_s, minimising the energy left (E_p+/E_s−) and the peak floor
+    /// force.
+    pub optimize: Vec<OptimizeReport>,
+    pub montecarlo: Option<MonteCarloResult>,
+    /// Why a study was left out (no damper, a failed study ...); shown on the page.
+    pub notes: Vec<String>,
+}
+
+/// The stages of [`MachineReport::run`], in order, for progress reporting.
+pub const STAGES: [&str; 7] = [
+    "modes",
+    "Monte Carlo",
+    "energy map",
+    "comparison",
+    "blow trains",
+    "optimiser",
+    "page",
+];
+
+fn case_of(c: CaseName) -> Case {
+    match c {
+        CaseName::NoDamper => Case::NoDamper,
+        CaseName::Damper => Case::Damper,
+        CaseName::AddedMass => Case::AddedMass,
+    }
+}
+
+/// `v` spaced evenly in ln from `c/span` to `c·span`, `n` values (odd), the middle one
+/// exactly `c`.
+fn log_grid(c: f64, span: f64, n: usize) -> Vec<f64> {
+    let half = (n / 2) as i64;
+    (-half..=half)
+        .map(|k| {
+            if k == 0 {
+                c
+            } else {
+                c * span.powf(k as f64 / half as f64)
+            }
+        })
+        .collect()
+}
+
+fn law_name(l: LawSpec) -> &'static str {
+    match l {
+        LawSpec::Linear => "linear",
+        LawSpec::Hertz => "hertz",
+        LawSpec::HuntCrossley => "hunt-crossley",
+    }
+}
+
+impl MachineReport {
+    /// Loads `path` (with `--set` overrides) and runs every study; `progress` is called with
+    /// each stage's name ([`STAGES`]) before it starts.
+    pub fn run(
+        path: &Path,
+        overrides: &[String],
+        options: &MachineOptions,
+        progress: &dyn Fn(&str),
+    ) -> Result<Self> {
+        if !(options.rate_bpm.is_finite() && options.rate_bpm > 0.0) {
+            return Err(Error::invalid(
+                "rate_bpm",
+                format!(
+                    "the stroke rate must be > 0 blows per minute (got {})",
+                    options.rate_bpm
+                ),
+            ));
+        }
+        if options.blows == 0 {
+            return Err(Error::invalid("blows", "needs at least one blow"));
+        }
+        if options.map_points < 3 {
+            return Err(Error::invalid(
+                "map_points",
+                format!(
+                    "the energy map needs at least 3 points per axis (got {})",
+                    options.map_points
+                ),
+            ));
+        }
+        if !(options.map_span.is_finite() && options.map_span > 1.0) {
+            return Err(Error::invalid(
+                "map_span",
+                format!(
+                    "the map's span factor must be > 1 (got {})",
+                    options.map_span
+                ),
+            ));
+        }
+        if !(options.record_s.is_finite() && options.record_s > 0.0) {
+            return Err(Error::invalid(
+                "record_s",
+                format!("the record length must be > 0 s (got {})", options.record_s),
+            ));
+        }
+        // The map's grid is estimated before anything is allocated (a sweep point ~2 KiB).
+        let n = (options.map_points | 1) as f64;
+        crate::limits::check_memory(
+            &format!("the energy map's {n} × {n} grid (2 KiB per point)"),
+            n * n * 2048.0,
+            "map_points",
+            "the map's points per axis (--map-points)",
+        )?;
+        progress(STAGES[0]);
+        let (model, analysis) = fem::from_file_with_analysis(path, overrides, None)?;
+        let modes = match &analysis {
+            Some(an) => an.report()?,
+            None => fem::report_from_modal(&model.structure),
+        }
+        .with_diagnostics(model.diagnostics());
+        drop(analysis);
+        let mut notes = Vec::new();
+        let mut options = options.clone();
+        options.map_points |= 1;
+
+        // Monte Carlo first: a bad --vary is an input error, found before the long studies.
+        progress(STAGES[1]);
+        let montecarlo = if options.uncertain.is_empty() {
+            None
+        } else {
+            Some(
+                MonteCarlo {
+                    model: model.clone(),
+                    inputs: options.uncertain.clone(),
+                    samples: options.samples,
+                    seed: options.seed,
+                }
+                .run()?,
+            )
+        };
+
+        progress(STAGES[2]);
+        let map = match Self::energy_map(&model, &modes, &options) {
+            Ok(m) => m,
+            Err(e) => {
+                notes.push(format!("energy map: {e}"));
+                None
+            }
+        };
+        if map.is_none() && model.spec.damper.is_none() {
+            notes.push("energy map: the model has no [damper]; the map of E_p+/E_s− over the damper's contact frequency needs one".into());
+        }
+
+        progress(STAGES[3]);
+        let comparison = Comparison::new(
+            model.clone(),
+            CompareOptions {
+                duration_s: options.record_s,
+                ..CompareOptions::default()
+            },
+        )
+        .run()?;
+
+        progress(STAGES[4]);
+        let mut blows = Vec::new();
+        let train = BlowOptions {
+            blows: options.blows,
+            rate_bpm: options.rate_bpm,
+            ..BlowOptions::default()
+        };
+        for c in comparison.cases.iter().map(|c| c.case) {
+            let sys = model.impact_system(case_of(c))?;
+            blows.push((
+                c,
+                run_blows_with(&sys, &model.options(), &train, None, false)?,
+            ));
+        }
+
+        progress(STAGES[5]);
+        let mut optimize = Vec::new();
+        if model.spec.damper.is_some() && model.spec.contact.bed_damper.is_some() {
+            for objective in [Objective::Energy, Objective::FloorForce] {
+                let study =
+                    OptimizeStudy::new(model.clone(), vec![(Quantity::WdOverWs, None)], objective)
+                        .and_then(|s| s.run());
+                match study {
+                    Ok(r) => optimize.push(r),
+                    Err(e) => notes.push(format!("optimiser ({}): {e}", objective.metric())),
+                }
+            }
+        } else {
+            notes.push("optimiser: the model has no [damper] to tune".into());
+        }
+        Ok(MachineReport {
+            model_path: path.display().to_string(),
+            model,
+            modes,
+            options,
+            map,
+            comparison,
+            blows,
+            optimize,
+            montecarlo,
+            notes,
+        })
+    }
+
+    /// The energy map study: ω_s/ω_n × ω_d/ω_n (linear contacts with a reference mode) or
+    /// K_s × K_d around the design. `None` without a damper.
+    fn energy_map(
+        model: &Model,
+        modes: &ModeReport,
+        options: &MachineOptions,
+    ) -> Result<Option<EnergyMap>> {
+        let s = &model.spec;
+        let (Some(d), Some(cd)) = (&s.damper, &s.contact.bed_damper) else {
+            return Ok(None);
+        };
+        let cs = &s.contact.slider_bed;
+        let n = options.map_points;
+        let linear = cs.law == LawSpec::Linear && cd.law == LawSpec::Linear;
+        let (axes, vary, design) = match (model.reference_omega(), linear) {
+            (Some(w_ref), true) if w_ref > 0.0 => {
+                let ws = (cs.stiffness / s.slider.mass).sqrt() / w_ref;
+                let wd = (cd.stiffness / d.mass).sqrt() / w_ref;
+                let r = s.structure.reference_mode.unwrap_or(1);
+                let number = modes.selected.get(r - 1).copied().unwrap_or(r);
+                let mk = |q: Quantity, c: f64| Vary {
+                    spec: format!("{}=grid around {c:e}", q.name()),
+                    quantity: q,
+                    spacing: Spacing::Log,
+                    values: log_grid(c, options.map_span, n),
+                };
+                (
+                    MapAxes::Ratios {
+                        reference_mode: number,
+                    },
+                    vec![mk(Quantity::WsOverWref, ws), mk(Quantity::WdOverWref, wd)],
+                    (ws, wd),
+                )
+            }
+            _ => {
+                let span = options.map_span * options.map_span;
+                let mk = |p: &str, c: f64| Vary {
+                    spec: format!("{p}=grid around {c:e}"),
+                    quantity: Quantity::Field(p.into()),
+                    spacing: Spacing::Log,
+                    values: log_grid(c, span, n),
+                };
+                (
+                    MapAxes::Stiffnesses,
+                    vec![
+                        mk("contact.slider_bed.stiffness", cs.stiffness),
+                        mk("contact.bed_damper.stiffness", cd.stiffness),
+                    ],
+                    (cs.stiffness, cd.stiffness),
+                )
+            }
+        };
+        let sweep = Sweep::new(model.clone(), vary)?;
+        let result = sweep.run(&|_, _| {});
+        if let Some(e) = sweep.all_failed_error(&result) {
+            return Err(e);
+        }
+        let centre = (n / 2) * n + n / 2;
+        let design_energy_ratio = result.points[centre].metric("energy_ratio");
+        let best = result.argmin("energy_ratio");
+        let minimum = best.map(|i| {
+            let p = &result.points[i];
+            (p.values[0], p.values[1], p.metric("energy_ratio"))
+        });
+        let minimum_on_edge = best.is_some_and(|i| {
+            let (a, b) = (i / n, i % n);
+            a == 0 || b == 0 || a == n - 1 || b == n - 1
+        });
+        Ok(Some(EnergyMap {
+            axes,
+            design,
+            design_energy_ratio,
+            minimum,
+            minimum_on_edge,
+            sweep: result,
+        }))
+    }
+
+    fn case(&self, c: CaseName) -> Option<&crate::analysis::compare::CaseResult> {
+        self.comparison.cases.iter().find(|x| x.case == c)
+    }
+
+    /// ω_n's name on the page, e.g. `ω_6`.
+    fn reference_name(&self) -> String {
+        match self.map.as_ref().map(|m| &m.axes) {
+            Some(MapAxes::Ratios { reference_mode }) => format!("ω_{reference_mode}"),
+            _ => "ω_ref".into(),
+        }
+    }
+
+    /// The key results as short lines (the page's first section and the CLI's summary).
+    pub fn key_results(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        let none = self.case(CaseName::NoDamper);
+        let damper = self.case(CaseName::Damper);
+        let added = self.case(CaseName::AddedMass);
+        if let (Some(n), Some(d)) = (none, damper) {
+            if let (Some(en), Some(ed)) = (n.energy_ratio, d.energy_ratio) {
+                out.push(format!(
+                    "Energy left in the machine after one blow (E_p+/E_s−, paper Eq. 10): {} % without damper, {} % with the impact damper ({:+.2} dB, energy ratio).",
+                    sig(100.0 * en, 4),
+                    sig(100.0 * ed, 4),
+                    10.0 * (en / ed).log10()
+                ));
+            }
+            out.push(format!(
+                "Exact time peaks, without → with damper: bed acceleration {} → {} m/s² ({:+.2} dB), floor force {} → {} N ({:+.2} dB).",
+                sig(n.peak_bed_acceleration_m_per_s2, 4),
+                sig(d.peak_bed_acceleration_m_per_s2, 4),
+                20.0 * (n.peak_bed_acceleration_m_per_s2 / d.peak_bed_acceleration_m_per_s2).log10(),
+                sig(n.peak_floor_force_n, 4),
+                sig(d.peak_floor_force_n, 4),
+                20.0 * (n.peak_floor_force_n / d.peak_floor_force_n).log10(),
+            ));
+        }
+        if let (Some(n), Some(a)) = (none, added) {
+            out.push(format!(
+                "The same mass fixed rigidly instead ({} kg at {}): bed acceleration {:+.2} dB, floor force {:+.2} dB (time peaks).",
+                self.comparison.added_mass.as_ref().map_or("—".into(), |m| sig(m.0, 4)),
+                self.comparison.added_mass.as_ref().map_or("—".into(), |m| m.1.clone()),
+                20.0 * (n.peak_bed_acceleration_m_per_s2 / a.peak_bed_acceleration_m_per_s2).log10(),
+                20.0 * (n.peak_floor_force_n / a.peak_floor_force_n).log10(),
+            ));
+        }
+        if let Some(m) = &self.map {
+            if let Some((x, y, e)) = m.minimum {
+                let (xn, yn) = self.map_names();
+                out.push(format!(
+                    "Energy map: E_p+/E_s− = {} % at the design; the map's smallest, {} %, is at {xn} = {}, {yn} = {} (grid value{}).",
+                    sig(100.0 * m.design_energy_ratio, 4),
+                    sig(100.0 * e, 4),
+                    sig(x, 4),
+                    sig(y, 4),
+                    if m.minimum_on_edge { ", on the map's edge: lower values may lie outside it" } else { "" }
+                ));
+            }
+        }
+        for r in &self.optimize {
+            out.push(format!(
+                "Optimiser ({}): ω_d/ω_s = {} gives {} against {} with the rule ω_d = ω_s ({:+.2} %).",
+                objective_text(r.objective),
+                sig(r.wd_over_ws_at_optimum, 4),
+                objective_value(r.objective, r.objective_value),
+                objective_value(r.objective, r.objective_at_wd_equal_ws),
+                100.0 * (r.objective_at_wd_equal_ws / r.objective_value - 1.0)
+            ));
+        }
+        if let (Some((_, n)), Some((_, d))) = (
+            self.blows.iter().find(|(c, _)| *c == CaseName::NoDamper),
+            self.blows.iter().find(|(c, _)| *c == CaseName::Damper),
+        ) {
+            let last = |r: &BlowsRun| r.blows.last().map_or(f64::NAN, |b| b.peak_floor_force_n);
+            out.push(format!(
+                "{} blows at {} /min: last blow's peak floor force {} N without damper, {} N with it ({:+.2} dB, time peak); damper gap at the next strike {}.",
+                self.options.blows,
+                figures::plain(self.options.rate_bpm),
+                sig(last(n), 4),
+                sig(last(d), 4),
+                20.0 * (last(n) / last(d)).log10(),
+                d.damper_gap_at_next_strike_m
+                    .map_or("—".into(), |g| format!("{} mm", sig(1e3 * g, 3)))
+            ));
+        }
+        if let Some(mc) = &self.montecarlo {
+            if let Some(s) = mc.metric_stats.first() {
+                out.push(format!(
+                    "Monte Carlo ({} samples, seed {}): E_p+/E_s− mean {} %, P95 {} % (estimates from the samples).",
+                    mc.samples.len(),
+                    mc.seed,
+                    sig(100.0 * s.mean, 4),
+                    sig(100.0 * s.p95, 4)
+                ));
+            }
+        }
+        out
+    }
+
+    fn map_names(&self) -> (String, String) {
+        match self.map.as_ref().map(|m| &m.axes) {
+            Some(MapAxes::Ratios { .. }) => {
+                let r = self.reference_name();
+                (format!("ω_s/{r}"), format!("ω_d/{r}"))
+            }
+            _ => ("K_s (N/m)".into(), "K_d (N/m)".into()),
+        }
+    }
+
+    /// The model summary table: machine, masses, contacts, damper, method.
+    pub fn model_table(&self) -> Table {
+        let s = &self.model.spec;
+        let m = &self.model;
+        let mut rows: Vec<Vec<String>> = Vec::new();
+        let mut row = |q: &str, sym: &str, v: String, unit: &str| {
+            rows.push(vec![q.into(), sym.into(), v, unit.into()]);
+        };
+        let structure = if let Some(l) = &s.structure.lumped {
+            format!(
+                "lumped: {} masses, {} springs",
+                l.masses.len(),
+                l.springs.len()
+            )
+        } else if s.structure.fem.is_some() {
+            format!("finite elements: {} DOFs", self.modes.dofs)
+        } else {
+            "tabulated modes".into()
+        };
+        row("structure", "", structure, "");
+        row(
+            "retained modes",
+            "",
+            format!(
+                "{} ({} Hz)",
+                m.structure.len(),
+                m.structure
+                    .omega_rad_per_s
+                    .iter()
+                    .map(|w| sig(w / (2.0 * std::f64::consts::PI), 4))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            "",
+        );
+        if let Some(w) = m.reference_omega() {
+            row(
+                "reference mode",
+                &self.reference_name(),
+                format!(
+                    "{} rad/s ({} Hz)",
+                    sig(w, 5),
+                    sig(w / (2.0 * std::f64::consts::PI), 4)
+                ),
+                "",
+            );
+        }
+        if let Some(mb) = m.bed_mass() {
+            row("bed mass", "m_b", sig(mb, 5), "kg");
+        }
+        row("slider mass", "m_s", sig(s.slider.mass, 5), "kg");
+        row("slider velocity", "v_s", sig(s.slider.velocity, 5), "m/s");
+        row(
+            "blow energy",
+            "E_s− = ½ m_s v_s²",
+            sig(0.5 * s.slider.mass * s.slider.velocity.powi(2), 5),
+            "J",
+        );
+        let cs = &s.contact.slider_bed;
+        row(
+            "slider-bed contact",
+            "K_s",
+            format!("{} ({} law)", sig(cs.stiffness, 5), law_name(cs.law)),
+            if cs.law == LawSpec::Linear {
+                "N/m"
+            } else {
+                "N/m^n"
+            },
+        );
+        let w_s = (cs.stiffness / s.slider.mass).sqrt();
+        if cs.law == LawSpec::Linear {
+            row(
+                "slider contact frequency",
+                "ω_s = √(K_s/m_s)",
+                sig(w_s, 5),
+                "rad/s",
+            );
+            if let Some(w) = m.reference_omega() {
+                row(
+                    "",
+                    &format!("ω_s/{}", self.reference_name()),
+                    sig(w_s / w, 4),
+                    "1",
+                );
+            }
+        }
+        if cs.damping != 0.0 {
+            row(
+                "slider-bed contact damping",
+                "C_s",
+                sig(cs.damping, 4),
+                "N·s/m",
+            );
+        }
+        match &s.damper {
+            Some(d) => {
+                row("damper mass", "m_d", sig(d.mass, 5), "kg");
+                if let Some(mb) = m.bed_mass() {
+                    row("", "m_d/m_b", sig(d.mass / mb, 4), "1");
+                }
+                row("damper spring", "k_d", sig(d.stiffness, 5), "N/m");
+                row(
+                    "damper dashpot",
+                    "c_d",
+                    format!(
+                        "{} ({})",
+                        sig(d.damping, 5),
+                        match d.dashpot {
+                            DashpotKindSpec::OneWay => "one-way, paper Eq. 7",
+                            DashpotKindSpec::TwoWay => "two-way",
+                        }
+                    ),
+                    "N·s/m",
+                );
+                if let Some(cd) = &s.contact.bed_damper {
+                    row(
+                        "bed-damper contact",
+                        "K_d",
+                        format!("{} ({} law)", sig(cd.stiffness, 5), law_name(cd.law)),
+                        if cd.law == LawSpec::Linear {
+                            "N/m"
+                        } else {
+                            "N/m^n"
+                        },
+                    );
+                    if cd.law == LawSpec::Linear {
+                        let w_d = (cd.stiffness / d.mass).sqrt();
+                        row(
+                            "damper contact frequency",
+                            "ω_d = √(K_d/m_d)",
+                            sig(w_d, 5),
+                            "rad/s",
+                        );
+                        row("", "ω_d/ω_s", sig(w_d / w_s, 4), "1");
+                    }
+                }
+            }
+            None => row("damper", "", "none in the model".into(), ""),
+        }
+        if let Some((mass, point)) = m.added_mass() {
+            row(
+                "added mass (comparison case)",
+                "m_a",
+                format!("{} at {point}", sig(mass, 5)),
+                "kg",
+            );
+        }
+        let sim = &s.simulation;
+        row(
+            "method",
+            "",
+            match sim.method {
+                MethodSpec::Exact => {
+                    "exact (piecewise-linear closed form, exactly located switches)".into()
+                }
+                MethodSpec::Dopri5 => format!(
+                    "dopri5 (adaptive Dormand-Prince 5(4), rtol {}, atol {})",
+                    sim.rtol, sim.atol
+                ),
+            },
+            "",
+        );
+        row("simulated time of one run", "", sig(sim.duration, 4), "s");
+        row("output sample rate", "", sig(sim.sample_rate, 6), "Hz");
+        Table {
+            caption: "The model".into(),
+            header: vec![
+                "quantity".into(),
+                "symbol".into(),
+                "value".into(),
+                "unit".into(),
+            ],
+            rows,
+            ..Default::default()
+        }
+    }
+
+    /// Writes the pictures and data into `dir` and returns the page. `generator` is the lead's
+    /// note of what produced the page (e.g. `meid 0.1.0 (commit …)`).
+    pub fn page(&self, dir: &Path, generator: &str) -> Result<Page> {
+        let mut sections = Vec::new();
+        let name = self
+            .model
+            .spec
+            .name
+            .clone()
+            .unwrap_or_else(|| self.model_path.clone());
+
+        // 1. Key results.
+        let mut blocks = vec![Block::List(self.key_results())];
+        if !self.notes.is_empty() {
+            blocks.push(Block::Paragraph("Left out:".into()));
+            blocks.push(Block::List(self.notes.clone()));
+        }
+        sections.push(Section {
+            id: "results".into(),
+            heading: "Key results".into(),
+            blocks,
+        });
+
+        // 2. The model.
+        sections.push(Section {
+            id: "model".into(),
+            heading: "Model".into(),
+            blocks: vec![Block::Table(self.model_table())],
+        });
+
+        // 3. Modes and truncation.
+        let mut blocks = vec![Block::Table(figures::mode_table(&self.modes))];
+        if !self.modes.truncation.is_empty() {
+            blocks.push(Block::Table(figures::truncation_table(
+                &self.modes.truncation,
+            )));
+        }
+        if !self.modes.notes.is_empty() {
+            blocks.push(Block::List(self.modes.notes.clone()));
+        }
+        if !self.modes.warnings.is_empty() {
+            blocks.push(Block::Paragraph("Warnings:".into()));
+            blocks.push(Block::List(self.modes.warnings.clone()));
+        }
+        sections.push(Section {
+            id: "modes".into(),
+            heading: "Modes and truncation".into(),
+            blocks,
+        });
+
+        // 4. Energy map.
+        let mut blocks = Vec::new();
+        match &self.map {
+            Some(m) => {
+                let (xn, yn) = self.map_names();
+                let ratio = matches!(m.axes, MapAxes::Ratios { .. });
+                let n = self.options.map_points;
+                let caption = format!(
+                    "Energy left in the machine after one blow, E_p+/E_s− (%, paper Eq. 10, each run stopped at the end of the collision), over {xn} × {yn} on a {n} × {n} grid spanning ÷/× {} around the current design (square and cross){}.",
+                    figures::plain(if ratio { self.options.map_span } else { self.options.map_span.powi(2) }),
+                    if ratio { "; the line is the paper's rule ω_d = ω_s" } else { "" }
+                );
+                let fig = figures::energy_map(
+                    dir,
+                    "energy-map",
+                    &MapSpec {
+                        sweep: Some(&m.sweep),
+                        metric: "energy_ratio".into(),
+                        z_scale: Some(100.0),
+                        title: format!("energy left in the machine, {xn} × {yn}"),
+                        x_label: if ratio { format!("{xn} (1)") } else { xn.clone() },
+                        y_label: if ratio { format!("{yn} (1)") } else { yn.clone() },
+                        colorbar_label: "E_p+/E_s− (%)".into(),
+                        marks: vec![Mark {
+                            label: format!(
+                                "current design ({} %)",
+                                sig(100.0 * m.design_energy_ratio, 3)
+                            ),
+                            x: m.design.0,
+                            y: m.design.1,
+                        }],
+                        diagonal_label: if ratio { "ω_d = ω_s".into() } else { String::new() },
+                        caption,
+                    },
+                )?;
+                blocks.push(Block::Figure(fig));
+                if let Some((x, y, e)) = m.minimum {
+                    blocks.push(Block::Paragraph(format!(
+                        "At the design ({xn} = {}, {yn} = {}) E_p+/E_s− = {} %. The grid's smallest value is {} % at {xn} = {}, {yn} = {}: a grid value (grid step × {} in each axis){}.",
+                        sig(m.design.0, 4),
+                        sig(m.design.1, 4),
+                        sig(100.0 * m.design_energy_ratio, 4),
+                        sig(100.0 * e, 4),
+                        sig(x, 4),
+                        sig(y, 4),
+                        sig(
+                            (if ratio { self.options.map_span } else { self.options.map_span.powi(2) })
+                                .powf(2.0 / (n - 1) as f64),
+                            4
+                        ),
+                        if m.minimum_on_edge {
+                            ", on the map's edge: the energy keeps falling outside the map (widen it with --map-span)"
+                        } else {
+                            ", within one grid step of the map's minimum"
+                        }
+                    )));
+                }
+            }
+            None => blocks.push(Block::Paragraph(
+                "No energy map: the model has no damper, or the map failed (see Key results, Left out).".into(),
+            )),
+        }
+        sections.push(Section {
+            id: "energy-map".into(),
+            heading: "Energy map around the design".into(),
+            blocks,
+        });
+
+        // 5. None / damper / added mass.
+        let r = &self.comparison;
+        let mut blocks = vec![
+            Block::Paragraph(format!(
+                "One blow of the machine in each case{}. {}",
+                r.added_mass
+                    .as_ref()
+                    .map_or(String::new(), |(m, p)| format!(
+                        " (the added mass is {} kg fixed rigidly at {p})",
+                        sig(*m, 4)
+                    )),
+                r.spectrum_text().trim()
+            )),
+            Block::Table(figures::case_peaks_table(r)),
+        ];
+        if !r.reductions.is_empty() {
+            blocks.push(Block::Table(figures::reductions_table(r)));
+        }
+        for f in figures::comparison_figures(dir, "cases", r)? {
+            blocks.push(Block::Figure(f));
+        }
+        sections.push(Section {
+            id: "cases".into(),
+            heading: "Without damper, with the damper, with an added mass".into(),
+            blocks,
+        });
+
+        // 6. Blow trains.
+        let runs: Vec<(CaseName, &BlowsRun)> = self.blows.iter().map(|(c, r)| (*c, r)).collect();
+        let mut rows = Vec::new();
+        for (c, run) in &runs {
+            let last = run.blows.last();
+            rows.push(vec![
+                c.label().to_string(),
+                last.map_or("—".into(), |b| sig(b.peak_floor_force_n, 4)),
+                last.map_or("—".into(), |b| sig(b.peak_bed_acceleration_m_per_s2, 4)),
+                last.and_then(|b| b.energy_ratio)
+                    .map_or("—".into(), |e| sig(100.0 * e, 4)),
+                if run.steady.converged {
+                    format!("yes, from blow {}", run.steady.from_blow.unwrap_or(1))
+                } else {
+                    format!(
+                        "no (last change {} % in floor force)",
+                        sig(100.0 * run.steady.last_change_peak_floor_force, 2)
+                    )
+                },
+                run.damper_gap_at_next_strike_m
+                    .map_or("—".into(), |g| sig(1e3 * g, 4)),
+                run.blows
+                    .iter()
+                    .skip(1)
+                    .filter(|b| b.damper_contact_time_s == Some(0.0))
+                    .count()
+                    .to_string(),
+            ]);
+        }
+        let interval = runs.first().map_or(f64::NAN, |(_, r)| r.interval_s);
+        let mut blocks = vec![
+            Block::Paragraph(format!(
+                "{} blows at {} blows/min (interval {} s, rounded to whole output samples); each blow starts from the state the previous one left, with a fresh slider at v_s. The model file has no stroke rate: it is the report's setting (meid report --rate-bpm). A single rate reads the rigid-body mode's comb filter as much as the damper (docs/studies.md, \"Repeated blows\"): check the neighbouring rates before concluding.",
+                self.options.blows,
+                figures::plain(self.options.rate_bpm),
+                figures::plain(interval)
+            )),
+            Block::Table(Table {
+                caption: "The last blow of each train".into(),
+                header: vec![
+                    "case".into(),
+                    "peak |F_floor| (N), time peak".into(),
+                    "peak |a_B| (m/s²), time peak".into(),
+                    "η = energy left (%)".into(),
+                    "steady (1 % tolerance)".into(),
+                    "damper gap at the next strike (mm)".into(),
+                    "blows after the first without bed-damper contact".into(),
+                ],
+                rows,
+                ..Default::default()
+            }),
+        ];
+        for f in figures::blow_train_figures(dir, "blows", &runs, self.options.rate_bpm)? {
+            blocks.push(Block::Figure(f));
+        }
+        sections.push(Section {
+            id: "blows".into(),
+            heading: "Repeated blows".into(),
+            blocks,
+        });
+
+        // 7. Optimiser.
+        let mut blocks = Vec::new();
+        if self.optimize.is_empty() {
+            blocks.push(Block::Paragraph(
+                "No optimisation: the model has no damper (see Key results, Left out).".into(),
+            ));
+        } else {
+            let rows = self
+                .optimize
+                .iter()
+                .map(|r| {
+                    vec![
+                        objective_text(r.objective),
+                        format!(
+                            "{}..{}{}",
+                            sig(r.variables[0].lower, 3),
+                            sig(r.variables[0].upper, 3),
+                            if r.variables[0].log { " (log)" } else { "" }
+                        ),
+                        sig(r.wd_over_ws_at_optimum, 5),
+                        objective_value(r.objective, r.objective_value),
+                        objective_value(r.objective, r.objective_at_wd_equal_ws),
+                        format!(
+                            "{:+.2}",
+                            100.0 * (r.objective_at_wd_equal_ws / r.objective_value - 1.0)
+                        ),
+                        format!(
+                            "{}{}",
+                            r.simulations,
+                            if r.converged { "" } else { " (budget reached)" }
+                        ),
+                    ]
+                })
+                .collect();
+            blocks.push(Block::Paragraph("The damper contact frequency ω_d/ω_s (K_d = m_d ω_d², other inputs as in the model) that minimises each objective: a 9-point scan in ln(ω_d/ω_s) then Brent's method, set against the paper's rule ω_d = ω_s (section 4.1).".into()));
+            blocks.push(Block::Table(Table {
+                caption: "The optimiser's damper against the rule ω_d = ω_s".into(),
+                header: vec![
+                    "objective".into(),
+                    "bounds of ω_d/ω_s".into(),
+                    "best ω_d/ω_s".into(),
+                    "objective there".into(),
+                    "objective with ω_d = ω_s".into(),
+                    "rule vs best (%)".into(),
+                    "simulations".into(),
+                ],
+                rows,
+                ..Default::default()
+            }));
+        }
+        sections.push(Section {
+            id: "optimiser".into(),
+            heading: "Optimiser against the rule ω_d = ω_s".into(),
+            blocks,
+        });
+
+        // 8. Monte Carlo.
+        let mut blocks = Vec::new();
+        match &self.montecarlo {
+            Some(mc) => {
+                let inputs: Vec<String> = mc
+                    .inputs
+                    .iter()
+                    .map(|u| format!("{} ~ {}", u.path, distribution_text(&u.distribution)))
+                    .collect();
+                blocks.push(Block::Paragraph(format!(
+                    "{} samples (seed {}, {} failed) with {}; every other input as in the model. Means and percentiles are estimates from the samples (standard error of the mean ≈ std/√n).",
+                    mc.samples.len(),
+                    mc.seed,
+                    mc.failed,
+                    inputs.join(", ")
+                )));
+                let rows = mc
+                    .input_stats
+                    .iter()
+                    .chain(&mc.metric_stats)
+                    .map(|s| {
+                        vec![
+                            s.name.clone(),
+                            sig(s.mean, 4),
+                            sig(s.std, 3),
+                            sig(s.p5, 4),
+                            sig(s.p50, 4),
+                            sig(s.p95, 4),
+                        ]
+                    })
+                    .collect();
+                blocks.push(Block::Table(Table {
+                    caption: "Sample statistics (units in the names: N/m, m/s², N; energy_ratio is E_p+/E_s−, 1)".into(),
+                    header: vec![
+                        "quantity".into(),
+                        "mean".into(),
+                        "std".into(),
+                        "P5".into(),
+                        "P50".into(),
+                        "P95".into(),
+                    ],
+                    rows,
+                    ..Default::default()
+                }));
+                for (k, (metric, stem, quantity, unit, scale)) in [
+                    (
+                        "energy_ratio",
+                        "mc-energy-ratio",
+                        "energy left in the machine",
+                        "E_p+/E_s− (%)",
+                        100.0,
+                    ),
+                    (
+                        "peak_floor_force_n",
+                        "mc-floor-force",
+                        "peak force to the floor",
+                        "peak |F_floor| (N)",
+                        1.0,
+                    ),
+                ]
+                .into_iter()
+                .enumerate()
+                {
+                    let values: Vec<f64> = mc
+                        .metric(metric)?
+                        .into_iter()
+                        .filter(|v| v.is_finite())
+                        .map(|v| v * scale)
+                        .collect();
+                    let Some(st) = mc.metric_stats.iter().find(|s| s.name == metric) else {
+                        continue;
+                    };
+                    if values.is_empty() {
+                        continue;
+                    }
+                    let mut st = st.clone();
+                    for v in [&mut st.mean, &mut st.std, &mut st.p5, &mut st.p50, &mut st.p95] {
+                        *v *= scale;
+                    }
+                    let _ = k;
+                    let fig = figures::histogram_figure(
+                        dir,
+                        stem,
+                        quantity,
+                        unit,
+                        &values,
+                        &st,
+                        format!(
+                            "Histogram of the {quantity}, {unit}, over {} samples, with the sample mean ({}) and 95th percentile ({}) marked (estimates).",
+                            values.len(),
+                            sig(st.mean, 4),
+                            sig(st.p95, 4)
+                        ),
+                    )?;
+                    blocks.push(Block::Figure(fig));
+                }
+            }
+            None => blocks.push(Block::Paragraph(
+                "No Monte Carlo study: the model gives no distribution. Give one with --vary PATH=DIST, e.g. meid report MODEL.toml --vary 'contact.slider_bed.stiffness=lognormal(K_s,0.2)' (K_s varies with the workpiece; distributions: normal(μ,σ), lognormal(mean,cov), uniform(a,b)).".into(),
+            )),
+        }
+        sections.push(Section {
+            id: "montecarlo".into(),
+            heading: "Monte Carlo over uncertain inputs".into(),
+            blocks,
+        });
+
+        // 9. How the numbers were obtained.
+        let mut method = String::new();
+        let _ = write!(
+            method,
+            "Peaks are exact: located on the continuous piecewise solution between exactly located switches, not on the output samples. Spectra are the exact Fourier transforms of the response including its free decay; one-third-octave levels integrate them by adaptive Gauss-Kronrod. Reductions name their measure (time-peak 20 log10 of peaks; esd-peak, band-level, signal-energy and energy-ratio 10 log10 of energies). The energy map and the energy objective stop each run at the end of the collision; the floor-force objective runs the model's {} s.",
+            sig(self.model.spec.simulation.duration, 4)
+        );
+        sections.push(Section {
+            id: "method".into(),
+            heading: "How the numbers were obtained".into(),
+            blocks: vec![
+                Block::Paragraph(method),
+                Block::Paragraph("Files: every picture as PNG and SVG, its data as CSV (linked under each caption), and report.json with the numbers of this page.".into()),
+            ],
+        });
+
+        Ok(Page {
+            title: format!("meid report: {name}"),
+            lead: format!("Model {} — {generator}.", self.model_path),
+            sections,
+        })
+    }
+
+    /// The numbers of the page as JSON (`report.json`, `meid report --json`).
+    pub fn summary_json(&self) -> serde_json::Value {
+        let map = self.map.as_ref().map(|m| {
+            serde_json::json!({
+                "axes": m.axes,
+                "design": m.design,
+                "design_energy_ratio": m.design_energy_ratio,
+                "minimum": m.minimum,
+            })
+        });
+        let blows: Vec<serde_json::Value> = self
+            .blows
+            .iter()
+            .map(|(c, r)| {
+                serde_json::json!({
+                    "case": c,
+                    "interval_s": r.interval_s,
+                    "blows": r.blows,
+                    "steady": r.steady,
+                    "damper_gap_at_next_strike_m": r.damper_gap_at_next_strike_m,
+                })
+            })
+            .collect();
+        let mc = self.montecarlo.as_ref().map(|mc| {
+            serde_json::json!({
+                "seed": mc.seed,
+                "samples": mc.samples.len(),
+                "failed": mc.failed,
+                "inputs": mc.inputs,
+                "input_stats": mc.input_stats,
+                "metric_stats": mc.metric_stats,
+            })
+        });
+        serde_json::json!({
+            "model": self.model_path,
+            "name": self.model.spec.name,
+            "key_results": self.key_results(),
+            "modes": self.modes,
+            "energy_map": map,
+            "comparison": self.comparison.summary(),
+            "blow_trains": blows,
+            "rate_bpm": self.options.rate_bpm,
+            "optimize": self.optimize,
+            "montecarlo": mc,
+            "notes": self.notes,
+        })
+    }
+
+    /// Writes the pictures, the data, `report.json` and `index.html` into `dir` (which must
+    /// exist), then checks the page ([`super::html::check_page`]).
+    pub fn write(&self, dir: &Path, generator: &str) -> Result<Page> {
+        let page = self.page(dir, generator)?;
+        crate::io::write_json(&dir.join("report.json"), &self.summary_json())?;
+        let index = dir.join("index.html");
+        page.write(&index)?;
+        super::html::verify_page_file(&index)?;
+        Ok(page)
+    }
+}
+
+/// `lognormal(mean 4.3e7, cov 0.2)` etc.
+fn distribution_text(d: &crate::analysis::montecarlo::Distribution) -> String {
+    use crate::analysis::montecarlo::Distribution as D;
+    match *d {
+        D::Normal { mean, std } => format!("normal(μ = {}, σ = {})", sig(mean, 5), sig(std, 4)),
+        D::LogNormal { mean, cov } => {
+            format!("lognormal(mean {}, cov {})", sig(mean, 5), sig(cov, 4))
+        }
+        D::Uniform { low, high } => format!("uniform({}, {})", sig(low, 5), sig(high, 5)),
+    }
+}
+
+fn objective_text(o: Objective) -> String {
+    match o {
+        Objective::Energy => "energy left E_p+/E_s−".into(),
+        Objective::BedAccel => "peak bed acceleration, time peak".into(),
+        Objective::FloorForce => "peak floor force, time peak".into(),
+    }
+}
+
+fn objective_value(o: Objective, v: f64) -> String {
+    match o {
+        Objective::Energy => format!("{} %", sig(100.0 * v, 4)),
+        Objective::BedAccel => format!("{} m/s²", sig(v, 4)),
+        Objective::FloorForce => format!("{} N", sig(v, 4)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::log_grid;
+
+    #[test]
+    fn log_grid_is_centred_on_the_design() {
+        let g = log_grid(150.0, 3.0, 5);
+        assert_eq!(g.len(), 5);
+        assert_eq!(g[2], 150.0);
+        assert!((g[0] - 50.0).abs() < 1e-12 && (g[4] - 450.0).abs() < 1e-9);
+        assert!(g.windows(2).all(|w| w[0] < w[1]));
+    }
+}
