@@ -35,6 +35,7 @@ mod modes;
 mod montecarlo;
 mod optimize;
 mod outputs;
+mod paper;
 mod shell;
 mod simulate;
 mod sweep;
@@ -75,6 +76,9 @@ enum Command {
     Blows(blows::BlowsArgs),
     /// Monte Carlo over uncertain inputs (seeded): mean, percentiles, histogram.
     Montecarlo(montecarlo::MonteCarloArgs),
+    /// The paper reproduced: every study of its Figs. 2-19, its numbers beside meid's, and why
+    /// they differ, as one HTML page.
+    Paper(paper::PaperArgs),
     /// Shell completion script for bash, zsh, fish, elvish or powershell, on stdout.
     Completions(shell::CompletionsArgs),
     /// The manual page (roff) on stdout, or every page into a directory with -o.
@@ -110,6 +114,7 @@ fn main() -> ExitCode {
         Command::Optimize(a) => optimize::run(a),
         Command::Blows(a) => blows::run(a),
         Command::Montecarlo(a) => montecarlo::run(a),
+        Command::Paper(a) => paper::run(a),
         Command::Completions(a) => shell::completions(a),
         Command::Man(a) => shell::man(a),
     };

@@ -11,3 +11,4 @@
 //! small structure, and escaping is the only subtle part.
 
 pub mod html;
+pub mod paper;
