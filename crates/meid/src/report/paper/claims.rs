@@ -433,11 +433,14 @@ pub fn rows(r: &Runs) -> Vec<Row> {
         (PCT_ADDED, CaseName::AddedMass),
     ] {
         let (l, f) = r.both(Base::Soft, |_, s| {
-            Some(measures::energy_reduction_percent(&s.compare, case))
+            Some(measures::energy_reduction_percent(
+                s.compare_for(case),
+                case,
+            ))
         });
         out.push(numeric(
             p,
-            "1 − η_case/η_none (%) at S, η = E_p+/E_s− (added mass on the bed)",
+            "1 − η_case/η_none (%) at S, η = E_p+/E_s− (the added mass on the bed)",
             l,
             f,
             5.0,

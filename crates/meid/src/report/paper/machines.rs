@@ -252,3 +252,50 @@ pub fn build() -> Result<Vec<Machine>> {
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The closed form reproduces the springs of `examples/paper-lumped.toml` (computed there
+    /// from 6.35/283 Hz), and its stiff-base springs give 141/292 Hz as the eigenvalues of the
+    /// two-mass system `[k_c/m_b, −k_c/m_b; −k_c/m_f, (k_c+k_f)/m_f]`.
+    #[test]
+    fn two_mode_springs_closed_form() {
+        let (k_c, k_f) = two_mode_springs(10.0, 41.0, 6.35, 283.0).unwrap();
+        assert!((k_c / 2.5415164e7 - 1.0).abs() < 1e-7, "{k_c}");
+        assert!((k_f / 8.1195270e4 - 1.0).abs() < 1e-7, "{k_f}");
+        let (k_c, k_f) = two_mode_springs(10.0, 41.0, 141.0, 292.0).unwrap();
+        let (a, d, bc) = (k_c / 10.0, (k_c + k_f) / 41.0, k_c * k_c / 410.0);
+        let mean = 0.5 * (a + d);
+        let root = (0.25 * (a - d) * (a - d) + bc).sqrt();
+        let f = |l: f64| l.sqrt() / (2.0 * std::f64::consts::PI);
+        assert!((f(mean - root) / 141.0 - 1.0).abs() < 1e-12);
+        assert!((f(mean + root) / 292.0 - 1.0).abs() < 1e-12);
+        // Equal frequencies: no two-mass system of these masses has them.
+        assert!(two_mode_springs(10.0, 41.0, 100.0, 100.0).is_err());
+    }
+
+    #[test]
+    fn six_machines_at_their_operating_points() {
+        let m = build().unwrap();
+        assert_eq!(m.len(), 6);
+        for x in &m {
+            // ω_d = ω_s: K_d/m_d = K_s/m_s.
+            let s = &x.model.spec;
+            let ws2 = s.contact.slider_bed.stiffness / s.slider.mass;
+            let wd2 =
+                s.contact.bed_damper.as_ref().unwrap().stiffness / s.damper.as_ref().unwrap().mass;
+            assert!((ws2 / wd2 - 1.0).abs() < 1e-12, "{}", x.label());
+            // T and U keep the K_s of S (same kind).
+            let soft = m
+                .iter()
+                .find(|y| y.kind == x.kind && y.base == Base::Soft)
+                .unwrap();
+            assert_eq!(
+                s.contact.slider_bed.stiffness,
+                soft.model.spec.contact.slider_bed.stiffness
+            );
+        }
+    }
+}

@@ -214,3 +214,19 @@ pub fn dominant_peak_hz(r: &ComparisonResult, q: Quantity, c: CaseName) -> f64 {
 pub fn energy_ratio(r: &ComparisonResult, c: CaseName) -> f64 {
     case(r, c).and_then(|x| x.energy_ratio).unwrap_or(f64::NAN)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percent_and_db_are_inverse_power_ratios() {
+        // 3.0103 dB halves the power.
+        assert!((db_to_percent(10.0 * 2f64.log10()) - 50.0).abs() < 1e-12);
+        assert!((percent_to_db(41.2) - 2.3062).abs() < 1e-4);
+        assert!((percent_to_db(25.9) - 1.3018).abs() < 1e-4);
+        for p in [1.0, 41.2, 90.0] {
+            assert!((db_to_percent(percent_to_db(p)) - p).abs() < 1e-12);
+        }
+    }
+}
