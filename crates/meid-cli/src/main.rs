@@ -35,6 +35,7 @@ mod modes;
 mod montecarlo;
 mod optimize;
 mod outputs;
+mod paper;
 mod report;
 mod shell;
 mod simulate;
@@ -79,6 +80,9 @@ enum Command {
     /// One page about the model's machine: modes, energy map, none/damper/added mass,
     /// blow train, optimiser, Monte Carlo (index.html with pictures and data).
     Report(report::ReportArgs),
+    /// The paper reproduced: every study of its Figs. 2-19, its numbers beside meid's, and why
+    /// they differ, as one HTML page.
+    Paper(paper::PaperArgs),
     /// Shell completion script for bash, zsh, fish, elvish or powershell, on stdout.
     Completions(shell::CompletionsArgs),
     /// The manual page (roff) on stdout, or every page into a directory with -o.
@@ -115,6 +119,7 @@ fn main() -> ExitCode {
         Command::Blows(a) => blows::run(a),
         Command::Montecarlo(a) => montecarlo::run(a),
         Command::Report(a) => report::run(a),
+        Command::Paper(a) => paper::run(a),
         Command::Completions(a) => shell::completions(a),
         Command::Man(a) => shell::man(a),
     };

@@ -8,7 +8,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use meid::analysis::sweep::{Quantity, Spacing, Sweep, SweepResult, Vary, DERIVED, METRICS};
+use meid::analysis::sweep::{
+    case_label, case_name, Quantity, Spacing, Sweep, SweepResult, Vary, DERIVED, METRICS,
+};
+use meid::model::Case;
 use meid::plot::{heat_map, line_plot, HeatMap, LinePlot, Series};
 
 use crate::args::{PrintArgs, SetArgs};
@@ -44,6 +47,11 @@ pub struct SweepArgs {
     /// Run every point for S seconds instead of stopping at the end of the collision.
     #[arg(long, value_name = "S")]
     duration: Option<f64>,
+    /// Compare cases in one run: every point is simulated once per case (none, damper,
+    /// added-mass, as-specified) and the metric columns become METRIC:CASE; the pictures draw
+    /// one curve (or map) per case.
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    cases: Vec<String>,
     /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, or the
     /// FE machine's bed plate; see docs/studies.md).
     #[arg(long, value_name = "KG")]
@@ -72,7 +80,15 @@ pub fn run(a: SweepArgs) -> Result<()> {
             bail!("--bed-mass must be > 0 kg (got {m})");
         }
     }
+    let cases = a
+        .cases
+        .iter()
+        .map(|c| c.trim().parse::<Case>())
+        .collect::<meid::Result<Vec<_>>>()?;
     let mut sweep = Sweep::with_bed_mass(model, vary.clone(), a.bed_mass)?;
+    if !cases.is_empty() {
+        sweep = sweep.with_cases(cases)?;
+    }
     if a.duration.is_some() {
         sweep.options.stop_at_collision_end = false;
     }
@@ -173,21 +189,34 @@ fn summarise(sweep: &Sweep, r: &SweepResult, metric: &str, elapsed: f64, files: 
         r.failures()
     );
     let names: Vec<String> = sweep.vary.iter().map(|v| v.quantity.name()).collect();
+    let mut shown: Vec<String> = Vec::new();
     for m in [metric, "energy_ratio"] {
-        match r.argmin(m) {
-            Some(i) => {
-                let p = &r.points[i];
-                let at: Vec<String> = names
-                    .iter()
-                    .zip(&p.values)
-                    .map(|(n, v)| format!("{n} = {v:.6}"))
-                    .collect();
-                println!("  min {m:<32} {:.6e}  at {}", p.metric(m), at.join(", "));
+        for k in 0..sweep.cases.len().max(1) {
+            let column = if DERIVED.contains(&m) {
+                m.to_string()
+            } else {
+                sweep.metric_column(k, m)
+            };
+            if shown.contains(&column) {
+                continue;
             }
-            None => println!("  min {m:<32} — (undefined at every point; no picture)"),
-        }
-        if metric == "energy_ratio" {
-            break;
+            match r.argmin(&column) {
+                Some(i) => {
+                    let p = &r.points[i];
+                    let at: Vec<String> = names
+                        .iter()
+                        .zip(&p.values)
+                        .map(|(n, v)| format!("{n} = {v:.6}"))
+                        .collect();
+                    println!(
+                        "  min {column:<32} {:.6e}  at {}",
+                        r.value(i, &column),
+                        at.join(", ")
+                    );
+                }
+                None => println!("  min {column:<32} — (undefined at every point; no picture)"),
+            }
+            shown.push(column);
         }
     }
     if let Some(p) = r.points.iter().find(|p| p.error.is_some()) {
@@ -237,6 +266,8 @@ fn increasing(v: &Vary) -> Option<Vec<usize>> {
     ok.then_some(idx)
 }
 
+// `..Default::default()` on every plot literal, so that fields added to the plot API merge.
+#[allow(clippy::needless_update)]
 fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<PathBuf>> {
     let mut out = Vec::new();
     // Quantities with a single value are fixed: the picture is over the others.
@@ -244,24 +275,42 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
         .filter(|&k| sweep.vary[k].values.len() > 1)
         .collect();
     let vary: Vec<&Vary> = active.iter().map(|&k| &sweep.vary[k]).collect();
-    let value = |i: usize, j: usize| -> f64 {
+    // The cases drawn (one curve or one map each): the sweep's, or the model as specified.
+    let ncases = sweep.cases.len().max(1);
+    let column = |k: usize| -> String {
+        if DERIVED.contains(&metric) {
+            metric.to_string()
+        } else {
+            sweep.metric_column(k, metric)
+        }
+    };
+    let value = |k: usize, i: usize, j: usize| -> f64 {
         // Row-major index with the active quantities at (i, j) and the fixed ones at 0.
         let mut index = 0;
-        for (k, v) in sweep.vary.iter().enumerate() {
-            let at = match active.iter().position(|&a| a == k) {
+        for (q, v) in sweep.vary.iter().enumerate() {
+            let at = match active.iter().position(|&a| a == q) {
                 Some(0) => i,
                 Some(1) => j,
                 _ => 0,
             };
             index = index * v.values.len() + at;
         }
-        r.points[index].metric(metric)
+        r.value(index, &column(k))
+    };
+    // A legend prefix naming the case (none without cases).
+    let case_prefix = |k: usize| -> String {
+        match sweep.cases.get(k) {
+            Some(c) => case_label(*c).to_string(),
+            None => String::new(),
+        }
     };
     let stem = metric.replace('/', "_");
     let w_ref = r.spec.reference_omega_rad_per_s;
     // No picture of a metric undefined at every point (e.g. the energy ratio when no run
     // reached the end of the collision); the summary says so.
-    if !r.points.iter().any(|p| p.metric(metric).is_finite()) {
+    let defined =
+        (0..ncases).any(|k| (0..r.points.len()).any(|i| r.value(i, &column(k)).is_finite()));
+    if !defined {
         return Ok(out);
     }
     match vary.len() {
@@ -275,36 +324,46 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                 y_label: metric_label(metric),
                 x_log: vary[0].spacing == Spacing::Log,
                 y_log: false,
-                series: vec![Series {
-                    label: String::new(),
-                    x: ix.iter().map(|&i| vary[0].values[i]).collect(),
-                    y: ix.iter().map(|&i| value(i, 0)).collect(),
-                    ..Default::default()
-                }],
+                series: (0..ncases)
+                    .map(|k| Series {
+                        label: case_prefix(k),
+                        x: ix.iter().map(|&i| vary[0].values[i]).collect(),
+                        y: ix.iter().map(|&i| value(k, i, 0)).collect(),
+                        ..Default::default()
+                    })
+                    .collect(),
                 ..Default::default()
             };
             let f = line_plot(dir.join(format!("{stem}_curve")), &plot)?;
             out.extend([f.png, f.svg]);
         }
         2 if vary[1].spacing == Spacing::List => {
-            // Families of curves: x = first quantity, one curve per listed value.
+            // Families of curves: x = first quantity, one curve per listed value (and case).
             let Some(ix) = increasing(vary[0]) else {
                 return Ok(out);
             };
-            let series = (0..vary[1].values.len())
-                .map(|j| Series {
-                    label: vary[1].quantity.legend_entry(vary[1].values[j]),
-                    x: ix.iter().map(|&i| vary[0].values[i]).collect(),
-                    y: ix.iter().map(|&i| value(i, j)).collect(),
-                    ..Default::default()
-                })
-                .collect();
+            let mut series = Vec::new();
+            for k in 0..ncases {
+                for j in 0..vary[1].values.len() {
+                    let family = vary[1].quantity.legend_entry(vary[1].values[j]);
+                    let prefix = case_prefix(k);
+                    series.push(Series {
+                        label: if prefix.is_empty() {
+                            family
+                        } else {
+                            format!("{prefix}, {family}")
+                        },
+                        x: ix.iter().map(|&i| vary[0].values[i]).collect(),
+                        y: ix.iter().map(|&i| value(k, i, j)).collect(),
+                        ..Default::default()
+                    });
+                }
+            }
             let plot = LinePlot {
                 title: format!("{} over {}", metric_name(metric), vary[0].quantity.symbol()),
                 x_label: label(&vary[0].quantity, w_ref),
                 y_label: metric_label(metric),
                 x_log: vary[0].spacing == Spacing::Log,
-                y_log: false,
                 series,
                 ..Default::default()
             };
@@ -315,69 +374,81 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
             let (Some(ix), Some(iy)) = (increasing(vary[0]), increasing(vary[1])) else {
                 return Ok(out);
             };
-            let x: Vec<f64> = ix.iter().map(|&i| vary[0].values[i]).collect();
-            let y: Vec<f64> = iy.iter().map(|&j| vary[1].values[j]).collect();
-            let mut z = Vec::with_capacity(x.len() * y.len());
-            for &j in &iy {
-                for &i in &ix {
-                    z.push(value(i, j));
+            for k in 0..ncases {
+                let x: Vec<f64> = ix.iter().map(|&i| vary[0].values[i]).collect();
+                let y: Vec<f64> = iy.iter().map(|&j| vary[1].values[j]).collect();
+                let mut z = Vec::with_capacity(x.len() * y.len());
+                for &j in &iy {
+                    for &i in &ix {
+                        z.push(value(k, i, j));
+                    }
                 }
-            }
-            let finite: Vec<f64> = z.iter().copied().filter(|v| v.is_finite()).collect();
-            let (lo, hi) = finite
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                    (a.min(v), b.max(v))
-                });
-            let contour_levels = meid::plot::nice_levels(lo, hi, 7);
-            let mut overlay_lines = Vec::new();
-            let (q0, q1) = (&vary[0].quantity, &vary[1].quantity);
-            let diag = matches!(
-                (q0, q1),
-                (Quantity::WsOverWref, Quantity::WdOverWref)
-                    | (Quantity::WdOverWref, Quantity::WsOverWref)
-            );
-            if diag {
-                let a = x[0].max(y[0]);
-                let b = x[x.len() - 1].min(y[y.len() - 1]);
-                if a < b {
+                let finite: Vec<f64> = z.iter().copied().filter(|v| v.is_finite()).collect();
+                let (lo, hi) = finite
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                        (a.min(v), b.max(v))
+                    });
+                let contour_levels = meid::plot::nice_levels(lo, hi, 7);
+                let mut overlay_lines = Vec::new();
+                let (q0, q1) = (&vary[0].quantity, &vary[1].quantity);
+                let diag = matches!(
+                    (q0, q1),
+                    (Quantity::WsOverWref, Quantity::WdOverWref)
+                        | (Quantity::WdOverWref, Quantity::WsOverWref)
+                );
+                if diag {
+                    let a = x[0].max(y[0]);
+                    let b = x[x.len() - 1].min(y[y.len() - 1]);
+                    if a < b {
+                        overlay_lines.push(Series {
+                            label: "ω_d = ω_s".into(),
+                            x: vec![a, b],
+                            y: vec![a, b],
+                            ..Default::default()
+                        });
+                    }
+                }
+                if matches!(q1, Quantity::WdOverWs) {
                     overlay_lines.push(Series {
                         label: "ω_d = ω_s".into(),
-                        x: vec![a, b],
-                        y: vec![a, b],
+                        x: vec![x[0], x[x.len() - 1]],
+                        y: vec![1.0, 1.0],
                         ..Default::default()
                     });
                 }
-            }
-            if matches!(q1, Quantity::WdOverWs) {
-                overlay_lines.push(Series {
-                    label: "ω_d = ω_s".into(),
-                    x: vec![x[0], x[x.len() - 1]],
-                    y: vec![1.0, 1.0],
-                    ..Default::default()
-                });
-            }
-            let map = HeatMap {
-                title: format!(
+                let prefix = case_prefix(k);
+                let what = format!(
                     "{} over {} and {}",
                     metric_name(metric),
                     q0.symbol(),
                     q1.symbol()
-                ),
-                x_label: label(q0, w_ref),
-                y_label: label(q1, w_ref),
-                x,
-                y,
-                z,
-                x_log: vary[0].spacing == Spacing::Log,
-                y_log: vary[1].spacing == Spacing::Log,
-                contour_levels,
-                overlay_lines,
-                colorbar_label: metric_label(metric),
-                ..Default::default()
-            };
-            let f = heat_map(dir.join(format!("{stem}_map")), &map)?;
-            out.extend([f.png, f.svg]);
+                );
+                let map = HeatMap {
+                    title: if prefix.is_empty() {
+                        what
+                    } else {
+                        format!("{what}, {prefix}")
+                    },
+                    x_label: label(q0, w_ref),
+                    y_label: label(q1, w_ref),
+                    x,
+                    y,
+                    z,
+                    x_log: vary[0].spacing == Spacing::Log,
+                    y_log: vary[1].spacing == Spacing::Log,
+                    contour_levels,
+                    overlay_lines,
+                    colorbar_label: metric_label(metric),
+                    ..Default::default()
+                };
+                let name = match sweep.cases.get(k) {
+                    Some(c) => format!("{stem}_map_{}", case_name(*c)),
+                    None => format!("{stem}_map"),
+                };
+                let f = heat_map(dir.join(name), &map)?;
+                out.extend([f.png, f.svg]);
+            }
         }
         _ => {}
     }

@@ -423,3 +423,43 @@ fn added_mass_point_from_the_command_line() {
         "{err}"
     );
 }
+
+#[test]
+fn sweep_cases_columns_and_one_curve_per_case() {
+    let d = tmpdir("cases");
+    let mut c = meid();
+    c.arg("sweep")
+        .arg(example())
+        .args([
+            "--vary",
+            "md/mb=0.35,0.7,1.0",
+            "--cases",
+            "none,damper,added-mass",
+        ])
+        .arg("-o")
+        .arg(&d);
+    let out = ok(c.output().unwrap());
+    assert!(out.contains("min energy_ratio:added-mass"), "{out}");
+    let csv = std::fs::read_to_string(d.join("sweep.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    for col in [
+        "energy_ratio:none",
+        "energy_ratio:damper",
+        "energy_ratio:added-mass",
+    ] {
+        assert!(header.contains(&col), "{col} missing: {header:?}");
+    }
+    let json = std::fs::read_to_string(d.join("sweep.json")).unwrap();
+    assert!(json.contains("\"cases\""), "{json}");
+    let svg = std::fs::read_to_string(d.join("energy_ratio_curve.svg")).unwrap();
+    for label in ["without damper", "impact damper", "added mass"] {
+        assert!(svg.contains(label), "legend lacks {label}");
+    }
+    // A case listed twice is an input error (exit code 2).
+    let mut c = meid();
+    c.arg("sweep")
+        .arg(example())
+        .args(["--vary", "md/mb=0.35", "--cases", "none,none"]);
+    let o = c.output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+}

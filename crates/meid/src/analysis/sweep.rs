@@ -30,6 +30,17 @@
 //! point's integration options ([`point_options`]); a varied `simulation.duration` runs the
 //! point for its duration instead of stopping at the end of the collision.
 //!
+//! # Cases
+//!
+//! [`Sweep::with_cases`] runs every point once per [`Case`] (`none`, `damper`, `added-mass`,
+//! `as-specified`): the bare machine, the impact damper and the rigid added mass
+//! ([`Model::added_mass`]: `added_mass.mass`, else the point's m_d, at `added_mass.point`, else
+//! the bed contact point) are compared in one run (paper Fig. 9). The point's model is built
+//! once; each case is [`Model::impact_system`] of it. The metric columns are then repeated per
+//! case, named `METRIC:CASE` (`energy_ratio:none`, `energy_ratio:damper`, ...), case by case in
+//! the order given. Without cases the columns are the plain [`METRICS`] of the model as
+//! specified (the files are those of a sweep without this option, byte for byte).
+//!
 //! # Cost and reproducibility
 //!
 //! The model file is parsed once. Derived ratios and non-structural fields are set on a clone
@@ -447,17 +458,30 @@ pub struct PointResult {
     pub values: Vec<f64>,
     /// [`DERIVED`]: K_s (N/m), K_d (N/m), m_d (kg), m_s (kg) of the point (NaN if unknown).
     pub derived: Vec<f64>,
-    /// [`METRICS`] (None: not defined, e.g. the collision did not end; NaN: the point failed).
+    /// [`METRICS`] (None: not defined, e.g. the collision did not end; NaN: the point failed);
+    /// with cases ([`Sweep::cases`]) the [`METRICS`] of each case in turn.
     pub metrics: Vec<Option<f64>>,
     /// Why the point failed.
     pub error: Option<String>,
 }
 
 impl PointResult {
-    /// A metric by name ([`METRICS`] or [`DERIVED`]); NaN if undefined or failed.
+    /// A metric by name ([`METRICS`] or [`DERIVED`]); NaN if undefined or failed. With
+    /// cases, a [`METRICS`] name reads the first case ([`PointResult::case_metric`]).
     pub fn metric(&self, name: &str) -> f64 {
+        self.case_metric(0, name)
+    }
+
+    /// A metric of the `k`-th case of the sweep (0 without cases; [`DERIVED`] names are the
+    /// point's, whatever `k`); NaN if undefined, failed or unknown.
+    pub fn case_metric(&self, k: usize, name: &str) -> f64 {
         if let Some(i) = METRICS.iter().position(|m| *m == name) {
-            return self.metrics.get(i).copied().flatten().unwrap_or(f64::NAN);
+            return self
+                .metrics
+                .get(k * METRICS.len() + i)
+                .copied()
+                .flatten()
+                .unwrap_or(f64::NAN);
         }
         if let Some(i) = DERIVED.iter().position(|m| *m == name) {
             return self.derived.get(i).copied().unwrap_or(f64::NAN);
@@ -487,6 +511,30 @@ pub struct Sweep {
     /// m_b (kg) for `md/mb`, when given (`--bed-mass`); `None`: each point's
     /// [`Model::bed_mass`].
     pub bed_mass_kg: Option<f64>,
+    /// The cases run at every point ([`Sweep::with_cases`]); empty: the model as specified,
+    /// with the plain [`METRICS`] columns.
+    pub cases: Vec<Case>,
+}
+
+/// The name of a case in `--cases` and in the `METRIC:CASE` columns: `none`, `damper`,
+/// `added-mass`, `as-specified` (what [`Case`]'s `FromStr` reads).
+pub fn case_name(c: Case) -> &'static str {
+    match c {
+        Case::AsSpecified => "as-specified",
+        Case::NoDamper => "none",
+        Case::Damper => "damper",
+        Case::AddedMass => "added-mass",
+    }
+}
+
+/// Legend text of a case (the paper's terms).
+pub fn case_label(c: Case) -> &'static str {
+    match c {
+        Case::AsSpecified => "as specified",
+        Case::NoDamper => "without damper",
+        Case::Damper => "impact damper",
+        Case::AddedMass => "added mass",
+    }
 }
 
 /// Everything a sweep produced, in grid order.
@@ -511,6 +559,9 @@ pub struct SweepSpec {
     pub sample_rate_hz: Option<f64>,
     pub reference_omega_rad_per_s: Option<f64>,
     pub bed_mass_kg: Option<f64>,
+    /// The cases run at every point ([`case_name`]); absent without cases.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub cases: Vec<String>,
     pub columns: Vec<String>,
 }
 
@@ -533,9 +584,53 @@ impl Sweep {
             vary,
             options,
             bed_mass_kg,
+            cases: Vec::new(),
         };
         s.check()?;
         Ok(s)
+    }
+
+    /// Runs every point once per case (module docs, "Cases"): the metric columns become
+    /// `METRIC:CASE`. Refuses a case listed twice and a case the model cannot build (`damper`
+    /// without a `[damper]`, `added-mass` without `[added_mass]` or `[damper]`), naming it.
+    pub fn with_cases(mut self, cases: Vec<Case>) -> Result<Self> {
+        for (i, c) in cases.iter().enumerate() {
+            if cases[..i].contains(c) {
+                return Err(Error::invalid(
+                    "cases",
+                    format!("the case `{}` is listed twice", case_name(*c)),
+                ));
+            }
+            self.model.impact_system(*c).map_err(|e| {
+                Error::invalid(
+                    "cases",
+                    format!(
+                        "the case `{}` cannot be built on this model: {e}",
+                        case_name(*c)
+                    ),
+                )
+            })?;
+        }
+        self.cases = cases;
+        self.check()?;
+        Ok(self)
+    }
+
+    /// The cases a point runs: [`Sweep::cases`], or the model as specified.
+    fn point_cases(&self) -> Vec<Case> {
+        if self.cases.is_empty() {
+            vec![Case::AsSpecified]
+        } else {
+            self.cases.clone()
+        }
+    }
+
+    /// Column name of a metric of the `k`-th case: `METRIC:CASE` with cases, `METRIC` without.
+    pub fn metric_column(&self, k: usize, metric: &str) -> String {
+        match self.cases.get(k) {
+            Some(c) => format!("{metric}:{}", case_name(*c)),
+            None => metric.to_string(),
+        }
     }
 
     fn check(&self) -> Result<()> {
@@ -601,10 +696,11 @@ impl Sweep {
     /// Memory one grid point takes (bytes): its [`PointResult`] (values, derived quantities,
     /// metrics) and its text in `sweep.csv` and `sweep.json`, each ≤ 24 characters per column.
     pub fn bytes_per_point(&self) -> f64 {
-        let columns = (self.vary.len() + DERIVED.len() + METRICS.len() + 2) as f64;
+        let metrics = (METRICS.len() * self.cases.len().max(1)) as f64;
+        let columns = (self.vary.len() + DERIVED.len()) as f64 + metrics + 2.0;
         std::mem::size_of::<PointResult>() as f64
             + 8.0 * (self.vary.len() + DERIVED.len()) as f64
-            + 16.0 * METRICS.len() as f64
+            + 16.0 * metrics
             + 2.0 * 24.0 * columns
     }
 
@@ -634,12 +730,15 @@ impl Sweep {
         self.vary.iter().map(|v| &v.quantity).collect()
     }
 
-    /// Column names of `sweep.csv`: `index`, varied names, [`DERIVED`], [`METRICS`], `error`.
+    /// Column names of `sweep.csv`: `index`, varied names, [`DERIVED`], [`METRICS`] (per case,
+    /// `METRIC:CASE`, with cases), `error`.
     pub fn columns(&self) -> Vec<String> {
         let mut c = vec!["index".to_string()];
         c.extend(self.vary.iter().map(|v| v.quantity.name()));
         c.extend(DERIVED.iter().map(|s| s.to_string()));
-        c.extend(METRICS.iter().map(|s| s.to_string()));
+        for k in 0..self.cases.len().max(1) {
+            c.extend(METRICS.iter().map(|m| self.metric_column(k, m)));
+        }
         c.push("error".into());
         c
     }
@@ -664,13 +763,14 @@ impl Sweep {
     /// Simulates grid point `index`; failures become a [`PointResult`] with its error.
     pub fn run_point(&self, index: usize) -> PointResult {
         let values = self.values_at(index);
-        evaluate(
+        evaluate_cases(
             &self.model,
             &self.quantities(),
             &values,
             self.bed_mass_kg,
             &self.options,
             index,
+            &self.point_cases(),
         )
     }
 
@@ -747,6 +847,11 @@ impl Sweep {
             sample_rate_hz: self.options.sample_rate,
             reference_omega_rad_per_s: self.model.reference_omega(),
             bed_mass_kg: self.bed_mass_kg.or_else(|| self.model.bed_mass()),
+            cases: self
+                .cases
+                .iter()
+                .map(|c| case_name(*c).to_string())
+                .collect(),
             columns: self.columns(),
         }
     }
@@ -771,6 +876,9 @@ impl Sweep {
             "|{:?}|{:?}|{:?}|{}",
             self.vary, self.options, self.bed_mass_kg, self.model.source.text
         );
+        if !self.cases.is_empty() {
+            let _ = write!(text, "|cases {:?}", self.cases);
+        }
         let mut h: u64 = 0xcbf2_9ce4_8422_2325;
         for b in text.bytes() {
             h ^= u64::from(b);
@@ -895,7 +1003,8 @@ impl Sweep {
             .from_reader(line.as_bytes());
         let rec = rdr.records().next()?.ok()?;
         let nv = self.vary.len();
-        if rec.len() != 1 + nv + DERIVED.len() + METRICS.len() + 1 {
+        let nm = METRICS.len() * self.cases.len().max(1);
+        if rec.len() != 1 + nv + DERIVED.len() + nm + 1 {
             return None;
         }
         let num = |s: &str| -> Option<f64> { s.parse().ok() };
@@ -908,8 +1017,8 @@ impl Sweep {
         let derived: Option<Vec<f64>> = (0..DERIVED.len())
             .map(|k| num(rec.get(1 + nv + k)?))
             .collect();
-        let mut metrics = Vec::with_capacity(METRICS.len());
-        for k in 0..METRICS.len() {
+        let mut metrics = Vec::with_capacity(nm);
+        for k in 0..nm {
             let s = rec.get(1 + nv + DERIVED.len() + k)?;
             metrics.push(if s.is_empty() { None } else { Some(num(s)?) });
         }
@@ -950,11 +1059,26 @@ impl SweepResult {
         crate::io::write_json(&dir.join("sweep.json"), self)
     }
 
-    /// Index (into `points`) of the smallest finite value of a metric.
+    /// The value of a column at point `i`: a [`METRICS`] name (the first case), a
+    /// `METRIC:CASE` column of a sweep with cases, or a [`DERIVED`] name; NaN if undefined.
+    pub fn value(&self, i: usize, column: &str) -> f64 {
+        let Some(p) = self.points.get(i) else {
+            return f64::NAN;
+        };
+        match column.split_once(':') {
+            Some((metric, case)) => match self.spec.cases.iter().position(|c| c == case) {
+                Some(k) => p.case_metric(k, metric),
+                None => f64::NAN,
+            },
+            None => p.metric(column),
+        }
+    }
+
+    /// Index (into `points`) of the smallest finite value of a column ([`SweepResult::value`]).
     pub fn argmin(&self, metric: &str) -> Option<usize> {
         let mut best: Option<(usize, f64)> = None;
-        for (i, p) in self.points.iter().enumerate() {
-            let v = p.metric(metric);
+        for i in 0..self.points.len() {
+            let v = self.value(i, metric);
             if v.is_finite() && best.is_none_or(|(_, b)| v < b) {
                 best = Some((i, v));
             }
@@ -1255,7 +1379,8 @@ pub fn point_model(
     Ok(PointModel { model, derived })
 }
 
-/// Simulates one point (`quantities = values`); never fails: errors are recorded.
+/// Simulates one point (`quantities = values`) of the model as specified; never fails: errors
+/// are recorded.
 pub fn evaluate(
     base: &Model,
     quantities: &[&Quantity],
@@ -1264,7 +1389,30 @@ pub fn evaluate(
     options: &Options,
     index: usize,
 ) -> PointResult {
-    let nan_metrics = || vec![Some(f64::NAN); METRICS.len()];
+    evaluate_cases(
+        base,
+        quantities,
+        values,
+        bed_mass_kg,
+        options,
+        index,
+        &[Case::AsSpecified],
+    )
+}
+
+/// Simulates one point once per case (the point's model is built once); the metrics are the
+/// [`METRICS`] of each case in turn. A case that fails gets NaN metrics and its error (prefixed
+/// with the case's name when there are several cases) in [`PointResult::error`].
+pub fn evaluate_cases(
+    base: &Model,
+    quantities: &[&Quantity],
+    values: &[f64],
+    bed_mass_kg: Option<f64>,
+    options: &Options,
+    index: usize,
+    cases: &[Case],
+) -> PointResult {
+    let nan_metrics = || vec![Some(f64::NAN); METRICS.len() * cases.len()];
     let pm = match point_model(base, quantities, values, bed_mass_kg) {
         Ok(pm) => pm,
         Err(e) => {
@@ -1278,34 +1426,40 @@ pub fn evaluate(
         }
     };
     let options = point_options(options, quantities, &pm.model);
-    let run = pm
-        .model
-        .impact_system(Case::AsSpecified)
-        .and_then(|sys| simulate(&sys, &options, false));
-    match run {
-        Ok(run) => {
-            let mut metrics = summary_metrics(&run.summary);
-            let [k_s, k_d, m_d, m_s] = [pm.derived[0], pm.derived[1], pm.derived[2], pm.derived[3]];
-            let w_s = (k_s / m_s).sqrt();
-            let w_d = (k_d / m_d).sqrt();
-            metrics.push(Some(w_d / w_s));
-            metrics.push(Some(
-                pm.model.reference_omega().map_or(f64::NAN, |w| w_s / w),
-            ));
-            PointResult {
-                index,
-                values: values.to_vec(),
-                derived: pm.derived,
-                metrics,
-                error: None,
+    let mut metrics = Vec::with_capacity(METRICS.len() * cases.len());
+    let mut errors: Vec<String> = Vec::new();
+    for &case in cases {
+        let run = pm
+            .model
+            .impact_system(case)
+            .and_then(|sys| simulate(&sys, &options, false));
+        match run {
+            Ok(run) => {
+                metrics.extend(summary_metrics(&run.summary));
+                let [k_s, k_d, m_d, m_s] =
+                    [pm.derived[0], pm.derived[1], pm.derived[2], pm.derived[3]];
+                let w_s = (k_s / m_s).sqrt();
+                let w_d = (k_d / m_d).sqrt();
+                metrics.push(Some(w_d / w_s));
+                metrics.push(Some(
+                    pm.model.reference_omega().map_or(f64::NAN, |w| w_s / w),
+                ));
+            }
+            Err(e) => {
+                metrics.extend(std::iter::repeat_n(Some(f64::NAN), METRICS.len()));
+                errors.push(if cases.len() > 1 {
+                    format!("case {}: {e}", case_name(case))
+                } else {
+                    e.to_string()
+                });
             }
         }
-        Err(e) => PointResult {
-            index,
-            values: values.to_vec(),
-            derived: pm.derived,
-            metrics: nan_metrics(),
-            error: Some(e.to_string()),
-        },
+    }
+    PointResult {
+        index,
+        values: values.to_vec(),
+        derived: pm.derived,
+        metrics,
+        error: (!errors.is_empty()).then(|| errors.join("; ")),
     }
 }

@@ -1496,12 +1496,19 @@ pub fn from_file_with_analysis(
     count: Option<usize>,
 ) -> Result<(Model, Option<FemAnalysis>)> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    from_text_with_analysis(&path.display().to_string(), text, overrides, count)
+}
+
+/// [`from_file_with_analysis`] on a model's text (`name` is used in messages).
+pub fn from_text_with_analysis(
+    name: &str,
+    text: String,
+    overrides: &[String],
+    count: Option<usize>,
+) -> Result<(Model, Option<FemAnalysis>)> {
     let mut analysis = None;
-    let mut model = Model::from_text_with(
-        &path.display().to_string(),
-        text,
-        overrides,
-        |spec, src| match &spec.structure.fem {
+    let mut model = Model::from_text_with(name, text, overrides, |spec, src| {
+        match &spec.structure.fem {
             Some(f) if spec.structure.lumped.is_none() && spec.structure.modal.is_none() => {
                 let mut f = f.clone();
                 if count.is_some() {
@@ -1513,8 +1520,8 @@ pub fn from_file_with_analysis(
                 Ok(modal)
             }
             _ => super::build_structure(spec, src),
-        },
-    )?;
+        }
+    })?;
     if let (Some(f), Some(c)) = (model.spec.structure.fem.as_mut(), count) {
         f.count = Some(c);
     }

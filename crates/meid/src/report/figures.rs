@@ -168,6 +168,7 @@ pub fn energy_map(dir: &Path, stem: &str, spec: &MapSpec) -> Result<Figure> {
                 label: spec.diagonal_label.clone(),
                 x: vec![a, b],
                 y: vec![a, b],
+                ..Default::default()
             });
         }
     }
@@ -190,16 +191,19 @@ pub fn energy_map(dir: &Path, stem: &str, spec: &MapSpec) -> Result<Figure> {
             label: mark.label.clone(),
             x: vec![x0, x1, x1, x0, x0],
             y: vec![y0, y0, y1, y1, y0],
+            ..Default::default()
         });
         overlay_lines.push(Series {
             label: String::new(),
             x: vec![x0, x1],
             y: vec![dy, dy],
+            ..Default::default()
         });
         overlay_lines.push(Series {
             label: String::new(),
             x: vec![dx, dx],
             y: vec![y0, y1],
+            ..Default::default()
         });
     }
     let map = HeatMap {
@@ -267,6 +271,7 @@ pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Res
                     label: c.case.label().into(),
                     x: c.history.time_s[..n].to_vec(),
                     y: pick(&c.history)[..n].to_vec(),
+                    ..Default::default()
                 }
             })
             .collect::<Vec<_>>()
@@ -362,6 +367,7 @@ pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Res
                     label: c.case.label().into(),
                     x,
                     y,
+                    ..Default::default()
                 })
             })
             .collect();
@@ -401,6 +407,7 @@ pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Res
                     label: c.case.label().into(),
                     x,
                     y,
+                    ..Default::default()
                 })
             })
             .collect();
@@ -585,6 +592,7 @@ pub fn blow_train_figures(
                 label: case.label().into(),
                 x: run.blows.iter().map(|b| b.blow as f64).collect(),
                 y: run.blows.iter().map(pick).collect(),
+                ..Default::default()
             })
             .collect();
         let s = format!("{stem}-{suffix}");
@@ -640,16 +648,19 @@ pub fn histogram_figure(
             label: format!("samples ({})", values.len()),
             x,
             y,
+            ..Default::default()
         },
         Series {
             label: format!("mean {}", sig(stats.mean, 4)),
             x: vec![stats.mean, stats.mean],
             y: vec![0.0, top],
+            ..Default::default()
         },
         Series {
             label: format!("P95 {}", sig(stats.p95, 4)),
             x: vec![stats.p95, stats.p95],
             y: vec![0.0, top],
+            ..Default::default()
         },
     ];
     plot::line_plot(

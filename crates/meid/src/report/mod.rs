@@ -13,3 +13,4 @@
 pub mod figures;
 pub mod html;
 pub mod machine;
+pub mod paper;

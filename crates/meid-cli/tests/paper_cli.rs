@@ -1,0 +1,99 @@
+//! `meid paper` end to end at a reduced resolution (9 × 9 maps, 13-point curves; the full run
+//! is timed in docs/performance.md, not here).
+//!
+//! References: the page passes `report::html::check_page` (every src/href resolves inside the
+//! output directory, every figure captioned); every paper figure 2-19 is present with a caption
+//! naming it; the table has a row for every number the paper states (the ids of
+//! `report::paper::claims::PAPER_NUMBERS`) and the qualitative claims; the closed-form checkable
+//! numbers: the tuned modal frequencies (6.35 / 283 Hz, 141 / 292 Hz) within 3 % (the lumped
+//! models to 1e-6 relative: their springs are solved in closed form from the two frequencies),
+//! and the paper's arithmetic 41.2 % ↔ −10 log10(1 − 0.412) = 2.306 dB, 25.9 % ↔ 1.302 dB.
+
+mod common;
+
+use common::{meid, ok};
+
+#[test]
+fn paper_page_figures_table_and_closed_forms() {
+    let dir = common::tmpdir("paper-cli", "run");
+    let mut c = meid();
+    c.args(["paper", "--map-points", "9", "--curve-points", "13", "-o"])
+        .arg(&dir);
+    let out = ok(c.output().unwrap());
+    assert!(out.contains("meid paper —"), "{out}");
+    assert!(out.contains("pct-damper-arithmetic"), "{out}");
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    let problems = meid::report::html::check_page(&dir, &html);
+    assert!(problems.is_empty(), "{problems:?}");
+    // Every paper figure 2-19, each inside a caption.
+    let captions: Vec<&str> = html
+        .split("<figcaption>")
+        .skip(1)
+        .map(|c| c.split("</figcaption>").next().unwrap())
+        .collect();
+    for n in 2..=19 {
+        let tag = format!("Reproduces paper Fig. {n}");
+        let hits = captions
+            .iter()
+            .filter(|c| {
+                c.contains(&format!("{tag}:"))
+                    || c.contains(&format!("{tag}("))
+                    || c.contains(&format!("{tag} "))
+            })
+            .count();
+        assert!(hits >= 1, "no captioned figure reproduces paper Fig. {n}");
+    }
+    // Each figure's data file and vector picture exist (check_page covered the links).
+    assert!(html.contains(".csv\">") && html.contains(".svg\">"));
+    // The table: every paper number has a row.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("paper.json")).unwrap()).unwrap();
+    let table = json["table"].as_array().unwrap();
+    let ids: Vec<&str> = table.iter().map(|r| r["id"].as_str().unwrap()).collect();
+    for p in meid::report::paper::claims::PAPER_NUMBERS {
+        assert!(ids.contains(&p.id), "no row for {}", p.id);
+        assert!(html.contains(p.source.split(',').next().unwrap()) || html.contains(p.what));
+    }
+    for id in [
+        "pct-added",
+        "pct-damper-arithmetic",
+        "pct-added-arithmetic",
+        "q-fig9",
+        "q-timing",
+    ] {
+        assert!(ids.contains(&id), "no row {id}");
+    }
+    let row = |id: &str| table.iter().find(|r| r["id"] == id).unwrap();
+    let val = |id: &str, k: &str| row(id)[k].as_f64().unwrap();
+    for (id, hz) in [
+        ("f6-soft", 6.35),
+        ("f10-soft", 283.0),
+        ("f6-stiff", 141.0),
+        ("f10-stiff", 292.0),
+    ] {
+        let l = val(id, "lumped");
+        let f = val(id, "fe");
+        assert!(((l - hz) / hz).abs() < 1e-6, "{id}: lumped {l} Hz vs {hz}");
+        assert!(((f - hz) / hz).abs() < 0.03, "{id}: FE {f} Hz vs {hz}");
+        assert_eq!(row(id)["verdict"], "reproduced");
+    }
+    let implied = |p: f64| -10.0 * (1.0 - p / 100.0).log10();
+    assert!((implied(41.2) - 2.306).abs() < 5e-4);
+    assert!((implied(25.9) - 1.302).abs() < 5e-4);
+    assert!((val("pct-damper-arithmetic", "lumped") - implied(41.2)).abs() < 1e-12);
+    assert!((val("pct-added-arithmetic", "lumped") - implied(25.9)).abs() < 1e-12);
+    assert_eq!(row("pct-damper-arithmetic")["verdict"], "not-reproduced");
+    // Every non-reproduced dB number got a deviation study.
+    let dev = json["deviations"].as_array().unwrap();
+    for r in table {
+        let id = r["id"].as_str().unwrap();
+        if r["verdict"] != "reproduced" && ["T-acc", "U-acc", "exp-force", "eta-md1"].contains(&id)
+        {
+            assert!(
+                dev.iter().any(|d| d["number"] == id),
+                "no deviation rows for {id}"
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
