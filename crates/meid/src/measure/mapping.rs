@@ -1,0 +1,1 @@
+//! Which measured channel is which simulated one.
