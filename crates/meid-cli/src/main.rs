@@ -31,6 +31,7 @@ macro_rules! eprintln {
 mod args;
 mod blows;
 mod compare;
+mod measure;
 mod modes;
 mod montecarlo;
 mod optimize;
@@ -75,6 +76,8 @@ enum Command {
     Blows(blows::BlowsArgs),
     /// Monte Carlo over uncertain inputs (seeded): mean, percentiles, histogram.
     Montecarlo(montecarlo::MonteCarloArgs),
+    /// Read measured records (UFF 58/58b, CSV): peaks, blows, dominant spectral lines.
+    Measure(measure::MeasureArgs),
     /// Shell completion script for bash, zsh, fish, elvish or powershell, on stdout.
     Completions(shell::CompletionsArgs),
     /// The manual page (roff) on stdout, or every page into a directory with -o.
@@ -110,6 +113,7 @@ fn main() -> ExitCode {
         Command::Optimize(a) => optimize::run(a),
         Command::Blows(a) => blows::run(a),
         Command::Montecarlo(a) => montecarlo::run(a),
+        Command::Measure(a) => measure::run(a),
         Command::Completions(a) => shell::completions(a),
         Command::Man(a) => shell::man(a),
     };

@@ -14,6 +14,7 @@
 
 pub mod mapping;
 pub mod process;
+pub mod report;
 pub mod units;
 pub mod validate;
 

@@ -79,7 +79,7 @@ pub struct Processing {
     /// Length of each blow's record (s); `None`: the shortest interval between triggers (a
     /// single blow: to the end of the file).
     pub record_s: Option<f64>,
-    /// Time after a trigger during which no other is taken (s, default 0.1).
+    /// Time after a trigger during which no other is taken (s, default 0.25).
     pub holdoff_s: f64,
     /// Window on responses (default rectangular).
     pub window: TransientWindow,
@@ -94,7 +94,7 @@ impl Default for Processing {
             level: Level::FractionOfPeak(0.1),
             pretrigger_s: 0.01,
             record_s: None,
-            holdoff_s: 0.1,
+            holdoff_s: 0.25,
             window: TransientWindow::Rectangular,
             force_window: false,
         }
@@ -522,12 +522,19 @@ pub struct ProcessedChannel {
     pub bands: Vec<(Band, f64)>,
 }
 
-/// The trigger channel of a set of records sampled together: the first force, else the first
-/// acceleration, else the first record.
-pub fn trigger_channel(records: &[&Record]) -> usize {
-    records
-        .iter()
-        .position(|r| r.quantity == Quantity::Force)
+/// The trigger channel of a set of records sampled together: the blow force when a channel
+/// is one by name ([`super::mapping`]), else the bed acceleration at B, else the first force,
+/// else the first acceleration, else the first record.
+pub fn trigger_channel(records: &[&Record], measurement_point: &str) -> usize {
+    use super::SimChannel;
+    let named = |c: SimChannel| {
+        records
+            .iter()
+            .position(|r| super::mapping::by_name(r, measurement_point) == Some(c))
+    };
+    named(SimChannel::BlowForce)
+        .or_else(|| named(SimChannel::BedAcceleration))
+        .or_else(|| records.iter().position(|r| r.quantity == Quantity::Force))
         .or_else(|| {
             records
                 .iter()
@@ -631,12 +638,37 @@ pub fn groups(records: &[Record]) -> Vec<Vec<usize>> {
     out
 }
 
-/// Processes every record (blows found per group on its [`trigger_channel`]).
-pub fn process_all(records: &[Record], p: &Processing) -> Result<Vec<ProcessedChannel>> {
+/// Processes every record; blows are found per group on the channel named `trigger` when the
+/// group has it, else on its [`trigger_channel`] (`point`: the model's measurement point name,
+/// for finding B by name).
+pub fn process_all(
+    records: &[Record],
+    p: &Processing,
+    trigger: Option<&str>,
+    point: &str,
+) -> Result<Vec<ProcessedChannel>> {
+    if let Some(name) = trigger {
+        if !records.iter().any(|r| r.name == name) {
+            let names: Vec<&str> = records.iter().map(|r| r.name.as_str()).collect();
+            return Err(Error::invalid(
+                "trigger",
+                format!(
+                    "no channel is named '{name}'; the channels are: {}",
+                    names.join(", ")
+                ),
+            ));
+        }
+    }
     let mut out: Vec<Option<ProcessedChannel>> = vec![None; records.len()];
     for g in groups(records) {
         let members: Vec<&Record> = g.iter().map(|&i| &records[i]).collect();
-        let t = trigger_channel(&members);
+        let t = match trigger {
+            Some(name) => members
+                .iter()
+                .position(|r| r.name == name)
+                .unwrap_or(trigger_channel(&members, point)),
+            None => trigger_channel(&members, point),
+        };
         let (blows, found) = group_blows(&members, t, p)?;
         for &i in &g {
             out[i] = Some(process_channel(&records[i], &blows, found, p)?);
