@@ -192,14 +192,22 @@ impl<R: BufRead> Parser<'_, R> {
                     ),
                 ));
             }
-            let start = self.line_no;
-            let Some(h) = self.line()? else {
-                return Err(self.err(
-                    None,
-                    None,
-                    self.line_no,
-                    "the file ends after a '-1' line: expected a dataset number".into(),
-                ));
+            let mut start = self.line_no;
+            // An empty block ("-1" twice, as some writers leave between datasets) is passed over.
+            let h = loop {
+                let Some(h) = self.line()? else {
+                    return Err(self.err(
+                        None,
+                        None,
+                        self.line_no,
+                        "the file ends after a '-1' line: expected a dataset number".into(),
+                    ));
+                };
+                if h.trim() == "-1" {
+                    start = self.line_no;
+                    continue;
+                }
+                break h;
             };
             ordinal += 1;
             let tok = h.split_whitespace().next().unwrap_or("");
@@ -1396,4 +1404,105 @@ mod tests {
         assert_eq!(f.nodes, nodes);
         assert_eq!(f.modes, vec![mode]);
     }
+}
+
+/// Writes evenly sampled records as datasets 58, one per record, in order; the response node
+/// is the record's position (1-based) unless the record names its point.
+pub fn write_records<W: Write>(w: &mut W, records: &[Record], binary: bool) -> Result<()> {
+    for (k, r) in records.iter().enumerate() {
+        let (start_s, step_s) = r.even()?;
+        let point = r.point.clone().unwrap_or(PointRef {
+            entity: r.name.split('_').next().unwrap_or("NONE").to_string(),
+            node: k as i64 + 1,
+            direction: 3,
+        });
+        let ch = Channel58 {
+            name: &r.name,
+            point,
+            quantity: r.quantity,
+            start_s,
+            step_s,
+            values: &r.values,
+        };
+        write_58(w, &ch, binary).map_err(|e| Error::io("UFF output", e))?;
+    }
+    Ok(())
+}
+
+/// Dataset 2411 + one dataset 55 per mode of a modal model's named points (a lumped or
+/// tabulated model has no geometry: point k, in name order, is node k at x = k − 1 m; its z
+/// translation is the mode-shape value, mass-normalised, modal mass 1). Damping ratios are
+/// `D_ii / (2 ω_i)` (0 for rigid-body modes).
+pub fn modes_uff_points(m: &crate::modal::ModalModel) -> Result<Vec<u8>> {
+    let names: Vec<&String> = m.points.keys().collect();
+    let nodes: Vec<Node> = (0..names.len())
+        .map(|k| Node {
+            label: k as i64 + 1,
+            xyz: [k as f64, 0.0, 0.0],
+        })
+        .collect();
+    let n = m.omega_rad_per_s.len();
+    let mut out = Vec::new();
+    write_2411(&mut out, &nodes).map_err(|e| Error::io("UFF output", e))?;
+    for i in 0..n {
+        let w = m.omega_rad_per_s[i];
+        let d = m.damping.get(i * n + i).copied().unwrap_or(0.0);
+        let mode = Mode {
+            number: i as i64 + 1,
+            frequency_hz: w / (2.0 * std::f64::consts::PI),
+            modal_mass: 1.0,
+            damping_ratio: if w > 0.0 { d / (2.0 * w) } else { 0.0 },
+            name: m
+                .labels
+                .get(i)
+                .cloned()
+                .unwrap_or_else(|| format!("mode {}", i + 1)),
+            shapes: names
+                .iter()
+                .enumerate()
+                .map(|(k, p)| (k as i64 + 1, [0.0, 0.0, m.points[*p][i]]))
+                .collect(),
+        };
+        write_55(&mut out, &mode).map_err(|e| Error::io("UFF output", e))?;
+    }
+    Ok(out)
+}
+
+/// Dataset 2411 (every mesh node, label = index + 1, coordinates in m) + one dataset 55 per
+/// computed mode (nodal translations of the mass-normalised shapes, modal mass 1) of an FE
+/// analysis; `zeta[i]` the modal damping ratios (missing: 0).
+pub fn modes_uff_fe(
+    model: &crate::structure::assembly::FeModel,
+    modes: &crate::modal::dense::DenseModes,
+    zeta: &[f64],
+) -> Result<Vec<u8>> {
+    let nodes: Vec<Node> = model
+        .mesh
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(k, p)| Node {
+            label: k as i64 + 1,
+            xyz: *p,
+        })
+        .collect();
+    let mut out = Vec::new();
+    write_2411(&mut out, &nodes).map_err(|e| Error::io("UFF output", e))?;
+    for i in 0..modes.omega_rad_per_s.len() {
+        let t = super::vtk::mode_translations(model, modes, i)?;
+        let mode = Mode {
+            number: i as i64 + 1,
+            frequency_hz: modes.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI),
+            modal_mass: 1.0,
+            damping_ratio: zeta.get(i).copied().unwrap_or(0.0),
+            name: format!("mode {}", i + 1),
+            shapes: t
+                .iter()
+                .enumerate()
+                .map(|(k, v)| (k as i64 + 1, *v))
+                .collect(),
+        };
+        write_55(&mut out, &mode).map_err(|e| Error::io("UFF output", e))?;
+    }
+    Ok(out)
 }
