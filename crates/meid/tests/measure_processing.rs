@@ -105,7 +105,8 @@ fn h1_of_a_known_sdof_equals_its_frequency_response() {
     assert!(images / h.norm() < 1e-4);
     assert!((at - h).norm() <= 1.001 * images + tail, "{at} vs {h}");
     assert!((h.norm() - 1.0 / (2.0 * ZETA * M * wn * wn)).abs() / h.norm() < 1e-12);
-    assert!(worst < 1e-6, "worst relative error {worst}");
+    // (Relative to |H|, the error is the truncated image sum's tail over |H|: 7e-6 at 250 Hz.)
+    assert!(worst < 1e-5, "worst relative error {worst}");
 }
 
 #[test]

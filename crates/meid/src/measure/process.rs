@@ -303,7 +303,7 @@ fn window_for(q: Quantity, x: &[f64], blows: &Blows, fs: f64, p: &Processing) ->
 }
 
 /// The mean energy spectral density of the blow records (module docs), unit²·s/Hz.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct BlowSpectrum {
     pub frequency_hz: Vec<f64>,
     pub density: Vec<f64>,
