@@ -40,6 +40,7 @@ mod shell;
 mod simulate;
 mod sweep;
 mod ui;
+mod validate;
 
 #[derive(Parser)]
 #[command(
@@ -78,6 +79,8 @@ enum Command {
     Montecarlo(montecarlo::MonteCarloArgs),
     /// Read measured records (UFF 58/58b, CSV): peaks, blows, dominant spectral lines.
     Measure(measure::MeasureArgs),
+    /// The simulation beside measured records: frequency, level and peak errors, reductions.
+    Validate(validate::ValidateArgs),
     /// Shell completion script for bash, zsh, fish, elvish or powershell, on stdout.
     Completions(shell::CompletionsArgs),
     /// The manual page (roff) on stdout, or every page into a directory with -o.
@@ -114,6 +117,7 @@ fn main() -> ExitCode {
         Command::Blows(a) => blows::run(a),
         Command::Montecarlo(a) => montecarlo::run(a),
         Command::Measure(a) => measure::run(a),
+        Command::Validate(a) => validate::run(a),
         Command::Completions(a) => shell::completions(a),
         Command::Man(a) => shell::man(a),
     };

@@ -8,7 +8,8 @@
 //!   the same rule on the same channel as in the measurement;
 //! * per mapped channel: the sample peak of the blow-averaged records, the peak error
 //!   `100 (peak_meas − peak_sim)/peak_sim` %;
-//! * per dominant mode of the simulated case (a mode with ω > 0 below 0.45 f_s whose simulated
+//! * per dominant mode of the simulated case, on the responses (not on the blow, the input)
+//!   (a mode with ω > 0 below 0.45 f_s whose simulated
 //!   ESD peak lies within 30 dB of the channel's strongest): the largest bin of each ESD within
 //!   ±10 % of the mode's frequency; frequency error `f_meas − f_sim` (Hz, %), level difference
 //!   `L_meas − L_sim` (dB re 1 (SI unit)²·s/Hz). Spectra are zero-padded so that a bin is at most
@@ -183,6 +184,17 @@ fn one_case(
     .unwrap_or(SimChannel::BedAcceleration);
     let tr = &m.records[map[&trigger]];
     let mb = detect_blows(&tr.values, fs, p)?;
+    if let (true, Some(&t)) = (mb.starts.is_empty(), mb.triggers.first()) {
+        if t < mb.pretrigger {
+            return Err(Error::Input {
+                location: tr.origin.clone(),
+                message: format!(
+                    "the first blow on '{}' triggers at {:.6} s, less than the pre-trigger ({:.6} s) after the record's start: give a shorter pre-trigger (--pretrigger; 0 for a simulated history, which starts with the blow)",
+                    tr.name, t as f64 / fs, mb.pretrigger as f64 / fs
+                ),
+            });
+        }
+    }
     if mb.starts.is_empty() {
         return Err(Error::Input {
             location: tr.origin.clone(),
@@ -282,7 +294,9 @@ fn one_case(
                     .map(|x| x.1)
             })
             .fold(0.0_f64, f64::max);
-        for (name, f) in &modes {
+        // The blow is the input, broadband: its spectrum has no modes to read.
+        let read_modes = if c == SimChannel::BlowForce { &[][..] } else { &modes[..] };
+        for (name, f) in read_modes {
             let (lo, hi) = (f * (1.0 - band), f * (1.0 + band));
             let (Some(sv), Some(mv)) = (ss.peak_in_band(lo, hi), ms.peak_in_band(lo, hi)) else {
                 continue;
