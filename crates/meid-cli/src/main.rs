@@ -31,6 +31,7 @@ macro_rules! eprintln {
 mod args;
 mod blows;
 mod compare;
+mod measure;
 mod modes;
 mod montecarlo;
 mod optimize;
@@ -41,6 +42,7 @@ mod shell;
 mod simulate;
 mod sweep;
 mod ui;
+mod validate;
 
 #[derive(Parser)]
 #[command(
@@ -83,6 +85,10 @@ enum Command {
     /// The paper reproduced: every study of its Figs. 2-19, its numbers beside meid's, and why
     /// they differ, as one HTML page.
     Paper(paper::PaperArgs),
+    /// Read measured records (UFF 58/58b, CSV): peaks, blows, dominant spectral lines.
+    Measure(measure::MeasureArgs),
+    /// The simulation beside measured records: frequency, level and peak errors, reductions.
+    Validate(validate::ValidateArgs),
     /// Shell completion script for bash, zsh, fish, elvish or powershell, on stdout.
     Completions(shell::CompletionsArgs),
     /// The manual page (roff) on stdout, or every page into a directory with -o.
@@ -120,6 +126,8 @@ fn main() -> ExitCode {
         Command::Montecarlo(a) => montecarlo::run(a),
         Command::Report(a) => report::run(a),
         Command::Paper(a) => paper::run(a),
+        Command::Measure(a) => measure::run(a),
+        Command::Validate(a) => validate::run(a),
         Command::Completions(a) => shell::completions(a),
         Command::Man(a) => shell::man(a),
     };

@@ -24,6 +24,10 @@ pub struct ModesArgs {
     /// Also write the reduced stiffness and mass matrices as K.mtx and M.mtx (needs -o).
     #[arg(long)]
     export_matrices: bool,
+    /// Also write DIR/modes.uff: nodes (UFF dataset 2411) and one dataset 55 per mode
+    /// (mass-normalised shapes), for test-lab tools (needs -o).
+    #[arg(long, requires = "output")]
+    uff: bool,
     /// Override a model field, e.g. --set structure.fem.machine.elements_per_side=12 (repeatable).
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
@@ -94,6 +98,25 @@ pub fn run(a: ModesArgs) -> Result<()> {
             }
         } else if a.export_matrices {
             anyhow::bail!("--export-matrices needs a [structure.fem] model");
+        }
+        if a.uff {
+            let bytes = match &analysis {
+                Some(an) => {
+                    // Damping ratios of the retained modes, D_kk/(2ω_k), at their indices.
+                    let st = &model.structure;
+                    let n = st.omega_rad_per_s.len();
+                    let mut zeta = vec![0.0; an.modes.omega_rad_per_s.len()];
+                    for (k, &j) in an.selected.iter().enumerate() {
+                        let w = st.omega_rad_per_s.get(k).copied().unwrap_or(0.0);
+                        if let (Some(z), true) = (zeta.get_mut(j), w > 0.0) {
+                            *z = st.damping.get(k * n + k).copied().unwrap_or(0.0) / (2.0 * w);
+                        }
+                    }
+                    io::uff::modes_uff_fe(&an.model, &an.modes, &zeta)?
+                }
+                None => io::uff::modes_uff_points(&model.structure)?,
+            };
+            io::write_atomic(&dir.join("modes.uff"), &bytes)?;
         }
         set.commit("modes")?;
         if a.print.human() {

@@ -17,6 +17,10 @@ pub struct SimulateArgs {
     /// notes and warnings) and truncation.csv into DIR.
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
+    /// Also write DIR/history.uff: the history's channels as UFF datasets 58 (time responses,
+    /// SI unit labels), for test-lab tools (needs -o).
+    #[arg(long, requires = "output")]
+    uff: bool,
     /// Simulated time (s).
     #[arg(long, value_name = "S")]
     duration: Option<f64>,
@@ -76,6 +80,13 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         o.extend(d);
     }
     if let Some(set) = set {
+        if a.uff {
+            // The same numbers as history.csv (read back from it), one dataset 58 per channel.
+            let records = meid::io::csv_records::read_csv(&set.path("history.csv"))?;
+            let mut f = meid::io::AtomicFile::create(&set.path("history.uff"))?;
+            meid::io::uff::write_records(&mut f, &records, false)?;
+            f.commit()?;
+        }
         meid::io::write_json(&set.path("summary.json"), &out)?;
         meid::io::write_atomic(
             &set.path("truncation.csv"),
@@ -86,7 +97,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     if a.print.json {
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else if a.print.human() {
-        print_summary(&model, s, a.output.as_deref());
+        print_summary(&model, s, a.output.as_deref(), a.uff);
         print!("{}", meid::modal::truncation::to_text(&diag.truncation));
         for n in &diag.notes {
             println!("note: {n}");
@@ -99,7 +110,7 @@ fn opt(v: Option<f64>, unit: &str, scale: f64) -> String {
     v.map_or("—".to_string(), |x| format!("{:.6} {unit}", x * scale))
 }
 
-fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>) {
+fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>, uff: bool) {
     let name = model.spec.name.as_deref().unwrap_or("model");
     let bold = crate::ui::bold;
     println!("{} — {} ({} method)", bold("meid simulate"), name, s.method);
@@ -188,8 +199,9 @@ fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>) {
     );
     if let Some(dir) = out {
         println!(
-            "  wrote {}/history.csv, summary.json and truncation.csv",
-            dir.display()
+            "  wrote {}/history.csv, summary.json and truncation.csv{}",
+            dir.display(),
+            if uff { " and history.uff" } else { "" }
         );
     }
 }

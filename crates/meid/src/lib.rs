@@ -26,6 +26,7 @@ pub mod impact;
 pub mod integrate;
 pub mod io;
 pub mod limits;
+pub mod measure;
 pub mod modal;
 pub mod model;
 pub mod plot;

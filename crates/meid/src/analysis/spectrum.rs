@@ -248,7 +248,7 @@ fn check_record(x: &[f64], sample_rate_hz: f64) -> Result<()> {
 }
 
 /// FFT of `x` (already windowed) zero-padded to `n_fft`; returns the `n_fft/2 + 1` bins.
-fn real_fft(x: &[f64], n_fft: usize) -> Result<Vec<Complex<f64>>> {
+pub(crate) fn real_fft(x: &[f64], n_fft: usize) -> Result<Vec<Complex<f64>>> {
     let mut planner = RealFftPlanner::<f64>::new();
     let r2c = planner.plan_fft_forward(n_fft);
     let mut input = r2c.make_input_vec();
@@ -262,7 +262,7 @@ fn real_fft(x: &[f64], n_fft: usize) -> Result<Vec<Complex<f64>>> {
 /// The one-sided weight of bin `k` of an `n_fft`-point real FFT: bins `1..n_fft/2` (the
 /// Nyquist bin of an even length excluded) stand for themselves and their mirror image (2),
 /// the DC and Nyquist bins for themselves only (1).
-fn one_sided_factor(k: usize, n_fft: usize) -> f64 {
+pub(crate) fn one_sided_factor(k: usize, n_fft: usize) -> f64 {
     if k == 0 || (n_fft % 2 == 0 && k == n_fft / 2) {
         1.0
     } else {

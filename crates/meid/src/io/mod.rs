@@ -3,7 +3,9 @@
 //! Every file is written to a temporary file in the target directory and renamed into place,
 //! so an interrupted run never leaves a half-written output.
 
+pub mod csv_records;
 pub mod matrix_market;
+pub mod uff;
 pub mod vtk;
 
 use std::io::Write;

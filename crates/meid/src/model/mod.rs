@@ -234,6 +234,11 @@ impl Model {
                 ));
             }
         }
+        if let Some(m) = &s.measurement {
+            if let Err((field, message)) = m.check(&s.points.measurement) {
+                return Err(src.error(&field, format!("{field}: {message}")));
+            }
+        }
         if s.damper.is_some() && s.contact.bed_damper.is_none() {
             return Err(src.error(
                 "damper",

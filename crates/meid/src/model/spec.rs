@@ -21,6 +21,10 @@ pub struct ModelSpec {
     pub contact: ContactsSpec,
     #[serde(default)]
     pub simulation: SimulationSpec,
+    /// `[measurement]`: how measured channels map to meid's and how they are processed
+    /// ([`crate::measure::mapping`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measurement: Option<crate::measure::mapping::MeasurementSpec>,
 }
 
 /// The structure: exactly one of the forms.

@@ -1,0 +1,109 @@
+"""pyuff side of meid's UFF interoperability test (crates/meid/tests/uff_interop.rs).
+
+    python interop_uff.py write DIR   pyuff writes DIR/*.uff and DIR/expected.json (SI values)
+    python interop_uff.py read FILE   pyuff reads FILE and prints its datasets as JSON
+
+Run by .ci/run through the Rust test, with the pyuff of its own virtual environment.
+"""
+import json
+import os
+import sys
+
+import numpy as np
+import pyuff
+
+G = 9.80665
+
+
+def ds58(name, node, x, y, spec, unit, binary, even=True):
+    return pyuff.prepare_58(
+        binary=binary,
+        id1=name,
+        func_type=1,
+        rsp_node=node,
+        rsp_dir=3,
+        ref_node=0,
+        ref_dir=0,
+        abscissa_spacing=1 if even else 0,
+        abscissa_spec_data_type=17,
+        abscissa_axis_units_lab="s",
+        ordinate_spec_data_type=spec,
+        ordinate_axis_units_lab=unit,
+        orddenom_spec_data_type=0,
+        z_axis_spec_data_type=0,
+        data=y,
+        x=x,
+    )
+
+
+def write(d):
+    fs = 51200.0
+    n = 1000
+    t = np.arange(n) / fs
+    acc_g = np.exp(-30.0 * t) * np.sin(2 * np.pi * 283.0 * t) * 12.5
+    force = np.where(t < 2e-3, 8e3 * np.sin(np.pi * t / 2e-3), 0.0) + 1e-3 * np.cos(t * 1e3)
+    acc_mm = acc_g * G * 1e3
+    expected = {}
+    # ASCII, even abscissa, double precision: acceleration in g, force in N.
+    path = os.path.join(d, "ascii.uff")
+    u = pyuff.UFF(path)
+    u.write_sets([ds58("accel_B", 1, t, acc_g, 12, "g", 0), ds58("force_floor", 2, t, force, 13, "N", 0)], mode="overwrite")
+    expected["ascii.uff"] = [
+        {"name": "accel_B", "unit": "m/s^2", "x0": 0.0, "dx": float(t[1]), "values": list(acc_g * G)},
+        {"name": "force_floor", "unit": "N", "x0": 0.0, "dx": float(t[1]), "values": list(force)},
+    ]
+    # Binary 58b: acceleration in mm/s^2.
+    path = os.path.join(d, "binary.uff")
+    u = pyuff.UFF(path)
+    # (pyuff 2.5.8 truncates the file around the binary data in "overwrite" mode: append to an
+    # empty file instead.)
+    if os.path.exists(path):
+        os.remove(path)
+    u = pyuff.UFF(path)
+    u.write_sets([ds58("accel_B", 1, t, acc_mm, 12, "mm/s^2", 1), ds58("blow", 3, t, force, 13, "N", 1)], mode="add")
+    expected["binary.uff"] = [
+        {"name": "accel_B", "unit": "m/s^2", "x0": 0.0, "dx": float(t[1]), "values": list(acc_mm * 1e-3)},
+        {"name": "blow", "unit": "N", "x0": 0.0, "dx": float(t[1]), "values": list(force)},
+    ]
+    # Uneven abscissa (times printed %13.5e by pyuff).
+    tu = np.cumsum(np.r_[0.0, 1e-4 * (1.0 + 0.5 * np.sin(np.arange(49)))])
+    yu = np.cos(tu * 100.0)
+    path = os.path.join(d, "uneven.uff")
+    u = pyuff.UFF(path)
+    u.write_sets([ds58("accel_u", 4, tu, yu, 12, "m/s^2", 0, even=False)], mode="overwrite")
+    expected["uneven.uff"] = [{"name": "accel_u", "unit": "m/s^2", "times": list(tu), "values": list(yu)}]
+    # Nodes and a normal mode.
+    path = os.path.join(d, "modes.uff")
+    u = pyuff.UFF(path)
+    nodes = pyuff.prepare_2411(node_nums=np.array([1, 2, 3]), def_cs=np.ones(3, dtype=int), disp_cs=np.ones(3, dtype=int), color=np.full(3, 11, dtype=int),
+                               x=np.array([0.0, 1.0, 2.5]), y=np.zeros(3), z=np.array([0.0, 0.125, -3.0]))
+    mode = pyuff.prepare_55(model_type=1, analysis_type=2, data_ch=2, spec_data_type=8, load_case=1, mode_n=2, freq=283.0,
+                            modal_m=1.0, modal_damp_vis=0.01, modal_damp_his=0.0, node_nums=np.array([1, 2, 3]),
+                            r1=np.zeros(3), r2=np.zeros(3), r3=np.array([0.5, -0.25, 0.125]), id1="bed mode")
+    u.write_sets([nodes, mode], mode="overwrite")
+    expected["modes.uff"] = {"nodes": [[1, 0.0, 0.0, 0.0], [2, 1.0, 0.0, 0.125], [3, 2.5, 0.0, -3.0]],
+                             "mode": {"number": 2, "frequency_hz": 283.0, "damping_ratio": 0.01, "z": [0.5, -0.25, 0.125]}}
+    with open(os.path.join(d, "expected.json"), "w") as f:
+        json.dump(expected, f)
+
+
+def read(path):
+    out = []
+    for s in pyuff.UFF(path).read_sets():
+        if s["type"] == 58:
+            out.append({"type": 58, "name": s["id1"].strip(), "unit": s["ordinate_axis_units_lab"].strip(),
+                        "x_unit": s["abscissa_axis_units_lab"].strip(), "x": [float(v) for v in s["x"]],
+                        "data": [float(v) for v in s["data"]], "node": int(s["rsp_node"]), "dir": int(s["rsp_dir"])})
+        elif s["type"] == 2411:
+            out.append({"type": 2411, "nodes": [[int(a), float(b), float(c), float(e)] for a, b, c, e in zip(s["node_nums"], s["x"], s["y"], s["z"])]})
+        elif s["type"] == 55:
+            out.append({"type": 55, "freq": float(s["freq"]), "mode_n": int(s["mode_n"]), "damping": float(s["modal_damp_vis"]),
+                        "node_nums": [int(v) for v in s["node_nums"]], "r3": [float(v) for v in s["r3"]]})
+    print(json.dumps(out))
+
+
+if __name__ == "__main__":
+    if sys.argv[1] == "write":
+        write(sys.argv[2])
+    else:
+        read(sys.argv[2])

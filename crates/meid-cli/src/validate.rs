@@ -1,0 +1,98 @@
+//! `meid validate`: the simulation beside measured records (thin: the library compares).
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+
+use meid::measure::mapping::parse_channel_flags;
+use meid::measure::read_records;
+use meid::measure::validate::{validate, MeasuredCase};
+use meid::model::Case;
+
+use crate::args::{PrintArgs, RunArgs};
+use crate::measure::ProcessingArgs;
+
+#[derive(clap::Args)]
+pub struct ValidateArgs {
+    /// Model file (TOML).
+    model: PathBuf,
+    /// Measured file (UFF or CSV), optionally with the case it measured: none=FILE (the bare
+    /// machine), damper=FILE, added-mass=FILE; a plain FILE is the model as specified
+    /// (repeatable; several files of one case are read together).
+    #[arg(long = "measured", value_name = "[CASE=]FILE", required = true)]
+    measured: Vec<String>,
+    /// Map a measured channel to meid's: NAME=B (bed acceleration at the measurement point),
+    /// NAME=floor (force to the floor), NAME=blow (slider-bed force). Repeatable; over the
+    /// model's [measurement] channels.
+    #[arg(long = "channel", value_name = "NAME=TARGET")]
+    channel: Vec<String>,
+    /// Write validation.json and the overlaid histories and spectra (<case>_<channel>_history
+    /// and _spectrum, .png and .svg) into DIR.
+    #[arg(short, long, value_name = "DIR")]
+    output: Option<PathBuf>,
+    #[command(flatten)]
+    processing: ProcessingArgs,
+    #[command(flatten)]
+    run: RunArgs,
+    #[command(flatten)]
+    print: PrintArgs,
+}
+
+/// `CASE=FILE` or `FILE`.
+fn split_case(s: &str) -> Result<(Case, PathBuf)> {
+    for (prefix, case) in [
+        ("none=", Case::NoDamper),
+        ("damper=", Case::Damper),
+        ("added-mass=", Case::AddedMass),
+        ("as-specified=", Case::AsSpecified),
+    ] {
+        if let Some(f) = s.strip_prefix(prefix) {
+            return Ok((case, PathBuf::from(f)));
+        }
+    }
+    Ok((Case::AsSpecified, PathBuf::from(s)))
+}
+
+pub fn run(a: ValidateArgs) -> Result<()> {
+    let model = a.run.load(&a.model, None)?;
+    let p = a.processing.processing(model.spec.measurement.as_ref())?;
+    let flags = parse_channel_flags(&a.channel, &model.spec.points.measurement)?;
+    let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
+    let mut cases: Vec<MeasuredCase> = Vec::new();
+    for m in &a.measured {
+        let (case, path) = split_case(m)?;
+        let records = read_records(&path)?;
+        let name = path.display().to_string();
+        match cases.iter_mut().find(|c| c.case == case) {
+            Some(c) => {
+                c.files.push(name);
+                c.records.extend(records);
+            }
+            None => cases.push(MeasuredCase {
+                case,
+                files: vec![name],
+                records,
+            }),
+        }
+    }
+    let v = validate(&model, &cases, &p, &flags)?;
+    if let Some(set) = set {
+        meid::io::write_json(&set.path("validation.json"), &v)?;
+        v.plots(set.staging())?;
+        set.commit("validate")?;
+    }
+    if a.print.json {
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else if a.print.human() {
+        println!(
+            "{} — {}",
+            crate::ui::bold("meid validate"),
+            model.spec.name.as_deref().unwrap_or("model")
+        );
+        print!("{}", v.to_text());
+        if let Some(dir) = &a.output {
+            println!("wrote {}", dir.display());
+        }
+    }
+    Ok(())
+}

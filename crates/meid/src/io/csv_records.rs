@@ -1,0 +1,237 @@
+//! Measured time histories in CSV: one header row naming each column's quantity and unit,
+//! then one row per sample.
+//!
+//! A column name is `NAME_UNIT` with a unit suffix of
+//! [`crate::measure::units::CSV_SUFFIXES`]: `time_s`, `accel_B_m_per_s2`, `accel_B_g`,
+//! `force_floor_n`, `force_floor_kn`, `bed_velocity_mm_per_s` ... The channel's name is the
+//! column's name without the suffix (`accel_B`). Exactly one column is a time (`_s`, `_ms`,
+//! `_us`); meid's own `history.csv` reads as is (its energy columns, `_j`, are passed over).
+//! Lines starting with `#` are comments. A column whose unit meid does not know is refused,
+//! naming the file, the column and the line.
+
+use std::path::Path;
+
+use crate::measure::units::{split_csv_name, Quantity};
+use crate::measure::{Abscissa, Record, EVEN_TOLERANCE};
+use crate::{Error, Result};
+
+/// Reads a CSV file of time histories (module docs).
+pub fn read_csv(path: &Path) -> Result<Vec<Record>> {
+    let f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    parse_csv(std::io::BufReader::new(f), &path.display().to_string())
+}
+
+/// Parses CSV text from `reader`; `file` names it in errors.
+pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>> {
+    let err = |line: u64, message: String| Error::Input {
+        location: format!("{file}:{line}"),
+        message,
+    };
+    let mut rd = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .comment(Some(b'#'))
+        .trim(csv::Trim::All)
+        .flexible(true)
+        .from_reader(reader);
+    let mut rows = rd.records();
+    let header = loop {
+        match rows.next() {
+            None => return Err(err(
+                1,
+                "empty file: expected a header row such as 'time_s,accel_B_m_per_s2,force_floor_n'"
+                    .into(),
+            )),
+            Some(Err(e)) => {
+                return Err(err(
+                    e.position().map_or(1, |p| p.line()),
+                    format!("not CSV text: {e}"),
+                ))
+            }
+            Some(Ok(r)) if r.iter().all(|c| c.is_empty()) => continue,
+            Some(Ok(r)) => break r,
+        }
+    };
+    let hline = header.position().map_or(1, |p| p.line());
+    // (column, name, quantity, factor); None for columns passed over.
+    let mut cols: Vec<Option<(String, Quantity, f64)>> = Vec::new();
+    let mut time_col = None;
+    for (k, name) in header.iter().enumerate() {
+        if name.to_ascii_lowercase().ends_with("_j") {
+            cols.push(None);
+            continue;
+        }
+        let Some((n, q, f)) = split_csv_name(name) else {
+            return Err(err(hline, format!(
+                "column {} '{name}': the name does not end in a unit meid knows; expected NAME_UNIT with UNIT one of s, ms, us, m_per_s2, mm_per_s2, g, mg, m_per_s, mm_per_s, m, mm, um, in, n, kn, lbf (e.g. time_s, accel_B_m_per_s2, accel_B_g, force_floor_n)",
+                k + 1
+            )));
+        };
+        if q == Quantity::Time {
+            if let Some(t) = time_col {
+                return Err(err(
+                    hline,
+                    format!(
+                        "columns {} and {} are both times: expected exactly one time column",
+                        t + 1,
+                        k + 1
+                    ),
+                ));
+            }
+            time_col = Some(k);
+        }
+        cols.push(Some((n, q, f)));
+    }
+    let Some(tc) = time_col else {
+        return Err(err(
+            hline,
+            "no time column: expected one named like time_s or time_ms".into(),
+        ));
+    };
+    let mut data: Vec<Vec<f64>> = vec![Vec::new(); cols.len()];
+    for row in rows {
+        let row = row.map_err(|e| {
+            err(
+                e.position().map_or(0, |p| p.line()),
+                format!("not CSV text: {e}"),
+            )
+        })?;
+        let line = row.position().map_or(0, |p| p.line());
+        if row.iter().all(|c| c.is_empty()) {
+            continue;
+        }
+        if row.len() != cols.len() {
+            return Err(err(
+                line,
+                format!("{} fields; the header has {}", row.len(), cols.len()),
+            ));
+        }
+        for (k, field) in row.iter().enumerate() {
+            let Some((name, _, f)) = &cols[k] else {
+                continue;
+            };
+            let v: f64 = field.parse().map_err(|_| {
+                err(
+                    line,
+                    format!(
+                        "column {} ({name}): expected a number, got '{field}'",
+                        k + 1
+                    ),
+                )
+            })?;
+            if !v.is_finite() {
+                return Err(err(
+                    line,
+                    format!("column {} ({name}): {field} is not a finite number", k + 1),
+                ));
+            }
+            data[k].push(v * f);
+        }
+    }
+    let t = std::mem::take(&mut data[tc]);
+    if t.len() < 2 {
+        return Err(err(
+            hline,
+            format!("{} rows of data: expected at least 2", t.len()),
+        ));
+    }
+    if let Some(i) = t.windows(2).position(|w| !(w[1] > w[0])) {
+        return Err(err(
+            hline,
+            format!(
+                "the time column does not increase at data row {} ({} s then {} s)",
+                i + 2,
+                t[i],
+                t[i + 1]
+            ),
+        ));
+    }
+    let n = t.len();
+    let mean = (t[n - 1] - t[0]) / (n - 1) as f64;
+    let worst = t
+        .windows(2)
+        .map(|w| ((w[1] - w[0]) - mean).abs())
+        .fold(0.0, f64::max);
+    let abscissa = if worst <= EVEN_TOLERANCE * mean {
+        Abscissa::Even {
+            start_s: t[0],
+            step_s: mean,
+        }
+    } else {
+        Abscissa::Uneven(t)
+    };
+    let mut out = Vec::new();
+    for (k, c) in cols.into_iter().enumerate() {
+        let Some((name, q, _)) = c else { continue };
+        if k == tc {
+            continue;
+        }
+        let header_name = header.get(k).unwrap_or("").to_string();
+        let unit = header_name[name.len().min(header_name.len())..]
+            .trim_start_matches('_')
+            .to_string();
+        out.push(Record {
+            name,
+            quantity: q,
+            source_unit: unit,
+            point: None,
+            abscissa: abscissa.clone(),
+            values: std::mem::take(&mut data[k]),
+            origin: format!("{file}, column {}", k + 1),
+        });
+    }
+    if out.is_empty() {
+        return Err(err(hline, "no data column besides the time".into()));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_units_and_names() {
+        let text = "# a comment\ntime_s,accel_B_g,force_floor_kn,ke_slider_j\n0,1,2,9\n0.001,0.5,-1,9\n0.002,0,0,9\n";
+        let r = parse_csv(text.as_bytes(), "lab.csv").unwrap();
+        assert_eq!(r.len(), 2);
+        assert_eq!(r[0].name, "accel_B");
+        assert_eq!(r[0].values, vec![9.80665, 0.5 * 9.80665, 0.0]);
+        assert_eq!(r[1].name, "force_floor");
+        assert_eq!(r[1].quantity, Quantity::Force);
+        assert_eq!(r[1].values, vec![2e3, -1e3, 0.0]);
+        assert_eq!(r[1].source_unit, "kn");
+        let (t0, dt) = r[0].even().unwrap();
+        assert_eq!(t0, 0.0);
+        assert!((dt - 1e-3).abs() < 1e-15);
+    }
+
+    #[test]
+    fn errors_name_line_and_column() {
+        let e = parse_csv("time_s,accel_B_furlongs\n0,1\n".as_bytes(), "lab.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("lab.csv:1: column 2 'accel_B_furlongs'"),
+            "{e}"
+        );
+        let e = parse_csv("time_s,accel_B_g\n0,1\n0.1,x\n".as_bytes(), "lab.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("lab.csv:3: column 2 (accel_B): expected a number, got 'x'"),
+            "{e}"
+        );
+        let e = parse_csv("time_s,accel_B_g\n0,1\n0,2\n".as_bytes(), "lab.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("does not increase"), "{e}");
+        let e = parse_csv("accel_B_g\n0\n".as_bytes(), "lab.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no time column"), "{e}");
+        let e = parse_csv("time_s,accel_B_g\n0,1,3\n".as_bytes(), "lab.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("3 fields; the header has 2"), "{e}");
+    }
+}

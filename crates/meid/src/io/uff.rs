@@ -1,0 +1,1508 @@
+//! Universal File Format (UFF/UNV) datasets: 58 (function at nodal DOF) in ASCII and binary
+//! (58b), 2411 (nodes, double precision) and 55 (data at nodes: normal modes), read and written.
+//!
+//! # Layout read and written (I-DEAS/SDRC Universal File definitions)
+//!
+//! A file is a sequence of datasets, each framed by lines holding `    -1`; the first line of a
+//! dataset holds its number in columns 1-6 (`    58`), and for binary 58b a `b` in column 7 and
+//! the binary header `byte order (1 little-endian, 2 big-endian), floating-point format
+//! (2 IEEE 754), number of ASCII lines (11), number of bytes of data, 0 0 0 0`.
+//!
+//! Dataset 58:
+//!
+//! | record | format | fields |
+//! |---|---|---|
+//! | 1-5 | 80A1 | ID lines (1: function name, meid's channel name; 3: date) |
+//! | 6 | 2(I5,I10),2(1X,10A1,I10,I4) | function type (1 time response), id, version, load case, response entity, node, direction, reference entity, node, direction |
+//! | 7 | 3I10,3E13.5 | ordinate data type (2 real single, 4 real double, 5/6 complex), number of points N, spacing (1 even, 0 uneven), abscissa minimum, increment, z value |
+//! | 8-11 | I10,3I5,2(1X,20A1) | abscissa / ordinate / ordinate denominator / z axis: specific data type (17 time, 12 acceleration, 13 force, ...), length, force, temperature unit exponents, axis label, **unit label** |
+//! | 12 | | data: even real N values; uneven real N pairs (x, y); complex twice (ASCII: single 6E13.5, double 4E20.12; uneven double 2(E13.5,E20.12)) |
+//!
+//! Units are read from the unit label of records 8 and 9 ([`crate::measure::units`]); a label
+//! `NONE` or blank falls back to the SI unit of the specific data type (the SI system, unit
+//! code 1, is the UFF default when no dataset 164 says otherwise); a file whose dataset 164
+//! names another unit system must label its axes. A unit neither label nor type identifies
+//! is refused.
+//!
+//! # Robustness
+//!
+//! The reader streams (a [`BufRead`]); it never allocates from a size field before the bytes
+//! are there: the number of points is checked against the bytes left in the file, binary data
+//! is decoded chunk by chunk, and every error names the file, the dataset (its ordinal and
+//! first line), the record, the line and what was expected.
+
+use std::io::{BufRead, Read, Write};
+use std::path::Path;
+
+use crate::measure::units::{parse_unit, Quantity, ACCEPTED_UNITS};
+use crate::measure::{Abscissa, PointRef, Record};
+use crate::{Error, Result};
+
+/// A node of dataset 2411 (coordinates in m as written).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Node {
+    pub label: i64,
+    pub xyz: [f64; 3],
+}
+
+/// A real normal mode of dataset 55 (analysis type 2).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mode {
+    /// Mode number (record 7).
+    pub number: i64,
+    /// Frequency (Hz), modal mass, viscous damping ratio (record 8).
+    pub frequency_hz: f64,
+    pub modal_mass: f64,
+    pub damping_ratio: f64,
+    /// ID line 1.
+    pub name: String,
+    /// `(node, [x, y, z] translations)` (the first three values of each node).
+    pub shapes: Vec<(i64, [f64; 3])>,
+}
+
+/// What a UFF file held that meid reads.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct UffFile {
+    /// Time responses of dataset 58 / 58b, values in SI.
+    pub records: Vec<Record>,
+    pub nodes: Vec<Node>,
+    pub modes: Vec<Mode>,
+    /// Datasets passed over, one line each (type, where, why).
+    pub skipped: Vec<String>,
+}
+
+/// Reads a UFF file (see the module docs).
+pub fn read_uff(path: &Path) -> Result<UffFile> {
+    let f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let len = f.metadata().map(|m| m.len()).ok();
+    let name = path.display().to_string();
+    parse_uff(std::io::BufReader::with_capacity(1 << 16, f), &name, len)
+}
+
+/// Parses UFF text/bytes from `reader`; `file` names it in errors; `len` (bytes), when known,
+/// bounds every size field.
+pub fn parse_uff<R: BufRead>(reader: R, file: &str, len: Option<u64>) -> Result<UffFile> {
+    let mut p = Parser {
+        r: reader,
+        file,
+        left: len.unwrap_or(u64::MAX),
+        line_no: 0,
+        after_binary: false,
+        buf: Vec::new(),
+    };
+    p.run()
+}
+
+/// Longest line accepted (bytes): far beyond any record of the format (80 columns).
+const MAX_LINE: u64 = 1 << 20;
+
+struct Parser<'a, R: BufRead> {
+    r: R,
+    file: &'a str,
+    /// Bytes not yet read (an upper bound when the length is unknown).
+    left: u64,
+    /// Number of the last line read (1-based); after binary data, lines are counted on.
+    line_no: usize,
+    after_binary: bool,
+    buf: Vec<u8>,
+}
+
+/// Where in a dataset: for messages.
+#[derive(Clone, Copy)]
+struct Ds {
+    ordinal: usize,
+    kind: &'static str,
+    line: usize,
+}
+
+impl<R: BufRead> Parser<'_, R> {
+    fn loc(&self, ds: Option<Ds>, record: Option<&str>, line: usize) -> String {
+        let mut s = self.file.to_string();
+        if let Some(d) = ds {
+            s.push_str(&format!(
+                ": dataset {} ({} starting at line {})",
+                d.ordinal, d.kind, d.line
+            ));
+        }
+        if let Some(r) = record {
+            s.push_str(&format!(", {r}"));
+        }
+        s.push_str(&format!(
+            ", line {line}{}",
+            if self.after_binary {
+                " (counting lines after binary data)"
+            } else {
+                ""
+            }
+        ));
+        s
+    }
+
+    fn err(&self, ds: Option<Ds>, record: Option<&str>, line: usize, msg: String) -> Error {
+        Error::Input {
+            location: self.loc(ds, record, line),
+            message: msg,
+        }
+    }
+
+    /// The next line without its end of line, or `None` at the end of the file.
+    fn line(&mut self) -> Result<Option<String>> {
+        self.buf.clear();
+        let n = (&mut self.r)
+            .take(MAX_LINE)
+            .read_until(b'\n', &mut self.buf)
+            .map_err(|e| Error::io(self.file, e))?;
+        if n == 0 {
+            return Ok(None);
+        }
+        self.left = self.left.saturating_sub(n as u64);
+        self.line_no += 1;
+        if n as u64 == MAX_LINE && self.buf.last() != Some(&b'\n') {
+            return Err(self.err(
+                None,
+                None,
+                self.line_no,
+                format!("a line longer than {MAX_LINE} bytes: not a Universal File"),
+            ));
+        }
+        while matches!(self.buf.last(), Some(b'\n' | b'\r')) {
+            self.buf.pop();
+        }
+        Ok(Some(String::from_utf8_lossy(&self.buf).into_owned()))
+    }
+
+    fn run(&mut self) -> Result<UffFile> {
+        let mut out = UffFile::default();
+        let mut ordinal = 0usize;
+        let mut unit_code: Option<i64> = None;
+        loop {
+            // Between datasets: blank lines, then "-1".
+            let Some(l) = self.line()? else { break };
+            if l.trim().is_empty() {
+                continue;
+            }
+            if l.trim() != "-1" {
+                return Err(self.err(
+                    None,
+                    None,
+                    self.line_no,
+                    format!(
+                        "expected the start of a dataset ('    -1'), got '{}'",
+                        clip(&l)
+                    ),
+                ));
+            }
+            let mut start = self.line_no;
+            // An empty block ("-1" twice, as some writers leave between datasets) is passed over.
+            let h = loop {
+                let Some(h) = self.line()? else {
+                    return Err(self.err(
+                        None,
+                        None,
+                        self.line_no,
+                        "the file ends after a '-1' line: expected a dataset number".into(),
+                    ));
+                };
+                if h.trim() == "-1" {
+                    start = self.line_no;
+                    continue;
+                }
+                break h;
+            };
+            ordinal += 1;
+            let tok = h.split_whitespace().next().unwrap_or("");
+            let (num, binary) = match tok.strip_suffix(['b', 'B']) {
+                Some(n) => (n, true),
+                None => (tok, false),
+            };
+            let Ok(num) = num.parse::<u32>() else {
+                return Err(self.err(
+                    None,
+                    None,
+                    self.line_no,
+                    format!(
+                        "dataset {ordinal}: expected a dataset number (e.g. '    58'), got '{}'",
+                        clip(&h)
+                    ),
+                ));
+            };
+            match (num, binary) {
+                (58, _) => {
+                    let ds = Ds {
+                        ordinal,
+                        kind: if binary { "58b" } else { "58" },
+                        line: start,
+                    };
+                    match self.dataset_58(ds, &h, binary, unit_code)? {
+                        Ok(r) => out.records.push(r),
+                        Err(why) => out.skipped.push(format!(
+                            "dataset {ordinal} (58 at line {start}): {why}"
+                        )),
+                    }
+                }
+                (2411, false) => {
+                    let ds = Ds {
+                        ordinal,
+                        kind: "2411",
+                        line: start,
+                    };
+                    out.nodes.extend(self.dataset_2411(ds)?);
+                }
+                (55, false) => {
+                    let ds = Ds {
+                        ordinal,
+                        kind: "55",
+                        line: start,
+                    };
+                    match self.dataset_55(ds)? {
+                        Ok(m) => out.modes.push(m),
+                        Err(why) => out.skipped.push(format!(
+                            "dataset {ordinal} (55 at line {start}): {why}"
+                        )),
+                    }
+                }
+                (164, false) => {
+                    let ds = Ds {
+                        ordinal,
+                        kind: "164",
+                        line: start,
+                    };
+                    let lines = self.skip_to_end(ds)?;
+                    // Record 1: unit code (I10), description, temperature mode.
+                    unit_code = lines
+                        .first()
+                        .and_then(|l| l.split_whitespace().next())
+                        .and_then(|t| t.parse::<i64>().ok());
+                }
+                (n, false) => {
+                    let ds = Ds {
+                        ordinal,
+                        kind: "other",
+                        line: start,
+                    };
+                    self.skip_to_end(ds)?;
+                    out.skipped.push(format!(
+                        "dataset {ordinal} (type {n} at line {start}): not read by meid"
+                    ));
+                }
+                (n, true) => {
+                    return Err(self.err(
+                        None,
+                        None,
+                        start + 1,
+                        format!(
+                            "dataset {ordinal}: binary dataset {n}b is not supported (binary: 58b only)"
+                        ),
+                    ))
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Reads lines to the closing "-1"; returns them.
+    fn skip_to_end(&mut self, ds: Ds) -> Result<Vec<String>> {
+        let mut lines = Vec::new();
+        loop {
+            let Some(l) = self.line()? else {
+                return Err(self.err(
+                    Some(ds),
+                    None,
+                    self.line_no,
+                    "the file ends inside the dataset: expected its closing '    -1'".into(),
+                ));
+            };
+            if l.trim() == "-1" {
+                return Ok(lines);
+            }
+            if lines.len() < 4 {
+                lines.push(l);
+            }
+        }
+    }
+
+    fn need_line(&mut self, ds: Ds, record: &str) -> Result<String> {
+        match self.line()? {
+            Some(l) if l.trim() == "-1" => Err(self.err(
+                Some(ds),
+                Some(record),
+                self.line_no,
+                format!("the dataset ends ('-1') where {record} was expected"),
+            )),
+            Some(l) => Ok(l),
+            None => Err(self.err(
+                Some(ds),
+                Some(record),
+                self.line_no + 1,
+                format!("the file ends where {record} was expected"),
+            )),
+        }
+    }
+
+    /// Dataset 58 after its header line. `Ok(Err(why))`: read past, not a time response.
+    fn dataset_58(
+        &mut self,
+        ds: Ds,
+        header: &str,
+        binary: bool,
+        unit_code: Option<i64>,
+    ) -> Result<std::result::Result<Record, String>> {
+        // Binary header: 58b, byte order, fp format, ASCII lines, bytes, 0 0 0 0.
+        let mut bin = None;
+        if binary {
+            let t: Vec<&str> = header.split_whitespace().collect();
+            let int = |k: usize, what: &str| -> Result<i64> {
+                t.get(k).and_then(|v| v.parse::<i64>().ok()).ok_or_else(|| {
+                    self.err(
+                        Some(ds),
+                        Some("binary header"),
+                        self.line_no,
+                        format!(
+                            "field {} ({what}): expected a whole number, got '{}'",
+                            k + 1,
+                            t.get(k).unwrap_or(&"")
+                        ),
+                    )
+                })
+            };
+            let order = int(1, "byte order: 1 little-endian, 2 big-endian")?;
+            let fp = int(2, "floating-point format: 2 IEEE 754")?;
+            let ascii = int(3, "number of ASCII lines: 11")?;
+            let bytes = int(4, "number of bytes of binary data")?;
+            if !(order == 1 || order == 2) {
+                return Err(self.err(
+                    Some(ds),
+                    Some("binary header"),
+                    self.line_no,
+                    format!("byte order {order}: expected 1 (little-endian) or 2 (big-endian)"),
+                ));
+            }
+            if fp != 2 {
+                return Err(self.err(
+                    Some(ds),
+                    Some("binary header"),
+                    self.line_no,
+                    format!("floating-point format {fp}: only 2 (IEEE 754) is read"),
+                ));
+            }
+            if ascii != 11 {
+                return Err(self.err(
+                    Some(ds),
+                    Some("binary header"),
+                    self.line_no,
+                    format!("{ascii} ASCII lines: expected 11 (records 1-11)"),
+                ));
+            }
+            if bytes < 0 || bytes as u64 > self.left {
+                return Err(self.err(Some(ds), Some("binary header"), self.line_no, format!("{bytes} bytes of binary data announced, but only {} bytes are left in the file", self.left)));
+            }
+            bin = Some((order == 1, bytes as u64));
+        }
+        let mut id = Vec::with_capacity(5);
+        for k in 1..=5 {
+            id.push(self.need_line(ds, &format!("record {k} (ID line {k})"))?);
+        }
+        let r6 = self.need_line(ds, "record 6")?;
+        let r6_line = self.line_no;
+        let fx = |line: &str, a: usize, b: usize| -> String { cols(line, a, b).trim().to_string() };
+        let int6 = |a: usize, b: usize, what: &str| -> Result<i64> {
+            let s = fx(&r6, a, b);
+            if s.is_empty() {
+                return Ok(0);
+            }
+            s.parse::<i64>().map_err(|_| {
+                self.err(
+                    Some(ds),
+                    Some("record 6"),
+                    r6_line,
+                    format!(
+                        "{what} (columns {}-{b}): expected a whole number, got '{s}'",
+                        a + 1
+                    ),
+                )
+            })
+        };
+        let func_type = int6(0, 5, "function type")?;
+        let rsp_entity = fx(&r6, 31, 41);
+        let rsp_node = int6(41, 51, "response node")?;
+        let rsp_dir = int6(51, 55, "response direction")?;
+
+        let r7 = self.need_line(ds, "record 7")?;
+        let r7_line = self.line_no;
+        let (ord_type, npts, even, x0, dx) = parse_record7(&r7).ok_or_else(|| {
+            self.err(
+                Some(ds),
+                Some("record 7"),
+                r7_line,
+                format!(
+                    "expected 3I10,3E13.5: ordinate data type, number of points, spacing (0/1), abscissa minimum, increment, z value; got '{}'",
+                    clip(&r7)
+                ),
+            )
+        })?;
+        let mut axes = Vec::with_capacity(4);
+        for k in 8..=11 {
+            let l = self.need_line(ds, &format!("record {k}"))?;
+            axes.push((l, self.line_no));
+        }
+        let per_point: u64 = match (ord_type, even) {
+            (2 | 4, true) => 1,
+            (2 | 4, false) => 2,
+            (5 | 6, true) => 2,
+            (5 | 6, false) => 3,
+            _ => {
+                return Err(self.err(
+                    Some(ds),
+                    Some("record 7"),
+                    r7_line,
+                    format!("ordinate data type {ord_type}: expected 2 (real single), 4 (real double), 5 (complex single) or 6 (complex double)"),
+                ))
+            }
+        };
+        if npts < 0 {
+            return Err(self.err(
+                Some(ds),
+                Some("record 7"),
+                r7_line,
+                format!("number of points {npts}: expected ≥ 0"),
+            ));
+        }
+        let count = (npts as u64).checked_mul(per_point).ok_or_else(|| {
+            self.err(
+                Some(ds),
+                Some("record 7"),
+                r7_line,
+                format!("number of points {npts} is too large"),
+            )
+        })?;
+        let single = matches!(ord_type, 2 | 5);
+        // Every value takes at least 2 bytes in ASCII (a digit and a separator) and 4 or 8
+        // in binary: a count the file cannot hold is refused before anything is allocated.
+        let width: u64 = if single { 4 } else { 8 };
+        let min_bytes = if bin.is_some() {
+            count.saturating_mul(width)
+        } else {
+            count.saturating_mul(2)
+        };
+        if min_bytes > self.left {
+            return Err(self.err(
+                Some(ds),
+                Some("record 7"),
+                r7_line,
+                format!("{npts} points ({count} values) announced, but only {} bytes are left in the file", self.left),
+            ));
+        }
+        let values = match bin {
+            Some((little, bytes)) => {
+                if bytes != count * width {
+                    return Err(self.err(
+                        Some(ds),
+                        Some("binary header"),
+                        ds.line + 1,
+                        format!("{bytes} bytes announced, but record 7's {npts} points of type {ord_type} take {} bytes", count * width),
+                    ));
+                }
+                let v = self.binary_values(ds, count, single, little)?;
+                self.after_binary = true;
+                // The closing "-1" (after an optional end of line).
+                loop {
+                    match self.line()? {
+                        Some(l) if l.trim().is_empty() => continue,
+                        Some(l) if l.trim() == "-1" => break,
+                        Some(l) => {
+                            return Err(self.err(Some(ds), None, self.line_no, format!("expected the closing '    -1' after {bytes} bytes of binary data, got '{}'", clip(&l))));
+                        }
+                        None => {
+                            return Err(self.err(Some(ds), None, self.line_no, format!("the file ends after the binary data: expected the closing '    -1'")));
+                        }
+                    }
+                }
+                v
+            }
+            None => self.ascii_values(ds, count, ord_type, even)?,
+        };
+        if !(func_type == 1 || func_type == 0) {
+            return Ok(Err(format!(
+                "function type {func_type} ({}), not a time response (1)",
+                function_name(func_type)
+            )));
+        }
+        if matches!(ord_type, 5 | 6) {
+            return Ok(Err("complex ordinate: not a time response".into()));
+        }
+        // Units: abscissa (record 8) and ordinate (record 9).
+        let (xq, xf, xu) =
+            self.axis_unit(ds, &axes[0].0, axes[0].1, "record 8 (abscissa)", unit_code)?;
+        if xq != Quantity::Time {
+            return Ok(Err(format!(
+                "the abscissa is {} ({xu}), not time",
+                xq.name()
+            )));
+        }
+        let (q, f, u) =
+            self.axis_unit(ds, &axes[1].0, axes[1].1, "record 9 (ordinate)", unit_code)?;
+        if q == Quantity::Time {
+            return Err(self.err(Some(ds), Some("record 9 (ordinate)"), axes[1].1, format!("the ordinate unit '{u}' is a time: expected an acceleration, velocity, displacement or force")));
+        }
+        let n = npts as usize;
+        let (abscissa, y) = if even {
+            if !(dx.is_finite() && dx > 0.0 && x0.is_finite()) {
+                return Err(self.err(Some(ds), Some("record 7"), r7_line, format!("even abscissa with minimum {x0} and increment {dx}: expected a finite minimum and an increment > 0")));
+            }
+            (
+                Abscissa::Even {
+                    start_s: x0 * xf,
+                    step_s: dx * xf,
+                },
+                values,
+            )
+        } else {
+            let mut t = Vec::with_capacity(n);
+            let mut y = Vec::with_capacity(n);
+            for c in values.chunks_exact(2) {
+                t.push(c[0] * xf);
+                y.push(c[1]);
+            }
+            if let Some(k) = t.windows(2).position(|w| !(w[1] > w[0])) {
+                return Err(self.err(Some(ds), Some("record 12"), r7_line + 5, format!("uneven abscissa: time {} s at point {} does not increase to {} s at point {}", t[k], k + 1, t[k + 1], k + 2)));
+            }
+            (Abscissa::Uneven(t), y)
+        };
+        let mut y = y;
+        if let Some(k) = y.iter().position(|v| !v.is_finite()) {
+            return Err(self.err(
+                Some(ds),
+                Some("record 12"),
+                r7_line + 5,
+                format!("point {} is not a finite number ({})", k + 1, y[k]),
+            ));
+        }
+        if f != 1.0 {
+            for v in &mut y {
+                *v *= f;
+            }
+        }
+        let name = {
+            let n1 = id[0].trim();
+            if !n1.is_empty() && n1 != "NONE" {
+                n1.to_string()
+            } else {
+                format!(
+                    "{}:{}:{}",
+                    if rsp_entity.is_empty() {
+                        "NONE"
+                    } else {
+                        &rsp_entity
+                    },
+                    rsp_node,
+                    rsp_dir
+                )
+            }
+        };
+        Ok(Ok(Record {
+            name,
+            quantity: q,
+            source_unit: u,
+            point: Some(PointRef {
+                entity: rsp_entity,
+                node: rsp_node,
+                direction: rsp_dir,
+            }),
+            abscissa,
+            values: y,
+            origin: format!(
+                "{}, dataset {} ({} at line {})",
+                self.file, ds.ordinal, ds.kind, ds.line
+            ),
+        }))
+    }
+
+    /// The quantity, factor to SI and unit text of an axis record (8-11).
+    fn axis_unit(
+        &self,
+        ds: Ds,
+        line: &str,
+        line_no: usize,
+        record: &str,
+        unit_code: Option<i64>,
+    ) -> Result<(Quantity, f64, String)> {
+        let ty_s = cols(line, 0, 10).trim().to_string();
+        let ty = if ty_s.is_empty() {
+            Ok(0)
+        } else {
+            ty_s.parse::<i64>()
+        };
+        let Ok(ty) = ty else {
+            return Err(self.err(
+                Some(ds),
+                Some(record),
+                line_no,
+                format!("specific data type (columns 1-10): expected a whole number, got '{ty_s}'"),
+            ));
+        };
+        let label = cols(line, 47, 67).trim().to_string();
+        let by_type = Quantity::from_uff_data_type(ty);
+        if label.is_empty() || label.eq_ignore_ascii_case("NONE") {
+            return match (by_type, unit_code) {
+                (Some(q), None | Some(1)) => Ok((q, 1.0, q.si_unit().to_string())),
+                (Some(_), Some(c)) => Err(self.err(Some(ds), Some(record), line_no, format!("no unit label (columns 48-67), and dataset 164 sets unit system {c}, not SI (1): label the axis with its unit ({ACCEPTED_UNITS})"))),
+                (None, _) => Err(self.err(Some(ds), Some(record), line_no, format!("no unit label (columns 48-67 are '{label}') and specific data type {ty} ({}) does not say the quantity: expected a unit label ({ACCEPTED_UNITS}) or data type 17 (time), 12 (acceleration), 11 (velocity), 8 (displacement), 13 or 9 (force)", data_type_name(ty)))),
+            };
+        }
+        let Some((q, f)) = parse_unit(&label) else {
+            return Err(self.err(
+                Some(ds),
+                Some(record),
+                line_no,
+                format!("unknown unit '{label}' (columns 48-67): expected one of {ACCEPTED_UNITS}"),
+            ));
+        };
+        if let Some(tq) = by_type {
+            if tq != q {
+                return Err(self.err(
+                    Some(ds),
+                    Some(record),
+                    line_no,
+                    format!(
+                        "the unit '{label}' is a {} but the specific data type {ty} says {}",
+                        q.name(),
+                        tq.name()
+                    ),
+                ));
+            }
+        }
+        Ok((q, f, label))
+    }
+
+    fn binary_values(
+        &mut self,
+        ds: Ds,
+        count: u64,
+        single: bool,
+        little: bool,
+    ) -> Result<Vec<f64>> {
+        let width = if single { 4 } else { 8 };
+        let total = count * width as u64;
+        let mut v = Vec::with_capacity(count.min(self.left / width as u64) as usize);
+        let mut chunk = vec![0u8; 1 << 16];
+        let mut done = 0u64;
+        while done < total {
+            let take = ((total - done) as usize).min(chunk.len());
+            let c = &mut chunk[..take];
+            self.r.read_exact(c).map_err(|e| {
+                if e.kind() == std::io::ErrorKind::UnexpectedEof {
+                    self.err(Some(ds), Some("record 12 (binary)"), self.line_no, format!("the file ends inside the binary data: {total} bytes announced, fewer present"))
+                } else {
+                    Error::io(self.file, e)
+                }
+            })?;
+            self.left = self.left.saturating_sub(take as u64);
+            if single {
+                for b in c.chunks_exact(4) {
+                    let a = [b[0], b[1], b[2], b[3]];
+                    v.push(if little {
+                        f32::from_le_bytes(a)
+                    } else {
+                        f32::from_be_bytes(a)
+                    } as f64);
+                }
+            } else {
+                for b in c.chunks_exact(8) {
+                    let a = [b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]];
+                    v.push(if little {
+                        f64::from_le_bytes(a)
+                    } else {
+                        f64::from_be_bytes(a)
+                    });
+                }
+            }
+            done += take as u64;
+        }
+        Ok(v)
+    }
+
+    fn ascii_values(&mut self, ds: Ds, count: u64, ord_type: i64, even: bool) -> Result<Vec<f64>> {
+        // Fixed widths of the fields, for lines whose numbers touch (no blank between).
+        let widths: &[usize] = match (ord_type, even) {
+            (2 | 5, _) => &[13],
+            (4, false) => &[13, 20],
+            (6, false) => &[13, 20, 20],
+            _ => &[20],
+        };
+        let mut v: Vec<f64> = Vec::with_capacity(count.min(self.left / 2) as usize);
+        let first = self.line_no + 1;
+        loop {
+            let Some(l) = self.line()? else {
+                return Err(self.err(
+                    Some(ds),
+                    Some("record 12"),
+                    self.line_no,
+                    format!(
+                        "the file ends inside the data: {} of {count} values read",
+                        v.len()
+                    ),
+                ));
+            };
+            if l.trim() == "-1" {
+                break;
+            }
+            let before = v.len();
+            let mut ok = true;
+            for tok in l.split_whitespace() {
+                match parse_f(tok) {
+                    Some(x) => v.push(x),
+                    None => {
+                        ok = false;
+                        break;
+                    }
+                }
+            }
+            if !ok {
+                v.truncate(before);
+                let mut at = 0usize;
+                let mut k = 0usize;
+                let bytes = l.as_bytes();
+                while at < bytes.len() {
+                    let w = widths[k % widths.len()];
+                    let field =
+                        String::from_utf8_lossy(&bytes[at..(at + w).min(bytes.len())]).into_owned();
+                    if field.trim().is_empty() {
+                        break;
+                    }
+                    let Some(x) = parse_f(field.trim()) else {
+                        return Err(self.err(
+                            Some(ds),
+                            Some("record 12"),
+                            self.line_no,
+                            format!(
+                                "value {}: expected a number, got '{}'",
+                                v.len() + 1,
+                                clip(field.trim())
+                            ),
+                        ));
+                    };
+                    v.push(x);
+                    at += w;
+                    k += 1;
+                }
+            }
+            if v.len() as u64 > count {
+                return Err(self.err(
+                    Some(ds),
+                    Some("record 12"),
+                    self.line_no,
+                    format!("more values than the {count} record 7 announces"),
+                ));
+            }
+        }
+        if (v.len() as u64) < count {
+            return Err(self.err(
+                Some(ds),
+                Some("record 12"),
+                self.line_no,
+                format!(
+                    "the data (from line {first}) holds {} values; record 7 announces {count}",
+                    v.len()
+                ),
+            ));
+        }
+        Ok(v)
+    }
+
+    fn dataset_2411(&mut self, ds: Ds) -> Result<Vec<Node>> {
+        let mut out = Vec::new();
+        loop {
+            let Some(l1) = self.line()? else {
+                return Err(self.err(
+                    Some(ds),
+                    None,
+                    self.line_no,
+                    "the file ends inside the dataset: expected its closing '    -1'".into(),
+                ));
+            };
+            if l1.trim() == "-1" {
+                return Ok(out);
+            }
+            let n1 = self.line_no;
+            let label = l1
+                .split_whitespace()
+                .next()
+                .and_then(|t| t.parse::<i64>().ok())
+                .ok_or_else(|| {
+                    self.err(
+                        Some(ds),
+                        Some("record 1"),
+                        n1,
+                        format!(
+                            "expected 4I10 (node label, coordinate systems, colour), got '{}'",
+                            clip(&l1)
+                        ),
+                    )
+                })?;
+            let l2 = self.need_line(ds, "record 2")?;
+            let xyz: Vec<f64> = l2.split_whitespace().filter_map(parse_f).collect();
+            if xyz.len() != 3 || xyz.iter().any(|v| !v.is_finite()) {
+                return Err(self.err(
+                    Some(ds),
+                    Some("record 2"),
+                    self.line_no,
+                    format!(
+                        "node {label}: expected 3 finite coordinates (1P3D25.16), got '{}'",
+                        clip(&l2)
+                    ),
+                ));
+            }
+            out.push(Node {
+                label,
+                xyz: [xyz[0], xyz[1], xyz[2]],
+            });
+        }
+    }
+
+    fn dataset_55(&mut self, ds: Ds) -> Result<std::result::Result<Mode, String>> {
+        let mut id = Vec::new();
+        for k in 1..=5 {
+            id.push(self.need_line(ds, &format!("record {k} (ID line {k})"))?);
+        }
+        let r6 = self.need_line(ds, "record 6")?;
+        let ints = |l: &str| -> Vec<i64> {
+            l.split_whitespace()
+                .filter_map(|t| t.parse().ok())
+                .collect()
+        };
+        let h = ints(&r6);
+        if h.len() < 6 {
+            return Err(self.err(Some(ds), Some("record 6"), self.line_no, format!("expected 6I10 (model type, analysis type, data characteristic, specific data type, data type, values per node), got '{}'", clip(&r6))));
+        }
+        let (analysis, data_type, ndv) = (h[1], h[4], h[5]);
+        let r7 = self.need_line(ds, "record 7")?;
+        let r7v = ints(&r7);
+        let r8 = self.need_line(ds, "record 8")?;
+        let r8v: Vec<f64> = r8.split_whitespace().filter_map(parse_f).collect();
+        let real = matches!(data_type, 2 | 4);
+        if analysis != 2 || !real || !(ndv == 3 || ndv == 6) {
+            self.skip_to_end(ds)?;
+            return Ok(Err(format!("analysis type {analysis}, data type {data_type}, {ndv} values per node: meid reads real normal modes (2, 2 or 4, 3 or 6)")));
+        }
+        if r7v.len() < 4 || r8v.len() < 3 {
+            return Err(self.err(
+                Some(ds),
+                Some("records 7-8"),
+                self.line_no,
+                "expected 2 4 load-case mode-number, then frequency, modal mass, damping ratio"
+                    .into(),
+            ));
+        }
+        let mut shapes = Vec::new();
+        loop {
+            let Some(l) = self.line()? else {
+                return Err(self.err(
+                    Some(ds),
+                    None,
+                    self.line_no,
+                    "the file ends inside the dataset: expected its closing '    -1'".into(),
+                ));
+            };
+            if l.trim() == "-1" {
+                break;
+            }
+            let node = l.trim().parse::<i64>().map_err(|_| {
+                self.err(
+                    Some(ds),
+                    Some("record 9"),
+                    self.line_no,
+                    format!("expected a node number (I10), got '{}'", clip(&l)),
+                )
+            })?;
+            let d = self.need_line(ds, "record 10")?;
+            let mut v: Vec<f64> = d.split_whitespace().filter_map(parse_f).collect();
+            if v.len() != ndv as usize {
+                // Fixed 13-column fields (numbers touching).
+                v = d
+                    .as_bytes()
+                    .chunks(13)
+                    .filter_map(|c| parse_f(String::from_utf8_lossy(c).trim()))
+                    .collect();
+            }
+            if v.len() != ndv as usize || v.iter().any(|x| !x.is_finite()) {
+                return Err(self.err(
+                    Some(ds),
+                    Some("record 10"),
+                    self.line_no,
+                    format!(
+                        "node {node}: expected {ndv} finite values, got '{}'",
+                        clip(&d)
+                    ),
+                ));
+            }
+            shapes.push((node, [v[0], v[1], v[2]]));
+        }
+        Ok(Ok(Mode {
+            number: r7v[3],
+            frequency_hz: r8v[0],
+            modal_mass: r8v[1],
+            damping_ratio: r8v[2],
+            name: id[0].trim().to_string(),
+            shapes,
+        }))
+    }
+}
+
+/// Columns `[a, b)` of a line (byte positions; a short line gives what there is).
+fn cols(line: &str, a: usize, b: usize) -> String {
+    let bytes = line.as_bytes();
+    if a >= bytes.len() {
+        return String::new();
+    }
+    String::from_utf8_lossy(&bytes[a..b.min(bytes.len())]).into_owned()
+}
+
+/// A number in Fortran or C notation (`1.5E+00`, `1.5D+00`, `1.5e0`).
+fn parse_f(s: &str) -> Option<f64> {
+    if s.contains(['D', 'd']) {
+        s.replace(['D', 'd'], "E").parse().ok()
+    } else {
+        s.parse().ok()
+    }
+}
+
+/// Record 7: whitespace-separated when possible, else fixed columns 3I10,3E13.5.
+fn parse_record7(l: &str) -> Option<(i64, i64, bool, f64, f64)> {
+    let t: Vec<&str> = l.split_whitespace().collect();
+    let ws = || -> Option<(i64, i64, i64, f64, f64)> {
+        if t.len() < 5 {
+            return None;
+        }
+        Some((
+            t[0].parse().ok()?,
+            t[1].parse().ok()?,
+            t[2].parse().ok()?,
+            parse_f(t[3])?,
+            parse_f(t[4])?,
+        ))
+    };
+    let fixed = || -> Option<(i64, i64, i64, f64, f64)> {
+        Some((
+            cols(l, 0, 10).trim().parse().ok()?,
+            cols(l, 10, 20).trim().parse().ok()?,
+            cols(l, 20, 30).trim().parse().ok()?,
+            parse_f(cols(l, 30, 43).trim())?,
+            parse_f(cols(l, 43, 56).trim())?,
+        ))
+    };
+    let (a, b, c, d, e) = ws().or_else(fixed)?;
+    match c {
+        0 => Some((a, b, false, d, e)),
+        1 => Some((a, b, true, d, e)),
+        _ => None,
+    }
+}
+
+fn clip(s: &str) -> String {
+    let t: String = s.chars().take(60).collect();
+    if t.len() < s.len() {
+        format!("{t}…")
+    } else {
+        t
+    }
+}
+
+fn function_name(t: i64) -> &'static str {
+    match t {
+        0 => "general or unknown",
+        1 => "time response",
+        2 => "auto spectrum",
+        3 => "cross spectrum",
+        4 => "frequency response function",
+        5 => "transmissibility",
+        6 => "coherence",
+        9 => "power spectral density",
+        _ => "other",
+    }
+}
+
+fn data_type_name(t: i64) -> &'static str {
+    match t {
+        0 => "unknown",
+        1 => "general",
+        2 => "stress",
+        3 => "strain",
+        5 => "temperature",
+        15 => "pressure",
+        18 => "frequency",
+        _ => "not a quantity meid reads",
+    }
+}
+
+// ------------------------------------------------------------------------------------ writing
+
+/// One channel to write as dataset 58 (even abscissa, time in s, values in SI).
+#[derive(Debug, Clone)]
+pub struct Channel58<'a> {
+    /// ID line 1 (the channel name).
+    pub name: &'a str,
+    /// Response entity (≤ 10 characters are kept), node and direction (3 = +Z).
+    pub point: PointRef,
+    pub quantity: Quantity,
+    pub start_s: f64,
+    pub step_s: f64,
+    /// Values in [`Quantity::si_unit`].
+    pub values: &'a [f64],
+}
+
+/// `v` as C's `%W.De` (sign, `D` decimals, exponent with a sign and at least 2 digits),
+/// right-aligned in `width`.
+pub fn format_e(v: f64, decimals: usize, width: usize) -> String {
+    let s = format!("{v:.decimals$e}");
+    let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+    let e: i32 = e.parse().unwrap_or(0);
+    let t = format!("{m}e{}{:02}", if e < 0 { '-' } else { '+' }, e.abs());
+    format!("{t:>width$}")
+}
+
+/// `v` in a 13-column field with as many digits as fit after one blank (the shortest form
+/// that reads back exactly when it fits; the abscissa of record 7).
+fn format_e13(v: f64) -> String {
+    let s = format!("{v:e}");
+    let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+    let e: i32 = e.parse().unwrap_or(0);
+    let t = format!("{m}e{}{:02}", if e < 0 { '-' } else { '+' }, e.abs());
+    if t.len() <= 12 {
+        return format!("{t:>13}");
+    }
+    for d in (1..=8).rev() {
+        let t = format_e(v, d, 0);
+        if t.len() <= 12 {
+            return format!("{t:>13}");
+        }
+    }
+    format_e(v, 5, 13)
+}
+
+fn finite(values: &[f64], what: &str) -> Result<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(k) => Err(Error::invalid(
+            what,
+            format!("sample {k} is not finite ({})", values[k]),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Writes one dataset 58 (function type 1, time response). ASCII: real double precision,
+/// four values a line in `%20.11e` (12 significant digits). Binary (58b): little-endian IEEE
+/// doubles, exact. Records 8 and 9 carry the SI unit labels and the specific data types.
+pub fn write_58<W: Write>(w: &mut W, ch: &Channel58, binary: bool) -> std::io::Result<()> {
+    if let Err(e) = finite(ch.values, ch.name) {
+        return Err(std::io::Error::other(e.to_string()));
+    }
+    let n = ch.values.len();
+    write!(w, "{:>6}\n{:>6}", -1, 58)?;
+    if binary {
+        writeln!(
+            w,
+            "b{:>6}{:>6}{:>12}{:>12}{:>6}{:>6}{:>12}{:>12}",
+            1,
+            2,
+            11,
+            n * 8,
+            0,
+            0,
+            0,
+            0
+        )?;
+    } else {
+        writeln!(w, "{:74}", "")?;
+    }
+    let line80 = |s: &str| -> String {
+        let t: String = s.chars().filter(|c| !c.is_control()).take(80).collect();
+        format!("{t:<80}")
+    };
+    writeln!(w, "{}", line80(ch.name))?;
+    writeln!(w, "{}", line80("written by meid"))?;
+    writeln!(w, "{}", line80("NONE"))?;
+    writeln!(w, "{}", line80("NONE"))?;
+    writeln!(w, "{}", line80("NONE"))?;
+    let ent: String = ch
+        .point
+        .entity
+        .chars()
+        .filter(|c| !c.is_whitespace())
+        .take(10)
+        .collect();
+    let ent = if ent.is_empty() {
+        "NONE".to_string()
+    } else {
+        ent
+    };
+    writeln!(
+        w,
+        "{:>5}{:>10}{:>5}{:>10} {:>10}{:>10}{:>4} {:>10}{:>10}{:>4}",
+        1, 0, 0, 0, ent, ch.point.node, ch.point.direction, "NONE", 0, 0
+    )?;
+    writeln!(
+        w,
+        "{:>10}{:>10}{:>10}{}{}{}",
+        4,
+        n,
+        1,
+        format_e13(ch.start_s),
+        format_e13(ch.step_s),
+        format_e13(0.0)
+    )?;
+    let axis = |w: &mut W, q: Option<Quantity>, label: &str| -> std::io::Result<()> {
+        let (ty, (le, fe, te), unit) = match q {
+            Some(q) => (q.uff_data_type(), q.uff_exponents(), q.si_unit()),
+            None => (0, (0, 0, 0), "NONE"),
+        };
+        writeln!(w, "{ty:>10}{le:>5}{fe:>5}{te:>5} {label:<20} {unit:<20}")
+    };
+    axis(w, Some(Quantity::Time), "Time")?;
+    axis(w, Some(ch.quantity), &capitalise(ch.quantity.name()))?;
+    axis(w, None, "NONE")?;
+    axis(w, None, "NONE")?;
+    if binary {
+        let mut buf = Vec::with_capacity(n.min(8192) * 8);
+        for c in ch.values.chunks(8192) {
+            buf.clear();
+            for v in c {
+                buf.extend_from_slice(&v.to_le_bytes());
+            }
+            w.write_all(&buf)?;
+        }
+    } else {
+        let mut line = String::with_capacity(82);
+        for c in ch.values.chunks(4) {
+            line.clear();
+            for v in c {
+                line.push_str(&format_e(*v, 11, 20));
+            }
+            line.push('\n');
+            w.write_all(line.as_bytes())?;
+        }
+    }
+    writeln!(w, "{:>6}", -1)
+}
+
+fn capitalise(s: &str) -> String {
+    let mut c = s.chars();
+    match c.next() {
+        Some(f) => f.to_uppercase().chain(c).collect(),
+        None => String::new(),
+    }
+}
+
+/// Writes dataset 2411 (nodes, double precision: 4I10 then 1P3D25.16, here `%25.16e`).
+pub fn write_2411<W: Write>(w: &mut W, nodes: &[Node]) -> std::io::Result<()> {
+    writeln!(w, "{:>6}\n{:>6}{:74}", -1, 2411, "")?;
+    for n in nodes {
+        writeln!(w, "{:>10}{:>10}{:>10}{:>10}", n.label, 1, 1, 11)?;
+        writeln!(
+            w,
+            "{}{}{}",
+            format_e(n.xyz[0], 16, 25),
+            format_e(n.xyz[1], 16, 25),
+            format_e(n.xyz[2], 16, 25)
+        )?;
+    }
+    writeln!(w, "{:>6}", -1)
+}
+
+/// Writes dataset 55 for one real normal mode (analysis type 2, 3 translations per node,
+/// data type 2 as pyuff and most readers expect: `%13.5e` values, 6 significant digits).
+/// Modal mass 1 means mass-normalised shapes.
+pub fn write_55<W: Write>(w: &mut W, mode: &Mode) -> std::io::Result<()> {
+    writeln!(w, "{:>6}\n{:>6}{:74}", -1, 55, "")?;
+    let line80 = |s: &str| -> String {
+        format!(
+            "{:<80}",
+            s.chars()
+                .filter(|c| !c.is_control())
+                .take(80)
+                .collect::<String>()
+        )
+    };
+    writeln!(w, "{}", line80(&mode.name))?;
+    writeln!(w, "{}", line80("written by meid"))?;
+    writeln!(w, "{}", line80("NONE"))?;
+    writeln!(w, "{}", line80("NONE"))?;
+    writeln!(w, "{}", line80("NONE"))?;
+    // Structural model, normal mode, 3 DOF translation, displacement, real single, 3 values.
+    writeln!(w, "{:>10}{:>10}{:>10}{:>10}{:>10}{:>10}", 1, 2, 2, 8, 2, 3)?;
+    writeln!(w, "{:>10}{:>10}{:>10}{:>10}", 2, 4, 1, mode.number)?;
+    writeln!(
+        w,
+        "{}{}{}{}",
+        format_e(mode.frequency_hz, 5, 13),
+        format_e(mode.modal_mass, 5, 13),
+        format_e(mode.damping_ratio, 5, 13),
+        format_e(0.0, 5, 13)
+    )?;
+    for (node, v) in &mode.shapes {
+        writeln!(w, "{node:>10}")?;
+        writeln!(
+            w,
+            "{}{}{}",
+            format_e(v[0], 5, 13),
+            format_e(v[1], 5, 13),
+            format_e(v[2], 5, 13)
+        )?;
+    }
+    writeln!(w, "{:>6}", -1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ch(values: &[f64]) -> Channel58<'_> {
+        Channel58 {
+            name: "bed_acceleration",
+            point: PointRef {
+                entity: "bed".into(),
+                node: 1,
+                direction: 3,
+            },
+            quantity: Quantity::Acceleration,
+            start_s: 0.0,
+            step_s: 1.0 / 51200.0,
+            values,
+        }
+    }
+
+    #[test]
+    fn format_e_is_c_style() {
+        assert_eq!(format_e(1.0, 11, 20), "   1.00000000000e+00");
+        assert_eq!(format_e(-1.5e-100, 11, 20), " -1.50000000000e-100");
+        assert_eq!(format_e13(1.0 / 51200.0), " 1.953125e-05");
+        assert_eq!(format_e13(5e-5), "        5e-05");
+        assert_eq!(format_e13(1.0 / 3.0).len(), 13);
+        assert_eq!(
+            parse_f(format_e13(1.0 / 51200.0).trim()),
+            Some(1.0 / 51200.0)
+        );
+    }
+
+    #[test]
+    fn binary_58b_round_trips_exactly_and_ascii_to_12_digits() {
+        let v: Vec<f64> = (0..103)
+            .map(|i| (i as f64 * 0.37).sin() * 1e3 + 1e-7 * i as f64)
+            .collect();
+        for binary in [true, false] {
+            let mut buf = Vec::new();
+            write_58(&mut buf, &ch(&v), binary).unwrap();
+            write_58(&mut buf, &ch(&v[..5]), binary).unwrap();
+            let f = parse_uff(&buf[..], "mem.uff", Some(buf.len() as u64)).unwrap();
+            assert_eq!(f.records.len(), 2);
+            let r = &f.records[0];
+            assert_eq!(r.name, "bed_acceleration");
+            assert_eq!(r.quantity, Quantity::Acceleration);
+            assert_eq!(r.point.as_ref().unwrap().label(), "bed:1 +Z");
+            assert_eq!(r.even().unwrap(), (0.0, 1.0 / 51200.0));
+            for (a, b) in r.values.iter().zip(&v) {
+                if binary {
+                    assert_eq!(a, b);
+                } else {
+                    assert!((a - b).abs() <= 5e-12 * b.abs().max(1e-300), "{a} {b}");
+                }
+            }
+            assert_eq!(f.records[1].values.len(), 5);
+        }
+    }
+
+    fn header(unit: &str, ty: i64, n: usize, even: i64) -> String {
+        format!(
+            "    -1\n    58\nacc g\nNONE\nNONE\nNONE\nNONE\n    1         0    0         0 NONE               1   3 NONE               0   0\n         2{n:>10}{even:>10}  0.00000e+00  1.00000e-03  0.00000e+00\n        17    0    0    0 Time                 s                   \n{ty:>10}    0    0    0 Acc                  {unit:<20}\n         0    0    0    0 NONE                 NONE                \n         0    0    0    0 NONE                 NONE                \n"
+        )
+    }
+
+    #[test]
+    fn g_and_mm_per_s2_convert_and_uneven_abscissa_reads() {
+        let text = format!(
+            "{}  1.00000e+00  2.00000e+00 -5.00000e-01\n    -1\n",
+            header("g", 12, 3, 1)
+        );
+        let f = parse_uff(text.as_bytes(), "g.uff", None).unwrap();
+        let r = &f.records[0];
+        assert_eq!(r.values, vec![9.80665, 2.0 * 9.80665, -0.5 * 9.80665]);
+        assert_eq!(r.source_unit, "g");
+        let text = format!("{}  0.00000e+00  1.00000e+03  1.00000e-03  2.00000e+03  2.50000e-03  0.00000e+00\n    -1\n", header("mm/s^2", 0, 3, 0));
+        let f = parse_uff(text.as_bytes(), "u.uff", None).unwrap();
+        let r = &f.records[0];
+        assert_eq!(r.values, vec![1.0, 2.0, 0.0]);
+        assert_eq!(r.abscissa, Abscissa::Uneven(vec![0.0, 1e-3, 2.5e-3]));
+        assert!(r.even().is_err());
+    }
+
+    #[test]
+    fn errors_name_file_dataset_record_and_line() {
+        let text = format!("{}  1.0\n    -1\n", header("furlong/s^2", 12, 1, 1));
+        let e = parse_uff(text.as_bytes(), "lab.uff", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("lab.uff: dataset 1 (58 starting at line 1), record 9 (ordinate), line 11")
+                && e.contains("unknown unit 'furlong/s^2'"),
+            "{e}"
+        );
+        let text = format!("{}  1.0\n    -1\n", header("N", 12, 1, 1));
+        let e = parse_uff(text.as_bytes(), "lab.uff", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("is a force but the specific data type 12 says acceleration"),
+            "{e}"
+        );
+        let text = format!("{}  1.0  2.0\n    -1\n", header("g", 12, 3, 1));
+        let e = parse_uff(text.as_bytes(), "lab.uff", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("record 12") && e.contains("holds 2 values; record 7 announces 3"),
+            "{e}"
+        );
+        // A huge point count is refused before any allocation.
+        let text = format!("{}  1.0\n    -1\n", header("g", 12, 1_000_000_000, 1));
+        let e = parse_uff(text.as_bytes(), "lab.uff", Some(text.len() as u64))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("record 7") && e.contains("bytes are left"),
+            "{e}"
+        );
+        let e = parse_uff(&b"    -1\n    58b     1     2          11    999999999     0     0           0           0\n"[..], "b.uff", Some(90)).unwrap_err().to_string();
+        assert!(
+            e.contains("binary header") && e.contains("bytes are left"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn nodes_and_modes_round_trip() {
+        let nodes = vec![
+            Node {
+                label: 1,
+                xyz: [0.0, 0.5, 1.25],
+            },
+            Node {
+                label: 7,
+                xyz: [-1.0, 2.0, 3.0e-3],
+            },
+        ];
+        let mode = Mode {
+            number: 2,
+            frequency_hz: 283.0,
+            modal_mass: 1.0,
+            damping_ratio: 0.01,
+            name: "mode 2".into(),
+            shapes: vec![(1, [0.0, 0.0, 0.25]), (7, [0.0, 0.0, -0.125])],
+        };
+        let mut buf = Vec::new();
+        write_2411(&mut buf, &nodes).unwrap();
+        write_55(&mut buf, &mode).unwrap();
+        let f = parse_uff(&buf[..], "m.unv", None).unwrap();
+        assert_eq!(f.nodes, nodes);
+        assert_eq!(f.modes, vec![mode]);
+    }
+}
+
+/// Writes evenly sampled records as datasets 58, one per record, in order; the response node
+/// is the record's position (1-based) unless the record names its point.
+pub fn write_records<W: Write>(w: &mut W, records: &[Record], binary: bool) -> Result<()> {
+    for (k, r) in records.iter().enumerate() {
+        let (start_s, step_s) = r.even()?;
+        let point = r.point.clone().unwrap_or(PointRef {
+            entity: r.name.split('_').next().unwrap_or("NONE").to_string(),
+            node: k as i64 + 1,
+            direction: 3,
+        });
+        let ch = Channel58 {
+            name: &r.name,
+            point,
+            quantity: r.quantity,
+            start_s,
+            step_s,
+            values: &r.values,
+        };
+        write_58(w, &ch, binary).map_err(|e| Error::io("UFF output", e))?;
+    }
+    Ok(())
+}
+
+/// Dataset 2411 + one dataset 55 per mode of a modal model's named points (a lumped or
+/// tabulated model has no geometry: point k, in name order, is node k at x = k − 1 m; its z
+/// translation is the mode-shape value, mass-normalised, modal mass 1). Damping ratios are
+/// `D_ii / (2 ω_i)` (0 for rigid-body modes).
+pub fn modes_uff_points(m: &crate::modal::ModalModel) -> Result<Vec<u8>> {
+    let names: Vec<&String> = m.points.keys().collect();
+    let nodes: Vec<Node> = (0..names.len())
+        .map(|k| Node {
+            label: k as i64 + 1,
+            xyz: [k as f64, 0.0, 0.0],
+        })
+        .collect();
+    let n = m.omega_rad_per_s.len();
+    let mut out = Vec::new();
+    write_2411(&mut out, &nodes).map_err(|e| Error::io("UFF output", e))?;
+    for i in 0..n {
+        let w = m.omega_rad_per_s[i];
+        let d = m.damping.get(i * n + i).copied().unwrap_or(0.0);
+        let mode = Mode {
+            number: i as i64 + 1,
+            frequency_hz: w / (2.0 * std::f64::consts::PI),
+            modal_mass: 1.0,
+            damping_ratio: if w > 0.0 { d / (2.0 * w) } else { 0.0 },
+            name: m
+                .labels
+                .get(i)
+                .cloned()
+                .unwrap_or_else(|| format!("mode {}", i + 1)),
+            shapes: names
+                .iter()
+                .enumerate()
+                .map(|(k, p)| (k as i64 + 1, [0.0, 0.0, m.points[*p][i]]))
+                .collect(),
+        };
+        write_55(&mut out, &mode).map_err(|e| Error::io("UFF output", e))?;
+    }
+    Ok(out)
+}
+
+/// Dataset 2411 (every mesh node, label = index + 1, coordinates in m) + one dataset 55 per
+/// computed mode (nodal translations of the mass-normalised shapes, modal mass 1) of an FE
+/// analysis; `zeta[i]` the modal damping ratios (missing: 0).
+pub fn modes_uff_fe(
+    model: &crate::structure::assembly::FeModel,
+    modes: &crate::modal::dense::DenseModes,
+    zeta: &[f64],
+) -> Result<Vec<u8>> {
+    let nodes: Vec<Node> = model
+        .mesh
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(k, p)| Node {
+            label: k as i64 + 1,
+            xyz: *p,
+        })
+        .collect();
+    let mut out = Vec::new();
+    write_2411(&mut out, &nodes).map_err(|e| Error::io("UFF output", e))?;
+    for i in 0..modes.omega_rad_per_s.len() {
+        let t = super::vtk::mode_translations(model, modes, i)?;
+        let mode = Mode {
+            number: i as i64 + 1,
+            frequency_hz: modes.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI),
+            modal_mass: 1.0,
+            damping_ratio: zeta.get(i).copied().unwrap_or(0.0),
+            name: format!("mode {}", i + 1),
+            shapes: t
+                .iter()
+                .enumerate()
+                .map(|(k, v)| (k as i64 + 1, *v))
+                .collect(),
+        };
+        write_55(&mut out, &mode).map_err(|e| Error::io("UFF output", e))?;
+    }
+    Ok(out)
+}

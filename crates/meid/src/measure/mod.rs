@@ -1,0 +1,263 @@
+//! Measured data: records read from the test lab's files, processed as a test lab does, and
+//! compared with the simulation.
+//!
+//! * [`Record`]: one channel of a time history, in SI units ([`units`]), read by
+//!   [`crate::io::uff`] (Universal File Format dataset 58, ASCII and binary 58b) or
+//!   [`crate::io::csv_records`] (CSV with `quantity_unit` column names), or made from a
+//!   simulated [`History`] ([`Record::from_history`]).
+//! * [`mapping`]: which channel is the bed acceleration at B, the force to the floor, the blow.
+//! * [`process`]: blow detection by a trigger, averaging over blows, force and exponential
+//!   windows, H1 frequency response and coherence, spectra and one-third-octave levels. The
+//!   same functions process simulated histories, so a comparison is like for like.
+//! * [`validate`]: simulation beside measurement (frequency, level and peak errors, measured
+//!   reductions beside simulated ones).
+
+pub mod mapping;
+pub mod process;
+pub mod report;
+pub mod units;
+pub mod validate;
+
+use serde::Serialize;
+
+pub use units::Quantity;
+
+use crate::analysis::History;
+use crate::{Error, Result};
+
+/// Where a channel was measured, as the file says (UFF record 6: response entity name, node
+/// and direction; direction 1/2/3 = +X/+Y/+Z, negative for −, 0 scalar).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct PointRef {
+    pub entity: String,
+    pub node: i64,
+    pub direction: i64,
+}
+
+impl PointRef {
+    /// e.g. "bed:1 +Z".
+    pub fn label(&self) -> String {
+        let d = match self.direction {
+            0 => "",
+            1 => " +X",
+            2 => " +Y",
+            3 => " +Z",
+            -1 => " -X",
+            -2 => " -Y",
+            -3 => " -Z",
+            4 => " +RX",
+            5 => " +RY",
+            6 => " +RZ",
+            -4 => " -RX",
+            -5 => " -RY",
+            -6 => " -RZ",
+            _ => " ?",
+        };
+        format!("{}:{}{d}", self.entity, self.node)
+    }
+}
+
+/// The sampling of a record.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Abscissa {
+    /// `t_n = start_s + n·step_s`.
+    Even { start_s: f64, step_s: f64 },
+    /// Explicit sample times (s), strictly increasing.
+    Uneven(Vec<f64>),
+}
+
+/// One measured (or simulated) channel, values in the SI unit of its quantity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Record {
+    /// Channel name (UFF record 1, or the CSV column without its unit).
+    pub name: String,
+    pub quantity: Quantity,
+    /// The unit the file gave (before conversion), e.g. "g".
+    pub source_unit: String,
+    /// Point and direction, when the file names them.
+    pub point: Option<PointRef>,
+    pub abscissa: Abscissa,
+    /// Samples in [`Quantity::si_unit`].
+    pub values: Vec<f64>,
+    /// Where it came from: "FILE, dataset 3 (line 120)" or "FILE, column 2".
+    pub origin: String,
+}
+
+/// Largest relative deviation of an uneven abscissa's steps from their mean for the record
+/// to count as evenly sampled (ASCII files print times to 6 significant digits).
+pub const EVEN_TOLERANCE: f64 = 1e-3;
+
+impl Record {
+    /// The SI unit of the values.
+    pub fn unit(&self) -> &'static str {
+        self.quantity.si_unit()
+    }
+
+    /// Sample `n`'s time (s).
+    pub fn time_at(&self, n: usize) -> f64 {
+        match &self.abscissa {
+            Abscissa::Even { start_s, step_s } => start_s + n as f64 * step_s,
+            Abscissa::Uneven(t) => t.get(n).copied().unwrap_or(f64::NAN),
+        }
+    }
+
+    /// `(start_s, step_s)` of an evenly sampled record. An uneven abscissa whose steps differ
+    /// from their mean by at most [`EVEN_TOLERANCE`] (relative) counts as even with the mean
+    /// step `(t_last − t_0)/(N − 1)`; otherwise the error says to resample.
+    pub fn even(&self) -> Result<(f64, f64)> {
+        match &self.abscissa {
+            Abscissa::Even { start_s, step_s } => {
+                if step_s.is_finite() && *step_s > 0.0 && start_s.is_finite() {
+                    Ok((*start_s, *step_s))
+                } else {
+                    Err(Error::Input {
+                        location: self.origin.clone(),
+                        message: format!(
+                            "channel '{}': the abscissa increment must be a positive finite time step, got {step_s} s",
+                            self.name
+                        ),
+                    })
+                }
+            }
+            Abscissa::Uneven(t) => {
+                let n = t.len();
+                if n < 2 {
+                    return Err(Error::Input {
+                        location: self.origin.clone(),
+                        message: format!("channel '{}': needs at least 2 samples", self.name),
+                    });
+                }
+                let mean = (t[n - 1] - t[0]) / (n - 1) as f64;
+                let worst = t
+                    .windows(2)
+                    .map(|w| ((w[1] - w[0]) - mean).abs())
+                    .fold(0.0, f64::max);
+                if mean > 0.0 && mean.is_finite() && worst <= EVEN_TOLERANCE * mean {
+                    Ok((t[0], mean))
+                } else {
+                    Err(Error::Input {
+                        location: self.origin.clone(),
+                        message: format!(
+                            "channel '{}': the sample times are uneven (steps differ from their mean {mean:e} s by up to {worst:e} s); spectra need even sampling: resample the record",
+                            self.name
+                        ),
+                    })
+                }
+            }
+        }
+    }
+
+    /// Sample rate `1/step` (Hz) of an evenly sampled record ([`Self::even`]).
+    pub fn sample_rate_hz(&self) -> Result<f64> {
+        Ok(1.0 / self.even()?.1)
+    }
+
+    /// A channel of a simulated history as a record (SI already): the same processing then
+    /// applies to simulation and measurement.
+    pub fn from_history(h: &History, channel: SimChannel) -> Result<Record> {
+        let (values, quantity) = match channel {
+            SimChannel::BedAcceleration => (&h.bed_acceleration_m_per_s2, Quantity::Acceleration),
+            SimChannel::FloorForce => (&h.floor_force_n, Quantity::Force),
+            SimChannel::BlowForce => (&h.contact_force_slider_bed_n, Quantity::Force),
+        };
+        let n = h.time_s.len();
+        if n < 2 {
+            return Err(Error::invalid(
+                "history",
+                format!("needs at least 2 samples, got {n}"),
+            ));
+        }
+        let step = (h.time_s[n - 1] - h.time_s[0]) / (n - 1) as f64;
+        Ok(Record {
+            name: channel
+                .column()
+                .trim_end_matches(channel.suffix())
+                .to_string(),
+            quantity,
+            source_unit: quantity.si_unit().to_string(),
+            point: None,
+            abscissa: Abscissa::Even {
+                start_s: h.time_s[0],
+                step_s: step,
+            },
+            values: values.clone(),
+            origin: "simulation".into(),
+        })
+    }
+}
+
+/// The simulated channels a measurement is compared with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, PartialOrd, Ord)]
+#[serde(rename_all = "kebab-case")]
+pub enum SimChannel {
+    /// Acceleration of the bed at the measurement point B (m/s²).
+    BedAcceleration,
+    /// Force to the floor (N).
+    FloorForce,
+    /// The blow: the slider-bed contact force (N).
+    BlowForce,
+}
+
+impl SimChannel {
+    /// All, in a fixed order.
+    pub const ALL: [SimChannel; 3] = [
+        SimChannel::BedAcceleration,
+        SimChannel::FloorForce,
+        SimChannel::BlowForce,
+    ];
+
+    /// The history.csv column.
+    pub fn column(self) -> &'static str {
+        match self {
+            SimChannel::BedAcceleration => "bed_acceleration_m_per_s2",
+            SimChannel::FloorForce => "floor_force_n",
+            SimChannel::BlowForce => "contact_force_slider_bed_n",
+        }
+    }
+
+    fn suffix(self) -> &'static str {
+        match self {
+            SimChannel::BedAcceleration => "_m_per_s2",
+            _ => "_n",
+        }
+    }
+
+    /// The quantity.
+    pub fn quantity(self) -> Quantity {
+        match self {
+            SimChannel::BedAcceleration => Quantity::Acceleration,
+            _ => Quantity::Force,
+        }
+    }
+
+    /// The mapping target's name (`[measurement]`, `--channel NAME=TARGET`).
+    pub fn target(self) -> &'static str {
+        match self {
+            SimChannel::BedAcceleration => "B",
+            SimChannel::FloorForce => "floor",
+            SimChannel::BlowForce => "blow",
+        }
+    }
+
+    /// Text for reports.
+    pub fn label(self) -> &'static str {
+        match self {
+            SimChannel::BedAcceleration => "bed acceleration at B",
+            SimChannel::FloorForce => "force to the floor",
+            SimChannel::BlowForce => "blow force (slider-bed)",
+        }
+    }
+}
+
+/// Reads the records of a file by its extension: `.uff`, `.unv`, `.uf` (UFF, ASCII or binary)
+/// or `.csv`; other extensions are tried as UFF when the file starts like one (`    -1`).
+pub fn read_records(path: &std::path::Path) -> Result<Vec<Record>> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "csv" | "txt" => crate::io::csv_records::read_csv(path),
+        _ => Ok(crate::io::uff::read_uff(path)?.records),
+    }
+}

@@ -1,0 +1,717 @@
+//! Test-lab processing of time histories: blows found by a trigger, records averaged over
+//! blows, force and exponential windows, energy spectra, one-third-octave levels, the H1
+//! frequency response and its coherence.
+//!
+//! Everything works on plain sampled channels (`&[f64]` at `f_s`), so the same
+//! [`Processing`] applies to a measured [`super::Record`] and to a simulated history
+//! ([`super::Record::from_history`]): same trigger, same record length, same windows — a
+//! like-for-like comparison.
+//!
+//! # Blows
+//!
+//! A blow is triggered at the first sample `i` with `|x_i| ≥ L` on the trigger channel
+//! (`L` absolute, or a fraction of the channel's largest `|x|`), once the detector is armed.
+//! After a trigger the detector ignores `hold-off` seconds, then re-arms when `|x|` falls below
+//! `L`. Each blow's record starts `pre-trigger` seconds before its trigger and lasts the record
+//! length (default: the shortest interval between triggers, or up to the end for a single
+//! blow). A blow whose record would start before the first sample or end after the last is
+//! counted but not averaged.
+//!
+//! # Averaging
+//!
+//! * in time: `x̄_n = (1/B) Σ_b x_b[n]` over the B complete blow records (aligned on the trigger
+//!   sample), for overlays;
+//! * in frequency: the energy spectral density is the mean of the blows' ESDs,
+//!   `Ē_k = (1/B) Σ_b E_{b,k}` with `E_{b,k} = 2|Δt Σ_n w_n x_b[n] e^{−2πikn/N}|²`
+//!   ([`crate::analysis::spectrum::esd_fft`]'s scaling; unit²·s/Hz). Levels are
+//!   `10 log10(Ē/E_ref)` dB re 1 (m/s²)²·s/Hz, 1 N²·s/Hz, 1 (m/s)²·s/Hz or 1 m²·s/Hz.
+//! * the H1 estimate of the frequency response from force `f` to response `x`:
+//!   `H1_k = Σ_b conj(F_{b,k}) X_{b,k} / Σ_b |F_{b,k}|²` and the coherence
+//!   `γ²_k = |Σ_b conj(F) X|² / (Σ_b |F|² · Σ_b |X|²)` (1 for noise-free linear data; with one
+//!   blow it is 1 by construction). Bendat & Piersol, *Random Data*, 4th ed., Eqs. (9.52), (9.60).
+//!
+//! # Windows and the added damping of the exponential window
+//!
+//! The windows are [`TransientWindow`]'s: the force window (1 over the pulse, a half-cosine
+//! taper, 0 after) on the force, and an exponential `w(t) = e^{−t/τ}` on the responses (and,
+//! multiplied in, on the force, so that H1 stays the ratio of equally windowed signals). The
+//! exponential window multiplies a mode's free decay `e^{−ζωt}` by `e^{−t/τ}`: the windowed
+//! record is that of a mode with decay rate `ζω + 1/τ`, i.e. a damping ratio
+//!
+//! ```text
+//! ζ_w = (ζω + 1/τ) / ω_w,   ω_w² = ω_d² + (ζω + 1/τ)²,   ω_d = ω √(1 − ζ²)
+//! ζ_w ≈ ζ + 1/(ωτ)                  (ζ, 1/(ωτ) ≪ 1)
+//! ```
+//!
+//! A damping ratio read from an exponentially windowed spectrum must be corrected by
+//! `ζ = ζ_w − 1/(ωτ)` ([`crate::analysis::spectrum::exponential_window_correction`]); the
+//! H1 of the windowed records *is* the FRF of that more damped mode
+//! ([`windowed_sdof_damping`]), which the tests check.
+
+use realfft::num_complex::Complex;
+use realfft::RealFftPlanner;
+use serde::Serialize;
+
+use crate::analysis::esd::esd_level_db;
+use crate::analysis::octave::{bands_covering, Band};
+use crate::analysis::spectrum::{one_sided_factor, TransientWindow};
+use crate::{Error, Result};
+
+use super::{Quantity, Record};
+
+/// The trigger level.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Level {
+    /// In the channel's SI unit.
+    Absolute(f64),
+    /// A fraction of the channel's largest `|x|`, in (0, 1].
+    FractionOfPeak(f64),
+}
+
+/// Settings shared by measured and simulated records.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Processing {
+    /// Trigger level (default 10 % of the trigger channel's peak).
+    pub level: Level,
+    /// Time kept before each trigger (s, default 0.01).
+    pub pretrigger_s: f64,
+    /// Length of each blow's record (s); `None`: the shortest interval between triggers (a
+    /// single blow: to the end of the file).
+    pub record_s: Option<f64>,
+    /// Time after a trigger during which no other is taken (s, default 0.25).
+    pub holdoff_s: f64,
+    /// Window on responses (default rectangular).
+    pub window: TransientWindow,
+    /// Apply the force window to force channels (pulse = the time `|F|` stays above the trigger
+    /// level after the trigger, taper = half of it).
+    pub force_window: bool,
+}
+
+impl Default for Processing {
+    fn default() -> Self {
+        Processing {
+            level: Level::FractionOfPeak(0.1),
+            pretrigger_s: 0.01,
+            record_s: None,
+            holdoff_s: 0.25,
+            window: TransientWindow::Rectangular,
+            force_window: false,
+        }
+    }
+}
+
+impl Processing {
+    fn check(&self) -> Result<()> {
+        match self.level {
+            Level::Absolute(l) if !(l.is_finite() && l > 0.0) => {
+                return Err(Error::invalid(
+                    "trigger level",
+                    format!("must be > 0 (got {l})"),
+                ))
+            }
+            Level::FractionOfPeak(f) if !(f > 0.0 && f <= 1.0) => {
+                return Err(Error::invalid(
+                    "trigger level",
+                    format!("a fraction of the peak must lie in (0, 1] (got {f})"),
+                ))
+            }
+            _ => {}
+        }
+        if !(self.pretrigger_s.is_finite() && self.pretrigger_s >= 0.0) {
+            return Err(Error::invalid(
+                "pre-trigger",
+                format!("must be ≥ 0 s (got {})", self.pretrigger_s),
+            ));
+        }
+        if !(self.holdoff_s.is_finite() && self.holdoff_s >= 0.0) {
+            return Err(Error::invalid(
+                "hold-off",
+                format!("must be ≥ 0 s (got {})", self.holdoff_s),
+            ));
+        }
+        if let Some(r) = self.record_s {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(Error::invalid(
+                    "record length",
+                    format!("must be > 0 s (got {r})"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The blows found in a record.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Blows {
+    /// Trigger samples.
+    pub triggers: Vec<usize>,
+    /// First sample of each complete blow record (trigger − pre-trigger).
+    pub starts: Vec<usize>,
+    /// Samples per blow record.
+    pub length: usize,
+    /// Samples before the trigger.
+    pub pretrigger: usize,
+    /// The absolute level used (SI).
+    pub level: f64,
+}
+
+/// Finds blows on `x` sampled at `fs` (module docs).
+pub fn detect_blows(x: &[f64], fs: f64, p: &Processing) -> Result<Blows> {
+    p.check()?;
+    if !(fs.is_finite() && fs > 0.0) {
+        return Err(Error::invalid(
+            "sample rate",
+            format!("must be > 0 Hz (got {fs})"),
+        ));
+    }
+    let peak = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let level = match p.level {
+        Level::Absolute(l) => l,
+        Level::FractionOfPeak(f) => f * peak,
+    };
+    let n = x.len();
+    let pre = (p.pretrigger_s * fs).round() as usize;
+    let hold = (p.holdoff_s * fs).round() as usize;
+    let mut triggers = Vec::new();
+    if level > 0.0 && n > 0 {
+        let mut armed = x[0].abs() < level;
+        let mut i = 0;
+        while i < n {
+            let a = x[i].abs();
+            if armed && a >= level {
+                triggers.push(i);
+                armed = false;
+                i = i.saturating_add(hold.max(1));
+                continue;
+            }
+            if !armed && a < level {
+                armed = true;
+            }
+            i += 1;
+        }
+    }
+    let length = match p.record_s {
+        Some(r) => ((r * fs).round() as usize).max(2),
+        None => {
+            let gaps = triggers.windows(2).map(|w| w[1] - w[0]).min();
+            match (gaps, triggers.first()) {
+                (Some(g), _) => g.max(2),
+                (None, Some(&t)) => (n - t.saturating_sub(pre)).max(2),
+                (None, None) => n,
+            }
+        }
+    };
+    let starts = triggers
+        .iter()
+        .filter(|&&t| t >= pre && t - pre + length <= n)
+        .map(|&t| t - pre)
+        .collect();
+    Ok(Blows {
+        triggers,
+        starts,
+        length,
+        pretrigger: pre,
+        level,
+    })
+}
+
+/// `(1/B) Σ_b x[s_b .. s_b + len]`: the time average of the blow records.
+pub fn average_blows(x: &[f64], starts: &[usize], len: usize) -> Result<Vec<f64>> {
+    if starts.is_empty() {
+        return Err(Error::invalid(
+            "blows",
+            "no complete blow record to average",
+        ));
+    }
+    let mut acc = vec![0.0; len];
+    for &s in starts {
+        let seg = x.get(s..s + len).ok_or_else(|| {
+            Error::invalid(
+                "blows",
+                format!(
+                    "the record from sample {s} ({len} samples) runs past the end ({} samples)",
+                    x.len()
+                ),
+            )
+        })?;
+        for (a, v) in acc.iter_mut().zip(seg) {
+            *a += v;
+        }
+    }
+    let b = starts.len() as f64;
+    acc.iter_mut().for_each(|a| *a /= b);
+    Ok(acc)
+}
+
+/// Windowed FFTs of blow records with one plan.
+struct Transformer {
+    fft: std::sync::Arc<dyn realfft::RealToComplex<f64>>,
+    input: Vec<f64>,
+    output: Vec<Complex<f64>>,
+}
+
+impl Transformer {
+    fn new(n_fft: usize) -> Self {
+        let fft = RealFftPlanner::<f64>::new().plan_fft_forward(n_fft);
+        let input = fft.make_input_vec();
+        let output = fft.make_output_vec();
+        Transformer { fft, input, output }
+    }
+    /// `X_k = Σ_n w_n x_n e^{−2πikn/N_fft}` into `self.output`.
+    fn run(&mut self, x: &[f64], w: &[f64]) -> Result<&[Complex<f64>]> {
+        self.input.iter_mut().for_each(|v| *v = 0.0);
+        for ((d, a), b) in self.input.iter_mut().zip(x).zip(w) {
+            *d = a * b;
+        }
+        self.fft
+            .process(&mut self.input, &mut self.output)
+            .map_err(|e| Error::numerical("FFT", e.to_string()))?;
+        Ok(&self.output)
+    }
+}
+
+fn freqs(bins: usize, n_fft: usize, fs: f64) -> Vec<f64> {
+    (0..bins).map(|k| k as f64 * fs / n_fft as f64).collect()
+}
+
+/// The force window for a blow record: pulse from the record start to the sample after the
+/// trigger where `|F|` drops below the level, taper half the pulse.
+fn force_window_for(x: &[f64], blows: &Blows, fs: f64) -> TransientWindow {
+    let s = blows.starts.first().copied().unwrap_or(0);
+    let t = s + blows.pretrigger;
+    let end = (t..x.len())
+        .find(|&i| x[i].abs() < blows.level)
+        .unwrap_or(x.len());
+    let pulse = ((end - s) as f64 / fs).max(1.0 / fs);
+    TransientWindow::Force {
+        pulse_s: pulse,
+        taper_s: 0.5 * pulse,
+    }
+}
+
+/// The windows of one channel: the response window, times the force window for a force when
+/// asked.
+fn window_for(q: Quantity, x: &[f64], blows: &Blows, fs: f64, p: &Processing) -> Result<Vec<f64>> {
+    let mut w = p.window.coefficients(blows.length, fs)?;
+    if p.force_window && q == Quantity::Force {
+        let f = force_window_for(x, blows, fs).coefficients(blows.length, fs)?;
+        w.iter_mut().zip(f).for_each(|(a, b)| *a *= b);
+    }
+    Ok(w)
+}
+
+/// The mean energy spectral density of the blow records (module docs), unit²·s/Hz.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct BlowSpectrum {
+    pub frequency_hz: Vec<f64>,
+    pub density: Vec<f64>,
+    /// Number of blow records averaged.
+    pub averages: usize,
+}
+
+impl BlowSpectrum {
+    /// Bin spacing (Hz).
+    pub fn bin_width_hz(&self) -> f64 {
+        self.frequency_hz.get(1).copied().unwrap_or(0.0)
+    }
+    /// `Σ Ē_k Δf` over the bins in `[f_lo, f_hi)` (unit²·s).
+    pub fn band_energy(&self, f_lo: f64, f_hi: f64) -> f64 {
+        self.frequency_hz
+            .iter()
+            .zip(&self.density)
+            .filter(|(f, _)| **f >= f_lo && **f < f_hi)
+            .map(|(_, e)| e)
+            .sum::<f64>()
+            * self.bin_width_hz()
+    }
+    /// The largest bin above DC: (frequency, density).
+    pub fn dominant(&self) -> Option<(f64, f64)> {
+        self.frequency_hz.iter().zip(&self.density).skip(1).fold(
+            None,
+            |b: Option<(f64, f64)>, (&f, &e)| match b {
+                Some(x) if x.1 >= e => Some(x),
+                _ => Some((f, e)),
+            },
+        )
+    }
+    /// The largest bin in `[f_lo, f_hi]`.
+    pub fn peak_in_band(&self, f_lo: f64, f_hi: f64) -> Option<(f64, f64)> {
+        self.frequency_hz
+            .iter()
+            .zip(&self.density)
+            .filter(|(f, _)| **f >= f_lo && **f <= f_hi)
+            .fold(None, |b: Option<(f64, f64)>, (&f, &e)| match b {
+                Some(x) if x.1 >= e => Some(x),
+                _ => Some((f, e)),
+            })
+    }
+    /// One-third-octave bands (IEC 61260-1) from the first bin above DC to the Nyquist
+    /// frequency, each with its energy (unit²·s); bands not wholly inside are left out.
+    pub fn third_octaves(&self) -> Vec<(Band, f64)> {
+        let df = self.bin_width_hz();
+        let top = self.frequency_hz.last().copied().unwrap_or(0.0);
+        if !(df > 0.0) {
+            return Vec::new();
+        }
+        bands_covering(df, top)
+            .into_iter()
+            .filter(|b| b.lower_hz >= df && b.upper_hz <= top)
+            .map(|b| (b, self.band_energy(b.lower_hz, b.upper_hz)))
+            .collect()
+    }
+}
+
+/// Mean ESD over the blow records `starts` of `x` (length `blows.length`, windowed as `p`
+/// says for the quantity `q`), zero-padded to `n_fft ≥ length` (None: no padding).
+pub fn blow_spectrum(
+    x: &[f64],
+    q: Quantity,
+    fs: f64,
+    blows: &Blows,
+    p: &Processing,
+    n_fft: Option<usize>,
+) -> Result<BlowSpectrum> {
+    if blows.starts.is_empty() {
+        return Err(Error::invalid("blows", "no complete blow record: lower the trigger level, the pre-trigger or the record length"));
+    }
+    let len = blows.length;
+    let n_fft = n_fft.unwrap_or(len).max(len);
+    let w = window_for(q, x, blows, fs, p)?;
+    let mut tr = Transformer::new(n_fft);
+    let dt = 1.0 / fs;
+    let mut acc = vec![0.0; n_fft / 2 + 1];
+    for &s in &blows.starts {
+        let seg = x
+            .get(s..s + len)
+            .ok_or_else(|| Error::invalid("blows", "a blow record runs past the end"))?;
+        let bins = tr.run(seg, &w)?;
+        for (k, (a, c)) in acc.iter_mut().zip(bins).enumerate() {
+            *a += one_sided_factor(k, n_fft) * c.norm_sqr() * dt * dt;
+        }
+    }
+    let b = blows.starts.len();
+    acc.iter_mut().for_each(|a| *a /= b as f64);
+    Ok(BlowSpectrum {
+        frequency_hz: freqs(acc.len(), n_fft, fs),
+        density: acc,
+        averages: b,
+    })
+}
+
+/// The H1 frequency response estimate and its coherence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frf {
+    pub frequency_hz: Vec<f64>,
+    /// `H1_k` (response unit per force unit).
+    pub h1: Vec<Complex<f64>>,
+    /// `γ²_k` in [0, 1].
+    pub coherence: Vec<f64>,
+    pub averages: usize,
+}
+
+/// H1 and coherence from a force and a response sampled together (module docs). The force
+/// gets the force window (when `p.force_window`) times the response window, the response the
+/// response window.
+pub fn h1(force: &[f64], response: &[f64], fs: f64, blows: &Blows, p: &Processing) -> Result<Frf> {
+    if force.len() != response.len() {
+        return Err(Error::invalid(
+            "H1",
+            format!(
+                "force and response differ in length ({} and {} samples)",
+                force.len(),
+                response.len()
+            ),
+        ));
+    }
+    if blows.starts.is_empty() {
+        return Err(Error::invalid("blows", "no complete blow record for H1"));
+    }
+    let len = blows.length;
+    let wf = window_for(Quantity::Force, force, blows, fs, p)?;
+    let wx = p.window.coefficients(len, fs)?;
+    let mut tf = Transformer::new(len);
+    let mut tx = Transformer::new(len);
+    let bins = len / 2 + 1;
+    let (mut gfx, mut gff, mut gxx) = (
+        vec![Complex::new(0.0, 0.0); bins],
+        vec![0.0; bins],
+        vec![0.0; bins],
+    );
+    for &s in &blows.starts {
+        let f = tf.run(&force[s..s + len], &wf)?;
+        let x = tx.run(&response[s..s + len], &wx)?;
+        for k in 0..bins {
+            gfx[k] += f[k].conj() * x[k];
+            gff[k] += f[k].norm_sqr();
+            gxx[k] += x[k].norm_sqr();
+        }
+    }
+    let h1 = gfx
+        .iter()
+        .zip(&gff)
+        .map(|(c, f)| {
+            if *f > 0.0 {
+                c / f
+            } else {
+                Complex::new(f64::NAN, f64::NAN)
+            }
+        })
+        .collect();
+    let coherence = (0..bins)
+        .map(|k| {
+            let d = gff[k] * gxx[k];
+            if d > 0.0 {
+                (gfx[k].norm_sqr() / d).min(1.0)
+            } else {
+                f64::NAN
+            }
+        })
+        .collect();
+    Ok(Frf {
+        frequency_hz: freqs(bins, len, fs),
+        h1,
+        coherence,
+        averages: blows.starts.len(),
+    })
+}
+
+/// The damping ratio and natural frequency of the mode an exponential window `e^{−t/τ}` makes
+/// of a mode `(ω, ζ)`: `σ_w = ζω + 1/τ`, `ω_w = √(ω_d² + σ_w²)`, `ζ_w = σ_w/ω_w` (module docs).
+pub fn windowed_sdof_damping(omega_rad_per_s: f64, zeta: f64, tau_s: f64) -> (f64, f64) {
+    let wd2 = omega_rad_per_s * omega_rad_per_s * (1.0 - zeta * zeta);
+    let sigma = zeta * omega_rad_per_s + 1.0 / tau_s;
+    let ww = (wd2 + sigma * sigma).sqrt();
+    (ww, sigma / ww)
+}
+
+/// The dB reference of a quantity's ESD levels (SI unit squared · s/Hz) and its text.
+pub fn esd_reference(q: Quantity) -> (f64, String) {
+    (1.0, format!("1 ({})²·s/Hz", q.si_unit()))
+}
+
+/// What `meid measure` reports for one channel.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ChannelSummary {
+    pub name: String,
+    /// SI unit of the values (after conversion).
+    pub unit: String,
+    pub samples: usize,
+    pub sample_rate_hz: f64,
+    /// Largest `|x|` over the samples (a sample peak: the true peak between samples may be
+    /// higher).
+    pub peak: f64,
+    pub peak_time_s: f64,
+    /// Blows detected on the trigger channel of the file.
+    pub blows: usize,
+    /// Frequency of the largest bin of the blow-averaged ESD above DC (Hz).
+    pub dominant_frequency_hz: f64,
+    /// Its level, dB re 1 (SI unit)²·s/Hz.
+    pub dominant_level_db: f64,
+}
+
+/// A processed channel: the summary, the blow-averaged record and spectrum, the bands.
+#[derive(Debug, Clone)]
+pub struct ProcessedChannel {
+    pub summary: ChannelSummary,
+    pub quantity: Quantity,
+    /// Time average of the complete blow records (the whole record when no blow was found).
+    pub average: Vec<f64>,
+    pub spectrum: BlowSpectrum,
+    pub bands: Vec<(Band, f64)>,
+}
+
+/// The trigger channel of a set of records sampled together: the blow force when a channel
+/// is one by name ([`super::mapping`]), else the bed acceleration at B, else the first force,
+/// else the first acceleration, else the first record.
+pub fn trigger_channel(records: &[&Record], measurement_point: &str) -> usize {
+    use super::SimChannel;
+    let named = |c: SimChannel| {
+        records
+            .iter()
+            .position(|r| super::mapping::by_name(r, measurement_point) == Some(c))
+    };
+    named(SimChannel::BlowForce)
+        .or_else(|| named(SimChannel::BedAcceleration))
+        .or_else(|| records.iter().position(|r| r.quantity == Quantity::Force))
+        .or_else(|| {
+            records
+                .iter()
+                .position(|r| r.quantity == Quantity::Acceleration)
+        })
+        .unwrap_or(0)
+}
+
+/// The blows of a group of records sampled together, found on `records[trigger]`; when none
+/// is found, the whole record counts as one.
+pub fn group_blows(records: &[&Record], trigger: usize, p: &Processing) -> Result<(Blows, usize)> {
+    let r = records
+        .get(trigger)
+        .ok_or_else(|| Error::invalid("trigger", "no such channel"))?;
+    let fs = r.sample_rate_hz()?;
+    let b = detect_blows(&r.values, fs, p)?;
+    let found = b.triggers.len();
+    let n = records.iter().map(|r| r.values.len()).min().unwrap_or(0);
+    if b.starts.is_empty() {
+        return Ok((
+            Blows {
+                triggers: Vec::new(),
+                starts: vec![0],
+                length: n,
+                pretrigger: 0,
+                level: b.level,
+            },
+            found,
+        ));
+    }
+    let starts = b
+        .starts
+        .iter()
+        .copied()
+        .filter(|&s| s + b.length <= n)
+        .collect();
+    Ok((Blows { starts, ..b }, found))
+}
+
+/// Processes one channel with the group's blows (summary, average, spectrum, bands).
+pub fn process_channel(
+    r: &Record,
+    blows: &Blows,
+    found: usize,
+    p: &Processing,
+) -> Result<ProcessedChannel> {
+    let fs = r.sample_rate_hz()?;
+    if r.values.len() < 2 {
+        return Err(Error::Input {
+            location: r.origin.clone(),
+            message: format!("channel '{}': needs at least 2 samples", r.name),
+        });
+    }
+    let (k, peak) = r.values.iter().enumerate().fold((0, 0.0_f64), |b, (i, v)| {
+        if v.abs() > b.1 {
+            (i, v.abs())
+        } else {
+            b
+        }
+    });
+    let average = average_blows(&r.values, &blows.starts, blows.length)?;
+    let spectrum = blow_spectrum(&r.values, r.quantity, fs, blows, p, None)?;
+    let (ref_e, _) = esd_reference(r.quantity);
+    let (df, de) = spectrum.dominant().unwrap_or((f64::NAN, f64::NAN));
+    let bands = spectrum.third_octaves();
+    Ok(ProcessedChannel {
+        summary: ChannelSummary {
+            name: r.name.clone(),
+            unit: r.unit().to_string(),
+            samples: r.values.len(),
+            sample_rate_hz: fs,
+            peak,
+            peak_time_s: r.time_at(k),
+            blows: found,
+            dominant_frequency_hz: df,
+            dominant_level_db: esd_level_db(de, ref_e),
+        },
+        quantity: r.quantity,
+        average,
+        spectrum,
+        bands,
+    })
+}
+
+/// Groups records by sampling (same file origin prefix, start, step and length): channels
+/// recorded together share their blows.
+pub fn groups(records: &[Record]) -> Vec<Vec<usize>> {
+    let mut out: Vec<Vec<usize>> = Vec::new();
+    let key = |r: &Record| {
+        let file = r.origin.split(", ").next().unwrap_or("").to_string();
+        let (s, d) = r.even().unwrap_or((f64::NAN, f64::NAN));
+        (file, s.to_bits(), d.to_bits(), r.values.len())
+    };
+    for (i, r) in records.iter().enumerate() {
+        let k = key(r);
+        match out.iter_mut().find(|g| key(&records[g[0]]) == k) {
+            Some(g) => g.push(i),
+            None => out.push(vec![i]),
+        }
+    }
+    out
+}
+
+/// Processes every record; blows are found per group on the channel named `trigger` when the
+/// group has it, else on its [`trigger_channel`] (`point`: the model's measurement point name,
+/// for finding B by name).
+pub fn process_all(
+    records: &[Record],
+    p: &Processing,
+    trigger: Option<&str>,
+    point: &str,
+) -> Result<Vec<ProcessedChannel>> {
+    if let Some(name) = trigger {
+        if !records.iter().any(|r| r.name == name) {
+            let names: Vec<&str> = records.iter().map(|r| r.name.as_str()).collect();
+            return Err(Error::invalid(
+                "trigger",
+                format!(
+                    "no channel is named '{name}'; the channels are: {}",
+                    names.join(", ")
+                ),
+            ));
+        }
+    }
+    let mut out: Vec<Option<ProcessedChannel>> = vec![None; records.len()];
+    for g in groups(records) {
+        let members: Vec<&Record> = g.iter().map(|&i| &records[i]).collect();
+        let t = match trigger {
+            Some(name) => members
+                .iter()
+                .position(|r| r.name == name)
+                .unwrap_or(trigger_channel(&members, point)),
+            None => trigger_channel(&members, point),
+        };
+        let (blows, found) = group_blows(&members, t, p)?;
+        for &i in &g {
+            out[i] = Some(process_channel(&records[i], &blows, found, p)?);
+        }
+    }
+    Ok(out.into_iter().flatten().collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triggers_with_pretrigger_and_holdoff() {
+        let fs = 1000.0;
+        let mut x = vec![0.0; 3000];
+        for &t in &[500usize, 1500, 2500] {
+            for k in 0..20 {
+                x[t + k] = 10.0 * (-(k as f64) / 5.0).exp() * if k % 2 == 0 { 1.0 } else { -1.0 };
+            }
+        }
+        let p = Processing {
+            pretrigger_s: 0.01,
+            ..Processing::default()
+        };
+        let b = detect_blows(&x, fs, &p).unwrap();
+        assert_eq!(b.triggers, vec![500, 1500, 2500]);
+        assert_eq!(b.length, 1000);
+        // The last blow's record (2490..3490) runs past the end: counted, not averaged.
+        assert_eq!(b.starts, vec![490, 1490]);
+        let avg = average_blows(&x, &b.starts, b.length).unwrap();
+        assert_eq!(avg[10], 10.0);
+        let p = Processing {
+            record_s: Some(0.4),
+            ..p
+        };
+        let b = detect_blows(&x, fs, &p).unwrap();
+        assert_eq!(b.starts, vec![490, 1490, 2490]);
+        // An absolute level above every sample: none.
+        let p = Processing {
+            level: Level::Absolute(11.0),
+            ..p
+        };
+        assert!(detect_blows(&x, fs, &p).unwrap().triggers.is_empty());
+    }
+}

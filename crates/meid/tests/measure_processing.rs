@@ -1,0 +1,220 @@
+//! Test-lab processing checked against closed forms: the H1 estimate of a known SDOF excited by
+//! a known force equals its frequency response; an exponential window adds exactly the decay
+//! rate 1/τ (damping ζ + 1/(ωτ) to first order); coherence is 1 for noise-free blows and drops
+//! with noise while H1 stays unbiased; the blow-averaged ESD keeps Parseval.
+
+use meid::analysis::spectrum::{exponential_window_correction, TransientWindow};
+use meid::measure::process::{
+    average_blows, blow_spectrum, detect_blows, h1, windowed_sdof_damping, Blows, Level, Processing,
+};
+use meid::measure::Quantity;
+use meid::rng::SplitMix64;
+use num_complex::Complex;
+
+const M: f64 = 1.0; // kg
+const FN: f64 = 50.0; // Hz
+const ZETA: f64 = 0.02;
+const FS: f64 = 2000.0; // Hz
+const N: usize = 8000; // record: 4 s, Δf = 0.25 Hz (50 Hz on bin 200)
+const PRE: usize = 20; // samples before the blow
+const J: f64 = 3.0; // impulse, N·s
+
+/// Receptance `1/(k − mω² + icω)` of the SDOF (m, ω_n, ζ).
+fn receptance(w: f64, wn: f64, zeta: f64) -> Complex<f64> {
+    let k = M * wn * wn;
+    let c = 2.0 * zeta * wn * M;
+    Complex::new(1.0, 0.0) / Complex::new(k - M * w * w, c * w)
+}
+
+/// Impulse response `h(t) = e^{−ζω t} sin(ω_d t)/(m ω_d)` of the SDOF.
+fn impulse_response(t: f64, wn: f64, zeta: f64) -> f64 {
+    let wd = wn * (1.0 - zeta * zeta).sqrt();
+    (-zeta * wn * t).exp() * (wd * t).sin() / (M * wd)
+}
+
+/// Sampled blows: force J/Δt on one sample at PRE of each record, displacement J h(t − t_blow).
+fn blows_record(count: usize) -> (Vec<f64>, Vec<f64>) {
+    let dt = 1.0 / FS;
+    let wn = 2.0 * std::f64::consts::PI * FN;
+    let mut f = vec![0.0; count * N];
+    let mut x = vec![0.0; count * N];
+    for b in 0..count {
+        f[b * N + PRE] = J / dt;
+        for m in 0..(N - PRE) {
+            x[b * N + PRE + m] = J * impulse_response(m as f64 * dt, wn, ZETA);
+        }
+    }
+    (f, x)
+}
+
+/// Poisson summation: `Δt Σ_m h(mΔt) e^{−iωmΔt} = Σ_l H(ω + lω_s)` (h(0) = 0), summed over
+/// |l| ≤ L; the tail beyond is below `2/(m ω_s² L)`.
+fn aliased(w: f64, wn: f64, zeta: f64) -> Complex<f64> {
+    let ws = 2.0 * std::f64::consts::PI * FS;
+    (-4000..=4000)
+        .map(|l| receptance(w + l as f64 * ws, wn, zeta))
+        .sum()
+}
+
+fn processing(window: TransientWindow) -> Processing {
+    Processing {
+        level: Level::FractionOfPeak(0.5),
+        pretrigger_s: PRE as f64 / FS,
+        record_s: Some(N as f64 / FS),
+        holdoff_s: 0.5,
+        window,
+        force_window: false,
+    }
+}
+
+#[test]
+fn h1_of_a_known_sdof_equals_its_frequency_response() {
+    let (f, x) = blows_record(3);
+    let p = processing(TransientWindow::Rectangular);
+    let b = detect_blows(&f, FS, &p).unwrap();
+    assert_eq!(b.triggers, vec![PRE, N + PRE, 2 * N + PRE]);
+    assert_eq!(b.starts, vec![0, N, 2 * N]);
+    let frf = h1(&f, &x, FS, &b, &p).unwrap();
+    assert_eq!(frf.averages, 3);
+    let wn = 2.0 * std::f64::consts::PI * FN;
+    let ws = 2.0 * std::f64::consts::PI * FS;
+    let tail = 2.0 / (M * ws * ws * 4000.0);
+    let mut worst: f64 = 0.0;
+    for (k, &fk) in frf.frequency_hz.iter().enumerate().skip(1).take(1000) {
+        let w = 2.0 * std::f64::consts::PI * fk;
+        let exact = aliased(w, wn, ZETA);
+        let err = (frf.h1[k] - exact).norm();
+        worst = worst.max(err / exact.norm());
+        assert!(
+            err <= tail + 1e-9 * exact.norm(),
+            "{fk} Hz: {} vs {exact}",
+            frf.h1[k]
+        );
+        assert!((frf.coherence[k] - 1.0).abs() < 1e-9);
+    }
+    // At resonance (50 Hz = bin 200) H1 is the continuous FRF, |H(ω_n)| = 1/(2ζk), to the
+    // sampling's aliasing Σ_{l≠0} |H(ω_n + lω_s)| ≈ 2ζ(2)/(m ω_s²) (8.2e-5 of |H| here).
+    let at = frf.h1[200];
+    let h = receptance(wn, wn, ZETA);
+    let images: f64 = (1..=4000)
+        .map(|l| {
+            receptance(wn + l as f64 * ws, wn, ZETA).norm()
+                + receptance(wn - l as f64 * ws, wn, ZETA).norm()
+        })
+        .sum();
+    assert!(images / h.norm() < 1e-4);
+    assert!((at - h).norm() <= 1.001 * images + tail, "{at} vs {h}");
+    assert!((h.norm() - 1.0 / (2.0 * ZETA * M * wn * wn)).abs() / h.norm() < 1e-12);
+    // (Relative to |H|, the error is the truncated image sum's tail over |H|: 7e-6 at 250 Hz.)
+    assert!(worst < 1e-5, "worst relative error {worst}");
+}
+
+#[test]
+fn exponential_window_adds_one_over_tau_to_the_decay_rate() {
+    let (f, x) = blows_record(1);
+    let tau = 0.5; // s
+    let p = processing(TransientWindow::Exponential { tau_s: tau });
+    let b = detect_blows(&f, FS, &p).unwrap();
+    let frf = h1(&f, &x, FS, &b, &p).unwrap();
+    let wn = 2.0 * std::f64::consts::PI * FN;
+    // The windowed records are those of the SDOF (ω_w, ζ_w) with σ_w = ζω + 1/τ.
+    let (ww, zw) = windowed_sdof_damping(wn, ZETA, tau);
+    let ws = 2.0 * std::f64::consts::PI * FS;
+    let tail = 2.0 / (M * ws * ws * 4000.0);
+    for (k, &fk) in frf.frequency_hz.iter().enumerate().skip(1).take(800) {
+        let w = 2.0 * std::f64::consts::PI * fk;
+        let exact = aliased(w, ww, zw);
+        assert!(
+            (frf.h1[k] - exact).norm() <= tail + 1e-9 * exact.norm(),
+            "{fk} Hz"
+        );
+    }
+    // ζ_w ≈ ζ + 1/(ωτ) to first order: here 0.02 + 0.006366 = 0.026366.
+    let first_order = ZETA + 1.0 / (wn * tau);
+    assert!(
+        (zw - first_order).abs() < first_order * first_order,
+        "{zw} vs {first_order}"
+    );
+    assert!((zw - 0.026366).abs() < 1e-4);
+    // The documented correction takes the window's damping back off.
+    let back = exponential_window_correction(zw, tau, ww);
+    assert!((back - ZETA).abs() < 1e-4, "{back}");
+    // And the windowed H1 is not the bare FRF: the peak is lower by ~ζ/ζ_w.
+    let bare = receptance(wn, wn, ZETA).norm();
+    let ratio = frf.h1[200].norm() / bare;
+    assert!((ratio - ZETA / zw).abs() < 0.02, "{ratio}");
+}
+
+#[test]
+fn noise_lowers_coherence_but_h1_stays_unbiased() {
+    let blows = 40;
+    let (f, mut x) = blows_record(blows);
+    let mut rng = SplitMix64::new(12);
+    let peak = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    for v in &mut x {
+        *v += 0.02 * peak * rng.next_normal();
+    }
+    let p = processing(TransientWindow::Rectangular);
+    let b = detect_blows(&f, FS, &p).unwrap();
+    assert_eq!(b.starts.len(), blows);
+    let frf = h1(&f, &x, FS, &b, &p).unwrap();
+    let wn = 2.0 * std::f64::consts::PI * FN;
+    // Near resonance the signal dominates: coherence close to 1, H1 within a few % of H.
+    let k = 200;
+    assert!(
+        frf.coherence[k] > 0.99 && frf.coherence[k] < 1.0,
+        "{}",
+        frf.coherence[k]
+    );
+    let h = aliased(wn, wn, ZETA);
+    assert!((frf.h1[k] - h).norm() / h.norm() < 0.02);
+    // Far above resonance the noise dominates: coherence well below 1.
+    let far = frf.frequency_hz.iter().position(|f| *f >= 800.0).unwrap();
+    assert!(frf.coherence[far] < 0.5, "{}", frf.coherence[far]);
+}
+
+#[test]
+fn blow_averaged_esd_keeps_parseval_and_time_average_is_the_blow() {
+    let (f, x) = blows_record(4);
+    let p = processing(TransientWindow::Exponential { tau_s: 1.0 });
+    let b = detect_blows(&f, FS, &p).unwrap();
+    let s = blow_spectrum(&x, Quantity::Displacement, FS, &b, &p, None).unwrap();
+    assert_eq!(s.averages, 4);
+    let w = p.window.coefficients(N, FS).unwrap();
+    let dt = 1.0 / FS;
+    let energy: f64 = x[..N]
+        .iter()
+        .zip(&w)
+        .map(|(a, b)| (a * b) * (a * b))
+        .sum::<f64>()
+        * dt;
+    let esd_energy: f64 = s.density.iter().sum::<f64>() * s.bin_width_hz();
+    assert!((esd_energy - energy).abs() < 1e-12 * energy);
+    let avg = average_blows(&x, &b.starts, b.length).unwrap();
+    assert_eq!(avg, x[..N].to_vec());
+    // The dominant bin is the mode.
+    assert_eq!(s.dominant().unwrap().0, 50.0);
+    let bands = s.third_octaves();
+    let b50 = bands.iter().find(|(b, _)| b.nominal_hz == 50.0).unwrap();
+    assert!(b50.1 > 0.5 * energy);
+}
+
+#[test]
+fn no_complete_blow_is_an_error_not_a_panic() {
+    let b = Blows {
+        triggers: vec![],
+        starts: vec![],
+        length: 10,
+        pretrigger: 0,
+        level: 1.0,
+    };
+    let p = Processing::default();
+    assert!(blow_spectrum(&[0.0; 5], Quantity::Force, 1.0, &b, &p, None).is_err());
+    assert!(h1(&[0.0; 5], &[0.0; 5], 1.0, &b, &p).is_err());
+    assert!(average_blows(&[0.0; 5], &[3], 10).is_err());
+    let bad = Processing {
+        level: Level::FractionOfPeak(2.0),
+        ..Processing::default()
+    };
+    assert!(detect_blows(&[1.0; 5], 1.0, &bad).is_err());
+}

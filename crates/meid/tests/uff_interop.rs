@@ -1,0 +1,266 @@
+//! Interoperability with pyuff (PyPI, the reference UFF reader/writer of the Python test-lab
+//! tools): pyuff writes files meid reads, and reads files meid writes, values equal to 1e-9
+//! relative in binary and to the printed precision in ASCII (`%20.11e`: 12 significant digits;
+//! pyuff's abscissa fields `%13.5e`: 6).
+//!
+//! Needs a Python with pyuff: `MEID_PYUFF_PYTHON`, else `target/ci-venv/bin/python` (which
+//! `.ci/run` creates). Without one the test prints why and passes, unless
+//! `MEID_PYUFF_REQUIRED=1` (set by `.ci/run`), when it fails.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use meid::io::uff::{self, Channel58, Mode, Node};
+use meid::measure::{Abscissa, PointRef, Quantity};
+use serde_json::Value;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn python() -> Option<PathBuf> {
+    let p = std::env::var_os("MEID_PYUFF_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target/ci-venv/bin/python"));
+    let ok = p.exists()
+        && Command::new(&p)
+            .args(["-c", "import pyuff"])
+            .status()
+            .is_ok_and(|s| s.success());
+    if ok {
+        Some(p)
+    } else if std::env::var("MEID_PYUFF_REQUIRED").as_deref() == Ok("1") {
+        panic!("MEID_PYUFF_REQUIRED=1 but {} has no pyuff", p.display());
+    } else {
+        eprintln!(
+            "skipped: no Python with pyuff at {} (set MEID_PYUFF_PYTHON, or run .ci/run, which creates target/ci-venv)",
+            p.display()
+        );
+        None
+    }
+}
+
+fn script(py: &Path, args: &[&str]) -> String {
+    let out = Command::new(py)
+        .arg(root().join(".ci/interop_uff.py"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs()) || a == b
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("meid-uff-interop-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn meid_reads_what_pyuff_writes() {
+    let Some(py) = python() else { return };
+    let dir = tmp("read");
+    script(&py, &["write", dir.to_str().unwrap()]);
+    let expected: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("expected.json")).unwrap()).unwrap();
+    for (file, rel) in [
+        ("ascii.uff", 5e-11),
+        ("binary.uff", 1e-12),
+        ("uneven.uff", 5e-11),
+    ] {
+        let f = uff::read_uff(&dir.join(file)).unwrap();
+        let exp = expected[file].as_array().unwrap();
+        assert_eq!(f.records.len(), exp.len(), "{file}");
+        for (r, e) in f.records.iter().zip(exp) {
+            assert_eq!(r.name, e["name"].as_str().unwrap());
+            assert_eq!(r.unit(), e["unit"].as_str().unwrap());
+            let ev: Vec<f64> = e["values"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect();
+            assert_eq!(r.values.len(), ev.len());
+            for (a, b) in r.values.iter().zip(&ev) {
+                assert!(close(*a, *b, rel), "{file} {}: {a} vs {b}", r.name);
+            }
+            match &r.abscissa {
+                Abscissa::Even { start_s, step_s } => {
+                    assert_eq!(*start_s, e["x0"].as_f64().unwrap());
+                    // pyuff prints the increment %13.5e (6 significant digits).
+                    assert!(close(*step_s, e["dx"].as_f64().unwrap(), 5e-6), "{step_s}");
+                }
+                Abscissa::Uneven(t) => {
+                    let et = e["times"].as_array().unwrap();
+                    for (a, b) in t.iter().zip(et) {
+                        assert!(close(*a, b.as_f64().unwrap(), 5e-6));
+                    }
+                }
+            }
+        }
+    }
+    let f = uff::read_uff(&dir.join("modes.uff")).unwrap();
+    let e = &expected["modes.uff"];
+    let nodes: Vec<Node> = e["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| {
+            let v: Vec<f64> = n
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap())
+                .collect();
+            Node {
+                label: v[0] as i64,
+                xyz: [v[1], v[2], v[3]],
+            }
+        })
+        .collect();
+    assert_eq!(f.nodes, nodes);
+    assert_eq!(f.modes.len(), 1);
+    let m = &f.modes[0];
+    assert_eq!(m.number, 2);
+    assert!(close(m.frequency_hz, 283.0, 5e-6) && close(m.damping_ratio, 0.01, 5e-6));
+    let z: Vec<f64> = m.shapes.iter().map(|s| s.1[2]).collect();
+    assert_eq!(z, vec![0.5, -0.25, 0.125]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn pyuff_reads_what_meid_writes() {
+    let Some(py) = python() else { return };
+    let dir = tmp("write");
+    let a: Vec<f64> = (0..1001)
+        .map(|i| (i as f64 * 0.113).sin() * 3.7e2 * (-(i as f64) * 1e-3).exp())
+        .collect();
+    let f: Vec<f64> = (0..1001)
+        .map(|i| {
+            if i < 40 {
+                8e3 * (i as f64 * 0.0785).sin()
+            } else {
+                1e-9 * i as f64
+            }
+        })
+        .collect();
+    for (binary, rel, step) in [(true, 1e-15, 1.0 / 51200.0), (false, 5e-12, 1.0 / 30000.0)] {
+        let path = dir.join(if binary { "b.uff" } else { "a.uff" });
+        let mut out = Vec::new();
+        for (name, q, v, node) in [
+            ("bed_acceleration", Quantity::Acceleration, &a, 1),
+            ("floor_force", Quantity::Force, &f, 2),
+        ] {
+            let ch = Channel58 {
+                name,
+                point: PointRef {
+                    entity: "bed".into(),
+                    node,
+                    direction: 3,
+                },
+                quantity: q,
+                start_s: 0.25,
+                step_s: step,
+                values: v,
+            };
+            uff::write_58(&mut out, &ch, binary).unwrap();
+        }
+        std::fs::write(&path, &out).unwrap();
+        let read: Value =
+            serde_json::from_str(&script(&py, &["read", path.to_str().unwrap()])).unwrap();
+        let sets = read.as_array().unwrap();
+        assert_eq!(sets.len(), 2);
+        for (s, (name, unit, v)) in sets
+            .iter()
+            .zip([("bed_acceleration", "m/s^2", &a), ("floor_force", "N", &f)])
+        {
+            assert_eq!(s["name"], name);
+            assert_eq!(s["unit"], unit);
+            assert_eq!(s["x_unit"], "s");
+            assert_eq!(s["dir"], 3);
+            let d: Vec<f64> = s["data"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap())
+                .collect();
+            assert_eq!(d.len(), v.len());
+            for (x, y) in d.iter().zip(v.iter()) {
+                assert!(close(*x, *y, rel), "{name}: {x} vs {y}");
+            }
+            // The abscissa increment is written with as many digits as its 13 columns hold:
+            // exact for 1/51200 s, 7 significant digits for 1/30000 s.
+            let x: Vec<f64> = s["x"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap())
+                .collect();
+            let last = 0.25 + 1000.0 * step;
+            assert!(
+                close(x[1000], last, if binary { 1e-15 } else { 1e-7 }),
+                "{} vs {last}",
+                x[1000]
+            );
+        }
+    }
+    // Nodes and modes.
+    let nodes = vec![
+        Node {
+            label: 1,
+            xyz: [0.0, 0.5, 1.0 / 3.0],
+        },
+        Node {
+            label: 2,
+            xyz: [1e-3, -2.0, 7.0],
+        },
+    ];
+    let mode = Mode {
+        number: 3,
+        frequency_hz: 283.0,
+        modal_mass: 1.0,
+        damping_ratio: 0.01,
+        name: "bed".into(),
+        shapes: vec![(1, [0.0, 0.0, 0.2835]), (2, [0.0, 0.0, -0.0691897])],
+    };
+    let mut out = Vec::new();
+    uff::write_2411(&mut out, &nodes).unwrap();
+    uff::write_55(&mut out, &mode).unwrap();
+    let path = dir.join("m.uff");
+    std::fs::write(&path, &out).unwrap();
+    let read: Value =
+        serde_json::from_str(&script(&py, &["read", path.to_str().unwrap()])).unwrap();
+    let sets = read.as_array().unwrap();
+    let n = sets[0]["nodes"].as_array().unwrap();
+    for (row, node) in n.iter().zip(&nodes) {
+        let v: Vec<f64> = row
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        assert_eq!(
+            v,
+            vec![node.label as f64, node.xyz[0], node.xyz[1], node.xyz[2]]
+        );
+    }
+    assert_eq!(sets[1]["mode_n"], 3);
+    assert!(close(sets[1]["freq"].as_f64().unwrap(), 283.0, 5e-6));
+    let r3: Vec<f64> = sets[1]["r3"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert!(close(r3[0], 0.2835, 5e-6) && close(r3[1], -0.0691897, 5e-6));
+    let _ = std::fs::remove_dir_all(&dir);
+}
