@@ -958,23 +958,76 @@ pub fn solve_modes(
                 "structure.fem.solver",
                 "the mesh, or use solver = \"lanczos\" (the lowest modes only)",
             )?;
-            let mut modes = model.solve_dense()?;
             let keep = count.min(n);
+            let mut modes = model
+                .solve_dense_lowest(keep)
+                .map_err(|e| solver_hint(e, model, "dense"))?;
             modes.eigenvalues.truncate(keep);
             modes.omega_rad_per_s.truncate(keep);
             modes.shapes = modes.shapes.subcols(0, keep).to_owned();
-            modes.rigid_body_modes = modes.omega_rad_per_s.iter().filter(|w| **w == 0.0).count();
-            Ok((modes, "dense"))
+            Ok((checked(model, modes, "dense")?, "dense"))
         }
         SolverSpec::Lanczos => {
             let opts = LanczosOptions {
                 count: count.min(n),
                 ..LanczosOptions::default()
             };
-            let s = lanczos::lowest_modes(model.stiffness.as_ref(), model.mass.as_ref(), &opts)?;
-            Ok((to_dense(s), "lanczos"))
+            let s = lanczos::lowest_modes(model.stiffness.as_ref(), model.mass.as_ref(), &opts)
+                .map_err(|e| solver_hint(e, model, "lanczos"))?;
+            Ok((checked(model, to_dense(s), "lanczos")?, "lanczos"))
         }
     }
+}
+
+/// A spring at least this many times stiffer than the elements at its DOF acts as a constraint
+/// ([`FeModel::constraint_like_springs`]): noted, and named when a solution fails.
+pub const CONSTRAINT_LIKE_RATIO: f64 = 1e3;
+
+/// What to change when the eigen-solution of `model` failed: the springs acting as
+/// constraints, if any; else the other solver or fewer modes.
+fn change_hint(model: &FeModel, solver: &str) -> String {
+    match model.constraint_like_note(CONSTRAINT_LIKE_RATIO) {
+        Some(note) => format!("what to change: {note}"),
+        None => format!(
+            "what to change: set structure.fem.solver = \"{}\", or lower structure.fem.count",
+            if solver == "dense" { "lanczos" } else { "dense" }
+        ),
+    }
+}
+
+fn solver_hint(e: Error, model: &FeModel, solver: &str) -> Error {
+    match e {
+        Error::Numerical { context, message } => Error::Numerical {
+            context,
+            message: format!("{message}. {}", change_hint(model, solver)),
+        },
+        other => other,
+    }
+}
+
+/// Checks the modes ([`crate::modal::check::check_modes`]: residual and M-orthonormality
+/// against stated bounds, rigid-body modes from the Rayleigh quotient's round-off) and returns
+/// them with ω, the rigid-body count, the orthonormality error and the largest residual the
+/// check measured. A failed check is an error saying what to change.
+fn checked(model: &FeModel, mut modes: DenseModes, solver: &str) -> Result<DenseModes> {
+    let what = if solver == "dense" {
+        "dense eigen-solver (check of the solution)"
+    } else {
+        "sparse eigen-solver (check of the solution)"
+    };
+    let c = crate::modal::check::check_modes(
+        model.stiffness.as_ref(),
+        model.mass.as_ref(),
+        &modes.eigenvalues,
+        modes.shapes.as_ref(),
+        what,
+    )
+    .map_err(|e| solver_hint(e, model, solver))?;
+    modes.omega_rad_per_s = c.omega_rad_per_s;
+    modes.rigid_body_modes = c.rigid_body_modes;
+    modes.orthonormality_error = c.orthonormality_error;
+    modes.max_residual = c.residuals.iter().fold(0.0_f64, |a, &b| a.max(b));
+    Ok(modes)
 }
 
 /// The most modes the block Lanczos solver computes on `n` degrees of freedom with blocks of
@@ -991,6 +1044,10 @@ pub fn lanczos_max_modes(n: usize, block: usize) -> usize {
 /// the solver refused come from the plates' and columns' sizes, materials and masses.
 fn unsolvable(e: Error, src: &Source) -> Error {
     match e {
+        e @ Error::Numerical { .. } if e.to_string().contains("what to change:") => src.error(
+            "structure.fem",
+            format!("structure.fem: the finite-element model cannot be solved ({e})"),
+        ),
         e @ (Error::InvalidValue { .. } | Error::Numerical { .. }) => src.error(
             "structure.fem",
             format!(
@@ -1250,6 +1307,9 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
     }
     modal.static_flexibility = static_flexibility;
     modal.warnings = warnings;
+    if let Some(note) = model.constraint_like_note(CONSTRAINT_LIKE_RATIO) {
+        modal.notes.push(format!("{base}: {note}"));
+    }
     Ok(FemAnalysis {
         model,
         modes,
