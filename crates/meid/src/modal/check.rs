@@ -288,7 +288,10 @@ mod tests {
         )
         .unwrap_err()
         .to_string();
-        assert!(e.contains("residual") && e.contains("above the bound"), "{e}");
+        assert!(
+            e.contains("residual") && e.contains("above the bound"),
+            "{e}"
+        );
         // Not M-orthonormal (scaled by 1.001): an error too.
         let shapes = Mat::from_fn(2, 1, |i, _| 1.001 * if i == 0 { s } else { -s });
         let e = check_modes(

@@ -94,7 +94,10 @@ pub fn default_shift(k: MatRef<'_, f64>, m: MatRef<'_, f64>, tr_k: f64, tr_m: f6
             break;
         }
     }
-    for s in [DEFAULT_RELATIVE_SHIFT * med, DEFAULT_RELATIVE_SHIFT * tr_k / tr_m] {
+    for s in [
+        DEFAULT_RELATIVE_SHIFT * med,
+        DEFAULT_RELATIVE_SHIFT * tr_k / tr_m,
+    ] {
         if s.is_finite() && s > 0.0 {
             return s;
         }
@@ -308,14 +311,28 @@ pub fn solve_shift_invert_lowest(
     // zero: the top of the spectrum there (λ = 1/μ − σ beyond what double precision resolves
     // next to the stiffest entry) is not computed. A μ negative beyond that round-off means M
     // is not positive definite.
-    let mu_floor = n as f64 * f64::EPSILON * mu_max.abs();
-    let resolved = (0..n).rev().take_while(|&i| mu_all[i] > mu_floor).count();
-    if mu_all.iter().any(|mu| mu.is_nan() || *mu < -mu_floor) {
+    if mu_all.iter().any(|mu| mu.is_nan()) {
         return Err(Error::numerical(
             "dense eigen-solver",
-            "the shift-inverted problem has a negative eigenvalue beyond round-off: the mass matrix is not positive definite",
+            "the shift-inverted problem has a NaN eigenvalue",
         ));
     }
+    let mut mu_floor = n as f64 * f64::EPSILON * mu_max.abs();
+    let mu_min = mu_all[0];
+    if mu_min < -mu_floor {
+        // Negative μ: M is indefinite, or forming C lost more than n ε μ_max (a very stiff
+        // spring next to light masses). A Cholesky factorisation of the equilibrated M decides.
+        let mh = Mat::<f64>::from_fn(n, n, |i, j| m[(i, j)] / (m[(i, i)] * m[(j, j)]).sqrt());
+        if kernels::llt_lower(mh.as_ref()).is_none() {
+            return Err(Error::numerical(
+                "dense eigen-solver",
+                format!("the mass matrix is not positive definite (its Cholesky factorisation fails; the shift-inverted problem has the eigenvalue {mu_min:e})"),
+            ));
+        }
+        // M is positive definite, so every exact μ is > 0: |μ_min| measures the round-off.
+        mu_floor = mu_floor.max(10.0 * mu_min.abs());
+    }
+    let resolved = (0..n).rev().take_while(|&i| mu_all[i] > mu_floor).count();
     let wanted = lowest.unwrap_or(n).min(n);
     if resolved < wanted {
         return Err(Error::numerical(

@@ -452,12 +452,57 @@ pub struct MeshFileSpec {
     /// Physical groups clamped (all six DOFs); the floor force is their reaction.
     #[serde(default)]
     pub fixed: Vec<String>,
+    /// Constraints on a subset of DOFs: `{ set = "edges", dofs = ["uz"] }` (a hard simple
+    /// support); the floor force includes their reactions.
+    #[serde(default)]
+    pub constraints: Vec<ConstraintSpec>,
     /// Springs to ground at every node of a group: `{ group = "feet", stiffness = [kx, ky, kz] }`.
     #[serde(default)]
     pub springs: Vec<GroupSpringSpec>,
     /// Impact direction (unit vector the slider moves along); default `[0, 0, -1]`.
     #[serde(default)]
     pub impact_direction: Option<[f64; 3]>,
+}
+
+/// Zero displacement of some DOFs at every node of a set.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ConstraintSpec {
+    /// Node set (Gmsh physical group or `[structure.fem.model]` set).
+    pub set: String,
+    /// Any of "ux", "uy", "uz", "rx", "ry", "rz", or "all", "translations", "rotations".
+    pub dofs: Vec<String>,
+}
+
+/// The DOFs a list of names gives (`field` names the list in errors).
+pub fn parse_dofs(names: &[String], field: &str) -> Result<Vec<crate::structure::Dof>> {
+    use crate::structure::Dof;
+    let mut out = Vec::new();
+    if names.is_empty() {
+        return Err(Error::invalid(
+            field,
+            "is empty; give some of \"ux\", \"uy\", \"uz\", \"rx\", \"ry\", \"rz\", \"all\", \"translations\", \"rotations\"",
+        ));
+    }
+    for n in names {
+        match n.as_str() {
+            "all" => out.extend(Dof::ALL),
+            "translations" => out.extend(Dof::TRANSLATIONS),
+            "rotations" => out.extend(Dof::ROTATIONS),
+            other => match crate::structure::DOF_NAMES.iter().position(|d| *d == other) {
+                Some(i) => out.push(Dof::ALL[i]),
+                None => {
+                    return Err(Error::invalid(
+                        field,
+                        format!("unknown DOF '{other}'; valid: ux, uy, uz, rx, ry, rz, all, translations, rotations"),
+                    ))
+                }
+            },
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    Ok(out)
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
@@ -736,6 +781,14 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
             mesh.fix_all(n);
         }
     }
+    for (i, c) in ms.constraints.iter().enumerate() {
+        let field = format!("{base}.constraints[{i}]");
+        let dofs = parse_dofs(&c.dofs, &format!("{field}.dofs"))
+            .map_err(|e| src.error(&format!("{field}.dofs"), e.to_string()))?;
+        for n in group(&c.set, &format!("{field}.set"), &mesh)? {
+            mesh.fix(n, &dofs);
+        }
+    }
     for (i, s) in ms.springs.iter().enumerate() {
         let field = format!("{base}.springs[{i}]");
         let k = s.stiffness.xyz();
@@ -990,7 +1043,11 @@ fn change_hint(model: &FeModel, solver: &str) -> String {
         Some(note) => format!("what to change: {note}"),
         None => format!(
             "what to change: set structure.fem.solver = \"{}\", or lower structure.fem.count",
-            if solver == "dense" { "lanczos" } else { "dense" }
+            if solver == "dense" {
+                "lanczos"
+            } else {
+                "dense"
+            }
         ),
     }
 }

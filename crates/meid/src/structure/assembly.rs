@@ -452,7 +452,11 @@ impl FeModel {
             .filter_map(|(spring, node, dof, k, j)| {
                 let own = diag[j] - spring_sum[j];
                 // Round-off of the subtraction: an own stiffness below ε K_ii is none.
-                let own = if own > f64::EPSILON * diag[j] { own } else { 0.0 };
+                let own = if own > f64::EPSILON * diag[j] {
+                    own
+                } else {
+                    0.0
+                };
                 let r = if own > 0.0 { k / own } else { f64::INFINITY };
                 (r >= ratio).then_some(StiffSpring {
                     spring,
