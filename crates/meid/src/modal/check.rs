@@ -11,7 +11,11 @@
 //! λ_R = φᵀ K φ / φᵀ M φ     has the round-off floor     λ_ε = ε |φ|ᵀ |K| |φ| / φᵀ M φ
 //! ```
 //!
-//! and the mode is rigid when `|λ_R| ≤ RIGID_FLOOR_FACTOR · λ_ε`. The floor is the mode's own:
+//! and the computed vector carries an error that moves λ_R by up to about its residual
+//! `u = (Σ_j r_j² / M_jj)^½`, `r = K φ − λ_R M φ` (for a symmetric pencil an exact eigenvalue lies
+//! within `‖r‖_{M⁻¹}` of λ_R for an M-normalised φ; the mass diagonal stands in for M). The mode
+//! is rigid when `|λ_R| ≤ RIGID_FLOOR_FACTOR · λ_ε + u`: zero is within its uncertainty. The
+//! floor is the mode's own:
 //! a very stiff spring enters it only through the motion of the mode at the spring (`k φ_s²`),
 //! which is what the spring physically contributes. No threshold on `max K_ii / M_ii` (a single
 //! stiff entry inflates that and made a 49 Hz plate mode a "rigid-body mode"). A Rayleigh
@@ -101,9 +105,36 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-/// Whether a mode with Rayleigh quotient `lam_r` and round-off floor `floor` is rigid.
-pub fn is_rigid(lam_r: f64, floor: f64) -> bool {
-    lam_r.abs() <= RIGID_FLOOR_FACTOR * floor
+/// Whether a mode with Rayleigh quotient `lam_r`, round-off floor `floor` and uncertainty `u`
+/// (module docs) is rigid.
+pub fn is_rigid(lam_r: f64, floor: f64, u: f64) -> bool {
+    lam_r.abs() <= RIGID_FLOOR_FACTOR * floor + u
+}
+
+/// `(λ_R, λ_ε, u)` of a mode from `φ`, `Kφ`, `|K||φ|`, `Mφ` and the mass diagonal (module docs).
+pub fn rigid_measures(
+    phi: &[f64],
+    kphi: &[f64],
+    akphi: &[f64],
+    mphi: &[f64],
+    mdiag: &[f64],
+) -> (f64, f64, f64) {
+    let (mut e, mut f, mut q) = (0.0, 0.0, 0.0);
+    for i in 0..phi.len() {
+        e += phi[i] * kphi[i];
+        f += phi[i].abs() * akphi[i];
+        q += phi[i] * mphi[i];
+    }
+    let lam_r = e / q;
+    let mut u2 = 0.0;
+    for i in 0..phi.len() {
+        if mdiag[i] > 0.0 {
+            let r = kphi[i] - lam_r * mphi[i];
+            u2 += r * r / mdiag[i];
+        }
+    }
+    // φ is normalised here: u scales like 1/‖φ‖_M as λ_R does not.
+    (lam_r, f64::EPSILON * f / q, u2.sqrt() / q.sqrt())
 }
 
 /// Checks the modes `shapes` (one column per mode, eigenvalues `eigenvalues` in rad²/s²) of the
@@ -157,10 +188,8 @@ pub fn check_modes(
                 ),
             ));
         }
-        let lam_r = dot(phi, &kphi) / q;
-        let abs_phi: Vec<f64> = phi.iter().map(|x| x.abs()).collect();
-        let floor = f64::EPSILON * dot(&abs_phi, &akphi) / q;
-        let rigid = is_rigid(lam_r, floor);
+        let (lam_r, floor, u) = rigid_measures(phi, &kphi, &akphi, &mphi, &mdiag);
+        let rigid = is_rigid(lam_r, floor, u);
         if !rigid && lam_r < 0.0 {
             return Err(Error::numerical(
                 what,

@@ -106,7 +106,8 @@ pub fn default_shift(k: MatRef<'_, f64>, m: MatRef<'_, f64>, tr_k: f64, tr_m: f6
 }
 
 /// ω per mode (exactly 0 for rigid-body modes) and the number of rigid-body modes, decided by
-/// [`crate::modal::check`]'s rule: `|φᵀKφ/φᵀMφ| ≤ 100 ε |φ|ᵀ|K||φ|/φᵀMφ`. Modes are ascending,
+/// [`crate::modal::check`]'s rule (zero within the Rayleigh quotient's round-off and the
+/// vector's residual). Modes are ascending,
 /// so the rigid ones come first; the test stops at the first elastic mode.
 fn classify(
     k: MatRef<'_, f64>,
@@ -120,26 +121,22 @@ fn classify(
     let mut elastic = false;
     for (j, &lam) in eigenvalues.iter().enumerate() {
         if !elastic {
-            let (mut q, mut e, mut f) = (0.0, 0.0, 0.0);
+            let phi: Vec<f64> = (0..n).map(|r| shapes[(r, j)]).collect();
+            let (mut kp, mut akp, mut mp) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
             for c in 0..n {
-                let pc = shapes[(c, j)];
+                let pc = phi[c];
                 if pc == 0.0 {
                     continue;
                 }
-                let (mut kp, mut akp, mut mp) = (0.0, 0.0, 0.0);
                 for r in 0..n {
-                    let pr = shapes[(r, j)];
-                    kp += k[(r, c)] * pr;
-                    akp += k[(r, c)].abs() * pr.abs();
-                    mp += m[(r, c)] * pr;
+                    kp[r] += k[(r, c)] * pc;
+                    akp[r] += k[(r, c)].abs() * pc.abs();
+                    mp[r] += m[(r, c)] * pc;
                 }
-                e += pc * kp;
-                f += pc.abs() * akp;
-                q += pc * mp;
             }
-            let lam_r = e / q;
-            let floor = f64::EPSILON * f / q;
-            if super::check::is_rigid(lam_r, floor) {
+            let mdiag: Vec<f64> = (0..n).map(|i| m[(i, i)]).collect();
+            let (lam_r, floor, u) = super::check::rigid_measures(&phi, &kp, &akp, &mp, &mdiag);
+            if super::check::is_rigid(lam_r, floor, u) {
                 rigid += 1;
                 omega.push(0.0);
                 continue;

@@ -169,6 +169,9 @@ pub struct FemSpec {
     /// A Gmsh `.msh` 4.1 quad mesh.
     #[serde(default)]
     pub mesh: Option<MeshFileSpec>,
+    /// The general model (nodes, shells, frames, discrete elements, constraints).
+    #[serde(default)]
+    pub model: Option<super::general::GeneralSpec>,
     /// Mode selection: "auto" (default, module docs), "participation", a list of 1-based mode
     /// numbers, or `{ band_hz = [lo, hi] }`.
     #[serde(default)]
@@ -746,6 +749,37 @@ pub fn machine_spec(m: &MachineFileSpec) -> Result<MachineSpec> {
     Ok(spec)
 }
 
+/// A material of a model file, refused at its field with the valid range.
+fn check_material(m: &MaterialSpec, field: &str, src: &Source) -> Result<()> {
+    let checks: [(&str, f64, bool, &str); 3] = [
+        (
+            "youngs_modulus",
+            m.youngs_modulus,
+            m.youngs_modulus.is_finite() && m.youngs_modulus > 0.0,
+            "a finite number > 0 Pa",
+        ),
+        (
+            "density",
+            m.density,
+            m.density.is_finite() && m.density > 0.0,
+            "a finite number > 0 kg/m³",
+        ),
+        (
+            "poisson_ratio",
+            m.poisson_ratio,
+            m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5,
+            "in (-1, 0.5)",
+        ),
+    ];
+    for (key, v, ok, range) in checks {
+        if !ok {
+            let f = format!("{field}.{key}");
+            return Err(src.error(&f, format!("{f} must be {range} (got {v})")));
+        }
+    }
+    Ok(())
+}
+
 fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
     let base = "structure.fem.mesh";
     let dir = Path::new(&src.name)
@@ -759,7 +793,16 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
             format!("{base}.thickness must be > 0 m (got {})", ms.thickness),
         ));
     }
+    if let Some(m) = &ms.material {
+        check_material(m, &format!("{base}.material"), src)?;
+    }
     let g = crate::structure::gmsh::read_msh(&path)?;
+    if g.quads.is_empty() {
+        return Err(src.error(
+            &format!("{base}.file"),
+            format!("{base}.file: {} has no 4-node quadrangles; [structure.fem.mesh] reads shell meshes (frames from 2-node lines: use [structure.fem.model])", path.display()),
+        ));
+    }
     let mut mesh = Mesh::new();
     g.add_to_mesh(
         &mut mesh,
@@ -824,18 +867,19 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
 
 /// Builds the finite-element model the spec describes (no modes yet).
 pub fn build_model(spec: &FemSpec, src: &Source) -> Result<FeModel> {
-    match (&spec.machine, &spec.mesh) {
-        (Some(m), None) => {
+    match (&spec.machine, &spec.mesh, &spec.model) {
+        (None, None, Some(g)) => super::general::build(g, src),
+        (Some(m), None, None) => {
             let field = "structure.fem.machine";
             let ms = machine_spec(m).map_err(|e| locate(e, field, src, Some(m)))?;
             ms.build()
                 .map(|mach| mach.model)
                 .map_err(|e| locate(e, field, src, Some(m)))
         }
-        (None, Some(ms)) => mesh_model(ms, src),
+        (None, Some(ms), None) => mesh_model(ms, src),
         _ => Err(src.error(
             "structure.fem",
-            "structure.fem: give exactly one of [structure.fem.machine] (parametric machine) or [structure.fem.mesh] (Gmsh file)",
+            "structure.fem: give exactly one of [structure.fem.machine] (parametric machine), [structure.fem.mesh] (Gmsh quad mesh) or [structure.fem.model] (general model)",
         )),
     }
 }
