@@ -218,7 +218,7 @@ pub fn check_modes(
             }
             (r2 / k2).sqrt()
         };
-        if !(residual <= RESIDUAL_BOUND) {
+        if residual.is_nan() || residual > RESIDUAL_BOUND {
             let f = if rigid || lam <= 0.0 {
                 "0 Hz, rigid-body".to_string()
             } else {
@@ -249,7 +249,7 @@ pub fn check_modes(
             orth = orth.max((dot(&phis[a], &mphis[b]) - target).abs());
         }
     }
-    if !(orth <= ORTHONORMALITY_BOUND) {
+    if orth.is_nan() || orth > ORTHONORMALITY_BOUND {
         return Err(Error::numerical(
             what,
             format!(
