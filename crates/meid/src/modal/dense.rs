@@ -28,14 +28,19 @@
 //! number of the equilibrated `K + σM`), i.e. mode i by a relative `ε κ (λ_i + σ)²/(σ λ_i)`:
 //! the modes near σ are the most accurate; the top of the spectrum (discretisation noise of a
 //! fine shell mesh, up to 1e15 rad²/s²) may have M-orthonormality and residual errors of 1e-3 and
-//! more. σ therefore favours the low, physical modes: `σ = 1e-4 · tr K / tr M` by default
-//! (positive, so `K + σM` is positive definite for free structures). `orthonormality_error` and
+//! more. σ therefore favours the low, physical modes: `σ = 1e-4 s̃` by default, s̃ the mass-weighted
+//! median of `K_ii / M_ii` ([`default_shift`]; positive, so `K + σM` is positive definite for free
+//! structures). `orthonormality_error` and
 //! `max_residual` report the *worst* mode; [`mode_residuals`] gives the residual of each mode, so
 //! a caller can report the accuracy of the modes it actually keeps.
 //!
 //! Relative residual of mode i: `‖K φ - λ M φ‖ / (‖K φ‖ + (|λ| + σ) ‖M φ‖)` (σ = 0 for the
-//! diagonal route; the σ term keeps it meaningful for λ = 0). Rigid-body modes (`|λ| ≤ 1e-10 λ_max`
-//! for the diagonal route, `|λ| ≤ 1e-8 σ` for shift-invert) are reported as ω = 0 exactly.
+//! diagonal route; the σ term keeps it meaningful for λ = 0). Rigid-body modes are those whose
+//! Rayleigh quotient cannot be told from zero in double precision (`crate::modal::check`, no
+//! threshold on the largest eigenvalue or on `max K_ii/M_ii`); they are reported as ω = 0 exactly.
+//! Eigenvalues of the shift-inverted problem below its round-off (`n ε μ_max`) belong to modes so
+//! far above σ that they are not resolved: they are left out of the result (at most the lowest
+//! modes asked for must be resolved, else an error says how many are).
 
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
@@ -62,12 +67,92 @@ pub struct DenseModes {
     pub rigid_body_modes: usize,
 }
 
-/// Relative size below which an eigenvalue is a rigid-body mode (ω = 0), diagonal-M route.
-pub const RIGID_BODY_TOL: f64 = 1e-10;
-/// Default relative shift `σ / (tr K / tr M)` of the shift-invert route.
+/// Default relative shift `σ / s̃` of the shift-invert route (s̃ the mass-weighted median of
+/// `K_ii / M_ii`, see [`default_shift`]).
 pub const DEFAULT_RELATIVE_SHIFT: f64 = 1e-4;
-/// Eigenvalues with `|λ| ≤ RIGID_TOL_REL · σ` are rigid-body modes (shift-invert route).
-pub const RIGID_TOL_REL: f64 = 1e-8;
+
+/// The default shift `σ = 1e-4 s̃`, `s̃` the **mass-weighted median** of `K_ii / M_ii` over the
+/// DOFs (the ratio below which DOFs holding half of `tr M` lie). It is the scale of the element
+/// stiffness per unit mass of the bulk of the structure. A mean (`tr K / tr M`, used before) is
+/// dominated by a few very stiff springs: springs of 1e14 N/m on a plate's edges put σ at
+/// 1e9 rad²/s², four decades above the plate's first mode, whose eigenvalues then drowned in
+/// round-off. Falls back to `1e-4 tr K / tr M`, then 1, when the median is 0.
+pub fn default_shift(k: MatRef<'_, f64>, m: MatRef<'_, f64>, tr_k: f64, tr_m: f64) -> f64 {
+    let n = k.nrows();
+    let mut r: Vec<(f64, f64)> = (0..n)
+        .filter(|&i| m[(i, i)] > 0.0)
+        .map(|i| (k[(i, i)] / m[(i, i)], m[(i, i)]))
+        .collect();
+    r.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let half = 0.5 * r.iter().map(|x| x.1).sum::<f64>();
+    let mut acc = 0.0;
+    let mut med = 0.0;
+    for (ratio, w) in &r {
+        acc += w;
+        if acc >= half {
+            med = *ratio;
+            break;
+        }
+    }
+    for s in [
+        DEFAULT_RELATIVE_SHIFT * med,
+        DEFAULT_RELATIVE_SHIFT * tr_k / tr_m,
+    ] {
+        if s.is_finite() && s > 0.0 {
+            return s;
+        }
+    }
+    1.0
+}
+
+/// ω per mode (exactly 0 for rigid-body modes) and the number of rigid-body modes, decided by
+/// [`crate::modal::check`]'s rule (zero within the Rayleigh quotient's round-off and the
+/// vector's residual). Modes are ascending,
+/// so the rigid ones come first; the test stops at the first elastic mode.
+fn classify(
+    k: MatRef<'_, f64>,
+    m: MatRef<'_, f64>,
+    eigenvalues: &[f64],
+    shapes: MatRef<'_, f64>,
+) -> Result<(Vec<f64>, usize)> {
+    let n = k.nrows();
+    let mut omega = Vec::with_capacity(eigenvalues.len());
+    let mut rigid = 0;
+    let mut elastic = false;
+    for (j, &lam) in eigenvalues.iter().enumerate() {
+        if !elastic {
+            let phi: Vec<f64> = (0..n).map(|r| shapes[(r, j)]).collect();
+            let (mut kp, mut akp, mut mp) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            for c in 0..n {
+                let pc = phi[c];
+                if pc == 0.0 {
+                    continue;
+                }
+                for r in 0..n {
+                    kp[r] += k[(r, c)] * pc;
+                    akp[r] += k[(r, c)].abs() * pc.abs();
+                    mp[r] += m[(r, c)] * pc;
+                }
+            }
+            let mdiag: Vec<f64> = (0..n).map(|i| m[(i, i)]).collect();
+            let (lam_r, floor, u) = super::check::rigid_measures(&phi, &kp, &akp, &mp, &mdiag);
+            if super::check::is_rigid(lam_r, floor, u) {
+                rigid += 1;
+                omega.push(0.0);
+                continue;
+            }
+            if lam_r < 0.0 || lam < 0.0 {
+                return Err(negative_error(j, lam_r.min(lam)));
+            }
+            elastic = true;
+        }
+        if lam < 0.0 {
+            return Err(negative_error(j, lam));
+        }
+        omega.push(lam.sqrt());
+    }
+    Ok((omega, rigid))
+}
 
 fn check_input(k: MatRef<'_, f64>, m: MatRef<'_, f64>) -> Result<()> {
     let n = k.nrows();
@@ -160,28 +245,28 @@ fn solve_diagonal_mass(k: MatRef<'_, f64>, m: MatRef<'_, f64>) -> Result<DenseMo
     symmetrise(&mut c);
     let (eigenvalues, u) = kernels::self_adjoint_eigen(c.as_ref(), "dense eigen-solver")?;
     let shapes = Mat::<f64>::from_fn(n, n, |i, j| s[i] * u[(i, j)]);
-    let lam_max = eigenvalues.iter().fold(0.0_f64, |a, &b| a.max(b.abs()));
-    let mut rigid = 0;
-    let mut omega = Vec::with_capacity(n);
-    for (i, &lam) in eigenvalues.iter().enumerate() {
-        if lam.abs() <= RIGID_BODY_TOL * lam_max {
-            rigid += 1;
-            omega.push(0.0);
-        } else if lam < 0.0 {
-            return Err(negative_error(i, lam));
-        } else {
-            omega.push(lam.sqrt());
-        }
-    }
+    let (omega, rigid) = classify(k, m, &eigenvalues, shapes.as_ref())?;
     Ok(finish(k, m, eigenvalues, omega, shapes, rigid, 0.0))
 }
 
 /// Solves `K φ = λ M φ` for all modes by the shift-invert reduction; `shift` = σ (rad²/s², > 0)
-/// or `None` for the default `1e-4 tr K / tr M`. Returns mass-normalised modes in ascending order.
+/// or `None` for the default [`default_shift`]. Returns mass-normalised modes in ascending order.
 pub fn solve_shift_invert(
     k: MatRef<'_, f64>,
     m: MatRef<'_, f64>,
     shift: Option<f64>,
+) -> Result<DenseModes> {
+    solve_shift_invert_lowest(k, m, shift, None)
+}
+
+/// [`solve_shift_invert`] for the lowest `lowest` modes (`None`: all). Modes above them whose
+/// eigenvalues double precision does not resolve (next to a very stiff spring) are left out of
+/// the result instead of failing; the result holds every resolved mode, at least `lowest`.
+pub fn solve_shift_invert_lowest(
+    k: MatRef<'_, f64>,
+    m: MatRef<'_, f64>,
+    shift: Option<f64>,
+    lowest: Option<usize>,
 ) -> Result<DenseModes> {
     check_input(k, m)?;
     let n = k.nrows();
@@ -198,14 +283,7 @@ pub fn solve_shift_invert(
                 format!("must be finite and > 0 rad^2/s^2 (got {s})"),
             ))
         }
-        None => {
-            let s = DEFAULT_RELATIVE_SHIFT * tr_k / tr_m;
-            if s > 0.0 {
-                s
-            } else {
-                1.0
-            }
-        }
+        None => default_shift(k, m, tr_k, tr_m),
     };
     // Equilibrate: D = diag(K + σM)^(-1/2), Â = D (K + σM) D has a unit diagonal; M̂ = D M D.
     let d: Vec<f64> = (0..n)
@@ -226,18 +304,48 @@ pub fn solve_shift_invert(
     symmetrise(&mut c);
     let (mu_all, u) = kernels::self_adjoint_eigen(c.as_ref(), "dense eigen-solver")?;
     let mu_max = mu_all[n - 1];
-    // Ascending λ = descending μ.
-    let mut eigenvalues = Vec::with_capacity(n);
-    let mut y = Mat::<f64>::zeros(n, n);
-    for col in 0..n {
-        let i = n - 1 - col;
-        let mu = mu_all[i];
-        if mu.is_nan() || mu <= 1e-300 * mu_max.max(1e-300) {
+    // μ below the round-off of the eigen-decomposition of C (≈ n ε μ_max) cannot be told from
+    // zero: the top of the spectrum there (λ = 1/μ − σ beyond what double precision resolves
+    // next to the stiffest entry) is not computed. A μ negative beyond that round-off means M
+    // is not positive definite.
+    if mu_all.iter().any(|mu| mu.is_nan()) {
+        return Err(Error::numerical(
+            "dense eigen-solver",
+            "the shift-inverted problem has a NaN eigenvalue",
+        ));
+    }
+    let mut mu_floor = n as f64 * f64::EPSILON * mu_max.abs();
+    let mu_min = mu_all[0];
+    if mu_min < -mu_floor {
+        // Negative μ: M is indefinite, or forming C lost more than n ε μ_max (a very stiff
+        // spring next to light masses). A Cholesky factorisation of the equilibrated M decides.
+        let mh = Mat::<f64>::from_fn(n, n, |i, j| m[(i, j)] / (m[(i, i)] * m[(j, j)]).sqrt());
+        if kernels::llt_lower(mh.as_ref()).is_none() {
             return Err(Error::numerical(
                 "dense eigen-solver",
-                format!("non-positive eigenvalue {mu:e} of the shift-inverted problem: the mass matrix is not positive definite"),
+                format!("the mass matrix is not positive definite (its Cholesky factorisation fails; the shift-inverted problem has the eigenvalue {mu_min:e})"),
             ));
         }
+        // M is positive definite, so every exact μ is > 0: |μ_min| measures the round-off.
+        mu_floor = mu_floor.max(10.0 * mu_min.abs());
+    }
+    let resolved = (0..n).rev().take_while(|&i| mu_all[i] > mu_floor).count();
+    let wanted = lowest.unwrap_or(n).min(n);
+    if resolved < wanted {
+        return Err(Error::numerical(
+            "dense eigen-solver",
+            format!(
+                "only the lowest {resolved} of the {wanted} modes asked for are resolved in double precision (the others lie so far above the shift σ = {sigma:.3e} rad²/s², near the stiffest spring or element, that their eigenvalues are round-off): ask for at most {resolved} modes"
+            ),
+        ));
+    }
+    // Ascending λ = descending μ; only the resolved ones.
+    let n_out = resolved;
+    let mut eigenvalues = Vec::with_capacity(n_out);
+    let mut y = Mat::<f64>::zeros(n, n_out);
+    for col in 0..n_out {
+        let i = n - 1 - col;
+        let mu = mu_all[i];
         eigenvalues.push(1.0 / mu - sigma);
         let s = 1.0 / mu.sqrt();
         for r in 0..n {
@@ -245,24 +353,12 @@ pub fn solve_shift_invert(
         }
     }
     solve_upper_triangular_in_place(l.transpose(), y.as_mut(), Par::Seq);
-    for j in 0..n {
+    for j in 0..n_out {
         for i in 0..n {
             y[(i, j)] *= d[i];
         }
     }
-    let tol = RIGID_TOL_REL * sigma;
-    let mut rigid = 0;
-    let mut omega = Vec::with_capacity(n);
-    for (i, &lam) in eigenvalues.iter().enumerate() {
-        if lam.abs() <= tol {
-            rigid += 1;
-            omega.push(0.0);
-        } else if lam < 0.0 {
-            return Err(negative_error(i, lam));
-        } else {
-            omega.push(lam.sqrt());
-        }
-    }
+    let (omega, rigid) = classify(k, m, &eigenvalues, y.as_ref())?;
     Ok(finish(k, m, eigenvalues, omega, y, rigid, sigma))
 }
 

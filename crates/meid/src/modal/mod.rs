@@ -12,7 +12,8 @@
 //! to the floor as a linear function of the modal coordinates. A lumped model, a
 //! finite-element model and a user's table of measured or imported modes all end here.
 //!
-//! Submodules: [`dense`] (dense generalised symmetric eigen-solver), [`lanczos`]
+//! Submodules: [`check`] (every computed set of modes checked against stated bounds; rigid-body
+//! modes from the problem itself), [`dense`] (dense generalised symmetric eigen-solver), [`lanczos`]
 //! (sparse shift-invert block Lanczos for large models), [`truncation`] (the static flexibility
 //! a set of retained modes captures at the named points), [`conditioning`] (spreads double
 //! precision cannot carry).
@@ -21,6 +22,7 @@
 //! called with `Par::Seq` only, and the parallel parts cut their work into chunks of a fixed
 //! size and combine them in index order (`kernels`).
 
+pub mod check;
 pub mod conditioning;
 pub mod dense;
 pub(crate) mod kernels;

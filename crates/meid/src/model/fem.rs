@@ -169,6 +169,9 @@ pub struct FemSpec {
     /// A Gmsh `.msh` 4.1 quad mesh.
     #[serde(default)]
     pub mesh: Option<MeshFileSpec>,
+    /// The general model (nodes, shells, frames, discrete elements, constraints).
+    #[serde(default)]
+    pub model: Option<super::general::GeneralSpec>,
     /// Mode selection: "auto" (default, module docs), "participation", a list of 1-based mode
     /// numbers, or `{ band_hz = [lo, hi] }`.
     #[serde(default)]
@@ -452,12 +455,57 @@ pub struct MeshFileSpec {
     /// Physical groups clamped (all six DOFs); the floor force is their reaction.
     #[serde(default)]
     pub fixed: Vec<String>,
+    /// Constraints on a subset of DOFs: `{ set = "edges", dofs = ["uz"] }` (a hard simple
+    /// support); the floor force includes their reactions.
+    #[serde(default)]
+    pub constraints: Vec<ConstraintSpec>,
     /// Springs to ground at every node of a group: `{ group = "feet", stiffness = [kx, ky, kz] }`.
     #[serde(default)]
     pub springs: Vec<GroupSpringSpec>,
     /// Impact direction (unit vector the slider moves along); default `[0, 0, -1]`.
     #[serde(default)]
     pub impact_direction: Option<[f64; 3]>,
+}
+
+/// Zero displacement of some DOFs at every node of a set.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ConstraintSpec {
+    /// Node set (Gmsh physical group or `[structure.fem.model]` set).
+    pub set: String,
+    /// Any of "ux", "uy", "uz", "rx", "ry", "rz", or "all", "translations", "rotations".
+    pub dofs: Vec<String>,
+}
+
+/// The DOFs a list of names gives (`field` names the list in errors).
+pub fn parse_dofs(names: &[String], field: &str) -> Result<Vec<crate::structure::Dof>> {
+    use crate::structure::Dof;
+    let mut out = Vec::new();
+    if names.is_empty() {
+        return Err(Error::invalid(
+            field,
+            "is empty; give some of \"ux\", \"uy\", \"uz\", \"rx\", \"ry\", \"rz\", \"all\", \"translations\", \"rotations\"",
+        ));
+    }
+    for n in names {
+        match n.as_str() {
+            "all" => out.extend(Dof::ALL),
+            "translations" => out.extend(Dof::TRANSLATIONS),
+            "rotations" => out.extend(Dof::ROTATIONS),
+            other => match crate::structure::DOF_NAMES.iter().position(|d| *d == other) {
+                Some(i) => out.push(Dof::ALL[i]),
+                None => {
+                    return Err(Error::invalid(
+                        field,
+                        format!("unknown DOF '{other}'; valid: ux, uy, uz, rx, ry, rz, all, translations, rotations"),
+                    ))
+                }
+            },
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    Ok(out)
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
@@ -701,6 +749,37 @@ pub fn machine_spec(m: &MachineFileSpec) -> Result<MachineSpec> {
     Ok(spec)
 }
 
+/// A material of a model file, refused at its field with the valid range.
+fn check_material(m: &MaterialSpec, field: &str, src: &Source) -> Result<()> {
+    let checks: [(&str, f64, bool, &str); 3] = [
+        (
+            "youngs_modulus",
+            m.youngs_modulus,
+            m.youngs_modulus.is_finite() && m.youngs_modulus > 0.0,
+            "a finite number > 0 Pa",
+        ),
+        (
+            "density",
+            m.density,
+            m.density.is_finite() && m.density > 0.0,
+            "a finite number > 0 kg/m³",
+        ),
+        (
+            "poisson_ratio",
+            m.poisson_ratio,
+            m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5,
+            "in (-1, 0.5)",
+        ),
+    ];
+    for (key, v, ok, range) in checks {
+        if !ok {
+            let f = format!("{field}.{key}");
+            return Err(src.error(&f, format!("{f} must be {range} (got {v})")));
+        }
+    }
+    Ok(())
+}
+
 fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
     let base = "structure.fem.mesh";
     let dir = Path::new(&src.name)
@@ -714,7 +793,16 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
             format!("{base}.thickness must be > 0 m (got {})", ms.thickness),
         ));
     }
+    if let Some(m) = &ms.material {
+        check_material(m, &format!("{base}.material"), src)?;
+    }
     let g = crate::structure::gmsh::read_msh(&path)?;
+    if g.quads.is_empty() {
+        return Err(src.error(
+            &format!("{base}.file"),
+            format!("{base}.file: {} has no 4-node quadrangles; [structure.fem.mesh] reads shell meshes (frames from 2-node lines: use [structure.fem.model])", path.display()),
+        ));
+    }
     let mut mesh = Mesh::new();
     g.add_to_mesh(
         &mut mesh,
@@ -734,6 +822,14 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
     for (i, gname) in ms.fixed.iter().enumerate() {
         for n in group(gname, &format!("{base}.fixed[{i}]"), &mesh)? {
             mesh.fix_all(n);
+        }
+    }
+    for (i, c) in ms.constraints.iter().enumerate() {
+        let field = format!("{base}.constraints[{i}]");
+        let dofs = parse_dofs(&c.dofs, &format!("{field}.dofs"))
+            .map_err(|e| src.error(&format!("{field}.dofs"), e.to_string()))?;
+        for n in group(&c.set, &format!("{field}.set"), &mesh)? {
+            mesh.fix(n, &dofs);
         }
     }
     for (i, s) in ms.springs.iter().enumerate() {
@@ -771,18 +867,19 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
 
 /// Builds the finite-element model the spec describes (no modes yet).
 pub fn build_model(spec: &FemSpec, src: &Source) -> Result<FeModel> {
-    match (&spec.machine, &spec.mesh) {
-        (Some(m), None) => {
+    match (&spec.machine, &spec.mesh, &spec.model) {
+        (None, None, Some(g)) => super::general::build(g, src),
+        (Some(m), None, None) => {
             let field = "structure.fem.machine";
             let ms = machine_spec(m).map_err(|e| locate(e, field, src, Some(m)))?;
             ms.build()
                 .map(|mach| mach.model)
                 .map_err(|e| locate(e, field, src, Some(m)))
         }
-        (None, Some(ms)) => mesh_model(ms, src),
+        (None, Some(ms), None) => mesh_model(ms, src),
         _ => Err(src.error(
             "structure.fem",
-            "structure.fem: give exactly one of [structure.fem.machine] (parametric machine) or [structure.fem.mesh] (Gmsh file)",
+            "structure.fem: give exactly one of [structure.fem.machine] (parametric machine), [structure.fem.mesh] (Gmsh quad mesh) or [structure.fem.model] (general model)",
         )),
     }
 }
@@ -958,23 +1055,80 @@ pub fn solve_modes(
                 "structure.fem.solver",
                 "the mesh, or use solver = \"lanczos\" (the lowest modes only)",
             )?;
-            let mut modes = model.solve_dense()?;
             let keep = count.min(n);
+            let mut modes = model
+                .solve_dense_lowest(keep)
+                .map_err(|e| solver_hint(e, model, "dense"))?;
             modes.eigenvalues.truncate(keep);
             modes.omega_rad_per_s.truncate(keep);
             modes.shapes = modes.shapes.subcols(0, keep).to_owned();
-            modes.rigid_body_modes = modes.omega_rad_per_s.iter().filter(|w| **w == 0.0).count();
-            Ok((modes, "dense"))
+            Ok((checked(model, modes, "dense")?, "dense"))
         }
         SolverSpec::Lanczos => {
             let opts = LanczosOptions {
                 count: count.min(n),
                 ..LanczosOptions::default()
             };
-            let s = lanczos::lowest_modes(model.stiffness.as_ref(), model.mass.as_ref(), &opts)?;
-            Ok((to_dense(s), "lanczos"))
+            let s = lanczos::lowest_modes(model.stiffness.as_ref(), model.mass.as_ref(), &opts)
+                .map_err(|e| solver_hint(e, model, "lanczos"))?;
+            Ok((checked(model, to_dense(s), "lanczos")?, "lanczos"))
         }
     }
+}
+
+/// A spring at least this many times stiffer than the elements at its DOF acts as a constraint
+/// ([`FeModel::constraint_like_springs`]): noted, and named when a solution fails.
+pub const CONSTRAINT_LIKE_RATIO: f64 = 1e3;
+
+/// What to change when the eigen-solution of `model` failed: the springs acting as
+/// constraints, if any; else the other solver or fewer modes.
+fn change_hint(model: &FeModel, solver: &str) -> String {
+    match model.constraint_like_note(CONSTRAINT_LIKE_RATIO) {
+        Some(note) => format!("what to change: {note}"),
+        None => format!(
+            "what to change: set structure.fem.solver = \"{}\", or lower structure.fem.count",
+            if solver == "dense" {
+                "lanczos"
+            } else {
+                "dense"
+            }
+        ),
+    }
+}
+
+fn solver_hint(e: Error, model: &FeModel, solver: &str) -> Error {
+    match e {
+        Error::Numerical { context, message } => Error::Numerical {
+            context,
+            message: format!("{message}. {}", change_hint(model, solver)),
+        },
+        other => other,
+    }
+}
+
+/// Checks the modes ([`crate::modal::check::check_modes`]: residual and M-orthonormality
+/// against stated bounds, rigid-body modes from the Rayleigh quotient's round-off) and returns
+/// them with ω, the rigid-body count, the orthonormality error and the largest residual the
+/// check measured. A failed check is an error saying what to change.
+fn checked(model: &FeModel, mut modes: DenseModes, solver: &str) -> Result<DenseModes> {
+    let what = if solver == "dense" {
+        "dense eigen-solver (check of the solution)"
+    } else {
+        "sparse eigen-solver (check of the solution)"
+    };
+    let c = crate::modal::check::check_modes(
+        model.stiffness.as_ref(),
+        model.mass.as_ref(),
+        &modes.eigenvalues,
+        modes.shapes.as_ref(),
+        what,
+    )
+    .map_err(|e| solver_hint(e, model, solver))?;
+    modes.omega_rad_per_s = c.omega_rad_per_s;
+    modes.rigid_body_modes = c.rigid_body_modes;
+    modes.orthonormality_error = c.orthonormality_error;
+    modes.max_residual = c.residuals.iter().fold(0.0_f64, |a, &b| a.max(b));
+    Ok(modes)
 }
 
 /// The most modes the block Lanczos solver computes on `n` degrees of freedom with blocks of
@@ -991,6 +1145,10 @@ pub fn lanczos_max_modes(n: usize, block: usize) -> usize {
 /// the solver refused come from the plates' and columns' sizes, materials and masses.
 fn unsolvable(e: Error, src: &Source) -> Error {
     match e {
+        e @ Error::Numerical { .. } if e.to_string().contains("what to change:") => src.error(
+            "structure.fem",
+            format!("structure.fem: the finite-element model cannot be solved ({e})"),
+        ),
         e @ (Error::InvalidValue { .. } | Error::Numerical { .. }) => src.error(
             "structure.fem",
             format!(
@@ -1250,6 +1408,9 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
     }
     modal.static_flexibility = static_flexibility;
     modal.warnings = warnings;
+    if let Some(note) = model.constraint_like_note(CONSTRAINT_LIKE_RATIO) {
+        modal.notes.push(format!("{base}: {note}"));
+    }
     Ok(FemAnalysis {
         model,
         modes,

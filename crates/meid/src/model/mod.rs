@@ -24,6 +24,7 @@
 //! the valid range; unknown keys get a did-you-mean.
 
 pub mod fem;
+pub mod general;
 mod lumped;
 pub mod source;
 pub mod spec;

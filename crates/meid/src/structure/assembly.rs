@@ -396,3 +396,118 @@ impl FeModel {
         )
     }
 }
+
+/// A spring DOF so stiff next to the structure's own stiffness that it acts as a constraint
+/// ([`FeModel::constraint_like_springs`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StiffSpring {
+    /// Index in `mesh.springs`.
+    pub spring: usize,
+    /// Node of the spring.
+    pub node: usize,
+    /// DOF (0..6: ux, uy, uz, rx, ry, rz).
+    pub dof: usize,
+    /// The spring's stiffness (N/m or N·m/rad).
+    pub stiffness: f64,
+    /// `k / K_own`, K_own the diagonal stiffness of the elements (not the springs) at the DOF;
+    /// infinite when the elements give none.
+    pub ratio: f64,
+}
+
+/// Names of the six DOFs of a node, as model files give them.
+pub const DOF_NAMES: [&str; 6] = ["ux", "uy", "uz", "rx", "ry", "rz"];
+
+impl FeModel {
+    /// Spring DOFs (to ground or between nodes) whose stiffness is at least `ratio` times the
+    /// diagonal stiffness the elements give that DOF, `K_ii − Σ k_springs`: the DOF then moves
+    /// `≲ 1/ratio` of what the structure alone would let it, i.e. the spring acts as a constraint,
+    /// and its stiffness only spreads the spectrum (the eigenvalues it adds are ~`k/m` of the
+    /// node, far above the structure's). DOFs that are not independent (fixed, rigid-link
+    /// slaves) are skipped. Sorted by descending ratio.
+    pub fn constraint_like_springs(&self, ratio: f64) -> Vec<StiffSpring> {
+        let n = self.n_dofs();
+        let mut diag = vec![0.0; n];
+        for t in self.stiffness.triplet_iter() {
+            if t.row == t.col {
+                diag[t.row] += *t.val;
+            }
+        }
+        let mut spring_sum = vec![0.0; n];
+        let mut cand = Vec::new();
+        for (si, s) in self.mesh.springs.iter().enumerate() {
+            for (d, &k) in s.stiffness.iter().enumerate() {
+                if k <= 0.0 {
+                    continue;
+                }
+                for node in std::iter::once(s.node).chain(s.other) {
+                    if let Some(j) = self.dofs.reduced_index(node, d) {
+                        spring_sum[j] += k;
+                        cand.push((si, node, d, k, j));
+                    }
+                }
+            }
+        }
+        let mut out: Vec<StiffSpring> = cand
+            .into_iter()
+            .filter_map(|(spring, node, dof, k, j)| {
+                let own = diag[j] - spring_sum[j];
+                // Round-off of the subtraction: an own stiffness below ε K_ii is none.
+                let own = if own > f64::EPSILON * diag[j] {
+                    own
+                } else {
+                    0.0
+                };
+                let r = if own > 0.0 { k / own } else { f64::INFINITY };
+                (r >= ratio).then_some(StiffSpring {
+                    spring,
+                    node,
+                    dof,
+                    stiffness: k,
+                    ratio: r,
+                })
+            })
+            .collect();
+        out.sort_by(|a, b| b.ratio.total_cmp(&a.ratio));
+        out
+    }
+
+    /// A sentence on the springs that act as constraints (`None` if none does), for notes and
+    /// error messages: how many, how stiff relative to the structure, an example node, and the
+    /// constraint to give instead.
+    pub fn constraint_like_note(&self, ratio: f64) -> Option<String> {
+        let v = self.constraint_like_springs(ratio);
+        let first = v.first()?;
+        let mut dofs: Vec<&str> = v.iter().map(|s| DOF_NAMES[s.dof]).collect();
+        dofs.sort_unstable();
+        dofs.dedup();
+        let min = v.iter().map(|s| s.ratio).fold(f64::INFINITY, f64::min);
+        let p = self.mesh.nodes[first.node];
+        Some(format!(
+            "{} spring DOF(s) ({}) are {min:.1e} to {:.1e} times the stiffness the elements give \
+             those DOFs (e.g. node {} at [{}, {}, {}] m, {}: {:e}): they act as constraints and only \
+             spread the spectrum beyond what double precision resolves; constrain those DOFs instead \
+             (`constraints = [{{ set = ..., dofs = [{}] }}]`)",
+            v.len(),
+            dofs.join(", "),
+            first.ratio,
+            first.node,
+            p[0],
+            p[1],
+            p[2],
+            DOF_NAMES[first.dof],
+            first.stiffness,
+            dofs.iter().map(|d| format!("\"{d}\"")).collect::<Vec<_>>().join(", ")
+        ))
+    }
+
+    /// All modes by [`crate::modal::dense::solve_shift_invert_lowest`] with the default shift:
+    /// every resolved mode, at least the lowest `count`.
+    pub fn solve_dense_lowest(&self, count: usize) -> Result<crate::modal::dense::DenseModes> {
+        crate::modal::dense::solve_shift_invert_lowest(
+            self.dense_stiffness().as_ref(),
+            self.dense_mass().as_ref(),
+            None,
+            Some(count),
+        )
+    }
+}

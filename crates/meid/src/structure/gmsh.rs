@@ -32,10 +32,18 @@ pub struct GmshMesh {
     pub quads: Vec<[usize; 4]>,
     /// Gmsh tag of each quadrilateral.
     pub quad_tags: Vec<usize>,
+    /// Line of the file each quadrilateral is on (1-based).
+    pub quad_lines: Vec<usize>,
     /// Physical group name → node indices (sorted, unique).
     pub node_sets: BTreeMap<String, Vec<usize>>,
     /// Physical surface name → quad indices.
     pub element_sets: BTreeMap<String, Vec<usize>>,
+    /// 2-node lines (type 1) as node indices: frame elements in a general model.
+    pub lines: Vec<[usize; 2]>,
+    /// Gmsh tag of each line.
+    pub line_tags: Vec<usize>,
+    /// Physical curve name → line indices.
+    pub line_sets: BTreeMap<String, Vec<usize>>,
 }
 
 #[derive(Clone, Copy)]
@@ -95,6 +103,21 @@ fn tokenize<'a>(lines: &[(usize, &'a str)]) -> Vec<Tok<'a>> {
 }
 
 impl<'a> Cursor<'a, '_> {
+    /// Refuses data left after what the section's header announced.
+    fn finish(&self, announced: &str) -> Result<()> {
+        match self.toks.get(self.pos) {
+            None => Ok(()),
+            Some(t) => Err(input_err(
+                self.file,
+                t.line,
+                t.col,
+                format!(
+                    "${} holds more data ('{}') after the {announced} its header announces: the header's counts disagree with the data (a block or entity missing from the count?)",
+                    self.section, t.text
+                ),
+            )),
+        }
+    }
     fn next(&mut self, what: &str) -> Result<Tok<'a>> {
         let t = self.toks.get(self.pos).copied().ok_or_else(|| {
             input_err(
@@ -369,8 +392,8 @@ pub fn parse_msh(text: &str, file: &str) -> Result<GmshMesh> {
     let mut c = cursor(nodes_sec, file);
     let nblocks = c.count("number of node blocks")?;
     let total = c.count("number of nodes")?;
-    c.count("minimum node tag")?;
-    c.count("maximum node tag")?;
+    let min_tag = c.count("minimum node tag")?;
+    let max_tag = c.count("maximum node tag")?;
     let mut mesh = GmshMesh::default();
     let mut index_of_tag: HashMap<usize, usize> = HashMap::new();
     for _ in 0..nblocks {
@@ -416,26 +439,37 @@ pub fn parse_msh(text: &str, file: &str) -> Result<GmshMesh> {
             mesh.node_tags.push(tag);
         }
     }
+    c.finish(&format!("{nblocks} node blocks"))?;
     if mesh.nodes.len() != total {
         return Err(input_err(
             file,
-            nodes_sec.start_line,
+            nodes_sec.start_line + 1,
             1,
             format!(
-                "$Nodes announces {total} nodes but its blocks hold {}",
+                "$Nodes announces {total} nodes but its {nblocks} blocks hold {}",
                 mesh.nodes.len()
             ),
         ));
     }
+    check_tag_range(
+        file,
+        nodes_sec.start_line + 1,
+        "node",
+        &mesh.node_tags,
+        min_tag,
+        max_tag,
+    )?;
 
     // $Elements
     let el_sec = find("Elements").ok_or_else(|| input_err(file, 1, 1, "no $Elements section"))?;
     let mut c = cursor(el_sec, file);
     let nblocks = c.count("number of element blocks")?;
-    c.count("number of elements")?;
-    c.count("minimum element tag")?;
-    c.count("maximum element tag")?;
+    let total_el = c.count("number of elements")?;
+    let min_el = c.count("minimum element tag")?;
+    let max_el = c.count("maximum element tag")?;
     let mut sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
+    let mut all_tags: Vec<usize> = Vec::with_capacity(total_el.min(1 << 24));
+    let mut seen_tags: HashMap<usize, usize> = HashMap::new();
     for _ in 0..nblocks {
         let dim = c.int("entity dimension")?;
         let etag = c.int("entity tag")?;
@@ -486,6 +520,15 @@ pub fn parse_msh(text: &str, file: &str) -> Result<GmshMesh> {
                     format!("expected an element tag, found '{}'", tag_tok.text),
                 )
             })?;
+            if let Some(prev) = seen_tags.insert(tag, tag_tok.line) {
+                return Err(input_err(
+                    file,
+                    tag_tok.line,
+                    tag_tok.col,
+                    format!("element tag {tag} appears twice (first on line {prev})"),
+                ));
+            }
+            all_tags.push(tag);
             let mut conn = Vec::with_capacity(nn);
             for _ in 0..nn {
                 let t = c.next("element node tag")?;
@@ -512,6 +555,29 @@ pub fn parse_msh(text: &str, file: &str) -> Result<GmshMesh> {
                     .or_default()
                     .extend(conn.iter().copied());
             }
+            if ty == 1 {
+                if conn[0] == conn[1] {
+                    return Err(input_err(
+                        file,
+                        tag_tok.line,
+                        1,
+                        format!(
+                            "line {tag} is degenerate: both ends are node {}",
+                            mesh.node_tags[conn[0]]
+                        ),
+                    ));
+                }
+                for g in &groups {
+                    if dim == 1 {
+                        mesh.line_sets
+                            .entry(g.clone())
+                            .or_default()
+                            .push(mesh.lines.len());
+                    }
+                }
+                mesh.lines.push([conn[0], conn[1]]);
+                mesh.line_tags.push(tag);
+            }
             if ty == 3 {
                 let q = [conn[0], conn[1], conn[2], conn[3]];
                 for g in &groups {
@@ -524,23 +590,98 @@ pub fn parse_msh(text: &str, file: &str) -> Result<GmshMesh> {
                 }
                 mesh.quads.push(q);
                 mesh.quad_tags.push(tag);
+                mesh.quad_lines.push(tag_tok.line);
             }
         }
+    }
+    c.finish(&format!("{nblocks} element blocks"))?;
+    if all_tags.len() != total_el {
+        return Err(input_err(
+            file,
+            el_sec.start_line + 1,
+            1,
+            format!(
+                "$Elements announces {total_el} elements but its {nblocks} blocks hold {}: the file is truncated or its header is wrong",
+                all_tags.len()
+            ),
+        ));
+    }
+    check_tag_range(
+        file,
+        el_sec.start_line + 1,
+        "element",
+        &all_tags,
+        min_el,
+        max_el,
+    )?;
+    // Element geometry: four distinct nodes, a non-degenerate, convex, not self-intersecting quad.
+    for (q, (&tag, &line)) in mesh
+        .quads
+        .iter()
+        .zip(mesh.quad_tags.iter().zip(&mesh.quad_lines))
+    {
+        let mut distinct = q.to_vec();
+        distinct.sort_unstable();
+        distinct.dedup();
+        let tags = q.map(|i| mesh.node_tags[i]);
+        if distinct.len() < 4 {
+            return Err(input_err(
+                file,
+                line,
+                1,
+                format!("quadrangle {tag} (nodes {tags:?}) is degenerate: a node is repeated; a quadrangle needs four distinct nodes"),
+            ));
+        }
+        super::shell::shell_geometry(&q.map(|i| mesh.nodes[i])).map_err(|e| {
+            let msg = match e {
+                Error::InvalidValue { message, .. } => message,
+                other => other.to_string(),
+            };
+            input_err(
+                file,
+                line,
+                1,
+                format!("quadrangle {tag} (nodes {tags:?}): {msg}"),
+            )
+        })?;
     }
     for (name, mut v) in sets {
         v.sort_unstable();
         v.dedup();
         mesh.node_sets.insert(name, v);
     }
-    if mesh.quads.is_empty() {
+    if mesh.quads.is_empty() && mesh.lines.is_empty() {
         return Err(input_err(
             file,
             el_sec.start_line,
             1,
-            "the mesh has no 4-node quadrangles (element type 3)",
+            "the mesh has no 4-node quadrangles (element type 3) and no 2-node lines (type 1)",
         ));
     }
     Ok(mesh)
+}
+
+/// The header's minimum and maximum tags must be those of the data.
+fn check_tag_range(
+    file: &str,
+    line: usize,
+    what: &str,
+    tags: &[usize],
+    min: usize,
+    max: usize,
+) -> Result<()> {
+    let (lo, hi) = tags
+        .iter()
+        .fold((usize::MAX, 0), |(a, b), &t| (a.min(t), b.max(t)));
+    if !tags.is_empty() && (lo != min || hi != max) {
+        return Err(input_err(
+            file,
+            line,
+            1,
+            format!("the header announces {what} tags {min} to {max} but the data hold tags {lo} to {hi}: the header's counts disagree with the data"),
+        ));
+    }
+    Ok(())
 }
 
 impl GmshMesh {

@@ -33,7 +33,7 @@ pub mod mesh;
 pub mod modes;
 pub mod shell;
 
-pub use assembly::{DofMap, FeModel};
+pub use assembly::{DofMap, FeModel, StiffSpring, DOF_NAMES};
 pub use discrete::{Dashpot, PointMass, RigidLink, Spring};
 pub use frame::{FrameElement, Section};
 pub use machine::{Machine, MachineSpec, Support};

@@ -43,22 +43,28 @@
 //! A Ritz pair is accepted when its operator residual is below `tol_op · θ_i`; the accepted
 //! vectors are then refined by a Rayleigh-Ritz step on `(Xᵀ K X, Xᵀ M X)` and checked with the
 //! true residual `‖K x - λ M x‖ / (‖K x‖ + |λ| ‖M x‖) ≤ tol`. If that fails, `tol_op` is
-//! tightened and the iteration continues. For rigid-body modes (`|λ| ≤ 1e-10 s`, see below;
-//! reported with ω = 0 when `-1e-10 s ≤ λ ≤ 1e-12 s`, see [`RIGID_BODY_TOL_POSITIVE`])
-//! `K x ≈ 0` makes that ratio 0/0; their residual is taken relative to the stiffness scale,
-//! `‖K x - λ M x‖ / (s ‖M x‖)`. In floating point the attainable residual of an elastic mode
-//! is about `ε s / λ` (ε machine precision: the residual of the exact eigenvector rounded to
-//! double precision), so for ill-conditioned models (`s/λ₁ > 1e6`, common for fine shell
-//! meshes) `tol` is unattainable. A mode is therefore also accepted when its residual is below
-//! `4 ε s / |λ|`, or when `tol_op` has reached 1e-14; then [`SparseModes::converged_to_tol`]
-//! is false and the true residual is reported.
+//! tightened and the iteration continues. Rigid-body modes are those whose Rayleigh quotient
+//! cannot be told from zero, within its round-off `100 ε |x|ᵀ|K||x|` and the uncertainty its
+//! residual leaves ([`crate::modal::check`]): no threshold on `max K_ii/M_ii`, which a single stiff spring
+//! inflates (springs of 1e16 N/m on a plate's edges made its 49 Hz mode a "rigid-body mode").
+//! For them `K x ≈ 0` makes the ratio above 0/0; their residual is taken relative to the terms
+//! that cancel in `K x`, `‖K x - λ M x‖ / (‖|K||x|‖ + |λ| ‖M x‖)`. In floating point the
+//! attainable residual of an elastic mode is about `ε ‖|K||x|‖ / ‖K x‖` (ε machine precision:
+//! the rounding of `K x` itself), so for ill-conditioned models (fine shell meshes) `tol` may be
+//! unattainable. A mode is therefore also accepted when its residual is below
+//! `4 ε ‖|K||x|‖ / ‖K x‖`, or when `tol_op` has reached 1e-14; then
+//! [`SparseModes::converged_to_tol`] is false and the true residual is reported. Every result is
+//! then checked again, against fixed bounds, by the caller ([`crate::modal::check`]).
 //!
 //! # Shift
-//! `s = max_i K_ii / M_ii` estimates the top of the spectrum. The automatic shift is
-//! `σ₀ = -1e-6 s`: far enough from zero that `K - σM` stays well conditioned
-//! (condition ≈ 1e6 in the M-norm, so rigid-body modes are resolved), close enough that the
-//! wanted eigenvalues stay separated. If after a cycle the k-th Ritz value `λ̃_k` lies far
-//! below `|σ|` (`|σ| > 4 λ̃_k`; slender or very finely meshed models), the factorisation is
+//! `s = max_i K_ii / M_ii` estimates the top of the spectrum. If the iteration does not converge
+//! with it, it is redone with `s = ` the mass-weighted median of `K_ii / M_ii` (the ratio below
+//! which DOFs holding half of `tr M` lie), the stiffness scale of the bulk of the structure: a
+//! maximum set by a single very stiff spring (1e16 N/m on a plate's edge) puts the shift decades
+//! below the wanted band. The automatic shift is `σ₀ = -1e-6 s`: far enough from zero that
+//! `K - σM` stays well conditioned in the bulk (so rigid-body modes are resolved), close enough
+//! that the wanted eigenvalues stay separated. If after a cycle the k-th Ritz value `λ̃_k` lies
+//! far below `|σ|` (`|σ| > 4 λ̃_k`; slender or very finely meshed models), the factorisation is
 //! redone at `σ = -max(λ̃_k, 1e-9 s)` and the iteration restarts from the Ritz vectors. A
 //! shift much closer to zero (user-given, e.g. -1e-12 s) makes `K - σM` so ill-conditioned
 //! that solve errors stall convergence when rigid-body modes are present; the solver then
@@ -100,17 +106,7 @@ use crate::{Error, Result};
 use block::{fill_random, m_norm, norm2, project_column, sym_matmul};
 use shifted::ShiftedPencil;
 
-/// Relative size (to `s = max K_ii/M_ii`) below which an eigenvalue is a rigid-body mode for the
-/// residual normalisation, and below which a *negative* eigenvalue is round-off of a rigid-body
-/// mode (reported as ω = 0).
-pub const RIGID_BODY_TOL: f64 = 1e-10;
-/// Relative size (to `s`) below which a *positive* eigenvalue is reported as a rigid-body mode
-/// (ω = 0). The round-off of a rigid-body eigenvalue is about ε s (ε = 2.2e-16, the error of
-/// forming `xᵀ K x`), so 1e-12 s keeps a margin of ~5000. It is tighter than
-/// [`RIGID_BODY_TOL`] because fine shell meshes have s ≈ 1e13 rad²/s²: 1e-10 s then swallowed
-/// the 2.8 Hz lateral bounce of the paper's soft-base machine at 107k DOFs (λ = 318 rad²/s²).
-pub const RIGID_BODY_TOL_POSITIVE: f64 = 1e-12;
-/// Automatic shift as a fraction of `s = max K_ii/M_ii`: `σ₀ = -AUTO_SHIFT_FRACTION · s`.
+/// Automatic shift as a fraction of `s` (the mass-weighted median of `K_ii/M_ii`): `σ₀ = -AUTO_SHIFT_FRACTION · s`.
 pub const AUTO_SHIFT_FRACTION: f64 = 1e-6;
 /// Floor of the operator tolerance when tightening it to reach the true-residual tolerance.
 const TOL_OP_FLOOR: f64 = 1e-14;
@@ -214,8 +210,12 @@ pub struct SparseModes {
     pub converged_to_tol: bool,
     /// Modes reported with ω = 0.
     pub rigid_body_modes: usize,
-    /// `s = max_i K_ii / M_ii` (rad²/s²), the stiffness scale used for thresholds.
+    /// `max_i K_ii / M_ii` (rad²/s²), an estimate of the top of the spectrum (reported only: no
+    /// threshold depends on it).
     pub stiffness_scale: f64,
+    /// The scale `s` of the automatic shift (rad²/s²): `max K_ii/M_ii`, or the mass-weighted
+    /// median of `K_ii / M_ii` when the first did not converge (module docs).
+    pub shift_scale: f64,
     /// Final operator shift σ (rad²/s²).
     pub shift: f64,
     /// Shift σ_u of the Sturm check (rad²/s²).
@@ -239,6 +239,26 @@ pub fn lowest_modes(
     m: SparseColMatRef<'_, usize, f64>,
     opts: &LanczosOptions,
 ) -> Result<SparseModes> {
+    match lowest_modes_scaled(k, m, opts, false) {
+        // A few very stiff entries (springs acting as constraints) put max K_ii/M_ii decades
+        // above the bulk of the structure, and the shift -1e-6 max K_ii/M_ii then lies so far
+        // below the wanted band that its eigenvalues are not separated: retry with the bulk
+        // scale (the mass-weighted median of K_ii/M_ii).
+        Err(Error::Numerical { message, .. })
+            if opts.shift.is_none() && message.starts_with("no convergence") =>
+        {
+            lowest_modes_scaled(k, m, opts, true)
+        }
+        other => other,
+    }
+}
+
+fn lowest_modes_scaled(
+    k: SparseColMatRef<'_, usize, f64>,
+    m: SparseColMatRef<'_, usize, f64>,
+    opts: &LanczosOptions,
+    bulk_scale: bool,
+) -> Result<SparseModes> {
     let n = k.nrows();
     validate(k, m, opts)?;
     let want = opts.count;
@@ -247,7 +267,7 @@ pub fn lowest_modes(
     // Stiffness scale s = max K_ii / M_ii (and the necessary diagonal conditions).
     let kd = diagonal(k);
     let md = diagonal(m);
-    let mut s_ref = 0.0_f64;
+    let mut s_max = 0.0_f64;
     for i in 0..n {
         if md[i] <= 0.0 {
             return Err(Error::invalid(
@@ -261,14 +281,21 @@ pub fn lowest_modes(
                 format!("diagonal entry {i} is {:.3e}; a positive semi-definite stiffness matrix needs every diagonal entry ≥ 0", kd[i]),
             ));
         }
-        s_ref = s_ref.max(kd[i] / md[i]);
+        s_max = s_max.max(kd[i] / md[i]);
     }
-    if s_ref <= 0.0 || !s_ref.is_finite() {
+    if s_max <= 0.0 || !s_max.is_finite() {
         return Err(Error::invalid(
             "stiffness matrix",
             "has no positive diagonal entry (all modes would be rigid-body modes)",
         ));
     }
+
+    // The bulk stiffness scale: the mass-weighted median of K_ii/M_ii (module docs).
+    let s_ref = if bulk_scale {
+        weighted_median_ratio(&kd, &md).max(f64::MIN_POSITIVE)
+    } else {
+        s_max
+    };
 
     let basis = {
         let target = opts.basis_size.unwrap_or(2 * want + 2 * b).max(want + b);
@@ -345,7 +372,7 @@ pub fn lowest_modes(
 
         if n_conv == want {
             let x = mul_rows(st.v.get(.., ..basis), y.get(.., ..want));
-            let fin = finalize(k, m, x, s_ref, &mut stats)?;
+            let fin = finalize(k, m, x, s_max, &mut stats)?;
             stats.ritz_s += clock.elapsed().as_secs_f64();
             clock = Instant::now();
             let max_res = fin.residuals.iter().fold(0.0_f64, |a, &r| a.max(r));
@@ -353,10 +380,8 @@ pub fn lowest_modes(
             let acceptable = fin
                 .residuals
                 .iter()
-                .zip(&fin.eigenvalues)
-                .all(|(&r, &lam)| {
-                    r <= opts.tol || r <= ATTAINABLE_FACTOR * f64::EPSILON * s_ref / lam.abs()
-                });
+                .zip(&fin.attainable)
+                .all(|(&r, &a)| r <= opts.tol || r <= a);
             let at_floor = tol_op <= TOL_OP_FLOOR;
             if acceptable || at_floor {
                 // Ritz estimates of the eigenvalues beyond the returned ones, with lower bounds
@@ -369,6 +394,7 @@ pub fn lowest_modes(
                     fin,
                     &beyond,
                     s_ref,
+                    s_max,
                     sigma,
                     max_res <= opts.tol,
                     par,
@@ -773,7 +799,49 @@ struct Finalized {
     eigenvalues: Vec<f64>,
     shapes: Mat<f64>,
     residuals: Vec<f64>,
+    /// Attainable residual per mode, `4 ε ‖|K||x|‖ / ‖K x‖` (elastic) or `4 ε` (rigid).
+    attainable: Vec<f64>,
+    /// Rigid-body mode per mode ([`crate::modal::check::is_rigid`]).
+    rigid: Vec<bool>,
     orthonormality_error: f64,
+}
+
+/// The mass-weighted median of `K_ii / M_ii` (DOFs with `M_ii > 0`): the ratio below which DOFs
+/// holding half of `tr M` lie. 0 when there are none.
+fn weighted_median_ratio(kd: &[f64], md: &[f64]) -> f64 {
+    let mut r: Vec<(f64, f64)> = kd
+        .iter()
+        .zip(md)
+        .filter(|(_, &m)| m > 0.0)
+        .map(|(&k, &m)| (k / m, m))
+        .collect();
+    r.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let half = 0.5 * r.iter().map(|x| x.1).sum::<f64>();
+    let mut acc = 0.0;
+    for (ratio, w) in &r {
+        acc += w;
+        if acc >= half {
+            return *ratio;
+        }
+    }
+    0.0
+}
+
+/// `|A| |X|` column by column (A sparse with both triangles; sequential, in storage order).
+fn abs_product(a: SparseColMatRef<'_, usize, f64>, x: faer::MatRef<'_, f64>) -> Mat<f64> {
+    let mut z = Mat::<f64>::zeros(a.nrows(), x.ncols());
+    for c in 0..x.ncols() {
+        for j in 0..a.ncols() {
+            let xj = x[(j, c)].abs();
+            if xj == 0.0 {
+                continue;
+            }
+            for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
+                z[(i, c)] += v.abs() * xj;
+            }
+        }
+    }
+    z
 }
 
 /// Rayleigh-Ritz of `(Xᵀ K X, Xᵀ M X)` on the converged Ritz vectors (better eigenvalues,
@@ -782,7 +850,7 @@ fn finalize(
     k: SparseColMatRef<'_, usize, f64>,
     m: SparseColMatRef<'_, usize, f64>,
     x: Mat<f64>,
-    s_ref: f64,
+    s_max: f64,
     stats: &mut LanczosStats,
 ) -> Result<Finalized> {
     let (n, p) = (x.nrows(), x.ncols());
@@ -820,28 +888,54 @@ fn finalize(
             orth = orth.max((gram[(i, j)] - target).abs());
         }
     }
-    let residuals = (0..p)
-        .map(|j| {
-            let lam = eigenvalues[j];
-            let mut r2 = 0.0;
-            for i in 0..n {
-                let r = kx[(i, j)] - lam * mx[(i, j)];
-                r2 += r * r;
-            }
-            let kn = norm2(kx.col(j));
-            let mn = norm2(mx.col(j));
-            let denom = if lam.abs() <= RIGID_BODY_TOL * s_ref {
-                s_ref * mn
-            } else {
-                kn + lam.abs() * mn
-            };
-            r2.sqrt() / denom
-        })
-        .collect();
+    let akx = abs_product(k, shapes.as_ref());
+    let mut residuals = Vec::with_capacity(p);
+    let mut attainable = Vec::with_capacity(p);
+    let mut rigid = Vec::with_capacity(p);
+    let mdiag = diagonal(m);
+    for j in 0..p {
+        let lam = eigenvalues[j];
+        let mut r2 = 0.0;
+        for i in 0..n {
+            let r = kx[(i, j)] - lam * mx[(i, j)];
+            r2 += r * r;
+        }
+        let col = |a: &Mat<f64>| -> Vec<f64> { a.col(j).iter().copied().collect() };
+        let (lam_r, floor, u) = crate::modal::check::rigid_measures(
+            &col(&shapes),
+            &col(&kx),
+            &col(&akx),
+            &col(&mx),
+            &mdiag,
+        );
+        let is_rigid = crate::modal::check::is_rigid(lam_r, floor, u);
+        let kn = norm2(kx.col(j));
+        let mn = norm2(mx.col(j));
+        let akn = norm2(akx.col(j));
+        // Rigid-body modes: K x ≈ 0 has no scale of its own; the terms that cancel in it do.
+        let denom = if is_rigid {
+            akn + lam.abs() * mn
+        } else {
+            kn + lam.abs() * mn
+        };
+        residuals.push(if denom > 0.0 { r2.sqrt() / denom } else { 0.0 });
+        // The stopping rule also keeps the former estimate `4 ε max(K_ii/M_ii) / |λ|`: it only
+        // ends the iteration; the caller checks the result against fixed bounds
+        // (`modal::check`).
+        let componentwise = if is_rigid || kn == 0.0 {
+            ATTAINABLE_FACTOR * f64::EPSILON
+        } else {
+            ATTAINABLE_FACTOR * f64::EPSILON * akn / kn
+        };
+        attainable.push(componentwise.max(ATTAINABLE_FACTOR * f64::EPSILON * s_max / lam.abs()));
+        rigid.push(is_rigid);
+    }
     Ok(Finalized {
         eigenvalues,
         shapes,
         residuals,
+        attainable,
+        rigid,
         orthonormality_error: orth,
     })
 }
@@ -866,6 +960,7 @@ fn sturm_and_assemble(
     fin: Finalized,
     beyond: &[(f64, f64)],
     s_ref: f64,
+    s_max: f64,
     sigma: f64,
     converged_to_tol: bool,
     par: Par,
@@ -904,12 +999,7 @@ fn sturm_and_assemble(
             let mut rigid = 0;
             let mut omega = Vec::with_capacity(p);
             for (i, &lam) in fin.eigenvalues.iter().enumerate() {
-                let rigid_mode = if lam > 0.0 {
-                    lam <= RIGID_BODY_TOL_POSITIVE * s_ref
-                } else {
-                    -lam <= RIGID_BODY_TOL * s_ref
-                };
-                if rigid_mode {
+                if fin.rigid[i] {
                     rigid += 1;
                     omega.push(0.0);
                 } else if lam < 0.0 {
@@ -935,7 +1025,8 @@ fn sturm_and_assemble(
                 max_residual,
                 converged_to_tol,
                 rigid_body_modes: rigid,
-                stiffness_scale: s_ref,
+                stiffness_scale: s_max,
+                shift_scale: s_ref,
                 shift: sigma,
                 sturm_shift: sigma_u,
                 sturm_count: count,

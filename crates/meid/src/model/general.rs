@@ -1,0 +1,649 @@
+//! The general finite-element model section, `[structure.fem.model]`: any structure of nodes,
+//! shells, frames, springs, dashpots, point masses, rigid links and constraints, inline or from a
+//! Gmsh mesh (see `docs/model-format.md`).
+//!
+//! ```toml
+//! [structure.fem.model]
+//! mesh = "press.msh"              # optional Gmsh 4.1 ASCII file (relative to the model file):
+//!                                 # quadrangles → shells, 2-node lines → frames, physical groups → sets
+//! nodes = [[0, 0, 0], [0, 0, 2]]  # inline nodes (m), referenced by 0-based index
+//! sets = { top = [1] }            # inline node sets (indices into `nodes`)
+//! material = { youngs_modulus = 2.1e11, poisson_ratio = 0.3, density = 7850 }   # default
+//! shells = [{ set = "plate", thickness = 0.02, shear_factor = 0.8333 }]         # per element set
+//! frames = [{ nodes = [0, 1], divisions = 10, area = 1e-3, iy = 1e-6, iz = 1e-6, j = 2e-6,
+//!             orientation = [1, 0, 0] }]                                       # or set = "columns"
+//! springs = [{ node = "feet", stiffness = [0, 0, 1e6, 0, 0, 0] }]  # to ground, or `to = <node>`
+//! dashpots = [{ node = "feet", damping = [0, 0, 1e3, 0, 0, 0] }]
+//! masses = [{ node = 1, mass = 10.0, inertia = [0.1, 0.1, 0.2] }]
+//! rigid_links = [{ master = 1, slaves = "top_ring" }]
+//! constraints = [{ set = "base", dofs = ["ux", "uy", "uz"] }]
+//! points = { O_b = "top", B = "top" }     # meid's points: node sets (every set is a point too)
+//! impact_direction = [0, 0, -1]
+//! ```
+//!
+//! A node reference (`node`, `to`, `master`, `slaves`) is an inline node index (integer) or the
+//! name of a node set (string): a Gmsh physical group or an entry of `sets`. Springs, dashpots
+//! and masses given on a set act at each of its nodes. Units: m, kg, N/m, N·m/rad, N·s/m, Pa,
+//! kg/m³, m², m⁴, kg·m². Rigid links are eliminated exactly (master-slave transformation,
+//! [`crate::structure::discrete`]); constraints remove DOFs and their reactions are part of the
+//! floor force.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::fem::{parse_dofs, ConstraintSpec, MaterialSpec};
+use super::Source;
+use crate::structure::{
+    Dashpot, FeModel, FrameElement, Material, Mesh, PointMass, RigidLink, Section, ShellElement,
+    Spring,
+};
+use crate::Result;
+
+/// A node by inline index or a node set by name.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum NodeRef {
+    Index(usize),
+    Set(String),
+}
+
+/// `[structure.fem.model]` (module docs).
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct GeneralSpec {
+    #[serde(default)]
+    pub mesh: Option<String>,
+    #[serde(default)]
+    pub nodes: Vec<[f64; 3]>,
+    #[serde(default)]
+    pub sets: BTreeMap<String, Vec<usize>>,
+    #[serde(default)]
+    pub material: Option<MaterialSpec>,
+    #[serde(default)]
+    pub shells: Vec<ShellSpec>,
+    #[serde(default)]
+    pub frames: Vec<FrameSpec>,
+    #[serde(default)]
+    pub springs: Vec<SpringSpec>,
+    #[serde(default)]
+    pub dashpots: Vec<DashpotSpec>,
+    #[serde(default)]
+    pub masses: Vec<MassSpec>,
+    #[serde(default)]
+    pub rigid_links: Vec<RigidLinkSpec>,
+    #[serde(default)]
+    pub constraints: Vec<ConstraintSpec>,
+    #[serde(default)]
+    pub points: BTreeMap<String, String>,
+    #[serde(default)]
+    pub impact_direction: Option<[f64; 3]>,
+}
+
+/// Shells of one section: the quadrangles of a Gmsh element set and/or inline quadrangles.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ShellSpec {
+    /// Gmsh physical surface.
+    #[serde(default)]
+    pub set: Option<String>,
+    /// Inline quadrangles (node indices, in order around the element).
+    #[serde(default)]
+    pub quads: Vec<[usize; 4]>,
+    /// m.
+    pub thickness: f64,
+    #[serde(default)]
+    pub material: Option<MaterialSpec>,
+    /// Transverse shear correction factor κ (default 5/6; π²/12 matches Mindlin's plate).
+    #[serde(default)]
+    pub shear_factor: Option<f64>,
+}
+
+/// 3-D Euler-Bernoulli frames of one section: the 2-node lines of a Gmsh physical curve, or a
+/// straight member between two inline nodes cut into `divisions` elements.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct FrameSpec {
+    #[serde(default)]
+    pub set: Option<String>,
+    #[serde(default)]
+    pub nodes: Option<[usize; 2]>,
+    #[serde(default)]
+    pub divisions: Option<usize>,
+    /// m².
+    pub area: f64,
+    /// m⁴, about local y.
+    pub iy: f64,
+    /// m⁴, about local z.
+    pub iz: f64,
+    /// Torsion constant, m⁴.
+    pub j: f64,
+    /// Local y lies in the plane of the element axis and this vector (default global Z, or X
+    /// for members along Z).
+    #[serde(default)]
+    pub orientation: Option<[f64; 3]>,
+    #[serde(default)]
+    pub material: Option<MaterialSpec>,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SpringSpec {
+    pub node: NodeRef,
+    /// Other end (one node); ground when absent.
+    #[serde(default)]
+    pub to: Option<NodeRef>,
+    /// `[x, y, z, rx, ry, rz]`: N/m and N·m/rad.
+    pub stiffness: [f64; 6],
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct DashpotSpec {
+    pub node: NodeRef,
+    #[serde(default)]
+    pub to: Option<NodeRef>,
+    /// `[x, y, z, rx, ry, rz]`: N·s/m and N·m·s/rad.
+    pub damping: [f64; 6],
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MassSpec {
+    pub node: NodeRef,
+    /// kg.
+    pub mass: f64,
+    /// `[Ixx, Iyy, Izz]` about global axes through the node (kg·m²).
+    #[serde(default)]
+    pub inertia: Option<[f64; 3]>,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RigidLinkSpec {
+    pub master: NodeRef,
+    pub slaves: NodeRef,
+}
+
+struct Builder<'a> {
+    src: &'a Source,
+    mesh: Mesh,
+    gmsh: Option<crate::structure::gmsh::GmshMesh>,
+    /// Gmsh node index → mesh node (added when used).
+    gmap: Vec<Option<usize>>,
+    /// Inline node index → mesh node.
+    inline: Vec<usize>,
+    sets: BTreeMap<String, Vec<usize>>,
+}
+
+const BASE: &str = "structure.fem.model";
+
+impl Builder<'_> {
+    fn err(&self, field: &str, msg: impl std::fmt::Display) -> crate::Error {
+        let f = format!("{BASE}.{field}");
+        self.src.error(&f, format!("{f}: {msg}"))
+    }
+    fn gnode(&mut self, i: usize) -> usize {
+        if let Some(x) = self.gmap[i] {
+            return x;
+        }
+        let p = self.gmsh.as_ref().map(|g| g.nodes[i]).unwrap_or([0.0; 3]);
+        let x = self.mesh.add_node(p);
+        self.gmap[i] = Some(x);
+        x
+    }
+    fn inline_node(&self, i: usize, field: &str) -> Result<usize> {
+        self.inline.get(i).copied().ok_or_else(|| {
+            self.err(
+                field,
+                format!(
+                    "node {i} does not exist; `nodes` holds {} nodes (0..{})",
+                    self.inline.len(),
+                    self.inline.len().saturating_sub(1)
+                ),
+            )
+        })
+    }
+    fn nodes_of(&mut self, r: &NodeRef, field: &str) -> Result<Vec<usize>> {
+        match r {
+            NodeRef::Index(i) => Ok(vec![self.inline_node(*i, field)?]),
+            NodeRef::Set(name) => {
+                if let Some(v) = self.sets.get(name) {
+                    return Ok(v.clone());
+                }
+                if let Some(g) = self
+                    .gmsh
+                    .as_ref()
+                    .and_then(|g| g.node_sets.get(name))
+                    .cloned()
+                {
+                    let v: Vec<usize> = g.iter().map(|&i| self.gnode(i)).collect();
+                    self.sets.insert(name.clone(), v.clone());
+                    return Ok(v);
+                }
+                let mut known: Vec<String> = self.sets.keys().cloned().collect();
+                if let Some(g) = &self.gmsh {
+                    known.extend(g.node_sets.keys().cloned());
+                }
+                known.sort();
+                known.dedup();
+                Err(self.err(
+                    field,
+                    format!(
+                        "unknown node set '{name}'; known sets: {}",
+                        if known.is_empty() {
+                            "(none)".into()
+                        } else {
+                            known.join(", ")
+                        }
+                    ),
+                ))
+            }
+        }
+    }
+    fn one_node(&mut self, r: &NodeRef, field: &str) -> Result<usize> {
+        let v = self.nodes_of(r, field)?;
+        match v.as_slice() {
+            [one] => Ok(*one),
+            _ => Err(self.err(
+                field,
+                format!("must be one node; the set holds {} nodes", v.len()),
+            )),
+        }
+    }
+    fn material(
+        &self,
+        m: &Option<MaterialSpec>,
+        default: Material,
+        field: &str,
+    ) -> Result<Material> {
+        match m {
+            Some(spec) => {
+                check_material(spec, field, self.src)?;
+                Ok(Material::from(*spec))
+            }
+            None => Ok(default),
+        }
+    }
+}
+
+fn check_material(m: &MaterialSpec, field: &str, src: &Source) -> Result<()> {
+    let f = format!("{BASE}.{field}");
+    for (key, v, ok, range) in [
+        (
+            "youngs_modulus",
+            m.youngs_modulus,
+            m.youngs_modulus.is_finite() && m.youngs_modulus > 0.0,
+            "a finite number > 0 Pa",
+        ),
+        (
+            "density",
+            m.density,
+            m.density.is_finite() && m.density > 0.0,
+            "a finite number > 0 kg/m³",
+        ),
+        (
+            "poisson_ratio",
+            m.poisson_ratio,
+            m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5,
+            "in (-1, 0.5)",
+        ),
+    ] {
+        if !ok {
+            let k = format!("{f}.{key}");
+            return Err(src.error(&k, format!("{k} must be {range} (got {v})")));
+        }
+    }
+    Ok(())
+}
+
+fn positive(b: &Builder<'_>, field: &str, v: f64, unit: &str) -> Result<()> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(b.err(
+            field,
+            format!("must be a finite number > 0 {unit} (got {v})"),
+        ))
+    }
+}
+
+fn nonnegative(b: &Builder<'_>, field: &str, v: &[f64], unit: &str) -> Result<()> {
+    match v.iter().position(|x| !(x.is_finite() && *x >= 0.0)) {
+        None => Ok(()),
+        Some(i) => Err(b.err(
+            field,
+            format!(
+                "component {} ({}) must be finite and >= 0 {unit} (got {})",
+                i + 1,
+                ["x", "y", "z", "rx", "ry", "rz"][i.min(5)],
+                v[i]
+            ),
+        )),
+    }
+}
+
+/// Builds the mesh a `[structure.fem.model]` describes and assembles it.
+pub fn build(spec: &GeneralSpec, src: &Source) -> Result<FeModel> {
+    let gmsh = match &spec.mesh {
+        Some(file) => {
+            let dir = Path::new(&src.name)
+                .parent()
+                .map(Path::to_path_buf)
+                .unwrap_or_default();
+            Some(crate::structure::gmsh::read_msh(dir.join(file))?)
+        }
+        None => None,
+    };
+    let ng = gmsh.as_ref().map(|g| g.nodes.len()).unwrap_or(0);
+    let mut b = Builder {
+        src,
+        mesh: Mesh::new(),
+        gmsh,
+        gmap: vec![None; ng],
+        inline: Vec::new(),
+        sets: BTreeMap::new(),
+    };
+    for (i, p) in spec.nodes.iter().enumerate() {
+        if p.iter().any(|c| !c.is_finite()) {
+            return Err(b.err(&format!("nodes[{i}]"), "coordinates must be finite (m)"));
+        }
+        let x = b.mesh.add_node(*p);
+        b.inline.push(x);
+    }
+    for (name, v) in &spec.sets {
+        let mut nodes = Vec::with_capacity(v.len());
+        for &i in v {
+            nodes.push(b.inline_node(i, &format!("sets.{name}"))?);
+        }
+        if nodes.is_empty() {
+            return Err(b.err(&format!("sets.{name}"), "is empty"));
+        }
+        b.sets.insert(name.clone(), nodes);
+    }
+    let default_mat = b.material(&spec.material, Material::STEEL, "material")?;
+
+    // Shells: every Gmsh quadrangle must get exactly one section.
+    let nq = b.gmsh.as_ref().map(|g| g.quads.len()).unwrap_or(0);
+    let mut quad_section: Vec<Option<usize>> = vec![None; nq];
+    for (si, s) in spec.shells.iter().enumerate() {
+        let field = format!("shells[{si}]");
+        positive(&b, &format!("{field}.thickness"), s.thickness, "m")?;
+        let mat = b.material(&s.material, default_mat, &format!("{field}.material"))?;
+        let kappa = s
+            .shear_factor
+            .unwrap_or(crate::structure::shell::DEFAULT_SHEAR_FACTOR);
+        positive(
+            &b,
+            &format!("{field}.shear_factor"),
+            kappa,
+            "(5/6 is usual)",
+        )?;
+        let mut quads: Vec<[usize; 4]> = Vec::new();
+        if let Some(set) = &s.set {
+            let g = b.gmsh.as_ref();
+            let ids = g
+                .and_then(|g| g.element_sets.get(set))
+                .cloned()
+                .ok_or_else(|| {
+                    let known: Vec<String> = g
+                        .map(|g| g.element_sets.keys().cloned().collect())
+                        .unwrap_or_default();
+                    b.err(
+                        &format!("{field}.set"),
+                        format!(
+                            "no physical surface '{set}' of quadrangles in the mesh; known: {}",
+                            if known.is_empty() {
+                                "(none)".to_string()
+                            } else {
+                                known.join(", ")
+                            }
+                        ),
+                    )
+                })?;
+            for q in ids {
+                if let Some(prev) = quad_section[q] {
+                    let tag = b.gmsh.as_ref().map(|g| g.quad_tags[q]).unwrap_or(0);
+                    return Err(b.err(
+                        &format!("{field}.set"),
+                        format!("quadrangle {tag} already has the section of shells[{prev}]; give each quadrangle one section"),
+                    ));
+                }
+                quad_section[q] = Some(si);
+                let gq = b.gmsh.as_ref().map(|g| g.quads[q]).unwrap_or([0; 4]);
+                quads.push(gq.map(|i| b.gnode(i)));
+            }
+        }
+        for (k, q) in s.quads.iter().enumerate() {
+            let mut nodes = [0; 4];
+            for (c, &i) in q.iter().enumerate() {
+                nodes[c] = b.inline_node(i, &format!("{field}.quads[{k}]"))?;
+            }
+            quads.push(nodes);
+        }
+        if quads.is_empty() {
+            return Err(b.err(
+                &field,
+                "has no quadrangles: give `set` (a Gmsh physical surface) or `quads`",
+            ));
+        }
+        for q in quads {
+            let mut el = ShellElement::new(q, mat, s.thickness);
+            el.shear_factor = kappa;
+            b.mesh.add_shell(el);
+        }
+    }
+    if let Some(q) = quad_section.iter().position(|s| s.is_none()) {
+        let tag = b.gmsh.as_ref().map(|g| g.quad_tags[q]).unwrap_or(0);
+        return Err(b.err(
+            "shells",
+            format!("quadrangle {tag} of the mesh is in no `shells` set: give its physical surface a section"),
+        ));
+    }
+
+    // Frames.
+    let nl = b.gmsh.as_ref().map(|g| g.lines.len()).unwrap_or(0);
+    let mut line_section: Vec<Option<usize>> = vec![None; nl];
+    for (fi, f) in spec.frames.iter().enumerate() {
+        let field = format!("frames[{fi}]");
+        for (k, v) in [("area", f.area), ("iy", f.iy), ("iz", f.iz), ("j", f.j)] {
+            positive(
+                &b,
+                &format!("{field}.{k}"),
+                v,
+                if k == "area" { "m²" } else { "m⁴" },
+            )?;
+        }
+        let section =
+            Section::new(f.area, f.iy, f.iz, f.j).map_err(|e| b.err(&field, e.to_string()))?;
+        let mat = b.material(&f.material, default_mat, &format!("{field}.material"))?;
+        if let Some(o) = f.orientation {
+            let n2 = o.iter().map(|x| x * x).sum::<f64>();
+            if !(n2.is_finite() && n2 > 0.0) {
+                return Err(b.err(
+                    &format!("{field}.orientation"),
+                    "must be a nonzero finite vector",
+                ));
+            }
+        }
+        let mut segs: Vec<[usize; 2]> = Vec::new();
+        match (&f.set, f.nodes) {
+            (Some(set), None) => {
+                if f.divisions.is_some() {
+                    return Err(b.err(
+                        &format!("{field}.divisions"),
+                        "applies to `nodes = [a, b]` only; a Gmsh curve is already divided",
+                    ));
+                }
+                let ids = b
+                    .gmsh
+                    .as_ref()
+                    .and_then(|g| g.line_sets.get(set))
+                    .cloned()
+                    .ok_or_else(|| {
+                        b.err(
+                            &format!("{field}.set"),
+                            format!("no physical curve '{set}' of 2-node lines in the mesh"),
+                        )
+                    })?;
+                for l in ids {
+                    if line_section[l].replace(fi).is_some() {
+                        return Err(b.err(
+                            &format!("{field}.set"),
+                            "a line already has another frame section",
+                        ));
+                    }
+                    let gl = b.gmsh.as_ref().map(|g| g.lines[l]).unwrap_or([0; 2]);
+                    segs.push(gl.map(|i| b.gnode(i)));
+                }
+            }
+            (None, Some([i, j])) => {
+                let a = b.inline_node(i, &format!("{field}.nodes"))?;
+                let c = b.inline_node(j, &format!("{field}.nodes"))?;
+                let nd = f.divisions.unwrap_or(1);
+                if nd == 0 || nd > 100_000 {
+                    return Err(b.err(
+                        &format!("{field}.divisions"),
+                        format!("must be in 1..=100000 (got {nd})"),
+                    ));
+                }
+                let (pa, pc) = (b.mesh.nodes[a], b.mesh.nodes[c]);
+                let mut prev = a;
+                for k in 1..=nd {
+                    let next = if k == nd {
+                        c
+                    } else {
+                        let t = k as f64 / nd as f64;
+                        b.mesh
+                            .add_node([0, 1, 2].map(|d| pa[d] + t * (pc[d] - pa[d])))
+                    };
+                    segs.push([prev, next]);
+                    prev = next;
+                }
+            }
+            _ => {
+                return Err(b.err(
+                    &field,
+                    "give either `set` (a Gmsh physical curve of 2-node lines) or `nodes = [a, b]`",
+                ));
+            }
+        }
+        for s in segs {
+            let mut el = FrameElement::new(s, mat, section);
+            el.orientation = f.orientation;
+            b.mesh.add_frame(el);
+        }
+    }
+
+    // Discrete elements.
+    for (i, s) in spec.springs.iter().enumerate() {
+        let field = format!("springs[{i}]");
+        nonnegative(
+            &b,
+            &format!("{field}.stiffness"),
+            &s.stiffness,
+            "N/m or N·m/rad",
+        )?;
+        let to = match &s.to {
+            Some(r) => Some(b.one_node(r, &format!("{field}.to"))?),
+            None => None,
+        };
+        for n in b.nodes_of(&s.node, &format!("{field}.node"))? {
+            b.mesh.add_spring(Spring {
+                node: n,
+                other: to,
+                stiffness: s.stiffness,
+            });
+        }
+    }
+    for (i, s) in spec.dashpots.iter().enumerate() {
+        let field = format!("dashpots[{i}]");
+        nonnegative(
+            &b,
+            &format!("{field}.damping"),
+            &s.damping,
+            "N·s/m or N·m·s/rad",
+        )?;
+        let to = match &s.to {
+            Some(r) => Some(b.one_node(r, &format!("{field}.to"))?),
+            None => None,
+        };
+        for n in b.nodes_of(&s.node, &format!("{field}.node"))? {
+            b.mesh.add_dashpot(Dashpot {
+                node: n,
+                other: to,
+                damping: s.damping,
+            });
+        }
+    }
+    for (i, m) in spec.masses.iter().enumerate() {
+        let field = format!("masses[{i}]");
+        positive(&b, &format!("{field}.mass"), m.mass, "kg")?;
+        let inertia = m.inertia.unwrap_or([0.0; 3]);
+        nonnegative(&b, &format!("{field}.inertia"), &inertia, "kg·m²")?;
+        for n in b.nodes_of(&m.node, &format!("{field}.node"))? {
+            b.mesh.add_mass(PointMass {
+                node: n,
+                mass_kg: m.mass,
+                inertia_kg_m2: inertia,
+            });
+        }
+    }
+    for (i, l) in spec.rigid_links.iter().enumerate() {
+        let field = format!("rigid_links[{i}]");
+        let master = b.one_node(&l.master, &format!("{field}.master"))?;
+        let slaves: Vec<usize> = b
+            .nodes_of(&l.slaves, &format!("{field}.slaves"))?
+            .into_iter()
+            .filter(|&s| s != master)
+            .collect();
+        if slaves.is_empty() {
+            return Err(b.err(
+                &format!("{field}.slaves"),
+                "holds no node other than the master",
+            ));
+        }
+        b.mesh.add_rigid_link(RigidLink { master, slaves });
+    }
+    for (i, c) in spec.constraints.iter().enumerate() {
+        let field = format!("constraints[{i}]");
+        let dofs = parse_dofs(&c.dofs, &format!("{BASE}.{field}.dofs"))
+            .map_err(|e| b.err(&format!("{field}.dofs"), e))?;
+        for n in b.nodes_of(&NodeRef::Set(c.set.clone()), &format!("{field}.set"))? {
+            b.mesh.fix(n, &dofs);
+        }
+    }
+    // Points: every set by its name, plus the `points` aliases.
+    let gsets: Vec<String> = b
+        .gmsh
+        .as_ref()
+        .map(|g| g.node_sets.keys().cloned().collect())
+        .unwrap_or_default();
+    for name in gsets {
+        // Only groups whose nodes are in the model (used by an element or a reference).
+        let all_used = b
+            .gmsh
+            .as_ref()
+            .is_some_and(|g| g.node_sets[&name].iter().all(|&i| b.gmap[i].is_some()));
+        if all_used {
+            let v = b.nodes_of(&NodeRef::Set(name.clone()), "points")?;
+            b.mesh.name_point(name, v);
+        }
+    }
+    for (name, v) in b.sets.clone() {
+        b.mesh.name_point(name, v);
+    }
+    for (p, set) in &spec.points {
+        let v = b.nodes_of(&NodeRef::Set(set.clone()), &format!("points.{p}"))?;
+        b.mesh.name_point(p.clone(), v);
+    }
+    let d = spec.impact_direction.unwrap_or([0.0, 0.0, -1.0]);
+    let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    if !(norm.is_finite() && norm > 0.0) {
+        return Err(b.err("impact_direction", "must be a nonzero finite vector"));
+    }
+    let mesh = b.mesh;
+    FeModel::assemble_with_direction(mesh, [d[0] / norm, d[1] / norm, d[2] / norm])
+        .map_err(|e| src.error(BASE, format!("{BASE}: {e}")))
+}

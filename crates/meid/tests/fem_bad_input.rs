@@ -1,0 +1,198 @@
+//! Bad finite-element input (issue 13, "Bad input"): Gmsh files whose counts disagree with their
+//! headers, elements referencing missing nodes, degenerate or inverted elements, and zero or
+//! negative section properties are refused with the file, line, entity and valid range.
+//!
+//! Before: a `$Elements` section whose header announced one block too few was read up to that
+//! count and the rest ignored, dropping half of a plate (floor force 36 N instead of 3,640 N).
+
+use std::fmt::Write;
+
+use meid::structure::gmsh::parse_msh;
+use meid::Error;
+
+/// A 2×1 quad mesh of [0, 2] × [0, 1] in two element blocks (one quad each) plus a point block.
+fn good() -> String {
+    let mut s = String::new();
+    s.push_str("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n");
+    s.push_str("$PhysicalNames\n1\n2 1 \"plate\"\n$EndPhysicalNames\n");
+    s.push_str("$Entities\n0 0 2 0\n1 0 0 0 1 1 0 1 1 0\n2 1 0 0 2 1 0 1 1 0\n$EndEntities\n");
+    s.push_str("$Nodes\n1 6 1 6\n2 1 0 6\n1\n2\n3\n4\n5\n6\n");
+    for (x, y) in [(0, 0), (1, 0), (2, 0), (0, 1), (1, 1), (2, 1)] {
+        writeln!(s, "{x} {y} 0").unwrap();
+    }
+    s.push_str("$EndNodes\n");
+    s.push_str("$Elements\n2 2 1 2\n2 1 3 1\n1 1 2 5 4\n2 2 3 1\n2 2 3 6 5\n$EndElements\n");
+    s
+}
+
+fn input_error(text: &str) -> (String, String) {
+    match parse_msh(text, "plate.msh") {
+        Err(Error::Input { location, message }) => (location, message),
+        other => panic!("expected an input error, got {other:?}"),
+    }
+}
+
+#[test]
+fn good_mesh_reads() {
+    let m = parse_msh(&good(), "plate.msh").unwrap();
+    assert_eq!(m.quads.len(), 2);
+    assert_eq!(m.quad_lines, vec![32, 34]);
+}
+
+/// The header announces one element block but the section holds two: refused at the first
+/// token past the announced data (line 33, the second block), not silently half a plate.
+#[test]
+fn one_block_too_few_in_the_header_is_refused() {
+    let bad = good().replace("$Elements\n2 2 1 2\n", "$Elements\n1 1 1 1\n");
+    let (loc, msg) = input_error(&bad);
+    assert_eq!(loc, "plate.msh:33:1", "{msg}");
+    assert!(msg.contains("after the 1 element blocks"), "{msg}");
+}
+
+#[test]
+fn element_count_disagreeing_with_the_blocks_is_refused() {
+    let bad = good().replace("$Elements\n2 2 1 2\n", "$Elements\n2 3 1 3\n");
+    let (loc, msg) = input_error(&bad);
+    assert_eq!(loc, "plate.msh:30:1");
+    assert!(
+        msg.contains("announces 3 elements but its 2 blocks hold 2"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn tag_range_disagreeing_with_the_data_is_refused() {
+    let bad = good().replace("$Nodes\n1 6 1 6\n", "$Nodes\n1 6 1 7\n");
+    let (_, msg) = input_error(&bad);
+    assert!(
+        msg.contains("node tags 1 to 7 but the data hold tags 1 to 6"),
+        "{msg}"
+    );
+    let bad = good().replace("$Elements\n2 2 1 2\n", "$Elements\n2 2 0 2\n");
+    let (_, msg) = input_error(&bad);
+    assert!(msg.contains("element tags 0 to 2"), "{msg}");
+}
+
+#[test]
+fn node_count_disagreeing_with_the_blocks_is_refused() {
+    let bad = good().replace("$Nodes\n1 6 1 6\n", "$Nodes\n1 7 1 6\n");
+    let (_, msg) = input_error(&bad);
+    assert!(msg.contains("announces 7 nodes"), "{msg}");
+}
+
+#[test]
+fn element_referencing_a_missing_node_is_refused() {
+    let bad = good().replace("2 2 3 6 5\n", "2 2 3 9 5\n");
+    let (loc, msg) = input_error(&bad);
+    assert_eq!(loc, "plate.msh:34:7");
+    assert!(msg.contains("refers to node '9'"), "{msg}");
+}
+
+#[test]
+fn duplicate_element_tag_is_refused() {
+    let bad = good().replace("2 2 3 6 5\n", "1 2 3 6 5\n");
+    let (loc, msg) = input_error(&bad);
+    assert_eq!(loc, "plate.msh:34:1");
+    assert!(
+        msg.contains("element tag 1 appears twice (first on line 32)"),
+        "{msg}"
+    );
+}
+
+/// A repeated node, a collapsed corner (three collinear nodes), a reflex corner and a
+/// self-intersecting ("bow-tie") order are refused at the element's line with its tag and nodes.
+#[test]
+fn degenerate_and_inverted_quads_are_refused() {
+    let bad = good().replace("2 2 3 6 5\n", "2 2 3 6 6\n");
+    let (loc, msg) = input_error(&bad);
+    assert_eq!(loc, "plate.msh:34:1");
+    assert!(
+        msg.contains("quadrangle 2 (nodes [2, 3, 6, 6]) is degenerate"),
+        "{msg}"
+    );
+    // Node 6 moved to (1.5, 0.5), on the line from node 3 (2, 0) to node 5 (1, 1): corner 180°.
+    let bad = good().replace("\n2 1 0\n", "\n1.5 0.5 0\n");
+    let (loc, msg) = input_error(&bad);
+    assert_eq!(loc, "plate.msh:34:1");
+    assert!(
+        msg.contains("quadrangle 2 (nodes [2, 3, 6, 5])") && msg.contains("collapsed corner"),
+        "{msg}"
+    );
+    // Node 6 moved to (1.2, 0.2), inside the triangle of nodes 2, 3, 5: a reflex corner.
+    let bad = good().replace("\n2 1 0\n", "\n1.2 0.2 0\n");
+    let (loc, msg) = input_error(&bad);
+    assert_eq!(loc, "plate.msh:34:1");
+    assert!(
+        msg.contains("quadrangle 2 (nodes [2, 3, 6, 5])") && msg.contains("inverted quad"),
+        "{msg}"
+    );
+    // Nodes in crossing ("bow-tie") order: zero area.
+    let bad = good().replace("2 2 3 6 5\n", "2 2 3 5 6\n");
+    let (_, msg) = input_error(&bad);
+    assert!(msg.contains("crossing diagonals"), "{msg}");
+}
+
+/// Zero or negative section and material properties in a model file are refused at their key.
+#[test]
+fn zero_or_negative_section_properties_are_refused() {
+    let dir = std::env::temp_dir().join(format!("meid-bad-input-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("plate.msh"), good()).unwrap();
+    let model = |mesh_extra: &str| {
+        format!(
+            r#"name = "bad"
+[structure]
+reference_mode = 1
+[structure.fem]
+select = [1]
+count = 3
+[structure.fem.mesh]
+file = "plate.msh"
+{mesh_extra}
+points = {{ O_b = "plate", B = "plate" }}
+fixed = ["plate"]
+[points]
+bed_contact = "O_b"
+measurement = "B"
+[slider]
+mass = 1.0
+velocity = 1.0
+[contact.slider_bed]
+law = "linear"
+stiffness = 1.0e8
+damping = 0.0
+release = "force"
+[simulation]
+method = "exact"
+duration = 0.02
+sample_rate = 20000.0
+"#
+        )
+    };
+    for (extra, key, range) in [
+        ("thickness = 0.0", "structure.fem.mesh.thickness", "> 0 m"),
+        ("thickness = -0.01", "structure.fem.mesh.thickness", "> 0 m"),
+        (
+            "thickness = 0.01\nmaterial = { youngs_modulus = -2e11, poisson_ratio = 0.3, density = 7850.0 }",
+            "structure.fem.mesh.material.youngs_modulus",
+            "> 0 Pa",
+        ),
+        (
+            "thickness = 0.01\nmaterial = { youngs_modulus = 2e11, poisson_ratio = 0.3, density = 0.0 }",
+            "structure.fem.mesh.material.density",
+            "> 0 kg/m³",
+        ),
+        (
+            "thickness = 0.01\nmaterial = { youngs_modulus = 2e11, poisson_ratio = 0.5, density = 7850.0 }",
+            "structure.fem.mesh.material.poisson_ratio",
+            "(-1, 0.5)",
+        ),
+    ] {
+        let path = dir.join("bad.toml");
+        std::fs::write(&path, model(extra)).unwrap();
+        let e = meid::model::Model::from_file(&path, &[]).unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, Error::Input { .. }), "{msg}");
+        assert!(msg.contains(key) && msg.contains(range), "{extra}: {msg}");
+    }
+}
