@@ -35,6 +35,8 @@ mod modes;
 mod montecarlo;
 mod optimize;
 mod outputs;
+mod progress;
+mod shard;
 mod shell;
 mod simulate;
 mod sweep;
@@ -56,11 +58,11 @@ pub(crate) struct Cli {
     #[arg(long, global = true, value_enum, default_value_t = ui::ColorChoice::Auto)]
     color: ui::ColorChoice,
     #[command(subcommand)]
-    command: Command,
+    pub(crate) command: Command,
 }
 
 #[derive(Subcommand)]
-enum Command {
+pub(crate) enum Command {
     /// Simulate one blow: energy left in the machine, contact forces, time histories.
     Simulate(simulate::SimulateArgs),
     /// Modal analysis of the model's structure: frequencies, effective masses, mode shapes.
@@ -75,6 +77,8 @@ enum Command {
     Blows(blows::BlowsArgs),
     /// Monte Carlo over uncertain inputs (seeded): mean, percentiles, histogram.
     Montecarlo(montecarlo::MonteCarloArgs),
+    /// Put the shards of a sweep or Monte Carlo (--shard K/N) together: the unsharded run's files.
+    Merge(shard::MergeArgs),
     /// Shell completion script for bash, zsh, fish, elvish or powershell, on stdout.
     Completions(shell::CompletionsArgs),
     /// The manual page (roff) on stdout, or every page into a directory with -o.
@@ -110,6 +114,7 @@ fn main() -> ExitCode {
         Command::Optimize(a) => optimize::run(a),
         Command::Blows(a) => blows::run(a),
         Command::Montecarlo(a) => montecarlo::run(a),
+        Command::Merge(a) => shard::merge(a),
         Command::Completions(a) => shell::completions(a),
         Command::Man(a) => shell::man(a),
     };

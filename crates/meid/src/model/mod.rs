@@ -23,6 +23,7 @@
 //! Errors name the file, line and column (or the `--set` that caused them), the field and
 //! the valid range; unknown keys get a did-you-mean.
 
+mod cache;
 pub mod fem;
 mod lumped;
 pub mod source;
@@ -31,6 +32,7 @@ pub mod strict;
 
 use std::path::Path;
 
+pub use cache::{StructureCache, StructureKey};
 pub use source::Source;
 pub use spec::*;
 
