@@ -310,10 +310,7 @@ impl Model {
         )
     }
 
-    fn __reduce__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyAny>, (String, String, Vec<String>))> {
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Reduce<'py>> {
         // Pickled as its text and overrides (dask ships models to workers this way).
         let f = py.import("meid")?.getattr("Model")?.getattr("from_toml")?;
         Ok((
@@ -377,17 +374,20 @@ impl Run {
     }
 }
 
-/// Columns of a study: names, float columns, the error column.
-type Columns = (Vec<String>, Vec<Vec<f64>>, Vec<Option<String>>);
-
-fn columns_py<'py>(
-    py: Python<'py>,
-    c: Columns,
-) -> PyResult<(
+/// Columns of a study as Python sees them: names, numpy columns, the error column.
+type PyColumns<'py> = (
     Vec<String>,
     Vec<Bound<'py, PyArray1<f64>>>,
     Vec<Option<String>>,
-)> {
+);
+
+/// Pickling: the constructor and its arguments (text, name, overrides).
+type Reduce<'py> = (Bound<'py, PyAny>, (String, String, Vec<String>));
+
+/// Columns of a study: names, float columns, the error column.
+type Columns = (Vec<String>, Vec<Vec<f64>>, Vec<Option<String>>);
+
+fn columns_py<'py>(py: Python<'py>, c: Columns) -> PyResult<PyColumns<'py>> {
     let arrays = c.1.into_iter().map(|v| PyArray1::from_vec(py, v)).collect();
     Ok((c.0, arrays, c.2))
 }
@@ -402,11 +402,7 @@ fn sweep_columns<'py>(
     specs: Vec<String>,
     bed_mass_kg: Option<f64>,
     threads: Option<usize>,
-) -> PyResult<(
-    Vec<String>,
-    Vec<Bound<'py, PyArray1<f64>>>,
-    Vec<Option<String>>,
-)> {
+) -> PyResult<PyColumns<'py>> {
     let pool = pool(threads)?;
     let m = model.inner.clone();
     let c = py
@@ -455,11 +451,7 @@ fn montecarlo_columns<'py>(
     first: usize,
     end: Option<usize>,
     threads: Option<usize>,
-) -> PyResult<(
-    Vec<String>,
-    Vec<Bound<'py, PyArray1<f64>>>,
-    Vec<Option<String>>,
-)> {
+) -> PyResult<PyColumns<'py>> {
     let pool = pool(threads)?;
     let m = model.inner.clone();
     let end = end.unwrap_or(samples);

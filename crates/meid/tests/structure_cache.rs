@@ -137,7 +137,10 @@ fn auto_cutoff_follows_the_contact_stiffness() {
     assert_eq!(pm.model.structure, fresh.structure);
 }
 
-fn bits(s: &[Sample]) -> Vec<(usize, Vec<u64>, Option<Vec<u64>>, Option<String>)> {
+/// A sample as bits: index, inputs, metrics, error.
+type SampleBits = (usize, Vec<u64>, Option<Vec<u64>>, Option<String>);
+
+fn bits(s: &[Sample]) -> Vec<SampleBits> {
     s.iter()
         .map(|s| {
             (
