@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use meid::analysis::blows::{run_blows_with, BlowOptions};
+use meid::analysis::blows::{run_blows_progress, BlowOptions};
 use meid::plot::{self, LinePlot, Series};
 
 use crate::args::{CaseArg, PrintArgs, RunArgs};
@@ -45,6 +45,8 @@ pub fn run(a: BlowsArgs) -> Result<()> {
     // pictured series (time, bed acceleration, floor force) are held.
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
     let mut pictured: [Vec<f64>; 3] = Default::default();
+    let bar = crate::progress::bar(a.print.quiet || a.print.json, a.blows, "blows");
+    let progress = |done: usize, _total: usize| bar.set_position(done as u64);
     let r = match &set {
         Some(set) => {
             let interval = meid::analysis::blows::blow_interval_s(a.rate_bpm, opts.sample_rate)?;
@@ -79,13 +81,18 @@ pub fn run(a: BlowsArgs) -> Result<()> {
                 pictured[2].extend_from_slice(&h.floor_force_n);
                 Ok(())
             };
-            let r = run_blows_with(&sys, &opts, &b, Some(&mut sink), false)
-                .context("blow train failed")?;
+            let r = run_blows_progress(&sys, &opts, &b, Some(&mut sink), false, &progress);
+            bar.finish_and_clear();
+            let r = r.context("blow train failed")?;
             w.into_inner()
                 .with_context(|| format!("cannot write {}", path.display()))?;
             r
         }
-        None => run_blows_with(&sys, &opts, &b, None, false).context("blow train failed")?,
+        None => {
+            let r = run_blows_progress(&sys, &opts, &b, None, false, &progress);
+            bar.finish_and_clear();
+            r.context("blow train failed")?
+        }
     };
     let out = serde_json::json!({
         "interval_s": r.interval_s,

@@ -88,9 +88,15 @@ pub fn run(a: CompareArgs) -> Result<()> {
         ..CompareOptions::default()
     };
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
-    let result = Comparison::new(model, options)
-        .run()
-        .context("comparison failed")?;
+    let comparison = Comparison::new(model, options);
+    let bar = crate::progress::bar(
+        a.print.quiet || a.print.json,
+        comparison.cases().len(),
+        "cases",
+    );
+    let result = comparison.run_with_progress(&|done, _| bar.set_position(done as u64));
+    bar.finish_and_clear();
+    let result = result.context("comparison failed")?;
     if let Some(set) = set {
         write_outputs(set.staging(), &result)?;
         set.commit("compare")?;

@@ -37,7 +37,9 @@ mod montecarlo;
 mod optimize;
 mod outputs;
 mod paper;
+mod progress;
 mod report;
+mod shard;
 mod shell;
 mod simulate;
 mod sweep;
@@ -60,11 +62,11 @@ pub(crate) struct Cli {
     #[arg(long, global = true, value_enum, default_value_t = ui::ColorChoice::Auto)]
     color: ui::ColorChoice,
     #[command(subcommand)]
-    command: Command,
+    pub(crate) command: Command,
 }
 
 #[derive(Subcommand)]
-enum Command {
+pub(crate) enum Command {
     /// Simulate one blow: energy left in the machine, contact forces, time histories.
     Simulate(simulate::SimulateArgs),
     /// Modal analysis of the model's structure: frequencies, effective masses, mode shapes.
@@ -89,6 +91,8 @@ enum Command {
     Measure(measure::MeasureArgs),
     /// The simulation beside measured records: frequency, level and peak errors, reductions.
     Validate(validate::ValidateArgs),
+    /// Put the shards of a sweep or Monte Carlo (--shard K/N) together: the unsharded run's files.
+    Merge(shard::MergeArgs),
     /// Shell completion script for bash, zsh, fish, elvish or powershell, on stdout.
     Completions(shell::CompletionsArgs),
     /// The manual page (roff) on stdout, or every page into a directory with -o.
@@ -128,6 +132,7 @@ fn main() -> ExitCode {
         Command::Paper(a) => paper::run(a),
         Command::Measure(a) => measure::run(a),
         Command::Validate(a) => validate::run(a),
+        Command::Merge(a) => shard::merge(a),
         Command::Completions(a) => shell::completions(a),
         Command::Man(a) => shell::man(a),
     };

@@ -2,9 +2,11 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 
-use meid::analysis::montecarlo::{histogram_outline, MonteCarlo, Uncertain, METRICS};
+use meid::analysis::montecarlo::{
+    histogram_outline, read_samples_exact_csv, samples_exact_csv, MonteCarlo, Uncertain, METRICS,
+};
 use meid::plot::{self, AreaPlot, Marker, Series};
 
 use crate::args::{MethodArg, PrintArgs, SetArgs};
@@ -35,6 +37,10 @@ pub struct MonteCarloArgs {
     output: Option<PathBuf>,
     #[command(flatten)]
     method: MethodArg,
+    /// Compute only shard K of N (1 <= K <= N: samples ⌊(K−1)S/N⌋..⌊KS/N⌋) into
+    /// DIR/shard.csv (needs -o DIR); `meid merge` puts the shards together.
+    #[arg(long, value_name = "K/N")]
+    shard: Option<crate::shard::Shard>,
     /// Simulated time per sample (s).
     #[arg(long, value_name = "S")]
     duration: Option<f64>,
@@ -44,7 +50,7 @@ pub struct MonteCarloArgs {
     print: PrintArgs,
 }
 
-pub fn run(a: MonteCarloArgs) -> Result<()> {
+fn prepare(a: &MonteCarloArgs) -> Result<MonteCarlo> {
     let model = load(
         &a.model,
         &a.set.set,
@@ -57,19 +63,129 @@ pub fn run(a: MonteCarloArgs) -> Result<()> {
         .iter()
         .map(|v| Uncertain::parse(v))
         .collect::<meid::Result<Vec<_>>>()?;
-    let study = MonteCarlo {
+    Ok(MonteCarlo {
         model,
         inputs,
         samples: a.samples,
         seed: a.seed,
-    };
+    })
+}
+
+fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
     let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(t) = a.threads {
+    if let Some(t) = threads {
         pool = pool.num_threads(t);
     }
-    let pool = pool.build().context("thread pool")?;
+    pool.build().context("thread pool")
+}
+
+pub fn run(a: MonteCarloArgs) -> Result<()> {
+    let study = prepare(&a)?;
+    let pool = pool(a.threads)?;
+    if let Some(shard) = a.shard {
+        let Some(dir) = &a.output else {
+            bail!(
+                "--shard needs -o DIR: the shard's samples go to DIR/shard.csv (then `meid merge`)"
+            );
+        };
+        let range = shard.range(study.samples);
+        study.check(range.len())?;
+        let bar = crate::progress::bar(a.print.quiet || a.print.json, range.len(), "samples");
+        let progress = |done: usize, _total: usize| bar.set_position(done as u64);
+        let samples = pool.install(|| study.run_range(range.clone(), &progress));
+        bar.finish_and_clear();
+        let rows = samples_exact_csv(&samples, study.inputs.len())?;
+        let files = crate::shard::write(
+            dir,
+            "montecarlo",
+            shard,
+            range.clone(),
+            study.samples,
+            &study.fingerprint(),
+            &rows,
+        )?;
+        if a.print.json {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&serde_json::json!({
+                    "shard": shard.k, "shards": shard.n, "first": range.start,
+                    "end": range.end, "total": study.samples, "files": files,
+                }))?
+            );
+        } else if a.print.human() {
+            println!(
+                "meid montecarlo — shard {}/{}: samples {}..{} of {} ({} failed)",
+                shard.k,
+                shard.n,
+                range.start,
+                range.end,
+                study.samples,
+                samples.iter().filter(|s| s.error.is_some()).count()
+            );
+            for f in files {
+                println!("  wrote {}", f.display());
+            }
+        }
+        return Ok(());
+    }
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
-    let r = pool.install(|| study.run()).context("Monte Carlo failed")?;
+    let bar = crate::progress::bar(a.print.quiet || a.print.json, study.samples, "samples");
+    let progress = |done: usize, _total: usize| bar.set_position(done as u64);
+    let r = pool.install(|| study.run_with_progress(&progress));
+    bar.finish_and_clear();
+    let r = r.context("Monte Carlo failed")?;
+    output(&a, &r, set)
+}
+
+/// `meid merge` of Monte Carlo shards: every sample of the study from the shards (checked to
+/// be this study's and to cover it once), the statistics and files as the unsharded run.
+pub fn merge(a: MonteCarloArgs, shards: &[crate::shard::ShardFiles]) -> Result<()> {
+    let study = prepare(&a)?;
+    study.check(study.samples)?;
+    crate::shard::check_cover(shards, &study.fingerprint(), study.samples)?;
+    let mut samples = Vec::with_capacity(study.samples);
+    for s in shards {
+        let file = s.dir.join("shard.csv");
+        let rows =
+            read_samples_exact_csv(&s.rows, study.inputs.len(), &file.display().to_string())?;
+        for r in &rows {
+            if r.index < s.first || r.index >= s.end {
+                bail!(
+                    "{}: sample {} is outside the shard's range {}..{}",
+                    file.display(),
+                    r.index,
+                    s.first,
+                    s.end
+                );
+            }
+        }
+        if rows.len() != s.end - s.first {
+            bail!(
+                "{}: {} samples, the shard's range {}..{} has {}",
+                file.display(),
+                rows.len(),
+                s.first,
+                s.end,
+                s.end - s.first
+            );
+        }
+        samples.extend(rows);
+    }
+    samples.sort_by_key(|s| s.index);
+    let r = study.finish(samples).context("Monte Carlo failed")?;
+    let Some(dir) = &a.output else {
+        bail!("meid merge needs -o DIR");
+    };
+    let set = crate::outputs::begin(dir)?;
+    output(&a, &r, Some(set))
+}
+
+/// Writes and prints a finished study as `meid montecarlo` does (shared with `meid merge`).
+fn output(
+    a: &MonteCarloArgs,
+    r: &meid::analysis::montecarlo::MonteCarloResult,
+    set: Option<meid::io::OutputSet>,
+) -> Result<()> {
     let stats = serde_json::json!({
         "seed": r.seed,
         "samples": r.samples.len(),

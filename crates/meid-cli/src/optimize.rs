@@ -89,7 +89,14 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
         OptimizeStudy::with_bed_mass(model, vars, Objective::parse(&a.objective)?, a.bed_mass)?;
     study.max_simulations = a.max_simulations;
     let t0 = std::time::Instant::now();
-    let rep = study.run()?;
+    let bar = crate::progress::bar(
+        a.print.quiet || a.print.json,
+        study.max_simulations,
+        "simulations (budget)",
+    );
+    let rep = study.run_with_progress(&|done, _| bar.set_position(done as u64));
+    bar.finish_and_clear();
+    let rep = rep?;
     let elapsed = t0.elapsed().as_secs_f64();
     if let Some(set) = set {
         meid::io::write_json(&set.staging().join("optimize.json"), &rep)?;

@@ -2,11 +2,9 @@
 //! energy map (2 ranges: paper Figs. 3, 12, 16) or families of curves (1 quantity, optionally
 //! times a listed family parameter: Figs. 4, 5, 9, 17).
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use indicatif::{ProgressBar, ProgressStyle};
 
 use meid::analysis::sweep::{
     case_label, case_name, Quantity, Spacing, Sweep, SweepResult, Vary, DERIVED, METRICS,
@@ -52,6 +50,10 @@ pub struct SweepArgs {
     /// one curve (or map) per case.
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     cases: Vec<String>,
+    /// Compute only shard K of N (1 <= K <= N: grid points ⌊(K−1)T/N⌋..⌊KT/N⌋) into
+    /// DIR/shard.csv (needs -o DIR); `meid merge` puts the shards together.
+    #[arg(long, value_name = "K/N")]
+    shard: Option<crate::shard::Shard>,
     /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, or the
     /// FE machine's bed plate; see docs/studies.md).
     #[arg(long, value_name = "KG")]
@@ -61,7 +63,9 @@ pub struct SweepArgs {
     print: PrintArgs,
 }
 
-pub fn run(a: SweepArgs) -> Result<()> {
+/// The sweep of the arguments (model loaded, grid checked), as `meid sweep` and `meid merge`
+/// build it.
+fn prepare(a: &SweepArgs) -> Result<Sweep> {
     if !METRICS.contains(&a.metric.as_str()) && !DERIVED.contains(&a.metric.as_str()) {
         bail!(
             "unknown --metric `{}`; valid: {}",
@@ -92,20 +96,73 @@ pub fn run(a: SweepArgs) -> Result<()> {
     if a.duration.is_some() {
         sweep.options.stop_at_collision_end = false;
     }
+    Ok(sweep)
+}
+
+fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    let mut b = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        if n == 0 {
+            bail!("--threads must be >= 1");
+        }
+        b = b.num_threads(n);
+    }
+    b.build().context("cannot start the worker threads")
+}
+
+pub fn run(a: SweepArgs) -> Result<()> {
+    let sweep = prepare(&a)?;
     let total = sweep.len();
-    let show = !a.print.quiet && std::io::stderr().is_terminal();
-    let bar = if show {
-        let b = ProgressBar::new(total as u64);
-        b.set_style(
-            ProgressStyle::with_template(
-                "{bar:40} {pos}/{len} points  {per_sec}  ETA {eta}  {elapsed}",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        b
-    } else {
-        ProgressBar::hidden()
-    };
+    if let Some(shard) = a.shard {
+        let Some(dir) = &a.output else {
+            bail!("--shard needs -o DIR: the shard's rows go to DIR/shard.csv (then `meid merge`)");
+        };
+        if a.resume || a.force {
+            bail!("--shard runs its slice afresh: drop --resume/--force");
+        }
+        let range = shard.range(total);
+        let bar = crate::progress::bar(a.print.quiet || a.print.json, range.len(), "points");
+        let progress = |done: usize, _total: usize| bar.set_position(done as u64);
+        let points = pool(a.threads)?.install(|| sweep.run_range(range.clone(), &progress))?;
+        bar.finish_and_clear();
+        let mut rows = sweep.columns().join(",");
+        rows.push('\n');
+        for p in &points {
+            rows.push_str(&sweep.row(p));
+        }
+        let files = crate::shard::write(
+            dir,
+            "sweep",
+            shard,
+            range.clone(),
+            total,
+            &sweep.fingerprint_text(),
+            rows.as_bytes(),
+        )?;
+        if a.print.json {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&serde_json::json!({
+                    "shard": shard.k, "shards": shard.n, "first": range.start,
+                    "end": range.end, "total": total, "files": files,
+                }))?
+            );
+        } else if a.print.human() {
+            println!(
+                "meid sweep — shard {}/{}: points {}..{} of {total} ({} failed)",
+                shard.k,
+                shard.n,
+                range.start,
+                range.end,
+                points.iter().filter(|p| p.error.is_some()).count()
+            );
+            for f in files {
+                println!("  wrote {}", f.display());
+            }
+        }
+        return Ok(());
+    }
+    let bar = crate::progress::bar(a.print.quiet, total, "points");
     let progress = |done: usize, _total: usize| bar.set_position(done as u64);
     if a.resume && a.output.is_none() {
         bail!("--resume needs -o DIR: the journal of the sweep is DIR/sweep.partial.csv");
@@ -124,16 +181,7 @@ pub fn run(a: SweepArgs) -> Result<()> {
             }
         }
     }
-    let pool = {
-        let mut b = rayon::ThreadPoolBuilder::new();
-        if let Some(n) = a.threads {
-            if n == 0 {
-                bail!("--threads must be >= 1");
-            }
-            b = b.num_threads(n);
-        }
-        b.build().context("cannot start the worker threads")?
-    };
+    let pool = pool(a.threads)?;
     let t0 = std::time::Instant::now();
     let result = match &a.output {
         Some(dir) => {
@@ -144,33 +192,82 @@ pub fn run(a: SweepArgs) -> Result<()> {
     };
     bar.finish_and_clear();
     let elapsed = t0.elapsed().as_secs_f64();
+    output(&a, &sweep, &result, set, elapsed)
+}
+
+/// Writes and prints a finished sweep as `meid sweep` does (shared with `meid merge`).
+fn output(
+    a: &SweepArgs,
+    sweep: &Sweep,
+    result: &SweepResult,
+    set: Option<meid::io::OutputSet>,
+    elapsed: f64,
+) -> Result<()> {
     let Some(set) = set else {
-        if let Some(e) = sweep.all_failed_error(&result) {
+        if let Some(e) = sweep.all_failed_error(result) {
             return Err(e.into());
         }
         if a.print.json {
-            println!("{}", serde_json::to_string_pretty(&result)?);
+            println!("{}", serde_json::to_string_pretty(result)?);
         } else if a.print.human() {
-            summarise(&sweep, &result, &a.metric, elapsed, &[]);
+            summarise(sweep, result, &a.metric, elapsed, &[]);
             println!();
             print!("{}", result.csv());
         }
         return Ok(());
     };
     result.write(set.staging())?;
-    if let Some(e) = sweep.all_failed_error(&result) {
+    if let Some(e) = sweep.all_failed_error(result) {
         // The results (every row with its error) are written; the run is that error.
         set.commit("sweep")?;
         return Err(e.into());
     }
-    draw(&sweep, &result, &a.metric, set.staging())?;
+    draw(sweep, result, &a.metric, set.staging())?;
     let files = set.commit("sweep")?;
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(&result)?);
+        println!("{}", serde_json::to_string_pretty(result)?);
     } else if a.print.human() {
-        summarise(&sweep, &result, &a.metric, elapsed, &files);
+        summarise(sweep, result, &a.metric, elapsed, &files);
     }
     Ok(())
+}
+
+/// `meid merge` of sweep shards: the rows of every shard, checked to be this sweep's and to
+/// cover its grid once, written as the unsharded `meid sweep -o DIR` writes them.
+pub fn merge(a: SweepArgs, shards: &[crate::shard::ShardFiles]) -> Result<()> {
+    let t0 = std::time::Instant::now();
+    let sweep = prepare(&a)?;
+    crate::shard::check_cover(shards, &sweep.fingerprint_text(), sweep.len())?;
+    let mut points = Vec::with_capacity(sweep.len());
+    for s in shards {
+        let text = String::from_utf8_lossy(&s.rows);
+        for (i, line) in text.lines().enumerate().skip(1) {
+            let p = sweep.parse_row(line).with_context(|| {
+                format!(
+                    "{}:{}: not a row of this sweep",
+                    s.dir.join("shard.csv").display(),
+                    i + 1
+                )
+            })?;
+            if p.index < s.first || p.index >= s.end {
+                bail!(
+                    "{}:{}: point {} is outside the shard's range {}..{}",
+                    s.dir.join("shard.csv").display(),
+                    i + 1,
+                    p.index,
+                    s.first,
+                    s.end
+                );
+            }
+            points.push(p);
+        }
+    }
+    let result = sweep.result_from(points)?;
+    let Some(dir) = &a.output else {
+        bail!("meid merge needs -o DIR");
+    };
+    let set = crate::outputs::begin(dir)?;
+    output(&a, &sweep, &result, Some(set), t0.elapsed().as_secs_f64())
 }
 
 /// Finished points in a sweep journal: its complete lines after the journal line and the

@@ -363,6 +363,7 @@ const SUBCOMMANDS: [&str; 10] = [
     "blows",
     "montecarlo",
     "report",
+    "merge",
     "completions",
     "man",
 ];

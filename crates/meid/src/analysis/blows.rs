@@ -232,8 +232,20 @@ pub fn run_blows_with(
     sys: &ImpactSystem,
     opts: &Options,
     blow: &BlowOptions,
+    on_history: Option<&mut HistorySink<'_>>,
+    keep_solutions: bool,
+) -> Result<BlowsRun> {
+    run_blows_progress(sys, opts, blow, on_history, keep_solutions, &|_, _| {})
+}
+
+/// [`run_blows_with`] calling `progress(blows done, blows)` after each blow.
+pub fn run_blows_progress(
+    sys: &ImpactSystem,
+    opts: &Options,
+    blow: &BlowOptions,
     mut on_history: Option<&mut HistorySink<'_>>,
     keep_solutions: bool,
+    progress: &dyn Fn(usize, usize),
 ) -> Result<BlowsRun> {
     let record = on_history.is_some();
     if blow.blows == 0 {
@@ -389,6 +401,7 @@ pub fn run_blows_with(
         let phi_b = &sys.points.bed_contact;
         x0[sys.slider_index()] = dot(phi_b, &x0[..n]);
         x0[nd + sys.slider_index()] = sys.slider.velocity;
+        progress(k + 1, blow.blows);
     }
     let steady = steady_state(&reports, blow.steady_tolerance);
     Ok(BlowsRun {

@@ -511,6 +511,11 @@ impl Comparison {
 
     /// Runs the cases and builds the table.
     pub fn run(&self) -> Result<ComparisonResult> {
+        self.run_with_progress(&|_, _| {})
+    }
+
+    /// [`Comparison::run`] calling `progress(cases done, cases)` after each case.
+    pub fn run_with_progress(&self, progress: &dyn Fn(usize, usize)) -> Result<ComparisonResult> {
         let fs = self.check()?;
         let o = &self.options;
         if o.curve_points < 2 {
@@ -564,7 +569,8 @@ impl Comparison {
             .map(|i| f_lo * (f_hi / f_lo).powf(i as f64 / (o.curve_points - 1) as f64))
             .collect();
         let mut cases = Vec::new();
-        for ((c, sys), centres) in systems.iter().zip(&centres) {
+        for (done, ((c, sys), centres)) in systems.iter().zip(&centres).enumerate() {
+            progress(done, systems.len());
             let c = *c;
             // Peaks on the continuous solution (not the samples): (bed acceleration, floor force).
             let (history, energy_ratio, peaks, traj) = if o.blows > 1 {

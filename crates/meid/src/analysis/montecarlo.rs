@@ -12,10 +12,12 @@
 //!   Distributions* vol. 1, ch. 14).
 //! * `uniform(a, b)`: `x = a + (b − a) u`, `u ~ U[0, 1)`.
 //!
-//! Sample `i` is the model with the drawn values set as `--set` overrides would (re-read
-//! from its text when an input lies under `structure.`; otherwise set on the parsed model,
-//! whose modes are reused, as a sweep point is) and simulated
-//! ([`super::simulate`], case as specified, the model's `[simulation]`). Metrics are the
+//! Sample `i` is the model with the drawn values set as `--set` overrides would
+//! ([`Model::with_fields`]) and simulated ([`super::simulate`], case as specified, the model's
+//! `[simulation]`). The structure is solved once: a sample reuses the base model's modes
+//! unless its inputs change the structural part of the model
+//! ([`crate::model::StructureKey`]), so a Monte Carlo over contact stiffness on an FE model
+//! costs what it costs on a lumped model of as many modes. Metrics are the
 //! summary's energy ratio E_p+/E_s−, peak bed acceleration at B, peak floor force and peak
 //! contact forces. Statistics over the successful samples: mean, sample standard deviation
 //! (`n − 1`), and the 5th, 50th and 95th percentiles by linear interpolation between order
@@ -29,16 +31,17 @@
 //!
 //! **Reproducibility.** The generator is SplitMix64 (Steele, Lea & Flood, OOPSLA 2014),
 //! hand-written (a dozen lines; no new dependency). Sample `i` draws from its own stream
-//! seeded with `mix(seed ⊕ mix(i + 1))`, so its inputs depend only on `(seed, i)`; samples run
-//! in parallel (rayon) and are collected in sample order: the result is identical for any
-//! thread count.
+//! seeded with `mix(seed ⊕ mix(i + 1))`: a counter-based key, so its inputs depend only on
+//! `(seed, i)`, never on which samples were drawn before; samples run in parallel (rayon) and
+//! are collected in sample order: the result is identical for any thread count and any split
+//! of the study into shards ([`MonteCarlo::run_range`], `meid montecarlo --shard K/N`).
 
 use rayon::prelude::*;
 use serde::Serialize;
 
 use super::energy::{simulate, Summary};
-use super::sweep::{field_kind, point_model, FieldKind, Quantity};
-use crate::model::{Case, Model};
+use super::sweep::{field_kind, FieldKind};
+use crate::model::{Case, Model, StructureCache};
 use crate::{Error, Result};
 
 pub use crate::rng::{mix64, SplitMix64};
@@ -304,40 +307,39 @@ impl MonteCarlo {
             .collect()
     }
 
-    fn run_sample(&self, values: &[f64]) -> Result<[f64; 5]> {
-        // Inputs outside `structure.` leave the structure as it is: set them on the model
-        // as a sweep point does (the modes are reused: no rebuild of a finite-element model
-        // per sample; the same model `--set` would give, test `montecarlo_fast_path_*`).
-        if !self.inputs.iter().any(|u| u.path.starts_with("structure")) {
-            let qs: Vec<Quantity> = self
-                .inputs
-                .iter()
-                .map(|u| Quantity::Field(u.path.clone()))
-                .collect();
-            let refs: Vec<&Quantity> = qs.iter().collect();
-            let m = point_model(&self.model, &refs, values, None)?.model;
-            let sys = m.impact_system(Case::AsSpecified)?;
-            let run = simulate(&sys, &m.options(), false)?;
-            return Ok(metrics_of(&run.summary));
-        }
-        let mut overrides: Vec<String> = self
-            .model
-            .source
-            .overrides
+    /// Simulates sample values `values`: the base model with the inputs set
+    /// ([`Model::with_fields`]; the structure is the base's, or `cache`'s, unless an input
+    /// changes the structural part of the model).
+    fn run_sample(&self, values: &[f64], cache: &StructureCache) -> Result<[f64; 5]> {
+        let fields: Vec<String> = self
+            .inputs
             .iter()
-            .map(|(p, v)| format!("{p}={v}"))
+            .zip(values)
+            .map(|(u, v)| format!("{}={v:e}", u.path))
             .collect();
-        for (u, v) in self.inputs.iter().zip(values) {
-            overrides.push(format!("{}={v:e}", u.path));
-        }
-        let m = Model::from_text(
-            &self.model.source.name,
-            self.model.source.text.clone(),
-            &overrides,
-        )?;
+        let m = self.model.with_fields(&fields, Some(cache))?;
         let sys = m.impact_system(Case::AsSpecified)?;
         let run = simulate(&sys, &m.options(), false)?;
         Ok(metrics_of(&run.summary))
+    }
+
+    /// Sample `i`: its drawn inputs and its metrics or error.
+    pub fn sample(&self, i: usize, cache: &StructureCache) -> Sample {
+        let inputs = self.draw(i);
+        match self.run_sample(&inputs, cache) {
+            Ok(m) => Sample {
+                index: i,
+                inputs,
+                metrics: Some(m),
+                error: None,
+            },
+            Err(e) => Sample {
+                index: i,
+                inputs,
+                metrics: None,
+                error: Some(e.to_string()),
+            },
+        }
     }
 
     /// Memory one sample takes in the study and its outputs (bytes): the result record with
@@ -351,8 +353,27 @@ impl MonteCarlo {
             + 24.0 * values
     }
 
-    /// Runs every sample in parallel on the current rayon pool; results in sample order.
-    pub fn run(&self) -> Result<MonteCarloResult> {
+    /// A fingerprint of everything that determines the samples (model, inputs, seed, count):
+    /// FNV-1a 64 over their text; shards of one study have the same.
+    pub fn fingerprint(&self) -> String {
+        let text = format!(
+            "{}|{:?}|{}|{}|{}",
+            serde_json::to_string(&self.model.spec).unwrap_or_default(),
+            self.inputs,
+            self.seed,
+            self.samples,
+            self.model.source.text
+        );
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for b in text.bytes() {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        format!("{h:016x}")
+    }
+
+    /// Checks the study's inputs and that `count` samples fit in memory.
+    pub fn check(&self, count: usize) -> Result<()> {
         if self.samples == 0 {
             return Err(Error::invalid("samples", "needs at least one sample"));
         }
@@ -389,42 +410,70 @@ impl MonteCarlo {
         crate::limits::check_memory(
             &format!(
                 "{} Monte Carlo samples ({} B each)",
-                self.samples,
+                count,
                 self.bytes_per_sample()
             ),
-            self.samples as f64 * self.bytes_per_sample(),
+            count as f64 * self.bytes_per_sample(),
             "samples",
             "the number of samples (--samples)",
-        )?;
-        let runs: Vec<(Sample, Option<Error>)> = (0..self.samples)
+        )
+    }
+
+    /// Runs every sample in parallel on the current rayon pool; results in sample order.
+    pub fn run(&self) -> Result<MonteCarloResult> {
+        self.run_with_progress(&|_, _| {})
+    }
+
+    /// [`MonteCarlo::run`] calling `progress(done, total)` after each sample (from the worker
+    /// threads).
+    pub fn run_with_progress(
+        &self,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<MonteCarloResult> {
+        self.check(self.samples)?;
+        let samples = self.run_range(0..self.samples, progress);
+        self.finish(samples)
+    }
+
+    /// The samples `range` (a shard of the study: sample `i` depends only on the seed and
+    /// `i`, so any split gives the same samples), in parallel, in sample order;
+    /// `progress(done, range length)` after each.
+    pub fn run_range(
+        &self,
+        range: std::ops::Range<usize>,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Vec<Sample> {
+        let cache = StructureCache::new();
+        let total = range.len();
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        range
             .into_par_iter()
             .map(|i| {
-                let inputs = self.draw(i);
-                match self.run_sample(&inputs) {
-                    Ok(m) => (
-                        Sample {
-                            index: i,
-                            inputs,
-                            metrics: Some(m),
-                            error: None,
-                        },
-                        None,
-                    ),
-                    Err(e) => (
-                        Sample {
-                            index: i,
-                            inputs,
-                            metrics: None,
-                            error: Some(e.to_string()),
-                        },
-                        Some(e),
-                    ),
-                }
+                let s = self.sample(i, &cache);
+                let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress(d, total);
+                s
             })
-            .collect();
-        let n = runs.len();
-        if runs.iter().all(|(_, e)| e.is_some()) {
-            let first = runs.into_iter().next().and_then(|(_, e)| e);
+            .collect()
+    }
+
+    /// The result of all the study's samples (in sample order, e.g. the shards' samples put
+    /// together): statistics, failures; when every sample failed, that failure as the error
+    /// (sample 0's, computed again for its kind, noting how many failed).
+    pub fn finish(&self, samples: Vec<Sample>) -> Result<MonteCarloResult> {
+        if samples.len() != self.samples || samples.iter().enumerate().any(|(i, s)| s.index != i) {
+            return Err(Error::numerical(
+                "montecarlo",
+                format!(
+                    "the samples are not the study's {} samples in order (got {})",
+                    self.samples,
+                    samples.len()
+                ),
+            ));
+        }
+        let n = samples.len();
+        if samples.iter().all(|s| s.error.is_some()) {
+            let first = self.run_sample(&self.draw(0), &StructureCache::new()).err();
             let tag = format!("all {n} samples failed; this is sample 0's error");
             return Err(match first {
                 Some(Error::Input { location, message }) => Error::Input {
@@ -440,10 +489,12 @@ impl MonteCarlo {
                     message: format!("{message} ({tag})"),
                 },
                 Some(e) => e,
-                None => Error::numerical("montecarlo", tag),
+                None => Error::numerical(
+                    "montecarlo",
+                    format!("{tag}: {}", samples[0].error.as_deref().unwrap_or("failed")),
+                ),
             });
         }
-        let samples: Vec<Sample> = runs.into_iter().map(|(s, _)| s).collect();
         let input_stats = self
             .inputs
             .iter()
@@ -474,6 +525,76 @@ impl MonteCarlo {
             failed,
         })
     }
+}
+
+/// Samples as exact rows (a shard of a study, `meid montecarlo --shard`): CSV with `sample`,
+/// the inputs, the metrics (Rust's shortest round-trip form `{:e}`, which reads back to the
+/// same bits, `NaN` included; empty when the sample failed) and the error.
+pub fn samples_exact_csv(samples: &[Sample], inputs: usize) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let err = |e: csv::Error| Error::numerical("csv", e.to_string());
+    let mut head = vec!["sample".to_string()];
+    head.extend((0..inputs).map(|k| format!("input{k}")));
+    head.extend(METRICS.iter().map(|m| m.to_string()));
+    head.push("error".into());
+    w.write_record(&head).map_err(err)?;
+    for s in samples {
+        let mut row = vec![s.index.to_string()];
+        row.extend(s.inputs.iter().map(|v| format!("{v:e}")));
+        match &s.metrics {
+            Some(m) => row.extend(m.iter().map(|v| format!("{v:e}"))),
+            None => row.extend(METRICS.iter().map(|_| String::new())),
+        }
+        row.push(s.error.clone().unwrap_or_default());
+        w.write_record(&row).map_err(err)?;
+    }
+    w.into_inner()
+        .map_err(|e| Error::numerical("csv", e.to_string()))
+}
+
+/// Reads [`samples_exact_csv`] back (`inputs` inputs per sample); `what` names the file in
+/// errors.
+pub fn read_samples_exact_csv(bytes: &[u8], inputs: usize, what: &str) -> Result<Vec<Sample>> {
+    let bad = |line: u64, m: String| Error::Input {
+        location: format!("{what}:{line}"),
+        message: m,
+    };
+    let mut r = csv::ReaderBuilder::new().from_reader(bytes);
+    let width = 1 + inputs + METRICS.len() + 1;
+    let mut out = Vec::new();
+    for rec in r.records() {
+        let rec = rec.map_err(|e| bad(e.position().map_or(0, |p| p.line()), e.to_string()))?;
+        let line = rec.position().map_or(0, |p| p.line());
+        if rec.len() != width {
+            return Err(bad(line, format!("{} fields, expected {width}", rec.len())));
+        }
+        let num = |k: usize| -> Result<f64> {
+            rec[k]
+                .parse::<f64>()
+                .map_err(|_| bad(line, format!("`{}` is not a number", &rec[k])))
+        };
+        let index: usize = rec[0]
+            .parse()
+            .map_err(|_| bad(line, format!("`{}` is not a sample index", &rec[0])))?;
+        let values = (1..=inputs).map(num).collect::<Result<Vec<f64>>>()?;
+        let metrics = if rec[1 + inputs].is_empty() {
+            None
+        } else {
+            let mut m = [0.0; 5];
+            for (k, x) in m.iter_mut().enumerate() {
+                *x = num(1 + inputs + k)?;
+            }
+            Some(m)
+        };
+        let e = &rec[width - 1];
+        out.push(Sample {
+            index,
+            inputs: values,
+            metrics,
+            error: (!e.is_empty()).then(|| e.to_string()),
+        });
+    }
+    Ok(out)
 }
 
 impl MonteCarloResult {

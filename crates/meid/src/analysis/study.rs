@@ -26,11 +26,11 @@ use serde::Serialize;
 
 use super::optimize::{brent_minimize, minimize_box, BrentOptions, NelderMeadOptions};
 use super::sweep::{
-    check_bed_mass, check_quantities, evaluate, failure_error, field_kind, FieldKind, PointResult,
-    Quantity,
+    check_bed_mass, check_quantities, evaluate, evaluate_cached, failure_error, field_kind,
+    FieldKind, PointResult, Quantity,
 };
 use crate::integrate::Options;
-use crate::model::Model;
+use crate::model::{Model, StructureCache};
 use crate::{Error, Result};
 
 /// Points of the coarse scan before Brent in one variable.
@@ -365,6 +365,32 @@ impl OptimizeStudy {
 
     /// Runs the search (see the module docs).
     pub fn run(&self) -> Result<OptimizeReport> {
+        self.run_with_progress(&|_, _| {})
+    }
+
+    /// [`OptimizeStudy::run`] calling `progress(simulations, max_simulations)` after each
+    /// simulation (the budget is the most the search can take; it may stop earlier).
+    pub fn run_with_progress(
+        &self,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<OptimizeReport> {
+        let cache = StructureCache::new();
+        let count = std::sync::atomic::AtomicUsize::new(0);
+        let qs_all: Vec<&Quantity> = self.variables.iter().map(|v| &v.quantity).collect();
+        let eval = |qs: &[&Quantity], x: &[f64]| -> PointResult {
+            let r = evaluate_cached(
+                &self.model,
+                qs,
+                x,
+                self.bed_mass_kg,
+                &self.options,
+                0,
+                Some(&cache),
+            );
+            let d = count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(d.min(self.max_simulations), self.max_simulations);
+            r
+        };
         let metric = self.objective.metric();
         let n = self.variables.len();
         let min = self.min_simulations();
@@ -387,7 +413,7 @@ impl OptimizeStudy {
         let search_budget = self.max_simulations - 2;
         let f = |u: &[f64]| -> f64 {
             let x: Vec<f64> = (0..n).map(|k| self.search_to_value(k, u[k])).collect();
-            self.evaluate(&x).metric(metric)
+            eval(&qs_all, &x).metric(metric)
         };
         let lo: Vec<f64> = (0..n)
             .map(|k| self.value_to_search(k, self.variables[k].lower))
@@ -458,7 +484,7 @@ impl OptimizeStudy {
             (r.x, r.evaluations, r.failures, r.converged)
         };
         let optimum: Vec<f64> = (0..n).map(|k| self.search_to_value(k, u_best[k])).collect();
-        let point = self.evaluate(&optimum);
+        let point = eval(&qs_all, &optimum);
         let objective_value = point.metric(metric);
         if !objective_value.is_finite() {
             if point.error.is_some() {
@@ -488,8 +514,7 @@ impl OptimizeStudy {
         qs.push(&wd);
         vals.push(1.0);
         let (rule, rule_runs) = if self.model.spec.damper.is_some() {
-            let r = evaluate(&self.model, &qs, &vals, self.bed_mass_kg, &self.options, 0)
-                .metric(metric);
+            let r = eval(&qs, &vals).metric(metric);
             (r, 1)
         } else {
             (f64::NAN, 0)

@@ -43,9 +43,12 @@
 //!
 //! # Cost and reproducibility
 //!
-//! The model file is parsed once. Derived ratios and non-structural fields are set on a clone
-//! of the [`ModelSpec`](crate::model::ModelSpec) and the modal model is reused; only a field
-//! under `structure.` rebuilds the model (with the field as an override). Points run in
+//! The model file is parsed once. Derived ratios and fields are set on a clone of the
+//! [`ModelSpec`](crate::model::ModelSpec), and the structure's modal model is reused unless
+//! the point changes the structural part of the model ([`crate::model::StructureKey`]: the
+//! `structure` table, the role points and, where the reduction uses it, the contact
+//! frequency); the structures built for such points are kept in [`Sweep::cache`] and shared
+//! by the points with the same structural part. Points run in
 //! parallel (rayon) and are collected in grid order, and numbers are written with Rust's
 //! shortest round-trip formatting (`{:e}`), so the CSV is byte-identical for any thread count
 //! and a resumed sweep reproduces an uninterrupted one exactly.
@@ -81,7 +84,7 @@ use serde::Serialize;
 
 use crate::analysis::{simulate, Summary};
 use crate::integrate::{Method, Options};
-use crate::model::{Case, Model};
+use crate::model::{Case, Model, StructureCache};
 use crate::{Error, Result};
 
 /// A quantity a sweep can vary. In JSON it is written as its [`Quantity::name`]
@@ -514,6 +517,9 @@ pub struct Sweep {
     /// The cases run at every point ([`Sweep::with_cases`]); empty: the model as specified,
     /// with the plain [`METRICS`] columns.
     pub cases: Vec<Case>,
+    /// The structures the points built (when a varied field changes the structural part of
+    /// the model, [`crate::model::StructureKey`]), shared by the points.
+    pub cache: std::sync::Arc<StructureCache>,
 }
 
 /// The name of a case in `--cases` and in the `METRIC:CASE` columns: `none`, `damper`,
@@ -585,6 +591,7 @@ impl Sweep {
             options,
             bed_mass_kg,
             cases: Vec::new(),
+            cache: Default::default(),
         };
         s.check()?;
         Ok(s)
@@ -745,11 +752,12 @@ impl Sweep {
 
     /// The model of grid point `index` (see the module docs for the order of resolution).
     pub fn point_model(&self, index: usize) -> Result<PointModel> {
-        point_model(
+        point_model_cached(
             &self.model,
             &self.quantities(),
             &self.values_at(index),
             self.bed_mass_kg,
+            Some(&self.cache),
         )
     }
 
@@ -771,6 +779,7 @@ impl Sweep {
             &self.options,
             index,
             &self.point_cases(),
+            Some(&self.cache),
         )
     }
 
@@ -783,6 +792,77 @@ impl Sweep {
             spec: self.spec(),
             points,
         }
+    }
+
+    /// Runs the grid points `range` only (a shard of the sweep: a point depends only on its
+    /// index, so any split gives the same rows); `progress(done, range length)`.
+    pub fn run_range(
+        &self,
+        range: std::ops::Range<usize>,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<Vec<PointResult>> {
+        if range.end > self.len() || range.start > range.end {
+            return Err(Error::invalid(
+                "shard",
+                format!(
+                    "points {}..{} are outside the grid of {} points",
+                    range.start,
+                    range.end,
+                    self.len()
+                ),
+            ));
+        }
+        let n = range.len();
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        Ok(range
+            .into_par_iter()
+            .map(|i| {
+                let r = self.run_point(i);
+                let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress(d, n);
+                r
+            })
+            .collect())
+    }
+
+    /// The result of the whole grid from its points in any order (e.g. the shards' rows):
+    /// refused unless every grid point is there exactly once.
+    pub fn result_from(&self, mut points: Vec<PointResult>) -> Result<SweepResult> {
+        points.sort_by_key(|p| p.index);
+        let total = self.len();
+        for (i, p) in points.iter().enumerate() {
+            if p.index != i {
+                let what = if p.index < i {
+                    format!("point {} is given twice", p.index)
+                } else {
+                    format!("point {i} is missing")
+                };
+                return Err(Error::invalid(
+                    "shards",
+                    format!("{what}; the sweep has {total} points"),
+                ));
+            }
+        }
+        if points.len() != total {
+            return Err(Error::invalid(
+                "shards",
+                format!(
+                    "{} of the sweep's {total} points are given; points {}..{total} are missing",
+                    points.len(),
+                    points.len()
+                ),
+            ));
+        }
+        Ok(SweepResult {
+            spec: self.spec(),
+            points,
+        })
+    }
+
+    /// A fingerprint of everything that determines the results (model, grid, options), as in
+    /// the journal's first line: shards of one sweep have the same.
+    pub fn fingerprint_text(&self) -> String {
+        self.fingerprint()
     }
 
     fn run_indices(
@@ -996,8 +1076,9 @@ impl Sweep {
         })
     }
 
-    /// Parses a journal row; `None` if it does not fit this sweep.
-    fn parse_row(&self, line: &str) -> Option<PointResult> {
+    /// Parses a journal row ([`Sweep::row`] without its newline); `None` if it does not fit
+    /// this sweep.
+    pub fn parse_row(&self, line: &str) -> Option<PointResult> {
         let mut rdr = csv::ReaderBuilder::new()
             .has_headers(false)
             .from_reader(line.as_bytes());
@@ -1276,14 +1357,26 @@ pub fn point_options(options: &Options, quantities: &[&Quantity], model: &Model)
 }
 
 /// Builds the model of one point: `base` with `quantities = values` resolved in the order of
-/// the module docs. The structure's modes are reused unless a `structure.` field is set.
-/// Field values are written as TOML literals of the field's kind ([`field_literal`]); the
-/// point's settings are checked as a model file's are.
+/// the module docs. The structure's modes are reused unless the fields change the structural
+/// part of the model ([`crate::model::StructureKey`]). Field values are written as TOML
+/// literals of the field's kind ([`field_literal`]); the point's settings are checked as a
+/// model file's are.
 pub fn point_model(
     base: &Model,
     quantities: &[&Quantity],
     values: &[f64],
     bed_mass_kg: Option<f64>,
+) -> Result<PointModel> {
+    point_model_cached(base, quantities, values, bed_mass_kg, None)
+}
+
+/// [`point_model`] keeping the structures it builds in `cache` (a study's points share them).
+pub fn point_model_cached(
+    base: &Model,
+    quantities: &[&Quantity],
+    values: &[f64],
+    bed_mass_kg: Option<f64>,
+    cache: Option<&StructureCache>,
 ) -> Result<PointModel> {
     let mut model = base.clone();
     // 1. Field paths.
@@ -1297,37 +1390,26 @@ pub fn point_model(
                 fields.push(format!("{p}={}", field_literal(p, *v, kind, "--vary")?));
             }
         }
-        let structural = quantities
-            .iter()
-            .any(|q| matches!(q, Quantity::Field(p) if p.starts_with("structure")));
-        if structural {
-            let mut ov: Vec<String> = base
-                .source
-                .overrides
-                .iter()
-                .map(|(p, v)| format!("{p}={v}"))
-                .collect();
-            ov.extend(fields);
-            model = Model::from_text(&base.source.name, base.source.text.clone(), &ov)?;
-        } else {
-            for f in &fields {
-                let applied = crate::model::source::apply_override(&mut table, f)?;
-                model.source.overrides.push(applied);
-            }
-            model.spec = crate::model::strict::deserialize(toml::Value::Table(table)).map_err(
-                |(e, track)| Error::Input {
-                    location: fields
-                        .iter()
-                        .map(|f| format!("--vary {f}"))
-                        .collect::<Vec<_>>()
-                        .join(" "),
-                    message: crate::model::strict::message(e.message(), &track),
-                },
-            )?;
-            model.validate_settings()?;
+        let mut source = base.source.clone();
+        for f in &fields {
+            let applied = crate::model::source::apply_override(&mut table, f)?;
+            source.overrides.push(applied);
         }
+        let spec = crate::model::strict::deserialize(toml::Value::Table(table)).map_err(
+            |(e, track)| Error::Input {
+                location: fields
+                    .iter()
+                    .map(|f| format!("--vary {f}"))
+                    .collect::<Vec<_>>()
+                    .join(" "),
+                message: crate::model::strict::message(e.message(), &track),
+            },
+        )?;
+        model = base.with_spec(spec, source, cache)?;
     }
     let get = |q: Quantity| quantities.iter().position(|x| **x == q).map(|i| values[i]);
+    let ratios = quantities.iter().any(|q| !matches!(q, Quantity::Field(_)));
+    let key_before = ratios.then(|| model.structure_key());
     let w_ref = model.reference_omega();
     let m_b = bed_mass_kg.or_else(|| model.bed_mass());
     let spec = &mut model.spec;
@@ -1365,6 +1447,11 @@ pub fn point_model(
         }
         c.stiffness = d.mass * w_d * w_d;
     }
+    // A contact frequency changed by a ratio can change the structure's reduction (a lumped
+    // model's rigid springs, an FE `select = "auto"` cutoff): then the point gets its own.
+    if key_before.is_some_and(|k| k != model.structure_key()) {
+        model.structure = base.structure_for(&model.spec, &model.source, cache)?;
+    }
     let derived = vec![
         model.spec.contact.slider_bed.stiffness,
         model
@@ -1397,12 +1484,37 @@ pub fn evaluate(
         options,
         index,
         &[Case::AsSpecified],
+        None,
     )
 }
 
-/// Simulates one point once per case (the point's model is built once); the metrics are the
-/// [`METRICS`] of each case in turn. A case that fails gets NaN metrics and its error (prefixed
-/// with the case's name when there are several cases) in [`PointResult::error`].
+/// [`evaluate`] with the point's structure from (or kept in) `cache`.
+pub fn evaluate_cached(
+    base: &Model,
+    quantities: &[&Quantity],
+    values: &[f64],
+    bed_mass_kg: Option<f64>,
+    options: &Options,
+    index: usize,
+    cache: Option<&StructureCache>,
+) -> PointResult {
+    evaluate_cases(
+        base,
+        quantities,
+        values,
+        bed_mass_kg,
+        options,
+        index,
+        &[Case::AsSpecified],
+        cache,
+    )
+}
+
+/// Simulates one point once per case (the point's model is built once, its structure from or
+/// kept in `cache`); the metrics are the [`METRICS`] of each case in turn. A case that fails
+/// gets NaN metrics and its error (prefixed with the case's name when there are several cases)
+/// in [`PointResult::error`].
+#[allow(clippy::too_many_arguments)]
 pub fn evaluate_cases(
     base: &Model,
     quantities: &[&Quantity],
@@ -1411,9 +1523,10 @@ pub fn evaluate_cases(
     options: &Options,
     index: usize,
     cases: &[Case],
+    cache: Option<&StructureCache>,
 ) -> PointResult {
     let nan_metrics = || vec![Some(f64::NAN); METRICS.len() * cases.len()];
-    let pm = match point_model(base, quantities, values, bed_mass_kg) {
+    let pm = match point_model_cached(base, quantities, values, bed_mass_kg, cache) {
         Ok(pm) => pm,
         Err(e) => {
             return PointResult {

@@ -23,6 +23,7 @@
 //! Errors name the file, line and column (or the `--set` that caused them), the field and
 //! the valid range; unknown keys get a did-you-mean.
 
+mod cache;
 pub mod fem;
 pub mod general;
 mod lumped;
@@ -32,6 +33,7 @@ pub mod strict;
 
 use std::path::Path;
 
+pub use cache::{StructureCache, StructureKey};
 pub use source::Source;
 pub use spec::*;
 
