@@ -205,7 +205,7 @@ pub fn detect_blows(x: &[f64], fs: f64, p: &Processing) -> Result<Blows> {
     };
     let starts = triggers
         .iter()
-        .filter(|&&t| t >= pre && t - pre + length <= n)
+        .filter(|&&t| t >= pre && (t - pre).checked_add(length).is_some_and(|e| e <= n))
         .map(|&t| t - pre)
         .collect();
     Ok(Blows {
@@ -225,9 +225,10 @@ pub fn average_blows(x: &[f64], starts: &[usize], len: usize) -> Result<Vec<f64>
             "no complete blow record to average",
         ));
     }
+    check_starts(x.len(), starts, len)?;
     let mut acc = vec![0.0; len];
     for &s in starts {
-        let seg = x.get(s..s + len).ok_or_else(|| {
+        let seg = x.get(s..s.saturating_add(len)).ok_or_else(|| {
             Error::invalid(
                 "blows",
                 format!(
@@ -243,6 +244,28 @@ pub fn average_blows(x: &[f64], starts: &[usize], len: usize) -> Result<Vec<f64>
     let b = starts.len() as f64;
     acc.iter_mut().for_each(|a| *a /= b);
     Ok(acc)
+}
+
+/// Every blow record `[s, s + len)` lies in a channel of `n` samples (checked before anything
+/// of size `len` is allocated).
+fn check_starts(n: usize, starts: &[usize], len: usize) -> Result<()> {
+    if len < 2 {
+        return Err(Error::invalid(
+            "blows",
+            format!("a blow record needs at least 2 samples, got {len}"),
+        ));
+    }
+    for &s in starts {
+        if s.checked_add(len).is_none_or(|e| e > n) {
+            return Err(Error::invalid(
+                "blows",
+                format!(
+                    "the record from sample {s} ({len} samples) runs past the end ({n} samples)"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Windowed FFTs of blow records with one plan.
@@ -377,6 +400,7 @@ pub fn blow_spectrum(
         return Err(Error::invalid("blows", "no complete blow record: lower the trigger level, the pre-trigger or the record length"));
     }
     let len = blows.length;
+    check_starts(x.len(), &blows.starts, len)?;
     let n_fft = n_fft.unwrap_or(len).max(len);
     let w = window_for(q, x, blows, fs, p)?;
     let mut tr = Transformer::new(n_fft);
@@ -429,6 +453,7 @@ pub fn h1(force: &[f64], response: &[f64], fs: f64, blows: &Blows, p: &Processin
         return Err(Error::invalid("blows", "no complete blow record for H1"));
     }
     let len = blows.length;
+    check_starts(force.len(), &blows.starts, len)?;
     let wf = window_for(Quantity::Force, force, blows, fs, p)?;
     let wx = p.window.coefficients(len, fs)?;
     let mut tf = Transformer::new(len);

@@ -466,14 +466,21 @@ impl Validation {
                 )?;
                 let (rref, _) = esd_reference(ch.channel.quantity());
                 let series = |label: String, s: &BlowSpectrum| {
-                    // At most ~4000 points drawn: every k-th bin.
-                    let k = (s.frequency_hz.len() / 4000).max(1);
+                    // On the logarithmic axis: a bin when its frequency is 0.2 % above the last
+                    // one drawn (every bin where they are sparser).
+                    let mut last = 0.0;
                     let (x, y) = s
                         .frequency_hz
                         .iter()
                         .zip(&s.density)
                         .skip(1)
-                        .step_by(k)
+                        .filter(|(f, _)| {
+                            let keep = **f >= last * 1.002;
+                            if keep {
+                                last = **f;
+                            }
+                            keep
+                        })
                         .map(|(f, e)| (*f, esd_level_db(*e, rref)))
                         .unzip();
                     Series {
