@@ -354,7 +354,7 @@ fn optimize_output_is_its_json_report() {
 // ---------------------------------------------------------------------------------------------
 // 4. Completions and manual pages.
 
-const SUBCOMMANDS: [&str; 10] = [
+const SUBCOMMANDS: [&str; 14] = [
     "simulate",
     "modes",
     "sweep",
@@ -364,6 +364,9 @@ const SUBCOMMANDS: [&str; 10] = [
     "montecarlo",
     "report",
     "merge",
+    "paper",
+    "measure",
+    "validate",
     "completions",
     "man",
 ];

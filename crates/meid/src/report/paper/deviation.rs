@@ -32,6 +32,13 @@ pub struct DeviationRow {
     pub reproduces: String,
 }
 
+/// A variant with its lumped and FE comparisons (`None`: not run on that kind).
+type VariantRuns = (
+    Variant,
+    Option<Result<ComparisonResult>>,
+    Option<Result<ComparisonResult>>,
+);
+
 fn verdict(p: f64, tol: f64, l: Option<f64>, f: Option<f64>) -> String {
     let ok = |v: Option<f64>| v.is_some_and(|x| (x - p).abs() <= tol);
     match (ok(l), ok(f)) {
@@ -188,7 +195,8 @@ fn run_variant(m: &Machine, v: &Variant) -> Option<Result<ComparisonResult>> {
             set_contacts(&mut model, r * m.w_ref);
         }
         let model = with_added_mass_at(&model, added_mass_point(m));
-        compare_model(&model, m.base, 200, &v.options)
+        let record = (v.options.spectrum == SpectrumMethod::Fft).then_some(v.options.duration_s);
+        compare_model(&model, m.base, 200, &v.options, record)
     };
     Some(build())
 }
@@ -207,14 +215,7 @@ pub fn study(machines: &[Machine], studies: &[MachineStudy], table: &[Row]) -> V
             .find(|(m, _)| m.base == base && m.kind == kind)
     };
     // The compare variants of each configuration, run once and shared by its numbers.
-    let mut cache: Vec<(
-        Base,
-        Vec<(
-            Variant,
-            Option<Result<ComparisonResult>>,
-            Option<Result<ComparisonResult>>,
-        )>,
-    )> = Vec::new();
+    let mut cache: Vec<(Base, Vec<VariantRuns>)> = Vec::new();
     for base in [Base::Soft, Base::Stiff, Base::None] {
         let needed = failing
             .iter()

@@ -155,7 +155,7 @@ pub fn two_mode_springs(m_b: f64, m_f: f64, f1: f64, f2: f64) -> Result<(f64, f6
     let s = w1 * w1 + w2 * w2;
     let a = 1.0 / m_b + 1.0 / m_f;
     let disc = s * s - 4.0 * a * p * m_b;
-    if !(disc >= 0.0) {
+    if disc.is_nan() || disc < 0.0 {
         return Err(Error::invalid(
             "two_mode_springs",
             format!("no two-mass model of {m_b} kg and {m_f} kg has modes {f1} and {f2} Hz"),

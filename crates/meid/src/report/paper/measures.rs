@@ -32,7 +32,7 @@ impl Quantity {
     }
 }
 
-fn case<'a>(r: &'a ComparisonResult, c: CaseName) -> Option<&'a CaseResult> {
+fn case(r: &ComparisonResult, c: CaseName) -> Option<&CaseResult> {
     r.cases.iter().find(|x| x.case == c)
 }
 

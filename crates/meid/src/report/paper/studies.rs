@@ -414,6 +414,7 @@ pub fn run(m: &Machine, res: &Resolution) -> Result<MachineStudy> {
             m.base,
             res.spectrum_points,
             &CompareOptions::default(),
+            None,
         )?),
         _ => None,
     };
@@ -442,7 +443,7 @@ pub fn record_s(base: Base) -> f64 {
 }
 
 /// The three-case comparison at the machine's operating point (added mass on the base where
-/// there is one), with `options` (its record length replaced by [`record_s`] unless set).
+/// there is one), over the record [`record_s`].
 pub fn compare_at(
     m: &Machine,
     curve_points: usize,
@@ -453,23 +454,22 @@ pub fn compare_at(
         m.base,
         curve_points,
         options,
+        None,
     )
 }
 
-/// [`compare_at`] on a given model of the machine.
+/// [`compare_at`] on a given model of the machine, over `record_s` seconds (default
+/// [`record_s`] of the configuration; the exact spectrum does not depend on it, the FFT path
+/// does).
 pub fn compare_model(
     model: &Model,
     base: Base,
     curve_points: usize,
     options: &CompareOptions,
+    record: Option<f64>,
 ) -> Result<ComparisonResult> {
-    let defaults = CompareOptions::default();
     let o = CompareOptions {
-        duration_s: if options.duration_s == defaults.duration_s {
-            record_s(base)
-        } else {
-            options.duration_s
-        },
+        duration_s: record.unwrap_or_else(|| record_s(base)),
         curve_points,
         ..options.clone()
     };
