@@ -349,9 +349,8 @@ fn contact_frequencies_match_closed_forms() {
 /// decouple).
 #[test]
 fn elastic_convention_matches_the_full_modal_sum() {
-    let (path, text) = bounce_model("free", "select = { band_hz = [0.0, 1e12] }\ncount = 1000");
+    let (path, text) = bounce_model("free", "");
     let text = text
-        .replace("count = 30\n", "")
         .replace(
             "springs = [{ group = \"corners\", stiffness",
             "#springs = [{ group = \"corners\", stiffness",
@@ -369,13 +368,27 @@ fn elastic_convention_matches_the_full_modal_sum() {
     let ctx = ReductionContext::of(&spec);
     let a = fem::analyse(spec.structure.fem.as_ref().unwrap(), &src, &ctx).unwrap();
     assert_eq!(a.modes.rigid_body_modes, 6);
-    assert_eq!(a.selected.len(), a.model.n_dofs());
-    let rows = a.modal.truncation(&ctx.role_points);
-    assert_eq!(rows.len(), 2);
-    for r in &rows {
-        eprintln!("{r:?}");
-        // Measured: 1.7e-13.
-        assert!((r.captured_share - 1.0).abs() <= 1e-11, "{r:?}");
+    // Every mode, from the dense solver directly (`meid` refuses the top of a full dense
+    // spectrum, whose residuals exceed the solution check's bound; their ψ²/ω² is negligible).
+    let all = meid::modal::dense::solve_shift_invert(
+        a.model.dense_stiffness().as_ref(),
+        a.model.dense_mass().as_ref(),
+        None,
+    )
+    .unwrap();
+    assert_eq!(all.rigid_body_modes, 6);
+    for p in ["O_b", "B"] {
+        let f = a.model.point_functional(p).unwrap();
+        let sum: f64 = (0..all.eigenvalues.len())
+            .filter(|&i| all.omega_rad_per_s[i] > 0.0)
+            .map(|i| {
+                let psi: f64 = (0..f.len()).map(|j| f[j] * all.shapes[(j, i)]).sum();
+                psi * psi / all.eigenvalues[i]
+            })
+            .sum();
+        let g = a.modal.static_flexibility[p];
+        eprintln!("{p}: full modal sum {sum:e}, G_PP {g:e}");
+        assert!((sum / g - 1.0).abs() <= 1e-11, "{p}: {sum} vs {g}");
     }
 
     // z-only springs: three in-plane rigid-body modes, same G_PP as with in-plane springs.

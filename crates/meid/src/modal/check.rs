@@ -36,8 +36,9 @@
 //!
 //! For a symmetric pencil the residual bounds the eigenvalue error: some exact eigenvalue lies
 //! within `‖r‖_{M⁻¹}` of λ for an M-normalised φ (Parlett, *The Symmetric Eigenvalue Problem*,
-//! §15.2). With `‖K φ‖ ≈ λ ‖M φ‖` the relative 2-norm residual 1e-6 keeps the frequencies'
-//! error far below the 1e-4 meid prints, unless M spans many decades.
+//! §15.2); for an isolated mode the Rayleigh quotient's error is of the order of the squared
+//! residual, so the bound [`RESIDUAL_BOUND`] keeps the frequencies' error far below what meid
+//! prints.
 
 use faer::sparse::SparseColMatRef;
 use faer::MatRef;
@@ -300,7 +301,7 @@ mod tests {
         }
     }
 
-    /// A wrong eigenvalue (2k (1 + 1e-5) for 2k) fails the residual bound: an error, not a result.
+    /// A wrong eigenvalue (2k (1 + 1e-4) for 2k) fails the residual bound: an error, not a result.
     #[test]
     fn wrong_eigenvalue_is_an_error() {
         let k = 3.0e5;
@@ -311,7 +312,7 @@ mod tests {
         let e = check_modes(
             kk.as_ref(),
             mm.as_ref(),
-            &[2.0 * k * (1.0 + 1e-5)],
+            &[2.0 * k * (1.0 + 1e-4)],
             shapes.as_ref(),
             "test",
         )

@@ -71,12 +71,13 @@ pub struct DenseModes {
 /// `K_ii / M_ii`, see [`default_shift`]).
 pub const DEFAULT_RELATIVE_SHIFT: f64 = 1e-4;
 
-/// The default shift `σ = 1e-4 s̃`, `s̃` the **mass-weighted median** of `K_ii / M_ii` over the
+/// The default shift `σ = 1e-4 min(s̃, tr K / tr M)`, `s̃` the **mass-weighted median** of `K_ii / M_ii` over the
 /// DOFs (the ratio below which DOFs holding half of `tr M` lie). It is the scale of the element
 /// stiffness per unit mass of the bulk of the structure. A mean (`tr K / tr M`, used before) is
 /// dominated by a few very stiff springs: springs of 1e14 N/m on a plate's edges put σ at
 /// 1e9 rad²/s², four decades above the plate's first mode, whose eigenvalues then drowned in
-/// round-off. Falls back to `1e-4 tr K / tr M`, then 1, when the median is 0.
+/// round-off. The mean stays a candidate: the smaller scale is the closer to the low modes.
+/// 1 when neither is positive.
 pub fn default_shift(k: MatRef<'_, f64>, m: MatRef<'_, f64>, tr_k: f64, tr_m: f64) -> f64 {
     let n = k.nrows();
     let mut r: Vec<(f64, f64)> = (0..n)
@@ -94,15 +95,16 @@ pub fn default_shift(k: MatRef<'_, f64>, m: MatRef<'_, f64>, tr_k: f64, tr_m: f6
             break;
         }
     }
-    for s in [
+    // The smaller of the median and the mean scale: the mean is the smaller one when the bulk's
+    // K_ii/M_ii is spread by light rotational DOFs, and it is the shift this solver had before.
+    [
         DEFAULT_RELATIVE_SHIFT * med,
         DEFAULT_RELATIVE_SHIFT * tr_k / tr_m,
-    ] {
-        if s.is_finite() && s > 0.0 {
-            return s;
-        }
-    }
-    1.0
+    ]
+    .into_iter()
+    .filter(|s| s.is_finite() && *s > 0.0)
+    .reduce(f64::min)
+    .unwrap_or(1.0)
 }
 
 /// ω per mode (exactly 0 for rigid-body modes) and the number of rigid-body modes, decided by

@@ -1040,6 +1040,20 @@ pub fn solve_modes(
     count: usize,
 ) -> Result<(DenseModes, &'static str)> {
     let n = model.n_dofs();
+    if solver.is_none() && n < DENSE_LIMIT_DOFS {
+        // The automatic choice: dense, and when its solution fails the check (the dense
+        // shift-invert loses accuracy on modes far below its shift, e.g. a soft bounce on stiff
+        // plates), the sparse solver, whose result is checked the same way.
+        let block = LanczosOptions::default().block_size;
+        return match solve_modes(model, Some(SolverSpec::Dense), count) {
+            Err(e) if lanczos_max_modes(n, block) >= count.min(n) => {
+                solve_modes(model, Some(SolverSpec::Lanczos), count).map_err(|e2| {
+                    Error::numerical("eigen-solvers", format!("dense: {e}; lanczos: {e2}"))
+                })
+            }
+            other => other,
+        };
+    }
     let solver = solver.unwrap_or(if n < DENSE_LIMIT_DOFS {
         SolverSpec::Dense
     } else {
