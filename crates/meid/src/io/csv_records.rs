@@ -134,7 +134,10 @@ pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>>
             format!("{} rows of data: expected at least 2", t.len()),
         ));
     }
-    if let Some(i) = t.windows(2).position(|w| !(w[1] > w[0])) {
+    if let Some(i) = t
+        .windows(2)
+        .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+    {
         return Err(err(
             hline,
             format!(

@@ -175,9 +175,8 @@ impl<R: BufRead> Parser<'_, R> {
         let mut out = UffFile::default();
         let mut ordinal = 0usize;
         let mut unit_code: Option<i64> = None;
-        loop {
-            // Between datasets: blank lines, then "-1".
-            let Some(l) = self.line()? else { break };
+        // Between datasets: blank lines, then "-1".
+        while let Some(l) = self.line()? {
             if l.trim().is_empty() {
                 continue;
             }
@@ -513,7 +512,7 @@ impl<R: BufRead> Parser<'_, R> {
                             return Err(self.err(Some(ds), None, self.line_no, format!("expected the closing '    -1' after {bytes} bytes of binary data, got '{}'", clip(&l))));
                         }
                         None => {
-                            return Err(self.err(Some(ds), None, self.line_no, format!("the file ends after the binary data: expected the closing '    -1'")));
+                            return Err(self.err(Some(ds), None, self.line_no, "the file ends after the binary data: expected the closing '    -1'".to_string()));
                         }
                     }
                 }
@@ -563,7 +562,10 @@ impl<R: BufRead> Parser<'_, R> {
                 t.push(c[0] * xf);
                 y.push(c[1]);
             }
-            if let Some(k) = t.windows(2).position(|w| !(w[1] > w[0])) {
+            if let Some(k) = t
+                .windows(2)
+                .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+            {
                 return Err(self.err(Some(ds), Some("record 12"), r7_line + 5, format!("uneven abscissa: time {} s at point {} does not increase to {} s at point {}", t[k], k + 1, t[k + 1], k + 2)));
             }
             (Abscissa::Uneven(t), y)
@@ -1251,6 +1253,107 @@ pub fn write_55<W: Write>(w: &mut W, mode: &Mode) -> std::io::Result<()> {
     writeln!(w, "{:>6}", -1)
 }
 
+/// Writes evenly sampled records as datasets 58, one per record, in order; the response node
+/// is the record's position (1-based) unless the record names its point.
+pub fn write_records<W: Write>(w: &mut W, records: &[Record], binary: bool) -> Result<()> {
+    for (k, r) in records.iter().enumerate() {
+        let (start_s, step_s) = r.even()?;
+        let point = r.point.clone().unwrap_or(PointRef {
+            entity: r.name.split('_').next().unwrap_or("NONE").to_string(),
+            node: k as i64 + 1,
+            direction: 3,
+        });
+        let ch = Channel58 {
+            name: &r.name,
+            point,
+            quantity: r.quantity,
+            start_s,
+            step_s,
+            values: &r.values,
+        };
+        write_58(w, &ch, binary).map_err(|e| Error::io("UFF output", e))?;
+    }
+    Ok(())
+}
+
+/// Dataset 2411 + one dataset 55 per mode of a modal model's named points (a lumped or
+/// tabulated model has no geometry: point k, in name order, is node k at x = k − 1 m; its z
+/// translation is the mode-shape value, mass-normalised, modal mass 1). Damping ratios are
+/// `D_ii / (2 ω_i)` (0 for rigid-body modes).
+pub fn modes_uff_points(m: &crate::modal::ModalModel) -> Result<Vec<u8>> {
+    let names: Vec<&String> = m.points.keys().collect();
+    let nodes: Vec<Node> = (0..names.len())
+        .map(|k| Node {
+            label: k as i64 + 1,
+            xyz: [k as f64, 0.0, 0.0],
+        })
+        .collect();
+    let n = m.omega_rad_per_s.len();
+    let mut out = Vec::new();
+    write_2411(&mut out, &nodes).map_err(|e| Error::io("UFF output", e))?;
+    for i in 0..n {
+        let w = m.omega_rad_per_s[i];
+        let d = m.damping.get(i * n + i).copied().unwrap_or(0.0);
+        let mode = Mode {
+            number: i as i64 + 1,
+            frequency_hz: w / (2.0 * std::f64::consts::PI),
+            modal_mass: 1.0,
+            damping_ratio: if w > 0.0 { d / (2.0 * w) } else { 0.0 },
+            name: m
+                .labels
+                .get(i)
+                .cloned()
+                .unwrap_or_else(|| format!("mode {}", i + 1)),
+            shapes: names
+                .iter()
+                .enumerate()
+                .map(|(k, p)| (k as i64 + 1, [0.0, 0.0, m.points[*p][i]]))
+                .collect(),
+        };
+        write_55(&mut out, &mode).map_err(|e| Error::io("UFF output", e))?;
+    }
+    Ok(out)
+}
+
+/// Dataset 2411 (every mesh node, label = index + 1, coordinates in m) + one dataset 55 per
+/// computed mode (nodal translations of the mass-normalised shapes, modal mass 1) of an FE
+/// analysis; `zeta[i]` the modal damping ratios (missing: 0).
+pub fn modes_uff_fe(
+    model: &crate::structure::assembly::FeModel,
+    modes: &crate::modal::dense::DenseModes,
+    zeta: &[f64],
+) -> Result<Vec<u8>> {
+    let nodes: Vec<Node> = model
+        .mesh
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(k, p)| Node {
+            label: k as i64 + 1,
+            xyz: *p,
+        })
+        .collect();
+    let mut out = Vec::new();
+    write_2411(&mut out, &nodes).map_err(|e| Error::io("UFF output", e))?;
+    for i in 0..modes.omega_rad_per_s.len() {
+        let t = super::vtk::mode_translations(model, modes, i)?;
+        let mode = Mode {
+            number: i as i64 + 1,
+            frequency_hz: modes.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI),
+            modal_mass: 1.0,
+            damping_ratio: zeta.get(i).copied().unwrap_or(0.0),
+            name: format!("mode {}", i + 1),
+            shapes: t
+                .iter()
+                .enumerate()
+                .map(|(k, v)| (k as i64 + 1, *v))
+                .collect(),
+        };
+        write_55(&mut out, &mode).map_err(|e| Error::io("UFF output", e))?;
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1404,105 +1507,4 @@ mod tests {
         assert_eq!(f.nodes, nodes);
         assert_eq!(f.modes, vec![mode]);
     }
-}
-
-/// Writes evenly sampled records as datasets 58, one per record, in order; the response node
-/// is the record's position (1-based) unless the record names its point.
-pub fn write_records<W: Write>(w: &mut W, records: &[Record], binary: bool) -> Result<()> {
-    for (k, r) in records.iter().enumerate() {
-        let (start_s, step_s) = r.even()?;
-        let point = r.point.clone().unwrap_or(PointRef {
-            entity: r.name.split('_').next().unwrap_or("NONE").to_string(),
-            node: k as i64 + 1,
-            direction: 3,
-        });
-        let ch = Channel58 {
-            name: &r.name,
-            point,
-            quantity: r.quantity,
-            start_s,
-            step_s,
-            values: &r.values,
-        };
-        write_58(w, &ch, binary).map_err(|e| Error::io("UFF output", e))?;
-    }
-    Ok(())
-}
-
-/// Dataset 2411 + one dataset 55 per mode of a modal model's named points (a lumped or
-/// tabulated model has no geometry: point k, in name order, is node k at x = k − 1 m; its z
-/// translation is the mode-shape value, mass-normalised, modal mass 1). Damping ratios are
-/// `D_ii / (2 ω_i)` (0 for rigid-body modes).
-pub fn modes_uff_points(m: &crate::modal::ModalModel) -> Result<Vec<u8>> {
-    let names: Vec<&String> = m.points.keys().collect();
-    let nodes: Vec<Node> = (0..names.len())
-        .map(|k| Node {
-            label: k as i64 + 1,
-            xyz: [k as f64, 0.0, 0.0],
-        })
-        .collect();
-    let n = m.omega_rad_per_s.len();
-    let mut out = Vec::new();
-    write_2411(&mut out, &nodes).map_err(|e| Error::io("UFF output", e))?;
-    for i in 0..n {
-        let w = m.omega_rad_per_s[i];
-        let d = m.damping.get(i * n + i).copied().unwrap_or(0.0);
-        let mode = Mode {
-            number: i as i64 + 1,
-            frequency_hz: w / (2.0 * std::f64::consts::PI),
-            modal_mass: 1.0,
-            damping_ratio: if w > 0.0 { d / (2.0 * w) } else { 0.0 },
-            name: m
-                .labels
-                .get(i)
-                .cloned()
-                .unwrap_or_else(|| format!("mode {}", i + 1)),
-            shapes: names
-                .iter()
-                .enumerate()
-                .map(|(k, p)| (k as i64 + 1, [0.0, 0.0, m.points[*p][i]]))
-                .collect(),
-        };
-        write_55(&mut out, &mode).map_err(|e| Error::io("UFF output", e))?;
-    }
-    Ok(out)
-}
-
-/// Dataset 2411 (every mesh node, label = index + 1, coordinates in m) + one dataset 55 per
-/// computed mode (nodal translations of the mass-normalised shapes, modal mass 1) of an FE
-/// analysis; `zeta[i]` the modal damping ratios (missing: 0).
-pub fn modes_uff_fe(
-    model: &crate::structure::assembly::FeModel,
-    modes: &crate::modal::dense::DenseModes,
-    zeta: &[f64],
-) -> Result<Vec<u8>> {
-    let nodes: Vec<Node> = model
-        .mesh
-        .nodes
-        .iter()
-        .enumerate()
-        .map(|(k, p)| Node {
-            label: k as i64 + 1,
-            xyz: *p,
-        })
-        .collect();
-    let mut out = Vec::new();
-    write_2411(&mut out, &nodes).map_err(|e| Error::io("UFF output", e))?;
-    for i in 0..modes.omega_rad_per_s.len() {
-        let t = super::vtk::mode_translations(model, modes, i)?;
-        let mode = Mode {
-            number: i as i64 + 1,
-            frequency_hz: modes.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI),
-            modal_mass: 1.0,
-            damping_ratio: zeta.get(i).copied().unwrap_or(0.0),
-            name: format!("mode {}", i + 1),
-            shapes: t
-                .iter()
-                .enumerate()
-                .map(|(k, v)| (k as i64 + 1, *v))
-                .collect(),
-        };
-        write_55(&mut out, &mode).map_err(|e| Error::io("UFF output", e))?;
-    }
-    Ok(out)
 }

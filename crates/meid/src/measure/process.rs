@@ -375,7 +375,7 @@ impl BlowSpectrum {
     pub fn third_octaves(&self) -> Vec<(Band, f64)> {
         let df = self.bin_width_hz();
         let top = self.frequency_hz.last().copied().unwrap_or(0.0);
-        if !(df > 0.0) {
+        if df.is_nan() || df <= 0.0 {
             return Vec::new();
         }
         bands_covering(df, top)

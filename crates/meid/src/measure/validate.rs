@@ -305,7 +305,7 @@ fn one_case(
             let (Some(sv), Some(mv)) = (ss.peak_in_band(lo, hi), ms.peak_in_band(lo, hi)) else {
                 continue;
             };
-            if !(sv.1 > 0.0) || sv.1 < strongest * 1e-3 {
+            if sv.1.is_nan() || sv.1 <= 0.0 || sv.1 < strongest * 1e-3 {
                 continue;
             }
             let (ls, lm) = (esd_level_db(sv.1, rref), esd_level_db(mv.1, rref));
