@@ -1,6 +1,6 @@
 //! Interoperability with pyuff (PyPI, the reference UFF reader/writer of the Python test-lab
 //! tools): pyuff writes files meid reads, and reads files meid writes, values equal to 1e-9
-//! relative in binary and to the printed precision in ASCII (`%20.11e`: 12 significant digits;
+//! relative in binary and to the printed precision in ASCII (pyuff `%20.11e`: 12 significant digits, meid `%20.12e`: 13;
 //! pyuff's abscissa fields `%13.5e`: 6).
 //!
 //! Needs a Python with pyuff: `MEID_PYUFF_PYTHON`, else `target/ci-venv/bin/python` (which

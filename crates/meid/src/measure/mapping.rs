@@ -214,13 +214,13 @@ pub fn map_records(
                 return Err(Error::Input {
                     location: r.origin.clone(),
                     message: format!(
-                        "channel '{}' is a {} ({}) but is mapped to {} ({}), a {}",
+                        "channel '{}' is {} ({}) but is mapped to {} ({}), which takes {}",
                         r.name,
-                        r.quantity.name(),
+                        with_article(r.quantity.name()),
                         r.source_unit,
                         t.target(),
                         t.label(),
-                        t.quantity().name()
+                        with_article(t.quantity().name())
                     ),
                 });
             }
@@ -244,6 +244,15 @@ pub fn map_records(
         }
     }
     Ok(out)
+}
+
+/// "an acceleration", "a force".
+fn with_article(w: &str) -> String {
+    if w.starts_with(['a', 'e', 'i', 'o', 'u']) {
+        format!("an {w}")
+    } else {
+        format!("a {w}")
+    }
 }
 
 /// The simulated channel a record is by its name alone (module docs), if any.
