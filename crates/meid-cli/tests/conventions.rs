@@ -342,7 +342,7 @@ fn optimize_output_is_its_json_report() {
 // ---------------------------------------------------------------------------------------------
 // 4. Completions and manual pages.
 
-const SUBCOMMANDS: [&str; 9] = [
+const SUBCOMMANDS: [&str; 11] = [
     "simulate",
     "modes",
     "sweep",
@@ -350,6 +350,8 @@ const SUBCOMMANDS: [&str; 9] = [
     "optimize",
     "blows",
     "montecarlo",
+    "measure",
+    "validate",
     "completions",
     "man",
 ];
