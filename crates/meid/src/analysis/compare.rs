@@ -276,6 +276,25 @@ pub struct ChannelSpectrum {
     pub peaks: Vec<(f64, f64)>,
 }
 
+impl ChannelSpectrum {
+    /// The curve to draw: the ESD on `frequency_hz` (the comparison's frequencies) with the
+    /// refined peaks merged in, at `f > 0`, sorted by frequency, as levels in dB re
+    /// `reference` ([`super::esd::esd_level_db`]).
+    pub fn level_curve_db(&self, frequency_hz: &[f64], reference: f64) -> (Vec<f64>, Vec<f64>) {
+        let mut pts: Vec<(f64, f64)> = frequency_hz
+            .iter()
+            .zip(&self.esd)
+            .map(|(f, e)| (*f, *e))
+            .chain(self.peaks.iter().copied())
+            .filter(|(f, _)| *f > 0.0)
+            .collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        pts.into_iter()
+            .map(|(f, e)| (f, super::esd::esd_level_db(e, reference)))
+            .unzip()
+    }
+}
+
 /// The results of one case.
 #[derive(Debug, Clone)]
 pub struct CaseResult {

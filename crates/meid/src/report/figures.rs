@@ -350,19 +350,7 @@ pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Res
             .iter()
             .filter_map(|c| {
                 let s = c.spectra.get(ch)?;
-                let mut pts: Vec<(f64, f64)> = r
-                    .frequency_hz
-                    .iter()
-                    .zip(&s.esd)
-                    .map(|(f, e)| (*f, *e))
-                    .chain(s.peaks.iter().copied())
-                    .filter(|(f, _)| *f > 0.0)
-                    .collect();
-                pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-                let (x, y) = pts
-                    .into_iter()
-                    .map(|(f, e)| (f, esd_level_db(e, reference)))
-                    .unzip();
+                let (x, y) = s.level_curve_db(&r.frequency_hz, reference);
                 Some(Series {
                     label: c.case.label().into(),
                     x,

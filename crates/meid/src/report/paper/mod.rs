@@ -27,7 +27,6 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::analysis::compare::{CaseName, ComparisonResult};
-use crate::analysis::esd::esd_level_db;
 use crate::plot::{HeatMap, LinePlot, Series, SpectrumPlot};
 use crate::report::html::{Block, Page, Section, Table};
 use crate::Result;
@@ -573,19 +572,7 @@ fn draw_compare(
             .iter()
             .map(|k| {
                 let s = &k.spectra[ch];
-                let mut pts: Vec<(f64, f64)> = c
-                    .frequency_hz
-                    .iter()
-                    .zip(&s.esd)
-                    .map(|(f, e)| (*f, *e))
-                    .chain(s.peaks.iter().copied())
-                    .filter(|(f, _)| *f > 0.0)
-                    .collect();
-                pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-                let (x, y) = pts
-                    .into_iter()
-                    .map(|(f, e)| (f, esd_level_db(e, reference)))
-                    .unzip();
+                let (x, y) = s.level_curve_db(&c.frequency_hz, reference);
                 Series {
                     label: label(k.case),
                     x,
