@@ -39,7 +39,15 @@
 //!
 //! **Guards**: 1000 consecutive rejected steps, 1000 consecutive switches that do not advance
 //! time, a step below 16 ulps of `t`, or more than [`MAX_STEPS`] steps end the run with an
-//! error naming the time, the mode and the likely cause.
+//! error naming the time, the mode and the likely cause; a run whose pace projects beyond
+//! [`MAX_STEPS`] for four windows of 2²⁰ steps in a row stops then, with the projection
+//! ([`Pace`]).
+//!
+//! **Resting one-way dashpot**: the dashpot's velocity has a zero band of `rtol/10` of the
+//! largest size it reached in the run ([`Selector::band`]), so a machine at rest, whose
+//! velocities the integration carries only to that accuracy, does not switch the dashpot at
+//! every half period of a contact for ever. The dashpot force is continuous at the switch
+//! (`c·v` with `v` in the band), so the band moves forces by at most `c` times its width.
 
 use super::peaks::Peaks;
 use super::roots::{first_crossing, hermite_dip, Scalar, SearchOptions};
@@ -434,8 +442,13 @@ impl Affine {
     /// are all physically zero, such as the relative velocity of bodies at rest, carries
     /// round-off only), as the lexicographic signs of [`super::switching`] do, unit by unit.
     fn noise(&self, x: &[f64], norms: (f64, f64), rel: f64) -> f64 {
-        let (_, scale) = self.l.dot_abs(x);
-        (rel * (scale + self.c.abs())).max(1e-12 * (self.norm_x * norms.0 + self.norm_v * norms.1))
+        (rel * self.scale(x)).max(1e-12 * (self.norm_x * norms.0 + self.norm_v * norms.1))
+    }
+
+    /// `Σ|ℓ_i X_i| + |c|`: the size of the terms the value is made of.
+    #[inline]
+    fn scale(&self, x: &[f64]) -> f64 {
+        self.l.dot_abs(x).1 + self.c.abs()
     }
 }
 
@@ -491,6 +504,9 @@ struct Selector<'a> {
     /// The relative width of the zero band ([`Affine::noise`]).
     rel: f64,
     inds: Vec<Affine>,
+    /// The largest [`Affine::scale`] of each indicator over the run so far (at the start and
+    /// at the end of every accepted step): the run's own size of that quantity.
+    run_scale: Vec<f64>,
     /// Derivative vectors (length `ny`) and the state padded to `ny`.
     work: [Vec<f64>; 2],
     pad: Vec<f64>,
@@ -508,16 +524,43 @@ fn norms(x: &[f64]) -> (f64, f64) {
 
 impl<'a> Selector<'a> {
     fn new(sys: &'a ImpactSystem, ny: usize, rtol: f64) -> Self {
+        let inds: Vec<Affine> = sys
+            .indicators()
+            .into_iter()
+            .map(|i| Affine::new(sys, i))
+            .collect();
         Selector {
             sys,
             rel: (64.0 * f64::EPSILON).max(0.1 * rtol),
-            inds: sys
-                .indicators()
-                .into_iter()
-                .map(|i| Affine::new(sys, i))
-                .collect(),
+            run_scale: vec![0.0; inds.len()],
+            inds,
             work: [vec![0.0; ny], vec![0.0; ny]],
             pad: vec![0.0; ny],
+        }
+    }
+
+    /// Takes the state `x` into the run's scales ([`Selector::run_scale`]).
+    fn observe(&mut self, x: &[f64]) {
+        for (a, r) in self.inds.iter().zip(self.run_scale.iter_mut()) {
+            *r = r.max(a.scale(x));
+        }
+    }
+
+    /// The zero band of indicator `i` at `x`: [`Affine::noise`], and at least `rel` times the
+    /// run's scale of the indicator. The second term is what the integration can resolve: a
+    /// one-way dashpot's velocity of 1e-12 m/s in a run struck at 1 m/s, or an overlap of
+    /// 1e-13 m in a run that moved millimetres, is below the accuracy `rtol` asks for. Without
+    /// it, a machine at rest under a constant force carries an oscillation of that size that
+    /// the integration's own error keeps alive (the exact solution decays it), and switches
+    /// the dashpot every half period of the contact (every 16 µs on the stiff-base machine)
+    /// for ever. With it, a crossing must leave the band on the other side: a switch is a
+    /// motion the run resolves.
+    fn band(&self, i: usize, x: &[f64], x_norms: (f64, f64)) -> f64 {
+        let a = &self.inds[i];
+        let noise = a.noise(x, x_norms, self.rel);
+        match a.ind {
+            Indicator::DashpotVelocity => noise.max(self.rel * self.run_scale[i]),
+            _ => noise,
         }
     }
 
@@ -528,8 +571,9 @@ impl<'a> Selector<'a> {
         let nx = x.len();
         let x_norms = norms(x);
         let mut open = 0;
-        for (i, a) in self.inds.iter().enumerate() {
-            sides.noise[i] = a.noise(x, x_norms, self.rel);
+        for i in 0..self.inds.len() {
+            sides.noise[i] = self.band(i, x, x_norms);
+            let a = &self.inds[i];
             sides.signs[i] = if sides.forced[i] != 0.0 {
                 sides.forced[i]
             } else {
@@ -974,6 +1018,75 @@ const MAX_STALLED: usize = 1000;
 /// error instead of running for hours.
 const MAX_STEPS: usize = 100_000_000;
 
+/// Steps in one window of the pace check ([`Pace`]).
+const PACE_WINDOW: usize = 1 << 20;
+/// Consecutive windows whose pace projects beyond [`MAX_STEPS`] before the run stops.
+const PACE_STRIKES: u32 = 4;
+
+/// The run's pace, checked every [`PACE_WINDOW`] steps: the steps the rest of the run would
+/// take at the rate of the last window. A run that would exceed [`MAX_STEPS`] at that rate
+/// for [`PACE_STRIKES`] windows in a row (about four million steps, a few seconds) stops
+/// then with the projection, instead of after 10⁸ steps: an explicit method's step on a
+/// closed stiff contact is bounded by its stability (`h ≲ 3.3/ω`), so a body resting on a
+/// 1 MHz contact for a minute needs about 10⁸ steps however smooth the motion is.
+struct Pace {
+    next_check: usize,
+    window_start: (usize, f64),
+    strikes: u32,
+}
+
+impl Pace {
+    fn new() -> Self {
+        Pace {
+            next_check: PACE_WINDOW,
+            window_start: (0, 0.0),
+            strikes: 0,
+        }
+    }
+
+    fn check(&mut self, n: usize, t: f64, t_end: f64, mode: Mode) -> Result<()> {
+        let (n0, t0) = self.window_start;
+        let mean_h = (t - t0) / (n - n0) as f64;
+        let projected = n as f64 + (t_end - t) / mean_h.max(f64::MIN_POSITIVE);
+        self.window_start = (n, t);
+        self.next_check = n + PACE_WINDOW;
+        if projected <= MAX_STEPS as f64 {
+            self.strikes = 0;
+            return Ok(());
+        }
+        self.strikes += 1;
+        if self.strikes < PACE_STRIKES {
+            return Ok(());
+        }
+        let closed: Vec<&str> = [
+            (Switch::SliderBed, "slider-bed"),
+            (Switch::BedDamper, "bed-damper"),
+        ]
+        .into_iter()
+        .filter(|(s, _)| mode.on(*s))
+        .map(|(_, name)| name)
+        .collect();
+        Err(Error::numerical(
+            "dopri5",
+            format!(
+                "the run would take about {projected:.2e} steps, more than the limit of \
+                 {MAX_STEPS:.0e}: at t = {t:.6} s of {t_end} s its last {PACE_WINDOW} steps \
+                 averaged {mean_h:.3e} s (closed contacts: {}). An explicit method's step on a \
+                 closed stiff contact is bounded by stability (h ≲ 3.3/ω; a step of that size \
+                 is the limit for ω ≈ {:.3e} rad/s), however smooth the motion. Use \
+                 method = \"exact\" (every contact law linear), a shorter simulation.duration, \
+                 or a softer contact stiffness",
+                if closed.is_empty() {
+                    "none".to_string()
+                } else {
+                    closed.join(", ")
+                },
+                3.3 / mean_h
+            ),
+        ))
+    }
+}
+
 /// Runs Dormand-Prince 5(4). See the module documentation.
 pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Result<Solution> {
     solve_from(sys, &sys.initial_state(), opts, obs)
@@ -1017,6 +1130,7 @@ pub fn solve_from(
     y[..nx].copy_from_slice(x0);
     let mut t = 0.0;
     let t_end = opts.duration;
+    selector.observe(&y[..nx]);
     let mut mode = selector.select(&rhs, &y[..nx], Mode(0), &mut sides);
     let mut grid = Grid::new(opts.sample_rate);
     let mut k: [Vec<f64>; 7] = std::array::from_fn(|_| vec![0.0; ny]);
@@ -1047,6 +1161,7 @@ pub fn solve_from(
     let (mut cv0, mut cd0) = ([0.0; N_CHANNELS], [0.0; N_CHANNELS]);
     let (mut cv1, mut cd1) = ([0.0; N_CHANNELS], [0.0; N_CHANNELS]);
 
+    let mut pace = Pace::new();
     let sc = |a: f64, b: f64| opts.atol + opts.rtol * a.abs().max(b.abs());
     let err_norm = |y0: &[f64], y1: &[f64], e: &[f64]| -> f64 {
         let mut s = 0.0;
@@ -1130,6 +1245,9 @@ pub fn solve_from(
                 t,
                 mode,
             ));
+        }
+        if steps + rejected >= pace.next_check {
+            pace.check(steps + rejected, t, t_end, mode)?;
         }
         // Stages: `out = y + h Σ c_j k_j`, one contiguous pass per term.
         let (k0, rest) = k.split_at_mut(1);
@@ -1219,9 +1337,8 @@ pub fn solve_from(
             if !sides.provisional[i] {
                 continue;
             }
-            let a = &selector.inds[i];
-            let g = a.value(&ynew[..nx]);
-            if g.abs() <= a.noise(&ynew[..nx], norms(&ynew[..nx]), selector.rel) {
+            let g = selector.inds[i].value(&ynew[..nx]);
+            if g.abs() <= selector.band(i, &ynew[..nx], norms(&ynew[..nx])) {
                 continue;
             }
             sides.provisional[i] = false;
@@ -1349,6 +1466,7 @@ pub fn solve_from(
         if switched {
             let t_old = t;
             y.copy_from_slice(&ybuf);
+            selector.observe(&y[..nx]);
             t += s_end;
             if t - t_old <= 16.0 * f64::EPSILON * t.abs() {
                 stalled_switches += 1;
@@ -1402,6 +1520,7 @@ pub fn solve_from(
             continue;
         }
         y.copy_from_slice(&ynew);
+        selector.observe(&y[..nx]);
         k.swap(0, 6);
         t += h;
         (cv0, cd0) = (cv1, cd1);
