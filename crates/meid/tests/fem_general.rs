@@ -240,3 +240,29 @@ fn nafems_test21_thick_plate_from_model_file() {
         );
     }
 }
+
+/// A 10 kg point mass with rotary inertia [0.3, 0.2, 0.4] kg·m² on a 0.5 m rigid arm from a node
+/// on six springs to ground (offset_mass.toml: masses, rigid_links, springs on all six DOFs, no
+/// elements). Closed form, u_1 = u_0 + θ_0 × r: ux: kx/m; rx: krx/Jx; (uy, rz) and (uz, ry):
+/// `m J λ² − (k (J + m r²) + k_r m) λ + k k_r = 0`. All six frequencies to 1e-9.
+#[test]
+fn offset_point_mass_on_rigid_arm_from_model_file() {
+    let (f, rigid) = modes_of("offset_mass.toml");
+    assert_eq!(rigid, 0);
+    let (m, r) = (10.0_f64, 0.5_f64);
+    let (jx, jy, jz) = (0.3, 0.2, 0.4);
+    let (kx, ky, kz, krx, kry, krz) = (1.0e4, 2.0e4, 3.0e4, 500.0, 700.0, 900.0);
+    let hz = |l: f64| l.sqrt() / (2.0 * std::f64::consts::PI);
+    let mut exact = vec![hz(kx / m), hz(krx / jx)];
+    for (k, kr, j) in [(ky, krz, jz), (kz, kry, jy)] {
+        let (a, b, c) = (m * j, k * (j + m * r * r) + kr * m, k * kr);
+        let d = (b * b - 4.0 * a * c).sqrt();
+        exact.push(hz((b - d) / (2.0 * a)));
+        exact.push(hz((b + d) / (2.0 * a)));
+    }
+    exact.sort_by(f64::total_cmp);
+    eprintln!("offset mass: {f:?} Hz; exact {exact:?}");
+    for (x, e) in f.iter().zip(&exact) {
+        assert!((x / e - 1.0).abs() <= 1e-9, "{f:?} vs {exact:?}");
+    }
+}
