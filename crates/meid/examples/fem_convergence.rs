@@ -475,7 +475,7 @@ fn main() {
     let dir = std::env::temp_dir().join(format!("meid-fem-convergence-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     println!(
-        "| benchmark | mesh | DOFs | frequencies (Hz), error vs reference (%) | max |error| (%) |"
+        "| benchmark | mesh | DOFs | frequencies (Hz), error vs reference (%) | largest error, absolute (%) |"
     );
     println!("|---|---|---|---|---|");
     for case in cases() {
