@@ -32,7 +32,7 @@ pub struct MonteCarloArgs {
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
-    /// Write samples.csv, stats.json and the histogram into DIR.
+    /// Write samples.csv, samples.parquet, stats.json and the histogram into DIR.
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
     #[command(flatten)]
@@ -134,7 +134,7 @@ pub fn run(a: MonteCarloArgs) -> Result<()> {
     let r = pool.install(|| study.run_with_progress(&progress));
     bar.finish_and_clear();
     let r = r.context("Monte Carlo failed")?;
-    output(&a, &r, set)
+    output(&a, &study, &r, set)
 }
 
 /// `meid merge` of Monte Carlo shards: every sample of the study from the shards (checked to
@@ -177,12 +177,13 @@ pub fn merge(a: MonteCarloArgs, shards: &[crate::shard::ShardFiles]) -> Result<(
         bail!("meid merge needs -o DIR");
     };
     let set = crate::outputs::begin(dir)?;
-    output(&a, &r, Some(set))
+    output(&a, &study, &r, Some(set))
 }
 
 /// Writes and prints a finished study as `meid montecarlo` does (shared with `meid merge`).
 fn output(
     a: &MonteCarloArgs,
+    study: &MonteCarlo,
     r: &meid::analysis::montecarlo::MonteCarloResult,
     set: Option<meid::io::OutputSet>,
 ) -> Result<()> {
@@ -197,6 +198,8 @@ fn output(
     if let Some(set) = set {
         let dir = set.staging();
         meid::io::write_atomic(&dir.join("samples.csv"), &r.samples_csv()?)?;
+        // samples.csv's rows with types, units and exact values (docs/studies.md, "Parquet").
+        meid::io::parquet::write_parquet(&dir.join("samples.parquet"), &study.table(r))?;
         meid::io::write_json(&dir.join("stats.json"), &stats)?;
         let values = r.metric(&a.metric)?;
         let bins = ((values.len() as f64).sqrt().ceil() as usize).clamp(5, 50);

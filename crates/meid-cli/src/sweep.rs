@@ -23,7 +23,7 @@ pub struct SweepArgs {
     /// model field path (repeatable; the grid is their Cartesian product, last fastest).
     #[arg(long = "vary", value_name = "SPEC", required = true)]
     vary: Vec<String>,
-    /// Output directory (sweep.csv, sweep.json, pictures, manifest.json, and the journal
+    /// Output directory (sweep.csv, sweep.parquet, sweep.json, pictures, manifest.json, and the journal
     /// sweep.partial.csv). Without it, nothing is written: the summary and the table of every
     /// point (sweep.csv's content) go to stdout.
     #[arg(short, long, value_name = "DIR")]
@@ -217,6 +217,8 @@ fn output(
         return Ok(());
     };
     result.write(set.staging())?;
+    // sweep.csv's rows with types and units (docs/studies.md, "Parquet").
+    meid::io::parquet::write_parquet(&set.path("sweep.parquet"), &sweep.table(result))?;
     if let Some(e) = sweep.all_failed_error(result) {
         // The results (every row with its error) are written; the run is that error.
         set.commit("sweep")?;

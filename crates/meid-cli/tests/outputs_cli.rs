@@ -426,13 +426,14 @@ fn a_failed_run_leaves_the_previous_output_set() {
             "manifest.json",
             "sweep.csv",
             "sweep.json",
+            "sweep.parquet",
             "sweep.partial.csv"
         ]
     );
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(d.join("manifest.json")).unwrap()).unwrap();
     assert_eq!(m["command"], "sweep");
-    assert_eq!(m["files"].as_array().unwrap().len(), 4);
+    assert_eq!(m["files"].as_array().unwrap().len(), 5);
 }
 
 #[test]

@@ -37,6 +37,11 @@ fn sweep_threads_resume_and_pictures() {
     sweep(&d2, &["--threads", "2", "--quiet"]);
     let a = std::fs::read(d1.join("sweep.csv")).unwrap();
     assert_eq!(a, std::fs::read(d2.join("sweep.csv")).unwrap());
+    // The Parquet table does not depend on the thread count either (pyarrow reads it:
+    // crates/meid-py/tests/test_parquet.py).
+    let p = std::fs::read(d1.join("sweep.parquet")).unwrap();
+    assert_eq!(&p[..4], b"PAR1");
+    assert_eq!(p, std::fs::read(d2.join("sweep.parquet")).unwrap());
     for f in [
         "sweep.json",
         "energy_ratio_family.png",

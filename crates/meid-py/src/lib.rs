@@ -496,6 +496,13 @@ fn montecarlo_columns<'py>(
     columns_py(py, c)
 }
 
+/// Where `evaluate` finds a requested metric in a point's result.
+#[derive(Clone, Copy)]
+enum Pick {
+    Metric(usize),
+    Derived(usize),
+}
+
 /// The metric names `evaluate` returns by default (the sweep's, in order).
 #[pyfunction]
 fn metric_names() -> Vec<String> {
@@ -525,19 +532,38 @@ fn evaluate<'py>(
             names.len()
         )));
     }
+    if k == 0 {
+        return Err(InputError::new_err(
+            "names is empty: give at least one quantity (a ratio such as \"wd/ws\" or a field path)",
+        ));
+    }
     let v = values.as_array();
-    let rows: Vec<Vec<f64>> = (0..n)
-        .map(|i| (0..k).map(|j| v[[i, j]]).collect())
+    // Row-major (N, k) values, and for each requested metric where a point keeps it.
+    let xs: Vec<f64> = (0..n)
+        .flat_map(|i| (0..k).map(move |j| v[[i, j]]))
         .collect();
     let metrics = metrics.unwrap_or_else(metric_names);
+    if metrics.is_empty() {
+        return Err(InputError::new_err(format!(
+            "metrics is empty; valid: {}",
+            sweep::METRICS.join(", ")
+        )));
+    }
+    let mut picks = Vec::with_capacity(metrics.len());
     for m in &metrics {
-        if !sweep::METRICS.contains(&m.as_str()) && !sweep::DERIVED.contains(&m.as_str()) {
+        if let Some(i) = sweep::METRICS.iter().position(|x| *x == m.as_str()) {
+            picks.push(Pick::Metric(i));
+        } else if let Some(i) = sweep::DERIVED.iter().position(|x| *x == m.as_str()) {
+            picks.push(Pick::Derived(i));
+        } else {
             return Err(InputError::new_err(format!(
-                "unknown metric '{m}'; valid: {}",
-                sweep::METRICS.join(", ")
+                "unknown metric '{m}'; valid: {}, {}",
+                sweep::METRICS.join(", "),
+                sweep::DERIVED.join(", ")
             )));
         }
     }
+    let m = picks.len();
     let pool = pool(threads)?;
     let base = model.inner.clone();
     let flat = py
@@ -550,30 +576,48 @@ fn evaluate<'py>(
             let qr: Vec<&Quantity> = qs.iter().collect();
             let bed = bed_mass_kg.or_else(|| base.bed_mass());
             sweep::check_quantities(&base, &qr, bed)?;
+            // The names checked as `meid sweep --vary` checks them: an unknown or non-numeric
+            // field is an InputError naming it (it used to give rows of NaN).
+            let vary = names
+                .iter()
+                .enumerate()
+                .map(|(j, name)| {
+                    let v = xs.get(j).copied().unwrap_or(1.0);
+                    Vary::parse(&format!("{name}={:e}", if v.is_finite() { v } else { 1.0 }))
+                })
+                .collect::<meid::Result<Vec<_>>>()?;
+            Sweep::with_bed_mass(base.clone(), vary, bed_mass_kg)?;
             let mut options = base.options();
             options.stop_at_collision_end = true;
             let cache = StructureCache::new();
-            let out: Vec<Vec<f64>> = pool.install(|| {
-                rows.par_iter()
+            // Each row is written in place: no per-row vectors, no lookups by name.
+            let mut out = vec![f64::NAN; n * m];
+            pool.install(|| {
+                out.par_chunks_mut(m)
+                    .zip(xs.par_chunks(k))
                     .enumerate()
-                    .map(|(i, r)| {
+                    .for_each(|(i, (row, x))| {
                         let p = sweep::evaluate_cached(
                             &base,
                             &qr,
-                            r,
+                            x,
                             bed_mass_kg,
                             &options,
                             i,
                             Some(&cache),
                         );
-                        metrics.iter().map(|m| p.metric(m)).collect()
+                        for (o, pick) in row.iter_mut().zip(&picks) {
+                            *o = match *pick {
+                                Pick::Metric(j) => p.metrics.get(j).copied().flatten(),
+                                Pick::Derived(j) => p.derived.get(j).copied(),
+                            }
+                            .unwrap_or(f64::NAN);
+                        }
                     })
-                    .collect()
             });
-            Ok(out.into_iter().flatten().collect())
+            Ok(out)
         })
         .map_err(err)?;
-    let m = flat.len().checked_div(n).unwrap_or(0);
     Ok(PyArray1::from_vec(py, flat).reshape([n, m])?.into_any())
 }
 

@@ -130,6 +130,11 @@ def test_evaluate_is_the_sweep_point():
     assert np.isnan(e[0, 0])
     with pytest.raises(meid.InputError):
         meid.evaluate(m, ["wd/ws"], np.zeros((2, 2)))
+    # A misspelled field is an error naming it (it used to give a row of NaN).
+    with pytest.raises(meid.InputError, match="damper.mas.*did you mean `mass`"):
+        meid.evaluate(m, ["damper.mas"], np.array([[1.0]]))
+    with pytest.raises(meid.InputError, match="damper.mas"):
+        meid.evaluate(m, ["damper.mas"], np.zeros((0, 1)))
 
 
 def test_model_pickles_as_its_text():

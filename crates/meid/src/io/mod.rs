@@ -5,6 +5,9 @@
 
 pub mod csv_records;
 pub mod matrix_market;
+#[cfg(feature = "parquet")]
+pub mod parquet;
+pub mod table;
 pub mod uff;
 pub mod vtk;
 
