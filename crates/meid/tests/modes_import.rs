@@ -3,7 +3,10 @@
 //! * a CalculiX `.frd` of a cantilever of 20-node bricks (`tests/data/ccx_cantilever`, written by
 //!   ccx 2.20; the test does not need ccx) against the beam's closed forms: Euler-Bernoulli
 //!   frequencies with the first-order Timoshenko correction, and the mass-normalised tip value
-//!   `|ψ(L)| = 2/√(ρAL)`;
+//!   `|ψ(L)| = 2/√(ρAL)`. Tolerances: the mesh's own discretisation error (0.003 % to 0.09 %
+//!   on the four z-bending frequencies against a 40 × 2 × 2 mesh) plus the first-order
+//!   Timoshenko formula's (≈ 0.1 % on the fourth: a converged mesh sits 0.11 % below it);
+//!   shapes: shear deformation changes the tip value by up to 0.3 % on the fourth mode;
 //! * UFF 2411 + 55 written by meid from a known modal model and read back; modal masses other
 //!   than 1 rescale, a missing modal mass is refused unless stated, a contradiction is refused;
 //! * every study runs on imported modes: a simulation with its energy balance, and the same
@@ -107,8 +110,10 @@ fn calculix_cantilever_matches_the_beam_closed_forms() {
             100.0 * e_eb,
             100.0 * e_t
         );
+        // Euler-Bernoulli alone is off by the shear/rotary correction (0.02 % to 0.7 %); with
+        // it the gap is the mesh's and the formula's (module docs).
         assert!(e_eb.abs() < 1e-2, "mode {k}: {e_eb:e}");
-        assert!(e_t.abs() < 5e-4, "mode {k}: {e_t:e}");
+        assert!(e_t.abs() < 3e-3, "mode {k}: {e_t:e}");
         // Mass normalisation: the tip value of a mass-normalised cantilever mode is 2/√(ρAL)
         // (|W(L)| = 2 for ∫W² = L); the shear correction of the shape is of the same order as
         // that of the frequency.
@@ -123,7 +128,14 @@ fn calculix_cantilever_matches_the_beam_closed_forms() {
             mid[i].abs(),
             100.0 * e_mid
         );
-        assert!(e_tip.abs() < 1e-2, "mode {k}: tip {e_tip:e}");
+        // Euler-Bernoulli's shape ignores shear: the tip value differs by about the size of the
+        // frequency's shear correction c_k = ½(β r)²(1 + E/κG) (measured 0.014 %, 0.11 %,
+        // 0.28 %, 0.53 % against c_k = 0.02 %, 0.13 %, 0.35 %, 0.69 %); 2e-4 for the mesh.
+        let c_k = 0.5 * (bl / L).powi(2) * r2 * shear;
+        assert!(
+            e_tip.abs() < c_k + 2e-4,
+            "mode {k}: tip {e_tip:e} (c_k {c_k:e})"
+        );
         // The same sign pattern as the closed form (tip and mid-span in or out of phase).
         assert_eq!(
             (tip[i] * mid[i]).signum(),
@@ -132,7 +144,7 @@ fn calculix_cantilever_matches_the_beam_closed_forms() {
     }
     // The first mode's mid-span value (the others have a node near mid-span).
     let e_mid = mid[0].abs() / psi(beta_l(1), 0.5 * L).abs() - 1.0;
-    assert!(e_mid.abs() < 1e-2, "{e_mid:e}");
+    assert!(e_mid.abs() < 5e-3, "{e_mid:e}");
 }
 
 #[test]

@@ -1,15 +1,20 @@
 #!/usr/bin/env python3
 """Writes ccx_cantilever.inp: a steel cantilever (L = 1 m along x, b = 0.04 m in y, h = 0.02 m
-in z) of 20-node bricks (C3D20R, 20 x 1 x 1), clamped at x = 0, Poisson ratio 0 (so that
+in z) of 20-node bricks (C3D20, 40 x 1 x 1), clamped at x = 0, Poisson ratio 0 (so that
 Euler-Bernoulli beam theory is the closed form), first 6 modes, nodal displacements to the
-.frd. Run: python3 gen_cantilever.py && ccx ccx_cantilever"""
+.frd. Run: python3 gen_cantilever.py && ccx ccx_cantilever (CalculiX 2.20, Debian calculix-ccx).
+
+Full integration (C3D20), not C3D20R: with one reduced-integration element across the section,
+ccx's mid-edge nodes carry spurious (hourglass) displacements of 40 % of the tip value while the
+frequencies stay right. Mesh convergence (z-bending frequencies, this mesh against 40 x 2 x 2):
+0.003 %, 0.02 %, 0.05 %, 0.09 % for the first four."""
 L, B, H = 1.0, 0.04, 0.02
-NX, NY, NZ = 20, 1, 1
+NX, NY, NZ = 40, 1, 1
 nodes = {}
 def nid(i, j, k):
     return nodes[(i, j, k)]
 n = 0
-lines = ["*HEADING", "meid test: cantilever beam of C3D20R bricks, closed form Euler-Bernoulli", "*NODE, NSET=NALL"]
+lines = ["*HEADING", "meid test: cantilever beam of C3D20 bricks, closed form Euler-Bernoulli", "*NODE, NSET=NALL"]
 for k in range(2 * NZ + 1):
     for j in range(2 * NY + 1):
         for i in range(2 * NX + 1):
@@ -18,7 +23,7 @@ for k in range(2 * NZ + 1):
             n += 1
             nodes[(i, j, k)] = n
             lines.append(f"{n}, {L * i / (2 * NX):.10g}, {B * j / (2 * NY):.10g}, {H * k / (2 * NZ):.10g}")
-lines.append("*ELEMENT, TYPE=C3D20R, ELSET=EALL")
+lines.append("*ELEMENT, TYPE=C3D20, ELSET=EALL")
 # C3D20 local node order: corners (-,-,-) (+,-,-) (+,+,-) (-,+,-) then z+, mid-edges of the
 # z- face, of the z+ face, then the vertical mid-edges.
 corner = [(0, 0, 0), (2, 0, 0), (2, 2, 0), (0, 2, 0), (0, 0, 2), (2, 0, 2), (2, 2, 2), (0, 2, 2)]
