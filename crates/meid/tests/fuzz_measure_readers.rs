@@ -9,10 +9,14 @@
 use meid::io::csv_records::parse_csv;
 use meid::io::frd;
 use meid::io::uff::{self, Channel58, Mode, Node};
-use meid::measure::{Abscissa, PointRef, Quantity};
+use meid::measure::{PointRef, Quantity};
 use meid::model::imported;
-use meid::model::{ModesFileSpec, Source};
+use meid::model::Source;
 use proptest::prelude::*;
+
+#[path = "fuzz_support/readers.rs"]
+mod readers;
+use readers::{check_csv, check_frd, check_uff, check_uff_import, import_spec};
 
 fn valid_uff(binary: bool) -> Vec<u8> {
     let v: Vec<f64> = (0..9).map(|i| (i as f64 * 0.7).sin()).collect();
