@@ -180,8 +180,8 @@ impl<R: BufRead> Parser<'_, R> {
             let key = t.split_whitespace().next().unwrap_or("");
             match key {
                 "9999" => seen_end = true,
-                "1C" => {}
-                k if k.starts_with("1U") => {}
+                // Header (`1C` with an optional name) and user lines (`1U…`).
+                k if k.starts_with("1C") || k.starts_with("1U") => {}
                 "2C" => {
                     let block = Block {
                         kind: "2C (nodes)",
