@@ -83,6 +83,19 @@ def write(d):
     u.write_sets([nodes, mode], mode="overwrite")
     expected["modes.uff"] = {"nodes": [[1, 0.0, 0.0, 0.0], [2, 1.0, 0.0, 0.125], [3, 2.5, 0.0, -3.0]],
                              "mode": {"number": 2, "frequency_hz": 283.0, "damping_ratio": 0.01, "z": [0.5, -0.25, 0.125]}}
+    # Two modes that are not mass-normalised: shapes 2 psi with modal mass 4, for meid's modes
+    # import ([structure.modes]), which divides by sqrt(modal mass).
+    path = os.path.join(d, "modes_scaled.uff")
+    u = pyuff.UFF(path)
+    sets = [nodes]
+    psi = {1: [0.125, -0.25, 0.5], 2: [0.0625, 0.375, -0.75]}
+    for k, f in [(1, 12.5), (2, 310.0)]:
+        sets.append(pyuff.prepare_55(model_type=1, analysis_type=2, data_ch=2, spec_data_type=8, load_case=1, mode_n=k, freq=f,
+                                     modal_m=4.0, modal_damp_vis=0.02, modal_damp_his=0.0, node_nums=np.array([1, 2, 3]),
+                                     r1=np.zeros(3), r2=np.zeros(3), r3=2.0 * np.array(psi[k]), id1=f"mode {k}"))
+    u.write_sets(sets, mode="overwrite")
+    expected["modes_scaled.uff"] = {"frequency_hz": [12.5, 310.0], "damping_ratio": 0.02,
+                                    "psi": {"n1": [psi[1][0], psi[2][0]], "n2": [psi[1][1], psi[2][1]], "n3": [psi[1][2], psi[2][2]]}}
     with open(os.path.join(d, "expected.json"), "w") as f:
         json.dump(expected, f)
 

@@ -1,12 +1,22 @@
-//! Property tests of the measured-data readers (UFF 58/58b/2411/55 and CSV): arbitrary bytes
-//! and line/token mutations of valid files never make a reader panic, and a size field never
-//! makes it allocate beyond the file (a huge point count or byte count is refused first).
-//! An accepted file keeps its promises: finite values, as many samples as the abscissa says.
+//! Property tests of the measured-data readers (UFF 58/58b/2411/55, CSV, CalculiX .frd) and of
+//! the modes import (`[structure.modes]`): arbitrary bytes and line/token mutations of valid
+//! files never make a reader panic, and a size field never makes it allocate beyond the file
+//! (a huge point count or byte count is refused first; a .frd node count is checked against
+//! the block, never allocated). An accepted file keeps its promises: finite values, as many
+//! samples as the abscissa says; an imported modal model is valid (finite, one value per mode
+//! at each point).
 
 use meid::io::csv_records::parse_csv;
+use meid::io::frd;
 use meid::io::uff::{self, Channel58, Mode, Node};
-use meid::measure::{Abscissa, PointRef, Quantity};
+use meid::measure::{PointRef, Quantity};
+use meid::model::imported;
+use meid::model::Source;
 use proptest::prelude::*;
+
+#[path = "fuzz_support/readers.rs"]
+mod readers;
+use readers::{check_csv, check_frd, check_uff, check_uff_import, import_spec};
 
 fn valid_uff(binary: bool) -> Vec<u8> {
     let v: Vec<f64> = (0..9).map(|i| (i as f64 * 0.7).sin()).collect();
@@ -80,31 +90,61 @@ const TOKENS: &[&str] = &[
     "time_s",
     "accel_g",
     "x",
+    " -1",
+    " -2",
+    " -3",
+    " -4  DISP        4    1",
+    " -5",
+    "    2C",
+    "    3C",
+    "  100CL  101",
+    "    1PGM",
+    "    1PMODE",
+    " 9999",
+    "-1.00000E+00",
+    "         2",
 ];
 
-fn check_uff(bytes: &[u8]) {
-    if let Ok(f) = uff::parse_uff(bytes, "fuzz.uff", Some(bytes.len() as u64)) {
-        for r in &f.records {
-            assert!(r.values.iter().all(|v| v.is_finite()));
-            assert!(r.values.len() as u64 <= bytes.len() as u64);
-            if let Abscissa::Uneven(t) = &r.abscissa {
-                assert_eq!(t.len(), r.values.len());
-                assert!(t.windows(2).all(|w| w[1] > w[0]));
-            }
-        }
-    }
-}
-
-fn check_csv(bytes: &[u8]) {
-    if let Ok(rs) = parse_csv(bytes, "fuzz.csv") {
-        for r in &rs {
-            assert!(r.values.iter().all(|v| v.is_finite()));
-            if let Abscissa::Uneven(t) = &r.abscissa {
-                assert_eq!(t.len(), r.values.len());
-            }
-        }
-    }
-}
+/// A small .frd as CalculiX writes it: 3 nodes, 2 modes (format 1, 12-column values).
+const FRD: &str = "    1C
+    1UUSER
+    2C                             3                                     1
+ -1         1 0.00000E+00 0.00000E+00 0.00000E+00
+ -1         2 5.00000E-01 0.00000E+00 0.00000E+00
+ -1         3 1.00000E+00 0.00000E+00 0.00000E+00
+ -3
+    3C                             1                                     1
+ -1         1   11    0    1
+ -2         1         2         3
+ -3
+    1PSTEP                         1           1           1
+    1PGM                1.000000E+00
+    1PMODE                         1
+  100CL  101 16.70645389           3                     2    1MODAL      1
+ -4  DISP        4    1
+ -5  D1          1    2    1    0
+ -5  D2          1    2    2    0
+ -5  D3          1    2    3    0
+ -5  ALL         1    2    0    0    1ALL
+ -1         1 0.00000E+00 0.00000E+00 0.00000E+00
+ -1         2 1.00000E-02-2.00000E-02-2.50000E-01
+ -1         3 3.00000E-02 4.00000E-03-7.98000E-01
+ -3
+    1PSTEP                         2           1           1
+    1PGM                4.000000E+00
+    1PMODE                         2
+  100CL  102 104.5534459           3                     2    2MODAL      1
+ -4  DISP        4    1
+ -5  D1          1    2    1    0
+ -5  D2          1    2    2    0
+ -5  D3          1    2    3    0
+ -5  ALL         1    2    0    0    1ALL
+ -1         1 0.00000E+00 0.00000E+00 0.00000E+00
+ -1         2-1.00000E-02 2.00000E-02 9.50000E-01
+ -1         3 3.00000E-02 4.00000E-03-1.59600E+00
+ -3
+ 9999
+";
 
 /// Replaces, deletes or inserts at line `l`, token `k` (modulo the counts).
 fn mutate(text: &[u8], edits: &[(u8, usize, usize, usize)]) -> Vec<u8> {
@@ -164,7 +204,32 @@ proptest! {
     #[test]
     fn uff_mutations_never_panic(binary in any::<bool>(), edits in proptest::collection::vec((any::<u8>(), any::<usize>(), any::<usize>(), any::<usize>()), 1..6)) {
         let text = valid_uff(binary);
-        check_uff(&mutate(&text, &edits));
+        let m = mutate(&text, &edits);
+        check_uff(&m);
+        check_uff_import(&m);
+    }
+
+    #[test]
+    fn frd_arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
+        check_frd(&bytes);
+        let mut framed = FRD.as_bytes()[..FRD.find("  100CL  102").unwrap()].to_vec();
+        framed.extend_from_slice(&bytes);
+        check_frd(&framed);
+    }
+
+    #[test]
+    fn frd_mutations_never_panic(edits in proptest::collection::vec((any::<u8>(), any::<usize>(), any::<usize>(), any::<usize>()), 1..6)) {
+        check_frd(&mutate(FRD.as_bytes(), &edits));
+    }
+
+    #[test]
+    fn frd_cut_or_flipped_never_panics(cut in any::<usize>(), flip in any::<usize>(), byte in any::<u8>()) {
+        let mut b = FRD.as_bytes().to_vec();
+        let i = flip % b.len();
+        b[i] = byte;
+        check_frd(&b);
+        b.truncate(cut % (b.len() + 1));
+        check_frd(&b);
     }
 
     #[test]
@@ -191,4 +256,21 @@ fn valid_inputs_are_accepted() {
         assert_eq!((f.records.len(), f.nodes.len(), f.modes.len()), (1, 1, 1));
     }
     assert_eq!(parse_csv(CSV.as_bytes(), "v.csv").unwrap().len(), 2);
+    let f = frd::parse_frd(FRD.as_bytes(), "v.frd").unwrap();
+    assert_eq!((f.nodes.len(), f.modes.len()), (3, 2));
+    // The import of the valid file: mode 2's generalised mass 4 halves its shapes.
+    let src = Source {
+        name: "v.toml".into(),
+        text: String::new(),
+        overrides: Vec::new(),
+    };
+    let m = imported::build(
+        &imported::modes_from_frd(&f),
+        &import_spec(&[("O_b", 3)], None),
+        "v.frd",
+        &src,
+    )
+    .unwrap();
+    // impact_direction defaults to -z.
+    assert_eq!(m.point("O_b").unwrap(), &[0.798, 0.798]);
 }

@@ -264,3 +264,82 @@ fn pyuff_reads_what_meid_writes() {
     assert!(close(r3[0], 0.2835, 5e-6) && close(r3[1], -0.0691897, 5e-6));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// pyuff writes 2411 + two datasets 55 whose shapes are `2ψ` with modal mass 4; meid imports
+/// them as a structure (`[structure.modes]`): shapes divided by √4 (exact: 6-digit prints of
+/// binary fractions), frequencies and damping ratios as written, and a simulation runs on them.
+#[test]
+fn pyuff_modes_import_as_a_structure() {
+    let Some(py) = python() else { return };
+    let dir = tmp("modes");
+    script(&py, &["write", dir.to_str().unwrap()]);
+    let expected: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("expected.json")).unwrap()).unwrap();
+    let e = &expected["modes_scaled.uff"];
+    let text = r#"
+[structure.modes]
+file = "modes_scaled.uff"
+points = { n1 = 1, n2 = 2, n3 = 3 }
+impact_direction = [0, 0, 1]
+
+[points]
+bed_contact = "n3"
+measurement = "n2"
+
+[slider]
+mass = 1.0
+velocity = 1.0
+
+[contact.slider_bed]
+stiffness = 1.0e7
+
+[simulation]
+duration = 0.02
+"#;
+    let m = meid::model::Model::from_text(
+        &dir.join("model.toml").display().to_string(),
+        text.into(),
+        &[],
+    )
+    .unwrap();
+    let s = &m.structure;
+    let f: Vec<f64> = s
+        .omega_rad_per_s
+        .iter()
+        .map(|w| w / (2.0 * std::f64::consts::PI))
+        .collect();
+    let ef: Vec<f64> = e["frequency_hz"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    for (a, b) in f.iter().zip(&ef) {
+        assert!(close(*a, *b, 1e-12), "{a} vs {b}");
+    }
+    let z = e["damping_ratio"].as_f64().unwrap();
+    for i in 0..2 {
+        let zi = s.damping[i * 2 + i] / (2.0 * s.omega_rad_per_s[i]);
+        assert!(close(zi, z, 1e-12), "{zi}");
+    }
+    for p in ["n1", "n2", "n3"] {
+        let want: Vec<f64> = e["psi"][p]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        assert_eq!(s.point(p).unwrap(), want.as_slice(), "{p}");
+    }
+    assert!(
+        s.notes
+            .iter()
+            .any(|n| n.contains("divided by √(modal mass)")),
+        "{:?}",
+        s.notes
+    );
+    let sys = m.impact_system(meid::model::Case::AsSpecified).unwrap();
+    let run = meid::analysis::energy::simulate(&sys, &m.options(), false).unwrap();
+    assert!(run.summary.energy_balance_residual.unwrap() < 1e-9);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -4,6 +4,7 @@
 //! so an interrupted run never leaves a half-written output.
 
 pub mod csv_records;
+pub mod frd;
 pub mod matrix_market;
 #[cfg(feature = "parquet")]
 pub mod parquet;

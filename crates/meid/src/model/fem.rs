@@ -1684,7 +1684,11 @@ pub fn from_text_with_analysis(
     let mut analysis = None;
     let mut model = Model::from_text_with(name, text, overrides, |spec, src| {
         match &spec.structure.fem {
-            Some(f) if spec.structure.lumped.is_none() && spec.structure.modal.is_none() => {
+            Some(f)
+                if spec.structure.lumped.is_none()
+                    && spec.structure.modal.is_none()
+                    && spec.structure.modes.is_none() =>
+            {
                 let mut f = f.clone();
                 if count.is_some() {
                     f.count = count;

@@ -15,7 +15,7 @@ use crate::Result;
 
 const GROUND: &str = "ground";
 
-fn ratios(r: &Option<Ratios>, n: usize, path: &str, src: &Source) -> Result<Vec<f64>> {
+pub(super) fn ratios(r: &Option<Ratios>, n: usize, path: &str, src: &Source) -> Result<Vec<f64>> {
     let v = match r {
         None => vec![0.0; n],
         Some(Ratios::All(z)) => vec![*z; n],

@@ -26,6 +26,7 @@
 mod cache;
 pub mod fem;
 pub mod general;
+pub mod imported;
 mod lumped;
 pub mod source;
 pub mod spec;
@@ -560,11 +561,12 @@ fn build_structure(spec: &ModelSpec, src: &Source) -> Result<ModalModel> {
     let st = &spec.structure;
     let given = usize::from(st.lumped.is_some())
         + usize::from(st.modal.is_some())
-        + usize::from(st.fem.is_some());
+        + usize::from(st.fem.is_some())
+        + usize::from(st.modes.is_some());
     if given > 1 {
         return Err(src.error(
             "structure",
-            "give one of [structure.lumped], [structure.modal] or [structure.fem], not several",
+            "give one of [structure.lumped], [structure.modal], [structure.fem] or [structure.modes], not several",
         ));
     }
     let ctx = fem::ReductionContext::of(spec);
@@ -577,9 +579,12 @@ fn build_structure(spec: &ModelSpec, src: &Source) -> Result<ModalModel> {
     if let Some(f) = &st.fem {
         return fem::modal_model(f, src, &ctx);
     }
+    if let Some(m) = &st.modes {
+        return imported::modal_model(m, src);
+    }
     Err(src.error(
         "structure",
-        "the structure is missing: add [structure.lumped] (masses, springs), [structure.modal] (frequencies_hz, shapes) or [structure.fem]",
+        "the structure is missing: add [structure.lumped] (masses, springs), [structure.modal] (frequencies_hz, shapes), [structure.fem] or [structure.modes] (file = a UFF or CalculiX .frd file)",
     ))
 }
 

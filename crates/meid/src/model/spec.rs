@@ -40,6 +40,10 @@ pub struct StructureSpec {
     pub modal: Option<ModalSpec>,
     #[serde(default)]
     pub fem: Option<super::fem::FemSpec>,
+    /// `[structure.modes]`: modes read from a file another tool wrote (UFF 55 + 2411, CalculiX
+    /// `.frd`; [`super::imported`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub modes: Option<ModesFileSpec>,
 }
 
 /// Point masses, springs and dashpots along z; modes from `K φ = ω² M φ`.
@@ -176,6 +180,43 @@ pub struct ModalSpec {
     /// Force to the floor per unit modal displacement (N) and velocity (N·s), per mode.
     #[serde(default)]
     pub floor_force: Option<FloorSpec>,
+}
+
+/// Modes imported from a file another tool wrote: an experimental modal analysis or an FE code
+/// (UFF datasets 55 + 2411, CalculiX `.frd`). See [`super::imported`].
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ModesFileSpec {
+    /// The file, relative to the model file's directory: `.uff`/`.unv` (UFF) or `.frd`.
+    pub file: String,
+    /// `"uff"` or `"frd"`; default from the file's extension.
+    #[serde(default)]
+    pub format: Option<String>,
+    /// meid point name → node label in the file: `{ O_b = 12, B = 7 }`.
+    pub points: BTreeMap<String, i64>,
+    /// The direction (in the file's axes) the slider moves when it strikes: meid's +z. The
+    /// shape value at a point is `d · u(node)` with `d` this vector normalised. Default
+    /// `[0, 0, -1]` (as `[structure.fem.model]`).
+    #[serde(default)]
+    pub impact_direction: Option<[f64; 3]>,
+    /// States that the file's shapes are mass-normalised (ψᵀMψ = 1). Needed when the file gives
+    /// no modal mass; refused when it gives one that is not 1.
+    #[serde(default)]
+    pub mass_normalised: Option<bool>,
+    /// The file's mode numbers to keep (default: all).
+    #[serde(default)]
+    pub select: Option<Vec<i64>>,
+    /// Keep only modes up to this frequency (Hz).
+    #[serde(default)]
+    pub max_hz: Option<f64>,
+    /// Modal damping ratios, one for all or one per retained mode; default: the file's
+    /// (UFF 55 record 8), else 0.
+    #[serde(default)]
+    pub damping_ratios: Option<Ratios>,
+    /// The file's unit system: `"m-kg-s"` (default, SI) or `"mm-t-s"` (mm, tonne, s, N: a
+    /// mass-normalised shape in mm/√t is `ψ · 1e-3/√1e3` in m/√kg).
+    #[serde(default)]
+    pub units: Option<String>,
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
