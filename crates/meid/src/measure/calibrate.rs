@@ -257,12 +257,14 @@ pub fn parameters(
         let (lower, upper) = match bounds.get(path) {
             Some(&b) => b,
             None if start > 0.0 => (start / 10.0, start * 10.0),
-            None => return Err(Error::invalid(
-                "--bounds",
-                format!(
+            None => {
+                return Err(Error::invalid(
+                    "--bounds",
+                    format!(
                     "`{path}` starts at {start}, not > 0: give its bounds, --bounds {path}=LO:HI"
                 ),
-            )),
+                ))
+            }
         };
         if !(lower <= start && start <= upper) {
             return Err(Error::invalid(
@@ -557,7 +559,7 @@ fn cholesky_solve(a: &[Vec<f64>], b: &[f64]) -> Option<Vec<f64>> {
                 s -= l[i][k] * l[j][k];
             }
             if i == j {
-                if !(s > 0.0) || !s.is_finite() {
+                if !(s.is_finite() && s > 0.0) {
                     return None;
                 }
                 l[i][i] = s.sqrt();
@@ -628,7 +630,7 @@ fn fd_jacobian(
             (r.to_vec(), f(&xm)?)
         };
         let d = xp[i] - xm[i];
-        if !(d > 0.0) {
+        if !(d.is_finite() && d > 0.0) {
             return Err(Error::invalid(
                 "--bounds",
                 "a parameter's bounds leave no room to vary it",
@@ -671,7 +673,7 @@ pub fn levenberg_marquardt(
     };
     let (mut a, mut g) = normal(&jac, &r);
     let mut mu = 1e-3 * (0..n).map(|i| a[i][i]).fold(0.0_f64, f64::max);
-    if !(mu > 0.0) {
+    if !(mu.is_finite() && mu > 0.0) {
         mu = 1e-3;
     }
     let mut nu = 2.0;
