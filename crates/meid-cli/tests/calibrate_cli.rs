@@ -10,8 +10,8 @@ use serde_json::Value;
 const KS: &str = "contact.slider_bed.stiffness";
 const ZETA: &str = "structure.lumped.damping_ratios[1]";
 
-fn measured() -> (std::path::PathBuf, std::path::PathBuf) {
-    let d = tmpdir("calibrate", "run");
+fn measured(tag: &str) -> (std::path::PathBuf, std::path::PathBuf) {
+    let d = tmpdir("calibrate", tag);
     let run = d.join("run");
     ok(meid()
         .args(["simulate", paper_example().to_str().unwrap(), "-o"])
@@ -24,7 +24,7 @@ fn measured() -> (std::path::PathBuf, std::path::PathBuf) {
 
 #[test]
 fn calibrate_recovers_the_simulated_values_and_writes_its_set() {
-    let (d, uff) = measured();
+    let (d, uff) = measured("fit");
     let out = d.join("cal");
     let ex = paper_example();
     let text = ok(meid()
@@ -83,7 +83,7 @@ fn calibrate_recovers_the_simulated_values_and_writes_its_set() {
 
 #[test]
 fn bad_fit_paths_and_bounds_exit_2_with_a_clear_message() {
-    let (_d, uff) = measured();
+    let (_d, uff) = measured("bad");
     let ex = paper_example();
     let run = |extra: &[&str]| {
         let o = meid()

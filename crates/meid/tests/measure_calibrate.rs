@@ -258,3 +258,32 @@ fn bad_fit_paths_and_bounds_are_refused_with_the_path_named() {
         "{e}"
     );
 }
+
+#[test]
+fn values_outside_the_structure_reuse_its_modes_and_are_recovered() {
+    // c_d (the damper's dashpot) is not part of the structural key: no structure is solved
+    // during the fit.
+    const CD: &str = "damper.damping";
+    let truth = model(&[]);
+    let known = value(&truth, CD);
+    let meas = measured(&truth, 0.05, 3, "cd");
+    let start = model(&[format!("{CD}={:e}", known * 1.5)]);
+    let params = parameters(&start, &[CD.to_string()], &BTreeMap::new()).unwrap();
+    let problem = Problem::new(
+        &start,
+        params,
+        &[meas],
+        &processing(),
+        &BTreeMap::new(),
+        Settings::default(),
+    )
+    .unwrap();
+    let c = calibrate(&problem).unwrap();
+    assert_eq!(c.structures_built, 0);
+    let e = &c.parameters[0];
+    assert!(c.converged, "{:?}", c.convergence);
+    assert!(
+        e.ci95_low <= known && known <= e.ci95_high,
+        "known {known}, {e:?}"
+    );
+}
