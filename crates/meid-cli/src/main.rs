@@ -30,6 +30,7 @@ macro_rules! eprintln {
 
 mod args;
 mod blows;
+mod calibrate;
 mod compare;
 mod measure;
 mod modes;
@@ -91,6 +92,9 @@ pub(crate) enum Command {
     Measure(measure::MeasureArgs),
     /// The simulation beside measured records: frequency, level and peak errors, reductions.
     Validate(validate::ValidateArgs),
+    /// Fit model values (damping ratios, contact stiffnesses, …) to measured records: estimates
+    /// with confidence intervals, residual, before/after overlays, the calibrated model file.
+    Calibrate(calibrate::CalibrateArgs),
     /// Put the shards of a sweep or Monte Carlo (--shard K/N) together: the unsharded run's files.
     Merge(shard::MergeArgs),
     /// Shell completion script for bash, zsh, fish, elvish or powershell, on stdout.
@@ -132,6 +136,7 @@ fn main() -> ExitCode {
         Command::Paper(a) => paper::run(a),
         Command::Measure(a) => measure::run(a),
         Command::Validate(a) => validate::run(a),
+        Command::Calibrate(a) => calibrate::run(a),
         Command::Merge(a) => shard::merge(a),
         Command::Completions(a) => shell::completions(a),
         Command::Man(a) => shell::man(a),

@@ -39,7 +39,7 @@ pub struct ValidateArgs {
 }
 
 /// `CASE=FILE` or `FILE`.
-fn split_case(s: &str) -> Result<(Case, PathBuf)> {
+pub(crate) fn split_case(s: &str) -> Result<(Case, PathBuf)> {
     for (prefix, case) in [
         ("none=", Case::NoDamper),
         ("damper=", Case::Damper),

@@ -354,7 +354,7 @@ fn optimize_output_is_its_json_report() {
 // ---------------------------------------------------------------------------------------------
 // 4. Completions and manual pages.
 
-const SUBCOMMANDS: [&str; 14] = [
+const SUBCOMMANDS: [&str; 15] = [
     "simulate",
     "modes",
     "sweep",
@@ -367,6 +367,7 @@ const SUBCOMMANDS: [&str; 14] = [
     "paper",
     "measure",
     "validate",
+    "calibrate",
     "completions",
     "man",
 ];

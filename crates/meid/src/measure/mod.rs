@@ -11,7 +11,10 @@
 //!   same functions process simulated histories, so a comparison is like for like.
 //! * [`validate`]: simulation beside measurement (frequency, level and peak errors, measured
 //!   reductions beside simulated ones).
+//! * [`calibrate`]: model values (damping ratios, contact stiffnesses, …) fitted to the
+//!   measurements by bounded least squares, with confidence intervals.
 
+pub mod calibrate;
 pub mod mapping;
 pub mod process;
 pub mod report;

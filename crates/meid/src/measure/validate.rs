@@ -141,14 +141,24 @@ pub fn validate(
     Ok(Validation { cases, reductions })
 }
 
-fn one_case(
-    model: &Model,
+/// The measured side of a case: channels mapped, sampling checked, blows detected on the
+/// trigger channel (the blow force, else the acceleration at B, else the floor force).
+#[derive(Debug, Clone)]
+pub(crate) struct MeasuredBlows {
+    /// Mapped channel → index into the case's records.
+    pub map: BTreeMap<SimChannel, usize>,
+    pub fs: f64,
+    pub trigger: SimChannel,
+    pub blows: Blows,
+}
+
+pub(crate) fn measured_blows(
     m: &MeasuredCase,
     p: &Processing,
     section: Option<&MeasurementSpec>,
     flags: &BTreeMap<String, SimChannel>,
     point: &str,
-) -> Result<CaseComparison> {
+) -> Result<MeasuredBlows> {
     let map = map_records(&m.records, section, flags, point)?;
     if map.is_empty() {
         let names: Vec<&str> = m.records.iter().map(|r| r.name.as_str()).collect();
@@ -204,36 +214,82 @@ fn one_case(
             ),
         });
     }
-    let n = mb.length;
-    let pre = mb.pretrigger;
+    Ok(MeasuredBlows {
+        map,
+        fs,
+        trigger,
+        blows: mb,
+    })
+}
+
+/// The simulated blow processed like the measured ones: the run at the measurement's rate,
+/// `pre` samples at rest put before it, its blow found by the same trigger rule.
+#[derive(Debug, Clone)]
+pub(crate) struct SimulatedBlow {
+    history: crate::analysis::History,
+    pre: usize,
+    fs: f64,
+    /// The blow record (one) of the simulated channels.
+    pub blows: Blows,
+    /// The processing of the simulated records (the measured record length).
+    pub processing: Processing,
+}
+
+impl SimulatedBlow {
+    /// Channel `c` of the run, at rest for the pre-trigger, then the blow.
+    pub fn record(&self, c: SimChannel) -> Result<Record> {
+        let mut r = Record::from_history(&self.history, c)?;
+        let mut v = vec![0.0; self.pre];
+        v.extend_from_slice(&r.values);
+        r.values = v;
+        r.abscissa = Abscissa::Even {
+            start_s: -(self.pre as f64) / self.fs,
+            step_s: 1.0 / self.fs,
+        };
+        Ok(r)
+    }
+}
+
+/// Simulates `sys` for records of `n` samples with `pre` samples before the trigger found on
+/// `trigger` (module docs: the simulated blow starts at rest).
+pub(crate) fn simulated_blow(
+    model: &Model,
+    sys: &crate::impact::ImpactSystem,
+    fs: f64,
+    n: usize,
+    pre: usize,
+    trigger: SimChannel,
+    p: &Processing,
+) -> Result<SimulatedBlow> {
     // The simulation: at rest for `pre` samples, then the blow; N + pre + margin samples.
     let margin = n / 100 + 16;
     let sim_samples = n + margin;
     let mut opts = model.options();
     opts.sample_rate = Some(fs);
     opts.duration = (sim_samples as f64 - 0.5) / fs;
-    let sys = model.impact_system(m.case)?;
-    let run = simulate(&sys, &opts, true)?;
-    let h = run
+    let run = simulate(sys, &opts, true)?;
+    let history = run
         .history
         .ok_or_else(|| Error::numerical("validate", "the run recorded no history"))?;
-    let sim_record = |c: SimChannel| -> Result<Record> {
-        let mut r = Record::from_history(&h, c)?;
-        let mut v = vec![0.0; pre];
-        v.extend_from_slice(&r.values);
-        r.values = v;
-        r.abscissa = Abscissa::Even {
-            start_s: -(pre as f64) / fs,
-            step_s: 1.0 / fs,
-        };
-        Ok(r)
-    };
     let sp = Processing {
         record_s: Some(n as f64 / fs),
         ..p.clone()
     };
-    let st = sim_record(trigger)?;
-    let sb0 = detect_blows(&st.values, fs, &sp)?;
+    let mut out = SimulatedBlow {
+        history,
+        pre,
+        fs,
+        blows: Blows {
+            triggers: Vec::new(),
+            starts: Vec::new(),
+            length: n,
+            pretrigger: pre,
+            level: 0.0,
+        },
+        processing: sp,
+    };
+    let st = out.record(trigger)?;
+    let sb0 = detect_blows(&st.values, fs, &out.processing)?;
     let Some(&t0) = sb0.triggers.first() else {
         return Err(Error::numerical(
             "validate",
@@ -243,14 +299,38 @@ fn one_case(
             ),
         ));
     };
-    let start = t0.saturating_sub(pre);
-    let sb = Blows {
+    out.blows = Blows {
         triggers: vec![t0],
-        starts: vec![start],
+        starts: vec![t0.saturating_sub(pre)],
         length: n,
         pretrigger: pre,
         level: sb0.level,
     };
+    Ok(out)
+}
+
+fn one_case(
+    model: &Model,
+    m: &MeasuredCase,
+    p: &Processing,
+    section: Option<&MeasurementSpec>,
+    flags: &BTreeMap<String, SimChannel>,
+    point: &str,
+) -> Result<CaseComparison> {
+    let MeasuredBlows {
+        map,
+        fs,
+        trigger,
+        blows: mb,
+    } = measured_blows(m, p, section, flags, point)?;
+    let tr = &m.records[map[&trigger]];
+    let n = mb.length;
+    let pre = mb.pretrigger;
+    let sys = model.impact_system(m.case)?;
+    let sim = simulated_blow(model, &sys, fs, n, pre, trigger, p)?;
+    let sb = sim.blows.clone();
+    let sp = sim.processing.clone();
+    let sim_record = |c: SimChannel| sim.record(c);
     // Zero padding: a bin ≤ 0.5 % of the lowest mode compared, at most 64× the record.
     let modes: Vec<(String, f64)> = sys
         .structure

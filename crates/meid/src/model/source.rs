@@ -70,6 +70,41 @@ impl Source {
         }
     }
 
+    /// The byte range of the value at the dotted path `path` (`a.b[2].c`) in [`Self::text`],
+    /// when the file writes that value itself (every key found, every index within its array);
+    /// `None` otherwise (a default, a value set by an override, a path through an array of
+    /// tables). Used to write a file with one value replaced and everything else kept.
+    pub fn value_span(&self, path: &str) -> Option<Range<usize>> {
+        let doc = DeTable::parse(&self.text).ok()?;
+        let mut table: &DeTable<'_> = doc.get_ref();
+        let segs = split_path(path);
+        let last = segs.len().checked_sub(1)?;
+        for (i, (key, index)) in segs.into_iter().enumerate() {
+            let v = table
+                .iter()
+                .find(|(k, _)| k.get_ref().as_ref() == key)
+                .map(|(_, v)| v)?;
+            let item = match index {
+                Some(j) => match v.get_ref() {
+                    DeValue::Array(a) => a.get(j)?,
+                    _ => return None,
+                },
+                None => v,
+            };
+            if i == last {
+                return match item.get_ref() {
+                    DeValue::Table(_) | DeValue::Array(_) => None,
+                    _ => Some(item.span()),
+                };
+            }
+            match item.get_ref() {
+                DeValue::Table(t) => table = t,
+                _ => return None,
+            }
+        }
+        None
+    }
+
     /// An input error at a path.
     pub fn error(&self, path: &str, message: impl Into<String>) -> Error {
         Error::Input {

@@ -1,0 +1,138 @@
+//! `meid calibrate`: model values fitted to measured records (thin: the library fits).
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+
+use meid::measure::calibrate::{
+    calibrate, calibrated_model_text, parameters, parse_bounds, parse_fit, Problem, ResidualKind,
+    Settings,
+};
+use meid::measure::mapping::parse_channel_flags;
+use meid::measure::read_records;
+use meid::measure::validate::MeasuredCase;
+
+use crate::args::{PrintArgs, RunArgs};
+use crate::measure::ProcessingArgs;
+
+#[derive(clap::Args)]
+pub struct CalibrateArgs {
+    /// Model file (TOML); its values are the start of the fit.
+    model: PathBuf,
+    /// Measured file (UFF or CSV), optionally with the case it measured: none=FILE (the bare
+    /// machine), damper=FILE, added-mass=FILE; a plain FILE is the model as specified
+    /// (repeatable; the cases are fitted together).
+    #[arg(long = "measured", value_name = "[CASE=]FILE", required = true)]
+    measured: Vec<String>,
+    /// Model paths to fit, as --set names them, comma-separated (repeatable), e.g.
+    /// contact.slider_bed.stiffness,contact.bed_damper.stiffness,structure.lumped.damping_ratios[1].
+    #[arg(long = "fit", value_name = "PATH[,PATH…]", required = true)]
+    fit: Vec<String>,
+    /// Bounds of fitted paths, PATH=LO:HI comma-separated (repeatable); default [p/10, 10 p]
+    /// around the model's value p (a value ≤ 0 needs bounds).
+    #[arg(long = "bounds", value_name = "PATH=LO:HI[,…]")]
+    bounds: Vec<String>,
+    /// Fit ESD levels (dB) between LO and HI Hz instead of the time histories.
+    #[arg(long = "spectrum", value_name = "LO:HI")]
+    spectrum: Option<String>,
+    /// Iteration limit of the Levenberg-Marquardt solver.
+    #[arg(long = "max-iterations", value_name = "N", default_value_t = 50)]
+    max_iterations: usize,
+    /// Map a measured channel to meid's: NAME=B, NAME=floor, NAME=blow (repeatable).
+    #[arg(long = "channel", value_name = "NAME=TARGET")]
+    channel: Vec<String>,
+    /// Write calibration.json, calibrated.toml (the model with the estimates) and the
+    /// before/after overlays (calibration_<case>_<channel>.png/.svg) into DIR.
+    #[arg(short, long, value_name = "DIR")]
+    output: Option<PathBuf>,
+    #[command(flatten)]
+    processing: ProcessingArgs,
+    #[command(flatten)]
+    run: RunArgs,
+    #[command(flatten)]
+    print: PrintArgs,
+}
+
+fn parse_band(s: &str) -> Result<ResidualKind> {
+    let bad = || {
+        anyhow::anyhow!(
+            "--spectrum {s}: give LO:HI in Hz with 0 ≤ LO < HI, e.g. --spectrum 200:400"
+        )
+    };
+    let (lo, hi) = s.split_once(':').ok_or_else(bad)?;
+    let lo: f64 = lo.trim().parse().map_err(|_| bad())?;
+    let hi: f64 = hi.trim().parse().map_err(|_| bad())?;
+    if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && lo < hi) {
+        bail!(bad());
+    }
+    Ok(ResidualKind::Spectrum {
+        lower_hz: lo,
+        upper_hz: hi,
+    })
+}
+
+pub fn run(a: CalibrateArgs) -> Result<()> {
+    let model = a.run.load(&a.model, None)?;
+    let paths = parse_fit(&a.fit)?;
+    let bounds = parse_bounds(&a.bounds)?;
+    let params = parameters(&model, &paths, &bounds)?;
+    if a.max_iterations == 0 {
+        bail!("--max-iterations must be at least 1");
+    }
+    let settings = Settings {
+        residual: match &a.spectrum {
+            Some(s) => parse_band(s)?,
+            None => ResidualKind::TimeHistory,
+        },
+        max_iterations: a.max_iterations,
+        ..Settings::default()
+    };
+    let p = a.processing.processing(model.spec.measurement.as_ref())?;
+    let flags = parse_channel_flags(&a.channel, &model.spec.points.measurement)?;
+    let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
+    let mut cases: Vec<MeasuredCase> = Vec::new();
+    for m in &a.measured {
+        let (case, path) = crate::validate::split_case(m)?;
+        let records = read_records(&path)?;
+        let name = path.display().to_string();
+        match cases.iter_mut().find(|c| c.case == case) {
+            Some(c) => {
+                c.files.push(name);
+                c.records.extend(records);
+            }
+            None => cases.push(MeasuredCase {
+                case,
+                files: vec![name],
+                records,
+            }),
+        }
+    }
+    let problem = Problem::new(&model, params, &cases, &p, &flags, settings)?;
+    let c = calibrate(&problem)?;
+    if let Some(set) = set {
+        meid::io::write_json(&set.path("calibration.json"), &c)?;
+        let text = calibrated_model_text(&model, problem.parameters(), &c.values())?;
+        meid::io::write_atomic(&set.path("calibrated.toml"), text.as_bytes())?;
+        c.plots(set.staging())?;
+        set.commit("calibrate")?;
+    }
+    if a.print.json {
+        println!("{}", serde_json::to_string_pretty(&c)?);
+    } else if a.print.human() {
+        println!(
+            "{} — {}",
+            crate::ui::bold("meid calibrate"),
+            model.spec.name.as_deref().unwrap_or("model")
+        );
+        print!("{}", c.to_text());
+        match &a.output {
+            Some(dir) => println!(
+                "wrote {} (calibrated model: {})",
+                dir.display(),
+                dir.join("calibrated.toml").display()
+            ),
+            None => println!("give -o DIR to write the calibrated model file and the overlays"),
+        }
+    }
+    Ok(())
+}

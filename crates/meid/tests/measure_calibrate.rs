@@ -1,0 +1,289 @@
+//! `meid calibrate`'s library: synthetic measurements of a known lumped model (ten blows, seeded
+//! white noise, written to a binary UFF file and read back) are fitted from a perturbed start;
+//! the known K_s, K_d and bed-mode damping ratio must lie within the reported 95 % intervals,
+//! and the intervals must be narrow (relative half-width < 10 %).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use meid::analysis::energy::simulate;
+use meid::io::uff;
+use meid::measure::calibrate::{
+    calibrate, calibrated_model_text, parameters, Problem, ResidualKind, Settings,
+};
+use meid::measure::process::Processing;
+use meid::measure::validate::MeasuredCase;
+use meid::measure::{Abscissa, Quantity, Record};
+use meid::model::{Case, Model};
+use meid::rng::SplitMix64;
+
+const FS: f64 = 20_000.0;
+// Samples at rest before each blow. The blow force is 0 at the blow's first sample and triggers
+// on its second: a pre-trigger of LEAD + 1 samples makes each blow's record its segment exactly
+// (a record reaching into the next segment would see that segment's rest, not the ringing).
+const LEAD: usize = 99;
+const SEGMENT: usize = 6_000; // samples per blow (0.3 s)
+const BLOWS: usize = 10;
+const KS: &str = "contact.slider_bed.stiffness";
+const KD: &str = "contact.bed_damper.stiffness";
+const ZETA: &str = "structure.lumped.damping_ratios[1]";
+
+fn example() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-lumped.toml")
+}
+
+fn model(overrides: &[String]) -> Model {
+    Model::from_file(&example(), overrides).unwrap()
+}
+
+/// `BLOWS` blows of the model, each `LEAD` samples at rest then `SEGMENT − LEAD` samples of the
+/// simulated blow, plus white noise of standard deviation `noise` × the channel's RMS (seeded),
+/// through a binary UFF file.
+fn measured(m: &Model, noise: f64, seed: u64, tag: &str) -> MeasuredCase {
+    let sys = m.impact_system(Case::AsSpecified).unwrap();
+    let mut o = m.options();
+    o.sample_rate = Some(FS);
+    o.duration = (SEGMENT - LEAD + 10) as f64 / FS;
+    o.stop_at_collision_end = false;
+    let h = simulate(&sys, &o, true).unwrap().history.unwrap();
+    let mut rng = SplitMix64::new(seed);
+    let mut channel = |name: &str, q: Quantity, v: &[f64]| {
+        let rms = (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
+        let mut out = Vec::with_capacity(BLOWS * SEGMENT);
+        for _ in 0..BLOWS {
+            let mut seg = vec![0.0; LEAD];
+            seg.extend(v.iter().take(SEGMENT - LEAD));
+            assert_eq!(seg.len(), SEGMENT);
+            out.extend(seg.into_iter().map(|x| x + noise * rms * rng.next_normal()));
+        }
+        Record {
+            name: name.into(),
+            quantity: q,
+            source_unit: q.si_unit().into(),
+            point: None,
+            abscissa: Abscissa::Even {
+                start_s: 0.0,
+                step_s: 1.0 / FS,
+            },
+            values: out,
+            origin: "synthetic".into(),
+        }
+    };
+    let records = vec![
+        channel(
+            "accel_B",
+            Quantity::Acceleration,
+            &h.bed_acceleration_m_per_s2,
+        ),
+        channel("force_floor", Quantity::Force, &h.floor_force_n),
+        channel("hammer", Quantity::Force, &h.contact_force_slider_bed_n),
+    ];
+    let path =
+        std::env::temp_dir().join(format!("meid-calibrate-{}-{tag}.uff", std::process::id()));
+    let mut f = std::fs::File::create(&path).unwrap();
+    uff::write_records(&mut f, &records, true).unwrap();
+    drop(f);
+    let back = uff::read_uff(&path).unwrap().records;
+    let _ = std::fs::remove_file(&path);
+    assert_eq!(back[2].values, records[2].values);
+    MeasuredCase {
+        case: Case::AsSpecified,
+        files: vec![tag.into()],
+        records: back,
+    }
+}
+
+fn processing() -> Processing {
+    Processing {
+        pretrigger_s: (LEAD + 1) as f64 / FS,
+        ..Processing::default()
+    }
+}
+
+fn value(m: &Model, path: &str) -> f64 {
+    let p = parameters(m, &[path.to_string()], &BTreeMap::new()).unwrap();
+    p[0].start
+}
+
+#[test]
+fn calibration_recovers_known_ks_kd_and_damping_within_its_intervals() {
+    let truth = model(&[]);
+    let known = [value(&truth, KS), value(&truth, KD), value(&truth, ZETA)];
+    let meas = measured(&truth, 0.05, 12, "known");
+    // Start 30 % stiff on K_s, 25 % soft on K_d, 1.6× the damping.
+    let start = model(&[
+        format!("{KS}={:e}", known[0] * 1.3),
+        format!("{KD}={:e}", known[1] * 0.75),
+        format!("{ZETA}={:e}", known[2] * 1.6),
+    ]);
+    let paths: Vec<String> = [KS, KD, ZETA].iter().map(|s| s.to_string()).collect();
+    let params = parameters(&start, &paths, &BTreeMap::new()).unwrap();
+    let problem = Problem::new(
+        &start,
+        params,
+        &[meas],
+        &processing(),
+        &BTreeMap::new(),
+        Settings::default(),
+    )
+    .unwrap();
+    let c = calibrate(&problem).unwrap();
+    eprintln!("{}", c.to_text());
+    assert!(c.converged, "{:?}", c.convergence);
+    for (e, k) in c.parameters.iter().zip(known) {
+        assert!(!e.at_bound, "{e:?}");
+        assert!(
+            e.ci95_low <= k && k <= e.ci95_high,
+            "{}: known {k:e} outside [{:e}, {:e}] (estimate {:e})",
+            e.path,
+            e.ci95_low,
+            e.ci95_high,
+            e.value
+        );
+        assert!(
+            e.relative_half_width < 0.10 && e.relative_half_width > 0.0,
+            "{}: ±{:.2} %",
+            e.path,
+            100.0 * e.relative_half_width
+        );
+    }
+    // The fit leaves the noise: every channel's residual RMS is its noise, 5 % of its RMS,
+    // blow-averaged over 10: 5 %/√10 = 1.58 % (the floor force hardly depends on these three
+    // values: 4.3 % before).
+    for ch in &c.channels {
+        assert!(
+            ch.relative_error_after < 0.0175,
+            "{:?} after: {}",
+            ch.channel,
+            ch.relative_error_after
+        );
+        assert!(ch.relative_error_before > ch.relative_error_after);
+    }
+    assert!(c.rms_residual_before > 10.0 * c.rms_residual_after);
+    // s estimates the noise of the averaged, RMS-scaled residual: 0.05 (1/√10) relative to
+    // the channel RMS with noise, within 10 %.
+    let want = 0.05 / (BLOWS as f64).sqrt();
+    assert!(
+        (c.sigma / want - 1.0).abs() < 0.1,
+        "s = {}, want {want}",
+        c.sigma
+    );
+    // The calibrated model file reads back with the estimates.
+    let text = calibrated_model_text(&start, problem.parameters(), &c.values()).unwrap();
+    let back = Model::from_text("calibrated.toml", text, &[]).unwrap();
+    for e in &c.parameters {
+        assert_eq!(value(&back, &e.path), e.value, "{}", e.path);
+    }
+}
+
+#[test]
+fn spectrum_residuals_recover_the_damping_ratio() {
+    let truth = model(&[]);
+    let zeta = value(&truth, ZETA);
+    let meas = measured(&truth, 0.02, 5, "spectrum");
+    let start = model(&[format!("{ZETA}={:e}", zeta * 2.0)]);
+    let params = parameters(&start, &[ZETA.to_string()], &BTreeMap::new()).unwrap();
+    let settings = Settings {
+        residual: ResidualKind::Spectrum {
+            lower_hz: 200.0,
+            upper_hz: 400.0,
+        },
+        ..Settings::default()
+    };
+    let problem = Problem::new(
+        &start,
+        params,
+        &[meas],
+        &processing(),
+        &BTreeMap::new(),
+        settings,
+    )
+    .unwrap();
+    let c = calibrate(&problem).unwrap();
+    eprintln!("{}", c.to_text());
+    let e = &c.parameters[0];
+    assert!(c.converged, "{:?}", c.convergence);
+    assert!(
+        (e.value / zeta - 1.0).abs() < 0.05,
+        "estimate {} vs known {zeta}",
+        e.value
+    );
+    assert!(c.rms_residual_after < c.rms_residual_before / 3.0);
+}
+
+#[test]
+fn the_calibrated_file_keeps_the_original_text_but_the_fitted_values() {
+    let m = model(&[]);
+    let p = parameters(&m, &[KS.to_string(), ZETA.to_string()], &BTreeMap::new()).unwrap();
+    let text = calibrated_model_text(&m, &p, &[5.5e7, 0.0123]).unwrap();
+    let original = std::fs::read_to_string(example()).unwrap();
+    // Every comment line of the original is kept; the values changed in place.
+    for l in original.lines().filter(|l| l.starts_with('#')) {
+        assert!(text.contains(l), "{l}");
+    }
+    assert!(text.contains("damping_ratios = [0.01, 1.23e-2]"), "{text}");
+    assert!(text.contains("stiffness = 5.5e7        # K_s"), "{text}");
+    let back = Model::from_text("c.toml", text, &[]).unwrap();
+    assert_eq!(value(&back, KS), 5.5e7);
+    assert_eq!(value(&back, ZETA), 0.0123);
+    assert_eq!(value(&back, KD), value(&m, KD));
+}
+
+#[test]
+fn bad_fit_paths_and_bounds_are_refused_with_the_path_named() {
+    let m = model(&[]);
+    let none = BTreeMap::new();
+    let e = parameters(&m, &["contact.slider_bed.stifness".into()], &none)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("contact.slider_bed.stifness"), "{e}");
+    let e = parameters(&m, &["slider.name_of_thing".into()], &none)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("slider.name_of_thing"), "{e}");
+    // The start outside the bounds.
+    let b: BTreeMap<String, (f64, f64)> = [(KS.to_string(), (1e6, 1e7))].into();
+    let e = parameters(&m, &[KS.into()], &b).unwrap_err().to_string();
+    assert!(e.contains("outside its bounds") && e.contains(KS), "{e}");
+    // Bounds for a path not fitted.
+    let b: BTreeMap<String, (f64, f64)> = [(KD.to_string(), (1e6, 1e9))].into();
+    let e = parameters(&m, &[KS.into()], &b).unwrap_err().to_string();
+    assert!(e.contains("not fitted"), "{e}");
+    // A start of 0 needs bounds (contact damping C_s = 0 in the example).
+    let e = parameters(&m, &["contact.slider_bed.damping".into()], &none)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("--bounds contact.slider_bed.damping=LO:HI"),
+        "{e}"
+    );
+}
+
+#[test]
+fn values_outside_the_structure_reuse_its_modes_and_are_recovered() {
+    // c_d (the damper's dashpot) is not part of the structural key: no structure is solved
+    // during the fit.
+    const CD: &str = "damper.damping";
+    let truth = model(&[]);
+    let known = value(&truth, CD);
+    let meas = measured(&truth, 0.05, 3, "cd");
+    let start = model(&[format!("{CD}={:e}", known * 1.5)]);
+    let params = parameters(&start, &[CD.to_string()], &BTreeMap::new()).unwrap();
+    let problem = Problem::new(
+        &start,
+        params,
+        &[meas],
+        &processing(),
+        &BTreeMap::new(),
+        Settings::default(),
+    )
+    .unwrap();
+    let c = calibrate(&problem).unwrap();
+    assert_eq!(c.structures_built, 0);
+    let e = &c.parameters[0];
+    assert!(c.converged, "{:?}", c.convergence);
+    assert!(
+        e.ci95_low <= known && known <= e.ci95_high,
+        "known {known}, {e:?}"
+    );
+}
