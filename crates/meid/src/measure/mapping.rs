@@ -11,6 +11,8 @@
 //! window = "exponential"    # rectangular (default), hann, exponential
 //! tau_s = 0.25              # the exponential window's time constant
 //! force_window = true       # force window on force channels
+//! files = ["none=meas/bare.uff", "damper=meas/damper.uff"]  # measured records ([CASE=]FILE,
+//!                           # relative to the model file), compared by `meid report`
 //! ```
 //!
 //! Targets: `B` (or the model's `points.measurement` name): the bed acceleration at the
@@ -57,6 +59,11 @@ pub struct MeasurementSpec {
     /// Force window on force channels (default false).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub force_window: Option<bool>,
+    /// Measured files, `[CASE=]FILE` as `meid validate --measured` takes them (CASE: none,
+    /// damper, added-mass, as-specified), relative to the model file's directory: `meid
+    /// report` compares the simulation with them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub files: Vec<String>,
 }
 
 impl MeasurementSpec {
