@@ -54,6 +54,9 @@ pub struct ReportArgs {
     /// model's [measurement] channels).
     #[arg(long = "channel", value_name = "NAME=TARGET")]
     channel: Vec<String>,
+    /// Processing of the measured records (over the model's [measurement] section).
+    #[command(flatten)]
+    processing: crate::measure::ProcessingArgs,
     #[command(flatten)]
     set: SetArgs,
     #[command(flatten)]
@@ -80,6 +83,7 @@ pub fn run(a: ReportArgs) -> Result<()> {
         seed: a.seed,
         measured: a.measured.clone(),
         channels: a.channel.clone(),
+        processing: a.processing.as_section(),
     };
     let dir = a.output.clone().unwrap_or_else(|| {
         let stem = a

@@ -23,6 +23,7 @@ use crate::analysis::compare::{CaseName, CompareOptions, Comparison, ComparisonR
 use crate::analysis::montecarlo::{MonteCarlo, MonteCarloResult, Uncertain};
 use crate::analysis::study::{Objective, OptimizeReport, OptimizeStudy};
 use crate::analysis::sweep::{Quantity, Spacing, Sweep, SweepResult, Vary};
+use crate::measure::mapping::MeasurementSpec;
 use crate::measure::validate::Validation;
 use crate::model::fem::{self, ModeReport};
 use crate::model::spec::{DashpotKindSpec, LawSpec, MethodSpec};
@@ -55,6 +56,9 @@ pub struct MachineOptions {
     pub measured: Vec<String>,
     /// `NAME=TARGET` channel mappings over the model's `[measurement] channels`.
     pub channels: Vec<String>,
+    /// Processing of the measurements (trigger, pre-trigger, record, window) over the
+    /// model's `[measurement]` section ([`MeasurementSpec::over`]).
+    pub processing: MeasurementSpec,
 }
 
 impl Default for MachineOptions {
@@ -70,6 +74,7 @@ impl Default for MachineOptions {
             seed: 1,
             measured: Vec::new(),
             channels: Vec::new(),
+            processing: MeasurementSpec::default(),
         }
     }
 }
@@ -230,7 +235,13 @@ impl MachineReport {
         options.map_points |= 1;
 
         // Measured records next: a bad file is an input error, found before the long studies.
-        let measured = super::measured::run(path, &model, &options.measured, &options.channels)?;
+        let measured = super::measured::run(
+            path,
+            &model,
+            &options.measured,
+            &options.channels,
+            &options.processing,
+        )?;
 
         // Monte Carlo first: a bad --vary is an input error, found before the long studies.
         progress(STAGES[1]);

@@ -12,8 +12,7 @@ use std::path::Path;
 
 use super::figures::sig;
 use super::html::{Block, Figure, Section, Table};
-use crate::measure::mapping::parse_channel_flags;
-use crate::measure::process::Processing;
+use crate::measure::mapping::{parse_channel_flags, MeasurementSpec};
 use crate::measure::validate::{read_measured, validate, Validation};
 use crate::model::Model;
 use crate::Result;
@@ -24,12 +23,14 @@ pub const DATA_FILE: &str = "measured.json";
 /// Runs the comparison when measured files are given: `measured` (`[CASE=]FILE`, as
 /// `meid validate --measured`, relative to the working directory) or else the model's
 /// `[measurement] files` (relative to the model file's directory); `channels` are
-/// `NAME=TARGET` mappings over the section's. `None` when there is no measured file.
+/// `NAME=TARGET` mappings over the section's; `processing`'s settings win over the section's
+/// ([`MeasurementSpec::over`]). `None` when there is no measured file.
 pub fn run(
     model_path: &Path,
     model: &Model,
     measured: &[String],
     channels: &[String],
+    processing: &MeasurementSpec,
 ) -> Result<Option<Validation>> {
     let section = model.spec.measurement.as_ref();
     let (files, base) = if !measured.is_empty() {
@@ -40,10 +41,7 @@ pub fn run(
             None => return Ok(None),
         }
     };
-    let p = match section {
-        Some(s) => s.processing()?,
-        None => Processing::default(),
-    };
+    let p = processing.over(section).processing()?;
     let flags = parse_channel_flags(channels, &model.spec.points.measurement)?;
     let cases = read_measured(&files, base)?;
     validate(model, &cases, &p, &flags).map(Some)

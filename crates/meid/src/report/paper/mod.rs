@@ -510,7 +510,9 @@ fn draw_compare(
         let (what, unit) = (ch.what(), ch.unit());
         let mut p = history_plot(c, ch, &label);
         let shown = p.x_range.map_or(studies::record_s(m.base), |(a, b)| b - a);
-        p.title = format!("{} at {point} ({})", p.title, m.label());
+        p.title = p
+            .title
+            .replacen(what, &format!("{what} at {point} ({})", m.label()), 1);
         let peaks: Vec<String> = c
             .cases
             .iter()
