@@ -229,7 +229,16 @@ fn simulated_uff_records_given_as_measurements_match_the_simulation() {
             .current_dir(&d)
             .arg("simulate")
             .arg(example_file("paper-lumped.toml"))
-            .args(["--case", case, "--duration", "0.5", "--uff", "-q", "-o", dir])
+            .args([
+                "--case",
+                case,
+                "--duration",
+                "0.5",
+                "--uff",
+                "-q",
+                "-o",
+                dir,
+            ])
             .output()
             .unwrap());
     }

@@ -47,7 +47,7 @@ fn write_measurement(m: &Model, case: Case, path: &Path) {
         .iter()
         .map(|&c| {
             let mut r = Record::from_history(&h, c).unwrap();
-            r.values.splice(0..0, std::iter::repeat(0.0).take(LEAD));
+            r.values.splice(0..0, std::iter::repeat_n(0.0, LEAD));
             r
         })
         .collect();
@@ -199,13 +199,13 @@ fn without_measurements_the_section_says_how_to_give_them() {
 
 #[test]
 fn a_missing_measured_file_is_an_error_naming_it() {
-    let e = MachineReport::run(
+    let Err(e) = MachineReport::run(
         &example(),
         &[],
         &options(vec!["damper=no-such-recording.uff".into()]),
         &|_| {},
-    )
-    .err()
-    .expect("an error");
+    ) else {
+        panic!("a missing measured file was accepted");
+    };
     assert!(e.to_string().contains("no-such-recording.uff"), "{e}");
 }

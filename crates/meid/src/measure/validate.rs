@@ -505,6 +505,8 @@ impl Validation {
                                 label: "simulated".into(),
                                 x: t,
                                 y: ch.simulated_average.clone(),
+                                // Dashed: where they agree the measured curve shows through.
+                                style: crate::plot::LineStyle::Dashed,
                                 ..Default::default()
                             },
                         ],
@@ -541,7 +543,8 @@ impl Validation {
                     format!("measured ({})", ch.measured_name),
                     &ch.measured_spectrum,
                 );
-                let ss = series("simulated".into(), &ch.simulated_spectrum);
+                let mut ss = series("simulated".into(), &ch.simulated_spectrum);
+                ss.style = crate::plot::LineStyle::Dashed;
                 if ms.y.iter().chain(&ss.y).any(|v| v.is_finite()) {
                     crate::plot::spectrum_plot(
                         dir.join(format!("{stem}_spectrum")),

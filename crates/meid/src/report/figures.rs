@@ -391,13 +391,17 @@ pub fn history_plot(r: &ComparisonResult, ch: Channel, label: CaseLabel) -> Line
     }
 }
 
+/// A curve of a channel's spectrum: `(x, y)` from the spectrum and the level reference.
+type SpectrumCurve<'a> =
+    &'a dyn Fn(&crate::analysis::compare::ChannelSpectrum, f64) -> (Vec<f64>, Vec<f64>);
+
 /// One curve per case of a channel's spectrum, `curve(spectrum, reference)` giving its points
 /// (added mass dashed).
 fn case_curves(
     r: &ComparisonResult,
     ch: Channel,
     label: CaseLabel,
-    curve: &dyn Fn(&crate::analysis::compare::ChannelSpectrum, f64) -> (Vec<f64>, Vec<f64>),
+    curve: SpectrumCurve,
 ) -> Vec<Series> {
     let (reference, _) = ch.esd_reference(r);
     r.cases

@@ -56,6 +56,8 @@ pub fn key_result(v: &Validation) -> String {
         .map(|c| c.peak_error_percent)
         .filter(|e| e.is_finite())
         .fold(0.0_f64, |m, e| if e.abs() > m.abs() { e } else { m });
+    // Below the printed precision: no sign ("-0.00 %" reads as a measured deficit).
+    let worst = if worst.abs() < 5e-3 { 0.0 } else { worst };
     let mut s = format!(
         "Measured against simulated ({} case(s), identical processing): largest sample-peak error {:+.2} %",
         v.cases.len(),
@@ -149,6 +151,16 @@ pub fn section(dir: &Path, v: Option<&Validation>) -> Result<Section> {
     })
 }
 
+/// `v` with a sign and 2 decimals; a value that rounds to zero is "0.00" (not "-0.00",
+/// which would read as a deficit).
+fn signed(v: f64) -> String {
+    if (100.0 * v).round() == 0.0 {
+        "0.00".into()
+    } else {
+        format!("{v:+.2}")
+    }
+}
+
 fn header(names: &[&str]) -> Vec<String> {
     names.iter().map(|s| s.to_string()).collect()
 }
@@ -165,7 +177,7 @@ pub fn peaks_table(v: &Validation) -> Table {
                 sig(ch.measured_peak, 5),
                 sig(ch.simulated_peak, 5),
                 ch.unit.clone(),
-                format!("{:+.2}", ch.peak_error_percent),
+                signed(ch.peak_error_percent),
             ]);
         }
     }
@@ -197,10 +209,10 @@ pub fn modes_table(v: &Validation) -> Table {
                     m.mode.clone(),
                     format!("{:.3}", m.measured_frequency_hz),
                     format!("{:.3}", m.simulated_frequency_hz),
-                    format!("{:+.2}", m.frequency_error_percent),
+                    signed(m.frequency_error_percent),
                     format!("{:.2}", m.measured_level_db),
                     format!("{:.2}", m.simulated_level_db),
-                    format!("{:+.2}", m.level_difference_db),
+                    signed(m.level_difference_db),
                     ch.level_reference.clone(),
                 ]);
             }
@@ -243,7 +255,7 @@ pub fn reductions_table(v: &Validation) -> Table {
                     r.metric.clone(),
                     format!("{:.2}", r.measured_db),
                     format!("{:.2}", r.simulated_db),
-                    format!("{:+.2}", r.measured_db - r.simulated_db),
+                    signed(r.measured_db - r.simulated_db),
                 ]
             })
             .collect(),
