@@ -511,32 +511,37 @@ pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Res
             ),
             &[&histories],
         ));
-        let p = esd_plot(r, ch, &default_case_label);
-        let stem = format!("{prefix}-{}-spectrum", ch.stem());
-        plot::spectrum_plot(dir.join(&stem), &p)?;
-        out.push(figure(
-            &stem,
-            &format!("{w} spectrum, three cases"),
-            format!(
-                "{}: {what} in {}, the three cases (the added mass dashed); the dominant modes' peaks are located by refinement.",
-                capitalise(w),
-                p.y_label
+        let esd = esd_plot(r, ch, &default_case_label);
+        let bands = band_plot(r, ch, &default_case_label);
+        let esd_caption = format!(
+            "{}: {what} in {}, the three cases (the added mass dashed); the dominant modes' peaks are located by refinement.",
+            capitalise(w),
+            esd.y_label
+        );
+        let bands_caption = format!(
+            "{}: energy in each one-third-octave band (IEC 61260-1, base 10), the integral of the ESD over the band, in {}; the three cases.",
+            capitalise(w),
+            bands.y_label.trim_start_matches("band level ")
+        );
+        for (p, kind, alt, caption, data) in [
+            (esd, "spectrum", "spectrum", esd_caption, &spectra),
+            (
+                bands,
+                "bands",
+                "one-third-octave levels",
+                bands_caption,
+                &bands_csv,
             ),
-            &[&spectra],
-        ));
-        let p = band_plot(r, ch, &default_case_label);
-        let stem = format!("{prefix}-{}-bands", ch.stem());
-        plot::spectrum_plot(dir.join(&stem), &p)?;
-        out.push(figure(
-            &stem,
-            &format!("{w} one-third-octave levels, three cases"),
-            format!(
-                "{}: energy in each one-third-octave band (IEC 61260-1, base 10), the integral of the ESD over the band, in {}; the three cases.",
-                capitalise(w),
-                p.y_label.trim_start_matches("band level ")
-            ),
-            &[&bands_csv],
-        ));
+        ] {
+            let stem = format!("{prefix}-{}-{kind}", ch.stem());
+            plot::spectrum_plot(dir.join(&stem), &p)?;
+            out.push(figure(
+                &stem,
+                &format!("{w} {alt}, three cases"),
+                caption,
+                &[data],
+            ));
+        }
     }
     Ok(out)
 }

@@ -167,20 +167,23 @@ fn header(names: &[&str]) -> Vec<String> {
 
 /// Sample peaks per case and channel, measured and simulated, and the error.
 pub fn peaks_table(v: &Validation) -> Table {
-    let mut rows = Vec::new();
-    for c in &v.cases {
-        for ch in &c.channels {
-            rows.push(vec![
-                c.case.clone(),
-                ch.channel.label().into(),
-                ch.measured_name.clone(),
-                sig(ch.measured_peak, 5),
-                sig(ch.simulated_peak, 5),
-                ch.unit.clone(),
-                signed(ch.peak_error_percent),
-            ]);
-        }
-    }
+    let rows = v
+        .cases
+        .iter()
+        .flat_map(|c| {
+            c.channels.iter().map(move |ch| {
+                vec![
+                    c.case.clone(),
+                    ch.channel.label().into(),
+                    ch.measured_name.clone(),
+                    sig(ch.measured_peak, 5),
+                    sig(ch.simulated_peak, 5),
+                    ch.unit.clone(),
+                    signed(ch.peak_error_percent),
+                ]
+            })
+        })
+        .collect();
     Table {
         caption: "Sample peaks of the blow-averaged records, measured and simulated; error 100 (measured − simulated)/simulated.".into(),
         header: header(&[
