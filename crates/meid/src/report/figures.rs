@@ -930,6 +930,7 @@ mod tests {
         (grid.x_log, grid.y_log) = (true, true);
         grid.x_label = "ω_s/ω_6 (1)".into();
         grid.y_label = "ω_d/ω_6 (1)".into();
+        grid.colorbar_label = "E_p+/E_s− (1)".into();
         let map = marked_heat_map(grid, &marks, "ω_d = ω_s");
         // The marks inside the grid are labelled points, in order; none is drawn as a curve.
         let labels: Vec<&str> = map.points.iter().map(|p| p.label.as_str()).collect();
