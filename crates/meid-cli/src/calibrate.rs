@@ -9,8 +9,7 @@ use meid::measure::calibrate::{
     Settings,
 };
 use meid::measure::mapping::parse_channel_flags;
-use meid::measure::read_records;
-use meid::measure::validate::MeasuredCase;
+use meid::measure::validate::read_measured;
 
 use crate::args::{PrintArgs, RunArgs};
 use crate::measure::ProcessingArgs;
@@ -90,23 +89,7 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
     let p = a.processing.processing(model.spec.measurement.as_ref())?;
     let flags = parse_channel_flags(&a.channel, &model.spec.points.measurement)?;
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
-    let mut cases: Vec<MeasuredCase> = Vec::new();
-    for m in &a.measured {
-        let (case, path) = crate::validate::split_case(m)?;
-        let records = read_records(&path)?;
-        let name = path.display().to_string();
-        match cases.iter_mut().find(|c| c.case == case) {
-            Some(c) => {
-                c.files.push(name);
-                c.records.extend(records);
-            }
-            None => cases.push(MeasuredCase {
-                case,
-                files: vec![name],
-                records,
-            }),
-        }
-    }
+    let cases = read_measured(&a.measured, None)?;
     let problem = Problem::new(&model, params, &cases, &p, &flags, settings)?;
     let c = calibrate(&problem)?;
     if let Some(set) = set {

@@ -42,6 +42,21 @@ pub struct ProcessingArgs {
 }
 
 impl ProcessingArgs {
+    /// The flags as a `[measurement]` section to lay over a model's
+    /// (`MeasurementSpec::over`; `--trigger` is not part of it).
+    pub fn as_section(&self) -> MeasurementSpec {
+        MeasurementSpec {
+            trigger_level: self.trigger_level,
+            pretrigger_s: self.pretrigger,
+            record_s: self.record,
+            holdoff_s: self.holdoff,
+            window: self.window.clone(),
+            tau_s: self.tau,
+            force_window: self.force_window.then_some(true),
+            ..MeasurementSpec::default()
+        }
+    }
+
     /// The section's settings with these flags over them.
     pub fn processing(&self, section: Option<&MeasurementSpec>) -> Result<Processing> {
         let s = section.cloned().unwrap_or_default();

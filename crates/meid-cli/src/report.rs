@@ -45,6 +45,18 @@ pub struct ReportArgs {
     /// Monte Carlo seed.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Measured file (UFF or CSV) to set beside the simulation, optionally with the case it
+    /// measured: none=FILE, damper=FILE, added-mass=FILE (repeatable; as `meid validate`).
+    /// Default: the model's [measurement] files.
+    #[arg(long = "measured", value_name = "[CASE=]FILE")]
+    measured: Vec<String>,
+    /// Map a measured channel to meid's: NAME=B, NAME=floor, NAME=blow (repeatable; over the
+    /// model's [measurement] channels).
+    #[arg(long = "channel", value_name = "NAME=TARGET")]
+    channel: Vec<String>,
+    /// Processing of the measured records (over the model's [measurement] section).
+    #[command(flatten)]
+    processing: crate::measure::ProcessingArgs,
     #[command(flatten)]
     set: SetArgs,
     #[command(flatten)]
@@ -69,6 +81,9 @@ pub fn run(a: ReportArgs) -> Result<()> {
         uncertain,
         samples: a.samples,
         seed: a.seed,
+        measured: a.measured.clone(),
+        channels: a.channel.clone(),
+        processing: a.processing.as_section(),
     };
     let dir = a.output.clone().unwrap_or_else(|| {
         let stem = a

@@ -5,9 +5,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 
 use meid::measure::mapping::parse_channel_flags;
-use meid::measure::read_records;
-use meid::measure::validate::{validate, MeasuredCase};
-use meid::model::Case;
+use meid::measure::validate::{read_measured, validate};
 
 use crate::args::{PrintArgs, RunArgs};
 use crate::measure::ProcessingArgs;
@@ -38,43 +36,12 @@ pub struct ValidateArgs {
     print: PrintArgs,
 }
 
-/// `CASE=FILE` or `FILE`.
-pub(crate) fn split_case(s: &str) -> Result<(Case, PathBuf)> {
-    for (prefix, case) in [
-        ("none=", Case::NoDamper),
-        ("damper=", Case::Damper),
-        ("added-mass=", Case::AddedMass),
-        ("as-specified=", Case::AsSpecified),
-    ] {
-        if let Some(f) = s.strip_prefix(prefix) {
-            return Ok((case, PathBuf::from(f)));
-        }
-    }
-    Ok((Case::AsSpecified, PathBuf::from(s)))
-}
-
 pub fn run(a: ValidateArgs) -> Result<()> {
     let model = a.run.load(&a.model, None)?;
     let p = a.processing.processing(model.spec.measurement.as_ref())?;
     let flags = parse_channel_flags(&a.channel, &model.spec.points.measurement)?;
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
-    let mut cases: Vec<MeasuredCase> = Vec::new();
-    for m in &a.measured {
-        let (case, path) = split_case(m)?;
-        let records = read_records(&path)?;
-        let name = path.display().to_string();
-        match cases.iter_mut().find(|c| c.case == case) {
-            Some(c) => {
-                c.files.push(name);
-                c.records.extend(records);
-            }
-            None => cases.push(MeasuredCase {
-                case,
-                files: vec![name],
-                records,
-            }),
-        }
-    }
+    let cases = read_measured(&a.measured, None)?;
     let v = validate(&model, &cases, &p, &flags)?;
     if let Some(set) = set {
         meid::io::write_json(&set.path("validation.json"), &v)?;

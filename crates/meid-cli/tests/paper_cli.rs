@@ -43,6 +43,38 @@ fn paper_page_figures_table_and_closed_forms() {
             .count();
         assert!(hits >= 1, "no captioned figure reproduces paper Fig. {n}");
     }
+    // Energy maps as the paper draws them: the operating points are labelled points (text
+    // of the picture, Q and S sharing one), the rule ω_d = ω_s is a legend entry, the axes are
+    // named after the paper's reference mode.
+    let texts = |stem: &str| {
+        meid::plot::svg_texts(&std::fs::read_to_string(dir.join(format!("{stem}.svg"))).unwrap())
+    };
+    for (stem, want) in [
+        (
+            "fig03a-soft-lumped",
+            &["P", "Q = S", "R", "ω_d = ω_s", "ω_s/ω_6 (1)", "ω_d/ω_6 (1)"][..],
+        ),
+        ("fig03a-soft-fe", &["P", "Q = S", "R", "ω_d = ω_s"][..]),
+        ("fig12-stiff-lumped", &["T", "ω_d = ω_s", "ω_s/ω_6 (1)"][..]),
+        (
+            "fig16-nobase-lumped",
+            &["U", "ω_d = ω_s", "ω_s/ω_4 (1)", "ω_d/ω_4 (1)"][..],
+        ),
+        ("fig16-nobase-fe", &["U", "ω_d = ω_s", "ω_s/ω_4 (1)"][..]),
+    ] {
+        let t = texts(stem);
+        for w in want {
+            assert!(t.iter().any(|s| s == w), "{stem}: no text {w:?} in {t:?}");
+        }
+    }
+    // Energy histories (Figs. 6-8): the slider's leaving and the PE K_d maximum are marked.
+    let t = texts("fig06-Q-soft-lumped");
+    for w in ["slider leaves", "PE K_d maximum"] {
+        assert!(
+            t.iter().any(|s| s.starts_with(w)),
+            "fig06: no {w:?} in {t:?}"
+        );
+    }
     // Each figure's data file and vector picture exist (check_page covered the links).
     assert!(html.contains(".csv\">") && html.contains(".svg\">"));
     // The table: every paper number has a row.

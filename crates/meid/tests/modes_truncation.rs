@@ -11,7 +11,7 @@ use meid::model::{ContactSpec, LawSpec, Model, ReleaseSpec};
 /// A structured nx × ny quad mesh of [0, a] × [0, b] in Gmsh 4.1 ASCII with physical groups
 /// "plate" (surface), "corners" (the four corner points) and "centre" (a point).
 fn plate_msh(nx: usize, ny: usize, a: f64, b: f64) -> String {
-    assert!(nx % 2 == 0 && ny % 2 == 0);
+    assert!(nx.is_multiple_of(2) && ny.is_multiple_of(2));
     let tag = |i: usize, j: usize| 1 + j * (nx + 1) + i;
     let mut s = String::new();
     s.push_str("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n");

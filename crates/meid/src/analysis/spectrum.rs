@@ -263,7 +263,7 @@ pub(crate) fn real_fft(x: &[f64], n_fft: usize) -> Result<Vec<Complex<f64>>> {
 /// Nyquist bin of an even length excluded) stand for themselves and their mirror image (2),
 /// the DC and Nyquist bins for themselves only (1).
 pub(crate) fn one_sided_factor(k: usize, n_fft: usize) -> f64 {
-    if k == 0 || (n_fft % 2 == 0 && k == n_fft / 2) {
+    if k == 0 || (n_fft.is_multiple_of(2) && k == n_fft / 2) {
         1.0
     } else {
         2.0

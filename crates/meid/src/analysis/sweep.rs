@@ -1476,16 +1476,7 @@ pub fn evaluate(
     options: &Options,
     index: usize,
 ) -> PointResult {
-    evaluate_cases(
-        base,
-        quantities,
-        values,
-        bed_mass_kg,
-        options,
-        index,
-        &[Case::AsSpecified],
-        None,
-    )
+    evaluate_cached(base, quantities, values, bed_mass_kg, options, index, None)
 }
 
 /// [`evaluate`] with the point's structure from (or kept in) `cache`.

@@ -560,7 +560,7 @@ fn emit_samples(
             break;
         }
         match step {
-            Some(e) if k % 64 != 0 => {
+            Some(e) if !k.is_multiple_of(64) => {
                 // faer's kernel (SIMD with run-time dispatch), sequential.
                 faer::linalg::matmul::matmul(
                     faer::MatMut::from_column_major_slice_mut(buf2, n, 1),

@@ -97,7 +97,7 @@ impl TaylorMatrix {
             let row = sum_x[i] / nu + sum_v[i];
             m.max(if i < nd { row * nu } else { row })
         });
-        let structured = n % 2 == 0
+        let structured = n.is_multiple_of(2)
             && (0..n).all(|j| {
                 col(j)[..nd]
                     .iter()

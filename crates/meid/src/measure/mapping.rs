@@ -11,6 +11,8 @@
 //! window = "exponential"    # rectangular (default), hann, exponential
 //! tau_s = 0.25              # the exponential window's time constant
 //! force_window = true       # force window on force channels
+//! files = ["none=meas/bare.uff", "damper=meas/damper.uff"]  # measured records ([CASE=]FILE,
+//!                           # relative to the model file), compared by `meid report`
 //! ```
 //!
 //! Targets: `B` (or the model's `points.measurement` name): the bed acceleration at the
@@ -57,6 +59,11 @@ pub struct MeasurementSpec {
     /// Force window on force channels (default false).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub force_window: Option<bool>,
+    /// Measured files, `[CASE=]FILE` as `meid validate --measured` takes them (CASE: none,
+    /// damper, added-mass, as-specified), relative to the model file's directory: `meid
+    /// report` compares the simulation with them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub files: Vec<String>,
 }
 
 impl MeasurementSpec {
@@ -75,6 +82,35 @@ impl MeasurementSpec {
             other => ("measurement".into(), other.to_string()),
         })?;
         Ok(())
+    }
+
+    /// This section's fields over `base`'s (command-line flags over a model's section): a
+    /// field given here wins, channels are merged (these win), files are these when any. A
+    /// time constant without a window anywhere means the exponential window.
+    pub fn over(&self, base: Option<&MeasurementSpec>) -> MeasurementSpec {
+        let b = base.cloned().unwrap_or_default();
+        let mut channels = b.channels;
+        channels.extend(self.channels.clone());
+        let window = self
+            .window
+            .clone()
+            .or(b.window)
+            .or_else(|| self.tau_s.map(|_| "exponential".to_string()));
+        MeasurementSpec {
+            channels,
+            trigger_level: self.trigger_level.or(b.trigger_level),
+            pretrigger_s: self.pretrigger_s.or(b.pretrigger_s),
+            record_s: self.record_s.or(b.record_s),
+            holdoff_s: self.holdoff_s.or(b.holdoff_s),
+            window,
+            tau_s: self.tau_s.or(b.tau_s),
+            force_window: self.force_window.or(b.force_window),
+            files: if self.files.is_empty() {
+                b.files
+            } else {
+                self.files.clone()
+            },
+        }
     }
 
     /// The processing settings the section gives (defaults of [`Processing`] otherwise).
@@ -348,6 +384,34 @@ mod tests {
             rec("B_accel", Quantity::Acceleration),
         ];
         assert!(map_records(&r, None, &BTreeMap::new(), "bed").is_err());
+    }
+
+    #[test]
+    fn flags_over_a_section() {
+        let section = MeasurementSpec {
+            channels: [("acc".to_string(), "B".to_string())].into(),
+            pretrigger_s: Some(0.02),
+            holdoff_s: Some(0.5),
+            files: vec!["none=a.uff".into()],
+            ..Default::default()
+        };
+        let flags = MeasurementSpec {
+            channels: [("f".to_string(), "floor".to_string())].into(),
+            pretrigger_s: Some(0.0),
+            tau_s: Some(0.3),
+            ..Default::default()
+        };
+        let m = flags.over(Some(&section));
+        assert_eq!(m.pretrigger_s, Some(0.0));
+        assert_eq!(m.holdoff_s, Some(0.5));
+        assert_eq!(m.channels.len(), 2);
+        assert_eq!(m.files, vec!["none=a.uff".to_string()]);
+        // A time constant alone means the exponential window.
+        assert_eq!(m.window.as_deref(), Some("exponential"));
+        assert_eq!(m.processing().unwrap().pretrigger_s, 0.0);
+        // Nothing over nothing: the defaults.
+        let d = MeasurementSpec::default().over(None);
+        assert_eq!(d, MeasurementSpec::default());
     }
 
     #[test]

@@ -50,6 +50,53 @@ pub fn case_name(c: Case) -> &'static str {
     }
 }
 
+/// Splits a `--measured` argument `[CASE=]FILE` (CASE: `none`, `damper`, `added-mass`,
+/// `as-specified`; a plain FILE is the model as specified).
+pub fn split_case(s: &str) -> (Case, std::path::PathBuf) {
+    for (prefix, case) in [
+        ("none=", Case::NoDamper),
+        ("damper=", Case::Damper),
+        ("added-mass=", Case::AddedMass),
+        ("as-specified=", Case::AsSpecified),
+    ] {
+        if let Some(f) = s.strip_prefix(prefix) {
+            return (case, std::path::PathBuf::from(f));
+        }
+    }
+    (Case::AsSpecified, std::path::PathBuf::from(s))
+}
+
+/// Reads `[CASE=]FILE` arguments ([`split_case`]) into measured cases, several files of one
+/// case read together; relative files are taken from `base_dir` when given (a model file's
+/// `[measurement] files`), else as they are.
+pub fn read_measured(
+    args: &[String],
+    base_dir: Option<&std::path::Path>,
+) -> Result<Vec<MeasuredCase>> {
+    let mut cases: Vec<MeasuredCase> = Vec::new();
+    for a in args {
+        let (case, path) = split_case(a);
+        let path = match base_dir {
+            Some(d) if path.is_relative() => d.join(path),
+            _ => path,
+        };
+        let records = super::read_records(&path)?;
+        let name = path.display().to_string();
+        match cases.iter_mut().find(|c| c.case == case) {
+            Some(c) => {
+                c.files.push(name);
+                c.records.extend(records);
+            }
+            None => cases.push(MeasuredCase {
+                case,
+                files: vec![name],
+                records,
+            }),
+        }
+    }
+    Ok(cases)
+}
+
 /// One mode of one channel.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ModeComparison {
@@ -538,6 +585,8 @@ impl Validation {
                                 label: "simulated".into(),
                                 x: t,
                                 y: ch.simulated_average.clone(),
+                                // Dashed: where they agree the measured curve shows through.
+                                style: crate::plot::LineStyle::Dashed,
                                 ..Default::default()
                             },
                         ],
@@ -574,7 +623,8 @@ impl Validation {
                     format!("measured ({})", ch.measured_name),
                     &ch.measured_spectrum,
                 );
-                let ss = series("simulated".into(), &ch.simulated_spectrum);
+                let mut ss = series("simulated".into(), &ch.simulated_spectrum);
+                ss.style = crate::plot::LineStyle::Dashed;
                 if ms.y.iter().chain(&ss.y).any(|v| v.is_finite()) {
                     crate::plot::spectrum_plot(
                         dir.join(format!("{stem}_spectrum")),

@@ -323,7 +323,8 @@ macro_rules! legend_sample {
 }
 
 /// Labelled vertical lines across the frame: dark grey dashes from the bottom to the top of
-/// the y range, the label beside the top (left of the line in the right quarter of the frame),
+/// the y range, the label beside the top (left of the line in the right half of the frame, so
+/// that it does not run under the legend in the upper right corner),
 /// successive labels 18 px lower so that neighbours do not overwrite one another.
 fn draw_markers<'a, DB, X, Y>(
     chart: &mut Chart<'a, DB, X, Y>,
@@ -357,7 +358,7 @@ where
         if with_labels && !m.label.is_empty() {
             let (px, _) = chart.backend_coord(&(m.x, yr.end));
             let frac = (px - px_lo.start) as f64 / width;
-            let right = frac > 0.75;
+            let right = frac > 0.5;
             let dy = 6 + 20 * (k as i32 % 4);
             let font = (FONT, 15).into_font().color(&ink);
             let (w, h) = chart

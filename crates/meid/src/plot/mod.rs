@@ -195,6 +195,18 @@ pub struct PlotFiles {
     pub svg: PathBuf,
 }
 
+/// The texts of an SVG picture's `<text>` elements in document order, trimmed (as written:
+/// XML escapes are kept) — to check what a picture says (labels, legends, axis names).
+pub fn svg_texts(svg: &str) -> Vec<String> {
+    svg.split("<text")
+        .skip(1)
+        .filter_map(|t| {
+            let body = &t[t.find('>')? + 1..];
+            Some(body[..body.find("</text>")?].trim().to_string())
+        })
+        .collect()
+}
+
 /// Font family name the bundled font is registered under.
 pub(crate) const FONT: &str = "sans-serif";
 

@@ -78,14 +78,9 @@ pub fn plain(v: f64) -> String {
     format!("{mantissa}{exponent}")
 }
 
-/// A point marked on a map, in axis values.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Mark {
-    /// Legend text (empty: unnamed).
-    pub label: String,
-    pub x: f64,
-    pub y: f64,
-}
+/// A point marked on a map, in axis values: drawn as a labelled point (a ringed disc with
+/// its label, e.g. "P" or "design", in a box beside it).
+pub use crate::plot::MarkedPoint as Mark;
 
 /// What [`energy_map`] draws: one metric of a two-quantity sweep over its grid.
 #[derive(Debug, Clone, Default)]
@@ -105,7 +100,7 @@ pub struct MapSpec<'a> {
     /// Colour-bar label with unit.
     pub colorbar_label: String,
     /// Points to mark (the current design; the paper's operating points P … U), each drawn
-    /// as a square with a cross, named in the legend.
+    /// as a labelled point.
     pub marks: Vec<Mark>,
     /// Draw the line x = y with this legend text (e.g. `ω_d = ω_s` on a ω_s/ω_ref × ω_d/ω_ref
     /// map); empty: no line.
@@ -115,7 +110,7 @@ pub struct MapSpec<'a> {
 }
 
 /// A heat map of `spec.metric` over the sweep's two quantities, with contour lines, the
-/// line x = y and the marks (each a square and a cross); writes `<stem>.png/.svg` and the
+/// line x = y and the marks ([`marked_heat_map`]); writes `<stem>.png/.svg` and the
 /// sweep table `<stem>.csv`.
 pub fn energy_map(dir: &Path, stem: &str, spec: &MapSpec) -> Result<Figure> {
     let sweep = spec
@@ -146,96 +141,335 @@ pub fn energy_map(dir: &Path, stem: &str, spec: &MapSpec) -> Result<Figure> {
             }));
         }
     }
-    let (lo, hi) = z
-        .iter()
-        .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
-    let contour_levels: Vec<f64> = if lo < hi {
-        (1..8).map(|k| lo + (hi - lo) * k as f64 / 8.0).collect()
-    } else {
-        Vec::new()
-    };
-    let x_log = vary[0].spacing == Spacing::Log;
-    let y_log = vary[1].spacing == Spacing::Log;
-    let mut overlay_lines = Vec::new();
-    if !spec.diagonal_label.is_empty() {
-        let a = x[0].max(y[0]);
-        let b = x[nx - 1].min(y[ny - 1]);
-        if a < b {
-            overlay_lines.push(Series {
-                label: spec.diagonal_label.clone(),
-                x: vec![a, b],
-                y: vec![a, b],
-                ..Default::default()
-            });
-        }
-    }
-    for mark in &spec.marks {
-        let (dx, dy) = (mark.x, mark.y);
-        // Half-sizes: 2.5 % of each axis span (in log or linear measure).
-        let half = |v: &[f64], log: bool, at: f64| -> (f64, f64) {
-            let (a, b) = (v[0], v[v.len() - 1]);
-            if log {
-                let f = (b / a).powf(0.025);
-                (at / f, at * f)
-            } else {
-                let h = 0.025 * (b - a);
-                (at - h, at + h)
-            }
-        };
-        let (x0, x1) = half(x, x_log, dx);
-        let (y0, y1) = half(y, y_log, dy);
-        overlay_lines.push(Series {
-            label: mark.label.clone(),
-            x: vec![x0, x1, x1, x0, x0],
-            y: vec![y0, y0, y1, y1, y0],
+    let map = marked_heat_map(
+        HeatMap {
+            title: spec.title.clone(),
+            x_label: spec.x_label.clone(),
+            y_label: spec.y_label.clone(),
+            x: x.clone(),
+            y: y.clone(),
+            z,
+            x_log: vary[0].spacing == Spacing::Log,
+            y_log: vary[1].spacing == Spacing::Log,
+            colorbar_label: spec.colorbar_label.clone(),
             ..Default::default()
-        });
-        overlay_lines.push(Series {
-            label: String::new(),
-            x: vec![x0, x1],
-            y: vec![dy, dy],
-            ..Default::default()
-        });
-        overlay_lines.push(Series {
-            label: String::new(),
-            x: vec![dx, dx],
-            y: vec![y0, y1],
-            ..Default::default()
-        });
-    }
-    let map = HeatMap {
-        title: spec.title.clone(),
-        x_label: spec.x_label.clone(),
-        y_label: spec.y_label.clone(),
-        x: x.clone(),
-        y: y.clone(),
-        z,
-        x_log,
-        y_log,
-        contour_levels,
-        overlay_lines,
-        colorbar_label: spec.colorbar_label.clone(),
-        ..Default::default()
-    };
+        },
+        &spec.marks,
+        &spec.diagonal_label,
+    );
     plot::heat_map(dir.join(stem), &map)?;
     let csv = format!("{stem}.csv");
     crate::io::write_atomic(&dir.join(&csv), sweep.csv().as_bytes())?;
     Ok(figure(stem, &spec.title, spec.caption.clone(), &[&csv]))
 }
 
-/// The reference text of the ESD levels, e.g. `1 (m/s²)²·s/Hz`, without `/Hz` for bands.
-fn band_reference(s: &str) -> String {
-    s.trim_end_matches("/Hz").to_string()
+/// Seven contour levels evenly spaced between the smallest and largest finite values of
+/// `z`, `z_k = lo + (hi − lo) k/8` (none when `z` is constant or empty).
+pub fn even_contour_levels(z: &[f64]) -> Vec<f64> {
+    let (lo, hi) = z
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if lo < hi {
+        (1..8).map(|k| lo + (hi - lo) * k as f64 / 8.0).collect()
+    } else {
+        Vec::new()
+    }
 }
 
-/// The comparison's figures: time histories of the bed acceleration at B (over the first
-/// part of the record, where the bed mode rings) and of the force to the floor (whole
-/// record), the energy spectral densities of both, and their one-third-octave band levels.
-/// Writes `<prefix>-*.png/.svg` and the data `<prefix>-histories.csv`, `<prefix>-spectra.csv`,
-/// `<prefix>-bands.csv`, `<prefix>-reductions.csv`.
+/// An energy map as the paper draws it (Figs. 3, 12, 16): `map` (grid, values, axes) with
+/// contour lines ([`even_contour_levels`] unless `map` gives its own), the line x = y over
+/// the range both axes share as a dashed overlay named `diagonal_label` in the legend (e.g.
+/// `ω_d = ω_s` on a ω_s/ω_6 × ω_d/ω_6 map; empty: no line), and `marks` as labelled points
+/// (the design, or the paper's P … U); marks at one place share a point labelled "Q = S".
+/// Marks outside the grid are left out (a point off the frame would be drawn over the axes).
+pub fn marked_heat_map(mut map: HeatMap, marks: &[Mark], diagonal_label: &str) -> HeatMap {
+    if map.contour_levels.is_empty() {
+        map.contour_levels = even_contour_levels(&map.z);
+    }
+    let (Some(&x0), Some(&x1), Some(&y0), Some(&y1)) =
+        (map.x.first(), map.x.last(), map.y.first(), map.y.last())
+    else {
+        return map;
+    };
+    if !diagonal_label.is_empty() {
+        let (a, b) = (x0.max(y0), x1.min(y1));
+        if a < b {
+            map.overlay_lines.push(Series {
+                label: diagonal_label.into(),
+                x: vec![a, b],
+                y: vec![a, b],
+                ..Default::default()
+            });
+        }
+    }
+    // Marks at one place (within 1e-6 relative, e.g. the paper's Q and S) share one point
+    // labelled "Q = S": two boxes over each other would hide a label.
+    let same = |a: f64, b: f64| (a - b).abs() <= 1e-6 * a.abs().max(b.abs());
+    for m in marks
+        .iter()
+        .filter(|m| (x0..=x1).contains(&m.x) && (y0..=y1).contains(&m.y))
+    {
+        match map
+            .points
+            .iter_mut()
+            .find(|p| same(p.x, m.x) && same(p.y, m.y))
+        {
+            Some(p) => {
+                p.label = format!("{} = {}", p.label, m.label);
+            }
+            None => map.points.push(m.clone()),
+        }
+    }
+    map
+}
+
+/// One channel of a comparison's histories and spectra.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Channel {
+    /// The bed acceleration a_B at the measurement point B (m/s²).
+    Acceleration,
+    /// The force to the floor F (N).
+    FloorForce,
+}
+
+impl Channel {
+    /// Both channels, in the order of the comparison's spectra.
+    pub const ALL: [Channel; 2] = [Channel::Acceleration, Channel::FloorForce];
+
+    /// Index of the channel in [`crate::analysis::compare::CaseResult::spectra`].
+    pub fn index(self) -> usize {
+        match self {
+            Channel::Acceleration => 0,
+            Channel::FloorForce => 1,
+        }
+    }
+
+    /// File-name part: `acceleration`, `floor-force`.
+    pub fn stem(self) -> &'static str {
+        match self {
+            Channel::Acceleration => "acceleration",
+            Channel::FloorForce => "floor-force",
+        }
+    }
+
+    /// What it is, in words: "bed acceleration at B", "force to the floor".
+    pub fn what(self) -> &'static str {
+        match self {
+            Channel::Acceleration => "bed acceleration at B",
+            Channel::FloorForce => "force to the floor",
+        }
+    }
+
+    /// SI unit.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Channel::Acceleration => "m/s²",
+            Channel::FloorForce => "N",
+        }
+    }
+
+    /// Axis label with unit: "acceleration (m/s²)", "force (N)".
+    pub fn axis_label(self) -> &'static str {
+        match self {
+            Channel::Acceleration => "acceleration (m/s²)",
+            Channel::FloorForce => "force (N)",
+        }
+    }
+
+    /// The channel's samples in a history.
+    pub fn samples(self, h: &crate::analysis::History) -> &[f64] {
+        match self {
+            Channel::Acceleration => &h.bed_acceleration_m_per_s2,
+            Channel::FloorForce => &h.floor_force_n,
+        }
+    }
+
+    /// The comparison's exact time peak of the channel in a case.
+    pub fn peak(self, c: &crate::analysis::compare::CaseResult) -> f64 {
+        match self {
+            Channel::Acceleration => c.peak_bed_acceleration_m_per_s2,
+            Channel::FloorForce => c.peak_floor_force_n,
+        }
+    }
+
+    /// The ESD level reference of the channel in `r`: `(value in SI² units, text)`, e.g.
+    /// `(1, "1 N²·s/Hz")`; levels are `10 log10(ESD / value)` dB.
+    pub fn esd_reference(self, r: &ComparisonResult) -> (f64, String) {
+        let (ea, ef) = r.esd_references();
+        match self {
+            Channel::Acceleration => (r.acceleration_reference_m_per_s2.powi(2), ea),
+            Channel::FloorForce => (1.0, ef),
+        }
+    }
+}
+
+/// How a case is named in a comparison's legends (e.g. the paper's "added mass on the
+/// floating base" instead of [`CaseName::label`]).
+pub type CaseLabel<'a> = &'a dyn Fn(CaseName) -> String;
+
+/// [`CaseName::label`] as a [`CaseLabel`].
+pub fn default_case_label(c: CaseName) -> String {
+    c.label().into()
+}
+
+/// Stroke of a case in overlaid spectra: the added mass dashed, so that it stays visible
+/// where it coincides with the bare machine.
+pub fn case_style(case: CaseName) -> plot::LineStyle {
+    match case {
+        CaseName::AddedMass => plot::LineStyle::Dashed,
+        _ => plot::LineStyle::Solid,
+    }
+}
+
+/// What the comparison's spectra are, in words (exact, or FFT with its window).
+pub fn spectrum_words(r: &ComparisonResult) -> String {
+    match r.spectrum {
+        SpectrumMethod::Exact => "exact ESD".into(),
+        SpectrumMethod::Fft => format!("FFT ESD, {} window", r.window.name()),
+    }
+}
+
+/// The time histories of a channel, one panel per case on a common scale (overlaid, the
+/// last-drawn case hid the others), titled `channel.what()`. The window shown runs up to
+/// 1.25 × the last instant any case exceeds 2 % of the largest |value| (the rest of the
+/// record is the decayed tail), stated in the title; `x_range` holds it (`None`: the whole
+/// record).
+pub fn history_plot(r: &ComparisonResult, ch: Channel, label: CaseLabel) -> LinePlot {
+    let series: Vec<Series> = r
+        .cases
+        .iter()
+        .map(|c| Series {
+            label: label(c.case),
+            x: c.history.time_s.clone(),
+            y: ch.samples(&c.history).to_vec(),
+            ..Default::default()
+        })
+        .collect();
+    let peak = series
+        .iter()
+        .flat_map(|s| s.y.iter())
+        .filter(|v| v.is_finite())
+        .fold(0.0_f64, |m, v| m.max(v.abs()));
+    let t_end = series
+        .iter()
+        .flat_map(|s| s.x.iter())
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max);
+    let t_last = series
+        .iter()
+        .flat_map(|s| s.x.iter().zip(&s.y))
+        .filter(|(_, v)| v.abs() > 0.02 * peak)
+        .map(|(t, _)| *t)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let t0 = series
+        .first()
+        .and_then(|s| s.x.first())
+        .copied()
+        .unwrap_or(0.0);
+    let shown = 1.25 * (t_last - t0) + t0;
+    let zoom = shown.is_finite() && shown > t0 && shown < 0.8 * t_end;
+    LinePlot {
+        title: if zoom {
+            format!(
+                "{}, first {} s of {} s",
+                ch.what(),
+                plot::axis::fmt_tick(&(shown - t0)),
+                plot::axis::fmt_tick(&(t_end - t0))
+            )
+        } else {
+            ch.what().into()
+        },
+        x_label: "time (s)".into(),
+        y_label: ch.axis_label().into(),
+        series,
+        panels: true,
+        x_range: zoom.then_some((t0, shown)),
+        ..Default::default()
+    }
+}
+
+/// A curve of a channel's spectrum: `(x, y)` from the spectrum and the level reference.
+type SpectrumCurve<'a> =
+    &'a dyn Fn(&crate::analysis::compare::ChannelSpectrum, f64) -> (Vec<f64>, Vec<f64>);
+
+/// One curve per case of a channel's spectrum, `curve(spectrum, reference)` giving its points
+/// (added mass dashed).
+fn case_curves(
+    r: &ComparisonResult,
+    ch: Channel,
+    label: CaseLabel,
+    curve: SpectrumCurve,
+) -> Vec<Series> {
+    let (reference, _) = ch.esd_reference(r);
+    r.cases
+        .iter()
+        .filter_map(|c| {
+            let (x, y) = curve(c.spectra.get(ch.index())?, reference);
+            Some(Series {
+                label: label(c.case),
+                x,
+                y,
+                style: case_style(c.case),
+                ..Default::default()
+            })
+        })
+        .collect()
+}
+
+/// The energy spectral densities of a channel in dB ([`Channel::esd_reference`]) against
+/// log frequency, the refined peaks merged in, one curve per case (added mass dashed).
+pub fn esd_plot(r: &ComparisonResult, ch: Channel, label: CaseLabel) -> SpectrumPlot {
+    let (_, text) = ch.esd_reference(r);
+    SpectrumPlot {
+        title: format!(
+            "{}, energy spectral density ({})",
+            ch.what(),
+            spectrum_words(r)
+        ),
+        y_label: format!("ESD level (dB re {text})"),
+        x_log: true,
+        series: case_curves(r, ch, label, &|s, reference| {
+            s.level_curve_db(&r.frequency_hz, reference)
+        }),
+        ..Default::default()
+    }
+}
+
+/// The one-third-octave band energies of a channel, `10 log10(E_band / ref)` dB drawn as a
+/// step over each band, one curve per case.
+pub fn band_plot(r: &ComparisonResult, ch: Channel, label: CaseLabel) -> SpectrumPlot {
+    let (_, text) = ch.esd_reference(r);
+    let steps = |s: &crate::analysis::compare::ChannelSpectrum, reference: f64| {
+        let mut x = Vec::new();
+        let mut y = Vec::new();
+        for (b, e) in r.bands.iter().zip(&s.band_energy) {
+            let l = esd_level_db(*e, reference);
+            x.extend([b.lower_hz, b.upper_hz]);
+            y.extend([l, l]);
+        }
+        (x, y)
+    };
+    SpectrumPlot {
+        title: format!(
+            "{}, one-third-octave band energy ({})",
+            ch.what(),
+            spectrum_words(r)
+        ),
+        y_label: format!("band level (dB re {})", text.trim_end_matches("/Hz")),
+        x_log: true,
+        series: case_curves(r, ch, label, &steps),
+        ..Default::default()
+    }
+}
+
+/// The comparison's figures: per channel (bed acceleration at B, force to the floor) the
+/// time histories ([`history_plot`]), the energy spectral densities ([`esd_plot`]) and the
+/// one-third-octave band levels ([`band_plot`]). Writes `<prefix>-*.png/.svg` and the data
+/// `<prefix>-histories.csv`, `<prefix>-spectra.csv`, `<prefix>-bands.csv`,
+/// `<prefix>-reductions.csv`.
 pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Result<Vec<Figure>> {
     let histories = format!("{prefix}-histories.csv");
     let spectra = format!("{prefix}-spectra.csv");
@@ -250,78 +484,6 @@ pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Res
         return Ok(out);
     };
     let record_s = first.history.time_s.last().copied().unwrap_or(0.0);
-    // The acceleration is dominated by the highest dominant mode while the contact lasts:
-    // show 20 of its periods (the whole record when shorter).
-    let f_high = first
-        .modes
-        .iter()
-        .map(|m| m.centre_hz)
-        .fold(0.0_f64, f64::max);
-    let zoom_s = if f_high > 0.0 {
-        (20.0 / f_high).min(record_s)
-    } else {
-        record_s
-    };
-    let time = |pick: &dyn Fn(&crate::analysis::History) -> &Vec<f64>, t_max: f64| {
-        r.cases
-            .iter()
-            .map(|c| {
-                let n = c.history.time_s.partition_point(|t| *t <= t_max);
-                Series {
-                    label: c.case.label().into(),
-                    x: c.history.time_s[..n].to_vec(),
-                    y: pick(&c.history)[..n].to_vec(),
-                    ..Default::default()
-                }
-            })
-            .collect::<Vec<_>>()
-    };
-    let rate = r.sample_rate_hz;
-    let stem = format!("{prefix}-acceleration-time");
-    plot::line_plot(
-        dir.join(&stem),
-        &LinePlot {
-            title: format!("bed acceleration at B, first {} ms", sig(1e3 * zoom_s, 3)),
-            x_label: "time (s)".into(),
-            y_label: "acceleration (m/s²)".into(),
-            series: time(&|h| &h.bed_acceleration_m_per_s2, zoom_s),
-            ..Default::default()
-        },
-    )?;
-    out.push(figure(
-        &stem,
-        "bed acceleration against time, three cases",
-        format!(
-            "Bed acceleration a_B (m/s²) at the measurement point B after one blow, without damper, with the impact damper and with the added mass: the first {} ms of the {} s record (output samples at {} Hz; the peaks in the tables are exact, located on the continuous solution).",
-            sig(1e3 * zoom_s, 3),
-            plain(record_s),
-            plain(rate)
-        ),
-        &[&histories],
-    ));
-    let stem = format!("{prefix}-floor-force-time");
-    plot::line_plot(
-        dir.join(&stem),
-        &LinePlot {
-            title: "force to the floor".into(),
-            x_label: "time (s)".into(),
-            y_label: "force (N)".into(),
-            series: time(&|h| &h.floor_force_n, record_s),
-            ..Default::default()
-        },
-    )?;
-    out.push(figure(
-        &stem,
-        "force to the floor against time, three cases",
-        format!(
-            "Force to the floor F (N) over the {} s record after one blow, the three cases.",
-            sig(record_s, 3)
-        ),
-        &[&histories],
-    ));
-
-    let (ea, ef) = r.esd_references();
-    let a2 = r.acceleration_reference_m_per_s2.powi(2);
     let what = match r.spectrum {
         SpectrumMethod::Exact => "exact energy spectral density of the whole response, free decay included (independent of record length and sample rate)".to_string(),
         SpectrumMethod::Fft => format!(
@@ -329,97 +491,57 @@ pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Res
             r.window.name()
         ),
     };
-    for (ch, name, what_short, reference, label) in [
-        (
-            0,
-            "acceleration",
-            "bed acceleration at B",
-            a2,
-            format!("ESD level (dB re {ea})"),
-        ),
-        (
-            1,
-            "floor-force",
-            "force to the floor",
-            1.0,
-            format!("ESD level (dB re {ef})"),
-        ),
-    ] {
-        let series = r
-            .cases
-            .iter()
-            .filter_map(|c| {
-                let s = c.spectra.get(ch)?;
-                let (x, y) = s.level_curve_db(&r.frequency_hz, reference);
-                Some(Series {
-                    label: c.case.label().into(),
-                    x,
-                    y,
-                    ..Default::default()
-                })
-            })
-            .collect();
-        let stem = format!("{prefix}-{name}-spectrum");
-        plot::spectrum_plot(
-            dir.join(&stem),
-            &SpectrumPlot {
-                title: format!("{what_short}, energy spectral density"),
-                y_label: label.clone(),
-                x_log: true,
-                series,
-                ..Default::default()
-            },
-        )?;
+    for ch in Channel::ALL {
+        let w = ch.what();
+        let p = history_plot(r, ch, &default_case_label);
+        let shown = p.x_range.map_or(record_s, |(a, b)| b - a);
+        let stem = format!("{prefix}-{}-time", ch.stem());
+        plot::line_plot(dir.join(&stem), &p)?;
         out.push(figure(
             &stem,
-            &format!("{what_short} spectrum, three cases"),
+            &format!("{w} against time, three cases"),
             format!(
-                "{}: {what} in {label}, the three cases; the dominant modes' peaks are located by refinement.",
-                capitalise(what_short)
+                "{} {} ({}) after one blow, one panel per case on a common scale: without damper, with the impact damper and with the added mass; the first {} s of the {} s record (output samples at {} Hz; the peaks in the tables are exact, located on the continuous solution).",
+                capitalise(w),
+                if ch == Channel::Acceleration { "a_B" } else { "F" },
+                ch.unit(),
+                sig(shown, 3),
+                plain(record_s),
+                plain(r.sample_rate_hz)
             ),
-            &[&spectra],
+            &[&histories],
         ));
-        let series = r
-            .cases
-            .iter()
-            .filter_map(|c| {
-                let s = c.spectra.get(ch)?;
-                let mut x = Vec::new();
-                let mut y = Vec::new();
-                for (b, e) in r.bands.iter().zip(&s.band_energy) {
-                    let l = esd_level_db(*e, reference);
-                    x.extend([b.lower_hz, b.upper_hz]);
-                    y.extend([l, l]);
-                }
-                Some(Series {
-                    label: c.case.label().into(),
-                    x,
-                    y,
-                    ..Default::default()
-                })
-            })
-            .collect();
-        let reference_text = band_reference(if ch == 0 { &ea } else { &ef });
-        let stem = format!("{prefix}-{name}-bands");
-        plot::spectrum_plot(
-            dir.join(&stem),
-            &SpectrumPlot {
-                title: format!("{what_short}, one-third-octave band energy"),
-                y_label: format!("band level (dB re {reference_text})"),
-                x_log: true,
-                series,
-                ..Default::default()
-            },
-        )?;
-        out.push(figure(
-            &stem,
-            &format!("{what_short} one-third-octave levels, three cases"),
-            format!(
-                "{}: energy in each one-third-octave band (IEC 61260-1, base 10), the integral of the ESD over the band, in dB re {reference_text}; the three cases.",
-                capitalise(what_short)
+        let esd = esd_plot(r, ch, &default_case_label);
+        let bands = band_plot(r, ch, &default_case_label);
+        let esd_caption = format!(
+            "{}: {what} in {}, the three cases (the added mass dashed); the dominant modes' peaks are located by refinement.",
+            capitalise(w),
+            esd.y_label
+        );
+        let bands_caption = format!(
+            "{}: energy in each one-third-octave band (IEC 61260-1, base 10), the integral of the ESD over the band, in {}; the three cases.",
+            capitalise(w),
+            bands.y_label.trim_start_matches("band level ")
+        );
+        for (p, kind, alt, caption, data) in [
+            (esd, "spectrum", "spectrum", esd_caption, &spectra),
+            (
+                bands,
+                "bands",
+                "one-third-octave levels",
+                bands_caption,
+                &bands_csv,
             ),
-            &[&bands_csv],
-        ));
+        ] {
+            let stem = format!("{prefix}-{}-{kind}", ch.stem());
+            plot::spectrum_plot(dir.join(&stem), &p)?;
+            out.push(figure(
+                &stem,
+                &format!("{w} {alt}, three cases"),
+                caption,
+                &[data],
+            ));
+        }
     }
     Ok(out)
 }
@@ -781,5 +903,58 @@ mod tests {
         assert_eq!(super::plain(62.5), "62.5");
         assert_eq!(super::plain(4.3e7), "4.3e7");
         assert_eq!(super::plain(100.0), "100");
+    }
+
+    #[test]
+    fn energy_map_marks_are_labelled_points_and_the_rule_an_overlay() {
+        use super::{marked_heat_map, Mark};
+        let x: Vec<f64> = (0..9).map(|i| 10.0 * 1.5_f64.powi(i)).collect();
+        let y = x.clone();
+        let z: Vec<f64> = (0..81)
+            .map(|k| ((k % 9) as f64 - (k / 9) as f64).abs())
+            .collect();
+        let mark = |l: &str, x: f64, y: f64| Mark {
+            label: l.into(),
+            x,
+            y,
+        };
+        let marks = [
+            mark("P", 150.0, 25.0),
+            mark("Q", 150.0, 150.0),
+            mark("R", 150.0, 220.0),
+            mark("S", 150.0 * (1.0 + 1e-12), 150.0),
+            mark("outside", 1e4, 20.0),
+        ];
+        let mut grid = crate::plot::HeatMap::default();
+        (grid.x, grid.y, grid.z) = (x.clone(), y, z);
+        (grid.x_log, grid.y_log) = (true, true);
+        grid.x_label = "ω_s/ω_6 (1)".into();
+        grid.y_label = "ω_d/ω_6 (1)".into();
+        grid.colorbar_label = "E_p+/E_s− (1)".into();
+        let map = marked_heat_map(grid, &marks, "ω_d = ω_s");
+        // The marks inside the grid are labelled points, in order; none is drawn as a curve.
+        let labels: Vec<&str> = map.points.iter().map(|p| p.label.as_str()).collect();
+        assert_eq!(labels, vec!["P", "Q = S", "R"]);
+        assert_eq!((map.points[0].x, map.points[0].y), (150.0, 25.0));
+        // One overlay: the rule ω_d = ω_s over the range both axes share, named in the legend.
+        assert_eq!(map.overlay_lines.len(), 1);
+        let rule = &map.overlay_lines[0];
+        assert_eq!(rule.label, "ω_d = ω_s");
+        assert_eq!(rule.x, rule.y);
+        assert_eq!(rule.x, vec![x[0], x[8]]);
+        // Seven contours strictly inside the values' range (0 … 8).
+        assert_eq!(map.contour_levels.len(), 7);
+        assert!(map.contour_levels.iter().all(|l| *l > 0.0 && *l < 8.0));
+        // Drawn: the labels and the legend entry are text of the picture, the axes are named
+        // after the reference mode.
+        let dir = std::env::temp_dir().join(format!("meid-figures-map-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let files = crate::plot::heat_map(dir.join("map"), &map).unwrap();
+        let texts = crate::plot::svg_texts(&std::fs::read_to_string(&files.svg).unwrap());
+        for t in ["P", "Q = S", "R", "ω_d = ω_s", "ω_s/ω_6 (1)", "ω_d/ω_6 (1)"] {
+            assert!(texts.iter().any(|s| s == t), "no text {t:?} in {texts:?}");
+        }
+        assert!(!texts.iter().any(|s| s == "outside"));
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -23,6 +23,8 @@ use crate::analysis::compare::{CaseName, CompareOptions, Comparison, ComparisonR
 use crate::analysis::montecarlo::{MonteCarlo, MonteCarloResult, Uncertain};
 use crate::analysis::study::{Objective, OptimizeReport, OptimizeStudy};
 use crate::analysis::sweep::{Quantity, Spacing, Sweep, SweepResult, Vary};
+use crate::measure::mapping::MeasurementSpec;
+use crate::measure::validate::Validation;
 use crate::model::fem::{self, ModeReport};
 use crate::model::spec::{DashpotKindSpec, LawSpec, MethodSpec};
 use crate::model::{Case, Model};
@@ -48,6 +50,15 @@ pub struct MachineOptions {
     /// Monte Carlo samples and seed.
     pub samples: usize,
     pub seed: u64,
+    /// Measured files `[CASE=]FILE` (as `meid validate --measured`); empty: the model's
+    /// `[measurement] files`, if any. With either, the page has the comparison
+    /// ([`super::measured`]).
+    pub measured: Vec<String>,
+    /// `NAME=TARGET` channel mappings over the model's `[measurement] channels`.
+    pub channels: Vec<String>,
+    /// Processing of the measurements (trigger, pre-trigger, record, window) over the
+    /// model's `[measurement]` section ([`MeasurementSpec::over`]).
+    pub processing: MeasurementSpec,
 }
 
 impl Default for MachineOptions {
@@ -61,6 +72,9 @@ impl Default for MachineOptions {
             uncertain: Vec::new(),
             samples: 100,
             seed: 1,
+            measured: Vec::new(),
+            channels: Vec::new(),
+            processing: MeasurementSpec::default(),
         }
     }
 }
@@ -107,6 +121,8 @@ pub struct MachineReport {
     /// force.
     pub optimize: Vec<OptimizeReport>,
     pub montecarlo: Option<MonteCarloResult>,
+    /// The simulation beside measured records, when some were given.
+    pub measured: Option<Validation>,
     /// Why a study was left out (no damper, a failed study ...); shown on the page.
     pub notes: Vec<String>,
 }
@@ -218,6 +234,15 @@ impl MachineReport {
         let mut options = options.clone();
         options.map_points |= 1;
 
+        // Measured records next: a bad file is an input error, found before the long studies.
+        let measured = super::measured::run(
+            path,
+            &model,
+            &options.measured,
+            &options.channels,
+            &options.processing,
+        )?;
+
         // Monte Carlo first: a bad --vary is an input error, found before the long studies.
         progress(STAGES[1]);
         let montecarlo = if options.uncertain.is_empty() {
@@ -296,6 +321,7 @@ impl MachineReport {
             blows,
             optimize,
             montecarlo,
+            measured,
             notes,
         })
     }
@@ -473,6 +499,9 @@ impl MachineReport {
                     sig(100.0 * s.p95, 4)
                 ));
             }
+        }
+        if let Some(v) = &self.measured {
+            out.push(super::measured::key_result(v));
         }
         out
     }
@@ -722,9 +751,10 @@ impl MachineReport {
                 let ratio = matches!(m.axes, MapAxes::Ratios { .. });
                 let n = self.options.map_points;
                 let caption = format!(
-                    "Energy left in the machine after one blow, E_p+/E_s− (%, paper Eq. 10, each run stopped at the end of the collision), over {xn} × {yn} on a {n} × {n} grid spanning ÷/× {} around the current design (square and cross){}.",
+                    "Energy left in the machine after one blow, E_p+/E_s− (%, paper Eq. 10, each run stopped at the end of the collision), over {xn} × {yn} on a {n} × {n} grid spanning ÷/× {} around the current design (the point marked \"design\", E_p+/E_s− = {} % there){}.",
                     figures::plain(if ratio { self.options.map_span } else { self.options.map_span.powi(2) }),
-                    if ratio { "; the line is the paper's rule ω_d = ω_s" } else { "" }
+                    sig(100.0 * m.design_energy_ratio, 3),
+                    if ratio { "; the dashed line is the paper's rule ω_d = ω_s" } else { "" }
                 );
                 let fig = figures::energy_map(
                     dir,
@@ -738,10 +768,7 @@ impl MachineReport {
                         y_label: if ratio { format!("{yn} (1)") } else { yn.clone() },
                         colorbar_label: "E_p+/E_s− (%)".into(),
                         marks: vec![Mark {
-                            label: format!(
-                                "current design ({} %)",
-                                sig(100.0 * m.design_energy_ratio, 3)
-                            ),
+                            label: "design".into(),
                             x: m.design.0,
                             y: m.design.1,
                         }],
@@ -808,6 +835,7 @@ impl MachineReport {
             heading: "Without damper, with the damper, with an added mass".into(),
             blocks,
         });
+        sections.push(super::measured::section(dir, self.measured.as_ref())?);
 
         // 6. Blow trains.
         let runs: Vec<(CaseName, &BlowsRun)> = self.blows.iter().map(|(c, r)| (*c, r)).collect();
@@ -1100,6 +1128,7 @@ impl MachineReport {
             "rate_bpm": self.options.rate_bpm,
             "optimize": self.optimize,
             "montecarlo": mc,
+            "measured": self.measured,
             "notes": self.notes,
         })
     }

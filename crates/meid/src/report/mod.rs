@@ -13,4 +13,5 @@
 pub mod figures;
 pub mod html;
 pub mod machine;
+pub mod measured;
 pub mod paper;

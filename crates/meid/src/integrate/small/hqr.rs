@@ -276,12 +276,12 @@ fn francis(h: &mut [f64], z: &mut [f64], n: usize, wr: &mut [f64], wi: &mut [f64
             let l = k;
             // Shifts: the eigenvalues of [[y, ·], [·, x]] with off-diagonal product w.
             let (mut x, mut y, mut w);
-            if its % 20 == 0 {
+            if its.is_multiple_of(20) {
                 let s = h[ix(i, i - 1, n)].abs() + h[ix(i - 1, i - 2, n)].abs();
                 x = 0.75 * s + h[ix(i, i, n)];
                 y = x;
                 w = -0.4375 * s * s;
-            } else if its % 10 == 0 {
+            } else if its.is_multiple_of(10) {
                 let s = h[ix(l + 1, l, n)].abs() + h[ix(l + 2, l + 1, n)].abs();
                 x = 0.75 * s + h[ix(l, l, n)];
                 y = x;

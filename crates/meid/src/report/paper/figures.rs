@@ -130,25 +130,3 @@ impl<'a> Figures<'a> {
         self.push(number, stem, &p.title, caption, data)
     }
 }
-
-/// A marker drawn with the current plot API: a `+` around `(x, y)` on log axes (±15 % in
-/// each direction), named in the legend.
-pub fn marker(label: String, x: f64, y: f64) -> Series {
-    let f = 1.15;
-    Series {
-        label,
-        x: vec![x / f, x * f, x, x, x],
-        y: vec![y, y, y, y / f, y * f],
-        ..Default::default()
-    }
-}
-
-/// A vertical line at `x` from `y0` to `y1`, named in the legend.
-pub fn vertical(label: String, x: f64, y0: f64, y1: f64) -> Series {
-    Series {
-        label,
-        x: vec![x, x],
-        y: vec![y0, y1],
-        ..Default::default()
-    }
-}

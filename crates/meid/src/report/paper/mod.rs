@@ -27,13 +27,14 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::analysis::compare::{CaseName, ComparisonResult};
-use crate::plot::{HeatMap, LinePlot, Series, SpectrumPlot};
+use crate::plot::{HeatMap, LinePlot, Marker, Series};
 use crate::report::html::{Block, Page, Section, Table};
 use crate::Result;
 
+use crate::report::figures::Mark;
 use claims::{Row, Runs};
 use deviation::DeviationRow;
-use figures::{marker, vertical, Figures};
+use figures::Figures;
 use machines::{Base, Kind, Machine, MASS_RATIO, WD_OVER_W6_PQR, WS_OVER_W6_S};
 pub use studies::Resolution;
 use studies::{MachineStudy, MapStudy};
@@ -323,32 +324,18 @@ fn draw_map(
     res: &Resolution,
 ) -> Result<()> {
     let r = m.base.reference();
-    let lo = map.ws_over_wref[0].max(map.wd_over_wref[0]);
     let hi = map.ws_over_wref[map.ws_over_wref.len() - 1]
         .min(map.wd_over_wref[map.wd_over_wref.len() - 1]);
-    let finite: Vec<f64> = map
-        .energy_ratio
-        .iter()
-        .copied()
-        .filter(|v| v.is_finite())
-        .collect();
-    let zmin = finite.iter().copied().fold(f64::INFINITY, f64::min);
-    let zmax = finite.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let mut overlay = vec![Series {
-        label: "ω_d = ω_s".into(),
-        x: vec![lo, hi],
-        y: vec![lo, hi],
-        ..Default::default()
-    }];
     let point = m.w_s / m.w_ref;
+    let mut marks = Vec::new();
     let mut marked = Vec::new();
     if m.base == Base::Soft && (map.mass_ratio - MASS_RATIO).abs() < 1e-12 {
         for (name, wd) in WD_OVER_W6_PQR {
-            overlay.push(marker(
-                format!("{name} ({WS_OVER_W6_S}, {wd})"),
-                WS_OVER_W6_S,
-                wd,
-            ));
+            marks.push(Mark {
+                label: name.into(),
+                x: WS_OVER_W6_S,
+                y: wd,
+            });
             marked.push(format!(
                 "{name} = ({WS_OVER_W6_S}, {wd}): E = {:.4}",
                 map.nearest(WS_OVER_W6_S, wd)
@@ -357,44 +344,45 @@ fn draw_map(
     }
     if (map.mass_ratio - MASS_RATIO).abs() < 1e-12 {
         let name = m.base.point();
-        overlay.push(marker(
-            format!("{name} ({point:.2}, {point:.2})"),
-            point,
-            point,
-        ));
+        marks.push(Mark {
+            label: name.into(),
+            x: point,
+            y: point,
+        });
         marked.push(format!(
             "{name} = ({point:.2}, {point:.2}): E = {:.4}",
             map.nearest(point, point)
         ));
     }
-    let hm = HeatMap {
-        title: format!("E_p+/E_s−, m_d/m_b = {} ({})", map.mass_ratio, m.label()),
-        x_label: format!("ω_s/{r} (1)"),
-        y_label: format!("ω_d/{r} (1)"),
-        x: map.ws_over_wref.clone(),
-        y: map.wd_over_wref.clone(),
-        z: map.energy_ratio.clone(),
-        x_log: true,
-        y_log: true,
-        contour_levels: if zmin < zmax {
-            (1..8)
-                .map(|k| zmin + (zmax - zmin) * k as f64 / 8.0)
-                .collect()
-        } else {
-            Vec::new()
+    let hm = crate::report::figures::marked_heat_map(
+        HeatMap {
+            title: format!("E_p+/E_s−, m_d/m_b = {} ({})", map.mass_ratio, m.label()),
+            x_label: format!("ω_s/{r} (1)"),
+            y_label: format!("ω_d/{r} (1)"),
+            x: map.ws_over_wref.clone(),
+            y: map.wd_over_wref.clone(),
+            z: map.energy_ratio.clone(),
+            x_log: true,
+            y_log: true,
+            colorbar_label: "E_p+/E_s− (1)".into(),
+            ..Default::default()
         },
-        overlay_lines: overlay,
-        colorbar_label: "E_p+/E_s− (1)".into(),
-        ..Default::default()
-    };
+        &marks,
+        "ω_d = ω_s",
+    );
     let stem = format!(
         "fig{number:02}{}-{}",
         sub.trim_matches(|c| c == '(' || c == ')'),
         m.tag()
     );
     f.map(number, &stem, &hm, format!(
-        "Reproduces paper Fig. {number}{sub} on the {} model: energy left in the machine after the blow, E_p+/E_s− (Eq. 10 over Eq. 11, colour), over ω_s/{r} (slider contact, Eq. 14) and ω_d/{r} (damper contact, Eq. 15), m_d/m_b = {}; {} spanning {:.1}-{:.0}, black lines are contours, the diagonal is ω_d = ω_s. Marked: {}.",
-        m.label(), map.mass_ratio, fmt_res(res), map.ws_over_wref[0], hi, marked.join("; ")
+        "Reproduces paper Fig. {number}{sub} on the {} model: energy left in the machine after the blow, E_p+/E_s− (Eq. 10 over Eq. 11, colour), over ω_s/{r} (slider contact, Eq. 14) and ω_d/{r} (damper contact, Eq. 15), m_d/m_b = {}; {} spanning {:.1}-{:.0}, black lines are contours, the dashed line is ω_d = ω_s. {}",
+        m.label(), map.mass_ratio, fmt_res(res), map.ws_over_wref[0], hi,
+        if marked.is_empty() {
+            format!("No operating point is marked: they lie at m_d/m_b = {MASS_RATIO}.")
+        } else {
+            format!("Marked points (labelled on the map): {}.", marked.join("; "))
+        }
     ))
 }
 
@@ -416,7 +404,6 @@ fn draw_history(
         .zip(&diss)
         .map(|(x, d)| x.ke_machine + x.pe_machine + d)
         .collect();
-    let top = h.slider_energy_before_j;
     let series = vec![
         Series {
             label: "KE m_s (Eq. 16)".into(),
@@ -472,18 +459,16 @@ fn draw_history(
             y: ep,
             ..Default::default()
         },
-        vertical(
-            format!("slider leaves, {:.4} ms", 1e3 * h.slider_leaves_s),
-            1e3 * h.slider_leaves_s,
-            0.0,
-            top,
-        ),
-        vertical(
-            format!("PE K_d maximum, {:.4} ms", 1e3 * h.pe_kd_peak_s),
-            1e3 * h.pe_kd_peak_s,
-            0.0,
-            top,
-        ),
+    ];
+    let markers = vec![
+        Marker {
+            x: 1e3 * h.slider_leaves_s,
+            label: format!("slider leaves, {:.4} ms", 1e3 * h.slider_leaves_s),
+        },
+        Marker {
+            x: 1e3 * h.pe_kd_peak_s,
+            label: format!("PE K_d maximum, {:.4} ms", 1e3 * h.pe_kd_peak_s),
+        },
     ];
     let p = LinePlot {
         title: format!(
@@ -495,6 +480,7 @@ fn draw_history(
         x_label: "time (ms)".into(),
         y_label: "energy (J)".into(),
         series,
+        markers,
         ..Default::default()
     };
     f.line(number, &format!("fig{number:02}-{}-{}", h.point, m.tag()), &p, format!(
@@ -503,7 +489,6 @@ fn draw_history(
     ))
 }
 
-#[allow(clippy::needless_update)]
 fn draw_compare(
     f: &mut Figures,
     m: &Machine,
@@ -511,95 +496,45 @@ fn draw_compare(
     na: u32,
     nf: u32,
 ) -> Result<()> {
+    use crate::report::figures::{esd_plot, history_plot, Channel};
     let point = m.base.point();
     let added = match studies::added_mass_point(m) {
         Some(_) => "added mass on the floating base",
         None => "added mass on the bed",
     };
-    for (number, ch, what, unit, reference) in [
-        (
-            na,
-            0usize,
-            "bed acceleration at B",
-            "m/s²",
-            c.acceleration_reference_m_per_s2.powi(2),
-        ),
-        (nf, 1, "force to the floor", "N", 1.0),
-    ] {
-        let label = |k: CaseName| match k {
-            CaseName::AddedMass => added.to_string(),
-            other => other.label().to_string(),
-        };
-        let p = LinePlot {
-            title: format!("{what} at {point} ({})", m.label()),
-            x_label: "time (s)".into(),
-            y_label: format!("{what} ({unit})"),
-            series: c
-                .cases
-                .iter()
-                .map(|k| Series {
-                    label: label(k.case),
-                    x: k.history.time_s.clone(),
-                    y: if ch == 0 {
-                        k.history.bed_acceleration_m_per_s2.clone()
-                    } else {
-                        k.history.floor_force_n.clone()
-                    },
-                    ..Default::default()
-                })
-                .collect(),
-            ..Default::default()
-        };
+    let label = |k: CaseName| match k {
+        CaseName::AddedMass => added.to_string(),
+        other => other.label().to_string(),
+    };
+    for (number, ch) in [(na, Channel::Acceleration), (nf, Channel::FloorForce)] {
+        let (what, unit) = (ch.what(), ch.unit());
+        let mut p = history_plot(c, ch, &label);
+        let shown = p.x_range.map_or(studies::record_s(m.base), |(a, b)| b - a);
+        p.title = p
+            .title
+            .replacen(what, &format!("{what} at {point} ({})", m.label()), 1);
         let peaks: Vec<String> = c
             .cases
             .iter()
-            .map(|k| {
-                let v = if ch == 0 {
-                    k.peak_bed_acceleration_m_per_s2
-                } else {
-                    k.peak_floor_force_n
-                };
-                format!("{} {v:.4e} {unit}", label(k.case))
-            })
+            .map(|k| format!("{} {:.4e} {unit}", label(k.case), ch.peak(k)))
             .collect();
         f.line(number, &format!("fig{number:02}-time-{}", m.tag()), &p, format!(
-            "Reproduces paper Fig. {number} on the {} model: {what} ({unit}) at operating point {point} for the three cases (m_d/m_b = m_add/m_b = 0.35), first {} s sampled at {} kHz; exact time peaks: {}.",
-            m.label(), studies::record_s(m.base), c.sample_rate_hz / 1e3, peaks.join(", ")
+            "Reproduces paper Fig. {number} on the {} model: {what} ({unit}) at operating point {point} for the three cases (m_d/m_b = m_add/m_b = 0.35), one panel per case on a common scale; the first {} s of the {} s record sampled at {} kHz; exact time peaks: {}.",
+            m.label(), crate::report::figures::sig(shown, 3), studies::record_s(m.base), c.sample_rate_hz / 1e3, peaks.join(", ")
         ))?;
-        let (ea, ef) = c.esd_references();
-        let series = c
-            .cases
-            .iter()
-            .map(|k| {
-                let s = &k.spectra[ch];
-                let (x, y) = s.level_curve_db(&c.frequency_hz, reference);
-                Series {
-                    label: label(k.case),
-                    x,
-                    y,
-                    ..Default::default()
-                }
-            })
-            .collect();
-        let sp = SpectrumPlot {
-            title: format!(
-                "{what} at {point}, exact energy spectral density ({})",
-                m.label()
-            ),
-            y_label: format!("ESD level (dB re {})", if ch == 0 { &ea } else { &ef }),
-            x_log: true,
-            series,
-            ..Default::default()
-        };
-        let q = if ch == 0 {
-            measures::Quantity::Acceleration
-        } else {
-            measures::Quantity::Force
+        let mut sp = esd_plot(c, ch, &label);
+        sp.title = format!(
+            "{what} at {point}, exact energy spectral density ({})",
+            m.label()
+        );
+        let q = match ch {
+            Channel::Acceleration => measures::Quantity::Acceleration,
+            Channel::FloorForce => measures::Quantity::Force,
         };
         let d = measures::primary(c, q, CaseName::Damper);
         let a = measures::primary(c, q, CaseName::AddedMass);
         f.spectrum(number, &format!("fig{number:02}-spectrum-{}", m.tag()), &sp, format!(
-            "Reproduces paper Fig. {number} as a spectrum on the {} model: exact energy spectral density of the {what} at {point} (the Fourier transform of the whole response including its free decay: independent of record length and sample rate), three cases. Reduction at the dominant mode ({}): damper {:.2} dB, added mass {:.2} dB.",
+            "Reproduces paper Fig. {number} as a spectrum on the {} model: exact energy spectral density of the {what} at {point} (the Fourier transform of the whole response including its free decay: independent of record length and sample rate), three cases (the added mass dashed). Reduction at the dominant mode ({}): damper {:.2} dB, added mass {:.2} dB.",
             m.label(), d.measure, d.reduction_db, a.reduction_db
         ))?;
     }
