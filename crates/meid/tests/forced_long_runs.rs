@@ -115,23 +115,26 @@ fn no_run_of_micro_stretches_at_a_dashpot_turning_point() {
 /// first 4 s while the slider settles).
 #[test]
 fn dopri5_at_the_event_limit_says_what_switches_and_what_to_do() {
-    for name in ["paper-stiff-base"] {
-        let m = example(name, &["simulation.max_events=20000"]);
-        let sys = m.impact_system(Case::Damper).expect("system");
-        let mut o = m.options();
-        o.method = Method::Dopri5;
-        o.duration = 60.0;
-        o.sample_rate = None;
-        let err = simulate(&sys, &o, false).err().map(|e| e.to_string());
-        let msg = err.unwrap_or_else(|| panic!("{name}: dopri5 completed (update this test)"));
-        for needle in [
-            "simulation.max_events",
-            "switched the",
-            "method = \"exact\"",
-        ] {
-            assert!(msg.contains(needle), "{name}: {needle:?} not in {msg}");
-        }
+    let msg = dopri5_sixty_seconds_fails("paper-stiff-base", &["simulation.max_events=20000"]);
+    for needle in [
+        "simulation.max_events",
+        "switched the",
+        "method = \"exact\"",
+    ] {
+        assert!(msg.contains(needle), "{needle:?} not in {msg}");
     }
+}
+
+/// The error of a 60 s dopri5 run of `name` that must fail.
+fn dopri5_sixty_seconds_fails(name: &str, extra: &[&str]) -> String {
+    let m = example(name, extra);
+    let sys = m.impact_system(Case::Damper).expect("system");
+    let mut o = m.options();
+    o.method = Method::Dopri5;
+    o.duration = 60.0;
+    o.sample_rate = None;
+    let err = simulate(&sys, &o, false).err().map(|e| e.to_string());
+    err.unwrap_or_else(|| panic!("{name}: dopri5 completed (update this test)"))
 }
 
 #[test]
@@ -158,14 +161,7 @@ fn max_events_out_of_range_is_refused_naming_the_field() {
 /// instead of running into the 1e8-step limit minutes later.
 #[test]
 fn dopri5_on_a_stiff_resting_contact_stops_early_with_its_projected_cost() {
-    let m = example("paper-no-base", &[]);
-    let sys = m.impact_system(Case::Damper).expect("system");
-    let mut o = m.options();
-    o.method = Method::Dopri5;
-    o.duration = 60.0;
-    o.sample_rate = None;
-    let err = simulate(&sys, &o, false).err().map(|e| e.to_string());
-    let msg = err.unwrap_or_else(|| panic!("dopri5 completed (update this test)"));
+    let msg = dopri5_sixty_seconds_fails("paper-no-base", &[]);
     for needle in [
         "the run would take about",
         "more than the limit of 1e8",
