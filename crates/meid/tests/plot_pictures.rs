@@ -765,3 +765,57 @@ fn mode_shape_names_its_mode_and_keys_both_meshes() {
         .fold(0.0, f64::max);
     assert!(key.y > lowest_edge, "key overlaps the picture");
 }
+
+/// The legend goes to the corner the curves leave free: a curve rising to the upper right
+/// puts it at the upper left, a falling one at the upper right (before, it always sat at the
+/// upper right, over the 283 Hz peak of the paper's spectra).
+#[test]
+fn legend_takes_the_corner_the_curves_leave_free() {
+    let x = linspace(0.0, 1.0, 200);
+    for rising in [true, false] {
+        let y = |k: f64| -> Vec<f64> {
+            x.iter()
+                .map(|&v| k * if rising { v * v } else { (1.0 - v) * (1.0 - v) })
+                .collect()
+        };
+        let plot = LinePlot {
+            title: "legend placement".into(),
+            x_label: "x (1)".into(),
+            y_label: "y (1)".into(),
+            series: vec![
+                Series {
+                    label: "first curve".into(),
+                    x: x.clone(),
+                    y: y(1.0),
+                    ..Default::default()
+                },
+                Series {
+                    label: "second curve".into(),
+                    x: x.clone(),
+                    y: y(0.9),
+                    ..Default::default()
+                },
+            ],
+            ..Default::default()
+        };
+        let name = if rising {
+            "legend-rising"
+        } else {
+            "legend-falling"
+        };
+        let files = line_plot(samples().join(name), &plot).unwrap();
+        let svg = read_svg(&files.svg);
+        let ticks = svg.x_ticks();
+        let mid = px_of(&ticks, 0.5, false);
+        for label in ["first curve", "second curve"] {
+            let t = svg.texts_eq(label);
+            assert_eq!(t.len(), 1, "{label}");
+            assert_eq!(
+                t[0].x < mid,
+                rising,
+                "{name}: {label} at x = {} (middle {mid})",
+                t[0].x
+            );
+        }
+    }
+}

@@ -228,6 +228,108 @@ where
     X: Ranged<ValueType = f64>,
     Y: Ranged<ValueType = f64>,
 {
+    legend_at(chart, dark, SeriesLabelPosition::UpperRight)
+}
+
+/// The corner of the frame where a legend of `entries` lines of at most `chars` characters
+/// covers the fewest points of the curves `curves` (each drawn as its polyline, sampled every
+/// few pixels): upper right, then upper left, lower right, lower left, upper and lower middle
+/// on ties.
+fn legend_corner<'a, DB, X, Y>(
+    chart: &Chart<'a, DB, X, Y>,
+    curves: &[Vec<(f64, f64)>],
+    entries: usize,
+    chars: usize,
+) -> SeriesLabelPosition
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let (px, py) = chart.plotting_area().get_pixel_range();
+    // Plotters' legend: 15 px text, a 24 px sample, margins of about 10 px.
+    let (w, h) = (chars as f64 * 8.0 + 50.0, entries as f64 * 19.0 + 14.0);
+    let mid = 0.5 * (px.start + px.end) as f64;
+    let boxes = [
+        (
+            SeriesLabelPosition::UpperRight,
+            px.end as f64 - w,
+            py.start as f64,
+        ),
+        (
+            SeriesLabelPosition::UpperLeft,
+            px.start as f64,
+            py.start as f64,
+        ),
+        (
+            SeriesLabelPosition::LowerRight,
+            px.end as f64 - w,
+            py.end as f64 - h,
+        ),
+        (
+            SeriesLabelPosition::LowerLeft,
+            px.start as f64,
+            py.end as f64 - h,
+        ),
+        (
+            SeriesLabelPosition::UpperMiddle,
+            mid - w / 2.0,
+            py.start as f64,
+        ),
+        (
+            SeriesLabelPosition::LowerMiddle,
+            mid - w / 2.0,
+            py.end as f64 - h,
+        ),
+    ];
+    let mut hits = [0usize; 6];
+    for c in curves {
+        let pix: Vec<(f64, f64)> = c
+            .iter()
+            .map(|q| {
+                let (x, y) = chart.backend_coord(q);
+                (x as f64, y as f64)
+            })
+            .collect();
+        let mut count = |x: f64, y: f64| {
+            for (k, (_, x0, y0)) in boxes.iter().enumerate() {
+                if x >= *x0 && x <= x0 + w && y >= *y0 && y <= y0 + h {
+                    hits[k] += 1;
+                }
+            }
+        };
+        if let [only] = pix.as_slice() {
+            count(only.0, only.1);
+        }
+        for seg in pix.windows(2) {
+            let (a, b) = (seg[0], seg[1]);
+            let n = (((b.0 - a.0).hypot(b.1 - a.1)) / 4.0)
+                .ceil()
+                .clamp(1.0, 1000.0) as usize;
+            for i in 0..n {
+                let t = i as f64 / n as f64;
+                count(a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+            }
+        }
+    }
+    let best = (0..hits.len()).min_by_key(|&k| (hits[k], k)).unwrap_or(0);
+    boxes
+        .into_iter()
+        .nth(best)
+        .map_or(SeriesLabelPosition::UpperRight, |b| b.0)
+}
+
+/// [`legend`] at a given corner (curves only).
+fn legend_at<'a, DB, X, Y>(
+    chart: &mut Chart<'a, DB, X, Y>,
+    dark: bool,
+    corner: SeriesLabelPosition,
+) -> std::result::Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
     let mut l = chart.configure_series_labels();
     if dark {
         l.background_style(RGBColor(90, 90, 90).mix(0.9))
@@ -238,7 +340,7 @@ where
         l.label_font((FONT, 15))
             .background_style(WHITE.mix(0.85))
             .border_style(RGBColor(120, 120, 120))
-            .position(SeriesLabelPosition::UpperRight);
+            .position(corner);
     }
     l.draw().map_err(e2s)
 }
@@ -544,6 +646,7 @@ where
 
     let mut failed_x = Vec::new();
     let mut any_label = false;
+    let (mut curves, mut entries, mut chars) = (Vec::new(), 0usize, 0usize);
     for &(k, s) in &view.series {
         let style = stroke(s, k, &PALETTE);
         let dash = dash_of(s, LineStyle::Solid);
@@ -576,11 +679,14 @@ where
             .map_err(e2s)?;
         if !s.label.is_empty() && !p.panels {
             any_label = true;
+            entries += 1;
+            chars = chars.max(s.label.chars().count());
             legend
                 .label(&s.label)
                 .legend(move |c| legend_sample!(c, dash, style));
         }
         for run in runs.into_iter().filter(|r| !r.is_empty()) {
+            curves.push(run.clone());
             if run.len() == 1 {
                 chart
                     .draw_series(run.iter().map(|&q| Circle::new(q, 3, style.filled())))
@@ -591,10 +697,15 @@ where
         }
     }
     draw_markers(&mut chart, &p.markers, view.marker_labels)?;
-    any_label |= !failed_x.is_empty();
+    if !failed_x.is_empty() {
+        any_label = true;
+        entries += 1;
+        chars = chars.max(16);
+    }
     failed_marks(&mut chart, &failed_x, y_bottom)?;
     if any_label {
-        legend(&mut chart, false)?;
+        let corner = legend_corner(&chart, &curves, entries, chars);
+        legend_at(&mut chart, false, corner)?;
     }
     Ok(())
 }
