@@ -750,7 +750,7 @@ pub fn machine_spec(m: &MachineFileSpec) -> Result<MachineSpec> {
 }
 
 /// A material of a model file, refused at its field with the valid range.
-fn check_material(m: &MaterialSpec, field: &str, src: &Source) -> Result<()> {
+pub(super) fn check_material(m: &MaterialSpec, field: &str, src: &Source) -> Result<()> {
     let checks: [(&str, f64, bool, &str); 3] = [
         (
             "youngs_modulus",

@@ -33,7 +33,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::fem::{parse_dofs, ConstraintSpec, MaterialSpec};
+use super::fem::{check_material, parse_dofs, ConstraintSpec, MaterialSpec};
 use super::Source;
 use crate::structure::{
     Dashpot, FeModel, FrameElement, Material, Mesh, PointMass, RigidLink, Section, ShellElement,
@@ -260,42 +260,12 @@ impl Builder<'_> {
     ) -> Result<Material> {
         match m {
             Some(spec) => {
-                check_material(spec, field, self.src)?;
+                check_material(spec, &format!("{BASE}.{field}"), self.src)?;
                 Ok(Material::from(*spec))
             }
             None => Ok(default),
         }
     }
-}
-
-fn check_material(m: &MaterialSpec, field: &str, src: &Source) -> Result<()> {
-    let f = format!("{BASE}.{field}");
-    for (key, v, ok, range) in [
-        (
-            "youngs_modulus",
-            m.youngs_modulus,
-            m.youngs_modulus.is_finite() && m.youngs_modulus > 0.0,
-            "a finite number > 0 Pa",
-        ),
-        (
-            "density",
-            m.density,
-            m.density.is_finite() && m.density > 0.0,
-            "a finite number > 0 kg/m³",
-        ),
-        (
-            "poisson_ratio",
-            m.poisson_ratio,
-            m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5,
-            "in (-1, 0.5)",
-        ),
-    ] {
-        if !ok {
-            let k = format!("{f}.{key}");
-            return Err(src.error(&k, format!("{k} must be {range} (got {v})")));
-        }
-    }
-    Ok(())
 }
 
 fn positive(b: &Builder<'_>, field: &str, v: f64, unit: &str) -> Result<()> {
