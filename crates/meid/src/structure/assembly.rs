@@ -7,11 +7,19 @@
 //! to the linear combination `u_s = u_m + θ_m × (x_s - x_m)`, `θ_s = θ_m` of its master's DOFs.
 //! Element matrices are transformed entry by entry, `K_red = Tᵀ K T`, and collected as triplets;
 //! faer sums duplicates when it builds the compressed-column matrices.
+//!
+//! # Parallel and deterministic
+//! Frames and shells are assembled in fixed chunks of [`ASSEMBLY_CHUNK`] elements: within a
+//! chunk the element matrices and their triplets are computed in parallel (rayon), each element
+//! into its own lists; the lists are then appended, and the floor-force terms summed, in element
+//! order. The triplet sequence, every floating-point sum and so K, M, C and the floor-force
+//! functional are the same bits for any thread count (tests `fem_thread_determinism`).
 
 use std::collections::BTreeMap;
 
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
+use rayon::prelude::*;
 
 use super::frame::frame_matrices;
 use super::mesh::Mesh;
@@ -168,7 +176,91 @@ enum Kind {
     C,
 }
 
+/// The triplets and floor-force terms of one element, computed apart from the collector (in
+/// parallel) and appended to it in element order.
+#[derive(Default)]
+struct Scattered {
+    k: Vec<Triplet<usize, usize, f64>>,
+    m: Vec<Triplet<usize, usize, f64>>,
+    /// `(reduced DOF, term)` to subtract from the floor stiffness functional, in order.
+    floor_k: Vec<(usize, f64)>,
+}
+
+/// Elements assembled per parallel chunk (module docs): large enough to keep both cores busy,
+/// small enough that a chunk's element lists stay a few megabytes.
+pub const ASSEMBLY_CHUNK: usize = 2048;
+
 impl Collector<'_> {
+    /// The triplets of a stiffness (`floor` = Some) or mass element matrix `a` over the full
+    /// DOFs `dofs`, with the support reactions `-(K u)_f` at fixed translations pushed to
+    /// `floor` (same arithmetic as [`Collector::add`]).
+    fn scatter(
+        &self,
+        dofs: &[usize],
+        a: &Mat<f64>,
+        list: &mut Vec<Triplet<usize, usize, f64>>,
+        mut floor: Option<&mut Vec<(usize, f64)>>,
+    ) {
+        for (p, &dp) in dofs.iter().enumerate() {
+            let react = if self.fixed.contains(&dp) && dp % 6 < 3 {
+                self.dir[dp % 6]
+            } else {
+                0.0
+            };
+            for (q, &dq) in dofs.iter().enumerate() {
+                let v = a[(p, q)];
+                if v == 0.0 {
+                    continue;
+                }
+                if react != 0.0 {
+                    if let Some(f) = floor.as_deref_mut() {
+                        for &(b, tb) in self.map.row(dq) {
+                            f.push((b, react * v * tb));
+                        }
+                    }
+                }
+                for &(a_, ta) in self.map.row(dp) {
+                    for &(b, tb) in self.map.row(dq) {
+                        list.push(Triplet::new(a_, b, ta * tb * v));
+                    }
+                }
+            }
+        }
+    }
+
+    /// Assembles the elements `elems` whose stiffness and mass matrices (and full DOFs)
+    /// `matrices` gives, chunk by chunk in parallel, appending in element order (module docs).
+    /// The first failing element (in element order) is the error.
+    fn add_elements<E: Sync>(
+        &mut self,
+        elems: &[E],
+        matrices: impl Fn(usize, &E) -> Result<(Vec<usize>, Mat<f64>, Mat<f64>)> + Sync,
+    ) -> Result<()> {
+        for (c, chunk) in elems.chunks(ASSEMBLY_CHUNK).enumerate() {
+            let this = &*self;
+            let parts: Vec<Result<Scattered>> = chunk
+                .par_iter()
+                .enumerate()
+                .map(|(i, e)| {
+                    let (dofs, k, m) = matrices(c * ASSEMBLY_CHUNK + i, e)?;
+                    let mut s = Scattered::default();
+                    this.scatter(&dofs, &k, &mut s.k, Some(&mut s.floor_k));
+                    this.scatter(&dofs, &m, &mut s.m, None);
+                    Ok(s)
+                })
+                .collect();
+            for part in parts {
+                let s = part?;
+                self.k.extend_from_slice(&s.k);
+                self.m.extend_from_slice(&s.m);
+                for (b, t) in s.floor_k {
+                    self.floor_k[b] -= t;
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Adds an element matrix `a` over the full DOFs `dofs`.
     fn add(&mut self, kind: Kind, dofs: &[usize], a: &Mat<f64>) {
         for (p, &dp) in dofs.iter().enumerate() {
@@ -306,7 +398,13 @@ impl FeModel {
             floor_k: vec![0.0; n],
             floor_c: vec![0.0; n],
         };
-        for (i, f) in mesh.frames.iter().enumerate() {
+        let node_dofs = |nodes: &[usize]| -> Vec<usize> {
+            nodes
+                .iter()
+                .flat_map(|&nd| (0..6).map(move |d| 6 * nd + d))
+                .collect()
+        };
+        col.add_elements(&mesh.frames, |i, f| {
             let (k, m) = frame_matrices(
                 mesh.nodes[f.nodes[0]],
                 mesh.nodes[f.nodes[1]],
@@ -315,26 +413,14 @@ impl FeModel {
                 f.orientation,
             )
             .map_err(|e| Error::invalid(format!("frame element {i}"), e.to_string()))?;
-            let dofs: Vec<usize> = f
-                .nodes
-                .iter()
-                .flat_map(|&nd| (0..6).map(move |d| 6 * nd + d))
-                .collect();
-            col.add(Kind::K, &dofs, &k);
-            col.add(Kind::M, &dofs, &m);
-        }
-        for (i, s) in mesh.shells.iter().enumerate() {
+            Ok((node_dofs(&f.nodes), k, m))
+        })?;
+        col.add_elements(&mesh.shells, |i, s| {
             let x = s.nodes.map(|nd| mesh.nodes[nd]);
             let (k, m) = shell_matrices(&x, s)
                 .map_err(|e| Error::invalid(format!("shell element {i}"), e.to_string()))?;
-            let dofs: Vec<usize> = s
-                .nodes
-                .iter()
-                .flat_map(|&nd| (0..6).map(move |d| 6 * nd + d))
-                .collect();
-            col.add(Kind::K, &dofs, &k);
-            col.add(Kind::M, &dofs, &m);
-        }
+            Ok((node_dofs(&s.nodes), k, m))
+        })?;
         for s in &mesh.springs {
             col.add_discrete(Kind::K, s.node, s.other, &s.stiffness);
         }
