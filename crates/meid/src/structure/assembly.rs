@@ -193,7 +193,7 @@ pub const ASSEMBLY_CHUNK: usize = 2048;
 impl Collector<'_> {
     /// The triplets of a stiffness (`floor` = Some) or mass element matrix `a` over the full
     /// DOFs `dofs`, with the support reactions `-(K u)_f` at fixed translations pushed to
-    /// `floor` (same arithmetic as [`Collector::add`]).
+    /// `floor`, one `(reduced DOF, term)` per term in the order the sum takes them.
     fn scatter(
         &self,
         dofs: &[usize],
@@ -261,43 +261,25 @@ impl Collector<'_> {
         Ok(())
     }
 
-    /// Adds an element matrix `a` over the full DOFs `dofs`.
+    /// Adds an element matrix `a` over the full DOFs `dofs` (support reactions of K and C to
+    /// the floor functional, [`Collector::scatter`]).
     fn add(&mut self, kind: Kind, dofs: &[usize], a: &Mat<f64>) {
-        for (p, &dp) in dofs.iter().enumerate() {
-            // Support reaction: force on the floor at a fixed translation = -(K u)_f.
-            let react = if self.fixed.contains(&dp) && dp % 6 < 3 {
-                self.dir[dp % 6]
-            } else {
-                0.0
-            };
-            for (q, &dq) in dofs.iter().enumerate() {
-                let v = a[(p, q)];
-                if v == 0.0 {
-                    continue;
-                }
-                if react != 0.0 {
-                    let f = match kind {
-                        Kind::K => Some(&mut self.floor_k),
-                        Kind::C => Some(&mut self.floor_c),
-                        Kind::M => None,
-                    };
-                    if let Some(f) = f {
-                        for &(b, tb) in self.map.row(dq) {
-                            f[b] -= react * v * tb;
-                        }
-                    }
-                }
-                let list = match kind {
-                    Kind::K => &mut self.k,
-                    Kind::M => &mut self.m,
-                    Kind::C => &mut self.c,
-                };
-                for &(a_, ta) in self.map.row(dp) {
-                    for &(b, tb) in self.map.row(dq) {
-                        list.push(Triplet::new(a_, b, ta * tb * v));
-                    }
-                }
-            }
+        let mut list = std::mem::take(match kind {
+            Kind::K => &mut self.k,
+            Kind::M => &mut self.m,
+            Kind::C => &mut self.c,
+        });
+        let mut floor = Vec::new();
+        let with_floor = !matches!(kind, Kind::M);
+        self.scatter(dofs, a, &mut list, with_floor.then_some(&mut floor));
+        let (target, f) = match kind {
+            Kind::K => (&mut self.k, &mut self.floor_k),
+            Kind::M => (&mut self.m, &mut self.floor_k),
+            Kind::C => (&mut self.c, &mut self.floor_c),
+        };
+        *target = list;
+        for (b, t) in floor {
+            f[b] -= t;
         }
     }
     /// Per-direction coefficients between two nodes or a node and the ground.
