@@ -299,18 +299,25 @@ impl<R: BufRead> Parser<'_, R> {
         Ok(out)
     }
 
+    /// The next line of dataset `ds`; the end of the file here is an error (the dataset's
+    /// closing `-1` is missing).
+    fn dataset_line(&mut self, ds: Ds) -> Result<String> {
+        match self.line()? {
+            Some(l) => Ok(l),
+            None => Err(self.err(
+                Some(ds),
+                None,
+                self.line_no,
+                "the file ends inside the dataset: expected its closing '    -1'".into(),
+            )),
+        }
+    }
+
     /// Reads lines to the closing "-1"; returns them.
     fn skip_to_end(&mut self, ds: Ds) -> Result<Vec<String>> {
         let mut lines = Vec::new();
         loop {
-            let Some(l) = self.line()? else {
-                return Err(self.err(
-                    Some(ds),
-                    None,
-                    self.line_no,
-                    "the file ends inside the dataset: expected its closing '    -1'".into(),
-                ));
-            };
+            let l = self.dataset_line(ds)?;
             if l.trim() == "-1" {
                 return Ok(lines);
             }
@@ -814,14 +821,7 @@ impl<R: BufRead> Parser<'_, R> {
     fn dataset_2411(&mut self, ds: Ds) -> Result<Vec<Node>> {
         let mut out = Vec::new();
         loop {
-            let Some(l1) = self.line()? else {
-                return Err(self.err(
-                    Some(ds),
-                    None,
-                    self.line_no,
-                    "the file ends inside the dataset: expected its closing '    -1'".into(),
-                ));
-            };
+            let l1 = self.dataset_line(ds)?;
             if l1.trim() == "-1" {
                 return Ok(out);
             }
@@ -897,14 +897,7 @@ impl<R: BufRead> Parser<'_, R> {
         }
         let mut shapes = Vec::new();
         loop {
-            let Some(l) = self.line()? else {
-                return Err(self.err(
-                    Some(ds),
-                    None,
-                    self.line_no,
-                    "the file ends inside the dataset: expected its closing '    -1'".into(),
-                ));
-            };
+            let l = self.dataset_line(ds)?;
             if l.trim() == "-1" {
                 break;
             }
