@@ -143,7 +143,7 @@ fn nafems_fv12_free_plate_from_model_file() {
 /// edges clamped): 7.938, 12.835, 17.941, 19.133, 24.009, 27.922 Hz, each within 1 % at this
 /// mesh (measured −0.38, +0.10, −0.17, −0.93, −0.89, −0.67 %). Modes 4 and 5 still fall with
 /// refinement; their extrapolated limits, −1.16 % and −1.45 %, are outside 1 % of NAFEMS, but
-/// the exact thin-plate frequencies are themselves 1.05, 1.32 and 1.04 % below NAFEMS for modes
+/// the exact thin-plate frequencies are themselves 1.06, 1.33 and 1.05 % (at least) below NAFEMS for modes
 /// 4-6 (Ritz upper bounds, `fem_kirchhoff_ritz.rs`). Also asserted: within 0.5 % of those
 /// thin-plate values (measured +0.05, +0.20, +0.30, +0.12, +0.43, +0.37 %, from above).
 #[test]

@@ -349,7 +349,10 @@ fn check_released_dofs(
         if ep.iter().map(|x| x * x).sum::<f64>() < 1e-12 {
             continue;
         }
-        let b = blk.get(&(node, block)).copied().unwrap_or([[[0.0; 3]; 3]; 2]);
+        let b = blk
+            .get(&(node, block))
+            .copied()
+            .unwrap_or([[[0.0; 3]; 3]; 2]);
         let q = |a: &[[f64; 3]; 3]| -> (f64, f64) {
             let mut s = 0.0;
             let mut mx: f64 = 0.0;
@@ -364,7 +367,11 @@ fn check_released_dofs(
         let (qk, kmax) = q(&b[0]);
         let (qm, mmax) = q(&b[1]);
         if qk <= 1e-12 * kmax && qm <= 1e-12 * mmax {
-            let what = if block == 0 { "translation" } else { "rotation" };
+            let what = if block == 0 {
+                "translation"
+            } else {
+                "rotation"
+            };
             return Err(Error::invalid(
                 format!("node {node}"),
                 format!(

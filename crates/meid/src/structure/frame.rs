@@ -531,9 +531,17 @@ mod tests {
         // v2 (7) bends with Iz, w2 (8) with Iy.
         for (dof, i) in [(7usize, sec.iz_m4), (8, sec.iy_m4)] {
             let want = 3.0 * e * i / l.powi(3);
-            assert!((k[(dof, dof)] - want).abs() < 1e-10 * want, "{}", k[(dof, dof)]);
+            assert!(
+                (k[(dof, dof)] - want).abs() < 1e-10 * want,
+                "{}",
+                k[(dof, dof)]
+            );
             let mw = 33.0 / 140.0 * mass;
-            assert!((m[(dof, dof)] - mw).abs() < 1e-12 * mass, "{}", m[(dof, dof)]);
+            assert!(
+                (m[(dof, dof)] - mw).abs() < 1e-12 * mass,
+                "{}",
+                m[(dof, dof)]
+            );
         }
         for d in [10usize, 11] {
             for j in 0..12 {
