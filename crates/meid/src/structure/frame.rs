@@ -245,7 +245,7 @@ fn condense(k: &Mat<f64>, m: &Mat<f64>, releases: &[[bool; 6]; 2]) -> Result<(Ma
         for p in 0..j {
             d -= l[j][p] * l[j][p];
         }
-        if !(d > 1e-9 * k[(r[j], r[j])].abs()) {
+        if d.is_nan() || d <= 1e-9 * k[(r[j], r[j])].abs() {
             let names: Vec<String> = r
                 .iter()
                 .map(|&i| format!("{} at end {}", LOCAL_DOF_NAMES[i % 6], i / 6 + 1))
