@@ -11,7 +11,8 @@
 //! material = { youngs_modulus = 2.1e11, poisson_ratio = 0.3, density = 7850 }   # default
 //! shells = [{ set = "plate", thickness = 0.02, shear_factor = 0.8333 }]         # per element set
 //! frames = [{ nodes = [0, 1], divisions = 10, area = 1e-3, iy = 1e-6, iz = 1e-6, j = 2e-6,
-//!             orientation = [1, 0, 0] }]                                       # or set = "columns"
+//!             orientation = [1, 0, 0],                                         # or set = "columns"
+//!             releases = [{ node = 1, dofs = ["ry", "rz"] }] }]                # hinge at node 1
 //! springs = [{ node = "feet", stiffness = [0, 0, 1e6, 0, 0, 0] }]  # to ground, or `to = <node>`
 //! dashpots = [{ node = "feet", damping = [0, 0, 1e3, 0, 0, 0] }]
 //! masses = [{ node = 1, mass = 10.0, inertia = [0.1, 0.1, 0.2] }]
@@ -125,6 +126,20 @@ pub struct FrameSpec {
     pub orientation: Option<[f64; 3]>,
     #[serde(default)]
     pub material: Option<MaterialSpec>,
+    /// End releases (hinges): at the element ends of this member that lie on `node`, the
+    /// element transmits no force or moment on the listed local DOFs (condensed out statically,
+    /// [`crate::structure::frame`]).
+    #[serde(default)]
+    pub releases: Vec<ReleaseSpec>,
+}
+
+/// `{ node = <node or set>, dofs = ["ry", "rz"] }`: local DOFs `ux` (axial), `rx` (torsion),
+/// `ry`, `rz` (bending rotations about the local y, z axes) released at that member end.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ReleaseSpec {
+    pub node: NodeRef,
+    pub dofs: Vec<String>,
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
@@ -499,9 +514,52 @@ pub fn build(spec: &GeneralSpec, src: &Source) -> Result<FeModel> {
                 ));
             }
         }
-        for s in segs {
+        let mut rel: Vec<[[bool; 6]; 2]> = vec![[[false; 6]; 2]; segs.len()];
+        for (ri, r) in f.releases.iter().enumerate() {
+            let rfield = format!("{field}.releases[{ri}]");
+            let mut mask = [false; 6];
+            if r.dofs.is_empty() {
+                return Err(b.err(
+                    &format!("{rfield}.dofs"),
+                    "is empty; give some of \"ux\" (axial), \"rx\" (torsion), \"ry\", \"rz\" (bending rotations, local axes)",
+                ));
+            }
+            for name in &r.dofs {
+                match ["ux", "rx", "ry", "rz"].iter().position(|n| n == name) {
+                    Some(p) => mask[[0, 3, 4, 5][p]] = true,
+                    None => {
+                        return Err(b.err(
+                            &format!("{rfield}.dofs"),
+                            format!("unknown or unsupported release '{name}'; valid: \"ux\" (axial), \"rx\" (torsion), \"ry\", \"rz\" (bending rotations about the local y, z axes)"),
+                        ))
+                    }
+                }
+            }
+            let at = b.nodes_of(&r.node, &format!("{rfield}.node"))?;
+            let mut hit = false;
+            for (k, s) in segs.iter().enumerate() {
+                for end in 0..2 {
+                    if at.contains(&s[end]) {
+                        hit = true;
+                        for d in 0..6 {
+                            rel[k][end][d] |= mask[d];
+                        }
+                    }
+                }
+            }
+            if !hit {
+                return Err(b.err(
+                    &format!("{rfield}.node"),
+                    "is not an end of any element of this member; give the member's end node (or a set holding it)",
+                ));
+            }
+        }
+        for (k, s) in segs.into_iter().enumerate() {
             let mut el = FrameElement::new(s, mat, section);
             el.orientation = f.orientation;
+            el.releases = rel[k];
+            crate::structure::frame::check_releases(&el.releases)
+                .map_err(|e| b.err(&format!("{field}.releases"), e.to_string()))?;
             b.mesh.add_frame(el);
         }
     }

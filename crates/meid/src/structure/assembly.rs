@@ -21,7 +21,7 @@ use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
 use rayon::prelude::*;
 
-use super::frame::frame_matrices;
+use super::frame::{frame_local_axes, frame_matrices_released, LOCAL_DOF_NAMES};
 use super::mesh::Mesh;
 use super::shell::shell_matrices;
 use crate::{Error, Result};
@@ -348,6 +348,115 @@ pub fn check_memory(n: usize) -> Result<()> {
     )
 }
 
+/// A released frame end leaves its node DOF a mechanism when nothing else at the node has
+/// stiffness or inertia along the released direction `e` (global): with K, M positive
+/// semi-definite, `eᵀ K e = 0` means `K e = 0`, so the node turns freely along `e` and the
+/// pencil (K, M) is singular when `eᵀ M e = 0` too. Such a node is an error naming it; with
+/// inertia (a point mass's rotary inertia) it is a zero-frequency mode, which the modal solver's
+/// rigid-body check reports. `e` is projected on the node's free independent DOFs (a fixed DOF
+/// holds its component); rigid-link slaves are left to their master.
+fn check_released_dofs(
+    mesh: &Mesh,
+    map: &DofMap,
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+) -> Result<()> {
+    // (node, block 0 = translations / 1 = rotations, global direction, label)
+    let mut dirs: Vec<(usize, usize, [f64; 3], String)> = Vec::new();
+    for (i, f) in mesh.frames.iter().enumerate() {
+        if !f.has_releases() {
+            continue;
+        }
+        let axes = frame_local_axes(
+            mesh.nodes[f.nodes[0]],
+            mesh.nodes[f.nodes[1]],
+            f.orientation,
+        )?;
+        for (end, rel) in f.releases.iter().enumerate() {
+            for (d, &r) in rel.iter().enumerate() {
+                if r {
+                    dirs.push((
+                        f.nodes[end],
+                        d / 3,
+                        axes[d % 3],
+                        format!(
+                            "{} (local) of frame element {i} at its end {}",
+                            LOCAL_DOF_NAMES[d],
+                            end + 1
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    if dirs.is_empty() {
+        return Ok(());
+    }
+    // Reduced indices of the blocks concerned and their 3×3 entries of K and M.
+    let mut want: BTreeMap<usize, (usize, usize)> = BTreeMap::new();
+    for &(node, block, _, _) in &dirs {
+        for c in 0..3 {
+            if let Some(j) = map.reduced_index(node, 3 * block + c) {
+                want.insert(j, (node, block));
+            }
+        }
+    }
+    let mut blk: BTreeMap<(usize, usize), [[[f64; 3]; 3]; 2]> = BTreeMap::new();
+    for (which, a) in [k, m].into_iter().enumerate() {
+        for t in a.triplet_iter() {
+            if let (Some(&(n1, b1)), Some(&(n2, b2))) = (want.get(&t.row), want.get(&t.col)) {
+                if (n1, b1) == (n2, b2) {
+                    let (r, c) = (map.full_of(t.row) % 3, map.full_of(t.col) % 3);
+                    blk.entry((n1, b1)).or_insert([[[0.0; 3]; 3]; 2])[which][r][c] += *t.val;
+                }
+            }
+        }
+    }
+    for (node, block, e, label) in dirs {
+        let free: Vec<bool> = (0..3)
+            .map(|c| map.reduced_index(node, 3 * block + c).is_some())
+            .collect();
+        if !free.iter().any(|&f| f) {
+            continue;
+        }
+        let ep: Vec<f64> = (0..3).map(|c| if free[c] { e[c] } else { 0.0 }).collect();
+        if ep.iter().map(|x| x * x).sum::<f64>() < 1e-12 {
+            continue;
+        }
+        let b = blk
+            .get(&(node, block))
+            .copied()
+            .unwrap_or([[[0.0; 3]; 3]; 2]);
+        let q = |a: &[[f64; 3]; 3]| -> (f64, f64) {
+            let mut s = 0.0;
+            let mut mx: f64 = 0.0;
+            for r in 0..3 {
+                mx = mx.max(a[r][r].abs());
+                for c in 0..3 {
+                    s += ep[r] * a[r][c] * ep[c];
+                }
+            }
+            (s, mx)
+        };
+        let (qk, kmax) = q(&b[0]);
+        let (qm, mmax) = q(&b[1]);
+        if qk <= 1e-12 * kmax && qm <= 1e-12 * mmax {
+            let what = if block == 0 {
+                "translation"
+            } else {
+                "rotation"
+            };
+            return Err(Error::invalid(
+                format!("node {node}"),
+                format!(
+                    "the release {label} leaves the node's {what} along {e:.3?} (global) with neither stiffness nor inertia: a mechanism. Keep one frame end at the node rigid, or constrain that DOF (`constraints`)"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl FeModel {
     /// Validates the mesh and assembles it with the impact direction +Z.
     pub fn assemble(mesh: Mesh) -> Result<Self> {
@@ -387,12 +496,13 @@ impl FeModel {
                 .collect()
         };
         col.add_elements(&mesh.frames, |i, f| {
-            let (k, m) = frame_matrices(
+            let (k, m) = frame_matrices_released(
                 mesh.nodes[f.nodes[0]],
                 mesh.nodes[f.nodes[1]],
                 &f.material,
                 &f.section,
                 f.orientation,
+                &f.releases,
             )
             .map_err(|e| Error::invalid(format!("frame element {i}"), e.to_string()))?;
             Ok((node_dofs(&f.nodes), k, m))
@@ -424,6 +534,7 @@ impl FeModel {
         let stiffness = sparse(n, &col.k, "stiffness")?;
         let mass = sparse(n, &col.m, "mass")?;
         let damping = sparse(n, &col.c, "damping")?;
+        check_released_dofs(&mesh, &map, &stiffness, &mass)?;
         let (floor_stiffness, floor_damping) = (col.floor_k, col.floor_c);
         Ok(FeModel {
             mesh,

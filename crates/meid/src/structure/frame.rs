@@ -13,6 +13,16 @@
 //! * bending in the x-z plane (w, θy = -dw/dx, uses Iy): the same matrices with the signs of the
 //!   rotation rows/columns flipped.
 //!
+//! **End releases** (hinges): any of the local DOFs `u` (axial), `θx` (torsion), `θy`, `θz`
+//! (bending) at either end may be released, i.e. the element transmits no force or moment on
+//! it. The released DOFs `r` are condensed out statically (Cook et al. §2.10; Przemieniecki
+//! §6.9): with the retained DOFs `c`, `u_r = −K_rr⁻¹ K_rc u_c`, i.e. `u = T u_c`, and
+//! `K* = Tᵀ K T = K_cc − K_cr K_rr⁻¹ K_rc`, `M* = Tᵀ M T` (the consistent mass of the condensed
+//! shape functions, e.g. the pinned-clamped cubic when one end rotation is released). The
+//! released rows and columns of `K*`, `M*` are zero, so the element no longer couples to that
+//! node DOF. A release set whose `K_rr` is singular (axial or torsion released at both ends)
+//! leaves the element a mechanism and is an error.
+//!
 //! Rotary inertia of the cross-section in bending and shear deformation are neglected
 //! (Euler-Bernoulli). Local axes: `e1` along the element, `e2` the component of the orientation
 //! vector normal to `e1`, `e3 = e1 × e2`. Global matrices are `Tᵀ K T` with `T` = four copies of
@@ -160,6 +170,9 @@ pub struct FrameElement {
     /// Orientation vector in global axes: local y lies in the plane of local x and this vector.
     /// `None`: global Z, or global X when the element is within ~0.6° of the Z axis.
     pub orientation: Option<[f64; 3]>,
+    /// Released local DOFs `[u, v, w, θx, θy, θz]` at node 1 (`[0]`) and node 2 (`[1]`); only
+    /// `u`, `θx`, `θy`, `θz` may be released (module docs). All `false`: a rigid joint.
+    pub releases: [[bool; 6]; 2],
 }
 
 impl FrameElement {
@@ -170,8 +183,135 @@ impl FrameElement {
             material,
             section,
             orientation: None,
+            releases: [[false; 6]; 2],
         }
     }
+
+    /// Whether any DOF of either end is released.
+    pub fn has_releases(&self) -> bool {
+        self.releases.iter().flatten().any(|&r| r)
+    }
+}
+
+/// Names of the local DOFs of a frame end, as model files give them in releases.
+pub const LOCAL_DOF_NAMES: [&str; 6] = ["ux", "uy", "uz", "rx", "ry", "rz"];
+
+/// Checks that `releases` only release `u`, `θx`, `θy`, `θz` and leave no mechanism within the
+/// element (`K_rr` positive definite); the error says which release to drop.
+pub fn check_releases(releases: &[[bool; 6]; 2]) -> Result<()> {
+    for (e, end) in releases.iter().enumerate() {
+        for d in [1usize, 2] {
+            if end[d] {
+                return Err(Error::invalid(
+                    "frame release",
+                    format!(
+                        "{} at end {} is a shear release, which is not supported; release ux (axial), rx (torsion), ry or rz (bending rotations)",
+                        LOCAL_DOF_NAMES[d],
+                        e + 1
+                    ),
+                ));
+            }
+        }
+    }
+    // Unit section and length: singularity of K_rr does not depend on the values.
+    let sec = Section {
+        area_m2: 1.0,
+        iy_m4: 1.0,
+        iz_m4: 1.0,
+        torsion_constant_m4: 1.0,
+    };
+    let mat = Material {
+        youngs_modulus_pa: 1.0,
+        poisson_ratio: 0.3,
+        density_kg_per_m3: 1.0,
+    };
+    let (k, _) = frame_local_matrices(1.0, &mat, &sec);
+    condense(&k, &k, releases).map(|_| ())
+}
+
+/// Static condensation of the released DOFs (module docs): `(Tᵀ K T, Tᵀ M T)` with
+/// `T = I` on the retained DOFs and `u_r = −K_rr⁻¹ K_rc u_c`.
+fn condense(k: &Mat<f64>, m: &Mat<f64>, releases: &[[bool; 6]; 2]) -> Result<(Mat<f64>, Mat<f64>)> {
+    let r: Vec<usize> = (0..12).filter(|&i| releases[i / 6][i % 6]).collect();
+    if r.is_empty() {
+        return Ok((k.clone(), m.clone()));
+    }
+    let nr = r.len();
+    // Cholesky K_rr = L Lᵀ with a relative pivot test: a pivot that vanishes against its
+    // diagonal entry means a rigid-body motion of the element lives on the released DOFs.
+    let mut l = vec![vec![0.0; nr]; nr];
+    for j in 0..nr {
+        let mut d = k[(r[j], r[j])];
+        for p in 0..j {
+            d -= l[j][p] * l[j][p];
+        }
+        if d.is_nan() || d <= 1e-9 * k[(r[j], r[j])].abs() {
+            let names: Vec<String> = r
+                .iter()
+                .map(|&i| format!("{} at end {}", LOCAL_DOF_NAMES[i % 6], i / 6 + 1))
+                .collect();
+            return Err(Error::invalid(
+                "frame release",
+                format!(
+                    "releasing {} leaves the element a mechanism (it could move without straining); release fewer DOFs, e.g. the axial ux or the torsion rx at one end only",
+                    names.join(", ")
+                ),
+            ));
+        }
+        l[j][j] = d.sqrt();
+        for i in j + 1..nr {
+            let mut s = k[(r[i], r[j])];
+            for p in 0..j {
+                s -= l[i][p] * l[j][p];
+            }
+            l[i][j] = s / l[j][j];
+        }
+    }
+    // T = I − E_r X with X = K_rr⁻¹ K_r,: (columns of released DOFs dropped).
+    let mut t = Mat::<f64>::identity(12, 12);
+    for c in 0..12 {
+        if r.contains(&c) {
+            for &ri in &r {
+                t[(ri, c)] = 0.0;
+            }
+            t[(c, c)] = 0.0;
+            continue;
+        }
+        // Solve L Lᵀ x = K_rc[:, c].
+        let mut y = vec![0.0; nr];
+        for i in 0..nr {
+            let mut s = k[(r[i], c)];
+            for p in 0..i {
+                s -= l[i][p] * y[p];
+            }
+            y[i] = s / l[i][i];
+        }
+        let mut x = vec![0.0; nr];
+        for i in (0..nr).rev() {
+            let mut s = y[i];
+            for p in i + 1..nr {
+                s -= l[p][i] * x[p];
+            }
+            x[i] = s / l[i][i];
+        }
+        for (i, &ri) in r.iter().enumerate() {
+            t[(ri, c)] = -x[i];
+        }
+    }
+    Ok((to_global(k, &t), to_global(m, &t)))
+}
+
+/// Local 12×12 stiffness and consistent mass with the end `releases` condensed out (module
+/// docs); an error when the releases leave the element a mechanism.
+pub fn frame_local_matrices_released(
+    length_m: f64,
+    material: &Material,
+    section: &Section,
+    releases: &[[bool; 6]; 2],
+) -> Result<(Mat<f64>, Mat<f64>)> {
+    check_releases(releases)?;
+    let (k, m) = frame_local_matrices(length_m, material, section);
+    condense(&k, &m, releases)
 }
 
 /// Local axes `[e1, e2, e3]` (rows of the rotation global → local) of a frame element.
@@ -279,8 +419,20 @@ pub fn frame_matrices(
     section: &Section,
     orientation: Option<V3>,
 ) -> Result<(Mat<f64>, Mat<f64>)> {
+    frame_matrices_released(x1, x2, material, section, orientation, &[[false; 6]; 2])
+}
+
+/// [`frame_matrices`] with end releases (local DOFs, module docs) condensed out.
+pub fn frame_matrices_released(
+    x1: V3,
+    x2: V3,
+    material: &Material,
+    section: &Section,
+    orientation: Option<V3>,
+    releases: &[[bool; 6]; 2],
+) -> Result<(Mat<f64>, Mat<f64>)> {
     let axes = frame_local_axes(x1, x2, orientation)?;
-    let (kl, ml) = frame_local_matrices(norm(sub(x2, x1)), material, section);
+    let (kl, ml) = frame_local_matrices_released(norm(sub(x2, x1)), material, section, releases)?;
     let t = block_rotation(&axes, 4);
     Ok((to_global(&kl, &t), to_global(&ml, &t)))
 }
@@ -358,6 +510,76 @@ mod tests {
             }
             assert!((s - mass).abs() < 1e-12 * mass, "{s} vs {mass}");
         }
+    }
+
+    /// One element clamped at node 1 with both bending rotations released at node 2: the
+    /// condensed transverse stiffness at node 2 is the propped value `3EI/L³` (a cantilever's
+    /// tip under a force with the moment-free end), not `12EI/L³`, and its mass coefficient is
+    /// that of the clamped-pinned cubic `N = (3ξ² − ξ³)/2`: `ρAL ∫N² = 33/140 ρAL`. Released
+    /// rows and columns are zero.
+    #[test]
+    fn released_end_rotation_condenses_to_the_propped_values() {
+        let sec = Section::new(2e-3, 3e-7, 5e-7, 1e-6).unwrap();
+        let mat = Material::STEEL;
+        let l = 1.3;
+        let mut rel = [[false; 6]; 2];
+        rel[1][4] = true;
+        rel[1][5] = true;
+        let (k, m) = frame_local_matrices_released(l, &mat, &sec, &rel).unwrap();
+        let e = mat.youngs_modulus_pa;
+        let mass = mat.density_kg_per_m3 * sec.area_m2 * l;
+        // v2 (7) bends with Iz, w2 (8) with Iy.
+        for (dof, i) in [(7usize, sec.iz_m4), (8, sec.iy_m4)] {
+            let want = 3.0 * e * i / l.powi(3);
+            assert!(
+                (k[(dof, dof)] - want).abs() < 1e-10 * want,
+                "{}",
+                k[(dof, dof)]
+            );
+            let mw = 33.0 / 140.0 * mass;
+            assert!(
+                (m[(dof, dof)] - mw).abs() < 1e-12 * mass,
+                "{}",
+                m[(dof, dof)]
+            );
+        }
+        for d in [10usize, 11] {
+            for j in 0..12 {
+                assert_eq!(k[(d, j)], 0.0);
+                assert_eq!(m[(j, d)], 0.0);
+            }
+        }
+        // Axial and torsion untouched.
+        let (k0, _) = frame_local_matrices(l, &mat, &sec);
+        assert_eq!(k[(0, 0)], k0[(0, 0)]);
+        assert_eq!(k[(3, 9)], k0[(3, 9)]);
+    }
+
+    /// Axial (or torsion) released at both ends, or every bending DOF of a plane, leaves the
+    /// element a mechanism: an error; shear releases are refused.
+    #[test]
+    fn mechanism_releases_are_errors() {
+        let mut rel = [[false; 6]; 2];
+        rel[0][0] = true;
+        rel[1][0] = true;
+        let e = check_releases(&rel).unwrap_err().to_string();
+        assert!(e.contains("mechanism"), "{e}");
+        let mut rel = [[false; 6]; 2];
+        rel[0][3] = true;
+        rel[1][3] = true;
+        assert!(check_releases(&rel).is_err());
+        let mut rel = [[false; 6]; 2];
+        rel[0][1] = true;
+        let e = check_releases(&rel).unwrap_err().to_string();
+        assert!(e.contains("shear"), "{e}");
+        // Pinned-pinned in both planes plus torsion at one end is fine.
+        let mut rel = [[false; 6]; 2];
+        for d in [3, 4, 5] {
+            rel[0][d] = true;
+        }
+        rel[1][4] = true;
+        rel[1][5] = true;
+        check_releases(&rel).unwrap();
     }
 
     #[test]

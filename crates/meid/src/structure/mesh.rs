@@ -4,7 +4,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use super::discrete::{check_coefficients, Dashpot, PointMass, RigidLink, Spring};
-use super::frame::{frame_local_axes, FrameElement};
+use super::frame::{check_releases, frame_local_axes, FrameElement};
 use super::shell::{shell_geometry, ShellElement};
 use crate::{Error, Result};
 
@@ -237,6 +237,7 @@ impl Mesh {
                 f.orientation,
             )
             .map_err(|e| Error::invalid(what.clone(), e.to_string()))?;
+            check_releases(&f.releases).map_err(|e| Error::invalid(what.clone(), e.to_string()))?;
         }
         for (i, s) in self.shells.iter().enumerate() {
             let what = format!(
