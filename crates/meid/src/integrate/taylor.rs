@@ -542,7 +542,7 @@ const FULL_TAIL: f64 = {
 /// the period) needs only a few terms: `r = 0.01` gives `d = 5`. Non-finite or
 /// `r ≥ REACH` gives `P`; at least 2 (a forced step with `ρ = 0` has `c₁ = b`, `c₂ = 0`).
 pub fn degree_for_reach(r: f64) -> usize {
-    if !(r >= 0.0 && r < REACH) {
+    if !(0.0..REACH).contains(&r) {
         return ORDER;
     }
     let mut terms = [0.0; TAIL_TERMS];
