@@ -220,9 +220,20 @@ pub fn solve_from(
             for &c in mc.zeros() {
                 totals.peaks.0[c].offer(0.0, t);
             }
+            // The channel polynomials only to the degree the stretch needs (its remainder
+            // bound no larger than the full step's, `taylor::degree_for_reach`).
+            let deg = tm.degree(s_end);
             for (r, &c) in mc.moving().iter().enumerate() {
-                mc.project(r, &coef, &mut chan_poly);
-                peaks::on_poly(&chan_poly, tau, period, t, s_end, &mut totals.peaks.0[c]);
+                mc.project(r, &coef, deg, &mut chan_poly);
+                peaks::on_poly(
+                    &chan_poly,
+                    deg,
+                    tau,
+                    period,
+                    t,
+                    s_end,
+                    &mut totals.peaks.0[c],
+                );
             }
             totals.dissipated += tm
                 .dissipated(&coef, &masses, s_end, &mut work)
@@ -651,16 +662,16 @@ impl ModeChannels {
     fn zeros(&self) -> &[usize] {
         &self.zero[..self.n_zero]
     }
-    /// The coefficients `ℓ_rᵀc_k`, k = 0..=P, of moving channel `r` on a Taylor step (`coef`:
-    /// rows of `n`).
+    /// The coefficients `ℓ_rᵀc_k`, k = 0..=deg, of moving channel `r` on a Taylor step
+    /// (`coef`: rows of `n`); those above `deg` are left zero.
     #[inline(never)]
-    fn project(&self, r: usize, coef: &[f64], out: &mut taylor::Coefficients) {
+    fn project(&self, r: usize, coef: &[f64], deg: usize, out: &mut taylor::Coefficients) {
         let nz = &self.nz[self.nz_off[r]..self.nz_off[r + 1]];
         let n = coef.len() / out.len();
         out.fill(0.0);
         for &(i, v) in nz {
             if i < n {
-                for (o, ck) in out.iter_mut().zip(coef.chunks_exact(n)) {
+                for (o, ck) in out.iter_mut().zip(coef.chunks_exact(n)).take(deg + 1) {
                     *o += v * ck[i];
                 }
             }

@@ -17,7 +17,9 @@ use faer::c64;
 
 use super::propagator::{ExpSum, Functional, Segment};
 use super::roots::{for_each_extremum, HermiteCubic, Scalar, SearchOptions};
-use super::taylor::{self, Coefficients, Poly};
+#[cfg(test)]
+use super::taylor::Poly;
+use super::taylor::{self, Coefficients};
 use crate::impact::{Channel, CHANNELS, N_CHANNELS};
 
 /// The search for extremes: a location to `1e-9` of the fastest period (see the module docs).
@@ -120,10 +122,41 @@ impl Peaks {
     }
 }
 
-/// Extremes of `p(s) = Σ a_k s^k` on `[0, len]` (a Taylor step of validity `tau` starting at
-/// time `t0`), offered to `ext`.
+/// Extremes of `p(s) = Σ_{k≤deg} a_k s^k` on `[0, len]` (a Taylor step of validity `tau`
+/// starting at time `t0`, truncated at degree `deg` by [`taylor::degree_for_reach`]; the
+/// coefficients above `deg` must be zero), offered to `ext`.
+///
+/// The evaluations and the search run on the lowest of 8, 12, 16, 20 or `P` that holds `deg`: a
+/// stretch much shorter than the step's validity costs a third of a full one.
+#[allow(clippy::too_many_arguments)]
 #[inline(never)]
 pub(crate) fn on_poly(
+    a: &Coefficients,
+    deg: usize,
+    tau: f64,
+    period: f64,
+    t0: f64,
+    len: f64,
+    ext: &mut Extremes,
+) {
+    match deg {
+        0..=8 => on_poly_m::<9>(a, tau, period, t0, len, ext),
+        9..=12 => on_poly_m::<13>(a, tau, period, t0, len, ext),
+        13..=16 => on_poly_m::<17>(a, tau, period, t0, len, ext),
+        17..=20 => on_poly_m::<21>(a, tau, period, t0, len, ext),
+        _ => on_poly_m::<{ taylor::ORDER + 1 }>(a, tau, period, t0, len, ext),
+    }
+}
+
+/// `Σ_{k<M} c_k x^k`.
+#[inline(always)]
+fn horner<const M: usize>(c: &Coefficients, x: f64) -> f64 {
+    taylor::poly4::<M>(x, |k| c[k])
+}
+
+/// [`on_poly`] on the first `M` coefficients.
+#[inline(always)]
+fn on_poly_m<const M: usize>(
     a: &Coefficients,
     tau: f64,
     period: f64,
@@ -135,38 +168,117 @@ pub(crate) fn on_poly(
     if len <= 0.0 {
         return;
     }
-    if !ext.could_improve(taylor::abs_horner(a, len)) {
+    if !ext.could_improve(taylor::poly4::<M>(len, |k| a[k].abs())) {
         // The end value cannot beat the extremes either: nothing to do.
         return;
     }
-    ext.offer(taylor::eval(a, len), t0 + len);
+    ext.offer(horner::<M>(a, len), t0 + len);
     let mut da = [0.0; taylor::ORDER + 1];
-    for (k, d) in da.iter_mut().take(taylor::ORDER).enumerate() {
+    for (k, d) in da.iter_mut().take(M - 1).enumerate() {
         *d = (k + 1) as f64 * a[k + 1];
     }
     // A slope of one sign throughout (a concave bound) leaves the extremes at the ends.
-    if taylor::keeps_sign(&da, 1.0, len) || taylor::keeps_sign(&da, -1.0, len) {
+    if one_signed::<M>(&da, len) {
         return;
     }
     // A monotone slope (its derivative `p''` keeps its sign) has at most one root, where its
     // end values differ in sign: safeguarded Newton on it, without the general search.
     let mut d2a = [0.0; taylor::ORDER + 1];
-    for (k, d) in d2a.iter_mut().take(taylor::ORDER).enumerate() {
+    for (k, d) in d2a.iter_mut().take(M - 1).enumerate() {
         *d = (k + 1) as f64 * da[k + 1];
     }
-    if taylor::keeps_sign(&d2a, 1.0, len) || taylor::keeps_sign(&d2a, -1.0, len) {
-        let (g0, g1) = (da[0], taylor::eval(&da, len));
+    if one_signed::<M>(&d2a, len) {
+        let (g0, g1) = (da[0], horner::<M>(&da, len));
         if g0 * g1 < 0.0 {
             let tol = EXTREMUM_SEARCH.tolerance * period;
-            let s = monotone_root(&da, &d2a, len, (g0, g1), tol);
-            ext.offer(taylor::eval(a, s), t0 + s);
+            let s = monotone_root::<M>(&da, &d2a, len, (g0, g1), tol);
+            ext.offer(horner::<M>(a, s), t0 + s);
         }
         return;
     }
-    let slope = Poly::new(&da, tau, period);
+    let slope = Slope::<M> {
+        a: da,
+        da: d2a,
+        period,
+        noise: 64.0 * f64::EPSILON * taylor::poly4::<M>(tau, |k| da[k].abs()),
+    };
     for_each_extremum(&slope, 0.0, len, EXTREMUM_SEARCH, |s, _| {
-        ext.offer(taylor::eval(a, s), t0 + s)
+        ext.offer(horner::<M>(a, s), t0 + s)
     });
+}
+
+/// The slope `Σ_{k<M} a_k s^k` of a channel on a Taylor step, for the general search: as
+/// [`taylor::Poly`] on the first `M` coefficients (the same round-off size, 64 ulps of `Σ|a_k|τ^k`).
+struct Slope<const M: usize> {
+    a: Coefficients,
+    /// `(k + 1) a_{k+1}`.
+    da: Coefficients,
+    period: f64,
+    noise: f64,
+}
+
+impl<const M: usize> Scalar for Slope<M> {
+    #[inline]
+    fn value_slope(&self, s: f64) -> (f64, f64) {
+        (horner::<M>(&self.a, s), horner::<M>(&self.da, s))
+    }
+    /// `Σ k(k−1)|a_k| b^{k−2}` (s ≥ 0).
+    #[inline]
+    fn curvature_bound(&self, _a: f64, b: f64) -> f64 {
+        taylor::poly4::<M>(b.abs(), |k| {
+            if k + 2 < M {
+                taylor::K_K1[k + 2] * self.a[k + 2].abs()
+            } else {
+                0.0
+            }
+        })
+    }
+    fn fastest_period(&self) -> f64 {
+        self.period
+    }
+    fn noise(&self) -> f64 {
+        self.noise
+    }
+}
+
+/// True when `p(s) = Σ_{k<M} a_k s^k` is non-zero with one sign on all of `(0, len]`, or is
+/// identically zero: with `j` the first index where `a_j ≠ 0`, `p(s) = s^j q(s)` with
+/// `q(s) = Σ_k a_{j+k} s^k` and `s^j > 0` on `(0, len]`, so the concave certificate of `q`
+/// ([`taylor::keeps_sign`]: `b₀ > 0` and `b₀ + b₁len + Σ_{k≥2} min(b_k, 0) len^k > 0` with
+/// `b_k = sign(a_j)·a_{j+k}`) proves it. (A slope that starts at exactly zero, a channel
+/// starting from rest, has `j ≥ 1`: the certificate of `p` itself needs `p(0) ≠ 0`.) A slope
+/// one-signed on `(0, len]` makes its integral monotone on `[0, len]`.
+#[inline]
+fn one_signed<const M: usize>(a: &Coefficients, len: f64) -> bool {
+    if a[0] != 0.0 {
+        return keeps_sign::<M>(a, len);
+    }
+    let Some(j) = a[..M].iter().position(|v| *v != 0.0) else {
+        return true;
+    };
+    let mut q = [0.0; taylor::ORDER + 1];
+    q[..M - j].copy_from_slice(&a[j..M]);
+    keeps_sign::<M>(&q, len)
+}
+
+/// [`taylor::keeps_sign`] on the first `M` coefficients, with the sign of `a₀`: true when
+/// `p(s) = Σ_{k<M} a_k s^k` has the sign of `a₀ ≠ 0` on all of `[0, len]`.
+#[inline(always)]
+fn keeps_sign<const M: usize>(a: &Coefficients, len: f64) -> bool {
+    let sign = a[0].signum();
+    let b0 = sign * a[0];
+    if b0.is_nan() || b0 <= 0.0 {
+        return false;
+    }
+    // Σ_{k≥2} min(b_k, 0) len^(k−2).
+    let neg = taylor::poly4::<M>(len, |k| {
+        if k + 2 < M {
+            (sign * a[k + 2]).min(0.0)
+        } else {
+            0.0
+        }
+    });
+    b0 + len * (sign * a[1] + len * neg) > 0.0
 }
 
 /// The root of `g = Σ g_k s^k` (slope `dg`) on `[0, len]`, given that `g` is monotone there and
@@ -175,7 +287,7 @@ pub(crate) fn on_poly(
 /// search ends when the bracket is that narrow or a Newton step is shorter than `tol/4`
 /// (Newton's error is then of the order of the step squared over the slope's scale, far
 /// below `tol`; a step that no longer moves `s` ends it too).
-fn monotone_root(
+fn monotone_root<const M: usize>(
     g: &Coefficients,
     dg: &Coefficients,
     len: f64,
@@ -190,7 +302,7 @@ fn monotone_root(
     }
     let mut last_step = f64::INFINITY;
     for _ in 0..100 {
-        let v = taylor::eval(g, s);
+        let v = horner::<M>(g, s);
         if v == 0.0 {
             return s;
         }
@@ -202,7 +314,7 @@ fn monotone_root(
         if hi - lo <= tol.max(4.0 * f64::EPSILON * hi) || last_step < 0.25 * tol {
             break;
         }
-        let d = taylor::eval(dg, s);
+        let d = horner::<M>(dg, s);
         let newton = s - v / d;
         let step = (newton - s).abs();
         if d != 0.0 && newton > lo && newton < hi && step < 0.5 * (hi - lo) {
@@ -519,7 +631,7 @@ mod tests {
         a[1] = 1.0;
         a[3] = -1.0;
         let mut e = Extremes::default();
-        on_poly(&a, 2.0, 1.0, 10.0, 1.5, &mut e);
+        on_poly(&a, taylor::ORDER, 2.0, 1.0, 10.0, 1.5, &mut e);
         let s = 1.0 / 3f64.sqrt();
         assert!((e.max - 2.0 / (3.0 * 3f64.sqrt())).abs() < 1e-15);
         assert!((e.t_max - (10.0 + s)).abs() < 1e-9);
@@ -536,13 +648,121 @@ mod tests {
         let mut e = Extremes::default();
         e.offer(5.0, 0.0);
         e.offer(-5.0, 1.0);
-        on_poly(&a, 2.0, 1.0, 3.0, 1.0, &mut e);
+        on_poly(&a, taylor::ORDER, 2.0, 1.0, 3.0, 1.0, &mut e);
         assert_eq!((e.max, e.min), (5.0, -5.0));
         e.offer(0.15, 9.0);
         let mut f = Extremes::default();
         f.offer(0.15, 0.0);
-        on_poly(&a, 2.0, 1.0, 3.0, 1.0, &mut f);
+        on_poly(&a, taylor::ORDER, 2.0, 1.0, 3.0, 1.0, &mut f);
         assert!((f.max - 0.2).abs() < 1e-15 && f.t_max == 4.0);
+    }
+
+    /// The coefficients `a_k = Re Σ_j A_j λ_j^k / k!` of `Re Σ_j A_j e^{λ_j s}` (a channel on
+    /// a Taylor step), with the step's validity `τ = 2.2/ρ`, `ρ = max|λ_j|`, and period `2π/ρ`.
+    fn exp_sum_poly(modes: &[(f64, f64, f64, f64)]) -> (Coefficients, f64, f64) {
+        let mut a = [0.0; taylor::ORDER + 1];
+        let mut rho = 0.0f64;
+        for &(f, zeta, amp, phase) in modes {
+            let w = 2.0 * std::f64::consts::PI * f;
+            let lam = c64::new(-zeta * w, w * (1.0 - zeta * zeta).sqrt());
+            rho = rho.max(lam.norm());
+            let mut term = c64::new(amp * phase.cos(), amp * phase.sin());
+            for (k, ak) in a.iter_mut().enumerate() {
+                if k > 0 {
+                    term = term * lam / k as f64;
+                }
+                *ak += term.re;
+            }
+        }
+        (a, 2.2 / rho, 2.0 * std::f64::consts::PI / rho)
+    }
+
+    /// The unpruned search: both ends and every root of the full-degree slope
+    /// ([`for_each_extremum`] on [`Poly`], no bound, no certificate).
+    fn unpruned(a: &Coefficients, tau: f64, period: f64, len: f64) -> Extremes {
+        let mut e = Extremes::default();
+        e.offer(a[0], 0.0);
+        e.offer(taylor::eval(a, len), len);
+        let mut da = [0.0; taylor::ORDER + 1];
+        for (k, d) in da.iter_mut().take(taylor::ORDER).enumerate() {
+            *d = (k + 1) as f64 * a[k + 1];
+        }
+        let slope = Poly::new(&da, tau, period);
+        for_each_extremum(&slope, 0.0, len, EXTREMUM_SEARCH, |s, _| {
+            e.offer(taylor::eval(a, s), s)
+        });
+        e
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(400))]
+
+        /// [`on_poly`] (degree lowered by `taylor::degree_for_reach`, the bound, the one-sign
+        /// certificates with leading zeros stripped, the monotone Newton) against the
+        /// unpruned search of the full-degree polynomial and dense evaluation, on sums of 1-3
+        /// damped oscillations over a fraction of the validity from 1e-4 to 1 (the blow's
+        /// first stretch is 3e-3 of it); `from_rest` zeroes the slope at 0 (a channel starting
+        /// from rest, `a₁ = 0`, and `a₂ = 0` too when `flat`).
+        #[test]
+        fn lowered_degree_and_certificates_match_unpruned_search(
+            modes in proptest::collection::vec(
+                (1.0f64..5000.0, 0.0f64..0.3, -1.0f64..1.0, 0.0f64..6.3), 1..4),
+            frac_exp in -4.0f64..0.0,
+            from_rest in proptest::bool::ANY,
+            flat in proptest::bool::ANY,
+        ) {
+            let (mut a, tau, period) = exp_sum_poly(&modes);
+            if from_rest {
+                a[1] = 0.0;
+                if flat {
+                    a[2] = 0.0;
+                }
+            }
+            let len = tau * 10f64.powf(frac_exp);
+            let deg = taylor::degree_for_reach(2.2 * len / tau);
+            let mut lowered = a;
+            lowered[deg + 1..].fill(0.0);
+            let mut got = Extremes::default();
+            on_poly(&lowered, deg, tau, period, 0.0, len, &mut got);
+            let want = unpruned(&a, tau, period, len);
+            let scale = taylor::abs_horner(&a, len);
+            let tol = 1e-14 * scale;
+            proptest::prop_assert!((got.max - want.max).abs() <= tol, "max {got:?} {want:?}");
+            proptest::prop_assert!((got.min - want.min).abs() <= tol, "min {got:?} {want:?}");
+            // The times reported are where the full polynomial takes those values.
+            proptest::prop_assert!((taylor::eval(&a, got.t_max) - want.max).abs() <= tol);
+            proptest::prop_assert!((taylor::eval(&a, got.t_min) - want.min).abs() <= tol);
+            for i in 0..=2000 {
+                let s = len * f64::from(i) / 2000.0;
+                let v = taylor::eval(&a, s);
+                proptest::prop_assert!(v <= got.max + tol && v >= got.min - tol, "{v} at {s}");
+            }
+        }
+    }
+
+    #[test]
+    fn degree_for_reach_bounds_the_remainder() {
+        // Full reach needs every term; a short stretch few; the bound holds at each.
+        assert_eq!(taylor::degree_for_reach(2.2), taylor::ORDER);
+        assert_eq!(taylor::degree_for_reach(f64::NAN), taylor::ORDER);
+        assert_eq!(taylor::degree_for_reach(0.0), 2);
+        let full: f64 = (taylor::ORDER + 1..60)
+            .map(|k| (1..=k).fold(1.0, |t, i| t * 2.2 / i as f64))
+            .sum();
+        for r in [1e-6, 1e-3, 0.0066, 0.1, 0.5, 1.0, 1.28, 2.0, 2.19] {
+            let d = taylor::degree_for_reach(r);
+            let tail = |d: usize| -> f64 {
+                (d + 1..60)
+                    .map(|k| (1..=k).fold(1.0, |t, i| t * r / i as f64))
+                    .sum()
+            };
+            assert!(tail(d) <= full, "r = {r}: degree {d}");
+            assert!(
+                d == 2 || tail(d - 1) > full,
+                "r = {r}: degree {d} not the lowest"
+            );
+        }
+        assert!(taylor::degree_for_reach(0.0066) <= 6);
     }
 
     /// The Hermite cubic's range against dense evaluation.

@@ -141,6 +141,12 @@ impl TaylorMatrix {
         }
     }
 
+    /// The lowest degree `d ≤ P` whose truncation on `[0, len]` is bounded as tightly as the
+    /// full series on its validity: [`degree_for_reach`] of `r = ρ·len`.
+    pub fn degree(&self, len: f64) -> usize {
+        degree_for_reach(self.rate * len)
+    }
+
     /// The time scale `2π/ρ` (s) used by the event search.
     pub fn period(&self) -> f64 {
         if self.rate > 0.0 {
@@ -505,12 +511,64 @@ pub fn state(coef: &[f64], s: f64, out: &mut [f64]) {
     }
 }
 
+/// Terms summed for the truncation remainders of [`degree_for_reach`] (beyond them
+/// `r^k/k! < 1e-30` for `r ≤ 2.2`).
+const TAIL_TERMS: usize = ORDER + 13;
+
+/// `Σ_{k>P} REACH^k/k!`: the remainder bound of a full step (in units of `‖D⁻¹X₀‖_∞`).
+const FULL_TAIL: f64 = {
+    let mut term = 1.0;
+    let mut k = 1;
+    let mut tail = 0.0;
+    while k < TAIL_TERMS {
+        term = term * REACH / k as f64;
+        if k > ORDER {
+            tail += term;
+        }
+        k += 1;
+    }
+    tail
+};
+
+/// The lowest degree `d` (`2 ≤ d ≤ P`) with
+///
+/// `Σ_{k>d} r^k/k! ≤ Σ_{k>P} REACH^k/k!`  (`r = ρ·len`):
+///
+/// since `‖D⁻¹c_k‖_∞ len^k ≤ (ρ·len)^k/k! ‖D⁻¹X₀‖_∞` (see the module docs; the forced
+/// coefficients `A^{k−1}b/k!` decay alike, scaled by `‖D⁻¹b‖_∞/ρ`), the series truncated at
+/// degree `d` on `[0, len]` is within the same bound of the solution as the full series
+/// (degree `P`) is on its validity `[0, τ]`: below a quarter of the unit round-off of
+/// `‖D⁻¹X₀‖_∞`. A stretch much shorter than `τ` (a dashpot that switches off after 1e-3 of
+/// the period) needs only a few terms: `r = 0.01` gives `d = 5`. Non-finite or
+/// `r ≥ REACH` gives `P`; at least 2 (a forced step with `ρ = 0` has `c₁ = b`, `c₂ = 0`).
+pub fn degree_for_reach(r: f64) -> usize {
+    if !(0.0..REACH).contains(&r) {
+        return ORDER;
+    }
+    let mut terms = [0.0; TAIL_TERMS];
+    let mut term = 1.0;
+    terms[0] = term;
+    for (k, t) in terms.iter_mut().enumerate().skip(1) {
+        term *= r / k as f64;
+        *t = term;
+    }
+    // Remainder after degree d: Σ_{k>d} terms[k], summed from the smallest term up.
+    let mut tail = 0.0;
+    for d in (2..TAIL_TERMS).rev() {
+        tail += terms[d];
+        if tail > FULL_TAIL {
+            return d.min(ORDER);
+        }
+    }
+    2
+}
+
 /// The `P + 1` coefficients of a polynomial of a Taylor step (fixed size, so that loops over
 /// them are unrolled).
 pub type Coefficients = [f64; ORDER + 1];
 
 /// `k(k−1)` for k = 0..=P (the curvature bound's weights).
-const K_K1: Coefficients = {
+pub(crate) const K_K1: Coefficients = {
     let mut t = [0.0; ORDER + 1];
     let mut k = 2;
     while k <= ORDER {
@@ -526,7 +584,7 @@ const K_K1: Coefficients = {
 /// chains keep the pipeline busy). It rounds differently from one chain, with an error of the
 /// same order. Polynomial evaluation is most of an event search on a Taylor step.
 #[inline(always)]
-fn poly4<const M: usize>(x: f64, c: impl Fn(usize) -> f64) -> f64 {
+pub(crate) fn poly4<const M: usize>(x: f64, c: impl Fn(usize) -> f64) -> f64 {
     let x2 = x * x;
     let t = x2 * x2;
     let mut v = [0.0; 4];
@@ -542,7 +600,7 @@ fn poly4<const M: usize>(x: f64, c: impl Fn(usize) -> f64) -> f64 {
 }
 
 /// `p(s) = Σ a_k s^k`.
-#[inline]
+#[cfg(test)]
 pub(crate) fn eval(a: &Coefficients, s: f64) -> f64 {
     poly4::<{ ORDER + 1 }>(s, |k| a[k])
 }
