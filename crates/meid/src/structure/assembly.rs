@@ -16,6 +16,7 @@ use faer::Mat;
 use super::frame::frame_matrices;
 use super::mesh::Mesh;
 use super::shell::shell_matrices;
+use super::tri3::tri_matrices;
 use crate::{Error, Result};
 
 /// Map from full DOFs (`6 node + dof`) to reduced DOFs: `u_full[i] = Σ coeff · u_red[j]`.
@@ -327,6 +328,18 @@ impl FeModel {
             let x = s.nodes.map(|nd| mesh.nodes[nd]);
             let (k, m) = shell_matrices(&x, s)
                 .map_err(|e| Error::invalid(format!("shell element {i}"), e.to_string()))?;
+            let dofs: Vec<usize> = s
+                .nodes
+                .iter()
+                .flat_map(|&nd| (0..6).map(move |d| 6 * nd + d))
+                .collect();
+            col.add(Kind::K, &dofs, &k);
+            col.add(Kind::M, &dofs, &m);
+        }
+        for (i, s) in mesh.triangles.iter().enumerate() {
+            let x = s.nodes.map(|nd| mesh.nodes[nd]);
+            let (k, m) = tri_matrices(&x, s)
+                .map_err(|e| Error::invalid(format!("triangle {i}"), e.to_string()))?;
             let dofs: Vec<usize> = s
                 .nodes
                 .iter()
