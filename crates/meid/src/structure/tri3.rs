@@ -447,7 +447,8 @@ mod tests {
 
     #[test]
     fn degenerate_triangles_are_rejected() {
-        let flat = |p: [[f64; 2]; 3]| -> [V3; 3] { std::array::from_fn(|i| [p[i][0], p[i][1], 0.0]) };
+        let flat =
+            |p: [[f64; 2]; 3]| -> [V3; 3] { std::array::from_fn(|i| [p[i][0], p[i][1], 0.0]) };
         for bad in [
             flat([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]),
             flat([[0.0, 0.0], [0.0, 0.0], [0.0, 1.0]]),
@@ -473,9 +474,9 @@ mod tests {
         let flipped: [&[usize]; 2] = [&[0, 1, 2], &[0, 3, 2]];
         let f = check_orientation(&flipped, &x).unwrap();
         assert!(f.same_direction && f.elements == [0, 1]);
-        // node 4 lies on the same side of edge 0-2 as node 1: (0, 4, 2)... reversed to keep
-        // the order consistent, the triangle (2, 0, 4) is folded back onto (0, 1, 2).
-        let folded: [&[usize]; 2] = [&[0, 1, 2], &[2, 0, 4]];
+        // node 4 lies on the same side of edge 0-2 as node 1: (0, 2, 4) runs the edge against
+        // (0, 1, 2), as it should, but is folded back onto it.
+        let folded: [&[usize]; 2] = [&[0, 1, 2], &[0, 2, 4]];
         let f = check_orientation(&folded, &x).unwrap();
         assert!(!f.same_direction && f.elements == [0, 1], "{f:?}");
     }
