@@ -22,7 +22,7 @@
 //!   thick plate of Test 21 (t/ℓ = 1/10) shows the missing shear deformation (about +1.4 % ×
 //!   (m² + n²) on mode (m, n)); mesh it with quadrangles.
 //!
-//! `--write-data DIR` writes `ss_plate_tri.toml` and `ss_plate_tri.msh` (irregular 24 × 24)
+//! `--write-data DIR` writes `ss_plate_tri.toml` and `ss_plate_tri.msh` (irregular 32 × 32 × 2)
 //! for `crates/meid/tests/fem_tri.rs`.
 
 use std::fmt::Write as _;
@@ -220,7 +220,7 @@ fn t21(n: usize, irregular: bool) -> (String, String) {
 
 fn run(dir: &Path, stem: &str, files: (String, String)) -> Result<(Vec<f64>, usize), String> {
     let path = dir.join(format!("{stem}.toml"));
-    std::fs::write(&path, files.0).map_err(|e| e.to_string())?;
+    std::fs::write(&path, &files.0).map_err(|e| e.to_string())?;
     let msh = files
         .0
         .lines()
@@ -238,7 +238,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     if let Some(i) = args.iter().position(|a| a == "--write-data") {
         let dir = PathBuf::from(args.get(i + 1).expect("--write-data DIR"));
-        let (m, msh) = ss_plate(24, true);
+        let (m, msh) = ss_plate(32, true);
         std::fs::write(dir.join("ss_plate_tri.toml"), m).expect("write model");
         std::fs::write(dir.join("ss_plate_tri.msh"), msh).expect("write mesh");
         println!(
