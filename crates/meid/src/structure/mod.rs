@@ -12,7 +12,7 @@
 //! | [`assembly`] | DOF numbering with rigid-link elimination, sparse/dense K, M, C, floor force |
 //! | [`modes`] | modal model (paper Eq. 9) and mode tables from the dense modes |
 //! | [`machine`] | the parametric forging machine (paper Fig. 1) |
-//! | [`gmsh`] | Gmsh `.msh` 4.1 ASCII quad meshes |
+//! | [`gmsh`] | Gmsh `.msh` 4.1 ASCII meshes: quadrangles, triangles, lines |
 //!
 //! All elements are hand-written: no Rust crate offers shell or frame elements; the linear algebra
 //! is faer's.
