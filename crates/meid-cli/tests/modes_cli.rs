@@ -303,3 +303,42 @@ fn rigid_column_note_in_simulate() {
     assert!(v["energy_balance_residual_run_end"].as_f64().unwrap() <= 1e-9);
     assert!(v["warnings"].as_array().unwrap().is_empty());
 }
+
+/// `meid modes` on a Gmsh 4.1 mesh of 3-node triangles (crates/meid/tests/data/ss_plate_tri.toml:
+/// simply supported 1 m × 1 m × 10 mm steel plate, 32 × 32 × 2 irregular triangles): the six
+/// lowest frequencies within 1 % of Kirchhoff's `f_mn = π/2 (m² + n²) sqrt(D/(ρ t))`, and the
+/// VTU file carries 2048 VTK_TRIANGLE (type 5) cells.
+#[test]
+fn triangle_mesh_modes_match_kirchhoff() {
+    let model =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../meid/tests/data/ss_plate_tri.toml");
+    let d = tmpdir("tri");
+    let out = meid()
+        .args(["modes", "--json", "--count", "6", "-o"])
+        .arg(&d)
+        .arg(&model)
+        .output()
+        .unwrap();
+    let v = common::ok_json(out);
+    let (e, nu, rho, t): (f64, f64, f64, f64) = (2.1e11, 0.3, 7850.0, 0.01);
+    let root = (e * t * t / (12.0 * (1.0 - nu * nu) * rho)).sqrt();
+    for (k, mn) in [2.0, 5.0, 5.0, 8.0, 10.0, 10.0].iter().enumerate() {
+        let exact = std::f64::consts::FRAC_PI_2 * mn * root;
+        let f = v["modes"][k]["frequency_hz"].as_f64().unwrap();
+        assert!(
+            (f / exact - 1.0).abs() <= 0.01,
+            "mode {}: {f} vs {exact}",
+            k + 1
+        );
+    }
+    let vtu = std::fs::read_to_string(d.join("modes.vtu")).unwrap();
+    check_xml(&vtu).unwrap();
+    let types = vtu
+        .split("Name=\"types\"")
+        .nth(1)
+        .unwrap()
+        .split("</DataArray>")
+        .next()
+        .unwrap();
+    assert_eq!(types.lines().filter(|l| l.trim() == "5").count(), 2048);
+}

@@ -1,5 +1,5 @@
 //! Mode shapes as VTK XML files that ParaView opens: an unstructured grid (`.vtu`, ASCII) with
-//! the mesh (quads for shells, lines for frames) and one point-data vector (displacement
+//! the mesh (quads and triangles for shells, lines for frames) and one point-data vector (displacement
 //! `[ux, uy, uz]`, mass-normalised, 1/√kg) per mode, and a `.pvd` collection pointing at it.
 //!
 //! Hand-written: the format is a few XML elements (VTK File Formats, "XML File Formats",
@@ -16,7 +16,7 @@ pub fn modes_vtu(model: &FeModel, modes: &DenseModes, which: &[usize]) -> Result
     let mesh = &model.mesh;
     let np = mesh.nodes.len();
     let mut s = String::new();
-    let ncells = mesh.shells.len() + mesh.frames.len();
+    let ncells = mesh.shells.len() + mesh.triangles.len() + mesh.frames.len();
     s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n");
     let _ = writeln!(
         s,
@@ -59,6 +59,10 @@ pub fn modes_vtu(model: &FeModel, modes: &DenseModes, which: &[usize]) -> Result
         let n = e.nodes;
         let _ = writeln!(s, "{} {} {} {}", n[0], n[1], n[2], n[3]);
     }
+    for e in &mesh.triangles {
+        let n = e.nodes;
+        let _ = writeln!(s, "{} {} {}", n[0], n[1], n[2]);
+    }
     for e in &mesh.frames {
         let _ = writeln!(s, "{} {}", e.nodes[0], e.nodes[1]);
     }
@@ -68,6 +72,10 @@ pub fn modes_vtu(model: &FeModel, modes: &DenseModes, which: &[usize]) -> Result
         off += 4;
         let _ = writeln!(s, "{off}");
     }
+    for _ in &mesh.triangles {
+        off += 3;
+        let _ = writeln!(s, "{off}");
+    }
     for _ in &mesh.frames {
         off += 2;
         let _ = writeln!(s, "{off}");
@@ -75,6 +83,9 @@ pub fn modes_vtu(model: &FeModel, modes: &DenseModes, which: &[usize]) -> Result
     s.push_str("</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
     for _ in &mesh.shells {
         s.push_str("9\n"); // VTK_QUAD
+    }
+    for _ in &mesh.triangles {
+        s.push_str("5\n"); // VTK_TRIANGLE
     }
     for _ in &mesh.frames {
         s.push_str("3\n"); // VTK_LINE
@@ -90,12 +101,18 @@ pub fn pvd(vtu_file: &str) -> String {
     )
 }
 
-/// Wireframe edges of the mesh: the four sides of each shell (each edge once) and each frame.
+/// Wireframe edges of the mesh: the sides of each shell (each edge once) and each frame.
 pub fn mesh_edges(model: &FeModel) -> Vec<[usize; 2]> {
     let mut set = std::collections::BTreeSet::new();
     for e in &model.mesh.shells {
         for k in 0..4 {
             let (a, b) = (e.nodes[k], e.nodes[(k + 1) % 4]);
+            set.insert([a.min(b), a.max(b)]);
+        }
+    }
+    for e in &model.mesh.triangles {
+        for k in 0..3 {
+            let (a, b) = (e.nodes[k], e.nodes[(k + 1) % 3]);
             set.insert([a.min(b), a.max(b)]);
         }
     }

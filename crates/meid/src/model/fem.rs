@@ -797,10 +797,10 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
         check_material(m, &format!("{base}.material"), src)?;
     }
     let g = crate::structure::gmsh::read_msh(&path)?;
-    if g.quads.is_empty() {
+    if g.quads.is_empty() && g.triangles.is_empty() {
         return Err(src.error(
             &format!("{base}.file"),
-            format!("{base}.file: {} has no 4-node quadrangles; [structure.fem.mesh] reads shell meshes (frames from 2-node lines: use [structure.fem.model])", path.display()),
+            format!("{base}.file: {} has no 4-node quadrangles or 3-node triangles; [structure.fem.mesh] reads shell meshes (frames from 2-node lines: use [structure.fem.model])", path.display()),
         ));
     }
     let mut mesh = Mesh::new();

@@ -5,7 +5,8 @@
 //! ```toml
 //! [structure.fem.model]
 //! mesh = "press.msh"              # optional Gmsh 4.1 ASCII file (relative to the model file):
-//!                                 # quadrangles → shells, 2-node lines → frames, physical groups → sets
+//!                                 # quadrangles and triangles → shells, 2-node lines → frames,
+//!                                 # physical groups → sets
 //! nodes = [[0, 0, 0], [0, 0, 2]]  # inline nodes (m), referenced by 0-based index
 //! sets = { top = [1] }            # inline node sets (indices into `nodes`)
 //! material = { youngs_modulus = 2.1e11, poisson_ratio = 0.3, density = 7850 }   # default
@@ -38,7 +39,7 @@ use super::fem::{check_material, parse_dofs, ConstraintSpec, MaterialSpec};
 use super::Source;
 use crate::structure::{
     Dashpot, FeModel, FrameElement, Material, Mesh, PointMass, RigidLink, Section, ShellElement,
-    Spring,
+    Spring, TriShellElement,
 };
 use crate::Result;
 
@@ -82,7 +83,8 @@ pub struct GeneralSpec {
     pub impact_direction: Option<[f64; 3]>,
 }
 
-/// Shells of one section: the quadrangles of a Gmsh element set and/or inline quadrangles.
+/// Shells of one section: the quadrangles and triangles of a Gmsh physical surface and/or inline
+/// quadrangles (MITC4) and triangles (CST + DKT, Kirchhoff: `shear_factor` acts on quadrangles).
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ShellSpec {
@@ -92,6 +94,9 @@ pub struct ShellSpec {
     /// Inline quadrangles (node indices, in order around the element).
     #[serde(default)]
     pub quads: Vec<[usize; 4]>,
+    /// Inline triangles (node indices; the triangles of one entry must be ordered alike).
+    #[serde(default)]
+    pub triangles: Vec<[usize; 3]>,
     /// m.
     pub thickness: f64,
     #[serde(default)]
@@ -352,6 +357,8 @@ pub fn build(spec: &GeneralSpec, src: &Source) -> Result<FeModel> {
     // Shells: every Gmsh quadrangle must get exactly one section.
     let nq = b.gmsh.as_ref().map(|g| g.quads.len()).unwrap_or(0);
     let mut quad_section: Vec<Option<usize>> = vec![None; nq];
+    let nt = b.gmsh.as_ref().map(|g| g.triangles.len()).unwrap_or(0);
+    let mut tri_section: Vec<Option<usize>> = vec![None; nt];
     for (si, s) in spec.shells.iter().enumerate() {
         let field = format!("shells[{si}]");
         positive(&b, &format!("{field}.thickness"), s.thickness, "m")?;
@@ -366,19 +373,33 @@ pub fn build(spec: &GeneralSpec, src: &Source) -> Result<FeModel> {
             "(5/6 is usual)",
         )?;
         let mut quads: Vec<[usize; 4]> = Vec::new();
+        let mut tris: Vec<[usize; 3]> = Vec::new();
         if let Some(set) = &s.set {
             let g = b.gmsh.as_ref();
+            let tri_ids = g
+                .and_then(|g| g.triangle_sets.get(set))
+                .cloned()
+                .unwrap_or_default();
             let ids = g
                 .and_then(|g| g.element_sets.get(set))
                 .cloned()
+                .or_else(|| (!tri_ids.is_empty()).then(Vec::new))
                 .ok_or_else(|| {
-                    let known: Vec<String> = g
-                        .map(|g| g.element_sets.keys().cloned().collect())
+                    let mut known: Vec<String> = g
+                        .map(|g| {
+                            g.element_sets
+                                .keys()
+                                .chain(g.triangle_sets.keys())
+                                .cloned()
+                                .collect()
+                        })
                         .unwrap_or_default();
+                    known.sort();
+                    known.dedup();
                     b.err(
                         &format!("{field}.set"),
                         format!(
-                            "no physical surface '{set}' of quadrangles in the mesh; known: {}",
+                            "no physical surface '{set}' of quadrangles or triangles in the mesh; known: {}",
                             if known.is_empty() {
                                 "(none)".to_string()
                             } else {
@@ -399,6 +420,18 @@ pub fn build(spec: &GeneralSpec, src: &Source) -> Result<FeModel> {
                 let gq = b.gmsh.as_ref().map(|g| g.quads[q]).unwrap_or([0; 4]);
                 quads.push(gq.map(|i| b.gnode(i)));
             }
+            for t in tri_ids {
+                if let Some(prev) = tri_section[t] {
+                    let tag = b.gmsh.as_ref().map(|g| g.triangle_tags[t]).unwrap_or(0);
+                    return Err(b.err(
+                        &format!("{field}.set"),
+                        format!("triangle {tag} already has the section of shells[{prev}]; give each triangle one section"),
+                    ));
+                }
+                tri_section[t] = Some(si);
+                let gt = b.gmsh.as_ref().map(|g| g.triangles[t]).unwrap_or([0; 3]);
+                tris.push(gt.map(|i| b.gnode(i)));
+            }
         }
         for (k, q) in s.quads.iter().enumerate() {
             let mut nodes = [0; 4];
@@ -407,10 +440,47 @@ pub fn build(spec: &GeneralSpec, src: &Source) -> Result<FeModel> {
             }
             quads.push(nodes);
         }
-        if quads.is_empty() {
+        let inline_tris = tris.len();
+        for (k, t) in s.triangles.iter().enumerate() {
+            let f = format!("{field}.triangles[{k}]");
+            let nodes = [
+                b.inline_node(t[0], &f)?,
+                b.inline_node(t[1], &f)?,
+                b.inline_node(t[2], &f)?,
+            ];
+            if nodes[0] == nodes[1] || nodes[1] == nodes[2] || nodes[0] == nodes[2] {
+                return Err(b.err(
+                    &f,
+                    format!("{t:?} is degenerate: a node is repeated; a triangle needs three distinct nodes"),
+                ));
+            }
+            crate::structure::tri3::tri_geometry(&nodes.map(|n| b.mesh.nodes[n]))
+                .map_err(|e| b.err(&f, format!("nodes {t:?}: {e}")))?;
+            tris.push(nodes);
+        }
+        {
+            let polys: Vec<&[usize]> = tris[inline_tris..].iter().map(|t| &t[..]).collect();
+            if let Some(fault) = crate::structure::tri3::check_orientation(&polys, &b.mesh.nodes) {
+                let (a, c) = (fault.elements[0], fault.elements[1]);
+                return Err(b.err(
+                    &format!("{field}.triangles[{c}]"),
+                    format!(
+                        "{:?} is inverted against triangles[{a}] {:?} ({}); order the nodes of one surface alike",
+                        s.triangles[c],
+                        s.triangles[a],
+                        if fault.same_direction {
+                            "both run their shared edge in the same direction"
+                        } else {
+                            "it folds back onto it"
+                        }
+                    ),
+                ));
+            }
+        }
+        if quads.is_empty() && tris.is_empty() {
             return Err(b.err(
                 &field,
-                "has no quadrangles: give `set` (a Gmsh physical surface) or `quads`",
+                "has no elements: give `set` (a Gmsh physical surface), `quads` or `triangles`",
             ));
         }
         for q in quads {
@@ -418,12 +488,23 @@ pub fn build(spec: &GeneralSpec, src: &Source) -> Result<FeModel> {
             el.shear_factor = kappa;
             b.mesh.add_shell(el);
         }
+        for t in tris {
+            b.mesh
+                .add_triangle(TriShellElement::new(t, mat, s.thickness));
+        }
     }
     if let Some(q) = quad_section.iter().position(|s| s.is_none()) {
         let tag = b.gmsh.as_ref().map(|g| g.quad_tags[q]).unwrap_or(0);
         return Err(b.err(
             "shells",
             format!("quadrangle {tag} of the mesh is in no `shells` set: give its physical surface a section"),
+        ));
+    }
+    if let Some(t) = tri_section.iter().position(|s| s.is_none()) {
+        let tag = b.gmsh.as_ref().map(|g| g.triangle_tags[t]).unwrap_or(0);
+        return Err(b.err(
+            "shells",
+            format!("triangle {tag} of the mesh is in no `shells` set: give its physical surface a section"),
         ));
     }
 

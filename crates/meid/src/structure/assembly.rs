@@ -24,6 +24,7 @@ use rayon::prelude::*;
 use super::frame::{frame_local_axes, frame_matrices_released, LOCAL_DOF_NAMES};
 use super::mesh::Mesh;
 use super::shell::shell_matrices;
+use super::tri3::tri_matrices;
 use crate::{Error, Result};
 
 /// Map from full DOFs (`6 node + dof`) to reduced DOFs: `u_full[i] = Σ coeff · u_red[j]`.
@@ -511,6 +512,12 @@ impl FeModel {
             let x = s.nodes.map(|nd| mesh.nodes[nd]);
             let (k, m) = shell_matrices(&x, s)
                 .map_err(|e| Error::invalid(format!("shell element {i}"), e.to_string()))?;
+            Ok((node_dofs(&s.nodes), k, m))
+        })?;
+        col.add_elements(&mesh.triangles, |i, s| {
+            let x = s.nodes.map(|nd| mesh.nodes[nd]);
+            let (k, m) = tri_matrices(&x, s)
+                .map_err(|e| Error::invalid(format!("triangle {i}"), e.to_string()))?;
             Ok((node_dofs(&s.nodes), k, m))
         })?;
         for s in &mesh.springs {

@@ -1,13 +1,16 @@
-//! Reader for Gmsh `.msh` version 4.1 ASCII quadrilateral shell meshes.
+//! Reader for Gmsh `.msh` version 4.1 ASCII shell meshes (quadrangles and triangles).
 //!
 //! Format: Gmsh reference manual, section "MSH file format" (version 4.1). Read sections:
 //! `$MeshFormat` (must be `4.1 0 <size>`), `$PhysicalNames`, `$Entities` (which physical groups
 //! each point/curve/surface belongs to), `$Nodes` (entity blocks: tags, then coordinates, plus
 //! parametric coordinates when flagged) and `$Elements` (entity blocks of one element type).
-//! Other sections are skipped. Element types: 3 (4-node quadrangle) becomes a shell; 15 (point),
-//! 1 and 8 (lines) only feed named node sets; any other surface or volume element is an error
-//! (triangles: recombine the mesh in Gmsh, `Mesh.RecombineAll = 1`). Physical groups become named
-//! node sets (all nodes of the group's elements) and, for surfaces, named element sets.
+//! Other sections are skipped. Element types: 3 (4-node quadrangle) becomes a MITC4 shell, 2
+//! (3-node triangle) a CST + DKT shell ([`super::tri3`]); 1 (2-node line) a frame in a general
+//! model; 15 (point) and 8 (3-node line) only feed named node sets; any other surface or volume
+//! element is an error. Physical groups become named node sets (all nodes of the group's
+//! elements) and, for surfaces, named element sets (quadrangles and triangles separately).
+//! Degenerate elements are refused, and so are triangles of one surface entity whose node order
+//! runs against a neighbour's or that fold back onto it ([`super::tri3::check_orientation`]).
 //! Errors carry `file:line:column`.
 //!
 //! Hand-written because the Rust `mshio` crate is not in the workspace and the subset needed is
@@ -19,9 +22,10 @@ use std::path::Path;
 use super::material::Material;
 use super::mesh::Mesh;
 use super::shell::ShellElement;
+use super::tri3::TriShellElement;
 use crate::{Error, Result};
 
-/// A quadrilateral mesh read from a `.msh` file. Indices are 0-based positions in the vectors.
+/// A shell/frame mesh read from a `.msh` file. Indices are 0-based positions in the vectors.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct GmshMesh {
     /// Node coordinates (file units, meant to be m).
@@ -38,6 +42,14 @@ pub struct GmshMesh {
     pub node_sets: BTreeMap<String, Vec<usize>>,
     /// Physical surface name → quad indices.
     pub element_sets: BTreeMap<String, Vec<usize>>,
+    /// 3-node triangles (type 2) as node indices.
+    pub triangles: Vec<[usize; 3]>,
+    /// Gmsh tag of each triangle.
+    pub triangle_tags: Vec<usize>,
+    /// Line of the file each triangle is on (1-based).
+    pub triangle_lines: Vec<usize>,
+    /// Physical surface name → triangle indices.
+    pub triangle_sets: BTreeMap<String, Vec<usize>>,
     /// 2-node lines (type 1) as node indices: frame elements in a general model.
     pub lines: Vec<[usize; 2]>,
     /// Gmsh tag of each line.
@@ -470,6 +482,7 @@ pub fn parse_msh(text: &str, file: &str) -> Result<GmshMesh> {
     let mut sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     let mut all_tags: Vec<usize> = Vec::with_capacity(total_el.min(1 << 24));
     let mut seen_tags: HashMap<usize, usize> = HashMap::new();
+    let mut tri_entity: Vec<(i64, i64)> = Vec::new();
     for _ in 0..nblocks {
         let dim = c.int("entity dimension")?;
         let etag = c.int("entity tag")?;
@@ -489,13 +502,13 @@ pub fn parse_msh(text: &str, file: &str) -> Result<GmshMesh> {
                 tt.line,
                 tt.col,
                 format!(
-                    "unsupported Gmsh element type {ty}; meid reads 4-node quadrangles (type 3)"
+                    "unsupported Gmsh element type {ty}; meid reads 4-node quadrangles (type 3), 3-node triangles (type 2) and 2-node lines (type 1)"
                 ),
             )
         })?;
-        if edim >= 2 && ty != 3 {
+        if edim >= 2 && ty != 3 && ty != 2 {
             let hint = if edim == 2 {
-                "mesh the surfaces with 4-node quadrangles only (Mesh.RecombineAll = 1, Mesh.ElementOrder = 1)"
+                "mesh the surfaces with first-order elements (Mesh.ElementOrder = 1): 4-node quadrangles or 3-node triangles"
             } else {
                 "meid reads shell (surface) meshes, not volume meshes"
             };
@@ -578,6 +591,20 @@ pub fn parse_msh(text: &str, file: &str) -> Result<GmshMesh> {
                 mesh.lines.push([conn[0], conn[1]]);
                 mesh.line_tags.push(tag);
             }
+            if ty == 2 {
+                for g in &groups {
+                    if dim == 2 {
+                        mesh.triangle_sets
+                            .entry(g.clone())
+                            .or_default()
+                            .push(mesh.triangles.len());
+                    }
+                }
+                mesh.triangles.push([conn[0], conn[1], conn[2]]);
+                mesh.triangle_tags.push(tag);
+                mesh.triangle_lines.push(tag_tok.line);
+                tri_entity.push((dim, etag));
+            }
             if ty == 3 {
                 let q = [conn[0], conn[1], conn[2], conn[3]];
                 for g in &groups {
@@ -645,20 +672,81 @@ pub fn parse_msh(text: &str, file: &str) -> Result<GmshMesh> {
             )
         })?;
     }
+    check_triangles(file, &mesh, &tri_entity)?;
     for (name, mut v) in sets {
         v.sort_unstable();
         v.dedup();
         mesh.node_sets.insert(name, v);
     }
-    if mesh.quads.is_empty() && mesh.lines.is_empty() {
+    if mesh.quads.is_empty() && mesh.triangles.is_empty() && mesh.lines.is_empty() {
         return Err(input_err(
             file,
             el_sec.start_line,
             1,
-            "the mesh has no 4-node quadrangles (element type 3) and no 2-node lines (type 1)",
+            "the mesh has no 4-node quadrangles (element type 3), 3-node triangles (type 2) or 2-node lines (type 1)",
         ));
     }
     Ok(mesh)
+}
+
+/// Triangles: three distinct nodes, a nonzero area, and, within one surface entity, a node
+/// order consistent with the neighbours' and no fold back onto a neighbour.
+fn check_triangles(file: &str, mesh: &GmshMesh, entity: &[(i64, i64)]) -> Result<()> {
+    let describe = |t: usize| {
+        format!(
+            "triangle {} (nodes {:?})",
+            mesh.triangle_tags[t],
+            mesh.triangles[t].map(|i| mesh.node_tags[i])
+        )
+    };
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let line = mesh.triangle_lines[t];
+        if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
+            return Err(input_err(
+                file,
+                line,
+                1,
+                format!(
+                    "{} is degenerate: a node is repeated; a triangle needs three distinct nodes",
+                    describe(t)
+                ),
+            ));
+        }
+        super::tri3::tri_geometry(&tri.map(|i| mesh.nodes[i])).map_err(|e| {
+            let msg = match e {
+                Error::InvalidValue { message, .. } => message,
+                other => other.to_string(),
+            };
+            input_err(file, line, 1, format!("{}: {msg}", describe(t)))
+        })?;
+    }
+    let mut by_entity: BTreeMap<(i64, i64), Vec<usize>> = BTreeMap::new();
+    for (t, e) in entity.iter().enumerate() {
+        by_entity.entry(*e).or_default().push(t);
+    }
+    for ((_, etag), ids) in by_entity {
+        let polys: Vec<&[usize]> = ids.iter().map(|&t| &mesh.triangles[t][..]).collect();
+        if let Some(f) = super::tri3::check_orientation(&polys, &mesh.nodes) {
+            let (a, b) = (ids[f.elements[0]], ids[f.elements[1]]);
+            let edge = f.edge.map(|i| mesh.node_tags[i]);
+            let why = if f.same_direction {
+                "runs their shared edge in the same direction: it is inverted (order its nodes like its neighbours')"
+            } else {
+                "is folded back onto it (normals more than 154 degrees apart): it is inverted"
+            };
+            return Err(input_err(
+                file,
+                mesh.triangle_lines[b],
+                1,
+                format!(
+                    "{} of surface {etag} {why}; neighbour {} across nodes {edge:?}",
+                    describe(b),
+                    describe(a)
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The header's minimum and maximum tags must be those of the data.
@@ -685,8 +773,8 @@ fn check_tag_range(
 }
 
 impl GmshMesh {
-    /// Adds the quads to `mesh` as shell elements of one material and thickness. Only nodes used
-    /// by a quad are added; node sets become named points and element sets become element sets
+    /// Adds the quads and triangles to `mesh` as shell elements of one material and thickness.
+    /// Only nodes used by a shell are added; node sets become named points and element sets become element sets
     /// (with the new indices). Returns, for each node of this mesh, its index in `mesh` (if added).
     pub fn add_to_mesh(
         &self,
@@ -711,6 +799,11 @@ impl GmshMesh {
             }
             mesh.add_shell(ShellElement::new(nodes, material, thickness_m));
         }
+        let first_tri = mesh.triangles.len();
+        for t in &self.triangles {
+            let nodes = t.map(|i| *map[i].get_or_insert_with(|| mesh.add_node(self.nodes[i])));
+            mesh.add_triangle(TriShellElement::new(nodes, material, thickness_m));
+        }
         for (name, set) in &self.node_sets {
             let mut v = Vec::with_capacity(set.len());
             for &i in set {
@@ -720,7 +813,7 @@ impl GmshMesh {
                         return Err(Error::invalid(
                             format!("physical group {name}"),
                             format!(
-                                "contains node tag {} at {:?}, which belongs to no quadrangle; put the group's points on the meshed surface",
+                                "contains node tag {} at {:?}, which belongs to no quadrangle or triangle; put the group's points on the meshed surface",
                                 self.node_tags[i], self.nodes[i]
                             ),
                         ))
@@ -732,6 +825,10 @@ impl GmshMesh {
         for (name, set) in &self.element_sets {
             mesh.element_sets
                 .insert(name.clone(), set.iter().map(|&e| first_shell + e).collect());
+        }
+        for (name, set) in &self.triangle_sets {
+            mesh.triangle_sets
+                .insert(name.clone(), set.iter().map(|&e| first_tri + e).collect());
         }
         Ok(map)
     }

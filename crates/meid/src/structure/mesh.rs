@@ -6,6 +6,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use super::discrete::{check_coefficients, Dashpot, PointMass, RigidLink, Spring};
 use super::frame::{check_releases, frame_local_axes, FrameElement};
 use super::shell::{shell_geometry, ShellElement};
+use super::tri3::{tri_geometry, TriShellElement};
 use crate::{Error, Result};
 
 /// Degrees of freedom of a node, in global axes; the global DOF index is `6 * node + dof as usize`.
@@ -35,6 +36,8 @@ pub struct Mesh {
     pub nodes: Vec<[f64; 3]>,
     pub frames: Vec<FrameElement>,
     pub shells: Vec<ShellElement>,
+    /// Three-node shells (CST + DKT, [`super::tri3`]).
+    pub triangles: Vec<TriShellElement>,
     pub springs: Vec<Spring>,
     pub dashpots: Vec<Dashpot>,
     pub masses: Vec<PointMass>,
@@ -45,6 +48,8 @@ pub struct Mesh {
     pub points: BTreeMap<String, Vec<usize>>,
     /// Named sets of shell elements (e.g. Gmsh physical surfaces).
     pub element_sets: BTreeMap<String, Vec<usize>>,
+    /// Named sets of triangles (indices into `triangles`), e.g. Gmsh physical surfaces.
+    pub triangle_sets: BTreeMap<String, Vec<usize>>,
 }
 
 impl Mesh {
@@ -66,6 +71,11 @@ impl Mesh {
     pub fn add_shell(&mut self, el: ShellElement) -> usize {
         self.shells.push(el);
         self.shells.len() - 1
+    }
+    /// Adds a three-node shell element and returns its index in `triangles`.
+    pub fn add_triangle(&mut self, el: TriShellElement) -> usize {
+        self.triangles.push(el);
+        self.triangles.len() - 1
     }
     /// Adds a spring and returns its index.
     pub fn add_spring(&mut self, s: Spring) -> usize {
@@ -190,6 +200,14 @@ impl Mesh {
                 m += s.material.density_kg_per_m3 * s.thickness_m * g.area_m2;
             }
         }
+        for s in &self.triangles {
+            if s.nodes.iter().any(|&n| n >= self.nodes.len()) {
+                continue;
+            }
+            if let Ok(g) = tri_geometry(&s.nodes.map(|n| self.nodes[n])) {
+                m += s.material.density_kg_per_m3 * s.thickness_m * g.area_m2;
+            }
+        }
         m + self.masses.iter().map(|p| p.mass_kg).sum::<f64>()
     }
 
@@ -282,6 +300,40 @@ impl Mesh {
             shell_geometry(&s.nodes.map(|n| self.nodes[n]))
                 .map_err(|e| Error::invalid(what.clone(), e.to_string()))?;
         }
+        for (i, s) in self.triangles.iter().enumerate() {
+            let what = format!(
+                "triangle {i} (nodes {}, {}, {})",
+                s.nodes[0], s.nodes[1], s.nodes[2]
+            );
+            for &n in &s.nodes {
+                self.check_node(&what, n)?;
+                used[n] = true;
+            }
+            s.material.validate(&what)?;
+            if !(s.thickness_m.is_finite() && s.thickness_m > 0.0) {
+                return Err(Error::invalid(
+                    format!("{what}: thickness"),
+                    format!("must be > 0 m (got {})", s.thickness_m),
+                ));
+            }
+            if !(s.drilling_factor.is_finite() && s.drilling_factor > 0.0) {
+                return Err(Error::invalid(
+                    format!("{what}: drilling factor"),
+                    format!(
+                        "must be > 0 (1e-3 is the default; got {})",
+                        s.drilling_factor
+                    ),
+                ));
+            }
+            if s.nodes[0] == s.nodes[1] || s.nodes[1] == s.nodes[2] || s.nodes[0] == s.nodes[2] {
+                return Err(Error::invalid(
+                    what,
+                    "is degenerate: a node is repeated; a triangle needs three distinct nodes",
+                ));
+            }
+            tri_geometry(&s.nodes.map(|n| self.nodes[n]))
+                .map_err(|e| Error::invalid(what.clone(), e.to_string()))?;
+        }
         for (i, s) in self.springs.iter().enumerate() {
             let what = format!("spring {i} (node {})", s.node);
             self.check_node(&what, s.node)?;
@@ -371,6 +423,17 @@ impl Mesh {
                         ),
                     ));
                 }
+            }
+        }
+        for (name, set) in &self.triangle_sets {
+            if let Some(&e) = set.iter().find(|&&e| e >= self.triangles.len()) {
+                return Err(Error::invalid(
+                    format!("triangle set {name}"),
+                    format!(
+                        "refers to triangle {e}, but the mesh has {}",
+                        self.triangles.len()
+                    ),
+                ));
             }
         }
         if let Some(n) = used.iter().position(|u| !u) {
