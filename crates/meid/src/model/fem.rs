@@ -865,6 +865,16 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
         .map_err(|e| src.error(base, format!("{base}: {e}")))
 }
 
+/// The general model (`[structure.fem.model]`) a `[structure.fem.machine]` table generates
+/// ([`MachineSpec::generate`]); errors name the machine's fields.
+pub fn machine_general(m: &MachineFileSpec, src: &Source) -> Result<super::general::GeneralSpec> {
+    let field = "structure.fem.machine";
+    machine_spec(m)
+        .and_then(|ms| ms.generate())
+        .map(|g| g.spec)
+        .map_err(|e| locate(e, field, src, Some(m)))
+}
+
 /// Builds the finite-element model the spec describes (no modes yet).
 pub fn build_model(spec: &FemSpec, src: &Source) -> Result<FeModel> {
     match (&spec.machine, &spec.mesh, &spec.model) {

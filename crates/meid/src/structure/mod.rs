@@ -36,7 +36,7 @@ pub mod shell;
 pub use assembly::{DofMap, FeModel, StiffSpring, DOF_NAMES};
 pub use discrete::{Dashpot, PointMass, RigidLink, Spring};
 pub use frame::{FrameElement, Section};
-pub use machine::{Machine, MachineSpec, Support};
+pub use machine::{GeneratedMachine, Machine, MachineSpec, Support};
 pub use material::Material;
 pub use mesh::{Dof, Mesh};
 pub use modes::ModeTable;
