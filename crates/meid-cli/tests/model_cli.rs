@@ -24,8 +24,8 @@ fn expanded_file_gives_the_machines_modes_and_summary() {
         assert!(printed.is_empty(), "{printed}");
         let written = std::fs::read_to_string(&out).unwrap();
         assert!(
-            written.contains("[structure.fem.model]")
-                && !written.contains("[structure.fem.machine]")
+            written.contains("\n[structure.fem.model]\n")
+                && !written.contains("\n[structure.fem.machine]")
         );
         // Without -o: the same text on stdout.
         let stdout = ok(meid()
