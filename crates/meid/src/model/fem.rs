@@ -1,5 +1,6 @@
-//! Finite-element structures in model files (`[structure.fem]`): the parametric machine of the
-//! paper's Fig. 1 ([`crate::structure::machine`]) or a Gmsh quad mesh, solved for its modes and
+//! Finite-element structures in model files (`[structure.fem]`): the general model
+//! ([`super::general`]), the parametric machine of the paper's Fig. 1 (a generator of the
+//! general model, [`crate::structure::machine`]) or a Gmsh quad mesh, solved for its modes and
 //! reduced to the selected ones (paper Eq. 9).
 //!
 //! ```toml

@@ -21,9 +21,12 @@
 //! impact_direction = [0, 0, -1]
 //! ```
 //!
-//! A node reference (`node`, `to`, `master`, `slaves`) is an inline node index (integer) or the
-//! name of a node set (string): a Gmsh physical group or an entry of `sets`. Springs, dashpots
-//! and masses given on a set act at each of its nodes. Units: m, kg, N/m, N·m/rad, N·s/m, Pa,
+//! A node reference (`node`, `to`, `master`, `slaves`) is an inline node index (integer), the
+//! name of a node set (string: a Gmsh physical group or an entry of `sets`) or a list of inline
+//! node indices. Springs, dashpots and masses given on a set or list act at each of its nodes.
+//! `frames[].nodes` is a chain `[a, b, c, ...]`: one straight member per consecutive pair. The
+//! paper's machine (`[structure.fem.machine]`) generates this model
+//! ([`crate::structure::MachineSpec::generate`]) and is built by [`build_mesh`] too. Units: m, kg, N/m, N·m/rad, N·s/m, Pa,
 //! kg/m³, m², m⁴, kg·m². Rigid links are eliminated exactly (master-slave transformation,
 //! [`crate::structure::discrete`]); constraints remove DOFs and their reactions are part of the
 //! floor force.

@@ -10,7 +10,7 @@
 //! | [`mesh`] | nodes, elements, supports, named points, validation |
 //! | [`assembly`] | DOF numbering with rigid-link elimination, sparse/dense K, M, C, floor force |
 //! | [`modes`] | modal model (paper Eq. 9) and mode tables from the dense modes |
-//! | [`machine`] | the parametric forging machine (paper Fig. 1) |
+//! | [`machine`] | the parametric forging machine (paper Fig. 1), a generator of the general model |
 //! | [`gmsh`] | Gmsh `.msh` 4.1 ASCII quad meshes |
 //!
 //! All elements are hand-written: no Rust crate offers shell or frame elements; the linear algebra
