@@ -507,8 +507,8 @@ fn generator_gives_the_old_matrices() {
         assert_eq!(entries(&old.damping), entries(&new.damping), "{what}: C");
         let (g_old, c_old) = old.floor_force_functional().unwrap();
         let (g_new, c_new) = new.floor_force_functional().unwrap();
-        assert_eq!(bits(&g_old), bits(&g_new), "{what}: floor force (K part)");
-        assert_eq!(bits(&c_old), bits(&c_new), "{what}: floor force (C part)");
+        assert_eq!(bits(g_old), bits(g_new), "{what}: floor force (K part)");
+        assert_eq!(bits(c_old), bits(c_new), "{what}: floor force (C part)");
         for (name, nodes) in &old.mesh.points {
             assert_eq!(
                 Some(nodes),
