@@ -33,6 +33,7 @@ mod blows;
 mod calibrate;
 mod compare;
 mod measure;
+mod model;
 mod modes;
 mod montecarlo;
 mod optimize;
@@ -72,6 +73,9 @@ pub(crate) enum Command {
     Simulate(simulate::SimulateArgs),
     /// Modal analysis of the model's structure: frequencies, effective masses, mode shapes.
     Modes(modes::ModesArgs),
+    /// Model-file tools: `expand` writes [structure.fem.machine] as the general model it
+    /// generates.
+    Model(model::ModelArgs),
     /// Vary model quantities over lists or ranges and record every summary metric.
     Sweep(sweep::SweepArgs),
     /// No damper vs impact damper vs added mass: time histories, spectra, dB reductions.
@@ -127,6 +131,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Simulate(a) => simulate::run(a),
         Command::Modes(a) => modes::run(a),
+        Command::Model(a) => model::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Optimize(a) => optimize::run(a),

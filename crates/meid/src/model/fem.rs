@@ -1,5 +1,6 @@
-//! Finite-element structures in model files (`[structure.fem]`): the parametric machine of the
-//! paper's Fig. 1 ([`crate::structure::machine`]) or a Gmsh quad mesh, solved for its modes and
+//! Finite-element structures in model files (`[structure.fem]`): the general model
+//! ([`super::general`]), the parametric machine of the paper's Fig. 1 (a generator of the
+//! general model, [`crate::structure::machine`]) or a Gmsh quad mesh, solved for its modes and
 //! reduced to the selected ones (paper Eq. 9).
 //!
 //! ```toml
@@ -863,6 +864,16 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
     }
     FeModel::assemble_with_direction(mesh, [d[0] / norm, d[1] / norm, d[2] / norm])
         .map_err(|e| src.error(base, format!("{base}: {e}")))
+}
+
+/// The general model (`[structure.fem.model]`) a `[structure.fem.machine]` table generates
+/// ([`MachineSpec::generate`]); errors name the machine's fields.
+pub fn machine_general(m: &MachineFileSpec, src: &Source) -> Result<super::general::GeneralSpec> {
+    let field = "structure.fem.machine";
+    machine_spec(m)
+        .and_then(|ms| ms.generate())
+        .map(|g| g.spec)
+        .map_err(|e| locate(e, field, src, Some(m)))
 }
 
 /// Builds the finite-element model the spec describes (no modes yet).

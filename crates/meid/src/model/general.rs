@@ -23,9 +23,12 @@
 //! impact_direction = [0, 0, -1]
 //! ```
 //!
-//! A node reference (`node`, `to`, `master`, `slaves`) is an inline node index (integer) or the
-//! name of a node set (string): a Gmsh physical group or an entry of `sets`. Springs, dashpots
-//! and masses given on a set act at each of its nodes. Units: m, kg, N/m, N·m/rad, N·s/m, Pa,
+//! A node reference (`node`, `to`, `master`, `slaves`) is an inline node index (integer), the
+//! name of a node set (string: a Gmsh physical group or an entry of `sets`) or a list of inline
+//! node indices. Springs, dashpots and masses given on a set or list act at each of its nodes.
+//! `frames[].nodes` is a chain `[a, b, c, ...]`: one straight member per consecutive pair. The
+//! paper's machine (`[structure.fem.machine]`) generates this model
+//! ([`crate::structure::MachineSpec::generate`]) and is built by [`build_mesh`] too. Units: m, kg, N/m, N·m/rad, N·s/m, Pa,
 //! kg/m³, m², m⁴, kg·m². Rigid links are eliminated exactly (master-slave transformation,
 //! [`crate::structure::discrete`]); constraints remove DOFs and their reactions are part of the
 //! floor force.
@@ -43,41 +46,43 @@ use crate::structure::{
 };
 use crate::Result;
 
-/// A node by inline index or a node set by name.
+/// A node by inline index, a node set by name, or a list of inline node indices.
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum NodeRef {
     Index(usize),
     Set(String),
+    /// Inline node indices, in order (e.g. the slaves of a rigid link).
+    List(Vec<usize>),
 }
 
 /// `[structure.fem.model]` (module docs).
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq, Default)]
 #[serde(deny_unknown_fields)]
 pub struct GeneralSpec {
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mesh: Option<String>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub nodes: Vec<[f64; 3]>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub sets: BTreeMap<String, Vec<usize>>,
     #[serde(default)]
     pub material: Option<MaterialSpec>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub shells: Vec<ShellSpec>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub frames: Vec<FrameSpec>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub springs: Vec<SpringSpec>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub dashpots: Vec<DashpotSpec>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub masses: Vec<MassSpec>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub rigid_links: Vec<RigidLinkSpec>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub constraints: Vec<ConstraintSpec>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub points: BTreeMap<String, String>,
     #[serde(default)]
     pub impact_direction: Option<[f64; 3]>,
@@ -95,7 +100,7 @@ pub struct ShellSpec {
     #[serde(default)]
     pub quads: Vec<[usize; 4]>,
     /// Inline triangles (node indices; the triangles of one entry must be ordered alike).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub triangles: Vec<[usize; 3]>,
     /// m.
     pub thickness: f64,
@@ -107,14 +112,15 @@ pub struct ShellSpec {
 }
 
 /// 3-D Euler-Bernoulli frames of one section: the 2-node lines of a Gmsh physical curve, or a
-/// straight member between two inline nodes cut into `divisions` elements.
+/// chain of inline nodes `[a, b, c, ...]` (one member per consecutive pair, each straight and
+/// cut into `divisions` elements).
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct FrameSpec {
     #[serde(default)]
     pub set: Option<String>,
     #[serde(default)]
-    pub nodes: Option<[usize; 2]>,
+    pub nodes: Option<Vec<usize>>,
     #[serde(default)]
     pub divisions: Option<usize>,
     /// m².
@@ -134,7 +140,7 @@ pub struct FrameSpec {
     /// End releases (hinges): at the element ends of this member that lie on `node`, the
     /// element transmits no force or moment on the listed local DOFs (condensed out statically,
     /// [`crate::structure::frame`]).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub releases: Vec<ReleaseSpec>,
 }
 
@@ -228,6 +234,12 @@ impl Builder<'_> {
     fn nodes_of(&mut self, r: &NodeRef, field: &str) -> Result<Vec<usize>> {
         match r {
             NodeRef::Index(i) => Ok(vec![self.inline_node(*i, field)?]),
+            NodeRef::List(v) => {
+                if v.is_empty() {
+                    return Err(self.err(field, "is an empty list of nodes"));
+                }
+                v.iter().map(|&i| self.inline_node(i, field)).collect()
+            }
             NodeRef::Set(name) => {
                 if let Some(v) = self.sets.get(name) {
                     return Ok(v.clone());
@@ -316,6 +328,15 @@ fn nonnegative(b: &Builder<'_>, field: &str, v: &[f64], unit: &str) -> Result<()
 
 /// Builds the mesh a `[structure.fem.model]` describes and assembles it.
 pub fn build(spec: &GeneralSpec, src: &Source) -> Result<FeModel> {
+    let (mesh, d) = build_mesh(spec, src)?;
+    FeModel::assemble_with_direction(mesh, d).map_err(|e| src.error(BASE, format!("{BASE}: {e}")))
+}
+
+/// The mesh a `[structure.fem.model]` describes and its unit impact direction, not yet
+/// assembled: the one path from a general model to elements, shared by users' models and the
+/// paper's machine ([`crate::structure::MachineSpec::generate`]). Inline nodes are the first
+/// mesh nodes, in their order; nodes of Gmsh elements and of `divisions` follow.
+pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> {
     let gmsh = match &spec.mesh {
         Some(file) => {
             let dir = Path::new(&src.name)
@@ -534,12 +555,12 @@ pub fn build(spec: &GeneralSpec, src: &Source) -> Result<FeModel> {
             }
         }
         let mut segs: Vec<[usize; 2]> = Vec::new();
-        match (&f.set, f.nodes) {
+        match (&f.set, &f.nodes) {
             (Some(set), None) => {
                 if f.divisions.is_some() {
                     return Err(b.err(
                         &format!("{field}.divisions"),
-                        "applies to `nodes = [a, b]` only; a Gmsh curve is already divided",
+                        "applies to `nodes = [a, b, ...]` only; a Gmsh curve is already divided",
                     ));
                 }
                 let ids = b
@@ -564,9 +585,13 @@ pub fn build(spec: &GeneralSpec, src: &Source) -> Result<FeModel> {
                     segs.push(gl.map(|i| b.gnode(i)));
                 }
             }
-            (None, Some([i, j])) => {
-                let a = b.inline_node(i, &format!("{field}.nodes"))?;
-                let c = b.inline_node(j, &format!("{field}.nodes"))?;
+            (None, Some(chain)) => {
+                if chain.len() < 2 {
+                    return Err(b.err(
+                        &format!("{field}.nodes"),
+                        format!("needs at least two nodes [a, b, ...] (got {})", chain.len()),
+                    ));
+                }
                 let nd = f.divisions.unwrap_or(1);
                 if nd == 0 || nd > 100_000 {
                     return Err(b.err(
@@ -574,24 +599,28 @@ pub fn build(spec: &GeneralSpec, src: &Source) -> Result<FeModel> {
                         format!("must be in 1..=100000 (got {nd})"),
                     ));
                 }
-                let (pa, pc) = (b.mesh.nodes[a], b.mesh.nodes[c]);
-                let mut prev = a;
-                for k in 1..=nd {
-                    let next = if k == nd {
-                        c
-                    } else {
-                        let t = k as f64 / nd as f64;
-                        b.mesh
-                            .add_node([0, 1, 2].map(|d| pa[d] + t * (pc[d] - pa[d])))
-                    };
-                    segs.push([prev, next]);
-                    prev = next;
+                for pair in chain.windows(2) {
+                    let a = b.inline_node(pair[0], &format!("{field}.nodes"))?;
+                    let c = b.inline_node(pair[1], &format!("{field}.nodes"))?;
+                    let (pa, pc) = (b.mesh.nodes[a], b.mesh.nodes[c]);
+                    let mut prev = a;
+                    for k in 1..=nd {
+                        let next = if k == nd {
+                            c
+                        } else {
+                            let t = k as f64 / nd as f64;
+                            b.mesh
+                                .add_node([0, 1, 2].map(|d| pa[d] + t * (pc[d] - pa[d])))
+                        };
+                        segs.push([prev, next]);
+                        prev = next;
+                    }
                 }
             }
             _ => {
                 return Err(b.err(
                     &field,
-                    "give either `set` (a Gmsh physical curve of 2-node lines) or `nodes = [a, b]`",
+                    "give either `set` (a Gmsh physical curve of 2-node lines) or `nodes = [a, b, ...]`",
                 ));
             }
         }
@@ -752,7 +781,5 @@ pub fn build(spec: &GeneralSpec, src: &Source) -> Result<FeModel> {
     if !(norm.is_finite() && norm > 0.0) {
         return Err(b.err("impact_direction", "must be a nonzero finite vector"));
     }
-    let mesh = b.mesh;
-    FeModel::assemble_with_direction(mesh, [d[0] / norm, d[1] / norm, d[2] / norm])
-        .map_err(|e| src.error(BASE, format!("{BASE}: {e}")))
+    Ok((b.mesh, [d[0] / norm, d[1] / norm, d[2] / norm]))
 }

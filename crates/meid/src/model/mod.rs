@@ -24,6 +24,7 @@
 //! the valid range; unknown keys get a did-you-mean.
 
 mod cache;
+pub mod expand;
 pub mod fem;
 pub mod general;
 pub mod imported;

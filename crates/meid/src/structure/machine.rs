@@ -1,5 +1,10 @@
 //! Parametric finite-element model of the forging machine of the paper's Fig. 1.
 //!
+//! The machine is a **generator** of the general model: [`MachineSpec::generate`] emits the
+//! [`GeneralSpec`] (`[structure.fem.model]`) that describes it, and [`MachineSpec::build`]
+//! hands that to the general model's one builder ([`crate::model::general::build_mesh`]), as
+//! for a user's model; `meid model expand` writes it out as a model file to edit.
+//!
 //! Geometry (global z up, the slider moves in -z, so the model's impact direction is `[0, 0, -1]`):
 //! a rectangular **bed** plate centred on the z axis at `z = column length`, four vertical
 //! **columns** (frame elements) from the bed down to `z = 0` at `(±(Lx/2 - inset), ±(Ly/2 - inset))`
@@ -34,10 +39,14 @@
 //! examples `examples/paper-*.toml` are).
 
 use super::assembly::FeModel;
-use super::discrete::{Dashpot, PointMass, RigidLink, Spring};
-use super::frame::{FrameElement, Section};
+use super::frame::Section;
 use super::material::Material;
+#[cfg(doc)]
 use super::mesh::Mesh;
+use crate::model::fem::{ConstraintSpec, MaterialSpec};
+use crate::model::general::{
+    DashpotSpec, FrameSpec, GeneralSpec, MassSpec, NodeRef, RigidLinkSpec, ShellSpec, SpringSpec,
+};
 use crate::{Error, Result};
 
 /// A rectangular plate centred on the z axis.
@@ -172,6 +181,20 @@ impl Default for MachineSpec {
     }
 }
 
+/// The machine as a general model ([`MachineSpec::generate`]) and where its parts are (inline
+/// node indices, which are also the mesh's node indices).
+#[derive(Debug, Clone)]
+pub struct GeneratedMachine {
+    /// What `[structure.fem.model]` would say.
+    pub spec: GeneralSpec,
+    /// Bed nodes `grid[i][j]`.
+    pub bed_grid: Vec<Vec<usize>>,
+    /// Base nodes, floating base only.
+    pub base_grid: Option<Vec<Vec<usize>>>,
+    /// Nodes of each column from the bed down.
+    pub columns: Vec<Vec<usize>>,
+}
+
 /// A generated machine: the assembled model and where its parts are.
 #[derive(Debug, Clone)]
 pub struct Machine {
@@ -296,8 +319,38 @@ impl MachineSpec {
         [[cx, cy], [-cx, cy], [-cx, -cy], [cx, -cy]]
     }
 
-    /// Builds and assembles the machine.
+    /// Builds and assembles the machine: [`MachineSpec::generate`] emits the general model,
+    /// and the general model's one builder ([`crate::model::general::build_mesh`]) makes the
+    /// mesh, as for a user's `[structure.fem.model]`.
     pub fn build(&self) -> Result<Machine> {
+        let g = self.generate()?;
+        let src = crate::model::Source {
+            name: "[structure.fem.machine]".to_string(),
+            text: String::new(),
+            overrides: Vec::new(),
+        };
+        let (mesh, direction) = crate::model::general::build_mesh(&g.spec, &src)?;
+        let model = FeModel::assemble_with_direction(mesh, direction)?;
+        Ok(Machine {
+            model,
+            bed_grid: g.bed_grid,
+            base_grid: g.base_grid,
+            columns: g.columns,
+        })
+    }
+
+    /// The machine as a general model (`[structure.fem.model]`, [`GeneralSpec`]): inline nodes
+    /// (bed grid, base grid, column nodes, clamped feet), one shell set per plate with its
+    /// quadrangles, one frame chain per column, the coil springs and dashpots on the list of
+    /// their base nodes, the added masses, one rigid link per column footprint (master = the
+    /// plate node on the column axis, slaves = the other plate nodes of the footprint), the
+    /// clamped feet (`constraints` on the set `column_feet`, fixed columns only) and the named
+    /// points `O_b`, `B` and `O_f` as one-node sets. Inline node `i` is mesh node `i`.
+    ///
+    /// This is the only thing the machine section adds to the general model: what it emits
+    /// can be written out (`meid model expand`), edited and read back as a model file, and
+    /// gives the same matrices.
+    pub fn generate(&self) -> Result<GeneratedMachine> {
         self.bed.validate("bed")?;
         self.column_section.validate("column section")?;
         self.column_material.validate("column")?;
@@ -345,7 +398,10 @@ impl MachineSpec {
         }
         inside("point B", self.b_offset_m, &self.bed)?;
         let cols = self.column_positions();
-        let mut mesh = Mesh::new();
+        let mut g = GeneralSpec {
+            impact_direction: Some([0.0, 0.0, -1.0]),
+            ..GeneralSpec::default()
+        };
         let zb = self.column_length_m;
 
         // Bed.
@@ -374,13 +430,12 @@ impl MachineSpec {
         let h_bed = self.bed.length_x_m.max(self.bed.length_y_m) / self.elements_per_side as f64;
         let bxs = grid_1d(self.bed.length_x_m, &bx, h_bed);
         let bys = grid_1d(self.bed.length_y_m, &by, h_bed);
-        let bed_grid =
-            mesh.add_plate_grid(&bxs, &bys, zb, self.bed.material, self.bed.thickness_m)?;
+        let bed_grid = plate_grid(&mut g, &bxs, &bys, zb, &self.bed)?;
         let bed_node = |p: [f64; 2]| (index_of(&bxs, p[0]), index_of(&bys, p[1]));
         let (i, j) = bed_node([0.0, 0.0]);
-        mesh.name_point("O_b", vec![bed_grid[i][j]]);
+        g.sets.insert("O_b".into(), vec![bed_grid[i][j]]);
         let (i, j) = bed_node(self.b_offset_m);
-        mesh.name_point("B", vec![bed_grid[i][j]]);
+        g.sets.insert("B".into(), vec![bed_grid[i][j]]);
 
         // Base.
         let mut base_grid = None;
@@ -441,26 +496,30 @@ impl MachineSpec {
             let h = base.length_x_m.max(base.length_y_m) / self.elements_per_side as f64;
             let gx = grid_1d(base.length_x_m, &xs, h);
             let gy = grid_1d(base.length_y_m, &ys, h);
-            let grid = mesh.add_plate_grid(&gx, &gy, 0.0, base.material, base.thickness_m)?;
-            mesh.name_point("O_f", vec![grid[index_of(&gx, 0.0)][index_of(&gy, 0.0)]]);
-            for p in springs {
-                let node = grid[index_of(&gx, p[0])][index_of(&gy, p[1])];
-                let k = spring_stiffness_n_per_m;
-                if k.iter().any(|&v| v > 0.0) {
-                    mesh.add_spring(Spring {
-                        node,
-                        other: None,
-                        stiffness: [k[0], k[1], k[2], 0.0, 0.0, 0.0],
-                    });
-                }
-                let c = spring_damping_n_s_per_m;
-                if c.iter().any(|&v| v > 0.0) {
-                    mesh.add_dashpot(Dashpot {
-                        node,
-                        other: None,
-                        damping: [c[0], c[1], c[2], 0.0, 0.0, 0.0],
-                    });
-                }
+            let grid = plate_grid(&mut g, &gx, &gy, 0.0, base)?;
+            g.sets.insert(
+                "O_f".into(),
+                vec![grid[index_of(&gx, 0.0)][index_of(&gy, 0.0)]],
+            );
+            let at: Vec<usize> = springs
+                .iter()
+                .map(|p| grid[index_of(&gx, p[0])][index_of(&gy, p[1])])
+                .collect();
+            let k = spring_stiffness_n_per_m;
+            if k.iter().any(|&v| v > 0.0) {
+                g.springs.push(SpringSpec {
+                    node: NodeRef::List(at.clone()),
+                    to: None,
+                    stiffness: [k[0], k[1], k[2], 0.0, 0.0, 0.0],
+                });
+            }
+            let c = spring_damping_n_s_per_m;
+            if c.iter().any(|&v| v > 0.0) {
+                g.dashpots.push(DashpotSpec {
+                    node: NodeRef::List(at),
+                    to: None,
+                    damping: [c[0], c[1], c[2], 0.0, 0.0, 0.0],
+                });
             }
             base_grid = Some(grid);
             base_lookup = Some((gx, gy, fx, fy));
@@ -472,21 +531,27 @@ impl MachineSpec {
         for c in &cols {
             let (bi, bj) = bed_node(*c);
             masters.insert(bed_grid[bi][bj]);
-            if let (Some(g), Some((gx, gy, _, _))) = (&base_grid, &base_lookup) {
-                masters.insert(g[index_of(gx, c[0])][index_of(gy, c[1])]);
+            if let (Some(gr), Some((gx, gy, _, _))) = (&base_grid, &base_lookup) {
+                masters.insert(gr[index_of(gx, c[0])][index_of(gy, c[1])]);
             }
         }
         let mut slaved = std::collections::BTreeSet::new();
-        let mut spider = |mesh: &mut Mesh, master: usize, candidates: Vec<usize>| {
+        let mut spider = |g: &mut GeneralSpec, master: usize, candidates: Vec<usize>| {
             let slaves: Vec<usize> = candidates
                 .into_iter()
                 .filter(|n| !masters.contains(n) && slaved.insert(*n))
                 .collect();
             if !slaves.is_empty() {
-                mesh.add_rigid_link(RigidLink { master, slaves });
+                g.rigid_links.push(RigidLinkSpec {
+                    master: NodeRef::Index(master),
+                    slaves: NodeRef::List(slaves),
+                });
             }
         };
+        let column_material = material_spec(self.column_material);
+        let s = self.column_section;
         let mut columns = Vec::new();
+        let mut feet = Vec::new();
         for (k, c) in cols.iter().enumerate() {
             let (bi, bj) = bed_node(*c);
             let top = bed_grid[bi][bj];
@@ -494,38 +559,50 @@ impl MachineSpec {
             let ne = self.column_elements;
             for e in 1..ne {
                 let z = zb * (1.0 - e as f64 / ne as f64);
-                nodes.push(mesh.add_node([c[0], c[1], z]));
+                nodes.push(add_node(&mut g, [c[0], c[1], z]));
             }
             let foot = match (&base_grid, &base_lookup) {
-                (Some(g), Some((gx, gy, fx, fy))) => {
+                (Some(gr), Some((gx, gy, fx, fy))) => {
                     let (fi, fj) = (index_of(gx, c[0]), index_of(gy, c[1]));
                     if self.spiders {
-                        spider(&mut mesh, g[fi][fj], footprint(g, gx, gy, *c, fx[k], fy[k]));
+                        spider(&mut g, gr[fi][fj], footprint(gr, gx, gy, *c, fx[k], fy[k]));
                     }
-                    g[fi][fj]
+                    gr[fi][fj]
                 }
                 _ => {
-                    let f = mesh.add_node([c[0], c[1], 0.0]);
-                    mesh.fix_all(f);
+                    let f = add_node(&mut g, [c[0], c[1], 0.0]);
+                    feet.push(f);
                     f
                 }
             };
             nodes.push(foot);
-            for w in nodes.windows(2) {
-                mesh.add_frame(FrameElement::new(
-                    [w[0], w[1]],
-                    self.column_material,
-                    self.column_section,
-                ));
-            }
+            g.frames.push(FrameSpec {
+                set: None,
+                nodes: Some(nodes.clone()),
+                divisions: None,
+                area: s.area_m2,
+                iy: s.iy_m4,
+                iz: s.iz_m4,
+                j: s.torsion_constant_m4,
+                orientation: None,
+                material: Some(column_material),
+                releases: Vec::new(),
+            });
             if self.spiders {
                 spider(
-                    &mut mesh,
+                    &mut g,
                     top,
                     footprint(&bed_grid, &bxs, &bys, *c, bed_fx[k], bed_fy[k]),
                 );
             }
             columns.push(nodes);
+        }
+        if !feet.is_empty() {
+            g.sets.insert(FEET.into(), feet);
+            g.constraints.push(ConstraintSpec {
+                set: FEET.into(),
+                dofs: vec!["all".into()],
+            });
         }
 
         for m in &self.added_masses {
@@ -535,8 +612,8 @@ impl MachineSpec {
                     bed_grid[i][j]
                 }
                 Plate::Base => match (&base_grid, &base_lookup) {
-                    (Some(g), Some((gx, gy, _, _))) => {
-                        g[index_of(gx, m.offset_m[0])][index_of(gy, m.offset_m[1])]
+                    (Some(gr), Some((gx, gy, _, _))) => {
+                        gr[index_of(gx, m.offset_m[0])][index_of(gy, m.offset_m[1])]
                     }
                     _ => return Err(Error::invalid(
                         "added mass",
@@ -544,19 +621,82 @@ impl MachineSpec {
                     )),
                 },
             };
-            mesh.add_mass(PointMass {
-                node,
-                mass_kg: m.mass_kg,
-                inertia_kg_m2: m.inertia_kg_m2,
+            g.masses.push(MassSpec {
+                node: NodeRef::Index(node),
+                mass: m.mass_kg,
+                inertia: Some(m.inertia_kg_m2),
             });
         }
-
-        let model = FeModel::assemble_with_direction(mesh, [0.0, 0.0, -1.0])?;
-        Ok(Machine {
-            model,
+        Ok(GeneratedMachine {
+            spec: g,
             bed_grid,
             base_grid,
             columns,
         })
     }
+}
+
+/// The name of the node set of the clamped column feet (fixed columns).
+pub const FEET: &str = "column_feet";
+
+fn material_spec(m: Material) -> MaterialSpec {
+    MaterialSpec {
+        youngs_modulus: m.youngs_modulus_pa,
+        poisson_ratio: m.poisson_ratio,
+        density: m.density_kg_per_m3,
+    }
+}
+
+fn add_node(g: &mut GeneralSpec, p: [f64; 3]) -> usize {
+    g.nodes.push(p);
+    g.nodes.len() - 1
+}
+
+/// A structured grid of quadrangles in the plane `z = z_m` with grid lines at `xs_m` and `ys_m`
+/// (each strictly increasing, at least two values), as one shell set of `plate`'s thickness
+/// and material. Returns the inline node indices as `grid[i][j]` for the node at
+/// `(xs_m[i], ys_m[j])`. Nodes are numbered with `j` fastest, quadrangles with `i` fastest,
+/// counter-clockwise about +z (as [`Mesh::add_plate_grid`]).
+fn plate_grid(
+    g: &mut GeneralSpec,
+    xs_m: &[f64],
+    ys_m: &[f64],
+    z_m: f64,
+    plate: &PlateSpec,
+) -> Result<Vec<Vec<usize>>> {
+    for (name, v) in [("x grid", xs_m), ("y grid", ys_m)] {
+        if v.len() < 2
+            || v.windows(2)
+                .any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+        {
+            return Err(Error::invalid(
+                format!("plate {name}"),
+                "needs at least two strictly increasing coordinates",
+            ));
+        }
+    }
+    let grid: Vec<Vec<usize>> = xs_m
+        .iter()
+        .map(|&x| ys_m.iter().map(|&y| add_node(g, [x, y, z_m])).collect())
+        .collect();
+    let mut quads = Vec::with_capacity((xs_m.len() - 1) * (ys_m.len() - 1));
+    for j in 0..ys_m.len() - 1 {
+        for i in 0..xs_m.len() - 1 {
+            quads.push([
+                grid[i][j],
+                grid[i + 1][j],
+                grid[i + 1][j + 1],
+                grid[i][j + 1],
+            ]);
+        }
+    }
+    g.shells.push(ShellSpec {
+        set: None,
+        quads,
+        triangles: Vec::new(),
+        thickness: plate.thickness_m,
+        material: Some(material_spec(plate.material)),
+        shear_factor: None,
+    });
+    Ok(grid)
 }

@@ -11,7 +11,7 @@
 //! | [`mesh`] | nodes, elements, supports, named points, validation |
 //! | [`assembly`] | DOF numbering with rigid-link elimination, sparse/dense K, M, C, floor force |
 //! | [`modes`] | modal model (paper Eq. 9) and mode tables from the dense modes |
-//! | [`machine`] | the parametric forging machine (paper Fig. 1) |
+//! | [`machine`] | the parametric forging machine (paper Fig. 1), a generator of the general model |
 //! | [`gmsh`] | Gmsh `.msh` 4.1 ASCII meshes: quadrangles, triangles, lines |
 //!
 //! All elements are hand-written: no Rust crate offers shell or frame elements; the linear algebra
@@ -38,7 +38,7 @@ pub mod tri3;
 pub use assembly::{DofMap, FeModel, StiffSpring, DOF_NAMES};
 pub use discrete::{Dashpot, PointMass, RigidLink, Spring};
 pub use frame::{FrameElement, Section};
-pub use machine::{Machine, MachineSpec, Support};
+pub use machine::{GeneratedMachine, Machine, MachineSpec, Support};
 pub use material::Material;
 pub use mesh::{Dof, Mesh};
 pub use modes::ModeTable;
