@@ -1112,10 +1112,7 @@ fn elements22(lx: &mut Lex, raw: &mut Raw) -> Result<()> {
         let elementary = tags.get(1).copied().unwrap_or(0);
         let edim = element_kind(ty).map(|k| k.1 as i64).unwrap_or(-1);
         let plist: Vec<i64> = if phys != 0 { vec![phys] } else { Vec::new() };
-        let desc = format!(
-            "element {tag} of {}",
-            raw.entity_desc("elementary entity", edim, elementary, &plist)
-        );
+        let desc = raw.entity_desc("elementary entity", edim, elementary, &plist);
         let (nn, _) = element_type(lx, ty, tyloc, &desc)?;
         let idx = read_element(lx, raw, ty, nn, tag, loc, &desc)?;
         let e = &raw.elems[idx];
