@@ -769,7 +769,7 @@ fn mesh_format(lx: &mut Lex) -> Result<(Version, Option<Bin>)> {
 /// `$PhysicalNames` (ASCII in every format): a count, then `dimension tag "name"` lines.
 fn physical_names(lx: &mut Lex, raw: &mut Raw) -> Result<()> {
     let (n, nloc) = lx.size("the number of physical names")?;
-    lx.check_fits(nloc, n, 8, "physical names")?;
+    lx.check_fits(nloc, n, 7, "physical names")?;
     for _ in 0..n {
         let (dim, _) = lx.int("the dimension of a physical name")?;
         let (tag, _) = lx.int("the tag of a physical name")?;
