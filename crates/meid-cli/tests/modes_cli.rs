@@ -378,7 +378,7 @@ sample_rate = 20000.0
             assert!((x / y - 1.0).abs() < 1e-9, "{x} vs {y}");
         }
     }
-    let (e, nu, rho, h) = (2.1e11, 0.3, 7850.0, 0.01);
+    let (e, nu, rho, h): (f64, f64, f64, f64) = (2.1e11, 0.3, 7850.0, 0.01);
     let dflex = e * h * h * h / (12.0 * (1.0 - nu * nu));
     let exact = std::f64::consts::PI * (dflex / (rho * h)).sqrt();
     assert!(
