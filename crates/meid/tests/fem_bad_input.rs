@@ -196,3 +196,33 @@ sample_rate = 20000.0
         assert!(msg.contains(key) && msg.contains(range), "{extra}: {msg}");
     }
 }
+
+/// A block announcing more elements than the section header's total is refused at the block's
+/// count (before its elements are read), naming the block, its surface and physical group.
+#[test]
+fn block_count_beyond_the_header_total_is_refused() {
+    let bad = good().replace(
+        "$Elements\n2 2 1 2\n2 1 3 1\n",
+        "$Elements\n2 2 1 2\n2 1 3 3\n",
+    );
+    let (loc, msg) = input_error(&bad);
+    assert_eq!(loc, "plate.msh:31:7");
+    assert!(
+        msg.contains("element block 1 of surface 1 (physical group \"plate\") holds 3 elements, but $Elements announces 2 in all and the blocks before hold 0"),
+        "{msg}"
+    );
+}
+
+/// A header announcing far more nodes than the file can hold is refused before allocation.
+#[test]
+fn node_count_beyond_the_file_is_refused() {
+    let bad = good().replace("$Nodes\n1 6 1 6\n", "$Nodes\n1 600000000000 1 6\n");
+    let (loc, msg) = input_error(&bad);
+    assert_eq!(loc, "plate.msh:14:3");
+    assert!(
+        msg.contains(
+            "$Nodes announces 600000000000 nodes, which take at least 4800000000000 bytes"
+        ),
+        "{msg}"
+    );
+}

@@ -13,7 +13,10 @@ use std::path::PathBuf;
 
 use proptest::prelude::*;
 
-use fuzz_support::{check_gmsh, check_model, check_spec, FE_SOFT_BASE, LUMPED, PLATE_MSH};
+use fuzz_support::{
+    check_gmsh, check_gmsh_bytes, check_model, check_spec, FE_SOFT_BASE, LUMPED, PLATE_MSH,
+    PLATE_MSH_22, PLATE_MSH_B41,
+};
 
 /// Values a mutation puts in place of a model value or a Gmsh token: the boundary numbers,
 /// non-numbers, wrong types and wrong shapes.
@@ -93,6 +96,83 @@ fn edit() -> impl Strategy<Value = Edit> {
         1 => (u(), u(), u()).prop_map(|(l, c, s)| Edit::Insert(l, c, s)),
         1 => u().prop_map(Edit::Truncate),
     ]
+}
+
+/// One edit of a binary file. Positions are taken near a section start (`$Name` line) with
+/// probability one half, since the headers' counts and the block headers sit there.
+#[derive(Debug, Clone)]
+enum ByteEdit {
+    /// Section, offset after its `$Name` line, value.
+    SetNear(usize, usize, u8),
+    Set(usize, u8),
+    Delete(usize, usize),
+    Insert(usize, Vec<u8>),
+    Truncate(usize),
+}
+
+fn byte_edit() -> impl Strategy<Value = ByteEdit> {
+    let u = any::<usize>;
+    let value = prop_oneof![
+        Just(0u8),
+        Just(1),
+        Just(0x7f),
+        Just(0x80),
+        Just(0xff),
+        any::<u8>()
+    ];
+    prop_oneof![
+        4 => (u(), 0usize..64, value.clone()).prop_map(|(s, o, v)| ByteEdit::SetNear(s, o, v)),
+        2 => (u(), value).prop_map(|(i, v)| ByteEdit::Set(i, v)),
+        1 => (u(), 1usize..16).prop_map(|(i, n)| ByteEdit::Delete(i, n)),
+        1 => (u(), prop::collection::vec(any::<u8>(), 1..16)).prop_map(|(i, b)| ByteEdit::Insert(i, b)),
+        1 => u().prop_map(ByteEdit::Truncate),
+    ]
+}
+
+fn apply_bytes(data: &[u8], edits: &[ByteEdit]) -> Vec<u8> {
+    let mut b = data.to_vec();
+    for e in edits {
+        let n = b.len().max(1);
+        match e {
+            ByteEdit::SetNear(s, o, v) => {
+                let starts: Vec<usize> = b
+                    .windows(2)
+                    .enumerate()
+                    .filter(|(_, w)| w[0] == b'\n' && w[1] == b'$')
+                    .filter_map(|(i, _)| {
+                        b[i + 1..]
+                            .iter()
+                            .position(|&c| c == b'\n')
+                            .map(|k| i + 2 + k)
+                    })
+                    .collect();
+                if !starts.is_empty() {
+                    let at = starts[s % starts.len()] + o;
+                    if at < b.len() {
+                        b[at] = *v;
+                    }
+                }
+            }
+            ByteEdit::Set(i, v) => {
+                if !b.is_empty() {
+                    b[i % n] = *v;
+                }
+            }
+            ByteEdit::Delete(i, k) => {
+                let at = i % n;
+                let end = (at + k).min(b.len());
+                if at < end {
+                    b.drain(at..end);
+                }
+            }
+            ByteEdit::Insert(i, bytes) => {
+                let at = i % (b.len() + 1);
+                b.splice(at..at, bytes.iter().copied());
+            }
+            ByteEdit::Truncate(i) => b.truncate(i % n),
+        }
+    }
+    b
 }
 
 fn apply(text: &str, edits: &[Edit]) -> String {
@@ -264,6 +344,16 @@ proptest! {
     #[test]
     fn gmsh_reader_mutations(edits in prop::collection::vec(edit(), 1..6)) {
         check_gmsh(&apply(PLATE_MSH, &edits));
+    }
+
+    #[test]
+    fn gmsh_binary_mutations(edits in prop::collection::vec(byte_edit(), 1..6)) {
+        check_gmsh_bytes(&apply_bytes(PLATE_MSH_B41, &edits));
+    }
+
+    #[test]
+    fn gmsh_msh22_mutations(edits in prop::collection::vec(edit(), 1..6)) {
+        check_gmsh(&apply(PLATE_MSH_22, &edits));
     }
 }
 

@@ -20,7 +20,7 @@ use meid::analysis::montecarlo::{Distribution, SplitMix64, Uncertain};
 use meid::analysis::study::{parse_bounds, Objective, OptimizeStudy};
 use meid::analysis::sweep::{Quantity, Spacing, Sweep, Vary};
 use meid::model::{Case, Model};
-use meid::structure::gmsh::parse_msh;
+use meid::structure::gmsh::parse_msh_bytes;
 use meid::structure::{Material, Mesh};
 
 /// The lumped paper example: the model the specifications are checked against.
@@ -29,6 +29,10 @@ pub const LUMPED: &str = include_str!("../../../../examples/paper-lumped.toml");
 pub const FE_SOFT_BASE: &str = include_str!("../../../../examples/paper-soft-base.toml");
 /// A Gmsh 4.1 mesh (8 × 6 quads, physical groups).
 pub const PLATE_MSH: &str = include_str!("../../../meid-cli/tests/data/clamped_plate.msh");
+/// The 16 × 16 plate Gmsh 4.15.2 wrote as MSH 4.1 binary (tests/data/gmsh/plate.py).
+pub const PLATE_MSH_B41: &[u8] = include_bytes!("../data/gmsh/gmsh_plate_b41.msh");
+/// The same plate as MSH 2.2 ASCII (each quadrangle twice: two physical groups).
+pub const PLATE_MSH_22: &str = include_str!("../data/gmsh/gmsh_plate_a22.msh");
 
 /// Largest `elements_per_side` and mode `count`/`auto_count` built by the fuzzers.
 pub const MAX_ELEMENTS_PER_SIDE: i64 = 24;
@@ -118,12 +122,23 @@ pub fn check_model(name: &str, text: &str, overrides: &[String]) {
 /// A Gmsh mesh: parses or fails with a located message; a parsed mesh's indices are in range
 /// and it becomes shell elements without a panic.
 pub fn check_gmsh(text: &str) {
-    match parse_msh(text, "fuzz.msh") {
+    check_gmsh_bytes(text.as_bytes());
+}
+
+/// As [`check_gmsh`], for any bytes (MSH 4.1 binary files included).
+pub fn check_gmsh_bytes(data: &[u8]) {
+    match parse_msh_bytes(data, "fuzz.msh") {
         Err(e) => check_error("gmsh", &e),
         Ok(g) => {
             let n = g.nodes.len();
             assert_eq!(g.node_tags.len(), n);
             assert_eq!(g.quad_tags.len(), g.quads.len());
+            assert_eq!(g.line_tags.len(), g.lines.len());
+            assert!(g.lines.iter().flatten().all(|&i| i < n), "line node index");
+            assert!(
+                g.line_sets.values().flatten().all(|&e| e < g.lines.len()),
+                "line set index"
+            );
             assert!(g.quads.iter().flatten().all(|&i| i < n), "quad node index");
             assert!(
                 g.nodes.iter().flatten().all(|x| x.is_finite()),
