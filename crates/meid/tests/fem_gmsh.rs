@@ -172,10 +172,11 @@ fn errors_carry_file_line_and_column() {
         "{msg}"
     );
 
-    let tri = good.replace("2 1 3 4\n", "2 1 2 4\n");
-    let (_, msg) = input_error(&tri);
+    // A second-order surface element (type 9, 6-node triangle) is refused with the fix.
+    let tri6 = good.replace("2 1 3 4\n", "2 1 9 4\n");
+    let (_, msg) = input_error(&tri6);
     assert!(
-        msg.contains("3-node triangle") && msg.contains("RecombineAll"),
+        msg.contains("6-node triangle") && msg.contains("Mesh.ElementOrder = 1"),
         "{msg}"
     );
 

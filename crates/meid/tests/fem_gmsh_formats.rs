@@ -517,7 +517,7 @@ fn unsupported_element_types_name_their_group() {
     assert_eq!(loc, format!("a41.msh:{line}:5"));
     assert!(
         msg.contains("element type 10 (9-node quadrangle) in element block 6 of surface 1 (physical group \"plate\") is not supported")
-            && msg.contains("meid reads types 1 (2-node line), 3 (4-node quadrangle)"),
+            && msg.contains("meid reads types 1 (2-node line), 2 (3-node triangle), 3 (4-node quadrangle)"),
         "{msg}"
     );
     // 2.2: a 4-node tetrahedron in physical volume 3.
