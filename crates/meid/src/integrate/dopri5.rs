@@ -43,6 +43,11 @@
 //! [`MAX_STEPS`] for four windows of 2²⁰ steps in a row stops then, with the projection
 //! ([`Pace`]).
 //!
+//! **Persistent (held) contacts**: a closed contact that rests, with a step limited by its
+//! stability rather than by its motion, is held: its gap frozen, its force the constraint's
+//! multiplier, the stiff frequency out of the step size; released when the multiplier would
+//! pull ([`Holder`]).
+//!
 //! **Resting one-way dashpot**: the dashpot's velocity has a zero band of `rtol/10` of the
 //! largest size it reached in the run ([`Selector::band`]), so a machine at rest, whose
 //! velocities the integration carries only to that accuracy, does not switch the dashpot at
@@ -1205,16 +1210,20 @@ const HOLD_STEPS: u32 = 16;
 /// explicit method's stability still resolves, drops out of the step size.
 ///
 /// **Entry.** A closed, not yet held contact `c` qualifies at the end of an accepted step of
-/// size `h` when (1) its relative velocity is within its zero band, `|δ̇_c| ≤ (rtol/10)·V_c`
-/// (`V_c` the largest `Σ|a_i ẋ_i|` of the run so far, as the dashpot's band), (2) the step is
+/// size `h` when (1) its own oscillation about its quasi-static state is within its zero
+/// band: `w = √((δ̇_c − λ̇_c/k_c)² + ((f_c − λ_c) ω_c/k_c)²) ≤ (rtol/10)·V_c`, with `λ_c`,
+/// `λ̇_c` the force the contact would carry if held and its rate, `k_c = ∂f_c/∂δ`, and `V_c`
+/// the largest `Σ|a_i ẋ_i|` of the run so far (as the dashpot's band): the bodies move
+/// together, up to the contact's quasi-static compression rate `λ̇_c/k_c`, (2) the step is
 /// stability-limited by the contact, `h·ω_c ≥ 1` with `ω_c² = (∂f_c/∂δ)·a_cᵀM⁻¹a_c` (a step
 /// that resolved the contact's motion to the tolerance would be far shorter, `h·ω_c ≈ 0.1`),
 /// and (3) the contact is loaded quasi-statically: its law's force `f_c(δ, δ̇) > 0` and the
 /// multiplier it would carry if held matches it, `|λ_c − f_c| ≤ f_c/2`. After [`HOLD_STEPS`]
 /// consecutive qualifying steps (each at least `1/ω_c` long, several contact periods in
 /// all) the contact is held. The velocities are projected (mass-weighted) so that no held gap
-/// moves, `ẋ ← ẋ − M⁻¹A G⁻¹Aᵀẋ`: a plastic impulse of `|δ̇_c| ≤` the zero band; the kinetic
-/// energy it takes, `½ δ̇ᵀG⁻¹δ̇`, is counted as dissipated.
+/// moves, `ẋ ← ẋ − M⁻¹A G⁻¹Aᵀẋ`: a plastic impulse that stops the relative velocity
+/// `δ̇_c ≈ λ̇_c/k_c` (the quasi-static compression rate, which the rigid constraint drops);
+/// the kinetic energy it takes, `½ δ̇ᵀG⁻¹δ̇`, is counted as dissipated.
 ///
 /// **Release** is an event located on the dense output like the other switches: `λ_c`
 /// crossing `−(rtol/10)·λ_c,entry` (the force would pull). The contact then continues as a
@@ -1289,10 +1298,15 @@ impl Holder {
             let band = (self.rel * self.rate_scale[ci]).max(1e-12 * speed);
             let f = law.force(d, r);
             let omega = (law.partials(d, r).0 * self.g[ci]).max(0.0).sqrt();
-            let mut ok = d > 0.0 && f > 0.0 && r.abs() <= band && h * omega >= 1.0;
+            let kc = law.partials(d, r).0;
+            let mut ok = d > 0.0 && f > 0.0 && kc > 0.0 && h * omega >= 1.0;
             if ok {
-                let lam = rhs.held_forces(mode.holding(s, true), y, yd).0[ci];
-                ok = lam > 0.0 && (lam - f).abs() <= 0.5 * f;
+                let (lam, rate) = rhs.held_forces(mode.holding(s, true), y, yd);
+                let (lam, rate) = (lam[ci], rate[ci]);
+                // The contact's own oscillation about its quasi-static state (`δ̇ = λ̇/k_c`,
+                // `f = λ`), in velocity units.
+                let w = (r - rate / kc).hypot((f - lam) * omega / kc);
+                ok = w <= band && lam > 0.0 && (lam - f).abs() <= 0.5 * f;
                 if ok && self.count[ci] + 1 >= HOLD_STEPS {
                     self.release_noise[ci] = self.rel * lam;
                 }
