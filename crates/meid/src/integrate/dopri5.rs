@@ -1231,8 +1231,8 @@ const HOLD_STEPS: u32 = 16;
 /// bodies apart, and the contact opens by its own indicators within about a quarter of its
 /// period). The hold does not end on a mismatch between `λ_c` and the law's force at the
 /// frozen gap: that difference is the rigid-contact approximation's error, a gap error
-/// `|λ_c − f_c(δ₀)|/(∂f/∂δ)` (≈ 1e-13 m on the no-base machine, whose static overlap is
-/// 1.3e-9 m) and a stored-energy error of about `δ₀·|λ_c − f_c(δ₀)|`; releasing on it would
+/// `|λ_c − f_c(δ₀)|/(∂f/∂δ)` (the overlap the compliant contact would have minus the frozen
+/// one) and a stored-energy error of about `δ₀·|λ_c − f_c(δ₀)|`; releasing on it would
 /// restart the stiff contact oscillation it measures. Re-entry needs [`HOLD_STEPS`] new
 /// qualifying steps of positive length and `λ_c ≥ f_c/2 > 0`: a release and a re-entry
 /// cannot chatter at one instant.
