@@ -138,7 +138,11 @@ impl ChannelMap {
         let n = sys.n_modes();
         let nd = sys.dofs();
         let m = sys.motions(x);
-        let (fbs, fbd, ffd) = sys.element_forces_from(mode, &m);
+        let (fbs, fbd, ffd) = if mode.any_held() {
+            sys.element_forces(mode, x)
+        } else {
+            sys.element_forces_from(mode, &m)
+        };
         let phi = &sys.points.measurement;
         let a_b = dot(&self.acc_q, &x[..n])
             + dot(&self.acc_v, &x[nd..nd + n])
@@ -191,6 +195,10 @@ impl ChannelMap {
         let m = 2 * nd;
         assert_eq!(out.len(), N_CHANNELS * m, "channel vector buffer");
         out.fill(0.0);
+        if mode.any_held() {
+            // A held contact's force is a multiplier, not `K aᵀx + C aᵀẋ`.
+            return None;
+        }
         let row = |c: Channel| c.index() * m;
         // f = K aᵀx + C aᵀẋ of a closed linear contact.
         for (s, c) in [

@@ -227,7 +227,10 @@ pub enum Switch {
 /// damper spring/dashpot at one state ([`ImpactSystem::motions`]).
 pub type Motions = [(f64, f64); 3];
 
-/// The discrete state: bit 0 slider-bed closed, bit 1 bed-damper closed, bit 2 dashpot acting.
+/// The discrete state: bit 0 slider-bed closed, bit 1 bed-damper closed, bit 2 dashpot acting;
+/// bits 3 and 4 (`dopri5` only): the slider-bed / bed-damper contact is **held**, a persistent
+/// contact whose gap is kept constant and whose force is the constraint's multiplier `λ`
+/// ([`ImpactSystem::held_forces`]). A held contact is also closed (its bit 0 or 1 is set).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, PartialOrd, Ord)]
 pub struct Mode(pub u8);
 
@@ -235,6 +238,56 @@ impl Mode {
     pub const SLIDER_BED: u8 = 1;
     pub const BED_DAMPER: u8 = 2;
     pub const DASHPOT: u8 = 4;
+    /// The slider-bed contact is held (persistent, [`Mode`]).
+    pub const HELD_SLIDER_BED: u8 = 8;
+    /// The bed-damper contact is held (persistent, [`Mode`]).
+    pub const HELD_BED_DAMPER: u8 = 16;
+    const HELD: u8 = Self::HELD_SLIDER_BED | Self::HELD_BED_DAMPER;
+
+    /// Is contact `s` held (persistent)? Always false for the dashpot.
+    #[inline]
+    pub fn held(self, s: Switch) -> bool {
+        let bit = match s {
+            Switch::SliderBed => Self::HELD_SLIDER_BED,
+            Switch::BedDamper => Self::HELD_BED_DAMPER,
+            Switch::Dashpot => 0,
+        };
+        self.0 & bit != 0
+    }
+
+    /// Is any contact held?
+    #[inline]
+    pub fn any_held(self) -> bool {
+        self.0 & Self::HELD != 0
+    }
+
+    /// This mode with contact `s` held (and closed) or not held (left closed).
+    #[inline]
+    pub fn holding(self, s: Switch, on: bool) -> Mode {
+        let bit = match s {
+            Switch::SliderBed => Self::HELD_SLIDER_BED,
+            Switch::BedDamper => Self::HELD_BED_DAMPER,
+            Switch::Dashpot => return self,
+        };
+        if on {
+            Mode(self.0 | bit | Self::bit(s))
+        } else {
+            Mode(self.0 & !bit)
+        }
+    }
+
+    /// The mode without its held contacts (opened, held bits cleared): the dynamics before the
+    /// constraint forces are added.
+    #[inline]
+    pub fn free(self) -> Mode {
+        let mut m = Mode(self.0 & !Self::HELD);
+        for s in [Switch::SliderBed, Switch::BedDamper] {
+            if self.held(s) {
+                m = m.with(s, false);
+            }
+        }
+        m
+    }
     /// Is this switch on (contact closed, dashpot acting)?
     #[inline]
     pub fn on(self, s: Switch) -> bool {
@@ -248,13 +301,13 @@ impl Mode {
             Switch::Dashpot => Self::DASHPOT,
         }
     }
-    /// This mode with switch `s` set to `on`.
+    /// This mode with switch `s` set to `on` (opening a held contact also ends its hold).
     #[inline]
     pub fn with(self, s: Switch, on: bool) -> Mode {
         if on {
             Mode(self.0 | Self::bit(s))
         } else {
-            Mode(self.0 & !Self::bit(s))
+            Mode(self.0 & !Self::bit(s)).holding(s, false)
         }
     }
 }
@@ -809,9 +862,78 @@ impl ImpactSystem {
     }
 
     /// Generalised contact and damper forces at state `X` in mode `mode`, for any law:
-    /// returns `(f_bs, f_bd, f_fd)` (N).
+    /// returns `(f_bs, f_bd, f_fd)` (N). A held contact's force is its multiplier `λ`
+    /// ([`Self::held_forces`]).
     pub fn element_forces(&self, mode: Mode, x: &[f64]) -> (f64, f64, f64) {
-        self.element_forces_from(mode, &self.motions(x))
+        let (fbs, fbd, ffd) = self.element_forces_from(mode, &self.motions(x));
+        if !mode.any_held() {
+            return (fbs, fbd, ffd);
+        }
+        let lam = self.held_forces(mode, x);
+        (
+            if mode.held(Switch::SliderBed) {
+                lam[0]
+            } else {
+                fbs
+            },
+            if mode.held(Switch::BedDamper) {
+                lam[1]
+            } else {
+                fbd
+            },
+            ffd,
+        )
+    }
+
+    /// The forces (N) of the held contacts of `mode` at the state `X = [x; ẋ]` (slider-bed,
+    /// bed-damper; 0 for a contact not held): the multipliers `λ` that keep each held gap
+    /// constant, `a_cᵀẍ = 0`. With `ẍ_f` the accelerations of [`Mode::free`] (the held
+    /// contacts open, every other force and the slider force acting),
+    /// `ẍ = ẍ_f − M⁻¹ A λ` and `G λ = Aᵀ ẍ_f`, `G = Aᵀ M⁻¹ A` (1×1 or 2×2; `A` the held
+    /// contacts' relative vectors, `M` [`Self::mass_diag`]).
+    pub fn held_forces(&self, mode: Mode, x: &[f64]) -> [f64; 2] {
+        let mut acc = vec![0.0; self.dofs()];
+        self.accelerations(mode.free(), x, &mut acc);
+        self.project_held(mode, &mut acc, &self.mass_diag())
+    }
+
+    /// Removes from the accelerations `acc` (length `dofs`) their component that changes a
+    /// held contact's relative velocity, `acc −= M⁻¹ A G⁻¹ Aᵀ acc` (see
+    /// [`Self::held_forces`]), and returns the multipliers `G⁻¹ Aᵀ acc` (slider-bed,
+    /// bed-damper; 0 for a contact not held). `masses` is [`Self::mass_diag`].
+    pub fn project_held(&self, mode: Mode, acc: &mut [f64], masses: &[f64]) -> [f64; 2] {
+        let mut lam = [0.0; 2];
+        let held: Vec<(usize, &[f64])> = [Switch::SliderBed, Switch::BedDamper]
+            .into_iter()
+            .enumerate()
+            .filter(|&(_, s)| mode.held(s) && (s == Switch::SliderBed || self.damper.is_some()))
+            .map(|(i, s)| (i, self.relative_vector(s)))
+            .collect();
+        let g = |a: &[f64], b: &[f64]| -> f64 {
+            a.iter()
+                .zip(b)
+                .zip(masses)
+                .map(|((ai, bi), m)| ai * bi / m)
+                .sum()
+        };
+        match held[..] {
+            [] => return lam,
+            [(i, a)] => lam[i] = dot(a, acc) / g(a, a),
+            [(i, a), (j, b)] => {
+                let (g11, g12, g22) = (g(a, a), g(a, b), g(b, b));
+                let (b1, b2) = (dot(a, acc), dot(b, acc));
+                let det = g11 * g22 - g12 * g12;
+                lam[i] = (g22 * b1 - g12 * b2) / det;
+                lam[j] = (g11 * b2 - g12 * b1) / det;
+            }
+            _ => unreachable!("two contacts at most"),
+        }
+        for (i, a) in &held {
+            for ((o, ak), m) in acc.iter_mut().zip(a.iter()).zip(masses) {
+                *o -= ak * lam[*i] / m;
+            }
+        }
+        lam
     }
 
     /// [`Self::element_forces`] from the relative motions ([`Self::motions`]) of the state.

@@ -43,6 +43,11 @@
 //! [`MAX_STEPS`] for four windows of 2²⁰ steps in a row stops then, with the projection
 //! ([`Pace`]).
 //!
+//! **Persistent (held) contacts**: a closed contact that rests, with a step limited by its
+//! stability rather than by its motion, is held: its gap frozen, its force the constraint's
+//! multiplier, the stiff frequency out of the step size; released when the multiplier would
+//! pull ([`Holder`]).
+//!
 //! **Resting one-way dashpot**: the dashpot's velocity has a zero band of `rtol/10` of the
 //! largest size it reached in the run ([`Selector::band`]), so a machine at rest, whose
 //! velocities the integration carries only to that accuracy, does not switch the dashpot at
@@ -190,10 +195,65 @@ impl<'a> Rhs<'a> {
     /// dissipation: its work is `F (z_s − z_s0)`, [`ImpactSystem::force_work`]).
     #[inline]
     fn eval(&self, mode: Mode, y: &[f64], dy: &mut [f64]) {
+        if mode.any_held() {
+            self.eval_held(mode, y, dy);
+            return;
+        }
         self.eval_unforced(mode, y, dy);
         if self.force_acc != 0.0 {
             dy[self.nd + self.n] += self.force_acc;
         }
+    }
+
+    /// [`Rhs::eval`] with held contacts ([`Mode::held`]): the free mode's accelerations
+    /// `ẍ_f` ([`Mode::free`], the slider force included) projected so that no held gap
+    /// changes, `ẍ = ẍ_f − M⁻¹ A λ`, `G λ = Aᵀ ẍ_f` ([`ImpactSystem::project_held`]). The
+    /// dissipated power gains `Σ (λ_c − f_c,el(δ_c)) δ̇_c` over the held contacts: the
+    /// difference between the work of the multiplier on the bodies and the change of the
+    /// contact's stored energy `E_c(δ_c)` (zero while `δ̇_c = 0`, round-off after the entry's
+    /// projection); with it the balance is closed whatever `δ̇_c` is.
+    fn eval_held(&self, mode: Mode, y: &[f64], dy: &mut [f64]) {
+        let nd = self.nd;
+        self.eval_unforced(mode.free(), y, dy);
+        if self.force_acc != 0.0 {
+            dy[nd + self.n] += self.force_acc;
+        }
+        let lam = self
+            .sys
+            .project_held(mode, &mut dy[nd..2 * nd], &self.masses);
+        let (x, v) = (&y[..nd], &y[nd..2 * nd]);
+        for (ci, (s, a)) in [
+            (Switch::SliderBed, &self.a_s),
+            (Switch::BedDamper, &self.a_d),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            if mode.held(s) {
+                let (d, r) = a.dots(x, v);
+                dy[2 * nd] += (lam[ci] - elastic(&self.sys.contact(s).law, d)) * r;
+            }
+        }
+    }
+
+    /// The held contacts' forces `λ` at the state `y` and their rates `λ̇` along the state's
+    /// derivative `yd` (`λ̇ = G⁻¹ Aᵀ J_f ẏ`, [`Rhs::jvp`] in the free mode).
+    fn held_forces(&self, mode: Mode, y: &[f64], yd: &[f64]) -> ([f64; 2], [f64; 2]) {
+        let nd = self.nd;
+        let mut a = vec![0.0; 2 * nd + 1];
+        let free = mode.free();
+        self.eval_unforced(free, y, &mut a);
+        if self.force_acc != 0.0 {
+            a[nd + self.n] += self.force_acc;
+        }
+        let lam = self
+            .sys
+            .project_held(mode, &mut a[nd..2 * nd], &self.masses);
+        self.jvp(free, y, &yd[..2 * nd], &mut a[..2 * nd]);
+        let rate = self
+            .sys
+            .project_held(mode, &mut a[nd..2 * nd], &self.masses);
+        (lam, rate)
     }
 
     /// [`Rhs::eval`] without the constant slider force.
@@ -272,6 +332,14 @@ impl Rhs<'_> {
     /// `f_σ` at `y` in the direction `w`, a non-linear law by its partial derivatives
     /// `∂f/∂δ`, `∂f/∂δ̇` ([`ContactLaw::partials`]) at `y`. For linear laws this is `A_σ w`.
     fn jvp(&self, mode: Mode, y: &[f64], w: &[f64], out: &mut [f64]) {
+        if mode.any_held() {
+            // `J = P J_f`: the free mode's derivative, projected as the accelerations are.
+            self.jvp(mode.free(), y, w, out);
+            let nd = self.nd;
+            self.sys
+                .project_held(mode, &mut out[nd..2 * nd], &self.masses);
+            return;
+        }
         let (n, nd) = (self.n, self.nd);
         let (x, v) = (&y[..nd], &y[nd..2 * nd]);
         let (wx, wv) = (&w[..nd], &w[nd..2 * nd]);
@@ -476,6 +544,16 @@ fn mode_side(ind: Indicator, mode: Mode) -> f64 {
     }
 }
 
+/// True for an indicator of a contact that `mode` holds ([`Mode::held`]): its overlap is
+/// frozen and positive and its force is the multiplier, so it is on the closed side and is not
+/// searched; the hold ends by [`HeldForce`] instead.
+fn of_held(ind: Indicator, mode: Mode) -> bool {
+    match ind {
+        Indicator::Overlap(s) | Indicator::Force(s) => mode.held(s),
+        Indicator::DashpotVelocity => false,
+    }
+}
+
 /// The indicators' sides at a restart point (the start of the run or a switch).
 struct Sides {
     /// `+1` or `−1`: the side each indicator is on just after the point under the selected
@@ -574,7 +652,9 @@ impl<'a> Selector<'a> {
         for i in 0..self.inds.len() {
             sides.noise[i] = self.band(i, x, x_norms);
             let a = &self.inds[i];
-            sides.signs[i] = if sides.forced[i] != 0.0 {
+            sides.signs[i] = if of_held(a.ind, mode) {
+                1.0
+            } else if sides.forced[i] != 0.0 {
                 sides.forced[i]
             } else {
                 let g = a.value(x);
@@ -630,13 +710,25 @@ impl<'a> Selector<'a> {
     /// Selects a consistent mode at `x` starting from `start`, and the sides of the
     /// indicators under it. Without a consistent mode the last candidate is taken (the search
     /// then finds the switch at once, and the progress guard of [`solve_from`] stops a loop).
+    ///
+    /// The contacts `start` holds stay held (their indicators are on the closed side,
+    /// [`of_held`]); only the other switches are selected.
     fn select(&mut self, rhs: &Rhs<'_>, x: &[f64], start: Mode, sides: &mut Sides) -> Mode {
+        let keep = |m: Mode| {
+            let mut m = m;
+            for s in [Switch::SliderBed, Switch::BedDamper] {
+                if start.held(s) {
+                    m = m.holding(s, true);
+                }
+            }
+            m
+        };
         let mut cand = start;
         let mut seen = 0u32;
         let mut found = None;
         for _ in 0..16 {
             self.signs(rhs, cand, x, sides);
-            let next = self.implied(&sides.signs);
+            let next = keep(self.implied(&sides.signs));
             if next == cand {
                 found = Some(cand);
                 break;
@@ -657,10 +749,10 @@ impl<'a> Selector<'a> {
                     .fold(0u8, |a, &s| a | Mode::bit(s));
                 let mut pick = None;
                 for bits in 0..8u8 {
-                    let m = Mode(bits);
-                    if m.0 & !allowed == 0 {
+                    let m = keep(Mode(bits));
+                    if Mode(bits).0 & !allowed == 0 {
                         self.signs(rhs, m, x, sides);
-                        if self.implied(&sides.signs) == m {
+                        if keep(self.implied(&sides.signs)) == m {
                             pick = Some(m);
                             break;
                         }
@@ -746,27 +838,36 @@ impl Channels {
             ]
         );
         Channels {
-            lin: vec![None; 8],
+            lin: vec![None; 32],
             w_c: dot(&sys.points.measurement, &sys.points.bed_contact),
             contacts: [contact(Switch::SliderBed), contact(Switch::BedDamper)],
             nd: sys.dofs(),
         }
     }
 
-    /// True when `mode` closes a contact with a non-linear law.
+    /// True when `mode` closes a contact with a non-linear law or holds a contact.
     fn nonlinear(&self, mode: Mode) -> bool {
-        self.contacts
-            .iter()
-            .any(|(s, _, law)| law.is_some() && mode.on(*s))
+        mode.any_held()
+            || self
+                .contacts
+                .iter()
+                .any(|(s, _, law)| law.is_some() && mode.on(*s))
+    }
+
+    /// Is contact `ci` of `mode` a non-linear part of the channels (a non-linear law closed,
+    /// or held: its force is the multiplier)?
+    fn contact_nonlinear(&self, mode: Mode, ci: usize) -> bool {
+        let (s, _, law) = &self.contacts[ci];
+        mode.on(*s) && (law.is_some() || mode.held(*s))
     }
 
     /// Builds `mode`'s vectors.
     fn prepare(&mut self, sys: &ImpactSystem, map: &ChannelMap, mode: Mode) {
-        let k = usize::from(mode.0 & 7);
+        let k = usize::from(mode.0 & 31);
         if self.lin[k].is_some() {
             return;
         }
-        let mut m = mode;
+        let mut m = mode.free();
         for (s, _, law) in &self.contacts {
             if law.is_some() {
                 m = m.with(*s, false);
@@ -783,23 +884,24 @@ impl Channels {
     fn vectors(&self, mode: Mode) -> &[Option<SparseVec>; N_CHANNELS] {
         const NONE: [Option<SparseVec>; N_CHANNELS] =
             [None, None, None, None, None, None, None, None];
-        self.lin[usize::from(mode.0 & 7)].as_ref().unwrap_or(&NONE)
+        self.lin[usize::from(mode.0 & 31)].as_ref().unwrap_or(&NONE)
     }
 
     /// Does channel `c` have a non-linear part in `mode`?
     fn has_nonlinear(&self, mode: Mode, c: usize) -> bool {
         (c == Channel::BedAcceleration.index() || CONTACT_CHANNEL.contains(&c))
-            && self.contacts.iter().enumerate().any(|(ci, (s, _, law))| {
-                law.is_some()
-                    && mode.on(*s)
+            && (0..2).any(|ci| {
+                self.contact_nonlinear(mode, ci)
                     && (c == CONTACT_CHANNEL[ci] || c == Channel::BedAcceleration.index())
             })
     }
 
     /// All channels' values and slopes at the state `x` with derivative `xd` in `mode`
-    /// (prepared).
+    /// (prepared). A held contact's force is its multiplier `λ`, its slope `λ̇`
+    /// ([`Rhs::held_forces`]).
     fn at(
         &self,
+        rhs: &Rhs<'_>,
         mode: Mode,
         x: &[f64],
         xd: &[f64],
@@ -813,16 +915,25 @@ impl Channels {
                 None => (0.0, 0.0),
             };
         }
+        let held = if mode.any_held() {
+            rhs.held_forces(mode, x, xd)
+        } else {
+            ([0.0; 2], [0.0; 2])
+        };
         for (ci, (s, a, law)) in self.contacts.iter().enumerate() {
-            let Some(law) = law else { continue };
-            if !mode.on(*s) {
+            if !self.contact_nonlinear(mode, ci) {
                 continue;
             }
-            let (del, rate) = a.dots(&x[..nd], &x[nd..2 * nd]);
-            let (_, acc) = a.dots(&xd[..nd], &xd[nd..2 * nd]);
-            let f = law.force(del, rate);
-            let (fd, fr) = law.partials(del, rate);
-            let fdot = fd * rate + fr * acc;
+            let (f, fdot) = match law {
+                _ if mode.held(*s) => (held.0[ci], held.1[ci]),
+                Some(law) => {
+                    let (del, rate) = a.dots(&x[..nd], &x[nd..2 * nd]);
+                    let (_, acc) = a.dots(&xd[..nd], &xd[nd..2 * nd]);
+                    let (fd, fr) = law.partials(del, rate);
+                    (law.force(del, rate), fd * rate + fr * acc)
+                }
+                None => continue,
+            };
             let sign = if ci == 0 { 1.0 } else { -1.0 };
             let cc = CONTACT_CHANNEL[ci];
             v[cc] += f;
@@ -835,8 +946,10 @@ impl Channels {
 
     /// Channel `c`'s value and slope at `s` on the dense output (`buf`, `bufd`: scratch of
     /// length `ny`).
+    #[allow(clippy::too_many_arguments)]
     fn on_dense(
         &self,
+        rhs: &Rhs<'_>,
         mode: Mode,
         c: usize,
         dense: &Dense,
@@ -852,7 +965,7 @@ impl Channels {
         }
         dense.eval_with_slope(s, buf, bufd);
         let (mut v, mut d) = ([0.0; N_CHANNELS], [0.0; N_CHANNELS]);
-        self.at(mode, buf, bufd, &mut v, &mut d);
+        self.at(rhs, mode, buf, bufd, &mut v, &mut d);
         (v[c], d[c])
     }
 }
@@ -868,6 +981,7 @@ impl Channels {
 #[allow(clippy::too_many_arguments)]
 fn step_extremes(
     ch: &Channels,
+    rhs: &Rhs<'_>,
     mode: Mode,
     dense: &Dense,
     t: f64,
@@ -890,14 +1004,14 @@ fn step_extremes(
         }
         let mut extremum = |a: f64, b: f64, da: f64, db: f64, buf: &mut [f64], bufd: &mut [f64]| {
             let s = slope_root(
-                |s| ch.on_dense(mode, c, dense, s, buf, bufd).1,
+                |s| ch.on_dense(rhs, mode, c, dense, s, buf, bufd).1,
                 a,
                 b,
                 da,
                 db,
                 1e-12 * len,
             );
-            let (v, _) = ch.on_dense(mode, c, dense, s, buf, bufd);
+            let (v, _) = ch.on_dense(rhs, mode, c, dense, s, buf, bufd);
             peaks.0[c].offer(v, t + s);
         };
         if d0[c] * d1[c] < 0.0 {
@@ -920,7 +1034,7 @@ fn step_extremes(
         let (mut sa, mut da) = (0.0, d0[c]);
         for k in 0..nk {
             let sm = 0.5 * (knots[k] + knots[k + 1]) * len;
-            let dm = ch.on_dense(mode, c, dense, sm, buf, bufd).1;
+            let dm = ch.on_dense(rhs, mode, c, dense, sm, buf, bufd).1;
             if da * dm < 0.0 {
                 extremum(sa, sm, da, dm, buf, bufd);
             }
@@ -1087,6 +1201,160 @@ impl Pace {
     }
 }
 
+/// Consecutive accepted steps a closed contact must qualify before it is held ([`Holder`]).
+const HOLD_STEPS: u32 = 16;
+
+/// The persistent ("held") contact of `dopri5`: when a closed contact rests, its gap is
+/// kept constant and its force becomes the constraint's multiplier `λ`
+/// ([`ImpactSystem::held_forces`]), so that the contact's frequency, which only the
+/// explicit method's stability still resolves, drops out of the step size.
+///
+/// **Entry.** A closed, not yet held contact `c` qualifies at the end of an accepted step of
+/// size `h` when (1) its own oscillation about its quasi-static state is within its zero
+/// band: `w = √((δ̇_c − λ̇_c/k_c)² + ((f_c − λ_c) ω_c/k_c)²) ≤ (rtol/10)·V_c`, with `λ_c`,
+/// `λ̇_c` the force the contact would carry if held and its rate, `k_c = ∂f_c/∂δ`, and `V_c`
+/// the largest `Σ|a_i ẋ_i|` of the run so far (as the dashpot's band): the bodies move
+/// together, up to the contact's quasi-static compression rate `λ̇_c/k_c`, (2) the step is
+/// stability-limited by the contact, `h·ω_c ≥ 1` with `ω_c² = (∂f_c/∂δ)·a_cᵀM⁻¹a_c` (a step
+/// that resolved the contact's motion to the tolerance would be far shorter, `h·ω_c ≈ 0.1`),
+/// and (3) the contact is loaded quasi-statically: its law's force `f_c(δ, δ̇) > 0` and the
+/// multiplier it would carry if held matches it, `|λ_c − f_c| ≤ f_c/2`. After [`HOLD_STEPS`]
+/// consecutive qualifying steps (each at least `1/ω_c` long, several contact periods in
+/// all) the contact is held. The velocities are projected (mass-weighted) so that no held gap
+/// moves, `ẋ ← ẋ − M⁻¹A G⁻¹Aᵀẋ`: a plastic impulse that stops the relative velocity
+/// `δ̇_c ≈ λ̇_c/k_c` (the quasi-static compression rate, which the rigid constraint drops);
+/// the kinetic energy it takes, `½ δ̇ᵀG⁻¹δ̇`, is counted as dissipated.
+///
+/// **Release** is an event located on the dense output like the other switches: `λ_c`
+/// crossing `−(rtol/10)·λ_c,entry` (the force would pull). The contact then continues as a
+/// compliant closed contact from its frozen gap (the law's force at that gap pushes the
+/// bodies apart, and the contact opens by its own indicators within about a quarter of its
+/// period). The hold does not end on a mismatch between `λ_c` and the law's force at the
+/// frozen gap: that difference is the rigid-contact approximation's error, a gap error
+/// `|λ_c − f_c(δ₀)|/(∂f/∂δ)` (the overlap the compliant contact would have minus the frozen
+/// one) and a stored-energy error of about `δ₀·|λ_c − f_c(δ₀)|`; releasing on it would
+/// restart the stiff contact oscillation it measures. Re-entry needs [`HOLD_STEPS`] new
+/// qualifying steps of positive length and `λ_c ≥ f_c/2 > 0`: a release and a re-entry
+/// cannot chatter at one instant.
+struct Holder {
+    /// `a_cᵀ M⁻¹ a_c` per contact.
+    g: [f64; 2],
+    /// `V_c`: the largest `Σ|a_i ẋ_i|` of the run so far.
+    rate_scale: [f64; 2],
+    /// Consecutive qualifying steps.
+    count: [u32; 2],
+    /// The release threshold's size: `(rtol/10)·λ_c` at entry.
+    release_noise: [f64; 2],
+    rel: f64,
+}
+
+const CONTACTS: [Switch; 2] = [Switch::SliderBed, Switch::BedDamper];
+
+impl Holder {
+    fn new(rhs: &Rhs<'_>, rel: f64) -> Self {
+        let g = |a: &SparseVec| {
+            let (idx, val) = a.parts();
+            idx.iter()
+                .zip(val)
+                .map(|(&i, &v)| v * v / rhs.masses[i])
+                .sum()
+        };
+        Holder {
+            g: [g(&rhs.a_s), g(&rhs.a_d)],
+            rate_scale: [0.0; 2],
+            count: [0; 2],
+            release_noise: [0.0; 2],
+            rel,
+        }
+    }
+
+    fn relative<'a>(rhs: &'a Rhs<'_>, ci: usize) -> &'a SparseVec {
+        if ci == 0 {
+            &rhs.a_s
+        } else {
+            &rhs.a_d
+        }
+    }
+
+    /// After an accepted step of size `h` ending at `y` (with `f(y) = yd`) in `mode`: the mode
+    /// with the contacts that now qualify ([`Holder`]) held, if any.
+    fn entry(&mut self, rhs: &Rhs<'_>, mode: Mode, y: &[f64], yd: &[f64], h: f64) -> Option<Mode> {
+        let nd = rhs.nd;
+        let (x, v) = (&y[..nd], &y[nd..2 * nd]);
+        let mut enter = mode;
+        for (ci, s) in CONTACTS.into_iter().enumerate() {
+            if ci == 1 && rhs.sys.damper.is_none() {
+                continue;
+            }
+            let a = Self::relative(rhs, ci);
+            let speed = a.dot_abs(v).1;
+            self.rate_scale[ci] = self.rate_scale[ci].max(speed);
+            if !mode.on(s) || mode.held(s) {
+                self.count[ci] = 0;
+                continue;
+            }
+            let law = rhs.sys.contact(s).law;
+            let (d, r) = a.dots(x, v);
+            let band = (self.rel * self.rate_scale[ci]).max(1e-12 * speed);
+            let f = law.force(d, r);
+            let omega = (law.partials(d, r).0 * self.g[ci]).max(0.0).sqrt();
+            let kc = law.partials(d, r).0;
+            let mut ok = d > 0.0 && f > 0.0 && kc > 0.0 && h * omega >= 1.0;
+            if ok {
+                let (lam, rate) = rhs.held_forces(mode.holding(s, true), y, yd);
+                let (lam, rate) = (lam[ci], rate[ci]);
+                // The contact's own oscillation about its quasi-static state (`δ̇ = λ̇/k_c`,
+                // `f = λ`), in velocity units.
+                let w = (r - rate / kc).hypot((f - lam) * omega / kc);
+                ok = w <= band && lam > 0.0 && (lam - f).abs() <= 0.5 * f;
+                if ok && self.count[ci] + 1 >= HOLD_STEPS {
+                    self.release_noise[ci] = self.rel * lam;
+                }
+            }
+            self.count[ci] = if ok { self.count[ci] + 1 } else { 0 };
+            if self.count[ci] >= HOLD_STEPS {
+                self.count[ci] = 0;
+                enter = enter.holding(s, true);
+            }
+        }
+        (enter != mode).then_some(enter)
+    }
+}
+
+/// The multiplier of held contact `ci` on the dense output of a step (its release
+/// indicator, [`Holder`]).
+struct HeldForce<'a, 'b> {
+    rhs: &'a Rhs<'b>,
+    mode: Mode,
+    dense: &'a Dense,
+    ci: usize,
+    noise: f64,
+}
+
+impl Scalar for HeldForce<'_, '_> {
+    fn value_slope(&self, s: f64) -> (f64, f64) {
+        let ny = self.dense.r[0].len();
+        let (mut b, mut d) = (vec![0.0; ny], vec![0.0; ny]);
+        self.dense.eval_with_slope(s, &mut b, &mut d);
+        let (l, r) = self.rhs.held_forces(self.mode, &b, &d);
+        (l[self.ci], r[self.ci])
+    }
+    fn curvature_bound(&self, _a: f64, _b: f64) -> f64 {
+        f64::INFINITY
+    }
+    fn fastest_period(&self) -> f64 {
+        8.0 * self.dense.h
+    }
+    fn noise(&self) -> f64 {
+        self.noise
+    }
+}
+
+/// The kinetic energy `½ Σ m_i ẋ_i²` (J) of the velocities `v` with masses `m`.
+fn kinetic(v: &[f64], m: &[f64]) -> f64 {
+    0.5 * v.iter().zip(m).map(|(v, m)| m * v * v).sum::<f64>()
+}
+
 /// Runs Dormand-Prince 5(4). See the module documentation.
 pub fn solve(sys: &ImpactSystem, opts: &Options, obs: &mut dyn Observer) -> Result<Solution> {
     solve_from(sys, &sys.initial_state(), opts, obs)
@@ -1162,6 +1430,7 @@ pub fn solve_from(
     let (mut cv1, mut cd1) = ([0.0; N_CHANNELS], [0.0; N_CHANNELS]);
 
     let mut pace = Pace::new();
+    let mut holder = Holder::new(&rhs, selector.rel);
     let sc = |a: f64, b: f64| opts.atol + opts.rtol * a.abs().max(b.abs());
     let err_norm = |y0: &[f64], y1: &[f64], e: &[f64]| -> f64 {
         let mut s = 0.0;
@@ -1210,13 +1479,13 @@ pub fn solve_from(
     let mut last_reject = false;
     'outer: loop {
         if need_k1 {
-            if all_linear {
+            if all_linear && !mode.any_held() {
                 // The mode's first-order matrix: its rows are the right-hand side.
                 rhs.set_lower_rows(mode, matrices.matrix(mode));
             }
             channels.prepare(sys, &map, mode);
             rhs.eval(mode, &y, &mut k[0]);
-            channels.at(mode, &y, &k[0], &mut cv0, &mut cd0);
+            channels.at(&rhs, mode, &y, &k[0], &mut cv0, &mut cd0);
             if h == 0.0 {
                 let (k0, k1) = k.split_at_mut(1);
                 h = initial_step(
@@ -1395,7 +1664,7 @@ pub fn solve_from(
         let mut s_end = h;
         let mut switched = false;
         for (i, a) in selector.inds.iter().enumerate() {
-            if sides.provisional[i] {
+            if sides.provisional[i] || of_held(a.ind, mode) {
                 continue;
             }
             // Values and slopes at the step ends come from the state and the stages
@@ -1423,6 +1692,40 @@ pub fn solve_from(
                 }
             }
         }
+        // Held contacts: the release, `λ_c` crossing below `−noise` ([`Holder`]).
+        let mut release = 0u8;
+        if mode.any_held() {
+            let (la, lda) = rhs.held_forces(mode, &y, &k[0]);
+            let (lb, ldb) = rhs.held_forces(mode, &ynew, &k[6]);
+            for (ci, sw) in CONTACTS.into_iter().enumerate() {
+                if !mode.held(sw) {
+                    continue;
+                }
+                let lift = holder.release_noise[ci];
+                let ga = (la[ci] + lift).max(0.0);
+                let gb = lb[ci] + lift;
+                if gb >= 0.0 && hermite_dip(ga, lda[ci], gb, ldb[ci], h).is_none() {
+                    continue;
+                }
+                let f = HeldForce {
+                    rhs: &rhs,
+                    mode,
+                    dense: &dense,
+                    ci,
+                    noise: lift,
+                };
+                let bit = Mode(0).holding(sw, true).0 & !Mode::bit(sw);
+                if let Some(s) = first_crossing(&f, s_end, 1.0, SearchOptions::default()) {
+                    if s < s_end || (s == s_end && !switched) {
+                        s_end = s;
+                        switched = true;
+                        release = bit;
+                    } else if s == s_end {
+                        release |= bit;
+                    }
+                }
+            }
+        }
         // Output samples inside (t, t + s_end].
         if let Some(g) = grid.as_mut() {
             loop {
@@ -1443,9 +1746,10 @@ pub fn solve_from(
             ydot.copy_from_slice(&k[6]);
         }
         // Channel extremes and closed times on [0, s_end].
-        channels.at(mode, &ybuf, &ydot, &mut cv1, &mut cd1);
+        channels.at(&rhs, mode, &ybuf, &ydot, &mut cv1, &mut cd1);
         step_extremes(
             &channels,
+            &rhs,
             mode,
             &dense,
             t,
@@ -1481,7 +1785,10 @@ pub fn solve_from(
                 stalled_switches = 0;
             }
             sides.forced.iter_mut().for_each(|f| *f = 0.0);
-            let new_mode = selector.select(&rhs, &y[..nx], mode, &mut sides);
+            holder.count = [0; 2];
+            // A released contact stays closed, compliant, from its frozen gap.
+            let start = Mode(mode.0 & !release);
+            let new_mode = selector.select(&rhs, &y[..nx], start, &mut sides);
             if new_mode != mode {
                 y[nx] += switch_to(
                     &map,
@@ -1542,7 +1849,31 @@ pub fn solve_from(
         }
         last_reject = false;
         facold = err.max(1e-4);
+        let h_step = h;
         h = hnew;
+        // A resting contact becomes held ([`Holder`]).
+        if let Some(held) = holder.entry(&rhs, mode, &y, &k[0], h_step) {
+            let ke0 = kinetic(&y[nd..nx], &rhs.masses);
+            sys.project_held(held, &mut y[nd..nx], &rhs.masses);
+            y[nx] += ke0 - kinetic(&y[nd..nx], &rhs.masses);
+            sides.forced.iter_mut().for_each(|f| *f = 0.0);
+            let new_mode = selector.select(&rhs, &y[..nx], held, &mut sides);
+            y[nx] += switch_to(
+                &map,
+                sys,
+                &mut totals,
+                &mut events,
+                &mut path,
+                t,
+                &y[..nx],
+                mode,
+                new_mode,
+                opts.max_events,
+            )?;
+            mode = new_mode;
+            totals.dissipated = y[nx];
+            need_k1 = true;
+        }
     }
     let mode_final = mode;
     Ok(Solution {
@@ -1813,7 +2144,7 @@ mod tests {
                 ch.prepare(&sys, &map, mode);
                 rhs.eval(mode, &y, &mut yd);
                 let (mut v, mut d) = ([0.0; N_CHANNELS], [0.0; N_CHANNELS]);
-                ch.at(mode, &y, &yd, &mut v, &mut d);
+                ch.at(&rhs, mode, &y, &yd, &mut v, &mut d);
                 let e = map.values(&sys, mode, &y[..n]);
                 let eps = 1e-7;
                 let yp: Vec<f64> = (0..n).map(|i| y[i] + eps * yd[i]).collect();
