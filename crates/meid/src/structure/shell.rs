@@ -227,27 +227,34 @@ fn covariant_shear(xy: &[[f64; 2]; 4], r: f64, s: f64) -> ([f64; 24], [f64; 24])
     (er, es)
 }
 
-fn add_btdb(k: &mut Mat<f64>, rows: &[[f64; 24]], d: &[Vec<f64>], w: f64) {
+/// `K += w Bᵀ D B` for strain rows `B` of length `N` (the element's DOFs: 24 for MITC4, 18 for
+/// the triangle).
+pub(super) fn add_btdb<const N: usize>(
+    k: &mut Mat<f64>,
+    rows: &[[f64; N]],
+    d: &[Vec<f64>],
+    w: f64,
+) {
     let nr = rows.len();
     // db = D B
-    let mut db = vec![[0.0; 24]; nr];
+    let mut db = vec![[0.0; N]; nr];
     for a in 0..nr {
         for b in 0..nr {
             let dab = d[a][b];
             if dab != 0.0 {
-                for c in 0..24 {
+                for c in 0..N {
                     db[a][c] += dab * rows[b][c];
                 }
             }
         }
     }
-    for p in 0..24 {
+    for p in 0..N {
         for a in 0..nr {
             let bp = rows[a][p];
             if bp == 0.0 {
                 continue;
             }
-            for q in 0..24 {
+            for q in 0..N {
                 k[(p, q)] += w * bp * db[a][q];
             }
         }

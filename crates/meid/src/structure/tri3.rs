@@ -68,7 +68,7 @@ use faer::Mat;
 use super::frame::{block_rotation, to_global};
 use super::geom::{cross, dot, norm, scale, sub, unit, V3};
 use super::material::Material;
-use super::shell::DEFAULT_DRILLING_FACTOR;
+use super::shell::{add_btdb, DEFAULT_DRILLING_FACTOR};
 use crate::{Error, Result};
 
 /// Smallest accepted area relative to the longest edge squared (an equilateral triangle has
@@ -150,33 +150,6 @@ pub fn tri_geometry(x: &[V3; 3]) -> Result<TriGeometry> {
         local_xy,
         area_m2: area,
     })
-}
-
-/// `K += w Bᵀ D B` for rows `B` of length 18.
-fn add_btdb(k: &mut Mat<f64>, rows: &[[f64; 18]], d: &[Vec<f64>], w: f64) {
-    let nr = rows.len();
-    let mut db = vec![[0.0; 18]; nr];
-    for a in 0..nr {
-        for b in 0..nr {
-            let dab = d[a][b];
-            if dab != 0.0 {
-                for c in 0..18 {
-                    db[a][c] += dab * rows[b][c];
-                }
-            }
-        }
-    }
-    for p in 0..18 {
-        for a in 0..nr {
-            let bp = rows[a][p];
-            if bp == 0.0 {
-                continue;
-            }
-            for q in 0..18 {
-                k[(p, q)] += w * bp * db[a][q];
-            }
-        }
-    }
 }
 
 /// Rows `[βx, βy]` of a corner rotation in local DOFs: `βx = θy`, `βy = -θx`.
