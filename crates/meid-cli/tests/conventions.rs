@@ -354,9 +354,10 @@ fn optimize_output_is_its_json_report() {
 // ---------------------------------------------------------------------------------------------
 // 4. Completions and manual pages.
 
-const SUBCOMMANDS: [&str; 15] = [
+const SUBCOMMANDS: [&str; 16] = [
     "simulate",
     "modes",
+    "model",
     "sweep",
     "compare",
     "optimize",

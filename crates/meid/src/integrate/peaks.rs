@@ -181,6 +181,14 @@ fn on_poly_m<const M: usize>(
     if one_signed::<M>(&da, len) {
         return;
     }
+    // A slope that starts at zero (a channel from rest, `p' = s^j q(s)`) has its sign changes
+    // in `(0, len]` where `q` has them: search `q`, whose start value is clearly signed. The
+    // slope itself starts at a root of order `j` and a dip of `3a₃s² + 4a₄s³` narrower than
+    // the search grid would not show in its end values.
+    if let Some(j) = da[..M - 1].iter().position(|&c| c != 0.0) {
+        da.copy_within(j..M - 1, 0);
+        da[M - 1 - j..].fill(0.0);
+    }
     // A monotone slope (its derivative `p''` keeps its sign) has at most one root, where its
     // end values differ in sign: safeguarded Newton on it, without the general search.
     let mut d2a = [0.0; taylor::ORDER + 1];
@@ -687,6 +695,11 @@ mod tests {
         for (k, d) in da.iter_mut().take(taylor::ORDER).enumerate() {
             *d = (k + 1) as f64 * a[k + 1];
         }
+        // With the slope's root of order `j` at a start from rest divided out (`p' = s^j q`).
+        if let Some(j) = da.iter().position(|&c| c != 0.0) {
+            da.copy_within(j.., 0);
+            da[taylor::ORDER + 1 - j..].fill(0.0);
+        }
         let slope = Poly::new(&da, tau, period);
         for_each_extremum(&slope, 0.0, len, EXTREMUM_SEARCH, |s, _| {
             e.offer(taylor::eval(a, s), s)
@@ -725,7 +738,11 @@ mod tests {
             let mut got = Extremes::default();
             on_poly(&lowered, deg, tau, period, 0.0, len, &mut got);
             let want = unpruned(&a, tau, period, len);
-            let scale = taylor::abs_horner(&a, len);
+            // Round-off scale: the coefficients are sums of the modal terms, so `a₀` carries
+            // an error of ε·Σ|A_j| however small the cancelled sum is, and the lowered
+            // degree's remainder is bounded relative to the same state scale.
+            let amplitudes: f64 = modes.iter().map(|m| m.2.abs()).sum();
+            let scale = taylor::abs_horner(&a, len).max(amplitudes);
             let tol = 1e-14 * scale;
             proptest::prop_assert!((got.max - want.max).abs() <= tol, "max {got:?} {want:?}");
             proptest::prop_assert!((got.min - want.min).abs() <= tol, "min {got:?} {want:?}");
@@ -735,7 +752,10 @@ mod tests {
             for i in 0..=2000 {
                 let s = len * f64::from(i) / 2000.0;
                 let v = taylor::eval(&a, s);
-                proptest::prop_assert!(v <= got.max + tol && v >= got.min - tol, "{v} at {s}");
+                proptest::prop_assert!(
+                    v <= got.max + tol && v >= got.min - tol,
+                    "{v} at {s}"
+                );
             }
         }
     }
