@@ -76,3 +76,72 @@ fn expand_refuses_what_it_cannot_expand() {
         stderr(&out)
     );
 }
+
+/// `md/mb` on the expanded file needs no `--bed-mass`: the bed plate and its added masses are
+/// written with `part = "bed"`, so the damper masses of a sweep are those of the machine file
+/// (m_d = r·m_b with m_b the plate's element masses against ρ L_x L_y t, to round-off).
+#[test]
+fn expanded_file_knows_its_bed_mass() {
+    let d = tmpdir("model", "bed-mass");
+    let src = example("paper-soft-base.toml");
+    let out = d.join("expanded.toml");
+    ok(meid()
+        .args(["model", "expand"])
+        .arg(&src)
+        .args(["--set", COARSE, "-o"])
+        .arg(&out)
+        .output()
+        .unwrap());
+    let damper_masses = |dir: &std::path::Path| -> Vec<f64> {
+        let text = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+        let mut lines = text.lines();
+        let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let k = head.iter().position(|h| *h == "damper_mass_kg").unwrap();
+        lines
+            .map(|l| l.split(',').nth(k).unwrap().parse::<f64>().unwrap())
+            .collect()
+    };
+    ok(meid()
+        .arg("sweep")
+        .arg(&src)
+        .args(["--set", COARSE, "--vary", "md/mb=0.35,0.7", "-q", "-o"])
+        .arg(d.join("machine"))
+        .output()
+        .unwrap());
+    ok(meid()
+        .arg("sweep")
+        .arg(&out)
+        .args(["--vary", "md/mb=0.35,0.7", "-q", "-o"])
+        .arg(d.join("expanded"))
+        .output()
+        .unwrap());
+    let (a, b) = (
+        damper_masses(&d.join("machine")),
+        damper_masses(&d.join("expanded")),
+    );
+    assert_eq!(a.len(), 2);
+    for (x, y) in a.iter().zip(&b) {
+        assert!(*x > 0.0 && (y / x - 1.0).abs() < 1e-12, "{a:?} vs {b:?}");
+    }
+    // Unlabelled, the general model cannot tell m_b: the error says how to give it.
+    let text = std::fs::read_to_string(&out).unwrap();
+    let unlabelled = d.join("unlabelled.toml");
+    std::fs::write(
+        &unlabelled,
+        text.replace("part = \"bed\"", "part = \"plate\""),
+    )
+    .unwrap();
+    let o = meid()
+        .arg("sweep")
+        .arg(&unlabelled)
+        .args(["--vary", "md/mb=0.35,0.7", "-q", "-o"])
+        .arg(d.join("unlabelled"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(
+        e.contains("part = \"bed\"") && e.contains("--bed-mass"),
+        "{e}"
+    );
+}

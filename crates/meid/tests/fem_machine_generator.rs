@@ -614,6 +614,13 @@ fn expanded_model_runs_like_the_machine() {
         b.structure.fem.as_mut().unwrap().model = None;
         assert_eq!(a, b, "{file}: the rest of the model");
         assert_eq!(machine.structure, model.structure, "{file}: modal model");
+        // The bed is labelled `part = "bed"` in the expansion: md/mb still knows m_b (the sum
+        // of the plate's element masses against ρ L_x L_y t, to round-off).
+        let (mb0, mb1) = (machine.bed_mass().unwrap(), model.bed_mass().unwrap());
+        assert!(
+            (mb1 / mb0 - 1.0).abs() < 1e-12,
+            "{file}: m_b {mb1} vs {mb0} kg"
+        );
         let run = |m: &Model| {
             simulate(
                 &m.impact_system(Case::AsSpecified).unwrap(),
@@ -666,6 +673,28 @@ fn expanded_model_can_be_edited() {
     let added = mass(&thicker) - mass(&expanded);
     let bed = 7850.0 * 0.432 * 0.2693 * t;
     assert!((added / bed - 1.0).abs() < 1e-12, "{added} kg vs {bed} kg");
+    // The bed mass of md/mb follows the edit: m_b is the labelled part's mass.
+    let m_b = |text: &str| {
+        Model::from_text("x.toml", text.to_string(), &[])
+            .unwrap()
+            .bed_mass()
+    };
+    let (b1, b2) = (m_b(&expanded).unwrap(), m_b(&thicker).unwrap());
+    assert!((b1 / bed - 1.0).abs() < 1e-12, "m_b {b1} kg vs {bed} kg");
+    assert!(
+        (b2 / (2.0 * bed) - 1.0).abs() < 1e-12,
+        "m_b {b2} kg vs {} kg",
+        2.0 * bed
+    );
+    // Without the label, or with the contact point off the bed, the model cannot tell.
+    assert_eq!(
+        m_b(&expanded.replace("part = \"bed\"", "part = \"top\"")),
+        None
+    );
+    assert_eq!(
+        m_b(&expanded.replace("bed_contact = \"O_b\"", "bed_contact = \"O_f\"")),
+        None
+    );
     let bad = expanded.replacen(&format!("thickness = {t}"), "thickness = -1.0", 1);
     let e = Model::from_text("x.toml", bad, &[])
         .unwrap_err()

@@ -614,3 +614,23 @@ sample_rate = 20000.0
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `part = "bed"` on a Gmsh surface's shells: the model's bed mass m_b (for `md/mb`) is
+/// ρ t A of its triangles, 7850 · 0.01 · 1 m² = 78.5 kg (the irregular triangles tile the
+/// square exactly, to round-off), and `None` without the label.
+#[test]
+fn bed_part_on_a_gmsh_surface_gives_the_bed_mass() {
+    let path = data("ss_plate_tri.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let name = path.display().to_string();
+    let plain = meid::model::Model::from_text(&name, text.clone(), &[]).unwrap();
+    assert_eq!(plain.bed_mass(), None);
+    let labelled = text.replace(
+        r#"shells = [{ set = "plate", thickness = 0.01 }]"#,
+        r#"shells = [{ set = "plate", thickness = 0.01, part = "bed" }]"#,
+    );
+    assert_ne!(labelled, text);
+    let m = meid::model::Model::from_text(&name, labelled, &[]).unwrap();
+    let m_b = m.bed_mass().unwrap();
+    assert!((m_b / 78.5 - 1.0).abs() < 1e-12, "m_b = {m_b} kg");
+}

@@ -1262,7 +1262,7 @@ pub fn check_quantities(model: &Model, qs: &[&Quantity], bed_mass_kg: Option<f64
     if has(&Quantity::MdOverMb) && !bed_mass_kg.is_some_and(|m| m > 0.0) {
         return Err(Error::invalid(
             "vary",
-            "md/mb needs the bed mass m_b, which this model cannot tell (it can for a lumped mass at points.bed_contact, or the parametric FE machine struck on its bed plate); give --bed-mass KG",
+            "md/mb needs the bed mass m_b, which this model cannot tell (it can for a lumped mass at points.bed_contact, the parametric FE machine struck on its bed plate, or a general model whose bed elements carry part = \"bed\" with points.bed_contact on them); give --bed-mass KG",
         ));
     }
     Ok(())

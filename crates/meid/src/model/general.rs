@@ -17,6 +17,7 @@
 //! springs = [{ node = "feet", stiffness = [0, 0, 1e6, 0, 0, 0] }]  # to ground, or `to = <node>`
 //! dashpots = [{ node = "feet", damping = [0, 0, 1e3, 0, 0, 0] }]
 //! masses = [{ node = 1, mass = 10.0, inertia = [0.1, 0.1, 0.2] }]
+//! # part = "bed" on shells, frames or masses marks the bed: its mass is m_b for md/mb studies
 //! rigid_links = [{ master = 1, slaves = "top_ring" }]
 //! constraints = [{ set = "base", dofs = ["ux", "uy", "uz"] }]
 //! points = { O_b = "top", B = "top" }     # meid's points: node sets (every set is a point too)
@@ -32,6 +33,11 @@
 //! kg/m³, m², m⁴, kg·m². Rigid links are eliminated exactly (master-slave transformation,
 //! [`crate::structure::discrete`]); constraints remove DOFs and their reactions are part of the
 //! floor force.
+//!
+//! `part = "<label>"` on a `shells`, `frames` or `masses` entry labels its elements
+//! ([`Mesh::parts`]). The label `"bed"` is meid's: the bed's mass (`ρ t A` of its shells,
+//! `ρ A L` of its frames, plus its point masses) is the bed mass m_b of `md/mb` studies when
+//! `points.bed_contact` lies on it ([`crate::model::Model::bed_mass`]).
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -41,8 +47,8 @@ use serde::{Deserialize, Serialize};
 use super::fem::{check_material, parse_dofs, ConstraintSpec, MaterialSpec};
 use super::Source;
 use crate::structure::{
-    Dashpot, FeModel, FrameElement, Material, Mesh, PointMass, RigidLink, Section, ShellElement,
-    Spring, TriShellElement,
+    Dashpot, FeModel, FrameElement, Material, Mesh, MeshPart, PointMass, RigidLink, Section,
+    ShellElement, Spring, TriShellElement,
 };
 use crate::Result;
 
@@ -109,6 +115,10 @@ pub struct ShellSpec {
     /// Transverse shear correction factor κ (default 5/6; π²/12 matches Mindlin's plate).
     #[serde(default)]
     pub shear_factor: Option<f64>,
+    /// Part label (docs/model-format.md): `part = "bed"` marks the bed, whose mass is the
+    /// bed mass m_b of `md/mb` studies.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub part: Option<String>,
 }
 
 /// 3-D Euler-Bernoulli frames of one section: the 2-node lines of a Gmsh physical curve, or a
@@ -142,6 +152,10 @@ pub struct FrameSpec {
     /// [`crate::structure::frame`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub releases: Vec<ReleaseSpec>,
+    /// Part label (docs/model-format.md): `part = "bed"` marks the bed, whose mass is the
+    /// bed mass m_b of `md/mb` studies.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub part: Option<String>,
 }
 
 /// `{ node = <node or set>, dofs = ["ry", "rz"] }`: local DOFs `ux` (axial), `rx` (torsion),
@@ -183,6 +197,10 @@ pub struct MassSpec {
     /// `[Ixx, Iyy, Izz]` about global axes through the node (kg·m²).
     #[serde(default)]
     pub inertia: Option<[f64; 3]>,
+    /// Part label (docs/model-format.md): `part = "bed"` marks the bed, whose mass is the
+    /// bed mass m_b of `md/mb` studies.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub part: Option<String>,
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
@@ -206,6 +224,12 @@ struct Builder<'a> {
 const BASE: &str = "structure.fem.model";
 
 impl Builder<'_> {
+    /// Records an element in its labelled part, if it has one.
+    fn in_part(&mut self, part: &Option<String>, add: impl FnOnce(&mut MeshPart)) {
+        if let Some(name) = part {
+            add(self.mesh.parts.entry(name.clone()).or_default());
+        }
+    }
     fn err(&self, field: &str, msg: impl std::fmt::Display) -> crate::Error {
         let f = format!("{BASE}.{field}");
         self.src.error(&f, format!("{f}: {msg}"))
@@ -507,11 +531,14 @@ pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> 
         for q in quads {
             let mut el = ShellElement::new(q, mat, s.thickness);
             el.shear_factor = kappa;
-            b.mesh.add_shell(el);
+            let e = b.mesh.add_shell(el);
+            b.in_part(&s.part, |p| p.shells.push(e));
         }
         for t in tris {
-            b.mesh
+            let e = b
+                .mesh
                 .add_triangle(TriShellElement::new(t, mat, s.thickness));
+            b.in_part(&s.part, |p| p.triangles.push(e));
         }
     }
     if let Some(q) = quad_section.iter().position(|s| s.is_none()) {
@@ -670,7 +697,8 @@ pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> 
             el.releases = rel[k];
             crate::structure::frame::check_releases(&el.releases)
                 .map_err(|e| b.err(&format!("{field}.releases"), e.to_string()))?;
-            b.mesh.add_frame(el);
+            let e = b.mesh.add_frame(el);
+            b.in_part(&f.part, |p| p.frames.push(e));
         }
     }
 
@@ -721,11 +749,12 @@ pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> 
         let inertia = m.inertia.unwrap_or([0.0; 3]);
         nonnegative(&b, &format!("{field}.inertia"), &inertia, "kg·m²")?;
         for n in b.nodes_of(&m.node, &format!("{field}.node"))? {
-            b.mesh.add_mass(PointMass {
+            let e = b.mesh.add_mass(PointMass {
                 node: n,
                 mass_kg: m.mass,
                 inertia_kg_m2: inertia,
             });
+            b.in_part(&m.part, |p| p.masses.push(e));
         }
     }
     for (i, l) in spec.rigid_links.iter().enumerate() {

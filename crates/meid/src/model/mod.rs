@@ -469,8 +469,12 @@ impl Model {
     /// * `[structure.fem.machine]` with `points.bed_contact` on the bed plate (`O_b` or `B`):
     ///   the bed plate's mass `ρ L_x L_y t` (exactly the sum of its shell elements' masses)
     ///   plus the `added_masses` on plate `"bed"`;
-    /// * otherwise (`[structure.modal]`, Gmsh meshes, a contact point elsewhere) `None`: give it
-    ///   (`--bed-mass`).
+    /// * `[structure.fem.model]` (a user's mesh, or `meid model expand`'s machine) with elements
+    ///   labelled `part = "bed"` and every node of `points.bed_contact` on them: their mass
+    ///   ([`crate::structure::Mesh::mass_of`]: `ρ t A` per shell, `ρ A L` per frame, plus the
+    ///   point masses of the part);
+    /// * otherwise (`[structure.modal]`, no bed part, a contact point off the bed) `None`: give
+    ///   it (`--bed-mass`).
     pub fn bed_mass(&self) -> Option<f64> {
         let st = &self.spec.structure;
         let contact = self.spec.points.bed_contact.as_str();
@@ -491,9 +495,24 @@ impl Model {
             let m_b = spec.bed.mass_kg() + added;
             return (m_b.is_finite() && m_b > 0.0).then_some(m_b);
         }
+        if let Some(g) = st.fem.as_ref().and_then(|f| f.model.as_ref()) {
+            let (mesh, _) = general::build_mesh(g, &self.source).ok()?;
+            let bed = mesh.parts.get(BED_PART)?;
+            let on_bed = mesh.nodes_of_part(bed);
+            let at = mesh.points.get(contact)?;
+            if at.is_empty() || at.iter().any(|n| on_bed.binary_search(n).is_err()) {
+                return None;
+            }
+            let m_b = mesh.mass_of(bed);
+            return (m_b.is_finite() && m_b > 0.0).then_some(m_b);
+        }
         None
     }
 }
+
+/// The part label of the bed in a general model (`part = "bed"`): its mass is the bed mass m_b
+/// of `md/mb` ([`Model::bed_mass`]).
+pub const BED_PART: &str = "bed";
 
 /// Reads a model file's text strictly ([`strict`]): errors name the file, line, column and
 /// field, in the model's terms.

@@ -47,6 +47,7 @@ use crate::model::fem::{ConstraintSpec, MaterialSpec};
 use crate::model::general::{
     DashpotSpec, FrameSpec, GeneralSpec, MassSpec, NodeRef, RigidLinkSpec, ShellSpec, SpringSpec,
 };
+use crate::model::BED_PART;
 use crate::{Error, Result};
 
 /// A rectangular plate centred on the z axis.
@@ -430,7 +431,7 @@ impl MachineSpec {
         let h_bed = self.bed.length_x_m.max(self.bed.length_y_m) / self.elements_per_side as f64;
         let bxs = grid_1d(self.bed.length_x_m, &bx, h_bed);
         let bys = grid_1d(self.bed.length_y_m, &by, h_bed);
-        let bed_grid = plate_grid(&mut g, &bxs, &bys, zb, &self.bed)?;
+        let bed_grid = plate_grid(&mut g, &bxs, &bys, zb, &self.bed, Some(BED_PART))?;
         let bed_node = |p: [f64; 2]| (index_of(&bxs, p[0]), index_of(&bys, p[1]));
         let (i, j) = bed_node([0.0, 0.0]);
         g.sets.insert("O_b".into(), vec![bed_grid[i][j]]);
@@ -496,7 +497,7 @@ impl MachineSpec {
             let h = base.length_x_m.max(base.length_y_m) / self.elements_per_side as f64;
             let gx = grid_1d(base.length_x_m, &xs, h);
             let gy = grid_1d(base.length_y_m, &ys, h);
-            let grid = plate_grid(&mut g, &gx, &gy, 0.0, base)?;
+            let grid = plate_grid(&mut g, &gx, &gy, 0.0, base, None)?;
             g.sets.insert(
                 "O_f".into(),
                 vec![grid[index_of(&gx, 0.0)][index_of(&gy, 0.0)]],
@@ -587,6 +588,7 @@ impl MachineSpec {
                 orientation: None,
                 material: Some(column_material),
                 releases: Vec::new(),
+                part: None,
             });
             if self.spiders {
                 spider(
@@ -625,6 +627,7 @@ impl MachineSpec {
                 node: NodeRef::Index(node),
                 mass: m.mass_kg,
                 inertia: Some(m.inertia_kg_m2),
+                part: (m.plate == Plate::Bed).then(|| BED_PART.to_string()),
             });
         }
         Ok(GeneratedMachine {
@@ -656,13 +659,15 @@ fn add_node(g: &mut GeneralSpec, p: [f64; 3]) -> usize {
 /// (each strictly increasing, at least two values), as one shell set of `plate`'s thickness
 /// and material. Returns the inline node indices as `grid[i][j]` for the node at
 /// `(xs_m[i], ys_m[j])`. Nodes are numbered with `j` fastest, quadrangles with `i` fastest,
-/// counter-clockwise about +z (as [`Mesh::add_plate_grid`]).
+/// counter-clockwise about +z (as [`Mesh::add_plate_grid`]). `part` labels the shells (the
+/// bed plate is [`BED_PART`]).
 fn plate_grid(
     g: &mut GeneralSpec,
     xs_m: &[f64],
     ys_m: &[f64],
     z_m: f64,
     plate: &PlateSpec,
+    part: Option<&str>,
 ) -> Result<Vec<Vec<usize>>> {
     for (name, v) in [("x grid", xs_m), ("y grid", ys_m)] {
         if v.len() < 2
@@ -697,6 +702,7 @@ fn plate_grid(
         thickness: plate.thickness_m,
         material: Some(material_spec(plate.material)),
         shear_factor: None,
+        part: part.map(str::to_string),
     });
     Ok(grid)
 }

@@ -50,6 +50,18 @@ pub struct Mesh {
     pub element_sets: BTreeMap<String, Vec<usize>>,
     /// Named sets of triangles (indices into `triangles`), e.g. Gmsh physical surfaces.
     pub triangle_sets: BTreeMap<String, Vec<usize>>,
+    /// Labelled parts (the model file's `part = "..."` on shells, frames and masses).
+    pub parts: BTreeMap<String, MeshPart>,
+}
+
+/// The elements of one labelled part: indices into [`Mesh::shells`], [`Mesh::triangles`],
+/// [`Mesh::frames`] and [`Mesh::masses`].
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct MeshPart {
+    pub shells: Vec<usize>,
+    pub triangles: Vec<usize>,
+    pub frames: Vec<usize>,
+    pub masses: Vec<usize>,
 }
 
 impl Mesh {
@@ -184,31 +196,79 @@ impl Mesh {
     /// Total translational mass (kg) of shells, frames and point masses (elements with invalid
     /// nodes or geometry are skipped; [`Mesh::validate`] reports them).
     pub fn total_mass_kg(&self) -> f64 {
+        let all = MeshPart {
+            shells: (0..self.shells.len()).collect(),
+            triangles: (0..self.triangles.len()).collect(),
+            frames: (0..self.frames.len()).collect(),
+            masses: (0..self.masses.len()).collect(),
+        };
+        self.mass_of(&all)
+    }
+
+    /// Translational mass (kg) of the elements of `part`: `ρ A L` per frame, `ρ t A` per
+    /// shell (its area `A` as the element integrates it), plus the point masses (elements with
+    /// invalid nodes or geometry are skipped; [`Mesh::validate`] reports them).
+    pub fn mass_of(&self, part: &MeshPart) -> f64 {
+        let at = |n: &[usize]| -> Option<Vec<[f64; 3]>> {
+            n.iter().map(|&i| self.nodes.get(i).copied()).collect()
+        };
         let mut m = 0.0;
-        for f in &self.frames {
-            if let (Some(a), Some(b)) = (self.nodes.get(f.nodes[0]), self.nodes.get(f.nodes[1])) {
-                let l = super::geom::norm(super::geom::sub(*b, *a));
+        for f in part.frames.iter().filter_map(|&i| self.frames.get(i)) {
+            if let Some(x) = at(&f.nodes) {
+                let l = super::geom::norm(super::geom::sub(x[1], x[0]));
                 m += f.material.density_kg_per_m3 * f.section.area_m2 * l;
             }
         }
-        for s in &self.shells {
-            if s.nodes.iter().any(|&n| n >= self.nodes.len()) {
-                continue;
-            }
-            let x = s.nodes.map(|n| self.nodes[n]);
-            if let Ok(g) = shell_geometry(&x) {
+        for s in part.shells.iter().filter_map(|&i| self.shells.get(i)) {
+            if let Some(g) =
+                at(&s.nodes).and_then(|x| shell_geometry(&[x[0], x[1], x[2], x[3]]).ok())
+            {
                 m += s.material.density_kg_per_m3 * s.thickness_m * g.area_m2;
             }
         }
-        for s in &self.triangles {
-            if s.nodes.iter().any(|&n| n >= self.nodes.len()) {
-                continue;
-            }
-            if let Ok(g) = tri_geometry(&s.nodes.map(|n| self.nodes[n])) {
+        for s in part.triangles.iter().filter_map(|&i| self.triangles.get(i)) {
+            if let Some(g) = at(&s.nodes).and_then(|x| tri_geometry(&[x[0], x[1], x[2]]).ok()) {
                 m += s.material.density_kg_per_m3 * s.thickness_m * g.area_m2;
             }
         }
-        m + self.masses.iter().map(|p| p.mass_kg).sum::<f64>()
+        m + part
+            .masses
+            .iter()
+            .filter_map(|&i| self.masses.get(i))
+            .map(|p| p.mass_kg)
+            .sum::<f64>()
+    }
+
+    /// The nodes the elements of `part` connect (sorted, without repeats).
+    pub fn nodes_of_part(&self, part: &MeshPart) -> Vec<usize> {
+        let mut v: Vec<usize> = Vec::new();
+        v.extend(
+            part.frames
+                .iter()
+                .filter_map(|&i| self.frames.get(i))
+                .flat_map(|e| e.nodes),
+        );
+        v.extend(
+            part.shells
+                .iter()
+                .filter_map(|&i| self.shells.get(i))
+                .flat_map(|e| e.nodes),
+        );
+        v.extend(
+            part.triangles
+                .iter()
+                .filter_map(|&i| self.triangles.get(i))
+                .flat_map(|e| e.nodes),
+        );
+        v.extend(
+            part.masses
+                .iter()
+                .filter_map(|&i| self.masses.get(i))
+                .map(|e| e.node),
+        );
+        v.sort_unstable();
+        v.dedup();
+        v
     }
 
     fn check_node(&self, what: &str, node: usize) -> Result<()> {

@@ -40,7 +40,7 @@ pub use discrete::{Dashpot, PointMass, RigidLink, Spring};
 pub use frame::{FrameElement, Section};
 pub use machine::{GeneratedMachine, Machine, MachineSpec, Support};
 pub use material::Material;
-pub use mesh::{Dof, Mesh};
+pub use mesh::{Dof, Mesh, MeshPart};
 pub use modes::ModeTable;
 pub use shell::ShellElement;
 pub use tri3::TriShellElement;
