@@ -1411,7 +1411,12 @@ pub fn point_model_cached(
     let ratios = quantities.iter().any(|q| !matches!(q, Quantity::Field(_)));
     let key_before = ratios.then(|| model.structure_key());
     let w_ref = model.reference_omega();
-    let m_b = bed_mass_kg.or_else(|| model.bed_mass());
+    // Only md/mb needs m_b (derived from the point's model: building a general model's mesh).
+    let m_b = if quantities.contains(&&Quantity::MdOverMb) {
+        bed_mass_kg.or_else(|| model.bed_mass())
+    } else {
+        None
+    };
     let spec = &mut model.spec;
     let m_s = spec.slider.mass;
     // 2. w_s.
