@@ -502,8 +502,7 @@ impl Model {
             // The mesh is built (a Gmsh file read) once per structure and contact point: the
             // points of a sweep share it.
             let key = (self.structure_key(), contact.to_string());
-            static MEMO: std::sync::Mutex<Vec<((StructureKey, String), Option<f64>)>> =
-                std::sync::Mutex::new(Vec::new());
+            static MEMO: std::sync::Mutex<Vec<BedMassEntry>> = std::sync::Mutex::new(Vec::new());
             if let Some(hit) = MEMO
                 .lock()
                 .ok()
@@ -523,6 +522,9 @@ impl Model {
         None
     }
 }
+
+/// A remembered bed mass: (structure, contact point) → m_b.
+type BedMassEntry = ((StructureKey, String), Option<f64>);
 
 /// Whether any shells, frames or masses entry of `g` is labelled [`BED_PART`].
 fn general_has_bed_part(g: &general::GeneralSpec) -> bool {
