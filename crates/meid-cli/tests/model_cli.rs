@@ -8,19 +8,24 @@ use common::{example_file as example, meid, ok, ok_json, stderr, tmpdir};
 
 const COARSE: &str = "structure.fem.machine.elements_per_side=6";
 
+/// `meid model expand SRC --set COARSE -o OUT`; what it printed.
+fn expand_coarse(src: &std::path::Path, out: &std::path::Path) -> String {
+    ok(meid()
+        .args(["model", "expand"])
+        .arg(src)
+        .args(["--set", COARSE, "-o"])
+        .arg(out)
+        .output()
+        .unwrap())
+}
+
 #[test]
 fn expanded_file_gives_the_machines_modes_and_summary() {
     let d = tmpdir("model", "expand");
     for file in ["paper-soft-base.toml", "paper-no-base.toml"] {
         let src = example(file);
         let out = d.join(file);
-        let printed = ok(meid()
-            .args(["model", "expand"])
-            .arg(&src)
-            .args(["--set", COARSE, "-o"])
-            .arg(&out)
-            .output()
-            .unwrap());
+        let printed = expand_coarse(&src, &out);
         assert!(printed.is_empty(), "{printed}");
         let written = std::fs::read_to_string(&out).unwrap();
         assert!(
@@ -85,13 +90,7 @@ fn expanded_file_knows_its_bed_mass() {
     let d = tmpdir("model", "bed-mass");
     let src = example("paper-soft-base.toml");
     let out = d.join("expanded.toml");
-    ok(meid()
-        .args(["model", "expand"])
-        .arg(&src)
-        .args(["--set", COARSE, "-o"])
-        .arg(&out)
-        .output()
-        .unwrap());
+    expand_coarse(&src, &out);
     let damper_masses = |dir: &std::path::Path| -> Vec<f64> {
         let text = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
         let mut lines = text.lines();
