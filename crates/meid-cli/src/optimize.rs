@@ -37,8 +37,9 @@ pub struct OptimizeArgs {
     /// variable: a 9-point scan, one Brent step and those two; n + 3 for n variables).
     #[arg(long, value_name = "N", default_value_t = 400)]
     max_simulations: usize,
-    /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, or the
-    /// FE machine's bed plate; see docs/studies.md).
+    /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, the
+    /// FE machine's bed plate, or a general FE model's elements labelled part = "bed"; see
+    /// docs/studies.md).
     #[arg(long, value_name = "KG")]
     bed_mass: Option<f64>,
     /// Write the report (optimize.json: variables, bounds, optimum, objective values) into DIR.

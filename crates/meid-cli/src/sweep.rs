@@ -54,8 +54,9 @@ pub struct SweepArgs {
     /// DIR/shard.csv (needs -o DIR); `meid merge` puts the shards together.
     #[arg(long, value_name = "K/N")]
     shard: Option<crate::shard::Shard>,
-    /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, or the
-    /// FE machine's bed plate; see docs/studies.md).
+    /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, the
+    /// FE machine's bed plate, or a general FE model's elements labelled part = "bed"; see
+    /// docs/studies.md).
     #[arg(long, value_name = "KG")]
     bed_mass: Option<f64>,
     // --json prints the result (sweep.json's content); -q: no progress bar or summary either.

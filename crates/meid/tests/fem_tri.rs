@@ -634,3 +634,47 @@ fn bed_part_on_a_gmsh_surface_gives_the_bed_mass() {
     let m_b = m.bed_mass().unwrap();
     assert!((m_b / 78.5 - 1.0).abs() < 1e-12, "m_b = {m_b} kg");
 }
+
+/// m_b comes from the mesh the modes came from: rewriting the Gmsh file with every x doubled
+/// and reading the model again doubles it (157 kg), in the same process.
+#[test]
+fn bed_mass_follows_the_mesh_file() {
+    let dir = std::env::temp_dir().join(format!("meid-bed-mesh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(data("ss_plate_tri.toml"))
+        .unwrap()
+        .replace(
+            r#"shells = [{ set = "plate", thickness = 0.01 }]"#,
+            r#"shells = [{ set = "plate", thickness = 0.01, part = "bed" }]"#,
+        );
+    let model = dir.join("plate.toml");
+    std::fs::write(&model, &text).unwrap();
+    let msh = std::fs::read_to_string(data("ss_plate_tri.msh")).unwrap();
+    std::fs::write(dir.join("ss_plate_tri.msh"), &msh).unwrap();
+    let m_b = |p: &std::path::Path| meid::model::Model::from_file(p, &[]).unwrap().bed_mass();
+    let one = m_b(&model).unwrap();
+    assert!((one / 78.5 - 1.0).abs() < 1e-12, "{one} kg");
+    // $Nodes of Gmsh 4.1: after each entity block header, `tag` lines then `x y z` lines.
+    let mut stretched = String::new();
+    let mut in_nodes = false;
+    for line in msh.lines() {
+        match line {
+            "$Nodes" => in_nodes = true,
+            "$EndNodes" => in_nodes = false,
+            _ => {}
+        }
+        let f: Vec<&str> = line.split_whitespace().collect();
+        if in_nodes && f.len() == 3 && (f[0].contains('.') || f[0].contains('e')) {
+            let x: f64 = f[0].parse().unwrap();
+            stretched.push_str(&format!("{} {} {}\n", 2.0 * x, f[1], f[2]));
+        } else {
+            stretched.push_str(line);
+            stretched.push('\n');
+        }
+    }
+    assert_ne!(stretched.trim_end(), msh.trim_end());
+    std::fs::write(dir.join("ss_plate_tri.msh"), &stretched).unwrap();
+    let two = m_b(&model).unwrap();
+    assert!((two / 157.0 - 1.0).abs() < 1e-12, "{two} kg");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -738,9 +738,9 @@ mod tests {
             let mut got = Extremes::default();
             on_poly(&lowered, deg, tau, period, 0.0, len, &mut got);
             let want = unpruned(&a, tau, period, len);
-            // Round-off scale: the coefficients are sums of the modal terms, so `a₀` carries
-            // an error of ε·Σ|A_j| however small the cancelled sum is, and the lowered
-            // degree's remainder is bounded relative to the same state scale.
+            // Scale: lowering the degree drops a remainder that `degree_for_reach` bounds
+            // relative to the state's size (‖X₀‖ ≈ Σ|A_j|), not to the values of a channel
+            // whose modal terms cancel (`a₀` ≪ Σ|A_j|).
             let amplitudes: f64 = modes.iter().map(|m| m.2.abs()).sum();
             let scale = taylor::abs_horner(&a, len).max(amplitudes);
             let tol = 1e-14 * scale;

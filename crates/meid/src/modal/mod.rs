@@ -67,6 +67,10 @@ pub struct ModalModel {
     /// What building the structure found doubtful (ill-conditioning, modes missing below the
     /// selection cutoff). Each names the model field concerned.
     pub warnings: Vec<String>,
+    /// The bed mass m_b (kg) an FE model tells by its elements labelled `part = "bed"` when
+    /// every node of the bed contact point is on them (`Mesh::mass_of`, computed from the
+    /// mesh the modes came from); `None` otherwise.
+    pub bed_mass_kg: Option<f64>,
 }
 
 impl ModalModel {
@@ -93,6 +97,7 @@ impl ModalModel {
             static_flexibility: BTreeMap::new(),
             notes: Vec::new(),
             warnings: Vec::new(),
+            bed_mass_kg: None,
         })
     }
 
@@ -185,6 +190,8 @@ impl ModalModel {
             },
             notes: self.notes.clone(),
             warnings: self.warnings.clone(),
+            // The bare structure's bed, as the mass ratio md/mb means it.
+            bed_mass_kg: self.bed_mass_kg,
         })
     }
 

@@ -1193,6 +1193,23 @@ pub const NEGLIGIBLE_SCORE: f64 = 1e-12;
 /// Selected modes with a relative residual above this are warned about.
 pub const RESIDUAL_WARNING: f64 = 1e-6;
 
+/// The mass of `mesh`'s elements labelled [`super::BED_PART`] when every node of the bed
+/// contact point (`ctx`'s role `bed_contact`) is on them: the bed mass m_b of `md/mb`.
+fn bed_part_mass(mesh: &crate::structure::Mesh, ctx: &ReductionContext) -> Option<f64> {
+    let bed = mesh.parts.get(super::BED_PART)?;
+    let contact = ctx
+        .role_points
+        .iter()
+        .find(|(_, roles)| roles.iter().any(|r| r == "bed_contact"))?;
+    let at = mesh.points.get(&contact.0)?;
+    let on_bed = mesh.nodes_of_part(bed);
+    if at.is_empty() || at.iter().any(|n| on_bed.binary_search(n).is_err()) {
+        return None;
+    }
+    let m_b = mesh.mass_of(bed);
+    (m_b.is_finite() && m_b > 0.0).then_some(m_b)
+}
+
 /// Builds, solves, selects and reduces: the full analysis behind `[structure.fem]`. `ctx`
 /// gives the contact frequency (for the "auto" cutoff) and the model's named points.
 pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<FemAnalysis> {
@@ -1433,6 +1450,7 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
     }
     modal.static_flexibility = static_flexibility;
     modal.warnings = warnings;
+    modal.bed_mass_kg = bed_part_mass(&model.mesh, ctx);
     if let Some(note) = model.constraint_like_note(CONSTRAINT_LIKE_RATIO) {
         modal.notes.push(format!("{base}: {note}"));
     }

@@ -495,56 +495,12 @@ impl Model {
             let m_b = spec.bed.mass_kg() + added;
             return (m_b.is_finite() && m_b > 0.0).then_some(m_b);
         }
-        if let Some(g) = st.fem.as_ref().and_then(|f| f.model.as_ref()) {
-            if !general_has_bed_part(g) {
-                return None;
-            }
-            // The mesh is built (a Gmsh file read) once per structure and contact point: the
-            // points of a sweep share it.
-            let key = (self.structure_key(), contact.to_string());
-            static MEMO: std::sync::Mutex<Vec<BedMassEntry>> = std::sync::Mutex::new(Vec::new());
-            if let Some(hit) = MEMO
-                .lock()
-                .ok()
-                .and_then(|m| m.iter().find(|(k, _)| *k == key).map(|(_, v)| *v))
-            {
-                return hit;
-            }
-            let m_b = general_bed_mass(g, &self.source, contact);
-            if let Ok(mut m) = MEMO.lock() {
-                if m.len() >= 64 {
-                    m.remove(0);
-                }
-                m.push((key, m_b));
-            }
-            return m_b;
+        if st.fem.as_ref().is_some_and(|f| f.model.is_some()) {
+            // Found when the structure was built, from the same mesh as its modes.
+            return self.structure.bed_mass_kg;
         }
         None
     }
-}
-
-/// A remembered bed mass: (structure, contact point) → m_b.
-type BedMassEntry = ((StructureKey, String), Option<f64>);
-
-/// Whether any shells, frames or masses entry of `g` is labelled [`BED_PART`].
-fn general_has_bed_part(g: &general::GeneralSpec) -> bool {
-    let bed = |p: &Option<String>| p.as_deref() == Some(BED_PART);
-    g.shells.iter().any(|s| bed(&s.part))
-        || g.frames.iter().any(|f| bed(&f.part))
-        || g.masses.iter().any(|m| bed(&m.part))
-}
-
-/// The mass of `g`'s [`BED_PART`] when every node of the point `contact` is on it.
-fn general_bed_mass(g: &general::GeneralSpec, src: &Source, contact: &str) -> Option<f64> {
-    let (mesh, _) = general::build_mesh(g, src).ok()?;
-    let bed = mesh.parts.get(BED_PART)?;
-    let on_bed = mesh.nodes_of_part(bed);
-    let at = mesh.points.get(contact)?;
-    if at.is_empty() || at.iter().any(|n| on_bed.binary_search(n).is_err()) {
-        return None;
-    }
-    let m_b = mesh.mass_of(bed);
-    (m_b.is_finite() && m_b > 0.0).then_some(m_b)
 }
 
 /// The part label of the bed in a general model (`part = "bed"`): its mass is the bed mass m_b
