@@ -193,6 +193,12 @@ fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>, uff: 
     if let Some(r) = s.energy_balance_residual {
         println!("  energy-balance residual               {r:.2e} (end of collision), {:.2e} (end of run)", s.energy_balance_residual_run_end);
     }
+    if let Some(r) = s.energy_balance_residual_transferred {
+        println!(
+            "    of the energy given to the machine  {r:.2e} (end of collision), {:.2e} (end of run)",
+            s.energy_balance_residual_transferred_run_end
+        );
+    }
     println!(
         "  {} events, {} segments/steps over {:.4} s",
         s.switching_events, s.steps, s.simulated_time_s

@@ -401,3 +401,55 @@ fn recorded_bed_acceleration_equals_modal_accelerations() {
         assert!(want.abs() > 1e-3 * scale, "mode {bits}: a trivial state");
     }
 }
+
+/// A slider far heavier than the machine keeps nearly all of its energy, so the energy left in
+/// the machine (Eq. 10, `E_s− − E_s+ − E_d+`) is a difference of numbers up to 1e12 times
+/// larger than itself. Before the transferred-energy check, `slider.mass = 1e15` passed with
+/// E_p+ wrong in the fourth digit (0.99498 J against its parts' 0.99421 J) and `1e100` with a
+/// negative E_p+. Now a run either gives E_p+ equal to its parts `KE_p + PE_p + ∫P dt` to
+/// 1e-6 (the check's bound is 1e-8), or fails with a message naming the cause; and the heavy-slider limit (the slider a
+/// prescribed velocity: E_p+ independent of its mass, to O(m_machine/m_s)) is reached.
+#[test]
+fn a_heavy_slider_gives_a_trusted_machine_energy_or_an_error() {
+    let mut limit = Vec::new();
+    for mass in [
+        "1e3", "1e6", "1e7", "1e8", "1e9", "1e10", "1e14", "1e15", "1e100",
+    ] {
+        let m = load(&[&format!("slider.mass={mass}"), "slider.velocity=0.1"]);
+        let sys = m.impact_system(Case::AsSpecified).unwrap();
+        match simulate(&sys, &opts(Method::Exact, 0.5, false), false) {
+            Ok(run) => {
+                let s = &run.summary;
+                let ep = s.machine_energy_after_j.unwrap();
+                let parts = s.machine_kinetic_energy_after_j.unwrap()
+                    + s.machine_potential_energy_after_j.unwrap()
+                    + s.dissipated_energy_after_j.unwrap();
+                assert!(
+                    (ep - parts).abs() <= 1e-6 * parts,
+                    "m_s = {mass}: E_p+ {ep} J against its parts {parts} J"
+                );
+                if (1e7..=1e9).contains(&mass.parse::<f64>().unwrap()) {
+                    limit.push(ep);
+                }
+            }
+            Err(e) => {
+                let msg = e.to_string();
+                assert!(
+                    mass.parse::<f64>().unwrap() >= 1e10,
+                    "m_s = {mass} must run: {msg}"
+                );
+                assert!(
+                    msg.contains("energy balance") && msg.contains("slider.mass"),
+                    "m_s = {mass}: {msg}"
+                );
+            }
+        }
+    }
+    // E_p+(m_s) = E_∞ + O(1/m_s): from 1e7 to 1e8 to 1e9 kg the change shrinks tenfold.
+    assert_eq!(limit.len(), 3, "1e7, 1e8 and 1e9 kg run");
+    let (d1, d2) = ((limit[1] - limit[0]).abs(), (limit[2] - limit[1]).abs());
+    assert!(
+        d1 <= 1e-4 * limit[0] && d2 <= 0.2 * d1,
+        "heavy-slider limit: {limit:?}"
+    );
+}

@@ -38,7 +38,7 @@
 
 use serde::Serialize;
 
-use super::energy::{balance_residual, check_run, EnergyTerms, History, Recorder};
+use super::energy::{check_run, Balance, EnergyTerms, History, Recorder};
 use crate::impact::{dot, Channel, ImpactSystem, Mode, Switch};
 use crate::integrate::{self, Options, Solution};
 use crate::{Error, Result};
@@ -350,13 +350,14 @@ pub fn run_blows_progress(
         // end + what it dissipated.
         let e_end = EnergyTerms::at(sys, sol.mode_final, &sol.x_final);
         // (With a constant slider force, plus its work W_F = F (z_s − z_s0).)
-        let residual = balance_residual(
+        let balance = Balance::new(
+            sol.t_final,
             e0.total(),
             sys.force_work(&x0, &sol.x_final),
-            e_end.total(),
+            &e_end,
             sol.totals.dissipated,
         );
-        check_run(sys, &o_blow, &sol, residual)?;
+        check_run(sys, &o_blow, &sol, &[balance])?;
         let end = sol.collision_end.as_ref();
         let energy_ratio = end.map(|c| {
             let vs = c.x[nd + sys.slider_index()];
