@@ -230,6 +230,7 @@ fn pyuff_reads_what_meid_writes() {
         modal_mass: 1.0,
         damping_ratio: 0.01,
         name: "bed".into(),
+        id_lines: vec!["written by meid".into()],
         shapes: vec![(1, [0.0, 0.0, 0.2835]), (2, [0.0, 0.0, -0.0691897])],
     };
     let mut out = Vec::new();
