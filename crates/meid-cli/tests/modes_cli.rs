@@ -359,7 +359,7 @@ fn lumped_modes_uff_nodes_follow_modes_csv() {
 /// Signed ψ must not depend on the eigen-solver: on the paper's FE machine the dense and the
 /// Lanczos solutions of 12 modes returned modes 2, 3, 6, 7, 8 and 12 with opposite signs (mode
 /// 7: ψ(B) = −0.0973 dense, +0.0973 Lanczos), harmless while the table held |ψ|. With the sign
-/// convention (largest entry of each mass-normalised shape positive, `fem::orient_modes`) both
+/// convention (largest entry of each mass-normalised shape positive, `modal::dense::orient_modes`) both
 /// give the same signed ψ at every named point, to 1e-6 of the table's largest |ψ|. Modes closer
 /// than 1 % in frequency to a neighbour are left out (their basis is not unique).
 #[test]

@@ -1149,36 +1149,12 @@ fn checked(model: &FeModel, mut modes: DenseModes, solver: &str) -> Result<Dense
         what,
     )
     .map_err(|e| solver_hint(e, model, solver))?;
-    orient_modes(&mut modes.shapes);
+    crate::modal::dense::orient_modes(&mut modes.shapes);
     modes.omega_rad_per_s = c.omega_rad_per_s;
     modes.rigid_body_modes = c.rigid_body_modes;
     modes.orthonormality_error = c.orthonormality_error;
     modes.max_residual = c.residuals.iter().fold(0.0_f64, |a, &b| a.max(b));
     Ok(modes)
-}
-
-/// Relative tolerance of [`orient_modes`]: entries within it of the largest count as tied.
-const ORIENT_TIE: f64 = 1e-6;
-
-/// Sign convention of computed modes (a mode `φ` and `−φ` are the same mode; the solvers return
-/// either): each column of `shapes` is negated when needed so that its entry of largest
-/// magnitude over the reduced DOFs is positive, taking the first in DOF order among the entries
-/// with `|φ_j| ≥ (1 − 10⁻⁶) max_k |φ_k|`, so that round-off between the dense and Lanczos
-/// solutions (or thread counts) cannot pick another entry of a symmetric pair. Signed outputs
-/// (ψ in `modes.csv`, shapes in `modes.vtu`/`modes.uff`) then do not depend on the solver. Within
-/// a degenerate (repeated) eigenvalue the basis itself is arbitrary; no sign rule fixes that.
-pub(crate) fn orient_modes(shapes: &mut faer::Mat<f64>) {
-    for i in 0..shapes.ncols() {
-        let max = (0..shapes.nrows()).fold(0.0_f64, |a, j| a.max(shapes[(j, i)].abs()));
-        let pick = (0..shapes.nrows()).find(|&j| shapes[(j, i)].abs() >= (1.0 - ORIENT_TIE) * max);
-        if let Some(j) = pick {
-            if shapes[(j, i)] < 0.0 {
-                for r in 0..shapes.nrows() {
-                    shapes[(r, i)] = -shapes[(r, i)];
-                }
-            }
-        }
-    }
 }
 
 /// The most modes the block Lanczos solver computes on `n` degrees of freedom with blocks of
