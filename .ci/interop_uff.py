@@ -111,7 +111,8 @@ def read(path):
             out.append({"type": 2411, "nodes": [[int(a), float(b), float(c), float(e)] for a, b, c, e in zip(s["node_nums"], s["x"], s["y"], s["z"])]})
         elif s["type"] == 55:
             out.append({"type": 55, "freq": float(s["freq"]), "mode_n": int(s["mode_n"]), "damping": float(s["modal_damp_vis"]),
-                        "node_nums": [int(v) for v in s["node_nums"]], "r3": [float(v) for v in s["r3"]]})
+                        "node_nums": [int(v) for v in s["node_nums"]], "r3": [float(v) for v in s["r3"]],
+                        "id": [s["id%d" % k].strip() for k in range(1, 6)]})
     print(json.dumps(out))
 
 

@@ -70,7 +70,7 @@ fn fem_model_table_json_and_files() {
         "index",
         "frequency_hz",
         "effective_mass_kg",
-        "participation",
+        "psi_per_sqrt_kg",
     ] {
         assert!(modes[0].get(key).is_some(), "missing {key}");
     }
@@ -80,7 +80,7 @@ fn fem_model_table_json_and_files() {
             "missing {key}"
         );
     }
-    assert!(modes[4]["participation"]["O_b"].as_f64().unwrap() > 0.0);
+    assert!(modes[4]["psi_per_sqrt_kg"]["O_b"].as_f64().unwrap().abs() > 0.0);
     // Paper: 6.35 Hz (3 %).
     let f5 = modes[4]["frequency_hz"].as_f64().unwrap();
     assert!((f5 - 6.35).abs() <= 0.03 * 6.35, "{f5}");
@@ -136,6 +136,282 @@ fn lumped_model_table() {
     let f = v["modes"][1]["frequency_hz"].as_f64().unwrap();
     // examples/paper-lumped.toml is built for 283 Hz.
     assert!((f - 283.0).abs() < 1e-3 * 283.0, "{f}");
+}
+
+/// modes.csv of a lumped model: header, point names (column order) and rows of strings.
+fn modes_csv(d: &std::path::Path) -> (Vec<String>, Vec<String>, Vec<Vec<String>>) {
+    let csv = std::fs::read_to_string(d.join("modes.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let points = header
+        .iter()
+        .filter_map(|h| h.strip_prefix("psi_")?.strip_suffix("_per_sqrt_kg"))
+        .map(str::to_string)
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    (header, points, rows)
+}
+
+fn col(header: &[String], name: &str) -> usize {
+    header
+        .iter()
+        .position(|h| h == name)
+        .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+}
+
+/// The model of examples/paper-lumped.toml with `structure` replaced by `structure_text`.
+fn lumped_with_structure(structure_text: &str) -> String {
+    let src = std::fs::read_to_string(example("paper-lumped.toml")).unwrap();
+    let start = src.find("[structure]").unwrap();
+    let end = src.find("[points]").unwrap();
+    format!("{}{structure_text}\n{}", &src[..start], &src[end..])
+}
+
+fn energy_ratio(model: &std::path::Path) -> f64 {
+    let out = meid()
+        .args(["simulate", "--json"])
+        .arg(model)
+        .output()
+        .unwrap();
+    common::ok_json(out)["energy_ratio"].as_f64().unwrap()
+}
+
+/// The defect (audit of c54de10): modes.csv / modes.json wrote |ψ| under columns named ψ, so
+/// mode 2 of the lumped example read +0.0692 at the base where the mode has −0.0692, and a
+/// `[structure.modal]` model built from modes.csv gave E_p+/E_s− = 14.70 % instead of 14.64 %.
+///
+/// References: (1) the closed form of the two-mass chain (bed m_b on columns k_c over the base
+/// m_f): `ψ(bed)/ψ(base) = k_c/(k_c − m_b ω²)` per mode, negative for the 283 Hz mode;
+/// (2) M-orthonormality `Σ_P m_P ψ_i(P) ψ_j(P) = δ_ij` with M = diag(m_base, m_bed);
+/// (3) the `[structure.modal]` model built from the written columns gives the original model's
+/// energy ratio to 1e-9 (the CSV values are exact decimal round-trips).
+#[test]
+fn lumped_modes_csv_psi_is_signed_and_rebuilds_the_model() {
+    let d = tmpdir("signed-psi");
+    let out = meid()
+        .args(["modes", "--json", "-o"])
+        .arg(&d)
+        .arg(example("paper-lumped.toml"))
+        .output()
+        .unwrap();
+    let v = common::ok_json(out);
+    let (header, points, rows) = modes_csv(&d);
+    assert_eq!(points, vec!["base".to_string(), "bed".to_string()]);
+    assert_eq!(rows.len(), 2);
+    let f = |r: &[String], c: &str| -> f64 { r[col(&header, c)].parse().unwrap() };
+    let psi: Vec<[f64; 2]> = rows
+        .iter()
+        .map(|r| [f(r, "psi_base_per_sqrt_kg"), f(r, "psi_bed_per_sqrt_kg")])
+        .collect();
+    // modes.json carries the same signed numbers.
+    for (i, p) in psi.iter().enumerate() {
+        let j = &v["modes"][i]["psi_per_sqrt_kg"];
+        assert_eq!(j["base"].as_f64().unwrap(), p[0]);
+        assert_eq!(j["bed"].as_f64().unwrap(), p[1]);
+    }
+    // (1) closed form of the chain, examples/paper-lumped.toml: m_b = 10 kg, m_f = 41 kg,
+    // k_c = 2.5415164e7 N/m.
+    let (m_bed, m_base, k_c) = (10.0, 41.0, 2.5415164e7);
+    for (r, p) in rows.iter().zip(&psi) {
+        let w = 2.0 * std::f64::consts::PI * f(r, "frequency_hz");
+        let ratio = k_c / (k_c - m_bed * w * w);
+        assert!(
+            (p[1] / p[0] / ratio - 1.0).abs() < 1e-9,
+            "psi(bed)/psi(base) = {} vs k_c/(k_c - m_b w^2) = {ratio}",
+            p[1] / p[0]
+        );
+    }
+    assert!(
+        psi[1][0] * psi[1][1] < 0.0,
+        "mode 2: bed and base in opposition {psi:?}"
+    );
+    // (2) M-orthonormality.
+    for i in 0..2 {
+        for j in 0..2 {
+            let g = m_base * psi[i][0] * psi[j][0] + m_bed * psi[i][1] * psi[j][1];
+            let want = if i == j { 1.0 } else { 0.0 };
+            assert!((g - want).abs() < 1e-12, "psi_{i}^T M psi_{j} = {g}");
+        }
+    }
+    // (3) a [structure.modal] model from the written columns.
+    let shapes: String = points
+        .iter()
+        .map(|p| {
+            let c = col(&header, &format!("psi_{p}_per_sqrt_kg"));
+            format!(
+                "{p} = [{}]\n",
+                rows.iter()
+                    .map(|r| r[c].as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        })
+        .collect();
+    let freqs: Vec<&str> = rows
+        .iter()
+        .map(|r| r[col(&header, "frequency_hz")].as_str())
+        .collect();
+    let text = lumped_with_structure(&format!(
+        "[structure]\nreference_mode = 1\n[structure.modal]\nfrequencies_hz = [{}]\ndamping_ratios = [0.01, 0.01]\n[structure.modal.shapes]\n{shapes}",
+        freqs.join(", ")
+    ));
+    let modal = d.join("from-modes-csv.toml");
+    std::fs::write(&modal, text).unwrap();
+    let r0 = energy_ratio(&example("paper-lumped.toml"));
+    let r1 = energy_ratio(&modal);
+    assert!(
+        (r1 / r0 - 1.0).abs() < 1e-9,
+        "energy ratio from modes.csv {r1} vs the lumped model {r0}"
+    );
+    // docs/studies.md: 14.64 % for this model at 0.5 s.
+    assert!((r0 - 0.1464).abs() < 5e-5, "{r0}");
+}
+
+/// The defect (audit of c54de10): modes.uff of a lumped model numbered its nodes by point name
+/// (base = 1, bed = 2) at made-up coordinates without saying so anywhere; mapping node 1 to the
+/// first mass of the model file (bed) gave 8.25 % instead of 14.64 %. Now the rule is in the
+/// file (ID lines 2-5 of every dataset 55: "node k = k-th point by name as in modes.csv" and
+/// the `label = name` pairs) and in docs/measure.md. Reference: modes.csv — reading modes.uff
+/// back with meid's reader and mapping node k to the k-th ψ column gives the same signed ψ
+/// (to the 6 significant digits of dataset 55), the nodes sit at x = k − 1 m, and importing the
+/// file as `[structure.modes]` with that mapping gives the model's energy ratio (to 1e-4).
+#[test]
+fn lumped_modes_uff_nodes_follow_modes_csv() {
+    let d = tmpdir("uff-nodes");
+    let out = meid()
+        .args(["modes", "--uff", "-o"])
+        .arg(&d)
+        .arg(example("paper-lumped.toml"))
+        .output()
+        .unwrap();
+    common::ok(out);
+    let (header, points, rows) = modes_csv(&d);
+    let f = meid::io::uff::read_uff(&d.join("modes.uff")).unwrap();
+    assert_eq!(f.nodes.len(), points.len());
+    for (k, n) in f.nodes.iter().enumerate() {
+        assert_eq!(n.label, k as i64 + 1);
+        assert_eq!(n.xyz, [k as f64, 0.0, 0.0]);
+    }
+    assert_eq!(f.modes.len(), rows.len());
+    for (m, r) in f.modes.iter().zip(&rows) {
+        // The rule and the names are in the file itself.
+        assert!(
+            m.id_lines
+                .iter()
+                .any(|l| l.contains("node k = k-th point by name as in modes.csv")),
+            "{:?}",
+            m.id_lines
+        );
+        let pairs = m
+            .id_lines
+            .iter()
+            .find_map(|l| l.strip_prefix("nodes:"))
+            .unwrap_or_else(|| panic!("no 'nodes:' line in {:?}", m.id_lines));
+        let want: Vec<String> = points
+            .iter()
+            .enumerate()
+            .map(|(k, p)| format!("{} = {p}", k + 1))
+            .collect();
+        let got: Vec<String> = pairs.split(',').map(|s| s.trim().to_string()).collect();
+        assert_eq!(got, want);
+        for (k, p) in points.iter().enumerate() {
+            let psi: f64 = r[col(&header, &format!("psi_{p}_per_sqrt_kg"))]
+                .parse()
+                .unwrap();
+            let (node, u) = m.shapes[k];
+            assert_eq!(node, k as i64 + 1);
+            assert_eq!((u[0], u[1]), (0.0, 0.0));
+            assert!(
+                (u[2] - psi).abs() <= 5e-6 * psi.abs() && u[2].signum() == psi.signum(),
+                "mode {}: node {node} z = {} vs psi({p}) = {psi}",
+                m.number,
+                u[2]
+            );
+        }
+    }
+    // Imported with the documented mapping, the file is the model.
+    let map: Vec<String> = points
+        .iter()
+        .enumerate()
+        .map(|(k, p)| format!("{p} = {}", k + 1))
+        .collect();
+    let text = lumped_with_structure(&format!(
+        "[structure]\nreference_mode = 1\n[structure.modes]\nfile = \"modes.uff\"\npoints = {{ {} }}\nimpact_direction = [0, 0, 1]\n",
+        map.join(", ")
+    ));
+    let imported = d.join("from-modes-uff.toml");
+    std::fs::write(&imported, text).unwrap();
+    let r0 = energy_ratio(&example("paper-lumped.toml"));
+    let r1 = energy_ratio(&imported);
+    assert!(
+        (r1 / r0 - 1.0).abs() < 1e-4,
+        "energy ratio from modes.uff {r1} vs the lumped model {r0}"
+    );
+}
+
+/// Signed ψ must not depend on the eigen-solver: on the paper's FE machine the dense and the
+/// Lanczos solutions of 12 modes returned modes 2, 3, 6, 7, 8 and 12 with opposite signs (mode
+/// 7: ψ(B) = −0.0973 dense, +0.0973 Lanczos), harmless while the table held |ψ|. With the sign
+/// convention (largest entry of each mass-normalised shape positive, `modal::dense::orient_modes`) both
+/// give the same signed ψ at every named point, to 1e-6 of the table's largest |ψ|. Modes closer
+/// than 1 % in frequency to a neighbour are left out (their basis is not unique).
+#[test]
+fn fe_signed_psi_does_not_depend_on_the_solver() {
+    let run = |solver: &str| -> serde_json::Value {
+        let out = meid()
+            .args(["modes", "--json", "--count", "12", "--set"])
+            .arg(format!("structure.fem.solver=\"{solver}\""))
+            .arg(example("paper-soft-base.toml"))
+            .output()
+            .unwrap();
+        common::ok_json(out)
+    };
+    let (a, b) = (run("dense"), run("lanczos"));
+    let (ma, mb) = (
+        a["modes"].as_array().unwrap(),
+        b["modes"].as_array().unwrap(),
+    );
+    assert_eq!(ma.len(), 12);
+    let f: Vec<f64> = ma
+        .iter()
+        .map(|m| m["frequency_hz"].as_f64().unwrap())
+        .collect();
+    // The tolerance: 1e-6 of the largest |ψ| of the table (eigenvector round-off is absolute;
+    // mode 3 moves the points by 2e-6 1/√kg only, still 4 times the tolerance).
+    let scale = ma
+        .iter()
+        .flat_map(|m| m["psi_per_sqrt_kg"].as_object().unwrap().values())
+        .fold(0.0_f64, |m, v| m.max(v.as_f64().unwrap().abs()));
+    let mut compared = 0;
+    for i in 0..ma.len() {
+        let isolated =
+            (i == 0 || f[i] > 1.01 * f[i - 1]) && (i + 1 == f.len() || f[i + 1] > 1.01 * f[i]);
+        if !isolated {
+            continue;
+        }
+        let (pa, pb) = (
+            ma[i]["psi_per_sqrt_kg"].as_object().unwrap(),
+            mb[i]["psi_per_sqrt_kg"].as_object().unwrap(),
+        );
+        for (p, va) in pa {
+            let (x, y) = (va.as_f64().unwrap(), pb[p].as_f64().unwrap());
+            assert!(
+                (x - y).abs() <= 1e-6 * scale,
+                "mode {}: psi({p}) dense {x} vs lanczos {y}",
+                i + 1
+            );
+        }
+        compared += 1;
+    }
+    // Modes 1-2 (2.74, 2.80 Hz) are 2 % apart: all 12 are compared.
+    assert_eq!(compared, 12);
 }
 
 #[test]

@@ -247,8 +247,8 @@ impl Model {
     }
 
     /// The retained modes: `{"frequencies_hz": (n,), "points": [names], "shapes": (points, n)}`
-    /// (mass-normalised z at the named points, m per unit modal coordinate), the first `count`
-    /// when given.
+    /// (signed mass-normalised ψ along the impact axis at the named points, 1/√kg; points in
+    /// name order, as the ψ columns of `meid modes`' modes.csv), the first `count` when given.
     #[pyo3(signature = (count=None))]
     fn modes<'py>(&self, py: Python<'py>, count: Option<usize>) -> PyResult<Bound<'py, PyDict>> {
         let s = &self.inner.structure;

@@ -50,6 +50,7 @@ fn valid_uff(binary: bool) -> Vec<u8> {
             modal_mass: 1.0,
             damping_ratio: 0.01,
             name: "m".into(),
+            id_lines: Vec::new(),
             shapes: vec![(1, [0.0, 0.0, 0.14])],
         },
     )

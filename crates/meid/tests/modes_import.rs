@@ -291,6 +291,7 @@ fn write_modes(path: &Path, modal_mass: f64, shape_scale: f64) {
                 modal_mass,
                 damping_ratio: 0.0,
                 name: format!("mode {}", k + 1),
+                id_lines: Vec::new(),
                 shapes: vec![
                     (7, [0.0, 0.0, a * shape_scale]),
                     (9, [0.0, 0.0, b * shape_scale]),

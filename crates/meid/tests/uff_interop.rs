@@ -230,6 +230,7 @@ fn pyuff_reads_what_meid_writes() {
         modal_mass: 1.0,
         damping_ratio: 0.01,
         name: "bed".into(),
+        id_lines: vec!["written by meid".into()],
         shapes: vec![(1, [0.0, 0.0, 0.2835]), (2, [0.0, 0.0, -0.0691897])],
     };
     let mut out = Vec::new();
@@ -262,6 +263,62 @@ fn pyuff_reads_what_meid_writes() {
         .map(|x| x.as_f64().unwrap())
         .collect();
     assert!(close(r3[0], 0.2835, 5e-6) && close(r3[1], -0.0691897, 5e-6));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `meid modes --uff` of a lumped model, read by pyuff: node k is the k-th named point by name
+/// (the order of modes.csv's ψ columns), the ID lines say so and name the nodes
+/// (`nodes: 1 = base, 2 = bed` for examples/paper-lumped.toml), and the z translations are the
+/// model's signed ψ (mode 2: base and bed in opposition) to the 6 digits of dataset 55.
+#[test]
+fn pyuff_reads_the_lumped_node_names() {
+    let Some(py) = python() else { return };
+    let dir = tmp("lumped");
+    let m = meid::model::Model::from_file(&root().join("examples/paper-lumped.toml"), &[]).unwrap();
+    let s = &m.structure;
+    let path = dir.join("modes.uff");
+    std::fs::write(&path, uff::modes_uff_points(s).unwrap()).unwrap();
+    let read: Value =
+        serde_json::from_str(&script(&py, &["read", path.to_str().unwrap()])).unwrap();
+    let sets = read.as_array().unwrap();
+    let names: Vec<&String> = s.points.keys().collect();
+    assert_eq!(names, ["base", "bed"]);
+    let nodes = sets[0]["nodes"].as_array().unwrap();
+    assert_eq!(nodes.len(), 2);
+    for (k, row) in nodes.iter().enumerate() {
+        assert_eq!(row[0].as_f64().unwrap(), k as f64 + 1.0);
+        assert_eq!(row[1].as_f64().unwrap(), k as f64);
+    }
+    for (i, set) in sets[1..].iter().enumerate() {
+        assert_eq!(set["type"], 55);
+        let id: Vec<&str> = set["id"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_str().unwrap())
+            .collect();
+        assert!(
+            id[2].starts_with("node k = k-th point by name as in modes.csv"),
+            "{id:?}"
+        );
+        assert_eq!(id[3], "nodes: 1 = base, 2 = bed");
+        let r3: Vec<f64> = set["r3"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        for (k, p) in names.iter().enumerate() {
+            let psi = s.points[*p][i];
+            assert!(
+                close(r3[k], psi, 5e-6),
+                "mode {}: {p} {} vs {psi}",
+                i + 1,
+                r3[k]
+            );
+        }
+    }
+    assert!(s.points["base"][1] < 0.0 && s.points["bed"][1] > 0.0);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -56,6 +56,9 @@ pub struct Mode {
     pub damping_ratio: f64,
     /// ID line 1.
     pub name: String,
+    /// ID lines 2-5 (free text, 80 columns each). The reader keeps those neither blank nor
+    /// `NONE`, trimmed; the writer writes the first four and `NONE` for the rest.
+    pub id_lines: Vec<String>,
     /// `(node, [x, y, z] translations)` (the first three values of each node).
     pub shapes: Vec<(i64, [f64; 3])>,
 }
@@ -938,6 +941,12 @@ impl<R: BufRead> Parser<'_, R> {
             modal_mass: r8v[1],
             damping_ratio: r8v[2],
             name: id[0].trim().to_string(),
+            id_lines: id[1..]
+                .iter()
+                .map(|l| l.trim())
+                .filter(|l| !l.is_empty() && *l != "NONE")
+                .map(str::to_string)
+                .collect(),
             shapes,
         }))
     }
@@ -1205,7 +1214,8 @@ pub fn write_2411<W: Write>(w: &mut W, nodes: &[Node]) -> std::io::Result<()> {
 
 /// Writes dataset 55 for one real normal mode (analysis type 2, 3 translations per node,
 /// data type 2 as pyuff and most readers expect: `%13.5e` values, 6 significant digits).
-/// Modal mass 1 means mass-normalised shapes.
+/// Modal mass 1 means mass-normalised shapes. ID line 1 is `mode.name`, ID lines 2-5
+/// `mode.id_lines` (clipped to 80 characters, `NONE` where there is none).
 pub fn write_55<W: Write>(w: &mut W, mode: &Mode) -> std::io::Result<()> {
     writeln!(w, "{:>6}\n{:>6}{:74}", -1, 55, "")?;
     let line80 = |s: &str| -> String {
@@ -1218,10 +1228,10 @@ pub fn write_55<W: Write>(w: &mut W, mode: &Mode) -> std::io::Result<()> {
         )
     };
     writeln!(w, "{}", line80(&mode.name))?;
-    writeln!(w, "{}", line80("written by meid"))?;
-    writeln!(w, "{}", line80("NONE"))?;
-    writeln!(w, "{}", line80("NONE"))?;
-    writeln!(w, "{}", line80("NONE"))?;
+    for k in 0..4 {
+        let l = mode.id_lines.get(k).map_or("NONE", String::as_str);
+        writeln!(w, "{}", line80(l))?;
+    }
     // Structural model, normal mode, 3 DOF translation, displacement, real single, 3 values.
     writeln!(w, "{:>10}{:>10}{:>10}{:>10}{:>10}{:>10}", 1, 2, 2, 8, 2, 3)?;
     writeln!(w, "{:>10}{:>10}{:>10}{:>10}", 2, 4, 1, mode.number)?;
@@ -1269,18 +1279,84 @@ pub fn write_records<W: Write>(w: &mut W, records: &[Record], binary: bool) -> R
     Ok(())
 }
 
-/// Dataset 2411 + one dataset 55 per mode of a modal model's named points (a lumped or
-/// tabulated model has no geometry: point k, in name order, is node k at x = k − 1 m; its z
-/// translation is the mode-shape value, mass-normalised, modal mass 1). Damping ratios are
-/// `D_ii / (2 ω_i)` (0 for rigid-body modes).
-pub fn modes_uff_points(m: &crate::modal::ModalModel) -> Result<Vec<u8>> {
-    let names: Vec<&String> = m.points.keys().collect();
-    let nodes: Vec<Node> = (0..names.len())
-        .map(|k| Node {
-            label: k as i64 + 1,
-            xyz: [k as f64, 0.0, 0.0],
+/// Node numbering of [`modes_uff_points`]: node label `k` (1-based) is the `k`-th named point of
+/// the modal model in name order (byte order of the names, the order of the
+/// `psi_<P>_per_sqrt_kg` columns of `modes.csv`). Returns `(label, name)` pairs.
+pub fn point_node_labels(m: &crate::modal::ModalModel) -> Vec<(i64, String)> {
+    m.points
+        .keys()
+        .enumerate()
+        .map(|(k, p)| (k as i64 + 1, p.clone()))
+        .collect()
+}
+
+/// ID lines 2-5 of the datasets 55 of [`modes_uff_points`]: who wrote the file, the numbering
+/// rule and as many `label = name` pairs as two more lines of 80 columns hold (the list ends
+/// with `...` when it is cut; the rule of line 3 holds for every node).
+fn point_id_lines(labels: &[(i64, String)]) -> Vec<String> {
+    let mut lines = vec![
+        "written by meid: lumped/tabulated model; z translation = signed psi, 1/sqrt(kg)"
+            .to_string(),
+        "node k = k-th point by name as in modes.csv; node at x = k-1 m (no geometry)".to_string(),
+    ];
+    // " 1 = base," ... " n = name": whole pairs only, on "nodes:" and one more line; when not
+    // all fit, the second line keeps 4 columns for " ...".
+    let items: Vec<String> = labels
+        .iter()
+        .enumerate()
+        .map(|(k, (label, name))| {
+            let comma = if k + 1 < labels.len() { "," } else { "" };
+            format!(" {label} = {name}{comma}")
         })
         .collect();
+    let pack = |last_cap: usize| -> (Vec<String>, usize) {
+        let mut out = vec![String::from("nodes:")];
+        let mut placed = 0;
+        for it in &items {
+            let cap = if out.len() == 1 { 80 } else { last_cap };
+            let cur = out.last().map_or(0, |l| l.chars().count());
+            if cur + it.chars().count() <= cap {
+                if let Some(l) = out.last_mut() {
+                    l.push_str(it);
+                }
+            } else if out.len() == 1 && it.chars().count() - 1 <= last_cap {
+                out.push(it.trim_start().to_string());
+            } else {
+                break;
+            }
+            placed += 1;
+        }
+        (out, placed)
+    };
+    let (mut list, placed) = pack(80);
+    if placed < items.len() {
+        list = pack(76).0;
+        if let Some(l) = list.last_mut() {
+            l.push_str(" ...");
+        }
+    }
+    lines.extend(list);
+    lines
+}
+
+/// Dataset 2411 + one dataset 55 per mode of a modal model's named points. A lumped or
+/// tabulated model has no geometry: node `k` is the `k`-th named point in name order
+/// ([`point_node_labels`], the column order of `modes.csv`), placed at x = k − 1 m, y = z = 0
+/// (coordinates for display only). Its z translation is the signed mass-normalised shape value
+/// `ψ_i(P)` along the impact direction (1/√kg, modal mass 1; import it back with
+/// `impact_direction = [0, 0, 1]`); x and y are 0. ID line 1 is the mode's label, ID lines 2-5
+/// state this rule and the `label = name` pairs. Damping ratios are `D_ii / (2 ω_i)` (0 for
+/// rigid-body modes).
+pub fn modes_uff_points(m: &crate::modal::ModalModel) -> Result<Vec<u8>> {
+    let labels = point_node_labels(m);
+    let nodes: Vec<Node> = labels
+        .iter()
+        .map(|(label, _)| Node {
+            label: *label,
+            xyz: [(*label - 1) as f64, 0.0, 0.0],
+        })
+        .collect();
+    let id_lines = point_id_lines(&labels);
     let n = m.omega_rad_per_s.len();
     let mut out = Vec::new();
     write_2411(&mut out, &nodes).map_err(|e| Error::io("UFF output", e))?;
@@ -1297,10 +1373,10 @@ pub fn modes_uff_points(m: &crate::modal::ModalModel) -> Result<Vec<u8>> {
                 .get(i)
                 .cloned()
                 .unwrap_or_else(|| format!("mode {}", i + 1)),
-            shapes: names
+            id_lines: id_lines.clone(),
+            shapes: labels
                 .iter()
-                .enumerate()
-                .map(|(k, p)| (k as i64 + 1, [0.0, 0.0, m.points[*p][i]]))
+                .map(|(label, p)| (*label, [0.0, 0.0, m.points[p][i]]))
                 .collect(),
         };
         write_55(&mut out, &mode).map_err(|e| Error::io("UFF output", e))?;
@@ -1336,6 +1412,11 @@ pub fn modes_uff_fe(
             modal_mass: 1.0,
             damping_ratio: zeta.get(i).copied().unwrap_or(0.0),
             name: format!("mode {}", i + 1),
+            id_lines: vec![
+                "written by meid: FE mesh; node label = mesh node index + 1 (modes.vtu order)"
+                    .into(),
+                "x y z translations of the mass-normalised shape (1/sqrt(kg)), global axes".into(),
+            ],
             shapes: t
                 .iter()
                 .enumerate()
@@ -1473,6 +1554,38 @@ mod tests {
         );
     }
 
+    /// ID lines of a lumped model's modes: the rule, then `label = name` pairs over two lines
+    /// of at most 80 columns, cut with `...` when they do not fit.
+    #[test]
+    fn point_id_lines_list_the_names_within_80_columns() {
+        let few = vec![(1, "base".to_string()), (2, "bed".to_string())];
+        let l = point_id_lines(&few);
+        assert_eq!(l.len(), 3);
+        assert_eq!(l[2], "nodes: 1 = base, 2 = bed");
+        assert!(l.iter().all(|x| x.chars().count() <= 80), "{l:?}");
+        let many: Vec<(i64, String)> = (1..=40).map(|k| (k, format!("point_{k:02}"))).collect();
+        let l = point_id_lines(&many);
+        assert_eq!(l.len(), 4);
+        assert!(l.iter().all(|x| x.chars().count() <= 80), "{l:?}");
+        assert!(
+            l[2].starts_with("nodes: 1 = point_01, 2 = point_02,"),
+            "{l:?}"
+        );
+        assert!(l[3].ends_with(" ..."), "{l:?}");
+        // Every pair listed is whole and right.
+        let listed: Vec<&str> = l[2]
+            .trim_start_matches("nodes:")
+            .split(',')
+            .chain(l[3].trim_end_matches(" ...").split(','))
+            .map(str::trim)
+            .filter(|x| !x.is_empty())
+            .collect();
+        assert!(listed.len() > 8, "{listed:?}");
+        for (k, x) in listed.iter().enumerate() {
+            assert_eq!(*x, format!("{} = point_{:02}", k + 1, k + 1));
+        }
+    }
+
     #[test]
     fn nodes_and_modes_round_trip() {
         let nodes = vec![
@@ -1491,6 +1604,7 @@ mod tests {
             modal_mass: 1.0,
             damping_ratio: 0.01,
             name: "mode 2".into(),
+            id_lines: vec!["written by meid".into(), "second line".into()],
             shapes: vec![(1, [0.0, 0.0, 0.25]), (7, [0.0, 0.0, -0.125])],
         };
         let mut buf = Vec::new();

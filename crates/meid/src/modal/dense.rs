@@ -464,9 +464,59 @@ pub fn mode_residuals(
     Ok(out)
 }
 
+/// Relative tolerance of [`orient_modes`]: entries within it of the largest count as tied.
+const ORIENT_TIE: f64 = 1e-6;
+
+/// Sign convention of computed modes (a mode `φ` and `−φ` are the same mode; the solvers return
+/// either): each column of `shapes` is negated when needed so that its entry of largest
+/// magnitude over the reduced DOFs is positive, taking the first in DOF order among the entries
+/// with `|φ_j| ≥ (1 − 10⁻⁶) max_k |φ_k|`, so that round-off between the dense and Lanczos
+/// solutions (or thread counts) cannot pick another entry of a symmetric pair. Signed outputs
+/// (ψ in `modes.csv`, shapes in `modes.vtu`/`modes.uff`) then do not depend on the solver. Within
+/// a degenerate (repeated) eigenvalue the basis itself is arbitrary; no sign rule fixes that.
+/// Applied to the FE solutions (`model::fem::solve_modes`) and the lumped models' modes.
+pub fn orient_modes(shapes: &mut Mat<f64>) {
+    for i in 0..shapes.ncols() {
+        let max = (0..shapes.nrows()).fold(0.0_f64, |a, j| a.max(shapes[(j, i)].abs()));
+        let pick = (0..shapes.nrows()).find(|&j| shapes[(j, i)].abs() >= (1.0 - ORIENT_TIE) * max);
+        if let Some(j) = pick {
+            if shapes[(j, i)] < 0.0 {
+                for r in 0..shapes.nrows() {
+                    shapes[(r, i)] = -shapes[(r, i)];
+                }
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The sign rule: largest entry positive; a pair tied within 1e-6 goes by the first entry;
+    /// a zero column is left alone; applying it twice changes nothing.
+    #[test]
+    fn orient_modes_makes_the_largest_entry_positive() {
+        let mut s = Mat::from_fn(3, 3, |r, c| match (r, c) {
+            (0, 0) => 0.1,
+            (1, 0) => -0.5,
+            (2, 0) => 0.2,
+            (0, 1) => -0.7,
+            (1, 1) => 0.7 * (1.0 + 1e-9),
+            (2, 1) => 0.1,
+            _ => 0.0,
+        });
+        orient_modes(&mut s);
+        assert_eq!([s[(0, 0)], s[(1, 0)], s[(2, 0)]], [-0.1, 0.5, -0.2]);
+        assert_eq!(
+            [s[(0, 1)], s[(1, 1)], s[(2, 1)]],
+            [0.7, -0.7 * (1.0 + 1e-9), -0.1]
+        );
+        assert_eq!([s[(0, 2)], s[(1, 2)], s[(2, 2)]], [0.0; 3]);
+        let before = s.clone();
+        orient_modes(&mut s);
+        assert_eq!(s, before);
+    }
 
     /// Fixed-free chain of n equal masses m and springs k:
     /// ω_j = 2 sqrt(k/m) sin((2j-1)π / (2(2n+1))).

@@ -1149,6 +1149,7 @@ fn checked(model: &FeModel, mut modes: DenseModes, solver: &str) -> Result<Dense
         what,
     )
     .map_err(|e| solver_hint(e, model, solver))?;
+    crate::modal::dense::orient_modes(&mut modes.shapes);
     modes.omega_rad_per_s = c.omega_rad_per_s;
     modes.rigid_body_modes = c.rigid_body_modes;
     modes.orthonormality_error = c.orthonormality_error;
@@ -1756,8 +1757,11 @@ pub struct ModeRow {
     pub frequency_hz: f64,
     /// `None` for lumped/tabulated models (no mass matrix in global directions).
     pub effective_mass_kg: Option<EffectiveMass>,
-    /// |ψ_i(P)| along the impact direction at each named point (1/√kg).
-    pub participation: BTreeMap<String, f64>,
+    /// Signed mass-normalised mode-shape value ψ_i(P) along the impact direction at each named
+    /// point (1/√kg): `ψ_i(P) = d · u_P(φ_i)` with `φ_iᵀ M φ_i = 1`. Within a mode the signs give
+    /// the relative phase of the points (e.g. bed and base in opposition); the sign of a whole
+    /// mode is a convention (FE modes: see [`solve_modes`]).
+    pub psi_per_sqrt_kg: BTreeMap<String, f64>,
     /// Participation score `Σ_A ψ_i(A)²` at the contact points (1/kg), FE models only.
     pub score: Option<f64>,
     pub selected: bool,
@@ -1801,8 +1805,8 @@ fn eff(a: [f64; 6]) -> EffectiveMass {
 }
 
 impl FemAnalysis {
-    /// The mode table of an FE analysis: all computed modes, participation along the impact
-    /// direction at the named points, and the selection with its reason.
+    /// The mode table of an FE analysis: all computed modes, the signed shape value ψ along the
+    /// impact direction at the named points, and the selection with its reason.
     pub fn report(&self) -> Result<ModeReport> {
         let nm = self.table.frequency_hz.len();
         let mut part: BTreeMap<String, Vec<f64>> = BTreeMap::new();
@@ -1815,7 +1819,6 @@ impl FemAnalysis {
                         (0..f.len())
                             .map(|j| f[j] * self.modes.shapes[(j, i)])
                             .sum::<f64>()
-                            .abs()
                     })
                     .collect(),
             );
@@ -1825,7 +1828,7 @@ impl FemAnalysis {
                 index: i + 1,
                 frequency_hz: self.table.frequency_hz[i],
                 effective_mass_kg: Some(eff(self.table.effective_mass[i])),
-                participation: part.iter().map(|(k, v)| (k.clone(), v[i])).collect(),
+                psi_per_sqrt_kg: part.iter().map(|(k, v)| (k.clone(), v[i])).collect(),
                 score: Some(self.scores[i]),
                 selected: self.selected.contains(&i),
             })
@@ -1870,11 +1873,7 @@ pub fn report_from_modal(m: &ModalModel) -> ModeReport {
             index: i + 1,
             frequency_hz: m.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI),
             effective_mass_kg: None,
-            participation: m
-                .points
-                .iter()
-                .map(|(k, v)| (k.clone(), v[i].abs()))
-                .collect(),
+            psi_per_sqrt_kg: m.points.iter().map(|(k, v)| (k.clone(), v[i])).collect(),
             score: None,
             selected: true,
         })
@@ -1910,7 +1909,7 @@ impl ModeReport {
         let points: Vec<String> = self
             .modes
             .first()
-            .map(|r| r.participation.keys().cloned().collect())
+            .map(|r| r.psi_per_sqrt_kg.keys().cloned().collect())
             .unwrap_or_default();
         let mut s = String::new();
         let _ = write!(
@@ -1919,7 +1918,7 @@ impl ModeReport {
             "mode", "Hz", "m_x kg", "m_y kg", "m_z kg", "I_rx", "I_ry", "I_rz"
         );
         for p in &points {
-            let _ = write!(s, " {:>10}", format!("|psi({p})|"));
+            let _ = write!(s, " {:>10}", format!("psi({p})"));
         }
         s.push_str("  sel\n");
         for r in &self.modes {
@@ -1940,7 +1939,7 @@ impl ModeReport {
                 let _ = write!(
                     s,
                     " {:>10.4e}",
-                    r.participation.get(p).copied().unwrap_or(0.0)
+                    r.psi_per_sqrt_kg.get(p).copied().unwrap_or(0.0)
                 );
             }
             s.push_str(if r.selected { "  *\n" } else { "\n" });
@@ -1967,12 +1966,14 @@ impl ModeReport {
         s
     }
 
-    /// CSV: `mode,frequency_hz,m_x_kg,...,I_rz_kg_m2,psi_<P>_per_sqrt_kg...,selected`.
+    /// CSV: `mode,frequency_hz,m_x_kg,...,I_rz_kg_m2,psi_<P>_per_sqrt_kg...,selected`, one
+    /// `psi_<P>_per_sqrt_kg` column per named point in name order (byte order): the signed
+    /// ψ_i(P) of [`ModeRow::psi_per_sqrt_kg`], written to round-trip (shortest exact decimal).
     pub fn to_csv(&self) -> String {
         let points: Vec<String> = self
             .modes
             .first()
-            .map(|r| r.participation.keys().cloned().collect())
+            .map(|r| r.psi_per_sqrt_kg.keys().cloned().collect())
             .unwrap_or_default();
         let mut s =
             String::from("mode,frequency_hz,m_x_kg,m_y_kg,m_z_kg,i_rx_kg_m2,i_ry_kg_m2,i_rz_kg_m2");
@@ -1993,7 +1994,7 @@ impl ModeReport {
             for p in &points {
                 s.push_str(&format!(
                     ",{:e}",
-                    r.participation.get(p).copied().unwrap_or(0.0)
+                    r.psi_per_sqrt_kg.get(p).copied().unwrap_or(0.0)
                 ));
             }
             s.push_str(if r.selected { ",1\n" } else { ",0\n" });

@@ -374,7 +374,9 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
             ));
         }
     }
-    let modes = dense::solve(sys.k.as_ref(), sys.mass_matrix().as_ref())?;
+    let mut modes = dense::solve(sys.k.as_ref(), sys.mass_matrix().as_ref())?;
+    // The sign convention of every computed mode: largest entry positive.
+    dense::orient_modes(&mut modes.shapes);
     let zeta_path = format!("{base}.damping_ratios");
     let zeta = match &l.damping_ratios {
         Some(Ratios::PerMode(v)) if nd < n && v.len() == n => {

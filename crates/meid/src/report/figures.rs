@@ -798,17 +798,17 @@ pub fn histogram_figure(
     ))
 }
 
-/// The mode table: frequency, participation |ψ| along the impact axis at the named points
-/// (1/√kg), effective vertical mass (FE models) and whether the mode is retained.
+/// The mode table: frequency, signed mass-normalised shape value ψ along the impact axis at the
+/// named points (1/√kg), effective vertical mass (FE models) and whether the mode is retained.
 pub fn mode_table(report: &ModeReport) -> Table {
     let points: Vec<String> = report
         .modes
         .first()
-        .map(|r| r.participation.keys().cloned().collect())
+        .map(|r| r.psi_per_sqrt_kg.keys().cloned().collect())
         .unwrap_or_default();
     let fe = report.modes.iter().any(|m| m.effective_mass_kg.is_some());
     let mut header = vec!["mode".to_string(), "frequency (Hz)".into()];
-    header.extend(points.iter().map(|p| format!("|ψ({p})| (1/√kg)")));
+    header.extend(points.iter().map(|p| format!("ψ({p}) (1/√kg)")));
     if fe {
         header.push("effective mass z (kg)".into());
     }
@@ -820,7 +820,7 @@ pub fn mode_table(report: &ModeReport) -> Table {
         row.extend(
             points
                 .iter()
-                .map(|p| m.participation.get(p).map_or("—".into(), |v| sig(*v, 4))),
+                .map(|p| m.psi_per_sqrt_kg.get(p).map_or("—".into(), |v| sig(*v, 4))),
         );
         if fe {
             row.push(
