@@ -590,6 +590,18 @@ impl<R: BufRead> Parser<'_, R> {
             for v in &mut y {
                 *v *= f;
             }
+            if let Some(k) = y.iter().position(|v| !v.is_finite()) {
+                return Err(self.err(
+                    Some(ds),
+                    Some("record 12"),
+                    r7_line + 5,
+                    format!(
+                        "point {}: the value × {f} (to SI) is beyond the largest double: expected |value| ≤ {:e}",
+                        k + 1,
+                        f64::MAX / f
+                    ),
+                ));
+            }
         }
         let name = {
             let n1 = id[0].trim();
