@@ -472,3 +472,45 @@ fn measure_refuses_non_finite_samples_with_line_and_column() {
         assert!(stderr(&o).contains(want), "{}", stderr(&o));
     }
 }
+
+/// When no blow is found at all (here the hammer channel sits at a constant 5 N, so the
+/// trigger never arms), the whole record is processed as one: a warning says so, the JSON
+/// gives 0 blows averaged, and the text never calls the spectrum blow-averaged.
+#[test]
+fn no_blow_found_is_reported_as_zero_blows_averaged() {
+    let d = tmpdir("measure", "noblow");
+    let f = d.join("lab.csv");
+    let mut s = String::from("time_s,accel_B_m_per_s2,hammer_n\n");
+    for i in 0..2000 {
+        let t = i as f64 * 1e-3;
+        let a = (2.0 * std::f64::consts::PI * 50.0 * t).sin();
+        s.push_str(&format!("{t},{a},5\n"));
+    }
+    std::fs::write(&f, s).unwrap();
+    let o = meid()
+        .args(["measure", f.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let text = ok(o.clone());
+    let e = stderr(&o);
+    assert!(
+        e.contains("warning") && e.contains("no blow found") && e.contains("accel_B, hammer"),
+        "{e}"
+    );
+    assert!(
+        text.contains("no blow was found for accel_B, hammer")
+            && text.contains("not blow-averaged")
+            && !text.contains("averaged over the blows"),
+        "{text}"
+    );
+    let v: Value = serde_json::from_str(&ok(meid()
+        .args(["measure", f.to_str().unwrap(), "--json"])
+        .output()
+        .unwrap()))
+    .unwrap();
+    let a = &v.as_array().unwrap()[0];
+    assert_eq!(a["blows"], 0);
+    assert_eq!(a["blows_averaged"], 0);
+    assert!((a["record_s"].as_f64().unwrap() - 2.0).abs() < 1e-9, "{a}");
+    assert_eq!(a["dominant_frequency_hz"], 50.0);
+}
