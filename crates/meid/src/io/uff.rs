@@ -1442,6 +1442,26 @@ mod tests {
         assert!(r.even().is_err());
     }
 
+    /// A finite value that overflows when converted to SI (1e308 g) is refused naming the
+    /// dataset, record and point, with the valid bound (session 11: no inf reaches a spectrum).
+    #[test]
+    fn values_beyond_the_largest_double_in_si_are_refused() {
+        let text = format!(
+            "{}  1.00000e+00  1.00000e+308 -5.00000e-01\n    -1\n",
+            header("g", 12, 3, 1)
+        );
+        let e = parse_uff(text.as_bytes(), "g.uff", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("g.uff: dataset 1")
+                && e.contains("record 12")
+                && e.contains("point 2")
+                && e.contains("beyond the largest double"),
+            "{e}"
+        );
+    }
+
     #[test]
     fn errors_name_file_dataset_record_and_line() {
         let text = format!("{}  1.0\n    -1\n", header("furlong/s^2", 12, 1, 1));
