@@ -20,7 +20,8 @@ pub struct ProcessingArgs {
     /// Time kept before each trigger (s, default 0.01).
     #[arg(long, value_name = "S")]
     pub pretrigger: Option<f64>,
-    /// Length of each blow's record (s; default the shortest interval between blows).
+    /// Length of each blow's record (s; default the shortest interval between blows); at least
+    /// 16 samples, and no longer than fits after a blow.
     #[arg(long, value_name = "S")]
     pub record: Option<f64>,
     /// Time after a trigger during which no other is taken (s, default 0.25).
@@ -138,15 +139,20 @@ pub fn run(a: MeasureArgs) -> Result<()> {
     }
     let channels = process_all(&records, &p, a.processing.trigger.as_deref(), &point)?;
     let summaries: Vec<_> = channels.iter().map(|c| &c.summary).collect();
+    if !a.print.quiet {
+        for w in report::warnings(&channels) {
+            crate::ui::warning(w);
+        }
+    }
     if let Some(set) = set {
         meid::io::write_json(&set.path("measure.json"), &summaries)?;
-        meid::io::write_atomic(&set.path("bands.csv"), &report::bands_csv(&channels))?;
+        meid::io::write_atomic(&set.path("bands.csv"), &report::bands_csv(&channels)?)?;
         let mut taken = Vec::new();
         for c in &channels {
             let stem = report::file_stem(&c.summary.name, &mut taken);
             meid::io::write_atomic(
                 &set.path(&format!("{stem}_spectrum.csv")),
-                &report::spectrum_csv(c),
+                &report::spectrum_csv(c)?,
             )?;
             meid::io::write_atomic(
                 &set.path(&format!("{stem}_average.csv")),

@@ -93,7 +93,7 @@ fn read(path: &Path) {
         c.blows,
         channels[0].spectrum.averages,
         channels[2].summary.name,
-        channels[2].summary.dominant_frequency_hz
+        channels[2].summary.dominant_frequency_hz.unwrap_or(f64::NAN)
     );
     println!("read {t_read:.3} s, read + process {total:.3} s (target ≤ 2 s)");
     if let (Some(b), Some(a)) = (before, after) {

@@ -218,3 +218,128 @@ fn no_complete_blow_is_an_error_not_a_panic() {
     };
     assert!(detect_blows(&[1.0; 5], 1.0, &bad).is_err());
 }
+
+/// Spectra are computed from the record scaled by a power of two (session 11 audit: a
+/// 1e300 m/s² record gave an infinite level at a wrong line). Scaling by 2^k is exact, so the
+/// ESD of `2^10 x` is bit for bit `2^20` times that of `x`; for 1e300·x (ESD beyond the range
+/// of doubles) and 1e−300·x (below it) the levels are those of `x` ± 6000 dB and the dominant
+/// line is the mode's.
+#[test]
+fn spectra_of_huge_and_tiny_records_keep_their_levels() {
+    let (f, x) = blows_record(2);
+    let p = processing(TransientWindow::Rectangular);
+    let b = detect_blows(&f, FS, &p).unwrap();
+    let base = blow_spectrum(&x, Quantity::Displacement, FS, &b, &p, None).unwrap();
+    assert_eq!(base.scale_db, 0.0);
+    let x10: Vec<f64> = x.iter().map(|v| v * 1024.0).collect();
+    let s10 = blow_spectrum(&x10, Quantity::Displacement, FS, &b, &p, None).unwrap();
+    for (a, b) in base.density.iter().zip(&s10.density) {
+        assert_eq!(a * 1_048_576.0, *b);
+    }
+    let (f0, e0) = base.dominant().unwrap();
+    assert_eq!(f0, 50.0);
+    let l0 = base.level_db(e0, 1.0);
+    for (factor, shift_db) in [(1e300, 6000.0), (1e-300, -6000.0)] {
+        let xs: Vec<f64> = x.iter().map(|v| v * factor).collect();
+        let s = blow_spectrum(&xs, Quantity::Displacement, FS, &b, &p, None).unwrap();
+        assert!(s.density_si().is_none(), "{factor}");
+        let (fs_, es) = s.dominant().unwrap();
+        assert_eq!(fs_, 50.0);
+        let l = s.level_db(es, 1.0);
+        assert!(l.is_finite());
+        assert!(
+            (l - l0 - shift_db).abs() < 1e-9,
+            "{factor}: {l} dB vs {l0} dB"
+        );
+        for ((bb, e), (_, e0)) in s.third_octaves().iter().zip(base.third_octaves()) {
+            if e0 > 0.0 {
+                let d = s.level_db(*e, 1.0) - base.level_db(e0, 1.0);
+                assert!((d - shift_db).abs() < 1e-9, "{} Hz: {d}", bb.nominal_hz);
+            }
+        }
+    }
+}
+
+/// A blow record must hold at least MIN_RECORD_SAMPLES (16) samples: 15 is refused naming
+/// the minimum, 16 accepted (session 11 audit: a 1e-6 s record gave a 2-sample record and a
+/// "dominant" line at the Nyquist frequency).
+#[test]
+fn records_shorter_than_the_minimum_are_refused() {
+    use meid::measure::process::MIN_RECORD_SAMPLES;
+    assert_eq!(MIN_RECORD_SAMPLES, 16);
+    let (f, _) = blows_record(2);
+    let p = |n: usize| Processing {
+        record_s: Some(n as f64 / FS),
+        ..processing(TransientWindow::Rectangular)
+    };
+    let e = detect_blows(&f, FS, &p(15)).unwrap_err().to_string();
+    assert!(e.contains("at least 16 samples (0.008000 s)"), "{e}");
+    assert_eq!(detect_blows(&f, FS, &p(16)).unwrap().length, 16);
+    // The default record (the shortest interval between triggers) too: blows 10 samples apart.
+    let mut g = vec![0.0; 100];
+    for k in [20, 30, 40] {
+        g[k] = 1.0;
+    }
+    let q = Processing {
+        holdoff_s: 0.0,
+        pretrigger_s: 0.0,
+        record_s: None,
+        ..Processing::default()
+    };
+    let e = detect_blows(&g, FS, &q).unwrap_err().to_string();
+    assert!(
+        e.contains("--holdoff") && e.contains("at least 16 samples"),
+        "{e}"
+    );
+}
+
+/// Blows found of which no record fits are refused naming the range that would fit (the rule
+/// `meid measure` and `meid validate` share): a pre-trigger longer than the time before the
+/// last trigger, or a record longer than the longest that fits after a blow.
+#[test]
+fn blows_that_do_not_fit_name_the_valid_range() {
+    use meid::measure::process::require_complete;
+    let (f, _) = blows_record(2);
+    let n = f.len();
+    // Pre-trigger 4.02 s: both triggers (at 0.01 s and 4.01 s) come earlier.
+    let p = Processing {
+        pretrigger_s: 4.02,
+        record_s: Some(1.0),
+        ..processing(TransientWindow::Rectangular)
+    };
+    let b = detect_blows(&f, FS, &p).unwrap();
+    assert_eq!(b.triggers, vec![PRE, N + PRE]);
+    assert!(b.starts.is_empty());
+    let e = require_complete(&b, n, FS, "hammer", "lab.uff")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("lab.uff")
+            && e.contains("'hammer'")
+            && e.contains("between 0 and 4.010000 s")
+            && e.contains("--pretrigger"),
+        "{e}"
+    );
+    // Record 9 s from 0.01 s before each trigger: the first blow's record may last up to 8 s.
+    let p = Processing {
+        record_s: Some(9.0),
+        ..processing(TransientWindow::Rectangular)
+    };
+    let b = detect_blows(&f, FS, &p).unwrap();
+    assert!(b.starts.is_empty());
+    let e = require_complete(&b, n, FS, "hammer", "lab.uff")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("between 0.008000 s (16 samples) and 8.000000 s") && e.contains("--record"),
+        "{e}"
+    );
+    // A record that fits: no error.
+    let p = Processing {
+        record_s: Some(8.0),
+        ..processing(TransientWindow::Rectangular)
+    };
+    let b = detect_blows(&f, FS, &p).unwrap();
+    assert_eq!(b.starts, vec![0]);
+    assert!(require_complete(&b, n, FS, "hammer", "lab.uff").is_ok());
+}

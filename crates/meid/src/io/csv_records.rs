@@ -124,7 +124,18 @@ pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>>
                     format!("column {} ({name}): {field} is not a finite number", k + 1),
                 ));
             }
-            data[k].push(v * f);
+            let si = v * f;
+            if !si.is_finite() {
+                return Err(err(
+                    line,
+                    format!(
+                        "column {} ({name}): {field} × {f} (to SI) is beyond the largest double: expected |value| ≤ {:e}",
+                        k + 1,
+                        f64::MAX / f
+                    ),
+                ));
+            }
+            data[k].push(si);
         }
     }
     let t = std::mem::take(&mut data[tc]);

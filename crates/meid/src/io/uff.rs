@@ -593,6 +593,18 @@ impl<R: BufRead> Parser<'_, R> {
             for v in &mut y {
                 *v *= f;
             }
+            if let Some(k) = y.iter().position(|v| !v.is_finite()) {
+                return Err(self.err(
+                    Some(ds),
+                    Some("record 12"),
+                    r7_line + 5,
+                    format!(
+                        "point {}: the value × {f} (to SI) is beyond the largest double: expected |value| ≤ {:e}",
+                        k + 1,
+                        f64::MAX / f
+                    ),
+                ));
+            }
         }
         let name = {
             let n1 = id[0].trim();
@@ -1509,6 +1521,26 @@ mod tests {
         assert_eq!(r.values, vec![1.0, 2.0, 0.0]);
         assert_eq!(r.abscissa, Abscissa::Uneven(vec![0.0, 1e-3, 2.5e-3]));
         assert!(r.even().is_err());
+    }
+
+    /// A finite value that overflows when converted to SI (1e308 g) is refused naming the
+    /// dataset, record and point, with the valid bound (session 11: no inf reaches a spectrum).
+    #[test]
+    fn values_beyond_the_largest_double_in_si_are_refused() {
+        let text = format!(
+            "{}  1.00000e+00  1.00000e+308 -5.00000e-01\n    -1\n",
+            header("g", 12, 3, 1)
+        );
+        let e = parse_uff(text.as_bytes(), "g.uff", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("g.uff: dataset 1")
+                && e.contains("record 12")
+                && e.contains("point 2")
+                && e.contains("beyond the largest double"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -391,8 +391,18 @@ impl<'a> Problem<'a> {
                                 ))
                             }
                         };
-                        let top = s.density.iter().fold(0.0_f64, |a, b| a.max(*b));
-                        (s.density, bins, 1e-12 * top)
+                        let Some(d) = s.density_si() else {
+                            return Err(Error::Input {
+                                location: r.origin.clone(),
+                                message: format!(
+                                    "channel '{}': its energy spectral density is beyond the range of doubles in ({})²·s/Hz: the spectral fit (--spectrum) cannot use it",
+                                    r.name,
+                                    r.unit()
+                                ),
+                            });
+                        };
+                        let top = d.iter().fold(0.0_f64, |a, b| a.max(*b));
+                        (d.to_vec(), bins, 1e-12 * top)
                     }
                 };
                 channels.push(ChannelTarget {
@@ -472,8 +482,14 @@ impl<'a> Problem<'a> {
                             &sim.processing,
                             None,
                         )?;
+                        let sd = ss.density_si().ok_or_else(|| {
+                            Error::numerical(
+                                "calibrate",
+                                "the simulated energy spectral density is beyond the range of doubles",
+                            )
+                        })?;
                         for k in ch.bins.clone() {
-                            let (es, em) = (ss.density[k], ch.spectrum[k]);
+                            let (es, em) = (sd[k], ch.spectrum[k]);
                             r.push(10.0 * ((es + ch.floor) / (em + ch.floor)).log10());
                         }
                     }

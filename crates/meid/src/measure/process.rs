@@ -15,7 +15,19 @@
 //! `L`. Each blow's record starts `pre-trigger` seconds before its trigger and lasts the record
 //! length (default: the shortest interval between triggers, or up to the end for a single
 //! blow). A blow whose record would start before the first sample or end after the last is
-//! counted but not averaged.
+//! counted but not averaged. When blows are found but none of their records fits in the file,
+//! [`require_complete`] refuses with the range of pre-trigger or record length that would fit
+//! (the same rule for `meid measure`, `validate` and `calibrate`). A record must hold at least
+//! [`MIN_RECORD_SAMPLES`] samples.
+//!
+//! # Scaling
+//!
+//! The spectra are computed from the record scaled by `2^−e`, `2^e` the power of two at or
+//! below its largest `|x|` (an exact scaling: the result is bit for bit that of the unscaled
+//! record whenever that neither overflows nor underflows). The energy spectral density is
+//! restored in unit²·s/Hz when it is representable as a double; otherwise it is kept scaled
+//! and [`BlowSpectrum::scale_db`] holds `10 log10` of the factor, so levels stay exact and
+//! finite for any finite data (e.g. amplitudes of 1e300).
 //!
 //! # Averaging
 //!
@@ -142,6 +154,11 @@ impl Processing {
     }
 }
 
+/// The fewest samples a blow record may hold: 16, i.e. 8 spectral lines above DC at the
+/// spacing `1/T` (a shorter record resolves nothing worth reporting: a 2-sample record's one
+/// line is the Nyquist frequency).
+pub const MIN_RECORD_SAMPLES: usize = 16;
+
 /// The blows found in a record.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Blows {
@@ -192,17 +209,50 @@ pub fn detect_blows(x: &[f64], fs: f64, p: &Processing) -> Result<Blows> {
             i += 1;
         }
     }
+    let min_s = MIN_RECORD_SAMPLES as f64 / fs;
     let length = match p.record_s {
-        Some(r) => ((r * fs).round() as usize).max(2),
+        Some(r) => {
+            let l = (r * fs).round();
+            if l < MIN_RECORD_SAMPLES as f64 {
+                return Err(Error::invalid(
+                    "record length",
+                    format!(
+                        "{r} s is {l} samples at {fs} Hz: a blow record needs at least {MIN_RECORD_SAMPLES} samples ({min_s:.6} s), 8 spectral lines above DC; give a longer record (--record or [measurement] record_s)"
+                    ),
+                ));
+            }
+            // Saturates for absurd lengths; the fit check below refuses them.
+            l as usize
+        }
         None => {
             let gaps = triggers.windows(2).map(|w| w[1] - w[0]).min();
             match (gaps, triggers.first()) {
-                (Some(g), _) => g.max(2),
-                (None, Some(&t)) => (n - t.saturating_sub(pre)).max(2),
+                (Some(g), _) => {
+                    if g < MIN_RECORD_SAMPLES {
+                        return Err(Error::invalid(
+                            "record length",
+                            format!(
+                                "the shortest interval between triggers is {g} samples ({:.6} s), and the record length defaults to it: a blow record needs at least {MIN_RECORD_SAMPLES} samples ({min_s:.6} s); give a longer hold-off (--holdoff) or a record length (--record)",
+                                g as f64 / fs
+                            ),
+                        ));
+                    }
+                    g
+                }
+                (None, Some(&t)) => n - t.saturating_sub(pre),
                 (None, None) => n,
             }
         }
     };
+    if length < MIN_RECORD_SAMPLES && p.record_s.is_none() {
+        return Err(Error::invalid(
+            "record length",
+            format!(
+                "the record runs to the end of the file and holds {length} samples ({:.6} s): a blow record needs at least {MIN_RECORD_SAMPLES} samples ({min_s:.6} s); the file is too short",
+                length as f64 / fs
+            ),
+        ));
+    }
     let starts = triggers
         .iter()
         .filter(|&&t| t >= pre && (t - pre).checked_add(length).is_some_and(|e| e <= n))
@@ -214,6 +264,61 @@ pub fn detect_blows(x: &[f64], fs: f64, p: &Processing) -> Result<Blows> {
         length,
         pretrigger: pre,
         level,
+    })
+}
+
+/// Refuses blows of which none has a complete record in a channel of `n` samples at `fs`,
+/// naming the settings that would make one fit (`channel`, `origin`: the trigger channel's
+/// name and where it came from). A blow `b` (trigger sample `t_b`) fits when
+/// `pre ≤ t_b` and `t_b − pre + L ≤ n` (pre-trigger `pre`, record `L` samples). When no
+/// blow has `t_b ≥ pre`, the pre-trigger must come down to at most the last trigger's time;
+/// otherwise the record must shorten to at most `max_b (n − t_b + pre)` samples. No trigger
+/// at all is not this function's concern (`Ok`).
+pub fn require_complete(b: &Blows, n: usize, fs: f64, channel: &str, origin: &str) -> Result<()> {
+    if !b.starts.is_empty() || b.triggers.is_empty() {
+        return Ok(());
+    }
+    let pre = b.pretrigger;
+    let secs = |k: usize| k as f64 / fs;
+    let first = b.triggers[0];
+    let last = *b.triggers.last().unwrap_or(&first);
+    let message = match b.triggers.iter().filter(|&&t| t >= pre).map(|&t| n - (t - pre)).max()
+    {
+        None => {
+            let latest = if b.triggers.len() > 1 {
+                format!(" (the last of {} at {:.6} s)", b.triggers.len(), secs(last))
+            } else {
+                String::new()
+            };
+            format!(
+                "the first blow on '{channel}' triggers at {:.6} s{latest}, less than the pre-trigger ({:.6} s) after the record's start, so no blow record fits: give a shorter pre-trigger, between 0 and {:.6} s (--pretrigger or [measurement] pretrigger_s; 0 for a simulated history, which starts with the blow)",
+                secs(first),
+                secs(pre),
+                secs(last)
+            )
+        }
+        Some(longest) if longest < MIN_RECORD_SAMPLES => format!(
+            "the blows on '{channel}' ({} found) trigger so close to the end of the file ({} samples, {:.6} s) that the longest record from {:.6} s before a trigger holds {longest} samples, fewer than the {MIN_RECORD_SAMPLES} a record needs: give a longer pre-trigger (--pretrigger or [measurement] pretrigger_s)",
+            b.triggers.len(),
+            n,
+            secs(n),
+            secs(pre)
+        ),
+        Some(longest) => format!(
+            "a record of {:.6} s ({} samples) from {:.6} s before each trigger runs past the end of the file ({} samples, {:.6} s) after every blow on '{channel}' ({} found): give a record length between {:.6} s ({MIN_RECORD_SAMPLES} samples) and {:.6} s (--record or [measurement] record_s)",
+            secs(b.length),
+            b.length,
+            secs(pre),
+            n,
+            secs(n),
+            b.triggers.len(),
+            secs(MIN_RECORD_SAMPLES),
+            secs(longest)
+        ),
+    };
+    Err(Error::Input {
+        location: origin.to_string(),
+        message,
     })
 }
 
@@ -329,24 +434,38 @@ fn window_for(q: Quantity, x: &[f64], blows: &Blows, fs: f64, p: &Processing) ->
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct BlowSpectrum {
     pub frequency_hz: Vec<f64>,
+    /// The mean ESD, in unit²·s/Hz when [`Self::scale_db`] is 0; otherwise divided by
+    /// `10^(scale_db/10)` (module docs, Scaling).
     pub density: Vec<f64>,
-    /// Number of blow records averaged.
+    /// Number of blow records averaged (0: the whole record, no blow found).
     pub averages: usize,
+    /// `10 log10` of the factor from [`Self::density`] to unit²·s/Hz: 0 unless the ESD in
+    /// unit²·s/Hz is beyond the range of doubles.
+    pub scale_db: f64,
 }
 
 impl BlowSpectrum {
+    /// The level of a [`Self::density`] value (or a band energy from [`Self::third_octaves`])
+    /// `e`: `10 log10(e/E_ref) + scale_db` dB re `E_ref`; −∞ for `e = 0`.
+    pub fn level_db(&self, e: f64, reference: f64) -> f64 {
+        esd_level_db(e, reference) + self.scale_db
+    }
+    /// The densities in unit²·s/Hz, when they are representable as doubles.
+    pub fn density_si(&self) -> Option<&[f64]> {
+        (self.scale_db == 0.0).then_some(&self.density[..])
+    }
     /// Bin spacing (Hz).
     pub fn bin_width_hz(&self) -> f64 {
         self.frequency_hz.get(1).copied().unwrap_or(0.0)
     }
-    /// `Σ Ē_k Δf` over the bins in `[f_lo, f_hi)` (unit²·s).
+    /// `Σ Ē_k Δf` over the bins in `[f_lo, f_hi)` (unit²·s; scaled as [`Self::density`]; 0
+    /// for a band holding no bin).
     pub fn band_energy(&self, f_lo: f64, f_hi: f64) -> f64 {
         self.frequency_hz
             .iter()
             .zip(&self.density)
             .filter(|(f, _)| **f >= f_lo && **f < f_hi)
-            .map(|(_, e)| e)
-            .sum::<f64>()
+            .fold(0.0, |a, (_, e)| a + e)
             * self.bin_width_hz()
     }
     /// The largest bin above DC: (frequency, density).
@@ -405,23 +524,75 @@ pub fn blow_spectrum(
     let w = window_for(q, x, blows, fs, p)?;
     let mut tr = Transformer::new(n_fft);
     let dt = 1.0 / fs;
+    // The scale 2^e at or below the largest |x| of the records (module docs, Scaling).
+    let mut top = 0.0_f64;
+    for &s in &blows.starts {
+        for v in &x[s..s + len] {
+            if !v.is_finite() {
+                return Err(Error::invalid(
+                    "blows",
+                    format!("sample value {v} is not finite: no spectrum"),
+                ));
+            }
+            top = top.max(v.abs());
+        }
+    }
+    // Clamped so that 2^e and 2^−e are both normal doubles.
+    let e = if top > 0.0 {
+        binary_exponent(top).clamp(-1022, 1022)
+    } else {
+        0
+    };
+    let down = pow2(-e);
+    let mut scaled = vec![0.0; len];
     let mut acc = vec![0.0; n_fft / 2 + 1];
     for &s in &blows.starts {
         let seg = x
             .get(s..s + len)
             .ok_or_else(|| Error::invalid("blows", "a blow record runs past the end"))?;
-        let bins = tr.run(seg, &w)?;
+        scaled.iter_mut().zip(seg).for_each(|(d, v)| *d = v * down);
+        let bins = tr.run(&scaled, &w)?;
         for (k, (a, c)) in acc.iter_mut().zip(bins).enumerate() {
             *a += one_sided_factor(k, n_fft) * c.norm_sqr() * dt * dt;
         }
     }
     let b = blows.starts.len();
     acc.iter_mut().for_each(|a| *a /= b as f64);
+    // Back to unit²·s/Hz (× 2^e × 2^e, exact) when every bin stays a finite normal double.
+    let up = pow2(e);
+    let restored: Vec<f64> = acc.iter().map(|a| a * up * up).collect();
+    let representable = restored
+        .iter()
+        .zip(&acc)
+        .all(|(r, a)| r.is_finite() && (*a == 0.0 || r.is_normal()));
+    let (density, scale_db) = if representable {
+        (restored, 0.0)
+    } else {
+        (acc, 20.0 * e as f64 * std::f64::consts::LOG10_2)
+    };
     Ok(BlowSpectrum {
-        frequency_hz: freqs(acc.len(), n_fft, fs),
-        density: acc,
+        frequency_hz: freqs(density.len(), n_fft, fs),
+        density,
         averages: b,
+        scale_db,
     })
+}
+
+/// `e` with `2^e ≤ |v| < 2^(e+1)` for a finite `v ≠ 0` (subnormals: −1023 or below).
+fn binary_exponent(v: f64) -> i32 {
+    let bits = ((v.abs().to_bits() >> 52) & 0x7ff) as i32;
+    if bits == 0 {
+        // Subnormal: 2^−1074 · mantissa.
+        let m = v.abs().to_bits() & ((1u64 << 52) - 1);
+        -1074 + 63 - m.leading_zeros() as i32
+    } else {
+        bits - 1023
+    }
+}
+
+/// `2^k` for `k` in −1022..=1023 (exact), clamped to that range.
+fn pow2(k: i32) -> f64 {
+    f64::from_bits(((k.clamp(-1022, 1023) + 1023) as u64) << 52)
 }
 
 /// The H1 frequency response estimate and its coherence.
@@ -530,10 +701,17 @@ pub struct ChannelSummary {
     pub peak_time_s: f64,
     /// Blows detected on the trigger channel of the file.
     pub blows: usize,
-    /// Frequency of the largest bin of the blow-averaged ESD above DC (Hz).
-    pub dominant_frequency_hz: f64,
-    /// Its level, dB re 1 (SI unit)²·s/Hz.
-    pub dominant_level_db: f64,
+    /// Blows whose records were averaged (0: no blow was found, the spectrum is the whole
+    /// record's).
+    pub blows_averaged: usize,
+    /// Length of each record (s) and the time it starts before its trigger (s).
+    pub record_s: f64,
+    pub pretrigger_s: f64,
+    /// Frequency of the largest bin of the blow-averaged ESD above DC (Hz); `None` when the
+    /// ESD is zero above DC.
+    pub dominant_frequency_hz: Option<f64>,
+    /// Its level, dB re 1 (SI unit)²·s/Hz (finite for any finite data: module docs, Scaling).
+    pub dominant_level_db: Option<f64>,
 }
 
 /// A processed channel: the summary, the blow-averaged record and spectrum, the bands.
@@ -541,6 +719,8 @@ pub struct ChannelSummary {
 pub struct ProcessedChannel {
     pub summary: ChannelSummary,
     pub quantity: Quantity,
+    /// Where the record came from ([`Record::origin`]).
+    pub origin: String,
     /// Time average of the complete blow records (the whole record when no blow was found).
     pub average: Vec<f64>,
     pub spectrum: BlowSpectrum,
@@ -568,8 +748,10 @@ pub fn trigger_channel(records: &[&Record], measurement_point: &str) -> usize {
         .unwrap_or(0)
 }
 
-/// The blows of a group of records sampled together, found on `records[trigger]`; when none
-/// is found, the whole record counts as one.
+/// The blows of a group of records sampled together, found on `records[trigger]`. Blows
+/// found of which none fits in the file are refused ([`require_complete`], as `validate`
+/// does); when no blow is found at all, the whole record counts as one (no trigger:
+/// `triggers` empty, and [`process_channel`] reports 0 blows averaged).
 pub fn group_blows(records: &[&Record], trigger: usize, p: &Processing) -> Result<(Blows, usize)> {
     let r = records
         .get(trigger)
@@ -578,7 +760,7 @@ pub fn group_blows(records: &[&Record], trigger: usize, p: &Processing) -> Resul
     let b = detect_blows(&r.values, fs, p)?;
     let found = b.triggers.len();
     let n = records.iter().map(|r| r.values.len()).min().unwrap_or(0);
-    if b.starts.is_empty() {
+    if b.triggers.is_empty() {
         return Ok((
             Blows {
                 triggers: Vec::new(),
@@ -594,9 +776,11 @@ pub fn group_blows(records: &[&Record], trigger: usize, p: &Processing) -> Resul
         .starts
         .iter()
         .copied()
-        .filter(|&s| s + b.length <= n)
+        .filter(|&s| s.checked_add(b.length).is_some_and(|e| e <= n))
         .collect();
-    Ok((Blows { starts, ..b }, found))
+    let b = Blows { starts, ..b };
+    require_complete(&b, n, fs, &r.name, &r.origin)?;
+    Ok((b, found))
 }
 
 /// Processes one channel with the group's blows (summary, average, spectrum, bands).
@@ -621,9 +805,20 @@ pub fn process_channel(
         }
     });
     let average = average_blows(&r.values, &blows.starts, blows.length)?;
-    let spectrum = blow_spectrum(&r.values, r.quantity, fs, blows, p, None)?;
+    let mut spectrum = blow_spectrum(&r.values, r.quantity, fs, blows, p, None)?;
+    // No trigger: the whole record, not a blow.
+    let averaged = if blows.triggers.is_empty() {
+        0
+    } else {
+        blows.starts.len()
+    };
+    spectrum.averages = averaged;
     let (ref_e, _) = esd_reference(r.quantity);
-    let (df, de) = spectrum.dominant().unwrap_or((f64::NAN, f64::NAN));
+    // A line only where there is energy (a channel zero throughout has none).
+    let (df, de) = match spectrum.dominant() {
+        Some((f, e)) if e > 0.0 => (Some(f), Some(spectrum.level_db(e, ref_e))),
+        _ => (None, None),
+    };
     let bands = spectrum.third_octaves();
     Ok(ProcessedChannel {
         summary: ChannelSummary {
@@ -634,10 +829,14 @@ pub fn process_channel(
             peak,
             peak_time_s: r.time_at(k),
             blows: found,
+            blows_averaged: averaged,
+            record_s: blows.length as f64 / fs,
+            pretrigger_s: blows.pretrigger as f64 / fs,
             dominant_frequency_hz: df,
-            dominant_level_db: esd_level_db(de, ref_e),
+            dominant_level_db: de,
         },
         quantity: r.quantity,
+        origin: r.origin.clone(),
         average,
         spectrum,
         bands,

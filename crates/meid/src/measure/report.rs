@@ -4,7 +4,6 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::process::{esd_reference, ProcessedChannel};
-use crate::analysis::esd::esd_level_db;
 use crate::plot::{LinePlot, Series, SpectrumPlot};
 use crate::Result;
 
@@ -40,7 +39,7 @@ pub fn summary_text(files: &[String], channels: &[ProcessedChannel]) -> String {
     let _ = writeln!(out, "meid measure — {}", files.join(", "));
     let _ = writeln!(
         out,
-        "  {:<24} {:<6} {:>9} {:>10} {:>13} {:>10} {:>6} {:>11} {:>9}",
+        "  {:<24} {:<6} {:>9} {:>10} {:>13} {:>10} {:>6} {:>8} {:>11} {:>9}",
         "channel",
         "unit",
         "samples",
@@ -48,14 +47,19 @@ pub fn summary_text(files: &[String], channels: &[ProcessedChannel]) -> String {
         "sample peak",
         "at (s)",
         "blows",
+        "averaged",
         "dominant",
         "level"
     );
     for c in channels {
         let s = &c.summary;
+        let line = match (s.dominant_frequency_hz, s.dominant_level_db) {
+            (Some(f), Some(l)) => format!("{f:>8.2} Hz {l:>6.2} dB"),
+            _ => format!("{:>11} {:>9}", "—", "no energy"),
+        };
         let _ = writeln!(
             out,
-            "  {:<24} {:<6} {:>9} {:>10.1} {:>13.5e} {:>10.6} {:>6} {:>8.2} Hz {:>6.2} dB",
+            "  {:<24} {:<6} {:>9} {:>10.1} {:>13.5e} {:>10.6} {:>6} {:>8} {line}",
             s.name,
             s.unit,
             s.samples,
@@ -63,18 +67,30 @@ pub fn summary_text(files: &[String], channels: &[ProcessedChannel]) -> String {
             s.peak,
             s.peak_time_s,
             s.blows,
-            s.dominant_frequency_hz,
-            s.dominant_level_db
+            s.blows_averaged,
         );
     }
     let _ = writeln!(
         out,
         "  peaks are sample peaks (the largest |x| among the samples; the signal between samples may go higher);"
     );
-    let _ = writeln!(
-        out,
-        "  the dominant line is the largest bin above DC of the blow-averaged energy spectral density, ± half a bin;"
-    );
+    let (averaged, whole): (Vec<_>, Vec<_>) =
+        channels.iter().partition(|c| c.summary.blows_averaged > 0);
+    if let Some(c) = averaged.first() {
+        let _ = writeln!(
+            out,
+            "  the dominant line is the largest bin above DC of the energy spectral density averaged over the blows' records ({:.6} s from {:.6} s before each trigger), ± half a bin;",
+            c.summary.record_s, c.summary.pretrigger_s
+        );
+    }
+    if !whole.is_empty() {
+        let names: Vec<&str> = whole.iter().map(|c| c.summary.name.as_str()).collect();
+        let _ = writeln!(
+            out,
+            "  no blow was found for {}: their dominant line is that of the whole record's energy spectral density, not blow-averaged;",
+            names.join(", ")
+        );
+    }
     let _ = writeln!(
         out,
         "  levels are dB re 1 (SI unit)²·s/Hz (1 (m/s^2)²·s/Hz, 1 N²·s/Hz)."
@@ -82,33 +98,86 @@ pub fn summary_text(files: &[String], channels: &[ProcessedChannel]) -> String {
     out
 }
 
-/// `frequency_hz,esd_<unit>2_s_per_hz,level_db` of one channel's blow-averaged ESD.
-pub fn spectrum_csv(c: &ProcessedChannel) -> Vec<u8> {
-    let (r, _) = esd_reference(c.quantity);
-    let mut s = String::from("frequency_hz,esd_si2_s_per_hz,level_db\n");
-    for (f, e) in c.spectrum.frequency_hz.iter().zip(&c.spectrum.density) {
-        let _ = writeln!(s, "{f:.9e},{e:.12e},{:.6}", esd_level_db(*e, r));
+/// The warnings of a `meid measure` run: channels whose spectrum is the whole record's
+/// because no blow was found on their trigger channel.
+pub fn warnings(channels: &[ProcessedChannel]) -> Vec<String> {
+    let whole: Vec<&str> = channels
+        .iter()
+        .filter(|c| c.summary.blows_averaged == 0)
+        .map(|c| c.summary.name.as_str())
+        .collect();
+    if whole.is_empty() {
+        Vec::new()
+    } else {
+        vec![format!(
+            "no blow found (no sample reaches the trigger level after one below it) for {}: their spectra are of the whole record, 0 blows averaged; lower the trigger level (--trigger-level) or choose the trigger channel (--trigger) to average blows",
+            whole.join(", ")
+        )]
     }
-    s.into_bytes()
 }
 
-/// One row per channel and one-third-octave band: energy (SI²·s) and level (dB re 1 SI²·s).
-pub fn bands_csv(channels: &[ProcessedChannel]) -> Vec<u8> {
+/// A level for CSV: empty where the energy is 0 (−∞ dB).
+fn level_field(c: &ProcessedChannel, e: f64) -> String {
+    let (r, _) = esd_reference(c.quantity);
+    if e > 0.0 {
+        format!("{:.6}", c.spectrum.level_db(e, r))
+    } else {
+        String::new()
+    }
+}
+
+/// The densities of a channel's spectrum in SI, or the error saying they cannot be written
+/// (`what`: the file that would hold them). The ESD is at most `2 (T max|x|)²` (rectangular
+/// window), so it is representable when `max|x| ≤ √(f64::MAX/2)/T`.
+fn density_si<'a>(c: &'a ProcessedChannel, what: &str) -> Result<&'a [f64]> {
+    c.spectrum.density_si().ok_or_else(|| {
+        let top = c.spectrum.density.iter().fold(0.0_f64, |a, b| a.max(*b));
+        let t = c.summary.record_s;
+        crate::Error::Input {
+            location: c.origin.clone(),
+            message: format!(
+                "channel '{}': its energy spectral density reaches 10^{:.1} ({})²·s/Hz, beyond the largest double ({:e}), so {what} cannot hold it; the levels in dB are printed without -o. Values with |x| ≤ {:.3e} {} keep the ESD of a {t:.6} s record representable",
+                c.summary.name,
+                (c.spectrum.level_db(top, 1.0)) / 10.0,
+                c.summary.unit,
+                f64::MAX,
+                (f64::MAX / 2.0).sqrt() / t,
+                c.summary.unit,
+            ),
+        }
+    })
+}
+
+/// `frequency_hz,esd_si2_s_per_hz,level_db` of one channel's blow-averaged ESD (the level
+/// empty where the ESD is 0). An error when the ESD is beyond the range of doubles.
+pub fn spectrum_csv(c: &ProcessedChannel) -> Result<Vec<u8>> {
+    let d = density_si(c, "<channel>_spectrum.csv")?;
+    let mut s = String::from("frequency_hz,esd_si2_s_per_hz,level_db\n");
+    for (f, e) in c.spectrum.frequency_hz.iter().zip(d) {
+        let _ = writeln!(s, "{f:.9e},{e:.12e},{}", level_field(c, *e));
+    }
+    Ok(s.into_bytes())
+}
+
+/// One row per channel and one-third-octave band: energy (SI²·s) and level (dB re 1 SI²·s;
+/// empty for zero energy). An error when an energy is beyond the range of doubles.
+pub fn bands_csv(channels: &[ProcessedChannel]) -> Result<Vec<u8>> {
     let mut s = String::from("channel,band_hz,lower_hz,upper_hz,energy_si2_s,level_db\n");
     for c in channels {
+        density_si(c, "bands.csv")?;
         for (b, e) in &c.bands {
             let _ = writeln!(
                 s,
-                "{},{},{:.6},{:.6},{e:.12e},{:.6}",
+                "{},{},{:.6},{:.6},{e:.12e},{}",
                 csv_field(&c.summary.name),
                 b.nominal_hz,
                 b.lower_hz,
                 b.upper_hz,
-                esd_level_db(*e, 1.0)
+                level_field(c, *e)
             );
         }
     }
-    s.into_bytes()
+    Ok(s.into_bytes())
 }
 
 /// `time_s,<name>_<unit>` of one channel's blow-averaged record (time from the record start).
@@ -138,17 +207,24 @@ pub fn plots(dir: &Path, stem: &str, c: &ProcessedChannel) -> Result<()> {
         .iter()
         .zip(&c.spectrum.density)
         .skip(1)
-        .map(|(f, e)| (*f, esd_level_db(*e, r)))
+        .map(|(f, e)| (*f, c.spectrum.level_db(*e, r)))
         .unzip();
     // A channel that is zero throughout has no level to draw.
     if y.iter().any(|v| v.is_finite()) {
         crate::plot::spectrum_plot(
             dir.join(format!("{stem}_spectrum")),
             &SpectrumPlot {
-                title: format!(
-                    "{}: blow-averaged ESD ({} blows)",
-                    c.summary.name, c.spectrum.averages
-                ),
+                title: if c.spectrum.averages > 0 {
+                    format!(
+                        "{}: blow-averaged ESD ({} blows)",
+                        c.summary.name, c.spectrum.averages
+                    )
+                } else {
+                    format!(
+                        "{}: ESD of the whole record (no blow found)",
+                        c.summary.name
+                    )
+                },
                 y_label: format!("ESD level (dB re {rtext})"),
                 x_log: true,
                 series: vec![Series {
@@ -165,7 +241,11 @@ pub fn plots(dir: &Path, stem: &str, c: &ProcessedChannel) -> Result<()> {
     crate::plot::line_plot(
         dir.join(format!("{stem}_average")),
         &LinePlot {
-            title: format!("{}: blow-averaged record", c.summary.name),
+            title: if c.spectrum.averages > 0 {
+                format!("{}: blow-averaged record", c.summary.name)
+            } else {
+                format!("{}: the whole record (no blow found)", c.summary.name)
+            },
             x_label: "time from the record start (s)".into(),
             y_label: format!("{} ({})", c.quantity.name(), c.summary.unit),
             series: vec![Series {

@@ -24,10 +24,11 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use super::mapping::{map_records, MeasurementSpec};
-use super::process::{blow_spectrum, detect_blows, esd_reference, BlowSpectrum, Blows, Processing};
+use super::process::{
+    blow_spectrum, detect_blows, esd_reference, require_complete, BlowSpectrum, Blows, Processing,
+};
 use super::{Abscissa, Record, SimChannel};
 use crate::analysis::energy::simulate;
-use crate::analysis::esd::esd_level_db;
 use crate::model::{Case, Model};
 use crate::{Error, Result};
 
@@ -241,17 +242,8 @@ pub(crate) fn measured_blows(
     .unwrap_or(SimChannel::BedAcceleration);
     let tr = &m.records[map[&trigger]];
     let mb = detect_blows(&tr.values, fs, p)?;
-    if let (true, Some(&t)) = (mb.starts.is_empty(), mb.triggers.first()) {
-        if t < mb.pretrigger {
-            return Err(Error::Input {
-                location: tr.origin.clone(),
-                message: format!(
-                    "the first blow on '{}' triggers at {:.6} s, less than the pre-trigger ({:.6} s) after the record's start: give a shorter pre-trigger (--pretrigger; 0 for a simulated history, which starts with the blow)",
-                    tr.name, t as f64 / fs, mb.pretrigger as f64 / fs
-                ),
-            });
-        }
-    }
+    // The rule `meid measure` applies too.
+    require_complete(&mb, tr.values.len(), fs, &tr.name, &tr.origin)?;
     if mb.starts.is_empty() {
         return Err(Error::Input {
             location: tr.origin.clone(),
@@ -435,7 +427,7 @@ fn one_case(
             if sv.1.is_nan() || sv.1 <= 0.0 || sv.1 < strongest * 1e-3 {
                 continue;
             }
-            let (ls, lm) = (esd_level_db(sv.1, rref), esd_level_db(mv.1, rref));
+            let (ls, lm) = (ss.level_db(sv.1, rref), ms.level_db(mv.1, rref));
             rows.push(ModeComparison {
                 mode: name.clone(),
                 simulated_frequency_hz: sv.0,
@@ -610,7 +602,7 @@ impl Validation {
                             }
                             keep
                         })
-                        .map(|(f, e)| (*f, esd_level_db(*e, rref)))
+                        .map(|(f, e)| (*f, s.level_db(*e, rref)))
                         .unzip();
                     Series {
                         label,
