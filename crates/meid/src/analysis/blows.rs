@@ -79,9 +79,10 @@ pub struct BlowReport {
     pub machine_energy_at_strike_j: f64,
     /// E_d of the damper at the strike (J).
     pub damper_energy_at_strike_j: f64,
-    /// Gap `z_d − u_b(O_b)` between the damper and the bed at the strike (m): 0 when the damper
-    /// is back against the bed, > 0 when it has not returned (it then cannot take the blow's
-    /// momentum until the bed has travelled the gap). `None` without a damper.
+    /// Gap `max(z_d − u_b(O_b), 0)` between the damper and the bed at the strike (m): 0 when
+    /// the damper is back against the bed (the contact closed, its compression is no gap),
+    /// > 0 when it has not returned (it then cannot take the blow's momentum until the bed has
+    /// travelled the gap). Never negative. `None` without a damper.
     pub damper_gap_at_strike_m: Option<f64>,
     /// Time the bed-damper contact was closed during the blow interval (s); 0 when the damper
     /// never touched the bed. `None` without a damper.
@@ -116,7 +117,7 @@ pub struct BlowsRun {
     pub interval_s: f64,
     pub blows: Vec<BlowReport>,
     pub steady: Steady,
-    /// Gap `z_d − u_b` at the end of the last interval, i.e. at the next strike (m); `None`
+    /// Gap `max(z_d − u_b, 0)` at the end of the last interval, i.e. at the next strike (m); `None`
     /// without a damper.
     pub damper_gap_at_next_strike_m: Option<f64>,
     /// Concatenated histories on one uniform grid (when recorded); `dissipated_j` is the
@@ -317,7 +318,10 @@ pub fn run_blows_progress(
     let damper_gap = |x: &[f64]| -> Option<f64> {
         sys.damper
             .as_ref()
-            .map(|_| -dot(sys.relative_vector(Switch::BedDamper), &x[..nd]))
+            // A gap is ≥ 0: with the contact closed (the bed against the damper, overlap
+            // δ = u_b − z_d > 0) it is 0; δ is the penalty contact's compression (δ = F/K_d for
+            // a linear law), not a distance between the bodies. (`max` also turns −0 into 0.)
+            .map(|_| (-dot(sys.relative_vector(Switch::BedDamper), &x[..nd])).max(0.0))
     };
     let mut x0 = sys.initial_state();
     let mut reports = Vec::with_capacity(blow.blows);
@@ -357,6 +361,16 @@ pub fn run_blows_progress(
             sol.totals.dissipated,
         );
         check_run(sys, &o_blow, &sol, residual)?;
+        if sol.collision_end.is_none() {
+            return Err(collision_longer_than_interval(
+                sys,
+                opts,
+                &x0,
+                k,
+                interval,
+                blow.rate_bpm,
+            ));
+        }
         let end = sol.collision_end.as_ref();
         let energy_ratio = end.map(|c| {
             let vs = c.x[nd + sys.slider_index()];
@@ -412,6 +426,75 @@ pub fn run_blows_progress(
         history: None,
         solutions,
     })
+}
+
+/// The error of a blow whose collision (a contact closed: slider-bed or bed-damper, see
+/// [`integrate::CollisionEnd`]) had not ended when the next blow was due, `t_c > T`: the next
+/// blow would strike a slider still on the bed, and the blow's η, peaks and damper gap would
+/// mean nothing. The collision's duration `t_c` is found by running blow `k` on from its strike
+/// `x0` until the collision ends (at most `max(simulation.duration, T)`); the largest valid
+/// stroke rate is then `R_max = 60 / T_min`, with `T_min = t_c` rounded up to whole output
+/// samples (the interval is rounded to whole samples, [`blow_interval_s`]).
+fn collision_longer_than_interval(
+    sys: &ImpactSystem,
+    opts: &Options,
+    x0: &[f64],
+    k: usize,
+    interval: f64,
+    rate_bpm: f64,
+) -> Error {
+    let bound = opts.duration.max(interval);
+    let probe = Options {
+        duration: bound,
+        sample_rate: None,
+        stop_at_collision_end: true,
+        ..*opts
+    };
+    let t_c = integrate::solve_from(sys, x0, &probe, &mut integrate::NoOutput)
+        .ok()
+        .and_then(|s| s.collision_end.map(|c| c.t));
+    let sig = |v: f64| crate::num(format!("{v:.4e}").parse().unwrap_or(v));
+    let head = format!(
+        "blow {} is not over when the next blow is due: a blow every {} s (--rate-bpm {}{}) is \
+         shorter than the collision",
+        k + 1,
+        sig(interval),
+        crate::num(rate_bpm),
+        match opts.sample_rate {
+            Some(fs) if fs.is_finite() && fs > 0.0 => format!(
+                ", the interval rounded to whole samples at {} Hz",
+                crate::num(fs)
+            ),
+            _ => String::new(),
+        }
+    );
+    let msg = match t_c {
+        Some(t_c) => {
+            let t_min = match opts.sample_rate {
+                Some(fs) if fs.is_finite() && fs > 0.0 => (t_c * fs).ceil().max(1.0) / fs,
+                _ => t_c,
+            };
+            // Rounded down to 4 significant digits, so that the rate printed is valid.
+            let r_max = 60.0 / t_min;
+            let scale = 10f64.powi(3 - r_max.log10().floor() as i32);
+            let r_max = (r_max * scale).floor() / scale;
+            format!(
+                "{head} (the collision of blow {} lasts {} s, until both contacts open). \
+                 Give --rate-bpm at most {} (one blow per {} s)",
+                k + 1,
+                sig(t_c),
+                crate::num(r_max),
+                sig(t_min)
+            )
+        }
+        None => format!(
+            "{head} (the collision of blow {} had not ended after {} s either: the slider \
+             does not leave the bed). A train of blows needs collisions that end",
+            k + 1,
+            crate::num(bound)
+        ),
+    };
+    Error::invalid("stroke rate (--rate-bpm)", msg)
 }
 
 /// Appends the samples of `b` (already shifted) to `h`.
