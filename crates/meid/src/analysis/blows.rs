@@ -33,6 +33,13 @@
 //! figures, and the comb filter of the rigid-body mode that makes a single stroke rate a poor
 //! basis for comparing cases.
 //!
+//! **The interval must outlast the collision**: a blow whose collision (slider-bed or bed-damper
+//! contact closed) has not ended at the next strike, `t_c > T`, is refused with `t_c` (found by
+//! running the blow on until its collision ends) and the largest valid rate `60 / T_min`,
+//! `T_min = ⌈t_c f_s⌉ / f_s`. A machine still moving at the strike is accepted: that is what a
+//! train is for. The reported damper gap is `max(z_d − u_b, 0)` (a closed contact's compression
+//! is no gap).
+//!
 //! Chaining restarts of the existing engine (rather than a periodic-forcing engine) keeps the
 //! exact propagator and its event location unchanged: a new blow is just a new initial state.
 
@@ -81,8 +88,8 @@ pub struct BlowReport {
     pub damper_energy_at_strike_j: f64,
     /// Gap `max(z_d − u_b(O_b), 0)` between the damper and the bed at the strike (m): 0 when
     /// the damper is back against the bed (the contact closed, its compression is no gap),
-    /// > 0 when it has not returned (it then cannot take the blow's momentum until the bed has
-    /// travelled the gap). Never negative. `None` without a damper.
+    /// positive when it has not returned (it then cannot take the blow's momentum until the
+    /// bed has travelled the gap). Never negative. `None` without a damper.
     pub damper_gap_at_strike_m: Option<f64>,
     /// Time the bed-damper contact was closed during the blow interval (s); 0 when the damper
     /// never touched the bed. `None` without a damper.
