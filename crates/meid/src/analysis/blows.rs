@@ -632,6 +632,91 @@ mod tests {
         assert_eq!(r.damper_gap_at_strike_m, Some(0.0));
     }
 
+    /// The spring-mounted mass of the periodic-impulse test below (M = 100 kg on 1e5 N/m,
+    /// ζ = 2 %) struck by m_s = 0.01 kg at 1 m/s through a linear undamped contact K = 1e6 N/m.
+    fn mounted_mass() -> Model {
+        let text = r#"
+name = "spring-mounted mass"
+[structure]
+reference_mode = 1
+[structure.lumped]
+damping_ratios = [0.02]
+masses = [{ name = "bed", mass = 100.0 }]
+springs = [{ name = "mount", nodes = ["bed", "ground"], stiffness = 1.0e5 }]
+floor = ["mount"]
+[points]
+bed_contact = "bed"
+measurement = "bed"
+[slider]
+mass = 0.01
+velocity = 1.0
+[contact.slider_bed]
+law = "linear"
+stiffness = 1.0e6
+damping = 0.0
+release = "force"
+[simulation]
+method = "exact"
+duration = 1.0
+sample_rate = 20000.0
+"#;
+        Model::from_text("mounted.toml", text.to_string(), &[]).unwrap()
+    }
+
+    /// A stroke interval shorter than the collision is refused. The collision of the mounted
+    /// mass is the half period of the two-body contact oscillation, `t_c = π / sqrt(K/μ)`,
+    /// μ = m_s M/(m_s + M) = 0.3141 ms (the mount, ω = 31.6 rad/s, moves M by ~1e-4 of the
+    /// contact's travel in that time: 1e-3 relative tolerance). At 20 kHz the shortest valid
+    /// interval is ⌈t_c f_s⌉/f_s = 7 samples = 0.35 ms, so the largest valid rate is
+    /// 60/0.35e-3 = 171 428.6 /min (printed rounded down: 171400). A train at that rate runs
+    /// (with η for every blow), one at 2 samples per blow (0.1 ms) is refused naming t_c.
+    #[test]
+    fn an_interval_shorter_than_the_collision_is_refused() {
+        let model = mounted_mass();
+        let sys = model.impact_system(Case::NoDamper).unwrap();
+        let opts = model.options();
+        let (ms, m, k) = (0.01_f64, 100.0_f64, 1.0e6_f64);
+        let t_closed = std::f64::consts::PI / (k * (ms + m) / (ms * m)).sqrt();
+        let probe = Options {
+            stop_at_collision_end: true,
+            sample_rate: None,
+            ..opts
+        };
+        let t_c =
+            integrate::solve_from(&sys, &sys.initial_state(), &probe, &mut integrate::NoOutput)
+                .unwrap()
+                .collision_end
+                .unwrap()
+                .t;
+        assert!(
+            ((t_c - t_closed) / t_closed).abs() < 1e-3,
+            "collision {t_c} s, closed form {t_closed} s"
+        );
+        let train = |rate_bpm: f64| {
+            let b = BlowOptions {
+                blows: 5,
+                rate_bpm,
+                ..BlowOptions::default()
+            };
+            run_blows(&sys, &opts, &b, false)
+        };
+        let e = train(60.0 / 1e-4).unwrap_err().to_string();
+        assert!(e.contains("shorter than the collision"), "{e}");
+        assert!(
+            e.contains(&format!(
+                "lasts {} s",
+                crate::num(format!("{t_c:.4e}").parse().unwrap())
+            )),
+            "{e}"
+        );
+        assert!(e.contains("at most 171400"), "{e}");
+        let r = train(171_400.0).unwrap();
+        assert!((r.interval_s - 3.5e-4).abs() < 1e-15, "{}", r.interval_s);
+        assert!(r.blows.iter().all(|b| b.energy_ratio.is_some()));
+        // 6 samples per blow (0.3 ms < t_c): refused
+        assert!(train(60.0 / 3e-4).is_err());
+    }
+
     /// Periodic impulses on a damped spring-mounted mass (M = 100 kg, k = 1e5 N/m, ζ = 0.02)
     /// struck by a light slider (m_s = 0.01 kg, v_s = 1 m/s, stiff undamped contact: an impulse
     /// to ~1e-4). Closed form of the periodic steady state (superposed impulse responses, a
