@@ -15,7 +15,8 @@ pub struct BlowsArgs {
     /// Number of blows.
     #[arg(long, value_name = "N", default_value_t = 10)]
     blows: usize,
-    /// Stroke rate (blows per minute).
+    /// Stroke rate (blows per minute). The interval 60/R must outlast each blow's collision
+    /// (else exit 2, naming the largest valid rate); the machine need not be at rest.
     #[arg(long, value_name = "R", default_value_t = 60.0)]
     rate_bpm: f64,
     /// Relative blow-to-blow change that counts as steady.

@@ -27,12 +27,13 @@ pub struct CalibrateArgs {
     /// contact.slider_bed.stiffness,contact.bed_damper.stiffness,structure.lumped.damping_ratios[1].
     #[arg(long = "fit", value_name = "PATH[,PATH…]", required = true)]
     fit: Vec<String>,
-    /// Bounds of fitted paths, PATH=LO:HI comma-separated (repeatable); default [p/10, 10 p]
-    /// around the model's value p (a value ≤ 0 needs bounds).
-    #[arg(long = "bounds", value_name = "PATH=LO:HI[,…]")]
+    /// Bounds of fitted paths, PATH=LO..HI comma-separated (repeatable; PATH=LO:HI is accepted
+    /// too); default [p/10, 10 p] around the model's value p (a value ≤ 0 needs bounds).
+    #[arg(long = "bounds", value_name = "PATH=LO..HI[,…]")]
     bounds: Vec<String>,
-    /// Fit ESD levels (dB) between LO and HI Hz instead of the time histories.
-    #[arg(long = "spectrum", value_name = "LO:HI")]
+    /// Fit ESD levels (dB) between LO and HI Hz instead of the time histories (LO:HI is
+    /// accepted too).
+    #[arg(long = "spectrum", value_name = "LO..HI")]
     spectrum: Option<String>,
     /// Iteration limit of the Levenberg-Marquardt solver.
     #[arg(long = "max-iterations", value_name = "N", default_value_t = 50)]
@@ -55,12 +56,10 @@ pub struct CalibrateArgs {
 fn parse_band(s: &str) -> Result<ResidualKind> {
     let bad = || {
         anyhow::anyhow!(
-            "--spectrum {s}: give LO:HI in Hz with 0 ≤ LO < HI, e.g. --spectrum 200:400"
+            "--spectrum {s}: give LO..HI (or LO:HI) in Hz with 0 ≤ LO < HI, e.g. --spectrum 200..400"
         )
     };
-    let (lo, hi) = s.split_once(':').ok_or_else(bad)?;
-    let lo: f64 = lo.trim().parse().map_err(|_| bad())?;
-    let hi: f64 = hi.trim().parse().map_err(|_| bad())?;
+    let (lo, hi) = meid::analysis::study::parse_range(s).map_err(|_| bad())?;
     if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && lo < hi) {
         bail!(bad());
     }

@@ -44,7 +44,8 @@ pub struct CompareArgs {
     /// Time constant (s) of the exponential window (default: the record length / 5).
     #[arg(long, value_name = "S")]
     tau: Option<f64>,
-    /// Read mode levels at these frequencies (Hz) instead of the model's dominant modes.
+    /// Read mode levels at these frequencies (Hz) instead of the model's dominant modes; each
+    /// at least the record's frequency resolution 1/T (0.5 Hz for the default 2 s record).
     #[arg(long, value_name = "HZ", value_delimiter = ',')]
     frequencies: Vec<f64>,
     #[command(flatten)]

@@ -184,14 +184,50 @@ pub(crate) fn load(
     rate: Option<f64>,
 ) -> Result<Model> {
     let mut overrides = set.to_vec();
+    // Each flag becomes a `--set` override; an error the model finds in one names the flag
+    // and the value as given (`--rate 0`), not the override it was turned into.
+    let mut flags: Vec<(String, String)> = Vec::new();
+    let mut flag = |field: &str, value: String, shown: String| {
+        let spec = format!("{field}={value}");
+        flags.push((format!("--set {spec}"), shown));
+        overrides.push(spec);
+    };
     if let Some(m) = method {
-        overrides.push(format!("simulation.method=\"{m}\""));
+        flag(
+            "simulation.method",
+            format!("\"{m}\""),
+            format!("--method {m}"),
+        );
     }
+    // TOML spells the non-finite numbers nan, inf and -inf.
+    let toml_number = |v: f64| {
+        if v.is_nan() {
+            "nan".to_string()
+        } else {
+            format!("{v:e}")
+        }
+    };
     if let Some(d) = duration {
-        overrides.push(format!("simulation.duration={d:e}"));
+        flag(
+            "simulation.duration",
+            toml_number(d),
+            format!("--duration {}", meid::num(d)),
+        );
     }
     if let Some(r) = rate {
-        overrides.push(format!("simulation.sample_rate={r:e}"));
+        flag(
+            "simulation.sample_rate",
+            toml_number(r),
+            format!("--rate {}", meid::num(r)),
+        );
     }
-    Ok(Model::from_file(path, &overrides)?)
+    Model::from_file(path, &overrides).map_err(|e| match e {
+        meid::Error::Input { location, message } => {
+            let location = flags
+                .iter()
+                .fold(location, |l, (spec, shown)| l.replace(spec.as_str(), shown));
+            meid::Error::Input { location, message }.into()
+        }
+        e => e.into(),
+    })
 }

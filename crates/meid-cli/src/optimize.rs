@@ -27,7 +27,8 @@ pub struct OptimizeArgs {
     /// the model's duration).
     #[arg(long, value_parser = ["energy", "bed-accel", "floor-force"], default_value = "energy")]
     objective: String,
-    /// Bounds of a variable, PATH=LO..HI (repeatable). Positive bounds are searched in log scale.
+    /// Bounds of a variable, PATH=LO..HI (repeatable; PATH=LO:HI is accepted too). Positive
+    /// bounds are searched in log scale.
     #[arg(long = "bounds", value_name = "PATH=LO..HI")]
     bounds: Vec<String>,
     #[command(flatten)]

@@ -115,6 +115,27 @@ fn paper_page_figures_table_and_closed_forms() {
     assert!((val("pct-damper-arithmetic", "lumped") - implied(41.2)).abs() < 1e-12);
     assert!((val("pct-added-arithmetic", "lumped") - implied(25.9)).abs() < 1e-12);
     assert_eq!(row("pct-damper-arithmetic")["verdict"], "not-reproduced");
+    // Each row's measure names its own case (the damper's percentage row once said "(the added
+    // mass on the bed)"): only the added-mass rows mention the added mass.
+    for id in [
+        "pct-damper",
+        "power-damper",
+        "T-acc",
+        "T-force",
+        "U-acc",
+        "U-force",
+    ] {
+        let measure = row(id)["measure"].as_str().unwrap();
+        assert!(!measure.contains("added mass"), "{id}: {measure}");
+    }
+    assert!(row("pct-damper")["measure"]
+        .as_str()
+        .unwrap()
+        .contains("impact damper"));
+    assert!(row("pct-added")["measure"]
+        .as_str()
+        .unwrap()
+        .contains("added mass on the bed"));
     // Every non-reproduced dB number got a deviation study.
     let dev = json["deviations"].as_array().unwrap();
     for r in table {

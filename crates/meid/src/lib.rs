@@ -34,4 +34,4 @@ pub mod report;
 pub mod rng;
 pub mod structure;
 
-pub use error::{Error, Result};
+pub use error::{num, Error, Result};

@@ -79,10 +79,22 @@ pub fn parse_bytes(s: &str) -> Result<u64> {
         _ => return Err(bad()),
     };
     let b = v * scale;
-    if !(b.is_finite() && b >= 1.0 && b < u64::MAX as f64) {
+    if b.is_nan() || b < 1.0 {
         return Err(Error::invalid(
             "--max-memory",
-            format!("`{s}` must be at least 1 byte and finite"),
+            format!("`{s}` is {} bytes; give at least 1 byte", crate::num(b)),
+        ));
+    }
+    // u64::MAX as f64 = 2^64: the largest size a u64 holds after rounding lies just below it.
+    if b >= u64::MAX as f64 {
+        return Err(Error::invalid(
+            "--max-memory",
+            format!(
+                "`{s}` is too large ({} bytes); the largest size accepted is just below 2^64 \
+                 bytes = {} B (16 EiB, e.g. 1.8e19 or 16000000TiB)",
+                crate::num(b),
+                crate::num(u64::MAX as f64)
+            ),
         ));
     }
     Ok(b.round() as u64)

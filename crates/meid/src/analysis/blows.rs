@@ -33,6 +33,13 @@
 //! figures, and the comb filter of the rigid-body mode that makes a single stroke rate a poor
 //! basis for comparing cases.
 //!
+//! **The interval must outlast the collision**: a blow whose collision (slider-bed or bed-damper
+//! contact closed) has not ended at the next strike, `t_c > T`, is refused with `t_c` (found by
+//! running the blow on until its collision ends) and the largest valid rate `60 / T_min`,
+//! `T_min = ⌈t_c f_s⌉ / f_s`. A machine still moving at the strike is accepted: that is what a
+//! train is for. The reported damper gap is `max(z_d − u_b, 0)` (a closed contact's compression
+//! is no gap).
+//!
 //! Chaining restarts of the existing engine (rather than a periodic-forcing engine) keeps the
 //! exact propagator and its event location unchanged: a new blow is just a new initial state.
 
@@ -79,9 +86,10 @@ pub struct BlowReport {
     pub machine_energy_at_strike_j: f64,
     /// E_d of the damper at the strike (J).
     pub damper_energy_at_strike_j: f64,
-    /// Gap `z_d − u_b(O_b)` between the damper and the bed at the strike (m): 0 when the damper
-    /// is back against the bed, > 0 when it has not returned (it then cannot take the blow's
-    /// momentum until the bed has travelled the gap). `None` without a damper.
+    /// Gap `max(z_d − u_b(O_b), 0)` between the damper and the bed at the strike (m): 0 when
+    /// the damper is back against the bed (the contact closed, its compression is no gap),
+    /// positive when it has not returned (it then cannot take the blow's momentum until the
+    /// bed has travelled the gap). Never negative. `None` without a damper.
     pub damper_gap_at_strike_m: Option<f64>,
     /// Time the bed-damper contact was closed during the blow interval (s); 0 when the damper
     /// never touched the bed. `None` without a damper.
@@ -116,7 +124,7 @@ pub struct BlowsRun {
     pub interval_s: f64,
     pub blows: Vec<BlowReport>,
     pub steady: Steady,
-    /// Gap `z_d − u_b` at the end of the last interval, i.e. at the next strike (m); `None`
+    /// Gap `max(z_d − u_b, 0)` at the end of the last interval, i.e. at the next strike (m); `None`
     /// without a damper.
     pub damper_gap_at_next_strike_m: Option<f64>,
     /// Concatenated histories on one uniform grid (when recorded); `dissipated_j` is the
@@ -317,7 +325,10 @@ pub fn run_blows_progress(
     let damper_gap = |x: &[f64]| -> Option<f64> {
         sys.damper
             .as_ref()
-            .map(|_| -dot(sys.relative_vector(Switch::BedDamper), &x[..nd]))
+            // A gap is ≥ 0: with the contact closed (the bed against the damper, overlap
+            // δ = u_b − z_d > 0) it is 0; δ is the penalty contact's compression (δ = F/K_d for
+            // a linear law), not a distance between the bodies. (`max` also turns −0 into 0.)
+            .map(|_| (-dot(sys.relative_vector(Switch::BedDamper), &x[..nd])).max(0.0))
     };
     let mut x0 = sys.initial_state();
     let mut reports = Vec::with_capacity(blow.blows);
@@ -358,6 +369,16 @@ pub fn run_blows_progress(
             sol.totals.dissipated,
         );
         check_run(sys, &o_blow, &sol, &[balance])?;
+        if sol.collision_end.is_none() {
+            return Err(collision_longer_than_interval(
+                sys,
+                opts,
+                &x0,
+                k,
+                interval,
+                blow.rate_bpm,
+            ));
+        }
         let end = sol.collision_end.as_ref();
         let energy_ratio = end.map(|c| {
             let vs = c.x[nd + sys.slider_index()];
@@ -413,6 +434,75 @@ pub fn run_blows_progress(
         history: None,
         solutions,
     })
+}
+
+/// The error of a blow whose collision (a contact closed: slider-bed or bed-damper, see
+/// [`integrate::CollisionEnd`]) had not ended when the next blow was due, `t_c > T`: the next
+/// blow would strike a slider still on the bed, and the blow's η, peaks and damper gap would
+/// mean nothing. The collision's duration `t_c` is found by running blow `k` on from its strike
+/// `x0` until the collision ends (at most `max(simulation.duration, T)`); the largest valid
+/// stroke rate is then `R_max = 60 / T_min`, with `T_min = t_c` rounded up to whole output
+/// samples (the interval is rounded to whole samples, [`blow_interval_s`]).
+fn collision_longer_than_interval(
+    sys: &ImpactSystem,
+    opts: &Options,
+    x0: &[f64],
+    k: usize,
+    interval: f64,
+    rate_bpm: f64,
+) -> Error {
+    let bound = opts.duration.max(interval);
+    let probe = Options {
+        duration: bound,
+        sample_rate: None,
+        stop_at_collision_end: true,
+        ..*opts
+    };
+    let t_c = integrate::solve_from(sys, x0, &probe, &mut integrate::NoOutput)
+        .ok()
+        .and_then(|s| s.collision_end.map(|c| c.t));
+    let sig = |v: f64| crate::num(format!("{v:.4e}").parse().unwrap_or(v));
+    let head = format!(
+        "blow {} is not over when the next blow is due: a blow every {} s (--rate-bpm {}{}) is \
+         shorter than the collision",
+        k + 1,
+        sig(interval),
+        crate::num(rate_bpm),
+        match opts.sample_rate {
+            Some(fs) if fs.is_finite() && fs > 0.0 => format!(
+                ", the interval rounded to whole samples at {} Hz",
+                crate::num(fs)
+            ),
+            _ => String::new(),
+        }
+    );
+    let msg = match t_c {
+        Some(t_c) => {
+            let t_min = match opts.sample_rate {
+                Some(fs) if fs.is_finite() && fs > 0.0 => (t_c * fs).ceil().max(1.0) / fs,
+                _ => t_c,
+            };
+            // Rounded down to 4 significant digits, so that the rate printed is valid.
+            let r_max = 60.0 / t_min;
+            let scale = 10f64.powi(3 - r_max.log10().floor() as i32);
+            let r_max = (r_max * scale).floor() / scale;
+            format!(
+                "{head} (the collision of blow {} lasts {} s, until both contacts open). \
+                 Give --rate-bpm at most {} (one blow per {} s)",
+                k + 1,
+                sig(t_c),
+                crate::num(r_max),
+                sig(t_min)
+            )
+        }
+        None => format!(
+            "{head} (the collision of blow {} had not ended after {} s either: the slider \
+             does not leave the bed). A train of blows needs collisions that end",
+            k + 1,
+            crate::num(bound)
+        ),
+    };
+    Error::invalid("stroke rate (--rate-bpm)", msg)
 }
 
 /// Appends the samples of `b` (already shifted) to `h`.
@@ -541,6 +631,91 @@ mod tests {
         assert_eq!(r.energy_ratio, single.summary.energy_ratio);
         assert_eq!(r.peak_floor_force_n, single.summary.peak_floor_force_n);
         assert_eq!(r.damper_gap_at_strike_m, Some(0.0));
+    }
+
+    /// The spring-mounted mass of the periodic-impulse test below (M = 100 kg on 1e5 N/m,
+    /// ζ = 2 %) struck by m_s = 0.01 kg at 1 m/s through a linear undamped contact K = 1e6 N/m.
+    fn mounted_mass() -> Model {
+        let text = r#"
+name = "spring-mounted mass"
+[structure]
+reference_mode = 1
+[structure.lumped]
+damping_ratios = [0.02]
+masses = [{ name = "bed", mass = 100.0 }]
+springs = [{ name = "mount", nodes = ["bed", "ground"], stiffness = 1.0e5 }]
+floor = ["mount"]
+[points]
+bed_contact = "bed"
+measurement = "bed"
+[slider]
+mass = 0.01
+velocity = 1.0
+[contact.slider_bed]
+law = "linear"
+stiffness = 1.0e6
+damping = 0.0
+release = "force"
+[simulation]
+method = "exact"
+duration = 1.0
+sample_rate = 20000.0
+"#;
+        Model::from_text("mounted.toml", text.to_string(), &[]).unwrap()
+    }
+
+    /// A stroke interval shorter than the collision is refused. The collision of the mounted
+    /// mass is the half period of the two-body contact oscillation, `t_c = π / sqrt(K/μ)`,
+    /// μ = m_s M/(m_s + M) = 0.3141 ms (the mount, ω = 31.6 rad/s, moves M by ~1e-4 of the
+    /// contact's travel in that time: 1e-3 relative tolerance). At 20 kHz the shortest valid
+    /// interval is ⌈t_c f_s⌉/f_s = 7 samples = 0.35 ms, so the largest valid rate is
+    /// 60/0.35e-3 = 171 428.6 /min (printed rounded down: 171400). A train at that rate runs
+    /// (with η for every blow), one at 2 samples per blow (0.1 ms) is refused naming t_c.
+    #[test]
+    fn an_interval_shorter_than_the_collision_is_refused() {
+        let model = mounted_mass();
+        let sys = model.impact_system(Case::NoDamper).unwrap();
+        let opts = model.options();
+        let (ms, m, k) = (0.01_f64, 100.0_f64, 1.0e6_f64);
+        let t_closed = std::f64::consts::PI / (k * (ms + m) / (ms * m)).sqrt();
+        let probe = Options {
+            stop_at_collision_end: true,
+            sample_rate: None,
+            ..opts
+        };
+        let t_c =
+            integrate::solve_from(&sys, &sys.initial_state(), &probe, &mut integrate::NoOutput)
+                .unwrap()
+                .collision_end
+                .unwrap()
+                .t;
+        assert!(
+            ((t_c - t_closed) / t_closed).abs() < 1e-3,
+            "collision {t_c} s, closed form {t_closed} s"
+        );
+        let train = |rate_bpm: f64| {
+            let b = BlowOptions {
+                blows: 5,
+                rate_bpm,
+                ..BlowOptions::default()
+            };
+            run_blows(&sys, &opts, &b, false)
+        };
+        let e = train(60.0 / 1e-4).unwrap_err().to_string();
+        assert!(e.contains("shorter than the collision"), "{e}");
+        assert!(
+            e.contains(&format!(
+                "lasts {} s",
+                crate::num(format!("{t_c:.4e}").parse().unwrap())
+            )),
+            "{e}"
+        );
+        assert!(e.contains("at most 171400"), "{e}");
+        let r = train(171_400.0).unwrap();
+        assert!((r.interval_s - 3.5e-4).abs() < 1e-15, "{}", r.interval_s);
+        assert!(r.blows.iter().all(|b| b.energy_ratio.is_some()));
+        // 6 samples per blow (0.3 ms < t_c): refused
+        assert!(train(60.0 / 3e-4).is_err());
     }
 
     /// Periodic impulses on a damped spring-mounted mass (M = 100 kg, k = 1e5 N/m, ζ = 0.02)

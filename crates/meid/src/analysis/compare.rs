@@ -420,6 +420,17 @@ impl Comparison {
         c
     }
 
+    /// The record the comparison simulates (s): `duration_s` for one blow, `blows · 60/rate`
+    /// for a train.
+    fn record_s(&self) -> f64 {
+        let o = &self.options;
+        if o.blows > 1 {
+            o.blows as f64 * 60.0 / o.rate_bpm
+        } else {
+            o.duration_s
+        }
+    }
+
     fn check(&self) -> Result<f64> {
         let o = &self.options;
         if !(o.duration_s.is_finite() && o.duration_s > 0.0) {
@@ -449,6 +460,26 @@ impl Comparison {
                     "give one or more frequencies > 0 Hz",
                 ));
             }
+            // The lowest frequency a record of T_record seconds resolves is its frequency
+            // resolution Δf = 1/T_record (one period in the record): below it a level, and the
+            // one-third-octave bands around it, describe nothing a measurement of that record
+            // could show (and the bands would crowd towards 0 Hz).
+            let record_s = self.record_s();
+            let lowest = 1.0 / record_s;
+            if let Some(v) = f.iter().find(|v| **v < lowest) {
+                return Err(Error::invalid(
+                    "mode frequencies (--frequencies)",
+                    format!(
+                        "{} Hz is below {} Hz, the frequency resolution 1/T of the {} s record \
+                         (one period must fit in the record). Name frequencies of at least {} \
+                         Hz, or lengthen the record (--duration, or --blows × 60/--rate-bpm)",
+                        crate::num(*v),
+                        crate::num(lowest),
+                        crate::num(record_s),
+                        crate::num(lowest)
+                    ),
+                ));
+            }
         }
         let fs = self.model.spec.simulation.sample_rate;
         if !(fs.is_finite() && fs > 0.0) {
@@ -467,11 +498,7 @@ impl Comparison {
     /// per sample each).
     fn check_memory(&self, fs: f64) -> Result<()> {
         let o = &self.options;
-        let record_s = if o.blows > 1 {
-            o.blows as f64 * 60.0 / o.rate_bpm
-        } else {
-            o.duration_s
-        };
+        let record_s = self.record_s();
         let samples = super::energy::sample_count(record_s, Some(fs));
         let per_sample = super::energy::HISTORY_SAMPLE_BYTES
             + if o.spectrum == SpectrumMethod::Fft {
@@ -886,6 +913,17 @@ pub fn record_spectrum(x: &[f64], sample_rate_hz: f64, window: Window) -> Result
     amplitude_spectrum_padded(x, sample_rate_hz, window, pad)
 }
 
+/// A band edge for the band table: one decimal from 1 Hz up (`281.8`), two significant
+/// digits below (`0.89`, `0.045`), so that no band of a low frequency prints as `0.0`.
+fn band_edge(f_hz: f64) -> String {
+    if !(f_hz > 0.0 && f_hz < 1.0) {
+        format!("{f_hz:.1}")
+    } else {
+        let decimals = (1 - f_hz.log10().floor() as i32).max(1) as usize;
+        format!("{f_hz:.decimals$}")
+    }
+}
+
 /// `20 log10(x/r)`.
 fn db20(x: f64, r: f64) -> f64 {
     20.0 * (x / r).log10()
@@ -1095,10 +1133,10 @@ impl ComparisonResult {
         let a2 = self.acceleration_reference_m_per_s2.powi(2);
         for (i, b) in self.bands.iter().enumerate() {
             s.push_str(&format!(
-                "{:>9} {:>8.1}-{:<10.1}",
+                "{:>9} {:>8}-{:<10}",
                 b.label(),
-                b.lower_hz,
-                b.upper_hz
+                band_edge(b.lower_hz),
+                band_edge(b.upper_hz)
             ));
             for c in &self.cases {
                 let l = |ch: usize, r: f64| {

@@ -47,14 +47,20 @@ impl Band {
         Self::new((10.0 * (f_hz / 1000.0).log10()).round() as i32)
     }
 
-    /// A label such as "315 Hz" or "6.3 Hz".
+    /// A label such as "315 Hz", "6.3 Hz" or "0.063 Hz": the R10 nominal value with its
+    /// significant digits at any size (exponent form below 1 mHz, "6.3e-5 Hz").
     pub fn label(&self) -> String {
         let v = self.nominal_hz;
+        let decade = 3 + self.index.div_euclid(10);
         if v >= 100.0 {
             format!("{v:.0} Hz")
-        } else {
-            let s = format!("{v:.2}");
+        } else if decade >= -3 {
+            // R10 values have at most 3 significant digits (3.15): 2 - decade decimals.
+            let decimals = (2 - decade).max(0) as usize;
+            let s = format!("{v:.decimals$}");
             format!("{} Hz", s.trim_end_matches('0').trim_end_matches('.'))
+        } else {
+            format!("{}e{decade} Hz", R10[self.index.rem_euclid(10) as usize])
         }
     }
 }
@@ -85,6 +91,12 @@ mod tests {
         assert_eq!(Band::new(-8).nominal_hz, 160.0);
         assert_eq!(Band::new(-22).nominal_hz, 6.3);
         assert_eq!(Band::new(-22).label(), "6.3 Hz");
+        // Labels keep their digits at any size (they used to print "0 Hz" below 5 mHz).
+        assert_eq!(Band::new(-25).label(), "3.15 Hz");
+        assert_eq!(Band::new(-42).label(), "0.063 Hz");
+        assert_eq!(Band::new(-55).label(), "0.00315 Hz");
+        assert_eq!(Band::new(-62).label(), "6.3e-4 Hz");
+        assert_eq!(Band::new(-120).label(), "1e-9 Hz");
         assert_eq!(Band::containing(6.35).index, -22);
         assert_eq!(Band::containing(283.0).nominal_hz, 315.0); // 315 Hz band: 281.8-354.8 Hz
         assert_eq!(Band::containing(279.0).nominal_hz, 250.0);

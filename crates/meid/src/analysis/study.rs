@@ -72,22 +72,34 @@ impl Objective {
     }
 }
 
-/// Parses one bound of an optimisation variable, `PATH=LO..HI` (`meid optimize --bounds`):
-/// the quantity ([`Quantity::parse`]) and `(LO, HI)` as written (the study checks them).
+/// Parses a range of two numbers, `LO..HI` (the canonical form, as in `--vary NAME=A..B:N`)
+/// or `LO:HI` (also accepted), as written: the caller checks the order and the domain. The one
+/// parser of every range option (`optimize --bounds`, `calibrate --bounds` and `--spectrum`).
+/// The error says what is wrong with the text.
+pub fn parse_range(text: &str) -> std::result::Result<(f64, f64), String> {
+    let (lo, hi) = match text.split_once("..") {
+        Some(parts) => parts,
+        None => text.split_once(':').ok_or_else(|| {
+            format!("`{text}` is not a range; give LO..HI (or LO:HI), e.g. 1e7..1e8")
+        })?,
+    };
+    let number = |t: &str| -> std::result::Result<f64, String> {
+        t.trim()
+            .parse()
+            .map_err(|_| format!("`{}` in `{text}` is not a number", t.trim()))
+    };
+    Ok((number(lo)?, number(hi)?))
+}
+
+/// Parses one bound of an optimisation variable, `PATH=LO..HI` or `PATH=LO:HI`
+/// (`meid optimize --bounds`, [`parse_range`]): the quantity ([`Quantity::parse`]) and
+/// `(LO, HI)` as written (the study checks them).
 pub fn parse_bounds(spec: &str) -> Result<(Quantity, (f64, f64))> {
     let bad = |what: String| Error::invalid("--bounds", format!("`{spec}`: {what}"));
     let (name, range) = spec
         .split_once('=')
-        .ok_or_else(|| bad("expected PATH=LO..HI".into()))?;
-    let (lo, hi) = range
-        .split_once("..")
-        .ok_or_else(|| bad("expected PATH=LO..HI".into()))?;
-    let number = |t: &str| -> Result<f64> {
-        t.trim()
-            .parse()
-            .map_err(|_| bad(format!("`{}` is not a number", t.trim())))
-    };
-    let (lo, hi) = (number(lo)?, number(hi)?);
+        .ok_or_else(|| bad("expected PATH=LO..HI (or PATH=LO:HI)".into()))?;
+    let (lo, hi) = parse_range(range).map_err(bad)?;
     Ok((Quantity::parse(name)?, (lo, hi)))
 }
 

@@ -147,7 +147,8 @@ pub fn parse_fit(list: &[String]) -> Result<Vec<String>> {
     Ok(out)
 }
 
-/// `--bounds` values: `PATH=LO:HI`, comma-separated, repeatable.
+/// `--bounds` values: `PATH=LO..HI` (or `PATH=LO:HI`, [`crate::analysis::study::parse_range`]),
+/// comma-separated, repeatable.
 pub fn parse_bounds(list: &[String]) -> Result<BTreeMap<String, (f64, f64)>> {
     let mut out = BTreeMap::new();
     for item in list {
@@ -156,13 +157,11 @@ pub fn parse_bounds(list: &[String]) -> Result<BTreeMap<String, (f64, f64)>> {
             let bad = |why: &str| {
                 Error::invalid(
                     "--bounds",
-                    format!("'{b}': {why}; give PATH=LO:HI with LO < HI, e.g. contact.slider_bed.stiffness=1e7:1e8"),
+                    format!("'{b}': {why}; give PATH=LO..HI (or PATH=LO:HI) with LO < HI, e.g. contact.slider_bed.stiffness=1e7..1e8"),
                 )
             };
             let (path, range) = b.split_once('=').ok_or_else(|| bad("no '='"))?;
-            let (lo, hi) = range.split_once(':').ok_or_else(|| bad("no ':'"))?;
-            let lo: f64 = lo.trim().parse().map_err(|_| bad("LO is not a number"))?;
-            let hi: f64 = hi.trim().parse().map_err(|_| bad("HI is not a number"))?;
+            let (lo, hi) = crate::analysis::study::parse_range(range).map_err(|e| bad(&e))?;
             if !(lo.is_finite() && hi.is_finite()) {
                 return Err(bad("the bounds must be finite"));
             }

@@ -718,7 +718,7 @@ pub fn machine_spec(m: &MachineFileSpec) -> Result<MachineSpec> {
         if !(a.mass.is_finite() && a.mass > 0.0) {
             return Err(Error::invalid(
                 format!("added_masses[{i}].mass"),
-                format!("must be > 0 kg (got {})", a.mass),
+                format!("must be > 0 kg (got {})", crate::num(a.mass)),
             ));
         }
         if !a.offset.iter().all(|v| v.is_finite()) {
@@ -775,7 +775,7 @@ pub(super) fn check_material(m: &MaterialSpec, field: &str, src: &Source) -> Res
     for (key, v, ok, range) in checks {
         if !ok {
             let f = format!("{field}.{key}");
-            return Err(src.error(&f, format!("{f} must be {range} (got {v})")));
+            return Err(src.error(&f, format!("{f} must be {range} (got {})", crate::num(v))));
         }
     }
     Ok(())
@@ -791,7 +791,10 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
     if !(ms.thickness.is_finite() && ms.thickness > 0.0) {
         return Err(src.error(
             &format!("{base}.thickness"),
-            format!("{base}.thickness must be > 0 m (got {})", ms.thickness),
+            format!(
+                "{base}.thickness must be > 0 m (got {})",
+                crate::num(ms.thickness)
+            ),
         ));
     }
     if let Some(m) = &ms.material {
@@ -1219,7 +1222,10 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
         if !(f.is_finite() && f > 0.0) {
             return Err(src.error(
                 &format!("{base}.auto_max_hz"),
-                format!("{base}.auto_max_hz must be a finite number > 0 Hz (got {f})"),
+                format!(
+                    "{base}.auto_max_hz must be a finite number > 0 Hz (got {})",
+                    crate::num(f)
+                ),
             ));
         }
     }
@@ -1421,7 +1427,10 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
     {
         return Err(src.error(
             &format!("{base}.damping_ratios"),
-            format!("{base}.damping_ratios must be in [0, 1) (got {z})"),
+            format!(
+                "{base}.damping_ratios must be in [0, 1) (got {})",
+                crate::num(*z)
+            ),
         ));
     }
     let mut modal = model.modal_model(&modes, &selected, &zeta)?;
@@ -1546,7 +1555,7 @@ fn auto_select(
         Some(f) => {
             return Err(src.error(
                 &format!("{base}.auto_max_hz"),
-                format!("{base}.auto_max_hz must be a finite number > 0 Hz (got {f})"),
+                format!("{base}.auto_max_hz must be a finite number > 0 Hz (got {})", crate::num(f)),
             ))
         }
         None if ctx.contact_omega_rad_per_s > 0.0 => {

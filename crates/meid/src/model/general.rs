@@ -330,7 +330,7 @@ fn positive(b: &Builder<'_>, field: &str, v: f64, unit: &str) -> Result<()> {
     } else {
         Err(b.err(
             field,
-            format!("must be a finite number > 0 {unit} (got {v})"),
+            format!("must be a finite number > 0 {unit} (got {})", crate::num(v)),
         ))
     }
 }
@@ -344,7 +344,7 @@ fn nonnegative(b: &Builder<'_>, field: &str, v: &[f64], unit: &str) -> Result<()
                 "component {} ({}) must be finite and >= 0 {unit} (got {})",
                 i + 1,
                 ["x", "y", "z", "rx", "ry", "rz"][i.min(5)],
-                v[i]
+                crate::num(v[i])
             ),
         )),
     }

@@ -237,7 +237,10 @@ pub fn build(
         if !(max.is_finite() && max > 0.0) {
             return Err(src.error(
                 &format!("{BASE}.max_hz"),
-                format!("{BASE}.max_hz: must be a finite number > 0 Hz (got {max})"),
+                format!(
+                    "{BASE}.max_hz: must be a finite number > 0 Hz (got {})",
+                    crate::num(max)
+                ),
             ));
         }
         kept.retain(|m| m.frequency_hz <= max);

@@ -32,7 +32,10 @@ pub(super) fn ratios(r: &Option<Ratios>, n: usize, path: &str, src: &Source) -> 
     {
         return Err(src.error(
             path,
-            format!("{path}: damping ratios must be in [0, 1) (got {z})"),
+            format!(
+                "{path}: damping ratios must be in [0, 1) (got {})",
+                crate::num(*z)
+            ),
         ));
     }
     Ok(v)
@@ -209,7 +212,8 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
                 &path,
                 format!(
                     "{path} ('{}') must be a finite number > 0 kg (got {})",
-                    m.name, m.mass
+                    m.name,
+                    crate::num(m.mass)
                 ),
             ));
         }
@@ -246,7 +250,7 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
                 &format!("{path}.stiffness"),
                 format!(
                     "{path}.stiffness must be a finite number > 0 N/m (got {})",
-                    s.stiffness
+                    crate::num(s.stiffness)
                 ),
             ));
         }
@@ -274,7 +278,7 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
                 &format!("{path}.damping"),
                 format!(
                     "{path}.damping must be a finite number >= 0 N·s/m (got {})",
-                    d.damping
+                    crate::num(d.damping)
                 ),
             ));
         }
@@ -608,7 +612,10 @@ pub fn from_modal_spec(s: &ModalSpec, src: &Source) -> Result<ModalModel> {
         if !(f.is_finite() && *f >= 0.0) {
             return Err(src.error(
                 &format!("{base}.frequencies_hz"),
-                format!("{base}.frequencies_hz[{i}] must be a finite number >= 0 Hz (got {f})"),
+                format!(
+                    "{base}.frequencies_hz[{i}] must be a finite number >= 0 Hz (got {})",
+                    crate::num(*f)
+                ),
             ));
         }
     }
@@ -650,7 +657,8 @@ pub fn from_modal_spec(s: &ModalSpec, src: &Source) -> Result<ModalModel> {
                 return Err(src.error(
                     &at,
                     format!(
-                        "{at} must be a finite number ({unit} per unit modal coordinate; got {v})"
+                        "{at} must be a finite number ({unit} per unit modal coordinate; got {})",
+                        crate::num(*v)
                     ),
                 ));
             }

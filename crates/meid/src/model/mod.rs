@@ -290,7 +290,9 @@ impl Model {
             return Err(src.error(
                 "slider.velocity",
                 format!(
-                    "slider.mass = {m_s} kg and slider.velocity = {v_s} m/s strike with ½ m_s v_s² = {e_s:e} J; meid takes at most {MAX_BLOW_ENERGY_J:e} J (the largest forging hammers strike with ~1e6 J), so that the energies, powers and their products in the energy balance stay far from double precision's limit 1.8e308"
+                    "slider.mass = {} kg and slider.velocity = {} m/s strike with ½ m_s v_s² = {e_s:e} J; meid takes at most {MAX_BLOW_ENERGY_J:e} J (the largest forging hammers strike with ~1e6 J), so that the energies, powers and their products in the energy balance stay far from double precision's limit 1.8e308",
+                    crate::num(m_s),
+                    crate::num(v_s)
                 ),
             ));
         }
@@ -302,20 +304,26 @@ impl Model {
             if !(v.is_finite() && v > 0.0) {
                 return Err(src.error(
                     field,
-                    format!("{field} must be a finite number > 0 {unit} (got {v})"),
+                    format!(
+                        "{field} must be a finite number > 0 {unit} (got {})",
+                        crate::num(v)
+                    ),
                 ));
             }
         }
         if !(sim.rtol > 0.0 && sim.rtol < 1.0) {
             return Err(src.error(
                 "simulation.rtol",
-                format!("simulation.rtol must be in (0, 1) (got {})", sim.rtol),
+                format!(
+                    "simulation.rtol must be in (0, 1) (got {})",
+                    crate::num(sim.rtol)
+                ),
             ));
         }
         if !(sim.atol > 0.0 && sim.atol.is_finite()) {
             return Err(src.error(
                 "simulation.atol",
-                format!("simulation.atol must be > 0 (got {})", sim.atol),
+                format!("simulation.atol must be > 0 (got {})", crate::num(sim.atol)),
             ));
         }
         if !(1..=100_000_000).contains(&sim.max_events) {

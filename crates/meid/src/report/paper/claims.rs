@@ -438,9 +438,16 @@ pub fn rows(r: &Runs) -> Vec<Row> {
                 case,
             ))
         });
+        let measure = format!(
+            "1 − η_case/η_none (%) at S, η = E_p+/E_s− ({})",
+            match case {
+                CaseName::AddedMass => "the added mass on the bed",
+                _ => "the impact damper on the bed",
+            }
+        );
         out.push(numeric(
             p,
-            "1 − η_case/η_none (%) at S, η = E_p+/E_s− (the added mass on the bed)",
+            &measure,
             l,
             f,
             5.0,
