@@ -636,21 +636,28 @@ mod tests {
     /// The spring-mounted mass of the periodic-impulse test below (M = 100 kg on 1e5 N/m,
     /// ζ = 2 %) struck by m_s = 0.01 kg at 1 m/s through a linear undamped contact K = 1e6 N/m.
     fn mounted_mass() -> Model {
-        let text = r#"
+        mounted(100.0, 1.0e5, 0.02, 0.01, 1.0)
+    }
+
+    /// A mass `m` (kg) on a spring `k` (N/m) to the floor, modal damping `zeta`, struck by a
+    /// slider `ms` (kg) at `vs` (m/s) through a linear undamped contact of 1e6 N/m.
+    fn mounted(m: f64, k: f64, zeta: f64, ms: f64, vs: f64) -> Model {
+        let text = format!(
+            r#"
 name = "spring-mounted mass"
 [structure]
 reference_mode = 1
 [structure.lumped]
-damping_ratios = [0.02]
-masses = [{ name = "bed", mass = 100.0 }]
-springs = [{ name = "mount", nodes = ["bed", "ground"], stiffness = 1.0e5 }]
+damping_ratios = [{zeta}]
+masses = [{{ name = "bed", mass = {m} }}]
+springs = [{{ name = "mount", nodes = ["bed", "ground"], stiffness = {k} }}]
 floor = ["mount"]
 [points]
 bed_contact = "bed"
 measurement = "bed"
 [slider]
-mass = 0.01
-velocity = 1.0
+mass = {ms}
+velocity = {vs}
 [contact.slider_bed]
 law = "linear"
 stiffness = 1.0e6
@@ -660,8 +667,9 @@ release = "force"
 method = "exact"
 duration = 1.0
 sample_rate = 20000.0
-"#;
-        Model::from_text("mounted.toml", text.to_string(), &[]).unwrap()
+"#
+        );
+        Model::from_text("mounted.toml", text, &[]).unwrap()
     }
 
     /// A stroke interval shorter than the collision is refused. The collision of the mounted
@@ -736,34 +744,7 @@ sample_rate = 20000.0
     #[test]
     fn periodic_impulses_reach_the_closed_form_steady_state() {
         let (m, k, zeta, ms, vs) = (100.0_f64, 1.0e5_f64, 0.02_f64, 0.01_f64, 1.0_f64);
-        let text = format!(
-            r#"
-name = "spring-mounted mass"
-[structure]
-reference_mode = 1
-[structure.lumped]
-damping_ratios = [{zeta}]
-masses = [{{ name = "bed", mass = {m} }}]
-springs = [{{ name = "mount", nodes = ["bed", "ground"], stiffness = {k} }}]
-floor = ["mount"]
-[points]
-bed_contact = "bed"
-measurement = "bed"
-[slider]
-mass = {ms}
-velocity = {vs}
-[contact.slider_bed]
-law = "linear"
-stiffness = 1.0e6
-damping = 0.0
-release = "force"
-[simulation]
-method = "exact"
-duration = 1.0
-sample_rate = 20000.0
-"#
-        );
-        let model = Model::from_text("mounted.toml", text, &[]).unwrap();
+        let model = mounted(m, k, zeta, ms, vs);
         let sys = model.impact_system(Case::NoDamper).unwrap();
         let opts = model.options();
         let w = (k / m).sqrt();
