@@ -750,7 +750,6 @@ pub fn simulate_observed(
         .map(|((e, .., c), w)| Balance::new(c.t, e_in, w, &e, c.totals.dissipated));
     let balances: Vec<Balance> = std::iter::once(run_end).chain(collision).collect();
     check_run(sys, opts, &sol, &balances)?;
-    let residual_run_end = run_end.residual;
     let pk = |c: Channel| sol.totals.peaks.get(c).peak();
     let summary = Summary {
         method: match opts.method {
@@ -787,10 +786,8 @@ pub fn simulate_observed(
         peak_floor_force_n: pk(Channel::FloorForce).0.abs(),
         peak_floor_force_time_s: pk(Channel::FloorForce).1,
         peaks: channel_peaks(sys, &sol.totals.peaks),
-        energy_balance_residual: at_end
-            .zip(w_ce)
-            .map(|((e, .., c), w)| balance_residual(e_in, w, e.total(), c.totals.dissipated)),
-        energy_balance_residual_run_end: residual_run_end,
+        energy_balance_residual: collision.map(|b| b.residual),
+        energy_balance_residual_run_end: run_end.residual,
         energy_balance_residual_transferred: collision.map(|b| b.residual_transferred),
         energy_balance_residual_transferred_run_end: run_end.residual_transferred,
         simulated_time_s: sol.t_final,
