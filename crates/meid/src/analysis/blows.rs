@@ -369,7 +369,7 @@ pub fn run_blows_progress(
             sol.totals.dissipated,
         );
         check_run(sys, &o_blow, &sol, &[balance])?;
-        if sol.collision_end.is_none() {
+        let Some(end) = sol.collision_end.as_ref() else {
             return Err(collision_longer_than_interval(
                 sys,
                 opts,
@@ -378,21 +378,20 @@ pub fn run_blows_progress(
                 interval,
                 blow.rate_bpm,
             ));
-        }
-        let end = sol.collision_end.as_ref();
-        let energy_ratio = end.map(|c| {
-            let vs = c.x[nd + sys.slider_index()];
+        };
+        let energy_ratio = {
+            let vs = end.x[nd + sys.slider_index()];
             let es_after = 0.5 * sys.slider.mass * vs * vs;
             // The slider force's work during the collision counts as energy put in (as in
             // `energy::simulate`); 0 without a force.
-            let w = sys.force_work(&x0, &c.x);
-            (e_s + w - es_after - (damper_energy(&c.x) - ed0)) / (e_s + w)
-        });
+            let w = sys.force_work(&x0, &end.x);
+            (e_s + w - es_after - (damper_energy(&end.x) - ed0)) / (e_s + w)
+        };
         reports.push(BlowReport {
             blow: k + 1,
             start_s: t0,
-            energy_ratio,
-            collision_end_s: end.map(|c| t0 + c.t),
+            energy_ratio: Some(energy_ratio),
+            collision_end_s: Some(t0 + end.t),
             machine_energy_at_strike_j: e0.ke_machine + e0.pe_machine,
             damper_energy_at_strike_j: ed0,
             damper_gap_at_strike_m: damper_gap(&x0),
@@ -403,8 +402,7 @@ pub fn run_blows_progress(
                 .get(Channel::BedAcceleration)
                 .abs_peak(),
             peak_floor_force_n: sol.totals.peaks.get(Channel::FloorForce).abs_peak(),
-            peak_contact_force_slider_bed_n: end
-                .map_or(sol.totals.peak_force(0), |c| c.totals.peak_force(0)),
+            peak_contact_force_slider_bed_n: end.totals.peak_force(0),
         });
         if let Some(sink) = on_history.as_mut() {
             // The recorder counts dissipation as E_s− − Σ stored; add what was stored at the
@@ -462,26 +460,21 @@ fn collision_longer_than_interval(
         .ok()
         .and_then(|s| s.collision_end.map(|c| c.t));
     let sig = |v: f64| crate::num(format!("{v:.4e}").parse().unwrap_or(v));
+    let fs = opts.sample_rate.filter(|f| f.is_finite() && *f > 0.0);
     let head = format!(
         "blow {} is not over when the next blow is due: a blow every {} s (--rate-bpm {}{}) is \
          shorter than the collision",
         k + 1,
         sig(interval),
         crate::num(rate_bpm),
-        match opts.sample_rate {
-            Some(fs) if fs.is_finite() && fs > 0.0 => format!(
-                ", the interval rounded to whole samples at {} Hz",
-                crate::num(fs)
-            ),
-            _ => String::new(),
-        }
+        fs.map_or(String::new(), |fs| format!(
+            ", the interval rounded to whole samples at {} Hz",
+            crate::num(fs)
+        ))
     );
     let msg = match t_c {
         Some(t_c) => {
-            let t_min = match opts.sample_rate {
-                Some(fs) if fs.is_finite() && fs > 0.0 => (t_c * fs).ceil().max(1.0) / fs,
-                _ => t_c,
-            };
+            let t_min = fs.map_or(t_c, |fs| (t_c * fs).ceil().max(1.0) / fs);
             // Rounded down to 4 significant digits, so that the rate printed is valid.
             let r_max = 60.0 / t_min;
             let scale = 10f64.powi(3 - r_max.log10().floor() as i32);
