@@ -547,9 +547,8 @@ pub fn blow_spectrum(
     let mut scaled = vec![0.0; len];
     let mut acc = vec![0.0; n_fft / 2 + 1];
     for &s in &blows.starts {
-        let seg = x
-            .get(s..s + len)
-            .ok_or_else(|| Error::invalid("blows", "a blow record runs past the end"))?;
+        // (In range: `check_starts` above.)
+        let seg = &x[s..s + len];
         scaled.iter_mut().zip(seg).for_each(|(d, v)| *d = v * down);
         let bins = tr.run(&scaled, &w)?;
         for (k, (a, c)) in acc.iter_mut().zip(bins).enumerate() {
@@ -560,16 +559,17 @@ pub fn blow_spectrum(
     acc.iter_mut().for_each(|a| *a /= b as f64);
     // Back to unit²·s/Hz (× 2^e × 2^e, exact) when every bin stays a finite normal double.
     let up = pow2(e);
-    let restored: Vec<f64> = acc.iter().map(|a| a * up * up).collect();
-    let representable = restored
-        .iter()
-        .zip(&acc)
-        .all(|(r, a)| r.is_finite() && (*a == 0.0 || r.is_normal()));
-    let (density, scale_db) = if representable {
-        (restored, 0.0)
+    let representable = acc.iter().all(|a| {
+        let r = a * up * up;
+        r.is_finite() && (*a == 0.0 || r.is_normal())
+    });
+    let scale_db = if representable {
+        acc.iter_mut().for_each(|a| *a = *a * up * up);
+        0.0
     } else {
-        (acc, 20.0 * e as f64 * std::f64::consts::LOG10_2)
+        20.0 * e as f64 * std::f64::consts::LOG10_2
     };
+    let density = acc;
     Ok(BlowSpectrum {
         frequency_hz: freqs(density.len(), n_fft, fs),
         density,

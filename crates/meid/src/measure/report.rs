@@ -74,17 +74,15 @@ pub fn summary_text(files: &[String], channels: &[ProcessedChannel]) -> String {
         out,
         "  peaks are sample peaks (the largest |x| among the samples; the signal between samples may go higher);"
     );
-    let (averaged, whole): (Vec<_>, Vec<_>) =
-        channels.iter().partition(|c| c.summary.blows_averaged > 0);
-    if let Some(c) = averaged.first() {
+    if let Some(c) = channels.iter().find(|c| c.summary.blows_averaged > 0) {
         let _ = writeln!(
             out,
             "  the dominant line is the largest bin above DC of the energy spectral density averaged over the blows' records ({:.6} s from {:.6} s before each trigger), ± half a bin;",
             c.summary.record_s, c.summary.pretrigger_s
         );
     }
-    if !whole.is_empty() {
-        let names: Vec<&str> = whole.iter().map(|c| c.summary.name.as_str()).collect();
+    let names = whole_record_names(channels);
+    if !names.is_empty() {
         let _ = writeln!(
             out,
             "  no blow was found for {}: their dominant line is that of the whole record's energy spectral density, not blow-averaged;",
@@ -98,14 +96,19 @@ pub fn summary_text(files: &[String], channels: &[ProcessedChannel]) -> String {
     out
 }
 
-/// The warnings of a `meid measure` run: channels whose spectrum is the whole record's
-/// because no blow was found on their trigger channel.
-pub fn warnings(channels: &[ProcessedChannel]) -> Vec<String> {
-    let whole: Vec<&str> = channels
+/// The names of the channels whose spectrum is the whole record's (no blow averaged).
+fn whole_record_names(channels: &[ProcessedChannel]) -> Vec<&str> {
+    channels
         .iter()
         .filter(|c| c.summary.blows_averaged == 0)
         .map(|c| c.summary.name.as_str())
-        .collect();
+        .collect()
+}
+
+/// The warnings of a `meid measure` run: channels whose spectrum is the whole record's
+/// because no blow was found on their trigger channel.
+pub fn warnings(channels: &[ProcessedChannel]) -> Vec<String> {
+    let whole = whole_record_names(channels);
     if whole.is_empty() {
         Vec::new()
     } else {
