@@ -180,7 +180,7 @@ fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>, uff: 
             s.peak_contact_force_bed_damper_n
         );
     }
-    println!("  peaks over the run (exact, on the continuous solution):");
+    println!("  peaks over the run ({}):", s.peak_accuracy);
     for p in &s.peaks {
         println!(
             "    {:<34} {:>14.6e} {:<5} at t = {:.6} ms",
