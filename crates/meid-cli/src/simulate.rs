@@ -106,8 +106,14 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     Ok(())
 }
 
+/// A summary value with 7 significant digits (plain, or in exponent form outside 1e-3..1e6), so
+/// that a small value never prints as zeros.
+fn val(v: f64, unit: &str) -> String {
+    format!("{} {unit}", meid::report::figures::sig(v, 7))
+}
+
 fn opt(v: Option<f64>, unit: &str, scale: f64) -> String {
-    v.map_or("—".to_string(), |x| format!("{:.6} {unit}", x * scale))
+    v.map_or("—".to_string(), |x| val(x * scale, unit))
 }
 
 fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>, uff: bool) {
@@ -118,7 +124,7 @@ fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>, uff: 
         Some(r) => {
             println!(
                 "  energy left in the machine E_p+/E_s-   {}",
-                bold(&format!("{:.4} %", 100.0 * r))
+                bold(&val(100.0 * r, "%"))
             );
             println!(
                 "  end of collision                      {}",
@@ -126,15 +132,15 @@ fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>, uff: 
             );
             if s.slider_force_n != 0.0 {
                 println!(
-                    "  slider force F, its work W_F+         {:.6} N, {} (the ratio is E_p+/(E_s- + W_F+) = E_p+/{})",
-                    s.slider_force_n,
+                    "  slider force F, its work W_F+         {}, {} (the ratio is E_p+/(E_s- + W_F+) = E_p+/{})",
+                    val(s.slider_force_n, "N"),
                     opt(s.force_work_after_j, "J", 1.0),
                     opt(s.energy_input_j, "J", 1.0)
                 );
             }
             println!(
-                "  slider energy before / after          {:.6} J / {}",
-                s.slider_energy_before_j,
+                "  slider energy before / after          {} / {}",
+                val(s.slider_energy_before_j, "J"),
                 opt(s.slider_energy_after_j, "J", 1.0)
             );
             println!(
@@ -168,16 +174,16 @@ fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>, uff: 
         ),
     }
     println!(
-        "  peak contact force slider-bed         {:.3} N (during the collision)",
-        s.peak_contact_force_slider_bed_n
+        "  peak contact force slider-bed         {} (during the collision)",
+        val(s.peak_contact_force_slider_bed_n, "N")
     );
     if s.peaks
         .iter()
         .any(|p| p.channel == "contact_force_bed_damper_n")
     {
         println!(
-            "  peak contact force bed-damper         {:.3} N (during the collision)",
-            s.peak_contact_force_bed_damper_n
+            "  peak contact force bed-damper         {} (during the collision)",
+            val(s.peak_contact_force_bed_damper_n, "N")
         );
     }
     println!("  peaks over the run ({}):", s.peak_accuracy);

@@ -206,3 +206,60 @@ fn missing_file_is_reported() {
     assert!(!out.status.success());
     assert!(stderr(&out).contains("/nonexistent/model.toml"));
 }
+
+/// The text summary gives every value with 7 significant digits: a blow at 1e-12 m/s (energies
+/// of 1e-25 J, forces of 1e-9 N) no longer reads as "0.000000 J" and "0.000 N", and each printed
+/// value agrees with the JSON's to those digits. The dopri5 peaks are labelled estimates.
+#[test]
+fn small_values_print_with_their_digits() {
+    let run = |extra: &[&str]| {
+        meid()
+            .arg("simulate")
+            .arg(example())
+            .args(["--set", "slider.velocity=1e-12"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let text = run(&[]);
+    assert!(text.status.success(), "{}", stderr(&text));
+    let text = String::from_utf8_lossy(&text.stdout).to_string();
+    let json = run(&["--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let line = |start: &str| -> String {
+        text.lines()
+            .find(|l| l.trim_start().starts_with(start))
+            .unwrap_or_else(|| panic!("no line '{start}' in\n{text}"))
+            .to_string()
+    };
+    let first_number = |l: &str, after: &str| -> f64 {
+        let rest = &l[l.find(after).expect("label") + after.len()..];
+        rest.split_whitespace()
+            .next()
+            .and_then(|w| w.parse().ok())
+            .unwrap_or_else(|| panic!("no number in '{l}'"))
+    };
+    for (label, key) in [
+        ("slider energy before / after", "slider_energy_before_j"),
+        ("damper energy after", "damper_energy_after_j"),
+        (
+            "peak contact force slider-bed",
+            "peak_contact_force_slider_bed_n",
+        ),
+    ] {
+        let l = line(label);
+        assert!(!l.contains(" 0.000"), "{l}");
+        let printed = first_number(&l, label);
+        let want = v[key].as_f64().expect(key);
+        assert!(want > 0.0 && want < 1e-8, "{key} = {want}");
+        assert!((printed / want - 1.0).abs() < 1e-6, "{l} vs {want}");
+    }
+    // (At 1e-12 m/s dopri5 needs an absolute tolerance below the bed's 8e-16 m motion.)
+    let dopri = run(&["--method", "dopri5", "--set", "simulation.atol=1e-22"]);
+    let dopri = String::from_utf8_lossy(&dopri.stdout).to_string();
+    assert!(
+        dopri.contains("peaks over the run (estimates on dopri5's dense output"),
+        "{dopri}"
+    );
+    assert!(text.contains("peaks over the run (exact, on the continuous solution)"));
+}

@@ -271,3 +271,41 @@ fn dopri5_peaks_are_estimates_within_the_integration_tolerance() {
         }
     }
 }
+
+/// A dopri5 run whose absolute tolerance is not small against the motion (a blow at 1e-12 m/s
+/// moves the bed by 8e-16 m, below the default atol 1e-14) fails its energy check, and the error
+/// names `simulation.atol` first with a value that works; that value does work.
+#[test]
+fn a_dopri5_tolerance_too_large_for_the_motion_is_named() {
+    use meid::integrate::Method;
+    let path = format!(
+        "{}/../../examples/paper-lumped.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let m = Model::from_file(path.as_ref(), &["slider.velocity=1e-12".to_string()]).expect("model");
+    let sys = m.impact_system(Case::Damper).expect("system");
+    let mut o = m.options();
+    o.method = Method::Dopri5;
+    let e = simulate(&sys, &o, false)
+        .expect_err("atol 1e-14 against 1e-16 m")
+        .to_string();
+    let hint = "Likely cause: simulation.atol = 1e-14 is not small against the motion";
+    assert!(e.contains(hint), "{e}");
+    let given: f64 = e
+        .split("): give ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|w| w.parse().ok())
+        .unwrap_or_else(|| panic!("no suggested atol in {e}"));
+    o.atol = given;
+    let s = simulate(&sys, &o, false)
+        .expect("the suggested atol")
+        .summary;
+    o.method = Method::Exact;
+    let x = simulate(&sys, &o, false).expect("exact").summary;
+    let (a, b) = (
+        s.energy_ratio.expect("ratio"),
+        x.energy_ratio.expect("ratio"),
+    );
+    assert!((a / b - 1.0).abs() < 1e-6, "dopri5 {a} vs exact {b}");
+}

@@ -521,13 +521,14 @@ pub fn check_run(
         Method::Exact => "exact".to_string(),
         Method::Dopri5 => format!("dopri5, rtol {:e}", opts.rtol),
     };
+    let tolerance = atol_hint(opts, sol);
     for b in balances {
         if b.residual > bound {
             return Err(Error::numerical(
                 "simulation",
                 format!(
                     "energy balance violated at t = {:.6e} s: residual {:.3e} of the blow's \
-                     energy > {bound:e} allowed ({method}). Likely cause: {}",
+                     energy > {bound:e} allowed ({method}). Likely cause: {tolerance}{}",
                     b.t,
                     b.residual,
                     likely_causes(sys)
@@ -542,7 +543,7 @@ pub fn check_run(
                      {:.3e} of the energy the slider gave the machine and damper ({:.3e} J), > \
                      {bound_transferred:e} allowed ({method}); the slider keeps {:.3e} J. The energies left in \
                      the machine are differences of numbers {:.1e} times larger than themselves, \
-                     beyond what double precision carries. Likely cause: slider.mass = {:e} kg \
+                     beyond what double precision carries. Likely cause: {tolerance}slider.mass = {:e} kg \
                      (a slider so heavy that it hardly slows down), or: {}",
                     b.t,
                     b.discrepancy_j,
@@ -557,6 +558,32 @@ pub fn check_run(
         }
     }
     Ok(())
+}
+
+/// The first likely cause of a `dopri5` run's failed balance when its absolute tolerance is not
+/// small against the motion: `simulation.atol` (m and m/s alike) above 1e-6 of the largest bed
+/// displacement or velocity at B (a blow at 1e-12 m/s moves the bed by 1e-16 m, below the default
+/// 1e-14, so the error control accepts any step). Empty otherwise, and for `exact`.
+fn atol_hint(opts: &Options, sol: &Solution) -> String {
+    if opts.method != Method::Dopri5 {
+        return String::new();
+    }
+    let p = &sol.totals.peaks;
+    let x = p.get(Channel::BedDisplacement).abs_peak();
+    let v = p.get(Channel::BedVelocity).abs_peak();
+    let motion = x.min(v);
+    if !(motion.is_finite() && opts.atol > 1e-6 * motion) {
+        return String::new();
+    }
+    format!(
+        "simulation.atol = {} is not small against the motion (largest bed displacement {:.3e} m, \
+         velocity {:.3e} m/s at B): give {} (below 1e-6 of it), or use method \"exact\" \
+         (linear contact laws); or: ",
+        crate::error::num(opts.atol),
+        x,
+        v,
+        crate::error::num(10f64.powf((1e-6 * motion).log10().floor()))
+    )
 }
 
 /// The energy balance of a run at one instant `t`:
