@@ -5,13 +5,18 @@
 //! `montecarlo`, `evaluate` as columns of numpy arrays (the package turns them into a pyarrow
 //! Table or a pandas DataFrame). Every study releases the GIL and runs on rayon's threads.
 //! meid's errors become `meid.InputError` (bad input: the message names the file:line:column or
-//! the `--set`/field) or `meid.MeidError`, with meid's own message.
+//! the `--set`/field), `meid.FileNotFound`/`meid.FileError` (also FileNotFoundError/OSError) or
+//! `meid.MeidError`, with meid's own message; the warnings `meid simulate` prints become
+//! `meid.MeidWarning`s. Every allocation that grows with an input is checked against
+//! `meid.max_memory()` before it is made.
 
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
 use meid::analysis::montecarlo::{self, MonteCarlo, Uncertain};
 use meid::analysis::sweep::{self, Quantity, Sweep, Vary};
@@ -30,63 +35,234 @@ create_exception!(
     "Bad input: the message names the file:line:column, the field or the override, and what would be valid."
 );
 
+create_exception!(
+    meid,
+    MeidWarning,
+    pyo3::exceptions::PyUserWarning,
+    "A finding of meid about a model or a run that does not stop it (e.g. retained modes that \
+     carry too little of the static flexibility at a point): the same text as the CLI's \
+     `warning:` lines and the `warnings` of `Run.summary`."
+);
+
+/// `meid.FileNotFound` (MeidError and FileNotFoundError) and `meid.FileError` (MeidError and
+/// OSError): a file meid could not read or write, caught by `except FileNotFoundError` /
+/// `except OSError` as a Python user writes it, and by `except MeidError`.
+static FILE_NOT_FOUND: pyo3::sync::PyOnceLock<Py<pyo3::types::PyType>> =
+    pyo3::sync::PyOnceLock::new();
+static FILE_ERROR: pyo3::sync::PyOnceLock<Py<pyo3::types::PyType>> = pyo3::sync::PyOnceLock::new();
+
+/// An I/O error as `meid.FileNotFound` / `meid.FileError` with meid's message, and `errno`,
+/// `strerror`, `filename` set as on Python's own OSError.
+fn io_err(text: &str, path: &std::path::Path, source: &std::io::Error) -> PyErr {
+    Python::attach(|py| {
+        let cell = if source.kind() == std::io::ErrorKind::NotFound {
+            &FILE_NOT_FOUND
+        } else {
+            &FILE_ERROR
+        };
+        let Some(cls) = cell.get(py) else {
+            return MeidError::new_err(text.to_string());
+        };
+        let make = || -> PyResult<PyErr> {
+            let e = cls.bind(py).call1((text,))?;
+            e.setattr("errno", source.raw_os_error())?;
+            e.setattr("strerror", source.to_string())?;
+            e.setattr("filename", path.to_string_lossy().to_string())?;
+            Ok(PyErr::from_value(e))
+        };
+        make().unwrap_or_else(|e| e)
+    })
+}
+
 fn err(e: meid::Error) -> PyErr {
+    let mut text = e.to_string();
+    if text.contains("--max-memory") {
+        // The limit is the CLI's --max-memory; from Python it is meid.set_max_memory.
+        text.push_str(" (from Python: meid.set_max_memory(BYTES))");
+    }
+    if let meid::Error::Io { path, source } = &e {
+        return io_err(&text, path, source);
+    }
     match e {
-        meid::Error::Input { .. } | meid::Error::InvalidValue { .. } => {
-            InputError::new_err(e.to_string())
-        }
-        _ => MeidError::new_err(e.to_string()),
+        meid::Error::Input { .. } | meid::Error::InvalidValue { .. } => InputError::new_err(text),
+        _ => MeidError::new_err(text),
     }
 }
 
-fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
+/// A count argument (`threads`, `samples`, `first`, `end`, `count`): an integer >= `min`, or an
+/// `InputError` naming the argument (a negative Python int used to give a bare OverflowError).
+fn count(name: &str, v: i64, min: i64) -> PyResult<usize> {
+    if v < min {
+        return Err(InputError::new_err(format!(
+            "{name}: must be an integer >= {min} (got {v})"
+        )));
+    }
+    usize::try_from(v).map_err(|_| InputError::new_err(format!("{name}: {v} is too large")))
+}
+
+/// A real as a TOML literal that reads back as the same double: the shortest round-trip
+/// decimal (`0.05`, `-1.0`, `1e-7`), or `nan`, `inf`, `-inf` (TOML's spellings, which meid's
+/// checks then name: "must be a finite number"; Rust's `NaN` used to read as a string).
+fn toml_real(x: f64) -> String {
+    if x.is_nan() {
+        "nan".into()
+    } else if x.is_infinite() {
+        if x > 0.0 { "inf" } else { "-inf" }.into()
+    } else {
+        format!("{x:?}")
+    }
+}
+
+/// True for numpy's bool scalar (`numpy.bool_`), which is not a Python bool.
+fn is_numpy_bool(v: &Bound<'_, PyAny>) -> bool {
+    v.get_type()
+        .name()
+        .map(|n| n == "bool_" || n == "bool")
+        .unwrap_or(false)
+        && !v.is_instance_of::<PyBool>()
+        && v.hasattr("dtype").unwrap_or(false)
+}
+
+/// A Python scalar (bool, int, float, str, or a numpy scalar of those kinds) as a TOML
+/// value; `None` when `v` is not a scalar.
+fn scalar_toml(path: &str, v: &Bound<'_, PyAny>) -> PyResult<Option<toml::Value>> {
+    // numpy arrays (and pandas Series) have `__index__`/`__float__` too: only 0-d ones are
+    // scalars.
+    if let Ok(ndim) = v.getattr("ndim").and_then(|n| n.extract::<i64>()) {
+        if ndim != 0 {
+            return Ok(None);
+        }
+    }
+    if v.is_instance_of::<PyBool>() || is_numpy_bool(v) {
+        return Ok(Some(toml::Value::Boolean(v.is_truthy()?)));
+    }
+    if v.is_instance_of::<PyString>() {
+        return Ok(Some(toml::Value::String(v.extract()?)));
+    }
+    // int, numpy integers (anything with __index__): an integer if it fits TOML's i64, else
+    // the nearest real.
+    if v.is_instance_of::<PyInt>() || (!v.is_instance_of::<PyFloat>() && v.hasattr("__index__")?) {
+        if let Ok(i) = v.extract::<i64>() {
+            return Ok(Some(toml::Value::Integer(i)));
+        }
+        let x: f64 = v.extract().map_err(|_| {
+            InputError::new_err(format!(
+                "{path}: the integer is too large for a real number"
+            ))
+        })?;
+        return Ok(Some(toml::Value::Float(x)));
+    }
+    // float, numpy floats (anything with __float__ that is not a container).
+    if v.is_instance_of::<PyFloat>() || v.hasattr("__float__")? {
+        if let Ok(x) = v.extract::<f64>() {
+            return Ok(Some(toml::Value::Float(x)));
+        }
+    }
+    Ok(None)
+}
+
+/// `overrides` as a list of "PATH=VALUE": a list/tuple of str, or one str (it used to be
+/// refused with pyo3's "Can't extract `str` to `Vec`").
+fn override_list(overrides: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<String>> {
+    let Some(o) = overrides else {
+        return Ok(Vec::new());
+    };
+    if o.is_none() {
+        return Ok(Vec::new());
+    }
+    if let Ok(s) = o.extract::<String>() {
+        return Ok(vec![s]);
+    }
+    o.extract::<Vec<String>>().map_err(|_| {
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "overrides: a list of \"PATH=VALUE\" strings, e.g. [\"damper.mass=3.5\"] (got {})",
+            type_name(o)
+        ))
+    })
+}
+
+/// The type name of `v` for messages.
+fn type_name(v: &Bound<'_, PyAny>) -> String {
+    v.get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_else(|_| "?".into())
+}
+
+fn pool(threads: Option<i64>) -> PyResult<rayon::ThreadPool> {
     let mut b = rayon::ThreadPoolBuilder::new();
     if let Some(n) = threads {
-        if n == 0 {
-            return Err(InputError::new_err("threads: needs at least 1"));
-        }
-        b = b.num_threads(n);
+        b = b.num_threads(count("threads", n, 1)?);
     }
     b.build()
         .map_err(|e| MeidError::new_err(format!("cannot start the worker threads: {e}")))
 }
 
-/// The TOML literal of a Python value for a field (`with_values`): int → integer, float →
-/// shortest round-trip real, bool, str → TOML string.
-fn literal(path: &str, v: &Bound<'_, PyAny>) -> PyResult<String> {
-    if v.is_instance_of::<PyBool>() {
-        return Ok(v.extract::<bool>()?.to_string());
-    }
-    if v.is_instance_of::<PyInt>() {
-        return Ok(v.extract::<i64>()?.to_string());
-    }
-    if let Ok(x) = v.extract::<f64>() {
-        if !v.is_instance_of::<PyString>() {
-            return Ok(format!("{x:e}"));
+/// Runs `work` on `pool` while this (the calling) thread checks Python's signals every 50 ms:
+/// on Ctrl-C (a KeyboardInterrupt from the signal handler) `cancel` is set, `work` stops what it
+/// has not started, and the KeyboardInterrupt is returned beside its result. Without this a long
+/// study ignored Ctrl-C until it ended: the GIL is released, and only the main thread runs
+/// Python's signal handlers. Call it without the GIL (inside `py.detach`).
+fn interruptible<R: Send>(
+    pool: &rayon::ThreadPool,
+    work: impl FnOnce(&AtomicBool) -> R + Send,
+) -> (R, Option<PyErr>) {
+    let cancel = AtomicBool::new(false);
+    let done = AtomicBool::new(false);
+    let caller = std::thread::current();
+    std::thread::scope(|sc| {
+        let h = sc.spawn(|| {
+            // Set even when `work` panics, so that the loop below ends and the panic is
+            // resumed here.
+            struct Done<'a>(&'a AtomicBool, std::thread::Thread);
+            impl Drop for Done<'_> {
+                fn drop(&mut self) {
+                    self.0.store(true, Ordering::Release);
+                    self.1.unpark();
+                }
+            }
+            let _done = Done(&done, caller);
+            pool.install(|| work(&cancel))
+        });
+        let mut interrupted = None;
+        while !done.load(Ordering::Acquire) {
+            std::thread::park_timeout(std::time::Duration::from_millis(50));
+            if interrupted.is_none() && !done.load(Ordering::Acquire) {
+                if let Err(e) = Python::attach(|py| py.check_signals()) {
+                    cancel.store(true, Ordering::Relaxed);
+                    interrupted = Some(e);
+                }
+            }
         }
+        match h.join() {
+            Ok(r) => (r, interrupted),
+            Err(p) => std::panic::resume_unwind(p),
+        }
+    })
+}
+
+/// Points a study runs between two looks at `cancel` (sweep and Monte Carlo run index ranges
+/// one after the other; a point depends only on its index, so the rows are the same).
+const CANCEL_CHUNK: usize = 1024;
+
+/// The TOML literal of a Python value for a field (`with_values`): bool (numpy's too) →
+/// boolean, int (numpy integers too) → integer, float (numpy floats too) → shortest
+/// round-trip real (`nan`/`inf` as TOML spells them), str → TOML string.
+fn literal(path: &str, v: &Bound<'_, PyAny>) -> PyResult<String> {
+    match scalar_toml(path, v)? {
+        Some(toml::Value::Float(x)) => Ok(toml_real(x)),
+        Some(t) => Ok(t.to_string()),
+        None => Err(InputError::new_err(format!(
+            "{path}: a value must be a number, a bool or a string (got {})",
+            type_name(v)
+        ))),
     }
-    if let Ok(s) = v.extract::<String>() {
-        return Ok(toml::Value::String(s).to_string());
-    }
-    Err(InputError::new_err(format!(
-        "{path}: a value must be a number, a bool or a string (got {})",
-        v.get_type().name()?
-    )))
 }
 
 /// A Python dict/list/scalar as a TOML value (`Model.from_dict`).
 fn to_toml(path: &str, v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
-    if v.is_instance_of::<PyBool>() {
-        return Ok(toml::Value::Boolean(v.extract()?));
-    }
-    if v.is_instance_of::<PyInt>() {
-        return Ok(toml::Value::Integer(v.extract()?));
-    }
-    if v.is_instance_of::<PyFloat>() {
-        return Ok(toml::Value::Float(v.extract()?));
-    }
-    if v.is_instance_of::<PyString>() {
-        return Ok(toml::Value::String(v.extract()?));
+    if let Some(t) = scalar_toml(path, v)? {
+        return Ok(t);
     }
     if let Ok(d) = v.cast::<PyDict>() {
         let mut t = toml::Table::new();
@@ -95,7 +271,12 @@ fn to_toml(path: &str, v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
                 continue; // TOML has no null: an absent key (what `to_dict` writes as None).
             }
             let k: String = k.extract().map_err(|_| {
-                InputError::new_err(format!("{path}: dictionary keys must be strings"))
+                let at = if path.is_empty() { "from_dict" } else { path };
+                InputError::new_err(format!(
+                    "{at}: dictionary keys must be strings (field names); got {} {}",
+                    type_name(&k),
+                    k.repr().map(|r| r.to_string()).unwrap_or_default()
+                ))
             })?;
             let p = if path.is_empty() {
                 k.clone()
@@ -113,9 +294,14 @@ fn to_toml(path: &str, v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
         }
         return Ok(toml::Value::Array(a));
     }
+    // A numpy array (or anything with `tolist`, e.g. a pandas Series): its nested lists.
+    if v.hasattr("tolist")? && v.hasattr("ndim")? {
+        return to_toml(path, &v.call_method0("tolist")?);
+    }
     Err(InputError::new_err(format!(
-        "{path}: cannot be written as TOML (got {}); use dicts, lists, str, int, float, bool",
-        v.get_type().name()?
+        "{path}: cannot be written as TOML (got {}); use dicts, lists, str, int, float, bool \
+         (numpy scalars and arrays too)",
+        type_name(v)
     )))
 }
 
@@ -141,9 +327,9 @@ impl Model {
     fn from_file(
         py: Python<'_>,
         path: std::path::PathBuf,
-        overrides: Option<Vec<String>>,
+        overrides: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let ov = overrides.unwrap_or_default();
+        let ov = override_list(overrides)?;
         py.detach(|| meid::model::Model::from_file(&path, &ov))
             .map(|inner| Model { inner })
             .map_err(err)
@@ -156,9 +342,9 @@ impl Model {
         py: Python<'_>,
         text: String,
         name: String,
-        overrides: Option<Vec<String>>,
+        overrides: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let ov = overrides.unwrap_or_default();
+        let ov = override_list(overrides)?;
         py.detach(|| meid::model::Model::from_text(&name, text, &ov))
             .map(|inner| Model { inner })
             .map_err(err)
@@ -184,7 +370,13 @@ impl Model {
     fn with_values(&self, py: Python<'_>, values: &Bound<'_, PyDict>) -> PyResult<Self> {
         let mut fields = Vec::new();
         for (k, v) in values.iter() {
-            let k: String = k.extract()?;
+            let k: String = k.extract().map_err(|_| {
+                pyo3::exceptions::PyTypeError::new_err(format!(
+                    "with_values: keys are field paths such as \"damper.mass\" (str); got {} {}",
+                    type_name(&k),
+                    k.repr().map(|r| r.to_string()).unwrap_or_default()
+                ))
+            })?;
             fields.push(format!("{k}={}", literal(&k, &v)?));
         }
         py.detach(|| self.inner.with_fields(&fields, None))
@@ -210,49 +402,82 @@ impl Model {
             fields.push(format!("simulation.method={}", toml::Value::String(m)));
         }
         if let Some(d) = duration {
-            fields.push(format!("simulation.duration={d:e}"));
+            fields.push(format!("simulation.duration={}", toml_real(d)));
         }
         if let Some(r) = rate {
-            fields.push(format!("simulation.sample_rate={r:e}"));
+            fields.push(format!("simulation.sample_rate={}", toml_real(r)));
         }
         let case: Case = case.parse().map_err(err)?;
-        let run = py
+        let (run_summary, columns, diag) = py
             .detach(|| -> meid::Result<_> {
                 let m = if fields.is_empty() {
                     self.inner.clone()
                 } else {
                     self.inner.with_fields(&fields, None)?
                 };
+                let opts = m.options();
+                if history {
+                    // In Python the history is held three times over: meid's record (160 B a
+                    // sample), the Run's columns and the numpy copy `Run.history` hands out
+                    // (21 × 8 B each). meid's own check counts the first only.
+                    let n = meid::analysis::energy::sample_count(opts.duration, opts.sample_rate);
+                    meid::limits::check_memory(
+                        &format!("the history in Python ({n:.3e} samples × {PY_HISTORY_SAMPLE_BYTES} B: meid's record, the Run's columns and one numpy copy)"),
+                        n * PY_HISTORY_SAMPLE_BYTES,
+                        "simulation.duration",
+                        "duration or rate, or simulate(history=False) (the summary's peaks are exact without samples)",
+                    )?;
+                }
                 let sys = m.impact_system(case)?;
-                meid::analysis::simulate(&sys, &m.options(), history)
+                let run = meid::analysis::simulate(&sys, &opts, history)?;
+                // The columns are built here too, without the GIL (a 10^6-sample history
+                // held it for 0.3 s when built after).
+                let columns = run.history.as_ref().map(|h| {
+                    let n = h.time_s.len();
+                    let mut cols: Vec<Vec<f64>> =
+                        vec![Vec::with_capacity(n); meid::io::HISTORY_COLUMNS.len()];
+                    for i in 0..n {
+                        for (c, v) in cols.iter_mut().zip(h.row(i)) {
+                            c.push(v);
+                        }
+                    }
+                    cols
+                });
+                Ok((run.summary, columns, m.diagnostics()))
             })
             .map_err(err)?;
-        let summary =
-            serde_json::to_string(&run.summary).map_err(|e| MeidError::new_err(e.to_string()))?;
-        let columns = run.history.map(|h| {
-            let n = h.time_s.len();
-            let mut cols: Vec<Vec<f64>> =
-                vec![Vec::with_capacity(n); meid::io::HISTORY_COLUMNS.len()];
-            for i in 0..n {
-                for (c, v) in cols.iter_mut().zip(h.row(i)) {
-                    c.push(v);
-                }
-            }
-            cols
-        });
+        // The summary's fields, then `truncation`, `notes` and `warnings`: `meid simulate
+        // --json`'s object.
+        let mut out =
+            serde_json::to_value(&run_summary).map_err(|e| MeidError::new_err(e.to_string()))?;
+        if let (serde_json::Value::Object(o), Ok(serde_json::Value::Object(d))) =
+            (&mut out, serde_json::to_value(&diag))
+        {
+            o.extend(d);
+        }
+        let summary = out.to_string();
+        let warn = py.import("warnings")?;
+        let category = py.get_type::<MeidWarning>();
+        for w in &diag.warnings {
+            warn.call_method1("warn", (w.as_str(), &category, 1))?;
+        }
         Ok(Run {
             summary_json: summary,
             columns,
         })
     }
 
-    /// The retained modes: `{"frequencies_hz": (n,), "points": [names], "shapes": (points, n)}`
+    /// The retained modes: `{"frequencies_hz": (n,), "points": [names], "shapes": (points, n),
+    /// "labels": [n names]}`
     /// (signed mass-normalised ψ along the impact axis at the named points, 1/√kg; points in
     /// name order, as the ψ columns of `meid modes`' modes.csv), the first `count` when given.
     #[pyo3(signature = (count=None))]
-    fn modes<'py>(&self, py: Python<'py>, count: Option<usize>) -> PyResult<Bound<'py, PyDict>> {
+    fn modes<'py>(&self, py: Python<'py>, count: Option<i64>) -> PyResult<Bound<'py, PyDict>> {
         let s = &self.inner.structure;
-        let n = count.unwrap_or(s.len()).min(s.len());
+        let n = match count {
+            Some(c) => self::count("count", c, 0)?.min(s.len()),
+            None => s.len(),
+        };
         let f: Vec<f64> = s.omega_rad_per_s[..n]
             .iter()
             .map(|w| w / (2.0 * std::f64::consts::PI))
@@ -271,6 +496,16 @@ impl Model {
         )?;
         d.set_item("labels", s.labels[..n.min(s.labels.len())].to_vec())?;
         Ok(d)
+    }
+
+    /// What `meid simulate` prints beside its results: `{"truncation": [{"point", "roles",
+    /// "static_flexibility_m_per_n", "modal_flexibility_m_per_n", "captured_share"}, ...],
+    /// "notes": [str], "warnings": [str]}` (captured share = modal / static flexibility at
+    /// each role point; a share below 0.95 is a warning).
+    fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let d = py.detach(|| self.inner.diagnostics());
+        let s = serde_json::to_string(&d).map_err(|e| MeidError::new_err(e.to_string()))?;
+        json_to_py(py, &s)
     }
 
     /// The file name (or the name given) the model was read from.
@@ -324,6 +559,12 @@ impl Model {
     }
 }
 
+/// Bytes a sample of a history costs in Python: meid's record
+/// ([`meid::analysis::energy::HISTORY_SAMPLE_BYTES`]), the Run's 21 columns and one numpy copy
+/// of them.
+const PY_HISTORY_SAMPLE_BYTES: f64 = meid::analysis::energy::HISTORY_SAMPLE_BYTES
+    + 2.0 * 8.0 * meid::io::HISTORY_COLUMNS.len() as f64;
+
 /// The result of `Model.simulate`.
 #[pyclass(module = "meid", frozen)]
 pub struct Run {
@@ -367,10 +608,52 @@ impl Run {
     }
 
     fn __repr__(&self) -> String {
-        format!(
-            "meid.Run({} samples)",
-            self.columns.as_ref().map_or(0, |c| c[0].len())
-        )
+        match &self.columns {
+            Some(c) => format!("meid.Run({} samples)", c.first().map_or(0, Vec::len)),
+            None => "meid.Run(no history)".into(),
+        }
+    }
+
+    /// Pickling (Dask ships a Run from a worker process back to the client this way): the
+    /// summary's JSON and the columns as little-endian f64 bytes, column after column.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<RunReduce<'py>> {
+        let f = py.import("meid")?.getattr("Run")?.getattr("_from_state")?;
+        let bytes = self.columns.as_ref().map(|cols| {
+            let b: Vec<u8> = cols
+                .iter()
+                .flat_map(|c| c.iter().flat_map(|x| x.to_le_bytes()))
+                .collect();
+            PyBytes::new(py, &b)
+        });
+        Ok((f, (self.summary_json.clone(), bytes)))
+    }
+
+    /// The inverse of `__reduce__`.
+    #[staticmethod]
+    #[pyo3(signature = (summary_json, columns))]
+    fn _from_state(summary_json: String, columns: Option<&[u8]>) -> PyResult<Run> {
+        let ncol = meid::io::HISTORY_COLUMNS.len();
+        let columns = match columns {
+            None => None,
+            Some(b) => {
+                if b.len() % (8 * ncol) != 0 {
+                    return Err(MeidError::new_err(format!(
+                        "Run._from_state: {} bytes are not {ncol} columns of f64",
+                        b.len()
+                    )));
+                }
+                let n = b.len() / (8 * ncol);
+                let xs: Vec<f64> = b
+                    .chunks_exact(8)
+                    .map(|c| f64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]))
+                    .collect();
+                Some((0..ncol).map(|j| xs[j * n..(j + 1) * n].to_vec()).collect())
+            }
+        };
+        Ok(Run {
+            summary_json,
+            columns,
+        })
     }
 }
 
@@ -380,6 +663,9 @@ type PyColumns<'py> = (
     Vec<Bound<'py, PyArray1<f64>>>,
     Vec<Option<String>>,
 );
+
+/// Pickling a Run: `Run._from_state` and (summary JSON, the columns' bytes).
+type RunReduce<'py> = (Bound<'py, PyAny>, (String, Option<Bound<'py, PyBytes>>));
 
 /// Pickling: the constructor and its arguments (text, name, overrides).
 type Reduce<'py> = (Bound<'py, PyAny>, (String, String, Vec<String>));
@@ -393,26 +679,50 @@ fn columns_py<'py>(py: Python<'py>, c: Columns) -> PyResult<PyColumns<'py>> {
 }
 
 /// A sweep over `specs` ("NAME=LIST", "NAME=A..B:N[:log]"): (column names, float columns,
-/// errors), one row per grid point in grid order.
+/// errors), one row per grid point in grid order. Each point stops at the end of the
+/// collision; with `duration` (s) it runs that long instead (`meid sweep --duration`).
 #[pyfunction]
-#[pyo3(signature = (model, specs, bed_mass_kg=None, threads=None))]
+#[pyo3(signature = (model, specs, bed_mass_kg=None, threads=None, duration=None))]
 fn sweep_columns<'py>(
     py: Python<'py>,
     model: &Model,
     specs: Vec<String>,
     bed_mass_kg: Option<f64>,
-    threads: Option<usize>,
+    threads: Option<i64>,
+    duration: Option<f64>,
 ) -> PyResult<PyColumns<'py>> {
     let pool = pool(threads)?;
-    let m = model.inner.clone();
+    let base = &model.inner;
     let c = py
-        .detach(|| -> meid::Result<Columns> {
+        .detach(|| -> meid::Result<PyResult<Columns>> {
+            let m = match duration {
+                Some(d) => {
+                    base.with_fields(&[format!("simulation.duration={}", toml_real(d))], None)?
+                }
+                None => base.clone(),
+            };
             let vary = specs
                 .iter()
                 .map(|s| Vary::parse(s))
                 .collect::<meid::Result<Vec<_>>>()?;
-            let s = Sweep::with_bed_mass(m, vary, bed_mass_kg)?;
-            let r = pool.install(|| s.run(&|_, _| {}));
+            let mut s = Sweep::with_bed_mass(m, vary, bed_mass_kg)?;
+            if duration.is_some() {
+                s.options.stop_at_collision_end = false;
+            }
+            let (points, interrupted) = interruptible(&pool, |cancel| {
+                let mut points = Vec::with_capacity(s.len());
+                for a in (0..s.len()).step_by(CANCEL_CHUNK) {
+                    if cancel.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    points.extend(s.run_range(a..(a + CANCEL_CHUNK).min(s.len()), &|_, _| {})?);
+                }
+                Ok::<_, meid::Error>(points)
+            });
+            if let Some(e) = interrupted {
+                return Ok(Err(e));
+            }
+            let r = s.result_from(points?)?;
             if let Some(e) = s.all_failed_error(&r) {
                 return Err(e);
             }
@@ -430,9 +740,9 @@ fn sweep_columns<'py>(
                 }
                 errors.push(p.error.clone());
             }
-            Ok((names[..ncol].to_vec(), cols, errors))
+            Ok(Ok((names[..ncol].to_vec(), cols, errors)))
         })
-        .map_err(err)?;
+        .map_err(err)??;
     columns_py(py, c)
 }
 
@@ -446,17 +756,25 @@ fn montecarlo_columns<'py>(
     py: Python<'py>,
     model: &Model,
     specs: Vec<String>,
-    samples: usize,
-    seed: u64,
-    first: usize,
-    end: Option<usize>,
-    threads: Option<usize>,
+    samples: i64,
+    seed: i128,
+    first: i64,
+    end: Option<i64>,
+    threads: Option<i64>,
 ) -> PyResult<PyColumns<'py>> {
     let pool = pool(threads)?;
     let m = model.inner.clone();
-    let end = end.unwrap_or(samples);
+    let samples = count("samples", samples, 0)?;
+    let seed = u64::try_from(seed).map_err(|_| {
+        InputError::new_err(format!("seed: must be an integer in 0..2^64 (got {seed})"))
+    })?;
+    let first = count("first", first, 0)?;
+    let end = match end {
+        Some(e) => count("end", e, 0)?,
+        None => samples,
+    };
     let c = py
-        .detach(|| -> meid::Result<Columns> {
+        .detach(|| -> meid::Result<PyResult<Columns>> {
             let inputs = specs
                 .iter()
                 .map(|s| Uncertain::parse(s))
@@ -474,7 +792,19 @@ fn montecarlo_columns<'py>(
                 ));
             }
             study.check(end - first)?;
-            let s = pool.install(|| study.run_range(first..end, &|_, _| {}));
+            let (s, interrupted) = interruptible(&pool, |cancel| {
+                let mut s = Vec::with_capacity(end - first);
+                for a in (first..end).step_by(CANCEL_CHUNK) {
+                    if cancel.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    s.extend(study.run_range(a..(a + CANCEL_CHUNK).min(end), &|_, _| {}));
+                }
+                s
+            });
+            if let Some(e) = interrupted {
+                return Ok(Err(e));
+            }
             let mut names = vec!["sample".to_string()];
             names.extend(study.inputs.iter().map(|u| u.path.clone()));
             names.extend(montecarlo::METRICS.iter().map(|m| m.to_string()));
@@ -490,11 +820,15 @@ fn montecarlo_columns<'py>(
                 }
                 errors.push(x.error.clone());
             }
-            Ok((names, cols, errors))
+            Ok(Ok((names, cols, errors)))
         })
-        .map_err(err)?;
+        .map_err(err)??;
     columns_py(py, c)
 }
+
+/// What `evaluate`'s rows give: the (N, m) metrics row-major, the errors (when asked for),
+/// and a KeyboardInterrupt that stopped them.
+type Evaluated = (Vec<f64>, Vec<Option<String>>, Option<PyErr>);
 
 /// Where `evaluate` finds a requested metric in a point's result.
 #[derive(Clone, Copy)]
@@ -512,9 +846,11 @@ fn metric_names() -> Vec<String> {
 /// `values` (N, k): N parameter sets of the k quantities `names` (sweep names: ratios such as
 /// "wd/ws" or field paths); returns (N, m) metrics (`metrics`, default all of
 /// `metric_names()`), NaN where a point failed or a metric is undefined. Releases the GIL;
-/// points run in parallel (rayon) and each is the single run of its values.
+/// points run in parallel (rayon) and each is the single run of its values. With `errors`,
+/// returns `(metrics, errors)`: `errors[i]` says why row i failed (`None` when it ran).
 #[pyfunction]
-#[pyo3(signature = (model, names, values, metrics=None, bed_mass_kg=None, threads=None))]
+#[pyo3(signature = (model, names, values, metrics=None, bed_mass_kg=None, threads=None, errors=false))]
+#[allow(clippy::too_many_arguments)]
 fn evaluate<'py>(
     py: Python<'py>,
     model: &Model,
@@ -522,10 +858,21 @@ fn evaluate<'py>(
     values: PyReadonlyArray2<'py, f64>,
     metrics: Option<Vec<String>>,
     bed_mass_kg: Option<f64>,
-    threads: Option<usize>,
+    threads: Option<i64>,
+    errors: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let shape = values.shape().to_vec();
     let (n, k) = (shape[0], shape[1]);
+    let m = metrics.as_ref().map_or(sweep::METRICS.len(), Vec::len);
+    // The (N, k) copy of the values and the (N, m) result, before either is allocated (a
+    // huge N used to abort the interpreter: "memory allocation of … bytes failed").
+    meid::limits::check_memory(
+        &format!("evaluate's {n} rows ({k} values and {m} metrics, 8 B each)"),
+        8.0 * n as f64 * (k + m) as f64,
+        "values",
+        "the number of rows of values (evaluate them in parts)",
+    )
+    .map_err(err)?;
     if k != names.len() {
         return Err(InputError::new_err(format!(
             "values has {k} columns for {} names",
@@ -566,8 +913,8 @@ fn evaluate<'py>(
     let m = picks.len();
     let pool = pool(threads)?;
     let base = model.inner.clone();
-    let flat = py
-        .detach(|| -> meid::Result<Vec<f64>> {
+    let (flat, why, interrupted) = py
+        .detach(|| -> meid::Result<Evaluated> {
             use rayon::prelude::*;
             let qs = names
                 .iter()
@@ -592,33 +939,101 @@ fn evaluate<'py>(
             let cache = StructureCache::new();
             // Each row is written in place: no per-row vectors, no lookups by name.
             let mut out = vec![f64::NAN; n * m];
-            pool.install(|| {
-                out.par_chunks_mut(m)
-                    .zip(xs.par_chunks(k))
-                    .enumerate()
-                    .for_each(|(i, (row, x))| {
-                        let p = sweep::evaluate_cached(
-                            &base,
-                            &qr,
-                            x,
-                            bed_mass_kg,
-                            &options,
-                            i,
-                            Some(&cache),
-                        );
-                        for (o, pick) in row.iter_mut().zip(&picks) {
-                            *o = match *pick {
-                                Pick::Metric(j) => p.metrics.get(j).copied().flatten(),
-                                Pick::Derived(j) => p.derived.get(j).copied(),
-                            }
-                            .unwrap_or(f64::NAN);
+            let mut why: Vec<Option<String>> = vec![None; if errors { n } else { 0 }];
+            // Ctrl-C stops the rows not yet started (see `interruptible`).
+            let work = |cancel: &AtomicBool| {
+                let rows = out.par_chunks_mut(m).zip(xs.par_chunks(k)).enumerate();
+                let each = |(i, (row, x)): (usize, (&mut [f64], &[f64])),
+                            e: Option<&mut Option<String>>| {
+                    if cancel.load(Ordering::Relaxed) {
+                        return;
+                    }
+                    let p = sweep::evaluate_cached(
+                        &base,
+                        &qr,
+                        x,
+                        bed_mass_kg,
+                        &options,
+                        i,
+                        Some(&cache),
+                    );
+                    for (o, pick) in row.iter_mut().zip(&picks) {
+                        *o = match *pick {
+                            Pick::Metric(j) => p.metrics.get(j).copied().flatten(),
+                            Pick::Derived(j) => p.derived.get(j).copied(),
                         }
-                    })
-            });
-            Ok(out)
+                        .unwrap_or(f64::NAN);
+                    }
+                    if let Some(e) = e {
+                        *e = p.error;
+                    }
+                };
+                if errors {
+                    rows.zip(why.par_iter_mut())
+                        .for_each(|(r, e)| each(r, Some(e)));
+                } else {
+                    rows.for_each(|r| each(r, None));
+                }
+            };
+            let ((), interrupted) = interruptible(&pool, work);
+            Ok((out, why, interrupted))
         })
         .map_err(err)?;
-    Ok(PyArray1::from_vec(py, flat).reshape([n, m])?.into_any())
+    let (flat, why) = match interrupted {
+        Some(e) => return Err(e),
+        None => (flat, why),
+    };
+    let y = PyArray1::from_vec(py, flat).reshape([n, m])?.into_any();
+    if errors {
+        return Ok((y, why).into_pyobject(py)?.into_any());
+    }
+    Ok(y)
+}
+
+/// The memory limit (bytes) every run checks its estimate against before it allocates: by
+/// default half the physical memory; `set_max_memory` changes it for this process.
+#[pyfunction]
+fn max_memory() -> u64 {
+    meid::limits::max_memory()
+}
+
+/// Sets the memory limit of this process (the CLI's `--max-memory`): an int of bytes
+/// (`8 * 2**30`) or a size text ("8GiB", "512MiB", "3GB").
+#[pyfunction]
+fn set_max_memory(size: &Bound<'_, PyAny>) -> PyResult<()> {
+    let bytes = if size.is_instance_of::<PyString>() {
+        meid::limits::parse_bytes(&size.extract::<String>()?)
+            .map_err(|e| InputError::new_err(e.to_string().replace("--max-memory", "max_memory")))?
+    } else {
+        let b: i128 = size.extract().map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(format!(
+                "set_max_memory: give bytes as an int or a size text such as \"8GiB\" (got {})",
+                type_name(size)
+            ))
+        })?;
+        u64::try_from(b).ok().filter(|b| *b >= 1).ok_or_else(|| {
+            InputError::new_err(format!(
+                "max_memory: {b} bytes; give at least 1 byte and less than 2^64"
+            ))
+        })?
+    };
+    meid::limits::set_max_memory(bytes);
+    Ok(())
+}
+
+/// The SI unit of a column of meid's results or of a varied quantity, as the Parquet files
+/// of `meid sweep`/`meid montecarlo` give it: by the name's suffix for result columns
+/// (`_j` J, `_n` N, `_m` m, `_s` s, `_m_per_s2` m/s^2, ...; "1" otherwise), "1" for the ratios
+/// (`wd/ws`), by the field's last name for a field path (`…stiffness` N/m, `…mass` kg,
+/// `…damping` N·s/m, `…velocity` m/s); `None` for a field path of unknown unit.
+#[pyfunction]
+fn column_unit(name: &str) -> Option<&'static str> {
+    if name.contains('.') || name.contains('/') {
+        // A field path or a ratio: the unit the sweep's and Monte Carlo's tables give it.
+        Quantity::parse(name).ok().and_then(|q| q.unit())
+    } else {
+        Some(meid::io::table::unit_of_column(name))
+    }
 }
 
 #[pymodule]
@@ -629,6 +1044,37 @@ fn _meid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(montecarlo_columns, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(metric_names, m)?)?;
+    m.add_function(wrap_pyfunction!(max_memory, m)?)?;
+    m.add_function(wrap_pyfunction!(set_max_memory, m)?)?;
+    m.add_function(wrap_pyfunction!(column_unit, m)?)?;
+    m.add("MeidWarning", m.py().get_type::<MeidWarning>())?;
+    // Two bases each: a class `create_exception!` cannot make.
+    let py = m.py();
+    let builtins = py.import("builtins")?;
+    let make = |name: &str, os_base: &str, doc: &str| -> PyResult<Py<pyo3::types::PyType>> {
+        let bases = (py.get_type::<MeidError>(), builtins.getattr(os_base)?);
+        let ns = PyDict::new(py);
+        ns.set_item("__module__", "meid")?;
+        ns.set_item("__doc__", doc)?;
+        let t = builtins.getattr("type")?.call1((name, bases, ns))?;
+        Ok(t.cast_into::<pyo3::types::PyType>()?.unbind())
+    };
+    let nf = FILE_NOT_FOUND.get_or_try_init(py, || {
+        make(
+            "FileNotFound",
+            "FileNotFoundError",
+            "A file meid was asked to read does not exist (a MeidError and a FileNotFoundError).",
+        )
+    })?;
+    m.add("FileNotFound", nf.bind(py))?;
+    let fe = FILE_ERROR.get_or_try_init(py, || {
+        make(
+            "FileError",
+            "OSError",
+            "A file meid could not read or write (a MeidError and an OSError).",
+        )
+    })?;
+    m.add("FileError", fe.bind(py))?;
     m.add("MeidError", m.py().get_type::<MeidError>())?;
     m.add("InputError", m.py().get_type::<InputError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

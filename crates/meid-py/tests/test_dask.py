@@ -132,3 +132,34 @@ def test_a_worker_killed_mid_study_loses_and_duplicates_nothing(client, tmp_path
     # Nothing lost, nothing duplicated, every value the single-process one.
     assert list(dist["sample"]) == list(range(400))
     equal_columns(whole, dist)
+
+
+def _simulate(model, duration):
+    return model.simulate(duration=duration)
+
+
+def test_a_run_comes_back_from_a_worker_process_and_errors_carry_meids_message(client):
+    # A Run computed in a worker process travels back pickled (it used to fail: "Could not
+    # serialize object of type Run"), bit for bit.
+    m = meid.Model.from_file(LUMPED)
+    here = m.simulate(duration=0.02)
+    there = client.submit(_simulate, m, 0.02, pure=False).result()
+    assert there.summary == here.summary
+    for k, v in here.history.items():
+        np.testing.assert_array_equal(there.history[k], v, err_msg=k)
+    # An error raised in a task is meid's, class and message, on the client.
+    with pytest.raises(meid.InputError, match=r"simulation\.duration must be a finite number > 0 s"):
+        client.submit(_simulate, m, -1.0, pure=False).result()
+
+
+def test_a_study_too_large_for_the_client_is_refused_before_any_task(client):
+    m = meid.Model.from_file(LUMPED)
+    before = len(client.futures)
+    # 10^12 samples used to pass the check (it looked at 0 samples) and queue 5 * 10^8 tasks.
+    with pytest.raises(meid.InputError, match=r"samples 0\.\.1000000000000: 1\.000e\+12 rows"):
+        meid.dask.montecarlo(client, m, VARY, samples=10**12)
+    # A grid of 10^4 x 10^4 x 10^4 points (the value lists are small; the grid is not).
+    big = np.linspace(1.0, 2.0, 10**4)
+    with pytest.raises(meid.InputError, match=r"the grid: 1\.000e\+12 rows of 27 columns"):
+        meid.dask.sweep(client, m, {"wd/ws": big, "damper.mass": big + 1, "slider.mass": big})
+    assert len(client.futures) == before

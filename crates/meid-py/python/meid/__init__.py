@@ -17,7 +17,13 @@ Problem -> solve -> solution::
 
 Studies release the GIL and run in parallel (rayon). Errors raise :class:`InputError` (bad
 input: the message names the file:line:column, field or override, and what would be valid) or
-:class:`MeidError`, with meid's own messages. See also :mod:`meid.dask` for clusters.
+:class:`MeidError`, with meid's own messages; a file that does not exist raises
+:class:`FileNotFound` (both a ``MeidError`` and a ``FileNotFoundError``), another I/O failure
+:class:`FileError` (``MeidError`` and ``OSError``); a wrong Python type raises ``TypeError``.
+What ``meid simulate`` prints as ``warning:`` comes as a :class:`MeidWarning` (and in
+``Run.summary["warnings"]``). Every run estimates its memory before it allocates and refuses
+one over :func:`max_memory` (default half the physical memory; :func:`set_max_memory`).
+See also :mod:`meid.dask` for clusters.
 """
 
 from __future__ import annotations
@@ -27,14 +33,20 @@ from typing import Any, Dict, Mapping, Optional, Sequence, Union
 import numpy as np
 
 from ._meid import (  # noqa: F401
+    FileError,
+    FileNotFound,
     InputError,
     MeidError,
+    MeidWarning,
     Model,
     Run,
     __version__,
+    column_unit,
     evaluate as _evaluate,
+    max_memory,
     metric_names,
     montecarlo_columns,
+    set_max_memory,
     sweep_columns,
 )
 
@@ -43,45 +55,39 @@ __all__ = [
     "Run",
     "MeidError",
     "InputError",
+    "MeidWarning",
+    "FileNotFound",
+    "FileError",
     "sweep",
     "montecarlo",
     "evaluate",
     "metric_names",
     "units",
+    "max_memory",
+    "set_max_memory",
     "__version__",
 ]
 
-_UNITS = [
-    ("_m_per_s2", "m/s^2"),
-    ("_m_per_s", "m/s"),
-    ("_n_per_m", "N/m"),
-    ("_kg", "kg"),
-    ("_j", "J"),
-    ("_n", "N"),
-    ("_s", "s"),
-]
-
-
-def units(column: str) -> str:
-    """The SI unit of a result column, from its name's suffix ("1" for ratios and counts)."""
-    for suffix, unit in _UNITS:
-        if column.endswith(suffix):
-            return unit
-    if column.endswith("stiffness"):
-        return "N/m"
-    if column.endswith("mass"):
-        return "kg"
-    if column.endswith("damping"):
-        return "N s/m"
-    if column.endswith("velocity"):
-        return "m/s"
-    return "1"
+def units(column: str) -> Optional[str]:
+    """The SI unit of a result column or a varied quantity, as meid's Parquet files give it:
+    by the name's suffix for result columns (``_j`` J, ``_n`` N, ``_m`` m, ``_s`` s,
+    ``_m_per_s2`` m/s^2, ...; "1" for ratios and counts), "1" for the ratios (``wd/ws``), by
+    the field's last name for a field path (``...stiffness`` N/m, ``...mass`` kg, ``...damping``
+    N·s/m, ``...velocity`` m/s); ``None`` for a field path of unknown unit."""
+    return column_unit(column)
 
 
 def _spec(name: str, values: Any) -> str:
+    if not isinstance(name, str):
+        raise TypeError(f"vary: keys are quantities or field paths (str), got {name!r}")
     if isinstance(values, str):
         return f"{name}={values}"
-    vals = np.asarray(values, dtype=float).ravel()
+    try:
+        vals = np.asarray(values, dtype=float).ravel()
+    except (TypeError, ValueError) as e:
+        raise TypeError(
+            f"vary[{name!r}]: give a list or array of numbers or a range text \"A..B:N\" ({e})"
+        ) from None
     return f"{name}=" + ",".join(repr(float(v)) for v in vals)
 
 
@@ -106,11 +112,13 @@ def _table(names, columns, errors, output: str, index: str):
     arrays = []
     for n, c in zip(names, columns):
         if n == index:
-            arrays.append(pa.array(c.astype("int64")))
-            fields.append(pa.field(n, pa.int64(), metadata={"unit": "1"}))
+            # uint64, as in the Parquet files of `meid sweep`/`meid montecarlo -o`.
+            arrays.append(pa.array(c.astype("uint64")))
+            fields.append(pa.field(n, pa.uint64(), metadata={"unit": "1"}))
         else:
+            u = units(n)
             arrays.append(pa.array(c, type=pa.float64()))
-            fields.append(pa.field(n, pa.float64(), metadata={"unit": units(n)}))
+            fields.append(pa.field(n, pa.float64(), metadata=None if u is None else {"unit": u}))
     arrays.append(pa.array(errors, type=pa.string()))
     fields.append(pa.field("error", pa.string()))
     return pa.Table.from_arrays(arrays, schema=pa.schema(fields))
@@ -122,19 +130,22 @@ def sweep(
     *,
     bed_mass_kg: Optional[float] = None,
     threads: Optional[int] = None,
+    duration: Optional[float] = None,
     output: str = "pyarrow",
 ):
     """Simulates one blow at every point of the Cartesian grid of ``vary`` (last fastest).
 
     ``vary`` maps a quantity -- a ratio ``ws/w_ref``, ``wd/w_ref``, ``wd/ws``, ``md/mb`` or a
     model field path -- to a list of values or a range ``"A..B:N"`` / ``"A..B:N:log"``. Each
-    point stops at the end of the collision, as ``meid sweep``. Returns a pyarrow Table (units
+    point stops at the end of the collision, as ``meid sweep`` (so ``peak_floor_force_n`` is
+    the peak during the collision); with ``duration`` (s) every point runs that long instead,
+    as ``meid sweep --duration``. Returns a pyarrow Table (units
     in each field's metadata ``unit``), a pandas DataFrame (``output="pandas"``) or a dict of
     numpy arrays (``output="numpy"``), one row per point: ``index``, the varied values, K_s,
     K_d, m_d, m_s and every metric; ``error`` says why a point failed (NaN metrics).
     """
     specs = [_spec(k, v) for k, v in vary.items()]
-    names, columns, errors = sweep_columns(model, specs, bed_mass_kg, threads)
+    names, columns, errors = sweep_columns(model, specs, bed_mass_kg, threads, duration)
     return _table(names, columns, errors, output, "index")
 
 
@@ -169,14 +180,34 @@ def evaluate(
     metrics: Optional[Sequence[str]] = None,
     bed_mass_kg: Optional[float] = None,
     threads: Optional[int] = None,
-) -> np.ndarray:
+    errors: bool = False,
+):
     """``values`` (N, k): N parameter sets of the quantities ``names``; returns the (N, m)
     metrics (``metrics``, default :func:`metric_names`), NaN where undefined or failed. Each row
-    is the sweep point of those values (one blow, stopped at the end of the collision).
-    Releases the GIL and runs the rows in parallel."""
-    arr = np.ascontiguousarray(np.asarray(values, dtype=np.float64))
-    if arr.ndim == 1:
+    is the sweep point of those values (one blow, stopped at the end of the collision). With
+    ``errors=True``, returns ``(metrics, errors)``: ``errors[i]`` is meid's message for a row
+    that failed (e.g. a negative mass), ``None`` for a row that ran.
+    Releases the GIL and runs the rows in parallel. ``values`` may be any array-like of
+    numbers (any dtype, any memory layout; read as float64); a 1-d array is N
+    rows of one quantity. A single name or metric may be given as a str."""
+    if isinstance(names, str):
+        names = [names]
+    if isinstance(metrics, str):
+        metrics = [metrics]
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise TypeError(f"values: needs an (N, k) array of numbers ({e})") from None
+    if arr.ndim == 1 and len(names) == 1:
         arr = arr.reshape(-1, 1)
+    if arr.ndim != 2:
+        raise ValueError(
+            f"values: needs shape (N, {len(names)}) -- N rows of the {len(names)} quantities "
+            f"{list(names)} -- (got shape {arr.shape})"
+        )
+    # Not copied: the extension reads any strides (a transposed, sliced or broadcast array
+    # too), and refuses a request over max_memory() before it allocates anything.
     return _evaluate(
-        model, list(names), arr, None if metrics is None else list(metrics), bed_mass_kg, threads
+        model, list(names), arr, None if metrics is None else list(metrics), bed_mass_kg, threads,
+        errors,
     )

@@ -101,6 +101,29 @@ def _sweep_task(margs, vary_items, a, b, bed_mass_kg, threads):
     return a, b, x, y
 
 
+def _format_bytes(b: float) -> str:
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if b < 1024 or unit == "PiB":
+            return f"{b:.0f} B" if unit == "B" else f"{b:.2f} {unit}"
+        b /= 1024
+    return f"{b:.2e} B"
+
+
+def _check_gather(rows: int, columns: int, what: str, reduce: str) -> None:
+    """Refuses, before any task is sent, a result the client could not hold: ``rows`` of
+    ``columns`` float64 values, held twice while the parts are concatenated (16 B a value),
+    plus 8 B a row for the error column, against :func:`meid.max_memory`."""
+    need = rows * (16.0 * columns + 8.0)
+    limit = meid.max_memory()
+    if need > limit:
+        raise meid.InputError(
+            f"{what}: {rows:.3e} rows of {columns} columns gathered on the client "
+            f"({16 * columns + 8} B a row) would need about {_format_bytes(need)} of memory, "
+            f"over the limit of {_format_bytes(limit)} (meid.max_memory(); "
+            f"meid.set_max_memory raises it). Reduce {reduce}"
+        )
+
+
 def _gather(client, futures, total: int, first: int = 0):
     """The tasks' results in index order, checked to tile ``first..total`` exactly once."""
     parts = client.gather(futures)
@@ -142,7 +165,10 @@ def montecarlo(
     margs = _model_args(model)
     specs = [f"{k}={v}" for k, v in vary.items()]
     # Checks the specification here, where the error is readable, before any task is sent.
-    meid.montecarlo_columns(_model(margs), specs, samples, seed, 0, 0, 1)
+    names = meid.montecarlo_columns(_model(margs), specs, samples, seed, 0, 0, 1)[0]
+    # ... and what the client will hold (10^12 samples used to queue 5 * 10^8 tasks).
+    _check_gather(end - first, len(names), f"samples {first}..{end}",
+                  "the range first..end (gather the study in parts)")
     futures = [
         client.submit(_mc_task, margs, specs, samples, seed, first + a, first + b, threads,
                       pure=True)
@@ -180,10 +206,15 @@ def sweep(
                 f"vary[{k!r}]: give the values as a list or array (e.g. np.linspace), not {v!r}"
             )
         items.append((k, [float(x) for x in np.asarray(v, dtype=float).ravel()]))
-    total = int(np.prod([len(v) for _, v in items])) if items else 0
+    total = 1
+    for _, v in items:
+        total *= len(v)  # Python ints: no overflow of a huge grid's count
+    total = total if items else 0
     # Checks names and values here, where the error is readable, before any task is sent.
     meid.evaluate(_model(margs), [k for k, _ in items], np.zeros((0, len(items))),
                   bed_mass_kg=bed_mass_kg, threads=1)
+    _check_gather(total, len(items) + len(meid.metric_names()), "the grid",
+                  "the number of values in vary")
     futures = [
         client.submit(_sweep_task, margs, items, a, b, bed_mass_kg, threads, pure=True)
         for a, b in chunks(total, chunk)
