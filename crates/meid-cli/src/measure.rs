@@ -33,7 +33,8 @@ pub struct ProcessingArgs {
     /// Time constant of the exponential window (s); it adds 1/(ωτ) to a mode's damping ratio.
     #[arg(long, value_name = "S")]
     pub tau: Option<f64>,
-    /// Force window on force channels.
+    /// Force window on the blow's excitation (the force named blow/hammer/slider, or mapped to
+    /// blow; else the --trigger channel when it is a force); other channels are responses.
     #[arg(long)]
     pub force_window: bool,
     /// The channel blows are detected on (default: the blow force by name, else the bed

@@ -5,7 +5,8 @@
 
 use meid::analysis::spectrum::{exponential_window_correction, TransientWindow};
 use meid::measure::process::{
-    average_blows, blow_spectrum, detect_blows, h1, windowed_sdof_damping, Blows, Level, Processing,
+    average_blows, blow_spectrum, detect_blows, h1, windowed_sdof_damping, Blows, Level,
+    Processing, Role,
 };
 use meid::measure::Quantity;
 use meid::rng::SplitMix64;
@@ -178,7 +179,7 @@ fn blow_averaged_esd_keeps_parseval_and_time_average_is_the_blow() {
     let (f, x) = blows_record(4);
     let p = processing(TransientWindow::Exponential { tau_s: 1.0 });
     let b = detect_blows(&f, FS, &p).unwrap();
-    let s = blow_spectrum(&x, Quantity::Displacement, FS, &b, &p, None).unwrap();
+    let s = blow_spectrum(&x, Role::Response, FS, &b, &p, None).unwrap();
     assert_eq!(s.averages, 4);
     let w = p.window.coefficients(N, FS).unwrap();
     let dt = 1.0 / FS;
@@ -209,7 +210,7 @@ fn no_complete_blow_is_an_error_not_a_panic() {
         level: 1.0,
     };
     let p = Processing::default();
-    assert!(blow_spectrum(&[0.0; 5], Quantity::Force, 1.0, &b, &p, None).is_err());
+    assert!(blow_spectrum(&[0.0; 5], Role::Excitation, 1.0, &b, &p, None).is_err());
     assert!(h1(&[0.0; 5], &[0.0; 5], 1.0, &b, &p).is_err());
     assert!(average_blows(&[0.0; 5], &[3], 10).is_err());
     let bad = Processing {
@@ -229,10 +230,10 @@ fn spectra_of_huge_and_tiny_records_keep_their_levels() {
     let (f, x) = blows_record(2);
     let p = processing(TransientWindow::Rectangular);
     let b = detect_blows(&f, FS, &p).unwrap();
-    let base = blow_spectrum(&x, Quantity::Displacement, FS, &b, &p, None).unwrap();
+    let base = blow_spectrum(&x, Role::Response, FS, &b, &p, None).unwrap();
     assert_eq!(base.scale_db, 0.0);
     let x10: Vec<f64> = x.iter().map(|v| v * 1024.0).collect();
-    let s10 = blow_spectrum(&x10, Quantity::Displacement, FS, &b, &p, None).unwrap();
+    let s10 = blow_spectrum(&x10, Role::Response, FS, &b, &p, None).unwrap();
     for (a, b) in base.density.iter().zip(&s10.density) {
         assert_eq!(a * 1_048_576.0, *b);
     }
@@ -241,7 +242,7 @@ fn spectra_of_huge_and_tiny_records_keep_their_levels() {
     let l0 = base.level_db(e0, 1.0);
     for (factor, shift_db) in [(1e300, 6000.0), (1e-300, -6000.0)] {
         let xs: Vec<f64> = x.iter().map(|v| v * factor).collect();
-        let s = blow_spectrum(&xs, Quantity::Displacement, FS, &b, &p, None).unwrap();
+        let s = blow_spectrum(&xs, Role::Response, FS, &b, &p, None).unwrap();
         assert!(s.density_si().is_none(), "{factor}");
         let (fs_, es) = s.dominant().unwrap();
         assert_eq!(fs_, 50.0);
@@ -342,4 +343,108 @@ fn blows_that_do_not_fit_name_the_valid_range() {
     let b = detect_blows(&f, FS, &p).unwrap();
     assert_eq!(b.starts, vec![0]);
     assert!(require_complete(&b, n, FS, "hammer", "lab.uff").is_ok());
+}
+
+/// A record of a group sampled at FS from t = 0.
+fn record(name: &str, q: Quantity, values: Vec<f64>) -> meid::measure::Record {
+    meid::measure::Record {
+        name: name.into(),
+        quantity: q,
+        source_unit: q.si_unit().into(),
+        point: None,
+        abscissa: meid::measure::Abscissa::Even {
+            start_s: 0.0,
+            step_s: 1.0 / FS,
+        },
+        values,
+        origin: "lab.csv".into(),
+    }
+}
+
+/// The force window belongs to the blow's excitation only (session 12 audit: `--force-window`
+/// windowed every force channel, so the force to the floor — a response ringing at its mode —
+/// was cut to the hammer's pulse: its dominant line moved from 30 Hz, 42.00 dB, to 48 Hz,
+/// 1.80 dB). The pulse is found on the excitation's own record, so it does not depend on the
+/// channel the blows were triggered on (the old code compared the force with the trigger
+/// channel's level, an acceleration in m/s²).
+#[test]
+fn force_window_applies_to_the_blow_force_only() {
+    use meid::measure::process::{force_window_for, process_all};
+    let dt = 1.0 / FS;
+    let (hammer, accel) = blows_record(2);
+    // The hammer: the blow (one sample of J/Δt = 6000 N), then a 1 % ringing of the load
+    // cell at 300 Hz that the force window must take out.
+    let ring: Vec<f64> = (0..hammer.len())
+        .map(|i| {
+            let m = i % N;
+            if m > PRE + 4 {
+                60.0 * (2.0 * std::f64::consts::PI * 300.0 * (m - PRE) as f64 * dt).sin()
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let hammer: Vec<f64> = hammer.iter().zip(&ring).map(|(a, b)| a + b).collect();
+    // The floor force: a response, the 20 Hz mode ringing after each blow.
+    let floor: Vec<f64> = (0..hammer.len())
+        .map(|i| {
+            let m = i % N;
+            if m >= PRE {
+                let t = (m - PRE) as f64 * dt;
+                500.0 * (-2.0 * t).exp() * (2.0 * std::f64::consts::PI * 20.0 * t).sin()
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let records = vec![
+        record("hammer", Quantity::Force, hammer.clone()),
+        record("accel_B", Quantity::Displacement, accel),
+        record("force_floor", Quantity::Force, floor),
+    ];
+    let plain = processing(TransientWindow::Rectangular);
+    let windowed = Processing {
+        force_window: true,
+        ..plain.clone()
+    };
+    for trigger in ["hammer", "accel_B"] {
+        let a = process_all(&records, &plain, Some(trigger), "B").unwrap();
+        let b = process_all(&records, &windowed, Some(trigger), "B").unwrap();
+        // The responses are untouched, bit for bit.
+        for k in [1, 2] {
+            assert_eq!(
+                a[k].spectrum, b[k].spectrum,
+                "{trigger}: {}",
+                a[k].summary.name
+            );
+            assert_eq!(b[k].summary.window, "rectangular");
+        }
+        // The hammer's pulse ends one sample after the blow: window 1 over the pre-trigger
+        // and the pulse (PRE + 1 samples), then a one-sample taper; the ringing is gone.
+        let blows = meid::measure::process::detect_blows(&records[0].values, FS, &plain).unwrap();
+        let w = force_window_for(&records[0].values, &blows, FS, &windowed);
+        assert_eq!(
+            w,
+            TransientWindow::Force {
+                pulse_s: (PRE + 1) as f64 * dt,
+                taper_s: dt
+            }
+        );
+        assert!(
+            b[0].summary.window.starts_with("rectangular × force"),
+            "{}",
+            b[0].summary.window
+        );
+        // Windowed, the hammer's ESD is the blow's alone: flat, 2 (J)² (N·s)²/Hz... plus at
+        // most the ringing's first samples; 300 Hz no longer stands out.
+        let flat = 2.0 * J * J;
+        let s = &b[0].spectrum;
+        let k300 = s.frequency_hz.iter().position(|f| *f == 300.0).unwrap();
+        assert!(
+            (s.density[k300] - flat).abs() < 1e-3 * flat,
+            "{trigger}: {} vs {flat}",
+            s.density[k300]
+        );
+        assert!(a[0].spectrum.density[k300] > 100.0 * flat);
+    }
 }

@@ -374,7 +374,7 @@ impl<'a> Problem<'a> {
                 let (spectrum, bins, floor) = match settings.residual {
                     ResidualKind::TimeHistory => (Vec::new(), 0..0, 0.0),
                     ResidualKind::Spectrum { lower_hz, upper_hz } => {
-                        let s = blow_spectrum(&r.values, r.quantity, mb.fs, &mb.blows, p, None)?;
+                        let s = blow_spectrum(&r.values, c.role(), mb.fs, &mb.blows, p, None)?;
                         let first = s.frequency_hz.iter().position(|f| *f >= lower_hz);
                         let last = s.frequency_hz.iter().rposition(|f| *f <= upper_hz);
                         let bins = match (first, last) {
@@ -475,7 +475,7 @@ impl<'a> Problem<'a> {
                     ResidualKind::Spectrum { .. } => {
                         let ss = blow_spectrum(
                             &s.values,
-                            ch.channel.quantity(),
+                            ch.channel.role(),
                             ct.fs,
                             &sim.blows,
                             &sim.processing,

@@ -45,7 +45,8 @@
 //! # Windows and the added damping of the exponential window
 //!
 //! The windows are [`TransientWindow`]'s: the force window (1 over the pulse, a half-cosine
-//! taper, 0 after) on the force, and an exponential `w(t) = e^{−t/τ}` on the responses (and,
+//! taper, 0 after) on the blow's force, the excitation ([`Role`]; never on a response such as
+//! the force to the floor), and an exponential `w(t) = e^{−t/τ}` on the responses (and,
 //! multiplied in, on the force, so that H1 stays the ratio of equally windowed signals). The
 //! exponential window multiplies a mode's free decay `e^{−ζωt}` by `e^{−t/τ}`: the windowed
 //! record is that of a mode with decay rate `ζω + 1/τ`, i.e. a damping ratio
@@ -95,8 +96,8 @@ pub struct Processing {
     pub holdoff_s: f64,
     /// Window on responses (default rectangular).
     pub window: TransientWindow,
-    /// Apply the force window to force channels (pulse = the time `|F|` stays above the trigger
-    /// level after the trigger, taper = half of it).
+    /// Apply the force window to the blow's excitation ([`Role::Excitation`]; the pulse is
+    /// found on the force itself: [`force_window_for`]).
     pub force_window: bool,
 }
 
@@ -404,27 +405,75 @@ fn freqs(bins: usize, n_fft: usize, fs: f64) -> Vec<f64> {
     (0..bins).map(|k| k as f64 * fs / n_fft as f64).collect()
 }
 
-/// The force window for a blow record: pulse from the record start to the sample after the
-/// trigger where `|F|` drops below the level, taper half the pulse.
-fn force_window_for(x: &[f64], blows: &Blows, fs: f64) -> TransientWindow {
-    let s = blows.starts.first().copied().unwrap_or(0);
-    let t = s + blows.pretrigger;
-    let end = (t..x.len())
-        .find(|&i| x[i].abs() < blows.level)
-        .unwrap_or(x.len());
-    let pulse = ((end - s) as f64 / fs).max(1.0 / fs);
-    TransientWindow::Force {
-        pulse_s: pulse,
-        taper_s: 0.5 * pulse,
+/// What a channel is to the blow: its excitation (the blow force: a hammer's, the slider's)
+/// or a response (every other channel, the force to the floor included: a transmitted force
+/// rings with the structure and is windowed like an acceleration). The force window applies to
+/// the excitation only.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Role {
+    Excitation,
+    Response,
+}
+
+impl super::SimChannel {
+    /// The blow force is the excitation; the bed acceleration and the floor force respond.
+    pub fn role(self) -> Role {
+        match self {
+            super::SimChannel::BlowForce => Role::Excitation,
+            _ => Role::Response,
+        }
     }
 }
 
-/// The windows of one channel: the response window, times the force window for a force when
-/// asked.
-fn window_for(q: Quantity, x: &[f64], blows: &Blows, fs: f64, p: &Processing) -> Result<Vec<f64>> {
+/// The force window of an excitation record, found on the record itself (so that the level
+/// is in its own unit, whatever channel the blows were triggered on): in the first blow record
+/// `x[s .. s + len]`, the pulse is the run of samples around the largest `|x|` with
+/// `|x| ≥ L_F`, `L_F = f · max|x|` (`f` the trigger fraction, 0.1 for an absolute trigger
+/// level, which is in the trigger channel's unit). The window is 1 from the record start to
+/// the pulse's end `T_p`, then a half-cosine taper over half the pulse's duration `T_c`
+/// (at least one sample), then 0.
+pub fn force_window_for(x: &[f64], blows: &Blows, fs: f64, p: &Processing) -> TransientWindow {
+    let s = blows.starts.first().copied().unwrap_or(0).min(x.len());
+    let rec = &x[s..(s + blows.length).min(x.len())];
+    let (k_max, top) =
+        rec.iter().enumerate().fold(
+            (0, 0.0_f64),
+            |b, (i, v)| {
+                if v.abs() > b.1 {
+                    (i, v.abs())
+                } else {
+                    b
+                }
+            },
+        );
+    let f = match p.level {
+        Level::FractionOfPeak(f) => f,
+        Level::Absolute(_) => 0.1,
+    };
+    let l = f * top;
+    let end = (k_max..rec.len())
+        .find(|&i| rec[i].abs() < l)
+        .unwrap_or(rec.len());
+    let begin = (0..=k_max)
+        .rev()
+        .find(|&i| rec[i].abs() < l)
+        .map_or(0, |i| i + 1);
+    let dt = 1.0 / fs;
+    let pulse = end.max(1) as f64 * dt;
+    let taper = (0.5 * (end - begin) as f64 * dt).max(dt);
+    TransientWindow::Force {
+        pulse_s: pulse,
+        taper_s: taper,
+    }
+}
+
+/// The windows of one channel: the response window, times the force window for the
+/// excitation when asked ([`Processing::force_window`]).
+fn window_for(role: Role, x: &[f64], blows: &Blows, fs: f64, p: &Processing) -> Result<Vec<f64>> {
     let mut w = p.window.coefficients(blows.length, fs)?;
-    if p.force_window && q == Quantity::Force {
-        let f = force_window_for(x, blows, fs).coefficients(blows.length, fs)?;
+    if p.force_window && role == Role::Excitation {
+        let f = force_window_for(x, blows, fs, p).coefficients(blows.length, fs)?;
         w.iter_mut().zip(f).for_each(|(a, b)| *a *= b);
     }
     Ok(w)
@@ -506,10 +555,10 @@ impl BlowSpectrum {
 }
 
 /// Mean ESD over the blow records `starts` of `x` (length `blows.length`, windowed as `p`
-/// says for the quantity `q`), zero-padded to `n_fft ≥ length` (None: no padding).
+/// says for a channel of that `role`), zero-padded to `n_fft ≥ length` (None: no padding).
 pub fn blow_spectrum(
     x: &[f64],
-    q: Quantity,
+    role: Role,
     fs: f64,
     blows: &Blows,
     p: &Processing,
@@ -521,7 +570,7 @@ pub fn blow_spectrum(
     let len = blows.length;
     check_starts(x.len(), &blows.starts, len)?;
     let n_fft = n_fft.unwrap_or(len).max(len);
-    let w = window_for(q, x, blows, fs, p)?;
+    let w = window_for(role, x, blows, fs, p)?;
     let mut tr = Transformer::new(n_fft);
     let dt = 1.0 / fs;
     // The scale 2^e at or below the largest |x| of the records (module docs, Scaling).
@@ -625,7 +674,7 @@ pub fn h1(force: &[f64], response: &[f64], fs: f64, blows: &Blows, p: &Processin
     }
     let len = blows.length;
     check_starts(force.len(), &blows.starts, len)?;
-    let wf = window_for(Quantity::Force, force, blows, fs, p)?;
+    let wf = window_for(Role::Excitation, force, blows, fs, p)?;
     let wx = p.window.coefficients(len, fs)?;
     let mut tf = Transformer::new(len);
     let mut tx = Transformer::new(len);
@@ -712,6 +761,9 @@ pub struct ChannelSummary {
     pub dominant_frequency_hz: Option<f64>,
     /// Its level, dB re 1 (SI unit)²·s/Hz (finite for any finite data: module docs, Scaling).
     pub dominant_level_db: Option<f64>,
+    /// The window the spectrum was computed with, e.g. "rectangular", or "rectangular × force
+    /// (pulse 0.0112 s, taper 0.0005 s)" on the blow's excitation with `--force-window`.
+    pub window: String,
 }
 
 /// A processed channel: the summary, the blow-averaged record and spectrum, the bands.
@@ -783,9 +835,11 @@ pub fn group_blows(records: &[&Record], trigger: usize, p: &Processing) -> Resul
     Ok((b, found))
 }
 
-/// Processes one channel with the group's blows (summary, average, spectrum, bands).
+/// Processes one channel with the group's blows (summary, average, spectrum, bands); `role`
+/// says whether it is the blow's excitation (the only channel the force window applies to).
 pub fn process_channel(
     r: &Record,
+    role: Role,
     blows: &Blows,
     found: usize,
     p: &Processing,
@@ -805,7 +859,16 @@ pub fn process_channel(
         }
     });
     let average = average_blows(&r.values, &blows.starts, blows.length)?;
-    let mut spectrum = blow_spectrum(&r.values, r.quantity, fs, blows, p, None)?;
+    let mut spectrum = blow_spectrum(&r.values, role, fs, blows, p, None)?;
+    let window = if p.force_window && role == Role::Excitation {
+        format!(
+            "{} × {}",
+            p.window.name(),
+            force_window_for(&r.values, blows, fs, p).name()
+        )
+    } else {
+        p.window.name()
+    };
     // No trigger: the whole record, not a blow.
     let averaged = if blows.triggers.is_empty() {
         0
@@ -834,6 +897,7 @@ pub fn process_channel(
             pretrigger_s: blows.pretrigger as f64 / fs,
             dominant_frequency_hz: df,
             dominant_level_db: de,
+            window,
         },
         quantity: r.quantity,
         origin: r.origin.clone(),
@@ -864,7 +928,10 @@ pub fn groups(records: &[Record]) -> Vec<Vec<usize>> {
 
 /// Processes every record; blows are found per group on the channel named `trigger` when the
 /// group has it, else on its [`trigger_channel`] (`point`: the model's measurement point name,
-/// for finding B by name).
+/// for finding B by name). The excitation of a group (the one channel the force window applies
+/// to) is the force named as the blow ([`super::mapping::by_name`]: `blow`, `hammer`,
+/// `slider` …), else the `trigger` channel when it is a force; every other channel is a
+/// response.
 pub fn process_all(
     records: &[Record],
     p: &Processing,
@@ -894,8 +961,21 @@ pub fn process_all(
             None => trigger_channel(&members, point),
         };
         let (blows, found) = group_blows(&members, t, p)?;
-        for &i in &g {
-            out[i] = Some(process_channel(&records[i], &blows, found, p)?);
+        let excitation = members
+            .iter()
+            .position(|r| super::mapping::by_name(r, point) == Some(super::SimChannel::BlowForce))
+            .or_else(|| {
+                (trigger.is_some_and(|name| members[t].name == name)
+                    && members[t].quantity == Quantity::Force)
+                    .then_some(t)
+            });
+        for (k, &i) in g.iter().enumerate() {
+            let role = if excitation == Some(k) {
+                Role::Excitation
+            } else {
+                Role::Response
+            };
+            out[i] = Some(process_channel(&records[i], role, &blows, found, p)?);
         }
     }
     Ok(out.into_iter().flatten().collect())
