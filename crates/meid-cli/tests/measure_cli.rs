@@ -59,6 +59,7 @@ fn measure_json_has_the_issue_fields_and_sample_peaks() {
         "pretrigger_s",
         "dominant_frequency_hz",
         "dominant_level_db",
+        "window",
     ];
     let mut got = keys.clone();
     want.sort();
