@@ -448,3 +448,82 @@ fn force_window_applies_to_the_blow_force_only() {
         assert!(a[0].spectrum.density[k300] > 100.0 * flat);
     }
 }
+
+/// One blow record: the whole of `x`.
+fn one_blow(n: usize) -> Blows {
+    Blows {
+        triggers: vec![0],
+        starts: vec![0],
+        length: n,
+        pretrigger: 0,
+        level: 1.0,
+    }
+}
+
+/// One-third-octave band energies integrate the ESD with each bin's energy spread over the
+/// frequencies it stands for (session 12 audit: a band took the bins whose centre lay in it,
+/// so with 2 Hz bins the 2.5, 3.15 and 5 Hz bands of a hammer blow held 0 energy and the 4 Hz
+/// band a whole bin, and the 10 Hz band of a decayed 100 Hz transient changed by 20 % between
+/// 0.5 s and 1 s records). A decayed transient's band energies are now those of its continuous
+/// spectrum (a 64× padded reference) whatever the record length, bands tiling [0, f_s/2] add
+/// up to the record's energy, and a tone at a mid-band frequency lands wholly in its band.
+#[test]
+fn third_octave_band_energies_do_not_depend_on_the_record_length() {
+    use meid::analysis::octave::Band;
+    let fs = 2000.0;
+    let p = Processing {
+        pretrigger_s: 0.0,
+        ..processing(TransientWindow::Rectangular)
+    };
+    let wn = 2.0 * std::f64::consts::PI * 100.0;
+    let decay = |n: usize| -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                let t = i as f64 / fs;
+                (-0.02 * wn * t).exp() * (wn * (1.0f64 - 0.0004).sqrt() * t).sin()
+            })
+            .collect()
+    };
+    // The reference: 4 s (the decay is e^{-50} by then), padded 64×.
+    let x = decay(8000);
+    let reference =
+        blow_spectrum(&x, Role::Response, fs, &one_blow(8000), &p, Some(64 * 8000)).unwrap();
+    let bands: Vec<Band> = (-20..=-1).map(Band::new).collect(); // 10 Hz … 794 Hz
+    for n in [1000, 2000, 3000, 8000] {
+        let x = decay(n);
+        let s = blow_spectrum(&x, Role::Response, fs, &one_blow(n), &p, None).unwrap();
+        // Parseval, and bands tiling [0, f_s/2] add up to it.
+        let time: f64 = x.iter().map(|v| v * v).sum::<f64>() / fs;
+        let total = s.band_energy(0.0, fs / 2.0);
+        assert!(
+            ((total - time) / time).abs() < 1e-12,
+            "{n}: {total} vs {time}"
+        );
+        let edges = [0.0, 3.3, 89.125, 112.2, 999.0, 1000.0];
+        let tiled: f64 = edges.windows(2).map(|e| s.band_energy(e[0], e[1])).sum();
+        assert!(
+            ((tiled - time) / time).abs() < 1e-12,
+            "{n}: {tiled} vs {time}"
+        );
+        for b in &bands {
+            let e = s.band_energy(b.lower_hz, b.upper_hz);
+            let r = reference.band_energy(b.lower_hz, b.upper_hz);
+            assert!(
+                ((e - r) / r).abs() < 0.01,
+                "{n} samples, {} band: {e} vs {r}",
+                b.label()
+            );
+        }
+        // A 100 Hz record of whole cycles: one bin, all of it in the 100 Hz band.
+        let a = 3.0;
+        let tone: Vec<f64> = (0..n)
+            .map(|i| a * (2.0 * std::f64::consts::PI * 100.0 * i as f64 / fs).sin())
+            .collect();
+        let s = blow_spectrum(&tone, Role::Response, fs, &one_blow(n), &p, None).unwrap();
+        let band = Band::containing(100.0);
+        assert!((band.centre_hz - 100.0).abs() < 1e-9);
+        let e = s.band_energy(band.lower_hz, band.upper_hz);
+        let whole = a * a * (n as f64 / fs) / 2.0; // A²T/2
+        assert!(((e - whole) / whole).abs() < 1e-12, "{n}: {e} vs {whole}");
+    }
+}

@@ -67,7 +67,7 @@ use serde::Serialize;
 
 use crate::analysis::esd::esd_level_db;
 use crate::analysis::octave::{bands_covering, Band};
-use crate::analysis::spectrum::{one_sided_factor, TransientWindow};
+use crate::analysis::spectrum::{bin_band_energy, one_sided_factor, TransientWindow};
 use crate::{Error, Result};
 
 use super::{Quantity, Record};
@@ -491,6 +491,8 @@ pub struct BlowSpectrum {
     /// `10 log10` of the factor from [`Self::density`] to unit²·s/Hz: 0 unless the ESD in
     /// unit²·s/Hz is beyond the range of doubles.
     pub scale_db: f64,
+    /// The sample rate (Hz): the bins stand for `[0, f_s/2]`.
+    pub sample_rate_hz: f64,
 }
 
 impl BlowSpectrum {
@@ -507,15 +509,19 @@ impl BlowSpectrum {
     pub fn bin_width_hz(&self) -> f64 {
         self.frequency_hz.get(1).copied().unwrap_or(0.0)
     }
-    /// `Σ Ē_k Δf` over the bins in `[f_lo, f_hi)` (unit²·s; scaled as [`Self::density`]; 0
-    /// for a band holding no bin).
+    /// `∫_{f_lo}^{f_hi} Ē df` (unit²·s; scaled as [`Self::density`]), each bin's energy
+    /// `Ē_k Δf` spread over the frequencies it stands for
+    /// ([`crate::analysis::spectrum::bin_band_energy`]): a bin across a band edge counts in
+    /// proportion, so a band level does not depend on where the bins fall (the record length,
+    /// the padding), and bands that tile the spectrum add up to `Σ Ē_k Δf`.
     pub fn band_energy(&self, f_lo: f64, f_hi: f64) -> f64 {
-        self.frequency_hz
-            .iter()
-            .zip(&self.density)
-            .filter(|(f, _)| **f >= f_lo && **f < f_hi)
-            .fold(0.0, |a, (_, e)| a + e)
-            * self.bin_width_hz()
+        bin_band_energy(
+            &self.frequency_hz,
+            &self.density,
+            self.sample_rate_hz,
+            f_lo,
+            f_hi,
+        )
     }
     /// The largest bin above DC: (frequency, density).
     pub fn dominant(&self) -> Option<(f64, f64)> {
@@ -624,6 +630,7 @@ pub fn blow_spectrum(
         density,
         averages: b,
         scale_db,
+        sample_rate_hz: fs,
     })
 }
 
