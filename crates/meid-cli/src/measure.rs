@@ -7,7 +7,7 @@ use anyhow::Result;
 
 use meid::measure::mapping::{parse_window, MeasurementSpec};
 use meid::measure::process::{process_all, Level, Processing};
-use meid::measure::{read_records, report};
+use meid::measure::{read_records_noting, report};
 
 use crate::args::PrintArgs;
 
@@ -128,19 +128,29 @@ pub fn run(a: MeasureArgs) -> Result<()> {
     let p = a.processing.processing(section.as_ref())?;
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
     let mut records = Vec::new();
+    let mut notes = Vec::new();
     for f in &a.files {
-        let r = read_records(f)?;
+        let (r, passed) = read_records_noting(f)?;
         if r.is_empty() {
             anyhow::bail!(
-                "{}: no time response (dataset 58, function type 1) in the file",
-                f.display()
+                "{}: no time response (dataset 58, function type 1, of an acceleration, velocity, displacement or force) in the file{}",
+                f.display(),
+                if passed.is_empty() {
+                    String::new()
+                } else {
+                    format!("; passed over:\n  {}", passed.join("\n  "))
+                }
             );
         }
         records.extend(r);
+        notes.extend(passed);
     }
     let channels = process_all(&records, &p, a.processing.trigger.as_deref(), &point)?;
     let summaries: Vec<_> = channels.iter().map(|c| &c.summary).collect();
     if !a.print.quiet {
+        for n in &notes {
+            crate::ui::warning(n);
+        }
         for w in report::warnings(&channels) {
             crate::ui::warning(w);
         }

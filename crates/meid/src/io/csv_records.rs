@@ -21,18 +21,70 @@ pub fn read_csv(path: &Path) -> Result<Vec<Record>> {
     parse_csv(std::io::BufReader::new(f), &path.display().to_string())
 }
 
-/// Parses CSV text from `reader`; `file` names it in errors.
+/// The field delimiter of a header line: of `,`, `;` and tab, the one it holds most (a comma
+/// on a tie or when it holds none).
+fn delimiter_of(header: &[u8]) -> u8 {
+    let count = |d: u8| header.iter().filter(|&&b| b == d).count();
+    let (c, s, t) = (count(b','), count(b';'), count(b'\t'));
+    if s > c && s >= t {
+        b';'
+    } else if t > c && t > s {
+        b'\t'
+    } else {
+        b','
+    }
+}
+
+/// A number of a field; with a delimiter other than the comma, a decimal comma (`1,5e-3`:
+/// one comma, no point) reads as a point, as spreadsheets in many locales write it.
+fn parse_number(field: &str, delimiter: u8) -> Option<f64> {
+    match field.parse() {
+        Ok(v) => Some(v),
+        Err(_) if delimiter != b',' && field.matches(',').count() == 1 && !field.contains('.') => {
+            field.replacen(',', ".", 1).parse().ok()
+        }
+        Err(_) => None,
+    }
+}
+
+/// Parses CSV text from `reader`; `file` names it in errors. The delimiter is found on the
+/// header line ([`delimiter_of`]: `,`, `;` or tab); a UTF-8 byte-order mark before it is
+/// dropped; CRLF line ends read as LF.
 pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>> {
+    use std::io::{BufRead as _, Read as _};
     let err = |line: u64, message: String| Error::Input {
         location: format!("{file}:{line}"),
         message,
     };
+    // Everything up to and including the header line (comments and blank lines before it),
+    // read ahead to find the delimiter, then parsed again by the CSV reader.
+    let mut input = std::io::BufReader::new(reader);
+    let mut ahead: Vec<u8> = Vec::new();
+    let delimiter = loop {
+        let mut line = Vec::new();
+        let n = (&mut input)
+            .take(1 << 20)
+            .read_until(b'\n', &mut line)
+            .map_err(|e| err(1, format!("cannot read: {e}")))?;
+        if ahead.is_empty() {
+            if let Some(rest) = line.strip_prefix("\u{feff}".as_bytes()) {
+                line = rest.to_vec();
+            }
+        }
+        ahead.extend_from_slice(&line);
+        let text = String::from_utf8_lossy(&line);
+        let t = text.trim();
+        if n == 0 || !(t.is_empty() || t.starts_with('#')) {
+            break delimiter_of(t.as_bytes());
+        }
+    };
     let mut rd = csv::ReaderBuilder::new()
         .has_headers(false)
         .comment(Some(b'#'))
+        .delimiter(delimiter)
         .trim(csv::Trim::All)
         .flexible(true)
-        .from_reader(reader);
+        .from_reader(std::io::Cursor::new(ahead).chain(input));
     let mut rows = rd.records();
     let header = loop {
         match rows.next() {
@@ -109,7 +161,7 @@ pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>>
             let Some((name, _, f)) = &cols[k] else {
                 continue;
             };
-            let v: f64 = field.parse().map_err(|_| {
+            let v: f64 = parse_number(field, delimiter).ok_or_else(|| {
                 err(
                     line,
                     format!(
@@ -217,6 +269,44 @@ mod tests {
         let (t0, dt) = r[0].even().unwrap();
         assert_eq!(t0, 0.0);
         assert!((dt - 1e-3).abs() < 1e-15);
+    }
+
+    /// Files as spreadsheets and DAQ software write them (session 12 audit: a semicolon or
+    /// tab file was refused with "no time column", as its header read as one column): the
+    /// delimiter is found on the header; with `;` or tab a decimal comma reads; a UTF-8
+    /// byte-order mark and CRLF line ends are dropped; errors still name line and column.
+    #[test]
+    fn semicolons_tabs_decimal_commas_bom_and_crlf_read() {
+        let want = |r: &[Record]| {
+            assert_eq!(r.len(), 2, "{r:?}");
+            assert_eq!(r[0].name, "accel_B");
+            assert_eq!(r[0].values, vec![9.80665 * 1.5, -0.25 * 9.80665]);
+            assert_eq!(r[1].name, "force_floor");
+            assert_eq!(r[1].values, vec![2e3, -1e3]);
+            let (t0, dt) = r[0].even().unwrap();
+            assert_eq!(t0, 0.0);
+            assert!((dt - 1e-3).abs() < 1e-15);
+        };
+        for text in [
+            "# Messung 3\r\naccel_B_g;time_s;force_floor_kn\r\n1,5;0;2\r\n-0,25;0,001;-1\r\n",
+            "\u{feff}accel_B_g\ttime_s\tforce_floor_kn\n1.5\t0\t2\n-0.25\t0.001\t-1\n",
+            "\u{feff}accel_B_g,time_s,force_floor_kn\r\n1.5,0,2\r\n-0.25,0.001,-1\r\n",
+            "accel_B_g ; time_s ; force_floor_kn\n1.5 ; 0 ; 2e0\n-2,5E-1 ; 1,0e-3 ; -1\n",
+        ] {
+            want(&parse_csv(text.as_bytes(), "lab.csv").unwrap());
+        }
+        // A comma-delimited file has no decimal comma: a field "1,5" is two fields.
+        let e = parse_csv("time_s,accel_B_g\n0,1,5\n".as_bytes(), "lab.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("lab.csv:2: 3 fields; the header has 2"), "{e}");
+        let e = parse_csv("time_s;accel_B_g\n0;1,5,2\n".as_bytes(), "lab.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("lab.csv:2: column 2 (accel_B): expected a number, got '1,5,2'"),
+            "{e}"
+        );
     }
 
     #[test]
