@@ -527,3 +527,40 @@ fn third_octave_band_energies_do_not_depend_on_the_record_length() {
         assert!(((e - whole) / whole).abs() < 1e-12, "{n}: {e} vs {whole}");
     }
 }
+
+/// Blows are found on deviations from the channel's baseline, its median (session 12 audit: a
+/// force channel with a DC offset above the trigger level, a transducer's preload or a charge
+/// amplifier's drift, never armed the detector: no blow found, the whole record processed as
+/// one). With an offset of ±2000 N under 6000 N blows and a trigger at 10 % of the peak, the
+/// triggers are those of the record without offset, also with noise on it.
+#[test]
+fn an_offset_neither_hides_blows_nor_triggers() {
+    use meid::measure::process::median;
+    let (f, _) = blows_record(3);
+    let p = Processing {
+        level: Level::FractionOfPeak(0.1),
+        ..processing(TransientWindow::Rectangular)
+    };
+    let clean = detect_blows(&f, FS, &p).unwrap();
+    assert_eq!(clean.triggers, vec![PRE, N + PRE, 2 * N + PRE]);
+    let mut rng = SplitMix64::new(3);
+    for offset in [2000.0, -2000.0] {
+        for noise in [0.0, 50.0] {
+            let g: Vec<f64> = f
+                .iter()
+                .map(|v| v + offset + noise * rng.next_normal())
+                .collect();
+            let b = detect_blows(&g, FS, &p).unwrap();
+            assert_eq!(b.triggers, clean.triggers, "offset {offset}, noise {noise}");
+            assert_eq!(b.starts, clean.starts);
+            // The level is 10 % of the largest deviation from the median.
+            let m = median(&g);
+            assert!((m - offset).abs() < 3.0 * noise + 1e-9, "{m}");
+            let top = g.iter().fold(0.0_f64, |a, v| a.max((v - m).abs()));
+            assert_eq!(b.level, 0.1 * top);
+        }
+    }
+    assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+    assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
+    assert_eq!(median(&[]), 0.0);
+}

@@ -9,10 +9,11 @@
 //!
 //! # Blows
 //!
-//! A blow is triggered at the first sample `i` with `|x_i| ≥ L` on the trigger channel
-//! (`L` absolute, or a fraction of the channel's largest `|x|`), once the detector is armed.
-//! After a trigger the detector ignores `hold-off` seconds, then re-arms when `|x|` falls below
-//! `L`. Each blow's record starts `pre-trigger` seconds before its trigger and lasts the record
+//! A blow is triggered at the first sample `i` with `|x_i − x̃| ≥ L` on the trigger channel
+//! (`x̃` the channel's median, its baseline: a DC offset or a transducer's preload neither hides
+//! the blows nor triggers; `L` absolute, or a fraction of the channel's largest `|x − x̃|`), once
+//! the detector is armed. After a trigger the detector ignores `hold-off` seconds, then re-arms
+//! when `|x − x̃|` falls below `L`. Each blow's record starts `pre-trigger` seconds before its trigger and lasts the record
 //! length (default: the shortest interval between triggers, or up to the end for a single
 //! blow). A blow whose record would start before the first sample or end after the last is
 //! counted but not averaged. When blows are found but none of their records fits in the file,
@@ -76,9 +77,9 @@ use super::{Quantity, Record};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Level {
-    /// In the channel's SI unit.
+    /// In the channel's SI unit, a deviation from its median (its baseline).
     Absolute(f64),
-    /// A fraction of the channel's largest `|x|`, in (0, 1].
+    /// A fraction of the channel's largest deviation from its median `|x − x̃|`, in (0, 1].
     FractionOfPeak(f64),
 }
 
@@ -171,7 +172,7 @@ pub struct Blows {
     pub length: usize,
     /// Samples before the trigger.
     pub pretrigger: usize,
-    /// The absolute level used (SI).
+    /// The absolute level used (SI), a deviation from the channel's median.
     pub level: f64,
 }
 
@@ -184,7 +185,11 @@ pub fn detect_blows(x: &[f64], fs: f64, p: &Processing) -> Result<Blows> {
             format!("must be > 0 Hz (got {fs})"),
         ));
     }
-    let peak = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    // Deviations from the channel's baseline (its median): a DC offset, a transducer's
+    // bias or preload, neither hides the blows nor triggers on its own.
+    let baseline = median(x);
+    let dev = |v: f64| (v - baseline).abs();
+    let peak = x.iter().fold(0.0_f64, |m, v| m.max(dev(*v)));
     let level = match p.level {
         Level::Absolute(l) => l,
         Level::FractionOfPeak(f) => f * peak,
@@ -194,10 +199,10 @@ pub fn detect_blows(x: &[f64], fs: f64, p: &Processing) -> Result<Blows> {
     let hold = (p.holdoff_s * fs).round() as usize;
     let mut triggers = Vec::new();
     if level > 0.0 && n > 0 {
-        let mut armed = x[0].abs() < level;
+        let mut armed = dev(x[0]) < level;
         let mut i = 0;
         while i < n {
-            let a = x[i].abs();
+            let a = dev(x[i]);
             if armed && a >= level {
                 triggers.push(i);
                 armed = false;
@@ -266,6 +271,23 @@ pub fn detect_blows(x: &[f64], fs: f64, p: &Processing) -> Result<Blows> {
         pretrigger: pre,
         level,
     })
+}
+
+/// The median of `x` (0 for an empty record; the mean of the two middle values for an even
+/// count).
+pub fn median(x: &[f64]) -> f64 {
+    let n = x.len();
+    if n == 0 {
+        return 0.0;
+    }
+    let mut v = x.to_vec();
+    let (_, &mut hi, _) = v.select_nth_unstable_by(n / 2, f64::total_cmp);
+    if n % 2 == 1 {
+        hi
+    } else {
+        let lo = v[..n / 2].iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        0.5 * (lo + hi)
+    }
 }
 
 /// Refuses blows of which none has a complete record in a channel of `n` samples at `fs`,
