@@ -14,7 +14,8 @@ use crate::args::PrintArgs;
 /// Processing flags shared by `measure` and `validate` (they override `[measurement]`).
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct ProcessingArgs {
-    /// Trigger level as a fraction of the trigger channel's peak, in (0, 1] (default 0.1).
+    /// Trigger level as a fraction of the trigger channel's largest deviation from its median,
+    /// in (0, 1] (default 0.1).
     #[arg(long, value_name = "FRACTION")]
     pub trigger_level: Option<f64>,
     /// Time kept before each trigger (s, default 0.01).

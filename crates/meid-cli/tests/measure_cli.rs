@@ -60,6 +60,7 @@ fn measure_json_has_the_issue_fields_and_sample_peaks() {
         "dominant_frequency_hz",
         "dominant_level_db",
         "window",
+        "clipped_samples",
     ];
     let mut got = keys.clone();
     want.sort();

@@ -564,3 +564,57 @@ fn an_offset_neither_hides_blows_nor_triggers() {
     assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
     assert_eq!(median(&[]), 0.0);
 }
+
+/// A record cut at its transducer's full scale is flagged (session 12 audit: a clipped
+/// accelerometer passed without a word; its sample peak read as the full scale, its spectrum
+/// skewed). A decaying 50 Hz response clipped at 60 % of its peak has every sample beyond
+/// ±60 % in a flat run; the same record unclipped, with noise, or a zero record, has none.
+#[test]
+fn clipped_records_are_flagged() {
+    use meid::measure::process::{clipped_samples, process_all};
+    use meid::measure::report::warnings;
+    let (_, x) = blows_record(2);
+    let top = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    assert_eq!(clipped_samples(&x), 0);
+    assert_eq!(clipped_samples(&vec![0.0; 100]), 0);
+    let cut = 0.6 * top;
+    // The samples of the original beyond ±cut in runs of 3 or more of one sign (the last
+    // cycles above the cut have shorter runs: they look like peaks, not a cut).
+    let mut beyond = 0;
+    for sign in [1.0, -1.0] {
+        let mut run = 0;
+        for v in x.iter().chain([0.0].iter()) {
+            if sign * v >= cut {
+                run += 1;
+            } else {
+                if run >= 3 {
+                    beyond += run;
+                }
+                run = 0;
+            }
+        }
+    }
+    let clipped: Vec<f64> = x.iter().map(|v| v.clamp(-cut, cut)).collect();
+    assert_eq!(clipped_samples(&clipped), beyond);
+    assert!(beyond > 20, "{beyond}");
+    let records = vec![
+        record("accel_B", Quantity::Acceleration, clipped),
+        record("plain", Quantity::Acceleration, x),
+    ];
+    let c = process_all(
+        &records,
+        &processing(TransientWindow::Rectangular),
+        None,
+        "B",
+    )
+    .unwrap();
+    assert_eq!(c[0].summary.clipped_samples, beyond);
+    assert_eq!(c[1].summary.clipped_samples, 0);
+    let w = warnings(&c);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].contains("'accel_B' is possibly clipped")
+            && w[0].contains(&format!("{beyond} samples")),
+        "{w:?}"
+    );
+}

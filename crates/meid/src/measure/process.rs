@@ -273,6 +273,40 @@ pub fn detect_blows(x: &[f64], fs: f64, p: &Processing) -> Result<Blows> {
     })
 }
 
+/// The shortest run of equal samples at a record's extreme that counts as clipping.
+pub const CLIP_RUN: usize = 3;
+
+/// The samples of `x` in runs of at least [`CLIP_RUN`] consecutive samples equal to its
+/// largest value, or to its smallest: a sampled transient does not stay at its extreme for
+/// three samples unless the signal was cut there (a transducer, amplifier or converter at its
+/// full scale). A constant record has no extreme to clip at (0). It can only flag: a slow
+/// signal quantised coarsely may also repeat its extreme; the count is for a warning.
+pub fn clipped_samples(x: &[f64]) -> usize {
+    let (lo, hi) = x
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if !(lo < hi) {
+        return 0;
+    }
+    let mut count = 0;
+    for target in [lo, hi] {
+        let mut run = 0usize;
+        for &v in x.iter().chain(std::iter::once(&f64::NAN)) {
+            if v == target {
+                run += 1;
+            } else {
+                if run >= CLIP_RUN {
+                    count += run;
+                }
+                run = 0;
+            }
+        }
+    }
+    count
+}
+
 /// The median of `x` (0 for an empty record; the mean of the two middle values for an even
 /// count).
 pub fn median(x: &[f64]) -> f64 {
@@ -790,6 +824,10 @@ pub struct ChannelSummary {
     pub dominant_frequency_hz: Option<f64>,
     /// Its level, dB re 1 (SI unit)²·s/Hz (finite for any finite data: module docs, Scaling).
     pub dominant_level_db: Option<f64>,
+    /// Samples in runs of [`CLIP_RUN`] or more consecutive samples at the record's largest or
+    /// smallest value ([`clipped_samples`]): a flat top where a transient peaks is the mark of
+    /// an overloaded transducer or amplifier (0: none).
+    pub clipped_samples: usize,
     /// The window the spectrum was computed with, e.g. "rectangular", or "rectangular × force
     /// (pulse 0.0112 s, taper 0.0005 s)" on the blow's excitation with `--force-window`.
     pub window: String,
@@ -926,6 +964,7 @@ pub fn process_channel(
             pretrigger_s: blows.pretrigger as f64 / fs,
             dominant_frequency_hz: df,
             dominant_level_db: de,
+            clipped_samples: clipped_samples(&r.values),
             window,
         },
         quantity: r.quantity,
