@@ -104,41 +104,8 @@ pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>>
         }
     };
     let hline = header.position().map_or(1, |p| p.line());
-    // (column, name, quantity, factor); None for columns passed over.
-    let mut cols: Vec<Option<(String, Quantity, f64)>> = Vec::new();
-    let mut time_col = None;
-    for (k, name) in header.iter().enumerate() {
-        if name.to_ascii_lowercase().ends_with("_j") {
-            cols.push(None);
-            continue;
-        }
-        let Some((n, q, f)) = split_csv_name(name) else {
-            return Err(err(hline, format!(
-                "column {} '{name}': the name does not end in a unit meid knows; expected NAME_UNIT with UNIT one of s, ms, us, m_per_s2, mm_per_s2, g, mg, m_per_s, mm_per_s, m, mm, um, in, n, kn, lbf (e.g. time_s, accel_B_m_per_s2, accel_B_g, force_floor_n)",
-                k + 1
-            )));
-        };
-        if q == Quantity::Time {
-            if let Some(t) = time_col {
-                return Err(err(
-                    hline,
-                    format!(
-                        "columns {} and {} are both times: expected exactly one time column",
-                        t + 1,
-                        k + 1
-                    ),
-                ));
-            }
-            time_col = Some(k);
-        }
-        cols.push(Some((n, q, f)));
-    }
-    let Some(tc) = time_col else {
-        return Err(err(
-            hline,
-            "no time column: expected one named like time_s or time_ms".into(),
-        ));
-    };
+    let names: Vec<String> = header.iter().map(str::to_string).collect();
+    let (cols, tc) = column_kinds(&names).map_err(|m| err(hline, m))?;
     let mut data: Vec<Vec<f64>> = vec![Vec::new(); cols.len()];
     for row in rows {
         let row = row.map_err(|e| {
@@ -190,25 +157,70 @@ pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>>
             data[k].push(si);
         }
     }
+    let origin = |k: usize| format!("{file}, column {}", k + 1);
+    records_from_columns(&names, cols, data, tc, &origin).map_err(|message| err(hline, message))
+}
+
+/// Each column's (channel, quantity, factor to SI) from its `NAME_UNIT` name (`None`: an
+/// energy, `_j`, passed over), and the time column. `Err`: the message naming the column.
+pub(crate) fn column_kinds(
+    names: &[String],
+) -> std::result::Result<(Vec<Option<(String, Quantity, f64)>>, usize), String> {
+    let mut cols: Vec<Option<(String, Quantity, f64)>> = Vec::new();
+    let mut time_col = None;
+    for (k, name) in names.iter().enumerate() {
+        if name.to_ascii_lowercase().ends_with("_j") {
+            cols.push(None);
+            continue;
+        }
+        let Some((n, q, f)) = split_csv_name(name) else {
+            return Err(format!(
+                "column {} '{name}': the name does not end in a unit meid knows; expected NAME_UNIT with UNIT one of s, ms, us, m_per_s2, mm_per_s2, g, mg, m_per_s, mm_per_s, m, mm, um, in, n, kn, lbf (e.g. time_s, accel_B_m_per_s2, accel_B_g, force_floor_n)",
+                k + 1
+            ));
+        };
+        if q == Quantity::Time {
+            if let Some(t) = time_col {
+                return Err(format!(
+                    "columns {} and {} are both times: expected exactly one time column",
+                    t + 1,
+                    k + 1
+                ));
+            }
+            time_col = Some(k);
+        }
+        cols.push(Some((n, q, f)));
+    }
+    let Some(tc) = time_col else {
+        return Err("no time column: expected one named like time_s or time_ms".into());
+    };
+    Ok((cols, tc))
+}
+
+/// The records of a table of columns (CSV, Parquet): `names` the column names, `cols` each
+/// column's (channel, quantity, factor) or `None` when passed over, `data` the values in SI,
+/// `tc` the time column. The time must increase; an abscissa even to [`EVEN_TOLERANCE`] is
+/// even. `Err`: the message (the caller adds the location).
+pub(crate) fn records_from_columns(
+    names: &[String],
+    cols: Vec<Option<(String, Quantity, f64)>>,
+    mut data: Vec<Vec<f64>>,
+    tc: usize,
+    origin: &dyn Fn(usize) -> String,
+) -> std::result::Result<Vec<Record>, String> {
     let t = std::mem::take(&mut data[tc]);
     if t.len() < 2 {
-        return Err(err(
-            hline,
-            format!("{} rows of data: expected at least 2", t.len()),
-        ));
+        return Err(format!("{} rows of data: expected at least 2", t.len()));
     }
     if let Some(i) = t
         .windows(2)
         .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
     {
-        return Err(err(
-            hline,
-            format!(
-                "the time column does not increase at data row {} ({} s then {} s)",
-                i + 2,
-                t[i],
-                t[i + 1]
-            ),
+        return Err(format!(
+            "the time column does not increase at data row {} ({} s then {} s)",
+            i + 2,
+            t[i],
+            t[i + 1]
         ));
     }
     let n = t.len();
@@ -231,7 +243,7 @@ pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>>
         if k == tc {
             continue;
         }
-        let header_name = header.get(k).unwrap_or("").to_string();
+        let header_name = names.get(k).cloned().unwrap_or_default();
         let unit = header_name[name.len().min(header_name.len())..]
             .trim_start_matches('_')
             .to_string();
@@ -242,11 +254,11 @@ pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>>
             point: None,
             abscissa: abscissa.clone(),
             values: std::mem::take(&mut data[k]),
-            origin: format!("{file}, column {}", k + 1),
+            origin: origin(k),
         });
     }
     if out.is_empty() {
-        return Err(err(hline, "no data column besides the time".into()));
+        return Err("no data column besides the time".into());
     }
     Ok(out)
 }
