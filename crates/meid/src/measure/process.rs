@@ -30,6 +30,15 @@
 //! and [`BlowSpectrum::scale_db`] holds `10 log10` of the factor, so levels stay exact and
 //! finite for any finite data (e.g. amplitudes of 1e300).
 //!
+//! # Baseline
+//!
+//! Before its window and FFT, each blow record loses its baseline: the median of its
+//! pre-trigger samples when it has at least [`MIN_BASELINE_SAMPLES`] of them
+//! ([`record_baseline`]; a simulated record, at rest before the blow, has 0). A DC offset (a
+//! transducer's bias or preload, an amplifier's drift) would otherwise leak into the low bins
+//! under a Hann or exponential window and could be the "dominant" line. The time averages and
+//! sample peaks are of the records as measured.
+//!
 //! # Averaging
 //!
 //! * in time: `x̄_n = (1/B) Σ_b x_b[n]` over the B complete blow records (aligned on the trigger
@@ -273,6 +282,20 @@ pub fn detect_blows(x: &[f64], fs: f64, p: &Processing) -> Result<Blows> {
     })
 }
 
+/// The fewest pre-trigger samples a blow record's baseline is taken from ([`record_baseline`]).
+pub const MIN_BASELINE_SAMPLES: usize = 16;
+
+/// The baseline of a blow record `seg` whose first `pre` samples precede the trigger: the
+/// median of those samples when there are at least [`MIN_BASELINE_SAMPLES`] (robust to the
+/// few samples of a blow's rise before the trigger level), else 0 (module docs, Baseline).
+pub fn record_baseline(seg: &[f64], pre: usize) -> f64 {
+    if pre >= MIN_BASELINE_SAMPLES && pre <= seg.len() {
+        median(&seg[..pre])
+    } else {
+        0.0
+    }
+}
+
 /// The shortest run of equal samples at a record's extreme that counts as clipping.
 pub const CLIP_RUN: usize = 3;
 
@@ -491,7 +514,9 @@ impl super::SimChannel {
 /// (at least one sample), then 0.
 pub fn force_window_for(x: &[f64], blows: &Blows, fs: f64, p: &Processing) -> TransientWindow {
     let s = blows.starts.first().copied().unwrap_or(0).min(x.len());
-    let rec = &x[s..(s + blows.length).min(x.len())];
+    let raw = &x[s..(s + blows.length).min(x.len())];
+    let base = record_baseline(raw, blows.pretrigger);
+    let rec: Vec<f64> = raw.iter().map(|v| v - base).collect();
     let (k_max, top) =
         rec.iter().enumerate().fold(
             (0, 0.0_f64),
@@ -660,7 +685,12 @@ pub fn blow_spectrum(
     for &s in &blows.starts {
         // (In range: `check_starts` above.)
         let seg = &x[s..s + len];
-        scaled.iter_mut().zip(seg).for_each(|(d, v)| *d = v * down);
+        // The record less its baseline (module docs, Baseline), scaled: (v − b)·2^−e exactly.
+        let b = record_baseline(seg, blows.pretrigger) * down;
+        scaled
+            .iter_mut()
+            .zip(seg)
+            .for_each(|(d, v)| *d = v * down - b);
         let bins = tr.run(&scaled, &w)?;
         for (k, (a, c)) in acc.iter_mut().zip(bins).enumerate() {
             *a += one_sided_factor(k, n_fft) * c.norm_sqr() * dt * dt;
@@ -747,9 +777,13 @@ pub fn h1(force: &[f64], response: &[f64], fs: f64, blows: &Blows, p: &Processin
         vec![0.0; bins],
         vec![0.0; bins],
     );
+    let less_baseline = |seg: &[f64]| -> Vec<f64> {
+        let b = record_baseline(seg, blows.pretrigger);
+        seg.iter().map(|v| v - b).collect()
+    };
     for &s in &blows.starts {
-        let f = tf.run(&force[s..s + len], &wf)?;
-        let x = tx.run(&response[s..s + len], &wx)?;
+        let f = tf.run(&less_baseline(&force[s..s + len]), &wf)?;
+        let x = tx.run(&less_baseline(&response[s..s + len]), &wx)?;
         for k in 0..bins {
             gfx[k] += f[k].conj() * x[k];
             gff[k] += f[k].norm_sqr();
