@@ -161,12 +161,15 @@ pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>>
     records_from_columns(&names, cols, data, tc, &origin).map_err(|message| err(hline, message))
 }
 
+/// A column's channel name, quantity and factor to SI; `None` for a column passed over.
+pub(crate) type ColumnKind = Option<(String, Quantity, f64)>;
+
 /// Each column's (channel, quantity, factor to SI) from its `NAME_UNIT` name (`None`: an
 /// energy, `_j`, passed over), and the time column. `Err`: the message naming the column.
 pub(crate) fn column_kinds(
     names: &[String],
-) -> std::result::Result<(Vec<Option<(String, Quantity, f64)>>, usize), String> {
-    let mut cols: Vec<Option<(String, Quantity, f64)>> = Vec::new();
+) -> std::result::Result<(Vec<ColumnKind>, usize), String> {
+    let mut cols: Vec<ColumnKind> = Vec::new();
     let mut time_col = None;
     for (k, name) in names.iter().enumerate() {
         if name.to_ascii_lowercase().ends_with("_j") {
@@ -203,7 +206,7 @@ pub(crate) fn column_kinds(
 /// even. `Err`: the message (the caller adds the location).
 pub(crate) fn records_from_columns(
     names: &[String],
-    cols: Vec<Option<(String, Quantity, f64)>>,
+    cols: Vec<ColumnKind>,
     mut data: Vec<Vec<f64>>,
     tc: usize,
     origin: &dyn Fn(usize) -> String,

@@ -310,7 +310,7 @@ pub fn clipped_samples(x: &[f64]) -> usize {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         });
-    if !(lo < hi) {
+    if lo >= hi || lo.is_nan() || hi.is_nan() {
         return 0;
     }
     let mut count = 0;
