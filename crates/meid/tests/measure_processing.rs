@@ -573,9 +573,13 @@ fn an_offset_neither_hides_blows_nor_triggers() {
 fn clipped_records_are_flagged() {
     use meid::measure::process::{clipped_samples, process_all};
     use meid::measure::report::warnings;
-    let (_, x) = blows_record(2);
+    let (f, x) = blows_record(2);
     let top = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
     assert_eq!(clipped_samples(&x), 0);
+    // A hammer's rest level, 0 between blows, is its smallest value: not a cut (also offset).
+    assert_eq!(clipped_samples(&f), 0);
+    let lifted: Vec<f64> = f.iter().map(|v| v + 2e4).collect();
+    assert_eq!(clipped_samples(&lifted), 0);
     assert_eq!(clipped_samples(&vec![0.0; 100]), 0);
     let cut = 0.6 * top;
     // The samples of the original beyond ±cut in runs of 3 or more of one sign (the last

@@ -300,10 +300,13 @@ pub fn record_baseline(seg: &[f64], pre: usize) -> f64 {
 pub const CLIP_RUN: usize = 3;
 
 /// The samples of `x` in runs of at least [`CLIP_RUN`] consecutive samples equal to its
-/// largest value, or to its smallest: a sampled transient does not stay at its extreme for
-/// three samples unless the signal was cut there (a transducer, amplifier or converter at its
-/// full scale). A constant record has no extreme to clip at (0). It can only flag: a slow
-/// signal quantised coarsely may also repeat its extreme; the count is for a warning.
+/// largest value, or to its smallest, of the extremes at least half the largest deviation from
+/// the median `x̃` away from it (`|ext − x̃| ≥ ½ max|x − x̃|`: the rest level of a one-sided
+/// record, a hammer's 0 between blows, is not a cut): a sampled transient does not stay at its
+/// extreme for three samples unless the signal was cut there (a transducer, amplifier or
+/// converter at its full scale). A constant record has no extreme to clip at (0). It can only
+/// flag: a slow signal quantised coarsely may also repeat its extreme; the count is for a
+/// warning.
 pub fn clipped_samples(x: &[f64]) -> usize {
     let (lo, hi) = x
         .iter()
@@ -313,8 +316,15 @@ pub fn clipped_samples(x: &[f64]) -> usize {
     if lo >= hi || lo.is_nan() || hi.is_nan() {
         return 0;
     }
+    // Only an extreme far from the baseline is a cut: the rest level of a one-sided record (a
+    // hammer's 0 between blows) is its smallest value and repeats by nature.
+    let m = median(x);
+    let reach = (hi - m).max(m - lo);
     let mut count = 0;
     for target in [lo, hi] {
+        if (target - m).abs() < 0.5 * reach {
+            continue;
+        }
         let mut run = 0usize;
         for &v in x.iter().chain(std::iter::once(&f64::NAN)) {
             if v == target {
