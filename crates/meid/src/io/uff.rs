@@ -503,7 +503,10 @@ impl<R: BufRead> Parser<'_, R> {
         }
         let values = match bin {
             Some((little, bytes)) => {
-                if bytes != count * width {
+                // pyuff (2.5.8) announces an uneven record's points, not its (x, y) pairs: the
+                // pairs are read, and the closing "-1" right after them confirms the layout.
+                let points_only = !even && bytes == count / 2 * width;
+                if bytes != count * width && !points_only {
                     return Err(self.err(
                         Some(ds),
                         Some("binary header"),
@@ -1600,6 +1603,32 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("does not say the quantity"), "{e}");
+    }
+
+    /// Binary uneven 58b whose header announces the points' bytes rather than the (x, y)
+    /// pairs' (pyuff 2.5.8) reads, the closing "-1" after the pairs confirming the layout;
+    /// any other count is refused.
+    #[test]
+    fn binary_uneven_with_the_points_bytes_announced_reads() {
+        let file = |announced: usize| -> Vec<u8> {
+            let mut b = format!("    -1\n    58b     1     2          11{announced:>12}     0     0           0           0\nacc\nNONE\nNONE\nNONE\nNONE\n    1         0    0         0 NONE               1   3 NONE               0   0\n         4         3         0  0.00000e+00  0.00000e+00  0.00000e+00\n        17    0    0    0 Time                 s                   \n        12    0    0    0 Acc                  g                   \n         0    0    0    0 NONE                 NONE                \n         0    0    0    0 NONE                 NONE                \n").into_bytes();
+            for (t, y) in [(0.0f64, 1.0f64), (1e-3, 2.0), (2.5e-3, -0.5)] {
+                b.extend_from_slice(&t.to_le_bytes());
+                b.extend_from_slice(&y.to_le_bytes());
+            }
+            b.extend_from_slice(b"\n    -1\n");
+            b
+        };
+        for announced in [48, 24] {
+            let f = parse_uff(&file(announced)[..], "u.uff", None).unwrap();
+            let r = &f.records[0];
+            assert_eq!(r.values, vec![9.80665, 2.0 * 9.80665, -0.5 * 9.80665]);
+            assert_eq!(r.abscissa, Abscissa::Uneven(vec![0.0, 1e-3, 2.5e-3]));
+        }
+        let e = parse_uff(&file(40)[..], "u.uff", None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("40 bytes announced"), "{e}");
     }
 
     /// A finite value that overflows when converted to SI (1e308 g) is refused naming the
