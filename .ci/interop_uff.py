@@ -15,8 +15,9 @@ import pyuff
 G = 9.80665
 
 
-def ds58(name, node, x, y, spec, unit, binary, even=True):
+def ds58(name, node, x, y, spec, unit, binary, even=True, **more):
     return pyuff.prepare_58(
+        **more,
         binary=binary,
         id1=name,
         func_type=1,
@@ -72,6 +73,14 @@ def write(d):
     u = pyuff.UFF(path)
     u.write_sets([ds58("accel_u", 4, tu, yu, 12, "m/s^2", 0, even=False)], mode="overwrite")
     expected["uneven.uff"] = [{"name": "accel_u", "unit": "m/s^2", "times": list(tu), "values": list(yu)}]
+    # The same uneven record in binary (pyuff announces the points' bytes, not the pairs').
+    path = os.path.join(d, "uneven_binary.uff")
+    if os.path.exists(path):
+        os.remove(path)
+    u = pyuff.UFF(path)
+    # (pyuff writes nothing for it in "overwrite" mode or without the ordinate type.)
+    u.write_sets([ds58("accel_u", 4, tu, yu, 12, "m/s^2", 1, even=False, ord_data_type=4)], mode="add")
+    expected["uneven_binary.uff"] = expected["uneven.uff"]
     # Nodes and a normal mode.
     path = os.path.join(d, "modes.uff")
     u = pyuff.UFF(path)

@@ -7,14 +7,15 @@ use anyhow::Result;
 
 use meid::measure::mapping::{parse_window, MeasurementSpec};
 use meid::measure::process::{process_all, Level, Processing};
-use meid::measure::{read_records, report};
+use meid::measure::{read_records_noting, report};
 
 use crate::args::PrintArgs;
 
 /// Processing flags shared by `measure` and `validate` (they override `[measurement]`).
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct ProcessingArgs {
-    /// Trigger level as a fraction of the trigger channel's peak, in (0, 1] (default 0.1).
+    /// Trigger level as a fraction of the trigger channel's largest deviation from its median,
+    /// in (0, 1] (default 0.1).
     #[arg(long, value_name = "FRACTION")]
     pub trigger_level: Option<f64>,
     /// Time kept before each trigger (s, default 0.01).
@@ -33,7 +34,8 @@ pub struct ProcessingArgs {
     /// Time constant of the exponential window (s); it adds 1/(ωτ) to a mode's damping ratio.
     #[arg(long, value_name = "S")]
     pub tau: Option<f64>,
-    /// Force window on force channels.
+    /// Force window on the blow's excitation (the force named blow/hammer/slider, or mapped to
+    /// blow; else the --trigger channel when it is a force); other channels are responses.
     #[arg(long)]
     pub force_window: bool,
     /// The channel blows are detected on (default: the blow force by name, else the bed
@@ -127,19 +129,29 @@ pub fn run(a: MeasureArgs) -> Result<()> {
     let p = a.processing.processing(section.as_ref())?;
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
     let mut records = Vec::new();
+    let mut notes = Vec::new();
     for f in &a.files {
-        let r = read_records(f)?;
+        let (r, passed) = read_records_noting(f)?;
         if r.is_empty() {
             anyhow::bail!(
-                "{}: no time response (dataset 58, function type 1) in the file",
-                f.display()
+                "{}: no time response (dataset 58, function type 1, of an acceleration, velocity, displacement or force) in the file{}",
+                f.display(),
+                if passed.is_empty() {
+                    String::new()
+                } else {
+                    format!("; passed over:\n  {}", passed.join("\n  "))
+                }
             );
         }
         records.extend(r);
+        notes.extend(passed);
     }
     let channels = process_all(&records, &p, a.processing.trigger.as_deref(), &point)?;
     let summaries: Vec<_> = channels.iter().map(|c| &c.summary).collect();
     if !a.print.quiet {
+        for n in &notes {
+            crate::ui::warning(n);
+        }
         for w in report::warnings(&channels) {
             crate::ui::warning(w);
         }

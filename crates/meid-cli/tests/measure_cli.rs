@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{meid, ok, paper_example, stderr, tmpdir};
+use common::{meid, ok, ok_json, paper_example, stderr, tmpdir};
 use serde_json::Value;
 
 #[test]
@@ -59,6 +59,8 @@ fn measure_json_has_the_issue_fields_and_sample_peaks() {
         "pretrigger_s",
         "dominant_frequency_hz",
         "dominant_level_db",
+        "window",
+        "clipped_samples",
     ];
     let mut got = keys.clone();
     want.sort();
@@ -513,4 +515,100 @@ fn no_blow_found_is_reported_as_zero_blows_averaged() {
     assert_eq!(a["blows_averaged"], 0);
     assert!((a["record_s"].as_f64().unwrap() - 2.0).abs() < 1e-9, "{a}");
     assert_eq!(a["dominant_frequency_hz"], 50.0);
+}
+
+/// A lab file as a spreadsheet in a decimal-comma locale writes it (`;`, `1,5`), with the
+/// blow force (hammer) and the force to the floor (a response ringing at 20 Hz):
+/// `--force-window` windows the hammer only, and the floor force keeps its line (session 12
+/// audit: the floor force was cut to the hammer's pulse, and `;` files were refused with "no
+/// time column"). A UFF file with a microphone channel beside the accelerometer reads, the
+/// microphone passed over with a warning (it was refused: "unknown unit 'Pa'").
+#[test]
+fn force_window_on_the_hammer_only_semicolon_csv_and_a_microphone_passed_over() {
+    let d = tmpdir("measure", "forcewin");
+    let f = d.join("lab.csv");
+    let mut s = String::from("time_s;hammer_n;force_floor_n\r\n");
+    for i in 0..4000 {
+        let t = i as f64 * 1e-3;
+        let tb = t % 1.0;
+        let hammer = if (0.1..0.103).contains(&tb) {
+            1000.0
+        } else {
+            0.0
+        };
+        let floor = if tb >= 0.1 {
+            let u = tb - 0.1;
+            200.0 * (-u * 3.0).exp() * (2.0 * std::f64::consts::PI * 20.0 * u).sin()
+        } else {
+            0.0
+        };
+        s.push_str(&format!("{t};{hammer};{floor}\r\n").replace('.', ","));
+    }
+    std::fs::write(&f, s).unwrap();
+    let run = |extra: &[&str]| -> Value {
+        let mut args = vec![
+            "measure",
+            f.to_str().unwrap(),
+            "--json",
+            "--pretrigger",
+            "0.05",
+        ];
+        args.extend_from_slice(extra);
+        ok_json(meid().args(&args).output().unwrap())
+    };
+    let plain = run(&[]);
+    let windowed = run(&["--force-window"]);
+    let (p, w) = (&plain[1], &windowed[1]);
+    assert_eq!(w["name"], "force_floor");
+    assert_eq!(w["window"], "rectangular");
+    assert_eq!(p["dominant_frequency_hz"], w["dominant_frequency_hz"]);
+    assert_eq!(w["dominant_frequency_hz"], 20.0);
+    assert_eq!(p["dominant_level_db"], w["dominant_level_db"]);
+    assert_eq!(windowed[0]["name"], "hammer");
+    assert!(
+        windowed[0]["window"]
+            .as_str()
+            .unwrap()
+            .starts_with("rectangular × force (pulse 0.053"),
+        "{}",
+        windowed[0]
+    );
+    assert_eq!(plain[0]["blows_averaged"], 3);
+
+    let u = d.join("lab.uff");
+    let dataset = |name: &str, ty: i64, unit: &str| {
+        let mut t = format!("    -1\n    58\n{name}\nNONE\nNONE\nNONE\nNONE\n    1         0    0         0 bed                1   3 NONE               0   0\n         4      2000         1  0.00000e+00  1.00000e-03  0.00000e+00\n        17    0    0    0 Time                 s                   \n{ty:>10}    0    0    0 {name:<20} {unit:<20}\n         0    0    0    0 NONE                 NONE                \n         0    0    0    0 NONE                 NONE                \n");
+        for i in 0..2000 {
+            let tb = i as f64 * 1e-3;
+            let v = if tb >= 0.1 {
+                (-(tb - 0.1) * 20.0).exp() * (2.0 * std::f64::consts::PI * 50.0 * (tb - 0.1)).sin()
+            } else {
+                0.0
+            };
+            t.push_str(&format!("{v:20.12e}"));
+            if i % 4 == 3 {
+                t.push('\n');
+            }
+        }
+        t.push_str("    -1\n");
+        t
+    };
+    std::fs::write(
+        &u,
+        dataset("accel_B", 12, "m/s^2") + &dataset("mic", 15, "Pa"),
+    )
+    .unwrap();
+    let o = meid()
+        .args(["measure", u.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let text = ok(o.clone());
+    assert!(text.contains("accel_B") && !text.contains("mic "), "{text}");
+    let e = stderr(&o);
+    assert!(
+        e.contains("dataset 2 (58 at line 515)")
+            && e.contains("specific data type 15 (pressure, unit 'Pa')")
+            && e.contains("passed over"),
+        "{e}"
+    );
 }

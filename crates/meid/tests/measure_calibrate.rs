@@ -40,7 +40,12 @@ fn model(overrides: &[String]) -> Model {
 /// simulated blow, plus white noise of standard deviation `noise` × the channel's RMS (seeded),
 /// through a binary UFF file.
 fn measured(m: &Model, noise: f64, seed: u64, tag: &str) -> MeasuredCase {
-    let sys = m.impact_system(Case::AsSpecified).unwrap();
+    measured_case(m, Case::AsSpecified, noise, seed, tag)
+}
+
+/// [`measured`] for a case of the machine.
+fn measured_case(m: &Model, case: Case, noise: f64, seed: u64, tag: &str) -> MeasuredCase {
+    let sys = m.impact_system(case).unwrap();
     let mut o = m.options();
     o.sample_rate = Some(FS);
     o.duration = (SEGMENT - LEAD + 10) as f64 / FS;
@@ -87,7 +92,7 @@ fn measured(m: &Model, noise: f64, seed: u64, tag: &str) -> MeasuredCase {
     let _ = std::fs::remove_file(&path);
     assert_eq!(back[2].values, records[2].values);
     MeasuredCase {
-        case: Case::AsSpecified,
+        case,
         files: vec![tag.into()],
         records: back,
     }
@@ -285,5 +290,51 @@ fn values_outside_the_structure_reuse_its_modes_and_are_recovered() {
     assert!(
         e.ci95_low <= known && known <= e.ci95_high,
         "known {known}, {e:?}"
+    );
+}
+
+/// A value the measurements do not depend on is named not identifiable, without an interval,
+/// and the others keep theirs (session 12 audit: K_d fitted with K_s to the bare machine's
+/// blows, where the damper is absent, made JᵀJ singular and printed "[NaN, NaN] NaN" for both).
+#[test]
+fn a_value_the_data_do_not_depend_on_is_named_not_identifiable() {
+    use meid::measure::calibrate::Identifiability;
+    let truth = model(&[]);
+    let ks = value(&truth, KS);
+    let meas = measured_case(&truth, Case::NoDamper, 0.05, 21, "bare");
+    let start = model(&[format!("{KS}={:e}", ks * 1.2)]);
+    let paths: Vec<String> = [KS, KD].iter().map(|s| s.to_string()).collect();
+    let params = parameters(&start, &paths, &BTreeMap::new()).unwrap();
+    let kd_start = params[1].start;
+    let problem = Problem::new(
+        &start,
+        params,
+        &[meas],
+        &processing(),
+        &BTreeMap::new(),
+        Settings::default(),
+    )
+    .unwrap();
+    let c = calibrate(&problem).unwrap();
+    let text = c.to_text();
+    eprintln!("{text}");
+    let (k, d) = (&c.parameters[0], &c.parameters[1]);
+    assert_eq!(k.identifiability, Identifiability::Identifiable);
+    assert!(
+        k.ci95_low <= ks && ks <= k.ci95_high && k.relative_half_width < 0.01,
+        "{k:?}"
+    );
+    assert_eq!(d.identifiability, Identifiability::NoEffect);
+    assert!(d.standard_error.is_nan());
+    assert!(
+        (d.value / kd_start - 1.0).abs() < 1e-12,
+        "{} vs {kd_start}",
+        d.value
+    );
+    assert!(!text.contains("NaN"), "{text}");
+    assert!(
+        text.contains("not identifiable: no effect")
+            && text.contains(&format!("not identifiable from these measurements: {KD}")),
+        "{text}"
     );
 }

@@ -5,7 +5,8 @@
 
 use meid::analysis::spectrum::{exponential_window_correction, TransientWindow};
 use meid::measure::process::{
-    average_blows, blow_spectrum, detect_blows, h1, windowed_sdof_damping, Blows, Level, Processing,
+    average_blows, blow_spectrum, detect_blows, h1, windowed_sdof_damping, Blows, Level,
+    Processing, Role,
 };
 use meid::measure::Quantity;
 use meid::rng::SplitMix64;
@@ -178,7 +179,7 @@ fn blow_averaged_esd_keeps_parseval_and_time_average_is_the_blow() {
     let (f, x) = blows_record(4);
     let p = processing(TransientWindow::Exponential { tau_s: 1.0 });
     let b = detect_blows(&f, FS, &p).unwrap();
-    let s = blow_spectrum(&x, Quantity::Displacement, FS, &b, &p, None).unwrap();
+    let s = blow_spectrum(&x, Role::Response, FS, &b, &p, None).unwrap();
     assert_eq!(s.averages, 4);
     let w = p.window.coefficients(N, FS).unwrap();
     let dt = 1.0 / FS;
@@ -209,7 +210,7 @@ fn no_complete_blow_is_an_error_not_a_panic() {
         level: 1.0,
     };
     let p = Processing::default();
-    assert!(blow_spectrum(&[0.0; 5], Quantity::Force, 1.0, &b, &p, None).is_err());
+    assert!(blow_spectrum(&[0.0; 5], Role::Excitation, 1.0, &b, &p, None).is_err());
     assert!(h1(&[0.0; 5], &[0.0; 5], 1.0, &b, &p).is_err());
     assert!(average_blows(&[0.0; 5], &[3], 10).is_err());
     let bad = Processing {
@@ -229,10 +230,10 @@ fn spectra_of_huge_and_tiny_records_keep_their_levels() {
     let (f, x) = blows_record(2);
     let p = processing(TransientWindow::Rectangular);
     let b = detect_blows(&f, FS, &p).unwrap();
-    let base = blow_spectrum(&x, Quantity::Displacement, FS, &b, &p, None).unwrap();
+    let base = blow_spectrum(&x, Role::Response, FS, &b, &p, None).unwrap();
     assert_eq!(base.scale_db, 0.0);
     let x10: Vec<f64> = x.iter().map(|v| v * 1024.0).collect();
-    let s10 = blow_spectrum(&x10, Quantity::Displacement, FS, &b, &p, None).unwrap();
+    let s10 = blow_spectrum(&x10, Role::Response, FS, &b, &p, None).unwrap();
     for (a, b) in base.density.iter().zip(&s10.density) {
         assert_eq!(a * 1_048_576.0, *b);
     }
@@ -241,7 +242,7 @@ fn spectra_of_huge_and_tiny_records_keep_their_levels() {
     let l0 = base.level_db(e0, 1.0);
     for (factor, shift_db) in [(1e300, 6000.0), (1e-300, -6000.0)] {
         let xs: Vec<f64> = x.iter().map(|v| v * factor).collect();
-        let s = blow_spectrum(&xs, Quantity::Displacement, FS, &b, &p, None).unwrap();
+        let s = blow_spectrum(&xs, Role::Response, FS, &b, &p, None).unwrap();
         assert!(s.density_si().is_none(), "{factor}");
         let (fs_, es) = s.dominant().unwrap();
         assert_eq!(fs_, 50.0);
@@ -342,4 +343,326 @@ fn blows_that_do_not_fit_name_the_valid_range() {
     let b = detect_blows(&f, FS, &p).unwrap();
     assert_eq!(b.starts, vec![0]);
     assert!(require_complete(&b, n, FS, "hammer", "lab.uff").is_ok());
+}
+
+/// A record of a group sampled at FS from t = 0.
+fn record(name: &str, q: Quantity, values: Vec<f64>) -> meid::measure::Record {
+    meid::measure::Record {
+        name: name.into(),
+        quantity: q,
+        source_unit: q.si_unit().into(),
+        point: None,
+        abscissa: meid::measure::Abscissa::Even {
+            start_s: 0.0,
+            step_s: 1.0 / FS,
+        },
+        values,
+        origin: "lab.csv".into(),
+    }
+}
+
+/// The force window belongs to the blow's excitation only (session 12 audit: `--force-window`
+/// windowed every force channel, so the force to the floor — a response ringing at its mode —
+/// was cut to the hammer's pulse: its dominant line moved from 30 Hz, 42.00 dB, to 48 Hz,
+/// 1.80 dB). The pulse is found on the excitation's own record, so it does not depend on the
+/// channel the blows were triggered on (the old code compared the force with the trigger
+/// channel's level, an acceleration in m/s²).
+#[test]
+fn force_window_applies_to_the_blow_force_only() {
+    use meid::measure::process::{force_window_for, process_all};
+    let dt = 1.0 / FS;
+    let (hammer, accel) = blows_record(2);
+    // The hammer: the blow (one sample of J/Δt = 6000 N), then a 1 % ringing of the load
+    // cell at 300 Hz that the force window must take out.
+    let ring: Vec<f64> = (0..hammer.len())
+        .map(|i| {
+            let m = i % N;
+            if m > PRE + 4 {
+                60.0 * (2.0 * std::f64::consts::PI * 300.0 * (m - PRE) as f64 * dt).sin()
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let hammer: Vec<f64> = hammer.iter().zip(&ring).map(|(a, b)| a + b).collect();
+    // The floor force: a response, the 20 Hz mode ringing after each blow.
+    let floor: Vec<f64> = (0..hammer.len())
+        .map(|i| {
+            let m = i % N;
+            if m >= PRE {
+                let t = (m - PRE) as f64 * dt;
+                500.0 * (-2.0 * t).exp() * (2.0 * std::f64::consts::PI * 20.0 * t).sin()
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let records = vec![
+        record("hammer", Quantity::Force, hammer.clone()),
+        record("accel_B", Quantity::Displacement, accel),
+        record("force_floor", Quantity::Force, floor),
+    ];
+    let plain = processing(TransientWindow::Rectangular);
+    let windowed = Processing {
+        force_window: true,
+        ..plain.clone()
+    };
+    for trigger in ["hammer", "accel_B"] {
+        let a = process_all(&records, &plain, Some(trigger), "B").unwrap();
+        let b = process_all(&records, &windowed, Some(trigger), "B").unwrap();
+        // The responses are untouched, bit for bit.
+        for k in [1, 2] {
+            assert_eq!(
+                a[k].spectrum, b[k].spectrum,
+                "{trigger}: {}",
+                a[k].summary.name
+            );
+            assert_eq!(b[k].summary.window, "rectangular");
+        }
+        // The hammer's pulse ends one sample after the blow: window 1 over the pre-trigger
+        // and the pulse (PRE + 1 samples), then a one-sample taper; the ringing is gone.
+        let blows = meid::measure::process::detect_blows(&records[0].values, FS, &plain).unwrap();
+        let w = force_window_for(&records[0].values, &blows, FS, &windowed);
+        assert_eq!(
+            w,
+            TransientWindow::Force {
+                pulse_s: (PRE + 1) as f64 * dt,
+                taper_s: dt
+            }
+        );
+        assert!(
+            b[0].summary.window.starts_with("rectangular × force"),
+            "{}",
+            b[0].summary.window
+        );
+        // Windowed, the hammer's ESD is the blow's alone: flat, 2 (J)² (N·s)²/Hz... plus at
+        // most the ringing's first samples; 300 Hz no longer stands out.
+        let flat = 2.0 * J * J;
+        let s = &b[0].spectrum;
+        let k300 = s.frequency_hz.iter().position(|f| *f == 300.0).unwrap();
+        assert!(
+            (s.density[k300] - flat).abs() < 1e-3 * flat,
+            "{trigger}: {} vs {flat}",
+            s.density[k300]
+        );
+        assert!(a[0].spectrum.density[k300] > 100.0 * flat);
+    }
+}
+
+/// One blow record: the whole of `x`.
+fn one_blow(n: usize) -> Blows {
+    Blows {
+        triggers: vec![0],
+        starts: vec![0],
+        length: n,
+        pretrigger: 0,
+        level: 1.0,
+    }
+}
+
+/// One-third-octave band energies integrate the ESD with each bin's energy spread over the
+/// frequencies it stands for (session 12 audit: a band took the bins whose centre lay in it,
+/// so with 2 Hz bins the 2.5, 3.15 and 5 Hz bands of a hammer blow held 0 energy and the 4 Hz
+/// band a whole bin, and the 10 Hz band of a decayed 100 Hz transient changed by 20 % between
+/// 0.5 s and 1 s records). A decayed transient's band energies are now those of its continuous
+/// spectrum (a 64× padded reference) whatever the record length, bands tiling [0, f_s/2] add
+/// up to the record's energy, and a tone at a mid-band frequency lands wholly in its band.
+#[test]
+fn third_octave_band_energies_do_not_depend_on_the_record_length() {
+    use meid::analysis::octave::Band;
+    let fs = 2000.0;
+    let p = Processing {
+        pretrigger_s: 0.0,
+        ..processing(TransientWindow::Rectangular)
+    };
+    let wn = 2.0 * std::f64::consts::PI * 100.0;
+    let decay = |n: usize| -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                let t = i as f64 / fs;
+                (-0.02 * wn * t).exp() * (wn * (1.0f64 - 0.0004).sqrt() * t).sin()
+            })
+            .collect()
+    };
+    // The reference: 4 s (the decay is e^{-50} by then), padded 64×.
+    let x = decay(8000);
+    let reference =
+        blow_spectrum(&x, Role::Response, fs, &one_blow(8000), &p, Some(64 * 8000)).unwrap();
+    let bands: Vec<Band> = (-20..=-1).map(Band::new).collect(); // 10 Hz … 794 Hz
+    for n in [1000, 2000, 3000, 8000] {
+        let x = decay(n);
+        let s = blow_spectrum(&x, Role::Response, fs, &one_blow(n), &p, None).unwrap();
+        // Parseval, and bands tiling [0, f_s/2] add up to it.
+        let time: f64 = x.iter().map(|v| v * v).sum::<f64>() / fs;
+        let total = s.band_energy(0.0, fs / 2.0);
+        assert!(
+            ((total - time) / time).abs() < 1e-12,
+            "{n}: {total} vs {time}"
+        );
+        let edges = [0.0, 3.3, 89.125, 112.2, 999.0, 1000.0];
+        let tiled: f64 = edges.windows(2).map(|e| s.band_energy(e[0], e[1])).sum();
+        assert!(
+            ((tiled - time) / time).abs() < 1e-12,
+            "{n}: {tiled} vs {time}"
+        );
+        for b in &bands {
+            let e = s.band_energy(b.lower_hz, b.upper_hz);
+            let r = reference.band_energy(b.lower_hz, b.upper_hz);
+            assert!(
+                ((e - r) / r).abs() < 0.01,
+                "{n} samples, {} band: {e} vs {r}",
+                b.label()
+            );
+        }
+        // A 100 Hz record of whole cycles: one bin, all of it in the 100 Hz band.
+        let a = 3.0;
+        let tone: Vec<f64> = (0..n)
+            .map(|i| a * (2.0 * std::f64::consts::PI * 100.0 * i as f64 / fs).sin())
+            .collect();
+        let s = blow_spectrum(&tone, Role::Response, fs, &one_blow(n), &p, None).unwrap();
+        let band = Band::containing(100.0);
+        assert!((band.centre_hz - 100.0).abs() < 1e-9);
+        let e = s.band_energy(band.lower_hz, band.upper_hz);
+        let whole = a * a * (n as f64 / fs) / 2.0; // A²T/2
+        assert!(((e - whole) / whole).abs() < 1e-12, "{n}: {e} vs {whole}");
+    }
+}
+
+/// Blows are found on deviations from the channel's baseline, its median (session 12 audit: a
+/// force channel with a DC offset above the trigger level, a transducer's preload or a charge
+/// amplifier's drift, never armed the detector: no blow found, the whole record processed as
+/// one). With an offset of ±2000 N under 6000 N blows and a trigger at 10 % of the peak, the
+/// triggers are those of the record without offset, also with noise on it.
+#[test]
+fn an_offset_neither_hides_blows_nor_triggers() {
+    use meid::measure::process::median;
+    let (f, _) = blows_record(3);
+    let p = Processing {
+        level: Level::FractionOfPeak(0.1),
+        ..processing(TransientWindow::Rectangular)
+    };
+    let clean = detect_blows(&f, FS, &p).unwrap();
+    assert_eq!(clean.triggers, vec![PRE, N + PRE, 2 * N + PRE]);
+    let mut rng = SplitMix64::new(3);
+    for offset in [2000.0, -2000.0] {
+        for noise in [0.0, 50.0] {
+            let g: Vec<f64> = f
+                .iter()
+                .map(|v| v + offset + noise * rng.next_normal())
+                .collect();
+            let b = detect_blows(&g, FS, &p).unwrap();
+            assert_eq!(b.triggers, clean.triggers, "offset {offset}, noise {noise}");
+            assert_eq!(b.starts, clean.starts);
+            // The level is 10 % of the largest deviation from the median.
+            let m = median(&g);
+            assert!((m - offset).abs() < 3.0 * noise + 1e-9, "{m}");
+            let top = g.iter().fold(0.0_f64, |a, v| a.max((v - m).abs()));
+            assert_eq!(b.level, 0.1 * top);
+        }
+    }
+    assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+    assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
+    assert_eq!(median(&[]), 0.0);
+}
+
+/// A record cut at its transducer's full scale is flagged (session 12 audit: a clipped
+/// accelerometer passed without a word; its sample peak read as the full scale, its spectrum
+/// skewed). A decaying 50 Hz response clipped at 60 % of its peak has every sample beyond
+/// ±60 % in a flat run; the same record unclipped, with noise, or a zero record, has none.
+#[test]
+fn clipped_records_are_flagged() {
+    use meid::measure::process::{clipped_samples, process_all};
+    use meid::measure::report::warnings;
+    let (f, x) = blows_record(2);
+    let top = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    assert_eq!(clipped_samples(&x), 0);
+    // A hammer's rest level, 0 between blows, is its smallest value: not a cut (also offset).
+    assert_eq!(clipped_samples(&f), 0);
+    let lifted: Vec<f64> = f.iter().map(|v| v + 2e4).collect();
+    assert_eq!(clipped_samples(&lifted), 0);
+    assert_eq!(clipped_samples(&vec![0.0; 100]), 0);
+    let cut = 0.6 * top;
+    // The samples of the original beyond ±cut in runs of 3 or more of one sign (the last
+    // cycles above the cut have shorter runs: they look like peaks, not a cut).
+    let mut beyond = 0;
+    for sign in [1.0, -1.0] {
+        let mut run = 0;
+        for v in x.iter().chain([0.0].iter()) {
+            if sign * v >= cut {
+                run += 1;
+            } else {
+                if run >= 3 {
+                    beyond += run;
+                }
+                run = 0;
+            }
+        }
+    }
+    let clipped: Vec<f64> = x.iter().map(|v| v.clamp(-cut, cut)).collect();
+    assert_eq!(clipped_samples(&clipped), beyond);
+    assert!(beyond > 20, "{beyond}");
+    let records = vec![
+        record("accel_B", Quantity::Acceleration, clipped),
+        record("plain", Quantity::Acceleration, x),
+    ];
+    let c = process_all(
+        &records,
+        &processing(TransientWindow::Rectangular),
+        None,
+        "B",
+    )
+    .unwrap();
+    assert_eq!(c[0].summary.clipped_samples, beyond);
+    assert_eq!(c[1].summary.clipped_samples, 0);
+    let w = warnings(&c);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].contains("'accel_B' is possibly clipped")
+            && w[0].contains(&format!("{beyond} samples")),
+        "{w:?}"
+    );
+}
+
+/// Each blow record loses its baseline (the median of its pre-trigger samples) before its
+/// window and FFT (session 12 audit: a 30 m/s² offset on a 99 m/s² accelerometer, with the
+/// Hann or an exponential window, moved the dominant line from the 100 Hz mode to 2 Hz, the
+/// offset's leakage). With an offset of 30 % of the peak the spectra, Hann, exponential and
+/// with the force window on the excitation, are those of the record without offset, and H1 too.
+#[test]
+fn a_dc_offset_does_not_leak_into_the_spectra() {
+    let (f, x) = blows_record(2);
+    let top = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    let xo: Vec<f64> = x.iter().map(|v| v + 0.3 * top).collect();
+    let fo: Vec<f64> = f.iter().map(|v| v - 500.0).collect();
+    for window in [
+        TransientWindow::Hann,
+        TransientWindow::Exponential { tau_s: 0.5 },
+    ] {
+        let p = Processing {
+            force_window: true,
+            ..processing(window)
+        };
+        let b = detect_blows(&f, FS, &p).unwrap();
+        assert_eq!(detect_blows(&fo, FS, &p).unwrap().triggers, b.triggers);
+        for (role, clean, offset) in [(Role::Response, &x, &xo), (Role::Excitation, &f, &fo)] {
+            let a = blow_spectrum(clean, role, FS, &b, &p, None).unwrap();
+            let o = blow_spectrum(offset, role, FS, &b, &p, None).unwrap();
+            let peak = a.density.iter().fold(0.0_f64, |m, v| m.max(*v));
+            for (k, (u, v)) in a.density.iter().zip(&o.density).enumerate() {
+                assert!(
+                    (u - v).abs() <= 1e-9 * peak,
+                    "{} {role:?} bin {k}: {u} vs {v}",
+                    window.name()
+                );
+            }
+            assert_eq!(a.dominant().unwrap().0, o.dominant().unwrap().0);
+        }
+        let (h, ho) = (
+            h1(&f, &x, FS, &b, &p).unwrap(),
+            h1(&fo, &xo, FS, &b, &p).unwrap(),
+        );
+        for k in 1..1000 {
+            assert!((h.h1[k] - ho.h1[k]).norm() <= 1e-9 * h.h1[k].norm(), "{k}");
+        }
+    }
 }

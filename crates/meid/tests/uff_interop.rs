@@ -76,6 +76,9 @@ fn meid_reads_what_pyuff_writes() {
         ("ascii.uff", 5e-11),
         ("binary.uff", 1e-12),
         ("uneven.uff", 5e-11),
+        // pyuff 2.5.8 announces the points' bytes, not the (x, y) pairs' (session 12: refused,
+        // "24000 bytes announced, but ... take 48000 bytes").
+        ("uneven_binary.uff", 1e-12),
     ] {
         let f = uff::read_uff(&dir.join(file)).unwrap();
         let exp = expected[file].as_array().unwrap();

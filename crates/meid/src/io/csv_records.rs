@@ -21,18 +21,70 @@ pub fn read_csv(path: &Path) -> Result<Vec<Record>> {
     parse_csv(std::io::BufReader::new(f), &path.display().to_string())
 }
 
-/// Parses CSV text from `reader`; `file` names it in errors.
+/// The field delimiter of a header line: of `,`, `;` and tab, the one it holds most (a comma
+/// on a tie or when it holds none).
+fn delimiter_of(header: &[u8]) -> u8 {
+    let count = |d: u8| header.iter().filter(|&&b| b == d).count();
+    let (c, s, t) = (count(b','), count(b';'), count(b'\t'));
+    if s > c && s >= t {
+        b';'
+    } else if t > c && t > s {
+        b'\t'
+    } else {
+        b','
+    }
+}
+
+/// A number of a field; with a delimiter other than the comma, a decimal comma (`1,5e-3`:
+/// one comma, no point) reads as a point, as spreadsheets in many locales write it.
+fn parse_number(field: &str, delimiter: u8) -> Option<f64> {
+    match field.parse() {
+        Ok(v) => Some(v),
+        Err(_) if delimiter != b',' && field.matches(',').count() == 1 && !field.contains('.') => {
+            field.replacen(',', ".", 1).parse().ok()
+        }
+        Err(_) => None,
+    }
+}
+
+/// Parses CSV text from `reader`; `file` names it in errors. The delimiter is found on the
+/// header line ([`delimiter_of`]: `,`, `;` or tab); a UTF-8 byte-order mark before it is
+/// dropped; CRLF line ends read as LF.
 pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>> {
+    use std::io::{BufRead as _, Read as _};
     let err = |line: u64, message: String| Error::Input {
         location: format!("{file}:{line}"),
         message,
     };
+    // Everything up to and including the header line (comments and blank lines before it),
+    // read ahead to find the delimiter, then parsed again by the CSV reader.
+    let mut input = std::io::BufReader::new(reader);
+    let mut ahead: Vec<u8> = Vec::new();
+    let delimiter = loop {
+        let mut line = Vec::new();
+        let n = (&mut input)
+            .take(1 << 20)
+            .read_until(b'\n', &mut line)
+            .map_err(|e| err(1, format!("cannot read: {e}")))?;
+        if ahead.is_empty() {
+            if let Some(rest) = line.strip_prefix("\u{feff}".as_bytes()) {
+                line = rest.to_vec();
+            }
+        }
+        ahead.extend_from_slice(&line);
+        let text = String::from_utf8_lossy(&line);
+        let t = text.trim();
+        if n == 0 || !(t.is_empty() || t.starts_with('#')) {
+            break delimiter_of(t.as_bytes());
+        }
+    };
     let mut rd = csv::ReaderBuilder::new()
         .has_headers(false)
         .comment(Some(b'#'))
+        .delimiter(delimiter)
         .trim(csv::Trim::All)
         .flexible(true)
-        .from_reader(reader);
+        .from_reader(std::io::Cursor::new(ahead).chain(input));
     let mut rows = rd.records();
     let header = loop {
         match rows.next() {
@@ -52,41 +104,8 @@ pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>>
         }
     };
     let hline = header.position().map_or(1, |p| p.line());
-    // (column, name, quantity, factor); None for columns passed over.
-    let mut cols: Vec<Option<(String, Quantity, f64)>> = Vec::new();
-    let mut time_col = None;
-    for (k, name) in header.iter().enumerate() {
-        if name.to_ascii_lowercase().ends_with("_j") {
-            cols.push(None);
-            continue;
-        }
-        let Some((n, q, f)) = split_csv_name(name) else {
-            return Err(err(hline, format!(
-                "column {} '{name}': the name does not end in a unit meid knows; expected NAME_UNIT with UNIT one of s, ms, us, m_per_s2, mm_per_s2, g, mg, m_per_s, mm_per_s, m, mm, um, in, n, kn, lbf (e.g. time_s, accel_B_m_per_s2, accel_B_g, force_floor_n)",
-                k + 1
-            )));
-        };
-        if q == Quantity::Time {
-            if let Some(t) = time_col {
-                return Err(err(
-                    hline,
-                    format!(
-                        "columns {} and {} are both times: expected exactly one time column",
-                        t + 1,
-                        k + 1
-                    ),
-                ));
-            }
-            time_col = Some(k);
-        }
-        cols.push(Some((n, q, f)));
-    }
-    let Some(tc) = time_col else {
-        return Err(err(
-            hline,
-            "no time column: expected one named like time_s or time_ms".into(),
-        ));
-    };
+    let names: Vec<String> = header.iter().map(str::to_string).collect();
+    let (cols, tc) = column_kinds(&names).map_err(|m| err(hline, m))?;
     let mut data: Vec<Vec<f64>> = vec![Vec::new(); cols.len()];
     for row in rows {
         let row = row.map_err(|e| {
@@ -109,7 +128,7 @@ pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>>
             let Some((name, _, f)) = &cols[k] else {
                 continue;
             };
-            let v: f64 = field.parse().map_err(|_| {
+            let v: f64 = parse_number(field, delimiter).ok_or_else(|| {
                 err(
                     line,
                     format!(
@@ -138,25 +157,73 @@ pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>>
             data[k].push(si);
         }
     }
+    let origin = |k: usize| format!("{file}, column {}", k + 1);
+    records_from_columns(&names, cols, data, tc, &origin).map_err(|message| err(hline, message))
+}
+
+/// A column's channel name, quantity and factor to SI; `None` for a column passed over.
+pub(crate) type ColumnKind = Option<(String, Quantity, f64)>;
+
+/// Each column's (channel, quantity, factor to SI) from its `NAME_UNIT` name (`None`: an
+/// energy, `_j`, passed over), and the time column. `Err`: the message naming the column.
+pub(crate) fn column_kinds(
+    names: &[String],
+) -> std::result::Result<(Vec<ColumnKind>, usize), String> {
+    let mut cols: Vec<ColumnKind> = Vec::new();
+    let mut time_col = None;
+    for (k, name) in names.iter().enumerate() {
+        if name.to_ascii_lowercase().ends_with("_j") {
+            cols.push(None);
+            continue;
+        }
+        let Some((n, q, f)) = split_csv_name(name) else {
+            return Err(format!(
+                "column {} '{name}': the name does not end in a unit meid knows; expected NAME_UNIT with UNIT one of s, ms, us, m_per_s2, mm_per_s2, g, mg, m_per_s, mm_per_s, m, mm, um, in, n, kn, lbf (e.g. time_s, accel_B_m_per_s2, accel_B_g, force_floor_n)",
+                k + 1
+            ));
+        };
+        if q == Quantity::Time {
+            if let Some(t) = time_col {
+                return Err(format!(
+                    "columns {} and {} are both times: expected exactly one time column",
+                    t + 1,
+                    k + 1
+                ));
+            }
+            time_col = Some(k);
+        }
+        cols.push(Some((n, q, f)));
+    }
+    let Some(tc) = time_col else {
+        return Err("no time column: expected one named like time_s or time_ms".into());
+    };
+    Ok((cols, tc))
+}
+
+/// The records of a table of columns (CSV, Parquet): `names` the column names, `cols` each
+/// column's (channel, quantity, factor) or `None` when passed over, `data` the values in SI,
+/// `tc` the time column. The time must increase; an abscissa even to [`EVEN_TOLERANCE`] is
+/// even. `Err`: the message (the caller adds the location).
+pub(crate) fn records_from_columns(
+    names: &[String],
+    cols: Vec<ColumnKind>,
+    mut data: Vec<Vec<f64>>,
+    tc: usize,
+    origin: &dyn Fn(usize) -> String,
+) -> std::result::Result<Vec<Record>, String> {
     let t = std::mem::take(&mut data[tc]);
     if t.len() < 2 {
-        return Err(err(
-            hline,
-            format!("{} rows of data: expected at least 2", t.len()),
-        ));
+        return Err(format!("{} rows of data: expected at least 2", t.len()));
     }
     if let Some(i) = t
         .windows(2)
         .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
     {
-        return Err(err(
-            hline,
-            format!(
-                "the time column does not increase at data row {} ({} s then {} s)",
-                i + 2,
-                t[i],
-                t[i + 1]
-            ),
+        return Err(format!(
+            "the time column does not increase at data row {} ({} s then {} s)",
+            i + 2,
+            t[i],
+            t[i + 1]
         ));
     }
     let n = t.len();
@@ -179,7 +246,7 @@ pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>>
         if k == tc {
             continue;
         }
-        let header_name = header.get(k).unwrap_or("").to_string();
+        let header_name = names.get(k).cloned().unwrap_or_default();
         let unit = header_name[name.len().min(header_name.len())..]
             .trim_start_matches('_')
             .to_string();
@@ -190,11 +257,11 @@ pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>>
             point: None,
             abscissa: abscissa.clone(),
             values: std::mem::take(&mut data[k]),
-            origin: format!("{file}, column {}", k + 1),
+            origin: origin(k),
         });
     }
     if out.is_empty() {
-        return Err(err(hline, "no data column besides the time".into()));
+        return Err("no data column besides the time".into());
     }
     Ok(out)
 }
@@ -217,6 +284,44 @@ mod tests {
         let (t0, dt) = r[0].even().unwrap();
         assert_eq!(t0, 0.0);
         assert!((dt - 1e-3).abs() < 1e-15);
+    }
+
+    /// Files as spreadsheets and DAQ software write them (session 12 audit: a semicolon or
+    /// tab file was refused with "no time column", as its header read as one column): the
+    /// delimiter is found on the header; with `;` or tab a decimal comma reads; a UTF-8
+    /// byte-order mark and CRLF line ends are dropped; errors still name line and column.
+    #[test]
+    fn semicolons_tabs_decimal_commas_bom_and_crlf_read() {
+        let want = |r: &[Record]| {
+            assert_eq!(r.len(), 2, "{r:?}");
+            assert_eq!(r[0].name, "accel_B");
+            assert_eq!(r[0].values, vec![9.80665 * 1.5, -0.25 * 9.80665]);
+            assert_eq!(r[1].name, "force_floor");
+            assert_eq!(r[1].values, vec![2e3, -1e3]);
+            let (t0, dt) = r[0].even().unwrap();
+            assert_eq!(t0, 0.0);
+            assert!((dt - 1e-3).abs() < 1e-15);
+        };
+        for text in [
+            "# Messung 3\r\naccel_B_g;time_s;force_floor_kn\r\n1,5;0;2\r\n-0,25;0,001;-1\r\n",
+            "\u{feff}accel_B_g\ttime_s\tforce_floor_kn\n1.5\t0\t2\n-0.25\t0.001\t-1\n",
+            "\u{feff}accel_B_g,time_s,force_floor_kn\r\n1.5,0,2\r\n-0.25,0.001,-1\r\n",
+            "accel_B_g ; time_s ; force_floor_kn\n1.5 ; 0 ; 2e0\n-2,5E-1 ; 1,0e-3 ; -1\n",
+        ] {
+            want(&parse_csv(text.as_bytes(), "lab.csv").unwrap());
+        }
+        // A comma-delimited file has no decimal comma: a field "1,5" is two fields.
+        let e = parse_csv("time_s,accel_B_g\n0,1,5\n".as_bytes(), "lab.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("lab.csv:2: 3 fields; the header has 2"), "{e}");
+        let e = parse_csv("time_s;accel_B_g\n0;1,5,2\n".as_bytes(), "lab.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("lab.csv:2: column 2 (accel_B): expected a number, got '1,5,2'"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -1,4 +1,5 @@
-//! Parquet output of a [`Table`] (cargo feature `parquet`, arrow-rs `parquet` crate).
+//! Parquet output of a [`Table`] (cargo feature `parquet`, arrow-rs `parquet` crate), and
+//! measured time histories read from Parquet ([`read_records`]).
 //!
 //! Types: `U64` → `uint64` (not null), `F64` → `double` (nullable: a metric not defined for a
 //! row is null, a failed row NaN, as the CSV's empty field and `NaN`), `Str` → `utf8`
@@ -117,6 +118,108 @@ pub fn write_parquet(path: &Path, table: &Table) -> Result<()> {
     file.commit()
 }
 
+// ------------------------------------------------------------------------------- reading
+
+/// The values of a numeric Arrow column as `f64` (`None`: null), or `None` when the column is
+/// not numeric.
+fn numbers(a: &dyn arrow_array::Array) -> Option<Vec<Option<f64>>> {
+    use arrow_array::cast::AsArray;
+    use arrow_array::types::*;
+    macro_rules! prim {
+        ($t:ty) => {
+            a.as_primitive_opt::<$t>()
+                .map(|p| p.iter().map(|v| v.map(|x| x as f64)).collect())
+        };
+    }
+    match a.data_type() {
+        DataType::Float64 => prim!(Float64Type),
+        DataType::Float32 => prim!(Float32Type),
+        DataType::Int64 => prim!(Int64Type),
+        DataType::Int32 => prim!(Int32Type),
+        DataType::Int16 => prim!(Int16Type),
+        DataType::Int8 => prim!(Int8Type),
+        DataType::UInt64 => prim!(UInt64Type),
+        DataType::UInt32 => prim!(UInt32Type),
+        DataType::UInt16 => prim!(UInt16Type),
+        DataType::UInt8 => prim!(UInt8Type),
+        _ => None,
+    }
+}
+
+/// Measured time histories in Parquet: the columns of a CSV file
+/// ([`crate::io::csv_records`]: `NAME_UNIT` names, one time column, `_j` energies passed
+/// over), of any numeric type (double, float, integers; converted to `f64`). A column of
+/// another type, a null, a non-finite value or one that overflows in SI is refused naming the
+/// file, the column and the row (counted from 1 over the whole file).
+pub fn read_records(path: &Path) -> Result<Vec<crate::measure::Record>> {
+    use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+    let file = path.display().to_string();
+    let bad = |message: String| Error::Input {
+        location: file.clone(),
+        message,
+    };
+    let f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let builder = ParquetRecordBatchReaderBuilder::try_new(f)
+        .map_err(|e| bad(format!("not a Parquet file meid can read: {e}")))?;
+    let names: Vec<String> = builder
+        .schema()
+        .fields()
+        .iter()
+        .map(|f| f.name().clone())
+        .collect();
+    let (cols, tc) = crate::io::csv_records::column_kinds(&names).map_err(&bad)?;
+    let rows = builder.metadata().file_metadata().num_rows().max(0) as usize;
+    let mut data: Vec<Vec<f64>> = cols
+        .iter()
+        .map(|c| {
+            if c.is_some() {
+                Vec::with_capacity(rows)
+            } else {
+                Vec::new()
+            }
+        })
+        .collect();
+    let reader = builder
+        .build()
+        .map_err(|e| bad(format!("cannot read the Parquet data: {e}")))?;
+    let mut row0 = 0usize;
+    for batch in reader {
+        let batch = batch.map_err(|e| bad(format!("cannot read the Parquet data: {e}")))?;
+        for (k, c) in cols.iter().enumerate() {
+            let Some((name, _, factor)) = c else { continue };
+            let column = batch.column(k);
+            let Some(v) = numbers(column.as_ref()) else {
+                return Err(bad(format!(
+                    "column {} '{}': type {}, expected numbers (double, float or integers)",
+                    k + 1,
+                    names[k],
+                    column.data_type()
+                )));
+            };
+            for (i, x) in v.into_iter().enumerate() {
+                let row = row0 + i + 1;
+                let Some(x) = x else {
+                    return Err(bad(format!(
+                        "column {} ({name}), row {row}: null, expected a number",
+                        k + 1
+                    )));
+                };
+                let si = x * factor;
+                if !si.is_finite() {
+                    return Err(bad(format!(
+                        "column {} ({name}), row {row}: {x} is not a finite number in SI (× {factor})",
+                        k + 1
+                    )));
+                }
+                data[k].push(si);
+            }
+        }
+        row0 += batch.num_rows();
+    }
+    let origin = |k: usize| format!("{file}, column {}", k + 1);
+    crate::io::csv_records::records_from_columns(&names, cols, data, tc, &origin).map_err(bad)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -157,6 +260,80 @@ mod tests {
             ],
             metadata: vec![("seed".into(), "42".into())],
         }
+    }
+
+    /// Measured records from Parquet: the CSV's column names, integer and double columns,
+    /// units converted to SI; a null, a text column or a file that is not Parquet refused
+    /// naming the file, column and row (session 12: `meid measure x.parquet` was read as UFF,
+    /// "expected the start of a dataset").
+    #[test]
+    fn measured_records_read_from_parquet() {
+        let dir = std::env::temp_dir().join(format!("meid-parquet-rec-{}", std::process::id()));
+        let path = dir.join("lab.parquet");
+        let col = |name: &str, data: ColumnData| Column {
+            name: name.into(),
+            unit: None,
+            data,
+        };
+        let rows = 70_000; // more than a row group
+        let accel = |i: usize| (i as f64 * 0.01).sin();
+        let mut t = Table {
+            columns: vec![
+                col(
+                    "time_us",
+                    ColumnData::U64((0..rows as u64).map(|i| 100 * i).collect()),
+                ),
+                col(
+                    "accel_B_g",
+                    ColumnData::F64((0..rows).map(|i| Some(accel(i))).collect()),
+                ),
+                col("ke_slider_j", ColumnData::F64(vec![Some(1.0); rows])),
+                col(
+                    "force_floor_kn",
+                    ColumnData::F64((0..rows).map(|i| Some(i as f64)).collect()),
+                ),
+            ],
+            metadata: Vec::new(),
+        };
+        write_parquet(&path, &t).unwrap();
+        let r = read_records(&path).unwrap();
+        assert_eq!(r.len(), 2);
+        assert_eq!(r[0].name, "accel_B");
+        assert_eq!(r[0].quantity, crate::measure::Quantity::Acceleration);
+        assert_eq!(r[0].values[rows - 1], accel(rows - 1) * 9.80665);
+        assert_eq!(r[1].values[rows - 1], (rows - 1) as f64 * 1e3);
+        assert_eq!(r[1].origin, format!("{}, column 4", path.display()));
+        let (t0, dt) = r[0].even().unwrap();
+        assert_eq!(t0, 0.0);
+        assert!((dt - 1e-4).abs() < 1e-16, "{dt}");
+        // A null in row 65 540 (the second row group).
+        if let ColumnData::F64(v) = &mut t.columns[1].data {
+            v[65_539] = None;
+        }
+        write_parquet(&path, &t).unwrap();
+        let e = read_records(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("lab.parquet: column 2 (accel_B), row 65540: null"),
+            "{e}"
+        );
+        t.columns[1] = col("accel_B_g", ColumnData::Str(vec![Some("1".into()); rows]));
+        write_parquet(&path, &t).unwrap();
+        let e = read_records(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("column 2 'accel_B_g': type Utf8, expected numbers"),
+            "{e}"
+        );
+        t.columns[1] = col("accel_B", ColumnData::F64(vec![Some(1.0); rows]));
+        write_parquet(&path, &t).unwrap();
+        let e = read_records(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("column 2 'accel_B': the name does not end in a unit"),
+            "{e}"
+        );
+        std::fs::write(&path, "time_s,accel_B_g\n0,1\n").unwrap();
+        let e = read_records(&path).unwrap_err().to_string();
+        assert!(e.contains("lab.parquet: not a Parquet file"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

@@ -503,7 +503,10 @@ impl<R: BufRead> Parser<'_, R> {
         }
         let values = match bin {
             Some((little, bytes)) => {
-                if bytes != count * width {
+                // pyuff (2.5.8) announces an uneven record's points, not its (x, y) pairs: the
+                // pairs are read, and the closing "-1" right after them confirms the layout.
+                let points_only = !even && bytes == count / 2 * width;
+                if bytes != count * width && !points_only {
                     return Err(self.err(
                         Some(ds),
                         Some("binary header"),
@@ -547,6 +550,9 @@ impl<R: BufRead> Parser<'_, R> {
                 "the abscissa is {} ({xu}), not time",
                 xq.name()
             )));
+        }
+        if let Some(why) = foreign_ordinate(&axes[1].0) {
+            return Ok(Err(why));
         }
         let (q, f, u) =
             self.axis_unit(ds, &axes[1].0, axes[1].1, "record 9 (ordinate)", unit_code)?;
@@ -1014,6 +1020,39 @@ fn parse_record7(l: &str) -> Option<(i64, i64, bool, f64, f64)> {
     }
 }
 
+/// Unit labels of quantities meid does not process (sound pressure, voltage, current,
+/// strain, temperature, rotational speed, frequency, level, mass), matched exactly after
+/// trimming.
+const FOREIGN_UNITS: [&str; 28] = [
+    "Pa", "kPa", "MPa", "mPa", "bar", "mbar", "psi", "V", "mV", "uV", "µV", "A", "mA", "uE", "µE",
+    "ue", "µε", "strain", "°C", "degC", "C", "K", "°F", "rpm", "RPM", "Hz", "dB", "kg",
+];
+
+/// Why a dataset 58's ordinate (record 9 line `line`) is a quantity meid does not process (a
+/// microphone, strain gauge, thermocouple or tachometer channel recorded beside the
+/// accelerometers), so that the dataset is passed over rather than the file refused: a specific
+/// data type of 2 or more that is none of meid's (17, 12, 11, 8, 9, 13), or, for types 0
+/// (unknown) and 1 (general), a unit label of [`FOREIGN_UNITS`]. `None`: the ordinate is for
+/// [`Parser::axis_unit`] to read (or refuse).
+fn foreign_ordinate(line: &str) -> Option<String> {
+    let ty = cols(line, 0, 10).trim().parse::<i64>().unwrap_or(0);
+    let label = cols(line, 47, 67).trim().to_string();
+    let shown = if label.is_empty() { "NONE" } else { &label };
+    if ty >= 2 && Quantity::from_uff_data_type(ty).is_none() {
+        return Some(format!(
+            "the ordinate is specific data type {ty} ({}, unit '{shown}'), not an acceleration, velocity, displacement or force",
+            data_type_name(ty)
+        ));
+    }
+    if matches!(ty, 0 | 1) && FOREIGN_UNITS.contains(&label.as_str()) {
+        return Some(format!(
+            "the ordinate's unit '{label}' (specific data type {ty}, {}) is not an acceleration, velocity, displacement or force",
+            data_type_name(ty)
+        ));
+    }
+    None
+}
+
 fn clip(s: &str) -> String {
     let t: String = s.chars().take(60).collect();
     if t.len() < s.len() {
@@ -1044,8 +1083,12 @@ fn data_type_name(t: i64) -> &'static str {
         2 => "stress",
         3 => "strain",
         5 => "temperature",
+        6 => "heat flux",
         15 => "pressure",
+        16 => "mass",
         18 => "frequency",
+        19 => "rpm",
+        20 => "order",
         _ => "not a quantity meid reads",
     }
 }
@@ -1521,6 +1564,71 @@ mod tests {
         assert_eq!(r.values, vec![1.0, 2.0, 0.0]);
         assert_eq!(r.abscissa, Abscissa::Uneven(vec![0.0, 1e-3, 2.5e-3]));
         assert!(r.even().is_err());
+    }
+
+    /// Channels of quantities meid does not process, recorded beside the accelerometer (a
+    /// microphone in Pa, type 15; a strain gauge, type 3; a bridge in V, type 1), are passed over
+    /// with the reason, and the file's other channels read (session 12 audit: a microphone
+    /// channel made the whole file unreadable, "unknown unit 'Pa'"). A contradiction (type 12
+    /// in N) or an unknown unit of one of meid's types is still refused.
+    #[test]
+    fn channels_of_other_quantities_are_passed_over_not_refused() {
+        let data = "  1.00000e+00  2.00000e+00 -5.00000e-01\n    -1\n";
+        let text = [
+            header("g", 12, 3, 1),
+            data.into(),
+            header("Pa", 15, 3, 1),
+            data.into(),
+            header("NONE", 3, 3, 1),
+            data.into(),
+            header("V", 1, 3, 1),
+            data.into(),
+        ]
+        .concat();
+        let f = parse_uff(text.as_bytes(), "lab.uff", None).unwrap();
+        assert_eq!(f.records.len(), 1);
+        assert_eq!(f.records[0].values[1], 2.0 * 9.80665);
+        assert_eq!(f.skipped.len(), 3, "{:?}", f.skipped);
+        assert!(
+            f.skipped[0].starts_with("dataset 2 (58 at line 16)")
+                && f.skipped[0].contains("specific data type 15 (pressure, unit 'Pa')"),
+            "{:?}",
+            f.skipped
+        );
+        assert!(f.skipped[1].contains("type 3 (strain, unit 'NONE')"));
+        assert!(f.skipped[2].contains("unit 'V' (specific data type 1, general)"));
+        // Type 0 without a unit says nothing of the quantity: refused, as before.
+        let text = format!("{}{data}", header("NONE", 0, 3, 1));
+        let e = parse_uff(text.as_bytes(), "lab.uff", None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("does not say the quantity"), "{e}");
+    }
+
+    /// Binary uneven 58b whose header announces the points' bytes rather than the (x, y)
+    /// pairs' (pyuff 2.5.8) reads, the closing "-1" after the pairs confirming the layout;
+    /// any other count is refused.
+    #[test]
+    fn binary_uneven_with_the_points_bytes_announced_reads() {
+        let file = |announced: usize| -> Vec<u8> {
+            let mut b = format!("    -1\n    58b     1     2          11{announced:>12}     0     0           0           0\nacc\nNONE\nNONE\nNONE\nNONE\n    1         0    0         0 NONE               1   3 NONE               0   0\n         4         3         0  0.00000e+00  0.00000e+00  0.00000e+00\n        17    0    0    0 Time                 s                   \n        12    0    0    0 Acc                  g                   \n         0    0    0    0 NONE                 NONE                \n         0    0    0    0 NONE                 NONE                \n").into_bytes();
+            for (t, y) in [(0.0f64, 1.0f64), (1e-3, 2.0), (2.5e-3, -0.5)] {
+                b.extend_from_slice(&t.to_le_bytes());
+                b.extend_from_slice(&y.to_le_bytes());
+            }
+            b.extend_from_slice(b"\n    -1\n");
+            b
+        };
+        for announced in [48, 24] {
+            let f = parse_uff(&file(announced)[..], "u.uff", None).unwrap();
+            let r = &f.records[0];
+            assert_eq!(r.values, vec![9.80665, 2.0 * 9.80665, -0.5 * 9.80665]);
+            assert_eq!(r.abscissa, Abscissa::Uneven(vec![0.0, 1e-3, 2.5e-3]));
+        }
+        let e = parse_uff(&file(40)[..], "u.uff", None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("40 bytes announced"), "{e}");
     }
 
     /// A finite value that overflows when converted to SI (1e308 g) is refused naming the

@@ -64,6 +64,14 @@
 //! residual of a real machine is also model error, correlated from sample to sample, and the
 //! interval is then narrower than the true uncertainty. **The intervals are estimates**; a
 //! parameter ending at a bound gets no interval (`at_bound`).
+//!
+//! # Identifiability
+//!
+//! A value the residuals do not depend on (its column of `J` zero: a damper stiffness fitted
+//! to the bare machine) or depend on only through the others (its column a combination of
+//! theirs) makes `JᵀJ` singular. Such values are named **not identifiable**
+//! ([`identifiability`]: Gram-Schmidt on the columns of `J`), get no interval, and the
+//! intervals of the others come from their own block of `JᵀJ`.
 
 use std::collections::BTreeMap;
 
@@ -374,7 +382,7 @@ impl<'a> Problem<'a> {
                 let (spectrum, bins, floor) = match settings.residual {
                     ResidualKind::TimeHistory => (Vec::new(), 0..0, 0.0),
                     ResidualKind::Spectrum { lower_hz, upper_hz } => {
-                        let s = blow_spectrum(&r.values, r.quantity, mb.fs, &mb.blows, p, None)?;
+                        let s = blow_spectrum(&r.values, c.role(), mb.fs, &mb.blows, p, None)?;
                         let first = s.frequency_hz.iter().position(|f| *f >= lower_hz);
                         let last = s.frequency_hz.iter().rposition(|f| *f <= upper_hz);
                         let bins = match (first, last) {
@@ -475,7 +483,7 @@ impl<'a> Problem<'a> {
                     ResidualKind::Spectrum { .. } => {
                         let ss = blow_spectrum(
                             &s.values,
-                            ch.channel.quantity(),
+                            ch.channel.role(),
                             ct.fs,
                             &sim.blows,
                             &sim.processing,
@@ -828,6 +836,73 @@ pub struct Estimate {
     pub relative_half_width: f64,
     /// The estimate sits on a bound: no interval.
     pub at_bound: bool,
+    /// Whether the residuals determine the value ([`identifiability`]); the value of one
+    /// that is not is the start (or wherever the others' steps left it) and has no interval.
+    pub identifiability: Identifiability,
+}
+
+/// Whether the data determine a fitted value, from the Jacobian `J = ∂r/∂θ` at the estimate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Identifiability {
+    /// Its column of `J` is independent of the others: it has an interval.
+    Identifiable,
+    /// The residuals do not depend on it: `‖J_i‖ ≤ 10⁻⁹ max_j ‖J_j‖` (a damper stiffness
+    /// fitted to the bare machine, a damping ratio of a mode no channel sees).
+    NoEffect,
+    /// Its column is a combination of the identifiable ones' (to 10⁻⁶ of its norm, above the
+    /// central differences' truncation error, 10⁻⁸ for smooth residuals): only a
+    /// combination of these values is determined (e.g. a stiffness and a mass that enter
+    /// through their ratio alone).
+    Dependent,
+}
+
+impl Identifiability {
+    /// Text for the report's interval column.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Identifiability::Identifiable => "identifiable",
+            Identifiability::NoEffect => "not identifiable: no effect",
+            Identifiability::Dependent => "not identifiable: dependent",
+        }
+    }
+}
+
+/// Classifies each fitted value ([`Identifiability`]) from the columns `J_i` (one per value,
+/// internal coordinates) of the Jacobian: Gram-Schmidt in the given order keeps a column when
+/// its part orthogonal to those kept has a norm above 10⁻⁶ of its own (a relative rank test
+/// that the columns' units do not affect); a column of norm at most 10⁻⁹ of the largest has no
+/// effect.
+pub fn identifiability(jacobian: &[Vec<f64>]) -> Vec<Identifiability> {
+    const TOL: f64 = 1e-9;
+    const DEPENDENT: f64 = 1e-6;
+    let norms: Vec<f64> = jacobian.iter().map(|c| dot(c, c).sqrt()).collect();
+    let top = norms.iter().copied().fold(0.0_f64, f64::max);
+    let mut basis: Vec<Vec<f64>> = Vec::new();
+    let mut out = Vec::with_capacity(jacobian.len());
+    for (c, &norm) in jacobian.iter().zip(&norms) {
+        if !(norm.is_finite() && norm > TOL * top) {
+            out.push(Identifiability::NoEffect);
+            continue;
+        }
+        let mut v = c.clone();
+        // Twice (re-orthogonalisation keeps the test honest in floating point).
+        for _ in 0..2 {
+            for q in &basis {
+                let d = dot(&v, q);
+                v.iter_mut().zip(q).for_each(|(a, b)| *a -= d * b);
+            }
+        }
+        let rest = dot(&v, &v).sqrt();
+        if rest > DEPENDENT * norm {
+            v.iter_mut().for_each(|a| *a /= rest);
+            basis.push(v);
+            out.push(Identifiability::Identifiable);
+        } else {
+            out.push(Identifiability::Dependent);
+        }
+    }
+    out
 }
 
 /// Fit of one channel of one case, before (the model's values) and after.
@@ -947,10 +1022,25 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
             out.jacobian[i].iter().map(|x| x / d).collect()
         })
         .collect();
-    let a: Vec<Vec<f64>> = (0..n)
-        .map(|i| (0..n).map(|j| dot(&jp[i], &jp[j])).collect())
+    let identifiability = identifiability(&out.jacobian);
+    // The covariance of the identifiable values (the others held: their columns are zero or
+    // dependent, and would make JᵀJ singular for every value).
+    let free: Vec<usize> = (0..n)
+        .filter(|&i| identifiability[i] == Identifiability::Identifiable)
         .collect();
-    let cov = spd_inverse(&a);
+    let a: Vec<Vec<f64>> = free
+        .iter()
+        .map(|&i| free.iter().map(|&j| dot(&jp[i], &jp[j])).collect())
+        .collect();
+    let cov: Option<Vec<Vec<f64>>> = spd_inverse(&a).map(|c| {
+        let mut full = vec![vec![f64::NAN; n]; n];
+        for (a, &i) in free.iter().enumerate() {
+            for (b, &j) in free.iter().enumerate() {
+                full[i][j] = c[a][b];
+            }
+        }
+        full
+    });
     let t = student_t_975(dof);
     let mut estimates = Vec::new();
     for (i, p) in params.iter().enumerate() {
@@ -971,6 +1061,7 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
             ci95_high: v + t * se,
             relative_half_width: t * se / v.abs(),
             at_bound,
+            identifiability: identifiability[i],
         });
     }
     let correlation = match &cov {
@@ -1089,7 +1180,17 @@ impl Calibration {
             "parameter", "start", "estimate", "95 % interval (estimated)", "± %"
         );
         for e in &self.parameters {
-            if e.at_bound {
+            if e.identifiability != Identifiability::Identifiable {
+                let _ = writeln!(
+                    s,
+                    "{:<40} {:>13.6e} {:>13.6e} {:>29} {:>9}",
+                    e.path,
+                    e.start,
+                    e.value,
+                    e.identifiability.describe(),
+                    "-"
+                );
+            } else if e.at_bound {
                 let _ = writeln!(
                     s,
                     "{:<40} {:>13.6e} {:>13.6e} {:>29} {:>9}",
@@ -1143,6 +1244,20 @@ impl Calibration {
             self.structures_built
         );
         let _ = writeln!(s, "intervals: linearised, s²(JᵀJ)⁻¹ with independent residuals assumed; correlated model error makes the true uncertainty larger");
+        let lost: Vec<&Estimate> = self
+            .parameters
+            .iter()
+            .filter(|e| e.identifiability != Identifiability::Identifiable)
+            .collect();
+        if !lost.is_empty() {
+            let names: Vec<&str> = lost.iter().map(|e| e.path.as_str()).collect();
+            let _ = writeln!(
+                s,
+                "not identifiable from these measurements: {} — the residuals do not depend on {} (no effect) or only through the other values (dependent); its value is not an estimate: fix it (leave it out of --fit) or measure a case it acts in",
+                names.join(", "),
+                if lost.len() == 1 { "it" } else { "them" }
+            );
+        }
         s
     }
 
@@ -1211,6 +1326,34 @@ mod tests {
         let o = levenberg_marquardt(f, &[1.0, 1.0], &[0.0, 0.0], &[10.0, 2.5], &s).unwrap();
         assert_eq!(o.x[1], 2.5);
         assert!(o.reason.converged(), "{:?}", o.reason);
+    }
+
+    #[test]
+    fn identifiability_of_jacobian_columns() {
+        let a = vec![1.0, 2.0, -1.0, 0.5];
+        let b = vec![0.3, -1.0, 2.0, 4.0];
+        let twice_a: Vec<f64> = a.iter().map(|x| 2.0 * x).collect();
+        let a_plus_b: Vec<f64> = a.iter().zip(&b).map(|(x, y)| 1e8 * (x + y)).collect();
+        use Identifiability::*;
+        assert_eq!(
+            identifiability(&[a.clone(), b.clone()]),
+            vec![Identifiable, Identifiable]
+        );
+        assert_eq!(
+            identifiability(&[a.clone(), vec![0.0; 4], twice_a]),
+            vec![Identifiable, NoEffect, Dependent]
+        );
+        // Scale does not matter: a column 1e8 times larger, a combination of the others.
+        assert_eq!(
+            identifiability(&[a, b, a_plus_b]),
+            vec![Identifiable, Identifiable, Dependent]
+        );
+        // Round-off below 1e-6 of a column is still dependence.
+        let c = vec![1.0, 1.0 + 1e-9, 1.0, 1.0];
+        assert_eq!(
+            identifiability(&[vec![1.0; 4], c]),
+            vec![Identifiable, Dependent]
+        );
     }
 
     #[test]

@@ -10,7 +10,7 @@
 //! holdoff_s = 0.25
 //! window = "exponential"    # rectangular (default), hann, exponential
 //! tau_s = 0.25              # the exponential window's time constant
-//! force_window = true       # force window on force channels
+//! force_window = true       # force window on the blow's force (the excitation)
 //! files = ["none=meas/bare.uff", "damper=meas/damper.uff"]  # measured records ([CASE=]FILE,
 //!                           # relative to the model file), compared by `meid report`
 //! ```
@@ -56,7 +56,7 @@ pub struct MeasurementSpec {
     /// Time constant of the exponential window (s).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tau_s: Option<f64>,
-    /// Force window on force channels (default false).
+    /// Force window on the blow's force, the excitation (default false).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub force_window: Option<bool>,
     /// Measured files, `[CASE=]FILE` as `meid validate --measured` takes them (CASE: none,

@@ -252,15 +252,40 @@ impl SimChannel {
     }
 }
 
-/// Reads the records of a file by its extension: `.uff`, `.unv`, `.uf` (UFF, ASCII or binary)
-/// or `.csv`; other extensions are tried as UFF when the file starts like one (`    -1`).
+/// Reads the records of a file by its extension: `.csv` (or `.txt`), `.parquet` (or `.pq`,
+/// the CSV's columns), anything else as UFF (`.uff`, `.unv`: ASCII or binary).
 pub fn read_records(path: &std::path::Path) -> Result<Vec<Record>> {
+    Ok(read_records_noting(path)?.0)
+}
+
+/// [`read_records`], with the time responses passed over, one line each (UFF datasets 58 that
+/// are not time responses or whose ordinate is a quantity meid does not process: a microphone
+/// in Pa, a strain gauge, a tachometer …).
+pub fn read_records_noting(path: &std::path::Path) -> Result<(Vec<Record>, Vec<String>)> {
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     match ext.as_str() {
-        "csv" | "txt" => crate::io::csv_records::read_csv(path),
-        _ => Ok(crate::io::uff::read_uff(path)?.records),
+        "csv" | "txt" => Ok((crate::io::csv_records::read_csv(path)?, Vec::new())),
+        #[cfg(feature = "parquet")]
+        "parquet" | "pq" => Ok((crate::io::parquet::read_records(path)?, Vec::new())),
+        #[cfg(not(feature = "parquet"))]
+        "parquet" | "pq" => Err(Error::Input {
+            location: path.display().to_string(),
+            message:
+                "this build of meid reads no Parquet (cargo feature `parquet`): export CSV or UFF"
+                    .into(),
+        }),
+        _ => {
+            let u = crate::io::uff::read_uff(path)?;
+            let notes = u
+                .skipped
+                .into_iter()
+                .filter(|s| s.contains("(58 at line"))
+                .map(|s| format!("{}: {s}: passed over", path.display()))
+                .collect();
+            Ok((u.records, notes))
+        }
     }
 }

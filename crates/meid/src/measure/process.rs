@@ -9,10 +9,11 @@
 //!
 //! # Blows
 //!
-//! A blow is triggered at the first sample `i` with `|x_i| ≥ L` on the trigger channel
-//! (`L` absolute, or a fraction of the channel's largest `|x|`), once the detector is armed.
-//! After a trigger the detector ignores `hold-off` seconds, then re-arms when `|x|` falls below
-//! `L`. Each blow's record starts `pre-trigger` seconds before its trigger and lasts the record
+//! A blow is triggered at the first sample `i` with `|x_i − x̃| ≥ L` on the trigger channel
+//! (`x̃` the channel's median, its baseline: a DC offset or a transducer's preload neither hides
+//! the blows nor triggers; `L` absolute, or a fraction of the channel's largest `|x − x̃|`), once
+//! the detector is armed. After a trigger the detector ignores `hold-off` seconds, then re-arms
+//! when `|x − x̃|` falls below `L`. Each blow's record starts `pre-trigger` seconds before its trigger and lasts the record
 //! length (default: the shortest interval between triggers, or up to the end for a single
 //! blow). A blow whose record would start before the first sample or end after the last is
 //! counted but not averaged. When blows are found but none of their records fits in the file,
@@ -28,6 +29,15 @@
 //! restored in unit²·s/Hz when it is representable as a double; otherwise it is kept scaled
 //! and [`BlowSpectrum::scale_db`] holds `10 log10` of the factor, so levels stay exact and
 //! finite for any finite data (e.g. amplitudes of 1e300).
+//!
+//! # Baseline
+//!
+//! Before its window and FFT, each blow record loses its baseline: the median of its
+//! pre-trigger samples when it has at least [`MIN_BASELINE_SAMPLES`] of them
+//! ([`record_baseline`]; a simulated record, at rest before the blow, has 0). A DC offset (a
+//! transducer's bias or preload, an amplifier's drift) would otherwise leak into the low bins
+//! under a Hann or exponential window and could be the "dominant" line. The time averages and
+//! sample peaks are of the records as measured.
 //!
 //! # Averaging
 //!
@@ -45,7 +55,8 @@
 //! # Windows and the added damping of the exponential window
 //!
 //! The windows are [`TransientWindow`]'s: the force window (1 over the pulse, a half-cosine
-//! taper, 0 after) on the force, and an exponential `w(t) = e^{−t/τ}` on the responses (and,
+//! taper, 0 after) on the blow's force, the excitation ([`Role`]; never on a response such as
+//! the force to the floor), and an exponential `w(t) = e^{−t/τ}` on the responses (and,
 //! multiplied in, on the force, so that H1 stays the ratio of equally windowed signals). The
 //! exponential window multiplies a mode's free decay `e^{−ζωt}` by `e^{−t/τ}`: the windowed
 //! record is that of a mode with decay rate `ζω + 1/τ`, i.e. a damping ratio
@@ -66,7 +77,7 @@ use serde::Serialize;
 
 use crate::analysis::esd::esd_level_db;
 use crate::analysis::octave::{bands_covering, Band};
-use crate::analysis::spectrum::{one_sided_factor, TransientWindow};
+use crate::analysis::spectrum::{bin_band_energy, one_sided_factor, TransientWindow};
 use crate::{Error, Result};
 
 use super::{Quantity, Record};
@@ -75,9 +86,9 @@ use super::{Quantity, Record};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Level {
-    /// In the channel's SI unit.
+    /// In the channel's SI unit, a deviation from its median (its baseline).
     Absolute(f64),
-    /// A fraction of the channel's largest `|x|`, in (0, 1].
+    /// A fraction of the channel's largest deviation from its median `|x − x̃|`, in (0, 1].
     FractionOfPeak(f64),
 }
 
@@ -95,8 +106,8 @@ pub struct Processing {
     pub holdoff_s: f64,
     /// Window on responses (default rectangular).
     pub window: TransientWindow,
-    /// Apply the force window to force channels (pulse = the time `|F|` stays above the trigger
-    /// level after the trigger, taper = half of it).
+    /// Apply the force window to the blow's excitation ([`Role::Excitation`]; the pulse is
+    /// found on the force itself: [`force_window_for`]).
     pub force_window: bool,
 }
 
@@ -170,7 +181,7 @@ pub struct Blows {
     pub length: usize,
     /// Samples before the trigger.
     pub pretrigger: usize,
-    /// The absolute level used (SI).
+    /// The absolute level used (SI), a deviation from the channel's median.
     pub level: f64,
 }
 
@@ -183,7 +194,11 @@ pub fn detect_blows(x: &[f64], fs: f64, p: &Processing) -> Result<Blows> {
             format!("must be > 0 Hz (got {fs})"),
         ));
     }
-    let peak = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    // Deviations from the channel's baseline (its median): a DC offset, a transducer's
+    // bias or preload, neither hides the blows nor triggers on its own.
+    let baseline = median(x);
+    let dev = |v: f64| (v - baseline).abs();
+    let peak = x.iter().fold(0.0_f64, |m, v| m.max(dev(*v)));
     let level = match p.level {
         Level::Absolute(l) => l,
         Level::FractionOfPeak(f) => f * peak,
@@ -193,10 +208,10 @@ pub fn detect_blows(x: &[f64], fs: f64, p: &Processing) -> Result<Blows> {
     let hold = (p.holdoff_s * fs).round() as usize;
     let mut triggers = Vec::new();
     if level > 0.0 && n > 0 {
-        let mut armed = x[0].abs() < level;
+        let mut armed = dev(x[0]) < level;
         let mut i = 0;
         while i < n {
-            let a = x[i].abs();
+            let a = dev(x[i]);
             if armed && a >= level {
                 triggers.push(i);
                 armed = false;
@@ -265,6 +280,81 @@ pub fn detect_blows(x: &[f64], fs: f64, p: &Processing) -> Result<Blows> {
         pretrigger: pre,
         level,
     })
+}
+
+/// The fewest pre-trigger samples a blow record's baseline is taken from ([`record_baseline`]).
+pub const MIN_BASELINE_SAMPLES: usize = 16;
+
+/// The baseline of a blow record `seg` whose first `pre` samples precede the trigger: the
+/// median of those samples when there are at least [`MIN_BASELINE_SAMPLES`] (robust to the
+/// few samples of a blow's rise before the trigger level), else 0 (module docs, Baseline).
+pub fn record_baseline(seg: &[f64], pre: usize) -> f64 {
+    if pre >= MIN_BASELINE_SAMPLES && pre <= seg.len() {
+        median(&seg[..pre])
+    } else {
+        0.0
+    }
+}
+
+/// The shortest run of equal samples at a record's extreme that counts as clipping.
+pub const CLIP_RUN: usize = 3;
+
+/// The samples of `x` in runs of at least [`CLIP_RUN`] consecutive samples equal to its
+/// largest value, or to its smallest, of the extremes at least half the largest deviation from
+/// the median `x̃` away from it (`|ext − x̃| ≥ ½ max|x − x̃|`: the rest level of a one-sided
+/// record, a hammer's 0 between blows, is not a cut): a sampled transient does not stay at its
+/// extreme for three samples unless the signal was cut there (a transducer, amplifier or
+/// converter at its full scale). A constant record has no extreme to clip at (0). It can only
+/// flag: a slow signal quantised coarsely may also repeat its extreme; the count is for a
+/// warning.
+pub fn clipped_samples(x: &[f64]) -> usize {
+    let (lo, hi) = x
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if lo >= hi || lo.is_nan() || hi.is_nan() {
+        return 0;
+    }
+    // Only an extreme far from the baseline is a cut: the rest level of a one-sided record (a
+    // hammer's 0 between blows) is its smallest value and repeats by nature.
+    let m = median(x);
+    let reach = (hi - m).max(m - lo);
+    let mut count = 0;
+    for target in [lo, hi] {
+        if (target - m).abs() < 0.5 * reach {
+            continue;
+        }
+        let mut run = 0usize;
+        for &v in x.iter().chain(std::iter::once(&f64::NAN)) {
+            if v == target {
+                run += 1;
+            } else {
+                if run >= CLIP_RUN {
+                    count += run;
+                }
+                run = 0;
+            }
+        }
+    }
+    count
+}
+
+/// The median of `x` (0 for an empty record; the mean of the two middle values for an even
+/// count).
+pub fn median(x: &[f64]) -> f64 {
+    let n = x.len();
+    if n == 0 {
+        return 0.0;
+    }
+    let mut v = x.to_vec();
+    let (_, &mut hi, _) = v.select_nth_unstable_by(n / 2, f64::total_cmp);
+    if n % 2 == 1 {
+        hi
+    } else {
+        let lo = v[..n / 2].iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        0.5 * (lo + hi)
+    }
 }
 
 /// Refuses blows of which none has a complete record in a channel of `n` samples at `fs`,
@@ -404,27 +494,77 @@ fn freqs(bins: usize, n_fft: usize, fs: f64) -> Vec<f64> {
     (0..bins).map(|k| k as f64 * fs / n_fft as f64).collect()
 }
 
-/// The force window for a blow record: pulse from the record start to the sample after the
-/// trigger where `|F|` drops below the level, taper half the pulse.
-fn force_window_for(x: &[f64], blows: &Blows, fs: f64) -> TransientWindow {
-    let s = blows.starts.first().copied().unwrap_or(0);
-    let t = s + blows.pretrigger;
-    let end = (t..x.len())
-        .find(|&i| x[i].abs() < blows.level)
-        .unwrap_or(x.len());
-    let pulse = ((end - s) as f64 / fs).max(1.0 / fs);
-    TransientWindow::Force {
-        pulse_s: pulse,
-        taper_s: 0.5 * pulse,
+/// What a channel is to the blow: its excitation (the blow force: a hammer's, the slider's)
+/// or a response (every other channel, the force to the floor included: a transmitted force
+/// rings with the structure and is windowed like an acceleration). The force window applies to
+/// the excitation only.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Role {
+    Excitation,
+    Response,
+}
+
+impl super::SimChannel {
+    /// The blow force is the excitation; the bed acceleration and the floor force respond.
+    pub fn role(self) -> Role {
+        match self {
+            super::SimChannel::BlowForce => Role::Excitation,
+            _ => Role::Response,
+        }
     }
 }
 
-/// The windows of one channel: the response window, times the force window for a force when
-/// asked.
-fn window_for(q: Quantity, x: &[f64], blows: &Blows, fs: f64, p: &Processing) -> Result<Vec<f64>> {
+/// The force window of an excitation record, found on the record itself (so that the level
+/// is in its own unit, whatever channel the blows were triggered on): in the first blow record
+/// `x[s .. s + len]`, the pulse is the run of samples around the largest `|x|` with
+/// `|x| ≥ L_F`, `L_F = f · max|x|` (`f` the trigger fraction, 0.1 for an absolute trigger
+/// level, which is in the trigger channel's unit). The window is 1 from the record start to
+/// the pulse's end `T_p`, then a half-cosine taper over half the pulse's duration `T_c`
+/// (at least one sample), then 0.
+pub fn force_window_for(x: &[f64], blows: &Blows, fs: f64, p: &Processing) -> TransientWindow {
+    let s = blows.starts.first().copied().unwrap_or(0).min(x.len());
+    let raw = &x[s..(s + blows.length).min(x.len())];
+    let base = record_baseline(raw, blows.pretrigger);
+    let rec: Vec<f64> = raw.iter().map(|v| v - base).collect();
+    let (k_max, top) =
+        rec.iter().enumerate().fold(
+            (0, 0.0_f64),
+            |b, (i, v)| {
+                if v.abs() > b.1 {
+                    (i, v.abs())
+                } else {
+                    b
+                }
+            },
+        );
+    let f = match p.level {
+        Level::FractionOfPeak(f) => f,
+        Level::Absolute(_) => 0.1,
+    };
+    let l = f * top;
+    let end = (k_max..rec.len())
+        .find(|&i| rec[i].abs() < l)
+        .unwrap_or(rec.len());
+    let begin = (0..=k_max)
+        .rev()
+        .find(|&i| rec[i].abs() < l)
+        .map_or(0, |i| i + 1);
+    let dt = 1.0 / fs;
+    let pulse = end.max(1) as f64 * dt;
+    let taper = (0.5 * (end - begin) as f64 * dt).max(dt);
+    TransientWindow::Force {
+        pulse_s: pulse,
+        taper_s: taper,
+    }
+}
+
+/// The windows of one channel: the response window, times the force window for the
+/// excitation when asked ([`Processing::force_window`]).
+fn window_for(role: Role, x: &[f64], blows: &Blows, fs: f64, p: &Processing) -> Result<Vec<f64>> {
     let mut w = p.window.coefficients(blows.length, fs)?;
-    if p.force_window && q == Quantity::Force {
-        let f = force_window_for(x, blows, fs).coefficients(blows.length, fs)?;
+    if p.force_window && role == Role::Excitation {
+        let f = force_window_for(x, blows, fs, p).coefficients(blows.length, fs)?;
         w.iter_mut().zip(f).for_each(|(a, b)| *a *= b);
     }
     Ok(w)
@@ -442,6 +582,8 @@ pub struct BlowSpectrum {
     /// `10 log10` of the factor from [`Self::density`] to unit²·s/Hz: 0 unless the ESD in
     /// unit²·s/Hz is beyond the range of doubles.
     pub scale_db: f64,
+    /// The sample rate (Hz): the bins stand for `[0, f_s/2]`.
+    pub sample_rate_hz: f64,
 }
 
 impl BlowSpectrum {
@@ -458,15 +600,19 @@ impl BlowSpectrum {
     pub fn bin_width_hz(&self) -> f64 {
         self.frequency_hz.get(1).copied().unwrap_or(0.0)
     }
-    /// `Σ Ē_k Δf` over the bins in `[f_lo, f_hi)` (unit²·s; scaled as [`Self::density`]; 0
-    /// for a band holding no bin).
+    /// `∫_{f_lo}^{f_hi} Ē df` (unit²·s; scaled as [`Self::density`]), each bin's energy
+    /// `Ē_k Δf` spread over the frequencies it stands for
+    /// ([`crate::analysis::spectrum::bin_band_energy`]): a bin across a band edge counts in
+    /// proportion, so a band level does not depend on where the bins fall (the record length,
+    /// the padding), and bands that tile the spectrum add up to `Σ Ē_k Δf`.
     pub fn band_energy(&self, f_lo: f64, f_hi: f64) -> f64 {
-        self.frequency_hz
-            .iter()
-            .zip(&self.density)
-            .filter(|(f, _)| **f >= f_lo && **f < f_hi)
-            .fold(0.0, |a, (_, e)| a + e)
-            * self.bin_width_hz()
+        bin_band_energy(
+            &self.frequency_hz,
+            &self.density,
+            self.sample_rate_hz,
+            f_lo,
+            f_hi,
+        )
     }
     /// The largest bin above DC: (frequency, density).
     pub fn dominant(&self) -> Option<(f64, f64)> {
@@ -506,10 +652,10 @@ impl BlowSpectrum {
 }
 
 /// Mean ESD over the blow records `starts` of `x` (length `blows.length`, windowed as `p`
-/// says for the quantity `q`), zero-padded to `n_fft ≥ length` (None: no padding).
+/// says for a channel of that `role`), zero-padded to `n_fft ≥ length` (None: no padding).
 pub fn blow_spectrum(
     x: &[f64],
-    q: Quantity,
+    role: Role,
     fs: f64,
     blows: &Blows,
     p: &Processing,
@@ -521,7 +667,7 @@ pub fn blow_spectrum(
     let len = blows.length;
     check_starts(x.len(), &blows.starts, len)?;
     let n_fft = n_fft.unwrap_or(len).max(len);
-    let w = window_for(q, x, blows, fs, p)?;
+    let w = window_for(role, x, blows, fs, p)?;
     let mut tr = Transformer::new(n_fft);
     let dt = 1.0 / fs;
     // The scale 2^e at or below the largest |x| of the records (module docs, Scaling).
@@ -549,7 +695,12 @@ pub fn blow_spectrum(
     for &s in &blows.starts {
         // (In range: `check_starts` above.)
         let seg = &x[s..s + len];
-        scaled.iter_mut().zip(seg).for_each(|(d, v)| *d = v * down);
+        // The record less its baseline (module docs, Baseline), scaled: (v − b)·2^−e exactly.
+        let b = record_baseline(seg, blows.pretrigger) * down;
+        scaled
+            .iter_mut()
+            .zip(seg)
+            .for_each(|(d, v)| *d = v * down - b);
         let bins = tr.run(&scaled, &w)?;
         for (k, (a, c)) in acc.iter_mut().zip(bins).enumerate() {
             *a += one_sided_factor(k, n_fft) * c.norm_sqr() * dt * dt;
@@ -575,6 +726,7 @@ pub fn blow_spectrum(
         density,
         averages: b,
         scale_db,
+        sample_rate_hz: fs,
     })
 }
 
@@ -625,7 +777,7 @@ pub fn h1(force: &[f64], response: &[f64], fs: f64, blows: &Blows, p: &Processin
     }
     let len = blows.length;
     check_starts(force.len(), &blows.starts, len)?;
-    let wf = window_for(Quantity::Force, force, blows, fs, p)?;
+    let wf = window_for(Role::Excitation, force, blows, fs, p)?;
     let wx = p.window.coefficients(len, fs)?;
     let mut tf = Transformer::new(len);
     let mut tx = Transformer::new(len);
@@ -635,9 +787,13 @@ pub fn h1(force: &[f64], response: &[f64], fs: f64, blows: &Blows, p: &Processin
         vec![0.0; bins],
         vec![0.0; bins],
     );
+    let less_baseline = |seg: &[f64]| -> Vec<f64> {
+        let b = record_baseline(seg, blows.pretrigger);
+        seg.iter().map(|v| v - b).collect()
+    };
     for &s in &blows.starts {
-        let f = tf.run(&force[s..s + len], &wf)?;
-        let x = tx.run(&response[s..s + len], &wx)?;
+        let f = tf.run(&less_baseline(&force[s..s + len]), &wf)?;
+        let x = tx.run(&less_baseline(&response[s..s + len]), &wx)?;
         for k in 0..bins {
             gfx[k] += f[k].conj() * x[k];
             gff[k] += f[k].norm_sqr();
@@ -712,6 +868,13 @@ pub struct ChannelSummary {
     pub dominant_frequency_hz: Option<f64>,
     /// Its level, dB re 1 (SI unit)²·s/Hz (finite for any finite data: module docs, Scaling).
     pub dominant_level_db: Option<f64>,
+    /// Samples in runs of [`CLIP_RUN`] or more consecutive samples at the record's largest or
+    /// smallest value ([`clipped_samples`]): a flat top where a transient peaks is the mark of
+    /// an overloaded transducer or amplifier (0: none).
+    pub clipped_samples: usize,
+    /// The window the spectrum was computed with, e.g. "rectangular", or "rectangular × force
+    /// (pulse 0.0112 s, taper 0.0005 s)" on the blow's excitation with `--force-window`.
+    pub window: String,
 }
 
 /// A processed channel: the summary, the blow-averaged record and spectrum, the bands.
@@ -783,9 +946,11 @@ pub fn group_blows(records: &[&Record], trigger: usize, p: &Processing) -> Resul
     Ok((b, found))
 }
 
-/// Processes one channel with the group's blows (summary, average, spectrum, bands).
+/// Processes one channel with the group's blows (summary, average, spectrum, bands); `role`
+/// says whether it is the blow's excitation (the only channel the force window applies to).
 pub fn process_channel(
     r: &Record,
+    role: Role,
     blows: &Blows,
     found: usize,
     p: &Processing,
@@ -805,7 +970,16 @@ pub fn process_channel(
         }
     });
     let average = average_blows(&r.values, &blows.starts, blows.length)?;
-    let mut spectrum = blow_spectrum(&r.values, r.quantity, fs, blows, p, None)?;
+    let mut spectrum = blow_spectrum(&r.values, role, fs, blows, p, None)?;
+    let window = if p.force_window && role == Role::Excitation {
+        format!(
+            "{} × {}",
+            p.window.name(),
+            force_window_for(&r.values, blows, fs, p).name()
+        )
+    } else {
+        p.window.name()
+    };
     // No trigger: the whole record, not a blow.
     let averaged = if blows.triggers.is_empty() {
         0
@@ -834,6 +1008,8 @@ pub fn process_channel(
             pretrigger_s: blows.pretrigger as f64 / fs,
             dominant_frequency_hz: df,
             dominant_level_db: de,
+            clipped_samples: clipped_samples(&r.values),
+            window,
         },
         quantity: r.quantity,
         origin: r.origin.clone(),
@@ -864,7 +1040,10 @@ pub fn groups(records: &[Record]) -> Vec<Vec<usize>> {
 
 /// Processes every record; blows are found per group on the channel named `trigger` when the
 /// group has it, else on its [`trigger_channel`] (`point`: the model's measurement point name,
-/// for finding B by name).
+/// for finding B by name). The excitation of a group (the one channel the force window applies
+/// to) is the force named as the blow ([`super::mapping::by_name`]: `blow`, `hammer`,
+/// `slider` …), else the `trigger` channel when it is a force; every other channel is a
+/// response.
 pub fn process_all(
     records: &[Record],
     p: &Processing,
@@ -894,8 +1073,21 @@ pub fn process_all(
             None => trigger_channel(&members, point),
         };
         let (blows, found) = group_blows(&members, t, p)?;
-        for &i in &g {
-            out[i] = Some(process_channel(&records[i], &blows, found, p)?);
+        let excitation = members
+            .iter()
+            .position(|r| super::mapping::by_name(r, point) == Some(super::SimChannel::BlowForce))
+            .or_else(|| {
+                (trigger.is_some_and(|name| members[t].name == name)
+                    && members[t].quantity == Quantity::Force)
+                    .then_some(t)
+            });
+        for (k, &i) in g.iter().enumerate() {
+            let role = if excitation == Some(k) {
+                Role::Excitation
+            } else {
+                Role::Response
+            };
+            out[i] = Some(process_channel(&records[i], role, &blows, found, p)?);
         }
     }
     Ok(out.into_iter().flatten().collect())

@@ -106,17 +106,29 @@ fn whole_record_names(channels: &[ProcessedChannel]) -> Vec<&str> {
 }
 
 /// The warnings of a `meid measure` run: channels whose spectrum is the whole record's
-/// because no blow was found on their trigger channel.
+/// because no blow was found on their trigger channel, and channels possibly clipped
+/// ([`super::process::clipped_samples`]).
 pub fn warnings(channels: &[ProcessedChannel]) -> Vec<String> {
     let whole = whole_record_names(channels);
-    if whole.is_empty() {
-        Vec::new()
-    } else {
-        vec![format!(
+    let mut out = Vec::new();
+    if !whole.is_empty() {
+        out.push(format!(
             "no blow found (no sample reaches the trigger level after one below it) for {}: their spectra are of the whole record, 0 blows averaged; lower the trigger level (--trigger-level) or choose the trigger channel (--trigger) to average blows",
             whole.join(", ")
-        )]
+        ));
     }
+    for c in channels.iter().filter(|c| c.summary.clipped_samples > 0) {
+        let s = &c.summary;
+        out.push(format!(
+            "channel '{}' is possibly clipped: {} samples sit in runs of {} or more at its extreme values (sample peak {:.6e} {}), as where a transducer or amplifier reaches its full scale; its peaks and spectra are then wrong — check the range of the measuring chain",
+            s.name,
+            s.clipped_samples,
+            super::process::CLIP_RUN,
+            s.peak,
+            s.unit
+        ));
+    }
+    out
 }
 
 /// A level for CSV: empty where the energy is 0 (−∞ dB).

@@ -398,8 +398,8 @@ fn one_case(
     for (&c, &i) in &map {
         let r = &m.records[i];
         let s = sim_record(c)?;
-        let ms = blow_spectrum(&r.values, r.quantity, fs, &mb, p, Some(n_fft))?;
-        let ss = blow_spectrum(&s.values, s.quantity, fs, &sb, &sp, Some(n_fft))?;
+        let ms = blow_spectrum(&r.values, c.role(), fs, &mb, p, Some(n_fft))?;
+        let ss = blow_spectrum(&s.values, c.role(), fs, &sb, &sp, Some(n_fft))?;
         let ma = super::process::average_blows(&r.values, &mb.starts, n)?;
         let sa = super::process::average_blows(&s.values, &sb.starts, n)?;
         let peak = |v: &[f64]| v.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
