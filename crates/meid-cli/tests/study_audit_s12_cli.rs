@@ -1,0 +1,202 @@
+//! Session-12 audit of the design studies, as a machine designer uses them.
+//!
+//! * `meid optimize`: the optimum does not depend on the order of `--over` (it did: on the
+//!   floor-force objective over `wd/ws,md/mb` the two orders gave 24.58 N and 26.03 N); the
+//!   optimum's `--set` overrides make `meid simulate` give the same objective, bit for bit;
+//!   the report says what the optimum is (a local minimum checked by its neighbours, a
+//!   minimum on a bound, a flat objective, fixed variables) and `LO = HI` holds a variable
+//!   fixed instead of being refused.
+
+mod common;
+
+use common::{meid, ok_json, paper_example};
+
+fn optimize(args: &[&str]) -> serde_json::Value {
+    ok_json(
+        meid()
+            .arg("optimize")
+            .arg(paper_example())
+            .args(args)
+            .arg("--json")
+            .output()
+            .unwrap(),
+    )
+}
+
+fn simulate(sets: &[String]) -> serde_json::Value {
+    let mut c = meid();
+    c.arg("simulate").arg(paper_example()).arg("--json");
+    for s in sets {
+        c.args(["--set", s]);
+    }
+    ok_json(c.output().unwrap())
+}
+
+fn f(v: &serde_json::Value) -> f64 {
+    v.as_f64().unwrap_or(f64::NAN)
+}
+
+/// The optimum's value of the variable named `name`.
+fn value_of(rep: &serde_json::Value, name: &str) -> f64 {
+    let k = rep["variables"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|v| v["quantity"] == name)
+        .unwrap();
+    f(&rep["optimum"][k])
+}
+
+fn overrides(rep: &serde_json::Value) -> Vec<String> {
+    rep["overrides"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_str().unwrap().to_string())
+        .collect()
+}
+
+#[test]
+fn optimize_does_not_depend_on_the_order_of_over() {
+    for objective in ["floor-force", "energy"] {
+        let a = optimize(&["--over", "wd/ws,md/mb", "--objective", objective]);
+        let b = optimize(&["--over", "md/mb,wd/ws", "--objective", objective]);
+        assert_eq!(
+            f(&a["objective_value"]).to_bits(),
+            f(&b["objective_value"]).to_bits(),
+            "{objective}: {} vs {}",
+            a["objective_value"],
+            b["objective_value"]
+        );
+        for name in ["wd/ws", "md/mb"] {
+            assert_eq!(
+                value_of(&a, name),
+                value_of(&b, name),
+                "{objective}: {name}"
+            );
+        }
+        assert_eq!(a["simulations"], b["simulations"], "{objective}");
+        assert_eq!(a["local_check"], b["local_check"], "{objective}");
+    }
+}
+
+#[test]
+fn the_optimum_is_what_simulate_gives_with_its_overrides() {
+    for (over, objective, metric) in [
+        ("wd/ws", "energy", "energy_ratio"),
+        ("wd/ws", "floor-force", "peak_floor_force_n"),
+        ("wd/ws,md/mb", "energy", "energy_ratio"),
+        (
+            "damper.mass,wd/ws",
+            "bed-accel",
+            "peak_bed_acceleration_m_per_s2",
+        ),
+    ] {
+        let rep = optimize(&["--over", over, "--objective", objective]);
+        let sets = overrides(&rep);
+        assert!(!sets.is_empty(), "{over}");
+        let sim = simulate(&sets);
+        assert_eq!(
+            f(&sim[metric]).to_bits(),
+            f(&rep["objective_value"]).to_bits(),
+            "{over} {objective}: simulate {} vs optimize {} with {sets:?}",
+            sim[metric],
+            rep["objective_value"]
+        );
+        // K_d = m_d (w_d/w_s)² w_s², w_s² = K_s/m_s: the override is the optimum's ratio.
+        let ks = 4.2980449e7 / 1.2;
+        let kd: f64 = sets
+            .iter()
+            .find_map(|s| s.strip_prefix("contact.bed_damper.stiffness="))
+            .unwrap()
+            .parse()
+            .unwrap();
+        let md = f(&rep["point"]["derived"][2]);
+        let r = value_of(&rep, "wd/ws");
+        assert!(
+            ((kd / (md * ks)).sqrt() / r - 1.0).abs() < 1e-14,
+            "{over}: K_d {kd}"
+        );
+    }
+}
+
+#[test]
+fn optimize_says_what_the_optimum_is() {
+    // One variable, the energy: an interior minimum; its neighbours (±0.1 % of ln(25)) lie
+    // above it.
+    let rep = optimize(&["--over", "wd/ws"]);
+    let check = &rep["local_check"];
+    assert_eq!(check["verdict"], "local-minimum", "{check}");
+    let f0 = f(&rep["objective_value"]);
+    let x0 = value_of(&rep, "wd/ws");
+    let nbs = check["neighbours"].as_array().unwrap();
+    assert_eq!(nbs.len(), 2);
+    for nb in nbs {
+        assert!(f(&nb["objective"]) > f0, "{nb}");
+        // The step is 1e-3 of ln(5/0.2) in ln(wd/ws).
+        let step = (f(&nb["value"]) / x0).ln().abs();
+        assert!((step / (1e-3 * 25f64.ln()) - 1.0).abs() < 1e-9, "{step}");
+        // An independent run at the neighbour gives its objective.
+        let kd = 3.5 * f(&nb["value"]).powi(2) * 4.2980449e7 / 1.2;
+        let sim = simulate(&[format!("contact.bed_damper.stiffness={kd:e}")]);
+        assert!(
+            (f(&sim["energy_ratio"]) / f(&nb["objective"]) - 1.0).abs() < 1e-12,
+            "{nb} vs {}",
+            sim["energy_ratio"]
+        );
+    }
+    assert!(check["statement"]
+        .as_str()
+        .unwrap()
+        .starts_with("a local minimum"));
+
+    // The floor force over wd/ws and md/mb ends on md/mb's upper bound (2): said so.
+    let rep = optimize(&["--over", "wd/ws,md/mb", "--objective", "floor-force"]);
+    let check = &rep["local_check"];
+    assert_eq!(value_of(&rep, "md/mb"), 2.0);
+    assert_eq!(check["verdict"], "on-bound", "{check}");
+    assert_eq!(check["at_bound"][0], "md/mb (upper)");
+    for nb in check["neighbours"].as_array().unwrap() {
+        assert!(f(&nb["objective"]) >= f(&rep["objective_value"]), "{nb}");
+    }
+
+    // E_p+/E_s− at the end of the collision does not depend on the one-way dashpot (it is
+    // off while the damper is pushed away) nor, with linear contacts, on v_s (every force
+    // scales with v_s, every energy with v_s²): flat, and said so.
+    for over in ["damper.damping", "slider.velocity"] {
+        let rep = optimize(&["--over", over]);
+        assert_eq!(rep["local_check"]["verdict"], "flat", "{over}");
+        assert!(
+            rep["local_check"]["statement"]
+                .as_str()
+                .unwrap()
+                .contains(&format!("does not depend on {over}")),
+            "{over}"
+        );
+    }
+
+    // LO = HI holds a variable fixed (it was refused: "needs finite LO < HI").
+    let rep = optimize(&["--over", "wd/ws,md/mb", "--bounds", "md/mb=0.35..0.35"]);
+    assert_eq!(value_of(&rep, "md/mb"), 0.35);
+    assert_eq!(rep["variables"][1]["fixed"], true);
+    let one = optimize(&["--over", "wd/ws"]);
+    assert_eq!(value_of(&rep, "wd/ws"), value_of(&one, "wd/ws"));
+    assert_eq!(rep["objective_value"], one["objective_value"]);
+    let rep = optimize(&["--over", "wd/ws", "--bounds", "wd/ws=1..1"]);
+    assert_eq!(rep["local_check"]["verdict"], "fixed");
+    assert_eq!(
+        rep["simulations"], 2,
+        "the point and the w_d = w_s comparison"
+    );
+    // The fixed point is K_d = m_d w_s² (the file's K_d, rounded to 8 digits, to 2.3e-8).
+    let kd = f(&rep["point"]["derived"][1]);
+    assert!((kd / (3.5 * 4.2980449e7 / 1.2) - 1.0).abs() < 1e-15, "{kd}");
+    assert!((kd / 1.2535964e8 - 1.0).abs() < 3e-8, "{kd}");
+    let sim = simulate(&overrides(&rep));
+    assert_eq!(rep["objective_value"], sim["energy_ratio"]);
+
+    // A budget at the minimum has no room for the check, and says so.
+    let rep = optimize(&["--over", "wd/ws", "--max-simulations", "12"]);
+    assert_eq!(rep["local_check"]["verdict"], "not-checked");
+    assert!(rep["simulations"].as_u64().unwrap() <= 12);
+}
