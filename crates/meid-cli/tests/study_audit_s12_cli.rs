@@ -335,3 +335,98 @@ fn sweep_peaks_say_they_stop_at_the_collision_and_match_simulate_over_the_run() 
         assert!(v > 10.0, "over the run: {v} N");
     }
 }
+
+/// The rows of the table in section `id` of a report page, cells as text.
+fn table_rows(html: &str, id: &str) -> Vec<Vec<String>> {
+    let start = html.find(&format!("<section id=\"{id}\">")).unwrap();
+    let sec = &html[start..start + html[start..].find("</section>").unwrap()];
+    sec.split("<tr>")
+        .skip(1)
+        .map(|tr| {
+            let tr = &tr[..tr.find("</tr>").unwrap_or(tr.len())];
+            tr.split("<td")
+                .skip(1)
+                .map(|td| {
+                    let td = &td[td.find('>').unwrap() + 1..];
+                    td[..td.find("</td>").unwrap()].to_string()
+                })
+                .collect::<Vec<String>>()
+        })
+        .filter(|r: &Vec<String>| !r.is_empty())
+        .collect()
+}
+
+/// Every number of the page's optimiser and Monte Carlo tables is `report.json`'s, to the
+/// digits printed (4 significant: within 5e-4 relative), and the intervals are labelled.
+#[test]
+fn report_tables_are_the_numbers_of_report_json() {
+    let d = common::tmpdir("s12", "report");
+    let out = d.join("page");
+    common::ok(
+        meid()
+            .arg("report")
+            .arg(paper_example())
+            .args(["-q", "--map-points", "9", "--blows", "3", "--samples", "80"])
+            .args([
+                "--vary",
+                "contact.slider_bed.stiffness=lognormal(4.3e7,0.2)",
+                "-o",
+            ])
+            .arg(&out)
+            .output()
+            .unwrap(),
+    );
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let num = |t: &str| -> f64 {
+        let t = t.trim().trim_end_matches(" %").trim_end_matches(" N");
+        t.replace('−', "-")
+            .parse()
+            .unwrap_or_else(|_| panic!("`{t}`"))
+    };
+    let close = |cell: &str, v: f64, scale: f64| {
+        let c = num(cell);
+        assert!(
+            (c / (v * scale) - 1.0).abs() <= 5e-4,
+            "page {cell} vs json {v}"
+        );
+    };
+    let opt = table_rows(&html, "optimiser");
+    let reps = json["optimize"].as_array().unwrap();
+    assert_eq!(opt.len(), reps.len());
+    for (row, r) in opt.iter().zip(reps) {
+        let scale = if row[3].ends_with('%') { 100.0 } else { 1.0 };
+        close(&row[2], f(&r["wd_over_ws_at_optimum"]), 1.0);
+        close(&row[3], f(&r["objective_value"]), scale);
+        close(&row[4], f(&r["objective_at_wd_equal_ws"]), scale);
+        assert_eq!(
+            row[6].split(' ').next().unwrap(),
+            r["simulations"].to_string()
+        );
+        assert_eq!(row[7], r["local_check"]["verdict"].as_str().unwrap());
+    }
+    let mc = table_rows(&html, "montecarlo");
+    let st: Vec<&serde_json::Value> = json["montecarlo"]["input_stats"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .chain(json["montecarlo"]["metric_stats"].as_array().unwrap())
+        .collect();
+    assert_eq!(mc.len(), st.len());
+    for (row, s) in mc.iter().zip(st) {
+        assert_eq!(row[0], s["name"].as_str().unwrap());
+        assert_eq!(row[1], s["count"].to_string());
+        close(&row[2], f(&s["mean"]), 1.0);
+        let (a, b) = row[3].split_once(" – ").unwrap();
+        close(a, f(&s["mean_ci95"][0]), 1.0);
+        close(b, f(&s["mean_ci95"][1]), 1.0);
+        close(&row[5], f(&s["p5"]), 1.0);
+        close(&row[6], f(&s["p50"]), 1.0);
+        close(&row[7], f(&s["p95"]), 1.0);
+        let (a, b) = row[8].split_once(" – ").unwrap();
+        close(a, f(&s["p95_ci95"][0]), 1.0);
+        close(b, f(&s["p95_ci95"][1]), 1.0);
+    }
+    assert!(html.contains("estimates from n samples with 95 % confidence intervals"));
+}

@@ -929,6 +929,10 @@ impl MachineReport {
                             r.simulations,
                             if r.converged { "" } else { " (budget reached)" }
                         ),
+                        serde_json::to_value(r.local_check.verdict)
+                            .ok()
+                            .and_then(|v| v.as_str().map(str::to_string))
+                            .unwrap_or_default(),
                     ]
                 })
                 .collect();
@@ -943,6 +947,7 @@ impl MachineReport {
                     "objective with ω_d = ω_s".into(),
                     "rule vs best (%)".into(),
                     "simulations".into(),
+                    "what the best is (neighbours ±0.1 % of ln range)".into(),
                 ],
                 rows,
                 ..Default::default()
