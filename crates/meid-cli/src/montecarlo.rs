@@ -282,15 +282,17 @@ fn output(
                 "too few samples".to_string()
             }
         };
+        let side =
+            |(a, b): (Option<f64>, Option<f64>)| (a.unwrap_or(f64::NAN), b.unwrap_or(f64::NAN));
         println!("  95 % confidence intervals (mean: Student t; percentiles: order statistics):");
         for s in r.input_stats.iter().chain(&r.metric_stats) {
             println!(
                 "  {:<34} mean {}  P5 {}  P50 {}  P95 {}",
                 s.name,
                 ci(s.mean_ci95),
-                ci(s.p5_ci95),
-                ci(s.p50_ci95),
-                ci(s.p95_ci95)
+                ci(side(s.p5_ci95)),
+                ci(side(s.p50_ci95)),
+                ci(side(s.p95_ci95))
             );
         }
     }

@@ -245,9 +245,9 @@ pub struct Stats {
     /// 95 % confidence intervals of P5, P50 and P95: order statistics `[x_(l), x_(u)]` with
     /// binomial coverage `P(l ≤ B < u) ≥ 0.95`, `B ~ Bin(count, p)`, equal tails ≤ 2.5 %
     /// ([`quantile_ci_ranks`]); distribution-free.
-    pub p5_ci95: (f64, f64),
-    pub p50_ci95: (f64, f64),
-    pub p95_ci95: (f64, f64),
+    pub p5_ci95: (Option<f64>, Option<f64>),
+    pub p50_ci95: (Option<f64>, Option<f64>),
+    pub p95_ci95: (Option<f64>, Option<f64>),
 }
 
 /// Percentile `p` in [0, 1] of sorted data, Hyndman & Fan definition 7.
@@ -379,14 +379,11 @@ pub fn quantile_ci_ranks(n: usize, p: f64) -> (Option<usize>, Option<usize>) {
     (l, u)
 }
 
-/// The 95 % interval of the `p`-quantile of sorted data ([`quantile_ci_ranks`]); NaN on a side
-/// the samples cannot bound.
-fn quantile_ci(sorted: &[f64], p: f64) -> (f64, f64) {
+/// The 95 % interval of the `p`-quantile of sorted data ([`quantile_ci_ranks`]); `None` on a
+/// side the samples cannot bound.
+fn quantile_ci(sorted: &[f64], p: f64) -> (Option<f64>, Option<f64>) {
     let (l, u) = quantile_ci_ranks(sorted.len(), p);
-    (
-        l.map_or(f64::NAN, |r| sorted[r - 1]),
-        u.map_or(f64::NAN, |r| sorted[r - 1]),
-    )
+    (l.map(|r| sorted[r - 1]), u.map(|r| sorted[r - 1]))
 }
 
 /// Mean, std (n − 1), P5, P50, P95, min, max of the finite values, with the standard error

@@ -21,6 +21,14 @@
 //!
 //! The paper's rule (section 4.1: the best damper has w_d = w_s) is evaluated at the
 //! optimum's other variables with `wd/ws = 1`.
+//!
+//! The free variables are searched in the order of their names (the result does not depend
+//! on the order they were given in); a variable with `LO = HI` is held fixed. After the
+//! search, each free variable is moved by ±[`NEIGHBOUR_STEP`] of its range in the search
+//! coordinate ([`LocalCheck`]): the report says whether the optimum is a local minimum, a
+//! minimum on a bound, not a minimum (a lower neighbour, then reported), or that the
+//! objective is flat; and it lists the `--set` overrides that make `meid simulate` give the
+//! same objective.
 
 use serde::Serialize;
 

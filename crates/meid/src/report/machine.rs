@@ -996,7 +996,10 @@ impl MachineReport {
                             sig(s.p5, 4),
                             sig(s.p50, 4),
                             sig(s.p95, 4),
-                            ci(s.p95_ci95),
+                            ci((
+                                s.p95_ci95.0.unwrap_or(f64::NAN),
+                                s.p95_ci95.1.unwrap_or(f64::NAN),
+                            )),
                         ]
                     })
                     .collect();
