@@ -194,6 +194,7 @@ fn output(
         "inputs": r.inputs,
         "input_stats": r.input_stats,
         "metric_stats": r.metric_stats,
+        "note": "mean, std and the percentiles are estimates from the `count` samples of each quantity; *_ci95 are their 95 % confidence intervals (mean: Student t; percentiles: order statistics, distribution-free; null where the samples are too few)",
     });
     if let Some(set) = set {
         let dir = set.staging();
@@ -255,19 +256,43 @@ fn output(
         println!("{}", serde_json::to_string_pretty(&stats)?);
     } else if a.print.human() {
         println!(
-            "meid montecarlo — {} samples, seed {}, {} failed",
+            "meid montecarlo — {} samples, seed {}, {} failed; estimates from the samples, 95 % confidence intervals below",
             r.samples.len(),
             r.seed,
             r.failed
         );
         println!(
-            "  {:<34} {:>12} {:>12} {:>12} {:>12} {:>12}",
-            "quantity", "mean", "std", "P5", "P50", "P95"
+            "  {:<34} {:>6} {:>12} {:>12} {:>12} {:>12} {:>12}",
+            "quantity", "n", "mean", "std", "P5", "P50", "P95"
         );
         for s in r.input_stats.iter().chain(&r.metric_stats) {
             println!(
-                "  {:<34} {:>12.5e} {:>12.5e} {:>12.5e} {:>12.5e} {:>12.5e}",
-                s.name, s.mean, s.std, s.p5, s.p50, s.p95
+                "  {:<34} {:>6} {:>12.5e} {:>12.5e} {:>12.5e} {:>12.5e} {:>12.5e}",
+                s.name, s.count, s.mean, s.std, s.p5, s.p50, s.p95
+            );
+        }
+        let ci = |(a, b): (f64, f64)| {
+            if a.is_finite() && b.is_finite() {
+                format!("[{a:.5e}, {b:.5e}]")
+            } else if b.is_finite() {
+                format!("[too few samples, {b:.5e}]")
+            } else if a.is_finite() {
+                format!("[{a:.5e}, too few samples]")
+            } else {
+                "too few samples".to_string()
+            }
+        };
+        let side =
+            |(a, b): (Option<f64>, Option<f64>)| (a.unwrap_or(f64::NAN), b.unwrap_or(f64::NAN));
+        println!("  95 % confidence intervals (mean: Student t; percentiles: order statistics):");
+        for s in r.input_stats.iter().chain(&r.metric_stats) {
+            println!(
+                "  {:<34} mean {}  P5 {}  P50 {}  P95 {}",
+                s.name,
+                ci(s.mean_ci95),
+                ci(side(s.p5_ci95)),
+                ci(side(s.p50_ci95)),
+                ci(side(s.p95_ci95))
             );
         }
     }

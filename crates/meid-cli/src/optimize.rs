@@ -28,14 +28,15 @@ pub struct OptimizeArgs {
     #[arg(long, value_parser = ["energy", "bed-accel", "floor-force"], default_value = "energy")]
     objective: String,
     /// Bounds of a variable, PATH=LO..HI (repeatable; PATH=LO:HI is accepted too). Positive
-    /// bounds are searched in log scale.
+    /// bounds are searched in log scale; LO = HI holds the variable fixed.
     #[arg(long = "bounds", value_name = "PATH=LO..HI")]
     bounds: Vec<String>,
     #[command(flatten)]
     set: SetArgs,
-    /// Simulation budget: at most this many simulations run (the optimum's own run and the
-    /// w_d = w_s comparison included); refused below the method's minimum (12 for one
-    /// variable: a 9-point scan, one Brent step and those two; n + 3 for n variables).
+    /// Simulation budget: at most this many simulations run (the optimum's own run, the
+    /// w_d = w_s comparison and the check of the optimum's 2n neighbours included); refused
+    /// below the method's minimum (12 for one variable: a 9-point scan, one Brent step and
+    /// those two; n + 3 for n variables); the neighbour check runs when 2n more remain.
     #[arg(long, value_name = "N", default_value_t = 400)]
     max_simulations: usize,
     /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, the
@@ -110,10 +111,10 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
     if !a.print.human() {
         return Ok(());
     }
-    let method = if rep.variables.len() == 1 {
-        "scan + Brent"
-    } else {
-        "bounded Nelder-Mead with restarts"
+    let method = match rep.variables.iter().filter(|v| !v.fixed).count() {
+        0 => "every variable fixed",
+        1 => "scan + Brent",
+        _ => "bounded Nelder-Mead with restarts",
     };
     println!(
         "meid optimize — minimise {} ({method}, {} simulations in {elapsed:.2} s{})",
@@ -126,6 +127,10 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
         }
     );
     for (v, x) in rep.variables.iter().zip(&rep.optimum) {
+        if v.fixed {
+            println!("  {:<32} {x:.6e}   (fixed: LO = HI)", v.quantity.name());
+            continue;
+        }
         println!(
             "  {:<32} {x:.6e}   (bounds {:.4e}..{:.4e}{})",
             v.quantity.name(),
@@ -138,15 +143,27 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
         "  objective at the optimum          {:.6e}",
         rep.objective_value
     );
+    println!("  what it is: {}", rep.local_check.statement);
     println!(
         "  w_d/w_s at the optimum            {:.6}",
         rep.wd_over_ws_at_optimum
     );
+    // +0.00, never -0.00, when the rule is the optimum (to rounding).
+    let rule_pct = 100.0 * (rep.objective_at_wd_equal_ws / rep.objective_value - 1.0);
+    let rule_pct = if rule_pct.abs() < 0.005 {
+        0.0
+    } else {
+        rule_pct
+    };
     println!(
         "  objective with w_d = w_s (paper)  {:.6e}  ({:+.2} % vs optimum)",
-        rep.objective_at_wd_equal_ws,
-        100.0 * (rep.objective_at_wd_equal_ws / rep.objective_value - 1.0)
+        rep.objective_at_wd_equal_ws, rule_pct
     );
+    let mut reproduce = format!("meid simulate {}", a.model.display());
+    for s in a.set.set.iter().chain(&rep.overrides) {
+        reproduce.push_str(&format!(" --set {s}"));
+    }
+    println!("  reproduce: {reproduce}");
     if rep.failures > 0 {
         println!("  failed simulations                {}", rep.failures);
     }

@@ -223,7 +223,9 @@ pub struct Sample {
     pub error: Option<String>,
 }
 
-/// Statistics of one quantity over the successful samples.
+/// Statistics of one quantity over the successful samples. Every value is an estimate from
+/// the `count` samples; the `*_ci95` intervals say how precise (95 % confidence; `null` in
+/// JSON where the samples are too few to bound it).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Stats {
     pub name: String,
@@ -235,6 +237,17 @@ pub struct Stats {
     pub p95: f64,
     pub min: f64,
     pub max: f64,
+    /// Standard error of the mean, `std/√count`.
+    pub std_error: f64,
+    /// 95 % confidence interval of the mean, `mean ± t(0.975, count − 1) std/√count`
+    /// (Student's t; exact for normal data, asymptotically for any finite variance).
+    pub mean_ci95: (f64, f64),
+    /// 95 % confidence intervals of P5, P50 and P95: order statistics `[x_(l), x_(u)]` with
+    /// binomial coverage `P(l ≤ B < u) ≥ 0.95`, `B ~ Bin(count, p)`, equal tails ≤ 2.5 %
+    /// ([`quantile_ci_ranks`]); distribution-free.
+    pub p5_ci95: (Option<f64>, Option<f64>),
+    pub p50_ci95: (Option<f64>, Option<f64>),
+    pub p95_ci95: (Option<f64>, Option<f64>),
 }
 
 /// Percentile `p` in [0, 1] of sorted data, Hyndman & Fan definition 7.
@@ -248,7 +261,133 @@ pub fn percentile_sorted(sorted: &[f64], p: f64) -> f64 {
     sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
 }
 
-/// Mean, std (n − 1), P5, P50, P95, min, max of the finite values.
+/// `P(|T| ≤ t)` for Student's t with `nu ≥ 1` degrees of freedom, by the exact finite sums of
+/// Abramowitz & Stegun 26.7.3-4 (θ = atan(t/√ν), c = cos θ): ν odd
+/// `(2/π)(θ + sin θ cos θ Σ_{j=0}^{(ν−3)/2} a_j c^{2j})`, `a_j = a_{j−1}·2j/(2j+1)`; ν even
+/// `sin θ Σ_{j=0}^{(ν−2)/2} b_j c^{2j}`, `b_j = b_{j−1}(2j−1)/(2j)`.
+pub fn student_t_central(t: f64, nu: usize) -> f64 {
+    let theta = (t.abs() / (nu as f64).sqrt()).atan();
+    let (s, c) = theta.sin_cos();
+    let c2 = c * c;
+    if nu % 2 == 1 {
+        let mut sum = 0.0;
+        if nu > 1 {
+            let (mut term, mut j) = (1.0, 0usize);
+            loop {
+                sum += term;
+                j += 1;
+                if 2 * j + 3 > nu {
+                    break;
+                }
+                term *= c2 * (2 * j) as f64 / (2 * j + 1) as f64;
+            }
+        }
+        std::f64::consts::FRAC_2_PI * (theta + s * c * sum)
+    } else {
+        let (mut sum, mut term, mut j) = (0.0, 1.0, 0usize);
+        loop {
+            sum += term;
+            j += 1;
+            if 2 * j + 2 > nu {
+                break;
+            }
+            term *= c2 * (2 * j - 1) as f64 / (2 * j) as f64;
+        }
+        s * sum
+    }
+}
+
+/// The two-sided 97.5 % point of Student's t, `t(0.975, ν)`: bisection on
+/// [`student_t_central`] = 0.95 for ν ≤ 1000, the Cornish-Fisher expansion of A&S 26.7.5
+/// (terms to ν⁻⁴, error below 1e-12 there) above.
+pub fn student_t_975(nu: usize) -> f64 {
+    const Z: f64 = 1.959_963_984_540_054;
+    if nu == 0 {
+        return f64::NAN;
+    }
+    if nu > 1000 {
+        let v = nu as f64;
+        let z = Z;
+        let g1 = (z.powi(3) + z) / 4.0;
+        let g2 = (5.0 * z.powi(5) + 16.0 * z.powi(3) + 3.0 * z) / 96.0;
+        let g3 = (3.0 * z.powi(7) + 19.0 * z.powi(5) + 17.0 * z.powi(3) - 15.0 * z) / 384.0;
+        let g4 = (79.0 * z.powi(9) + 776.0 * z.powi(7) + 1482.0 * z.powi(5)
+            - 1920.0 * z.powi(3)
+            - 945.0 * z)
+            / 92160.0;
+        return z + g1 / v + g2 / (v * v) + g3 / v.powi(3) + g4 / v.powi(4);
+    }
+    let (mut lo, mut hi) = (0.0_f64, 2.0_f64);
+    while student_t_central(hi, nu) < 0.95 {
+        lo = hi;
+        hi *= 2.0;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if student_t_central(mid, nu) < 0.95 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The 1-based ranks `(l, u)` of the order statistics bounding the `p`-quantile of `n`
+/// samples with 95 % confidence: with `B ~ Bin(n, p)` the number of samples below the
+/// quantile, `l` is the largest rank with `P(B ≤ l − 1) ≤ 0.025` and `u` the smallest with
+/// `P(B ≤ u − 1) ≥ 0.975`, so `P(x_(l) ≤ ξ_p ≤ x_(u)) ≥ 0.95` for any continuous
+/// distribution (David & Nagaraja, *Order Statistics*, 3rd ed., §7.1). `None` for a side
+/// that `n` samples cannot bound (e.g. the lower side of P5 below 72 samples). The binomial
+/// CDF is summed exactly (log-space recurrence) for n ≤ 100 000; above, the normal
+/// approximation `n p ∓ 1.96 √(n p (1 − p))` (continuity-corrected) is used.
+pub fn quantile_ci_ranks(n: usize, p: f64) -> (Option<usize>, Option<usize>) {
+    if n == 0 || !(p > 0.0 && p < 1.0) {
+        return (None, None);
+    }
+    if n > 100_000 {
+        let (nf, z) = (n as f64, 1.959_963_984_540_054);
+        let sd = (nf * p * (1.0 - p)).sqrt();
+        let l = (nf * p - z * sd + 0.5).floor();
+        let u = (nf * p + z * sd + 0.5).ceil() + 1.0;
+        let l = (l >= 1.0).then_some(l as usize);
+        let u = (u <= nf).then_some(u as usize);
+        return (l, u);
+    }
+    // ln P(B = k), k = 0..n, by ln P(B = k + 1) = ln P(B = k) + ln((n − k)/(k + 1)) + ln(p/(1 − p)).
+    let odds = (p / (1.0 - p)).ln();
+    let mut lp = n as f64 * (1.0 - p).ln();
+    let (mut cdf, mut l, mut u) = (0.0_f64, None, None);
+    for k in 0..=n {
+        // cdf = P(B ≤ k − 1) here: rank k + 1 bounds from below when it is ≤ 0.025.
+        if k >= 1 && cdf <= 0.025 {
+            l = Some(k);
+        }
+        cdf += lp.exp();
+        // Now cdf = P(B ≤ k): rank u = k + 1 bounds from above once it reaches 0.975.
+        if cdf >= 0.975 {
+            u = (k < n).then_some(k + 1);
+            break;
+        }
+        if k < n {
+            lp += ((n - k) as f64 / (k + 1) as f64).ln() + odds;
+        }
+    }
+    (l, u)
+}
+
+/// The 95 % interval of the `p`-quantile of sorted data ([`quantile_ci_ranks`]); `None` on a
+/// side the samples cannot bound.
+fn quantile_ci(sorted: &[f64], p: f64) -> (Option<f64>, Option<f64>) {
+    let (l, u) = quantile_ci_ranks(sorted.len(), p);
+    (l.map(|r| sorted[r - 1]), u.map(|r| sorted[r - 1]))
+}
+
+/// Mean, std (n − 1), P5, P50, P95, min, max of the finite values, with the standard error
+/// and 95 % confidence intervals of the mean and the percentiles (see [`Stats`]).
 pub fn stats(name: &str, values: &[f64]) -> Stats {
     let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
     v.sort_by(f64::total_cmp);
@@ -263,6 +402,12 @@ pub fn stats(name: &str, values: &[f64]) -> Stats {
     } else {
         f64::NAN
     };
+    let std_error = std / (n as f64).sqrt();
+    let half = if n > 1 {
+        student_t_975(n - 1) * std_error
+    } else {
+        f64::NAN
+    };
     Stats {
         name: name.to_string(),
         count: n,
@@ -273,6 +418,11 @@ pub fn stats(name: &str, values: &[f64]) -> Stats {
         p95: percentile_sorted(&v, 0.95),
         min: v.first().copied().unwrap_or(f64::NAN),
         max: v.last().copied().unwrap_or(f64::NAN),
+        std_error,
+        mean_ci95: (mean - half, mean + half),
+        p5_ci95: quantile_ci(&v, 0.05),
+        p50_ci95: quantile_ci(&v, 0.50),
+        p95_ci95: quantile_ci(&v, 0.95),
     }
 }
 
@@ -668,4 +818,90 @@ pub fn histogram_outline(values: &[f64], bins: usize) -> (Vec<f64>, Vec<f64>) {
     xs.push(hi);
     ys.push(0.0);
     (xs, ys)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// t(0.975, ν) from statistical tables (Fisher & Yates; R `qt(0.975, nu)`): 12.706205,
+    /// 4.302653, 3.182446, 2.262157, 2.042272, 1.983972, 1.962339, 1.960201; the exact sums
+    /// (ν ≤ 1000) and the Cornish-Fisher branch (above) to 1e-6.
+    #[test]
+    fn student_t_points_match_the_tables() {
+        for (nu, t) in [
+            (1, 12.706_205),
+            (2, 4.302_653),
+            (3, 3.182_446),
+            (9, 2.262_157),
+            (30, 2.042_272),
+            (100, 1.983_972),
+            (1000, 1.962_339),
+            (10_000, 1.960_201),
+        ] {
+            let got = student_t_975(nu);
+            assert!((got - t).abs() < 1e-6, "nu {nu}: {got} vs {t}");
+        }
+        // The two branches meet: ν = 1000 by the sums and by the expansion agree to 1e-12.
+        let v = 1000.0_f64;
+        let z = 1.959_963_984_540_054_f64;
+        let cf = z
+            + (z.powi(3) + z) / (4.0 * v)
+            + (5.0 * z.powi(5) + 16.0 * z.powi(3) + 3.0 * z) / (96.0 * v * v)
+            + (3.0 * z.powi(7) + 19.0 * z.powi(5) + 17.0 * z.powi(3) - 15.0 * z)
+                / (384.0 * v.powi(3));
+        assert!((student_t_975(1000) - cf).abs() < 1e-10);
+        // ν = 1: the Cauchy distribution, P(|T| ≤ t) = (2/π) atan t.
+        assert!((student_t_975(1) - (0.475 * std::f64::consts::PI).tan()).abs() < 1e-10);
+    }
+
+    /// The order-statistic ranks against a direct binomial sum: n = 100, p = 0.5 gives the
+    /// textbook (40, 61) (coverage 0.9648); P5 of 59 samples cannot be bounded below
+    /// (0.95^59 = 0.0485 > 0.025), of 72 it can (0.95^72 = 0.0249).
+    #[test]
+    fn quantile_ranks_cover_95_percent() {
+        assert_eq!(quantile_ci_ranks(100, 0.5), (Some(40), Some(61)));
+        assert_eq!(quantile_ci_ranks(59, 0.05).0, None);
+        assert_eq!(quantile_ci_ranks(72, 0.05).0, Some(1));
+        // Coverage by an independent sum of binomial terms (lgamma-free: products).
+        for (n, p) in [
+            (20usize, 0.5),
+            (200, 0.05),
+            (200, 0.95),
+            (1000, 0.5),
+            (5000, 0.95),
+        ] {
+            let (l, u) = quantile_ci_ranks(n, p);
+            let (l, u) = (l.unwrap_or(0), u.unwrap_or(n + 1));
+            let mut pmf = vec![0.0_f64; n + 1];
+            // P(B = k) built from the mode outward in linear space, then normalised.
+            let mode = ((n as f64 + 1.0) * p).floor() as usize;
+            pmf[mode.min(n)] = 1.0;
+            for k in (mode.min(n) + 1)..=n {
+                pmf[k] = pmf[k - 1] * ((n - k + 1) as f64 / k as f64) * (p / (1.0 - p));
+            }
+            for k in (0..mode.min(n)).rev() {
+                pmf[k] = pmf[k + 1] * ((k + 1) as f64 / (n - k) as f64) * ((1.0 - p) / p);
+            }
+            let total: f64 = pmf.iter().sum();
+            // x_(l) ≤ ξ_p ≤ x_(u) ⇔ l ≤ B ≤ u − 1 (rank 0: no lower bound, n + 1: no upper).
+            let cover: f64 = (l..u.min(n + 1)).map(|k| pmf[k]).sum::<f64>() / total;
+            assert!(cover >= 0.95, "n {n} p {p}: ranks {l}..{u} cover {cover}");
+            // Equal tails: P(B ≤ l − 1) ≤ 2.5 % < P(B ≤ l); P(B ≤ u − 2) < 97.5 % ≤ P(B ≤ u − 1).
+            if l >= 1 {
+                let below: f64 = pmf[..l].iter().sum::<f64>() / total;
+                assert!(
+                    below <= 0.025 + 1e-12 && below + pmf[l] / total > 0.025,
+                    "n {n} p {p}"
+                );
+            }
+            if u <= n {
+                let upto: f64 = pmf[..u].iter().sum::<f64>() / total;
+                assert!(
+                    upto >= 0.975 - 1e-12 && upto - pmf[u - 1] / total < 0.975,
+                    "n {n} p {p}"
+                );
+            }
+        }
+    }
 }

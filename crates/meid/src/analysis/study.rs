@@ -21,6 +21,14 @@
 //!
 //! The paper's rule (section 4.1: the best damper has w_d = w_s) is evaluated at the
 //! optimum's other variables with `wd/ws = 1`.
+//!
+//! The free variables are searched in the order of their names (the result does not depend
+//! on the order they were given in); a variable with `LO = HI` is held fixed. After the
+//! search, each free variable is moved by ±[`NEIGHBOUR_STEP`] of its range in the search
+//! coordinate ([`LocalCheck`]): the report says whether the optimum is a local minimum, a
+//! minimum on a bound, not a minimum (a lower neighbour, then reported), or that the
+//! objective is flat; and it lists the `--set` overrides that make `meid simulate` give the
+//! same objective.
 
 use serde::Serialize;
 
@@ -35,6 +43,10 @@ use crate::{Error, Result};
 
 /// Points of the coarse scan before Brent in one variable.
 pub const SCAN_POINTS: usize = 9;
+
+/// The neighbour check's step ([`LocalCheck`]): a fraction of each variable's box width in
+/// the search coordinate (`ln x` for a log variable), 1000 times the Brent tolerance.
+pub const NEIGHBOUR_STEP: f64 = 1e-3;
 
 /// What to minimise.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -111,6 +123,57 @@ pub struct Variable {
     pub upper: f64,
     /// Searched in `ln x`.
     pub log: bool,
+    /// `LO = HI`: held at that value, not searched.
+    pub fixed: bool,
+}
+
+/// A point next to the optimum, evaluated after the search to establish what the optimum is
+/// ([`LocalCheck`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Neighbour {
+    /// The variable moved (its name); the others stay at the optimum.
+    pub variable: String,
+    /// Its value at the neighbour.
+    pub value: f64,
+    /// The objective there (NaN when the run failed).
+    pub objective: f64,
+}
+
+/// What the reported optimum is, as established by the neighbour check.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Verdict {
+    /// Every neighbour gives a larger or equal objective and no variable sits on a bound.
+    LocalMinimum,
+    /// No neighbour inside the bounds is lower, but a variable sits on a bound: the objective
+    /// falls towards it, and a lower value may lie beyond it.
+    OnBound,
+    /// A neighbour was lower: the reported optimum is that neighbour, not a verified local
+    /// minimum (the search stopped short, or the objective is rough at the step's scale).
+    NotAMinimum,
+    /// The objective took the same value at every point evaluated: it does not depend on the
+    /// variables within the bounds, and any value is as good as the one reported.
+    Flat,
+    /// Every variable is fixed (`LO = HI`): one point was evaluated, nothing searched.
+    Fixed,
+    /// The budget left no simulations for the neighbour check.
+    NotChecked,
+}
+
+/// The check of the optimum by its neighbours: each free variable moved by
+/// `±step_fraction` of its box width in the search coordinate (`ln x` for a log variable,
+/// so the value is multiplied by `(HI/LO)^(±step_fraction)`), the others kept; a neighbour
+/// outside the bounds is not evaluated (the variable is then on that bound).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LocalCheck {
+    pub verdict: Verdict,
+    /// The step as a fraction of each box width in the search coordinate.
+    pub step_fraction: f64,
+    pub neighbours: Vec<Neighbour>,
+    /// Variables on a bound, `NAME (lower)` / `NAME (upper)`.
+    pub at_bound: Vec<String>,
+    /// The verdict in words, with the numbers that establish it.
+    pub statement: String,
 }
 
 /// An optimisation study; build with [`OptimizeStudy::new`], run with [`OptimizeStudy::run`].
@@ -147,6 +210,13 @@ pub struct OptimizeReport {
     pub objective_at_wd_equal_ws: f64,
     /// The whole point at the optimum (every metric).
     pub point: PointResult,
+    /// What the optimum is, from a check of its neighbours ([`LocalCheck`]).
+    pub local_check: LocalCheck,
+    /// The model fields the optimum sets, `PATH=VALUE` (shortest round-trip numbers): `meid
+    /// simulate MODEL --set …` with these (and the study's own `--set`) runs the optimum,
+    /// the same objective to the last bit (a ratio is set as the stiffness or mass it
+    /// derives: `wd/ws` as `contact.bed_damper.stiffness`, `md/mb` as `damper.mass`).
+    pub overrides: Vec<String>,
 }
 
 /// A given bound must lie in its quantity's valid domain: a ratio (`wd/ws`, `md/mb` ...) must
@@ -303,10 +373,13 @@ impl OptimizeStudy {
                     }
                 }
             };
-            if !(lower.is_finite() && upper.is_finite() && lower < upper) {
+            if !(lower.is_finite() && upper.is_finite() && lower <= upper) {
                 return Err(Error::invalid(
                     "bounds",
-                    format!("{}: needs finite LO < HI, got {lower}..{upper}", q.name()),
+                    format!(
+                        "{}: needs finite LO < HI (or LO = HI to hold it fixed), got {lower}..{upper}",
+                        q.name()
+                    ),
                 ));
             }
             if b.is_some() {
@@ -317,6 +390,7 @@ impl OptimizeStudy {
                 lower,
                 upper,
                 log: lower > 0.0,
+                fixed: lower == upper,
             });
         }
         let mut options = model.options();
@@ -331,12 +405,29 @@ impl OptimizeStudy {
         })
     }
 
-    /// The fewest simulations [`OptimizeStudy::run`] can work with: for one variable the
-    /// [`SCAN_POINTS`]-point scan and one Brent step, for n variables one simplex (n + 1
-    /// points); plus, always, the optimum's own run and the w_d = w_s comparison.
+    /// The free variables (not fixed by `LO = HI`) in the order the search takes them: by
+    /// name, so that the search, and so the optimum, does not depend on the order in which
+    /// the variables were given (`--over a,b` or `--over b,a`).
+    fn search_order(&self) -> Vec<usize> {
+        let mut free: Vec<usize> = (0..self.variables.len())
+            .filter(|&k| !self.variables[k].fixed)
+            .collect();
+        free.sort_by_key(|&k| self.variables[k].quantity.name());
+        free
+    }
+
+    /// The fewest simulations [`OptimizeStudy::run`] can work with: for one free variable the
+    /// [`SCAN_POINTS`]-point scan and one Brent step, for n free variables one simplex (n + 1
+    /// points), none when every variable is fixed; plus, always, the optimum's own run and
+    /// the w_d = w_s comparison. The neighbour check ([`LocalCheck`], 2n more) runs when the
+    /// budget allows it on top of this minimum.
     pub fn min_simulations(&self) -> usize {
-        let n = self.variables.len();
-        let search = if n == 1 { SCAN_POINTS + 1 } else { n + 1 };
+        let n = self.search_order().len();
+        let search = match n {
+            0 => 0,
+            1 => SCAN_POINTS + 1,
+            _ => n + 1,
+        };
         search + 2
     }
 
@@ -375,6 +466,45 @@ impl OptimizeStudy {
         )
     }
 
+    /// The model fields the point `x` (with its result `point`) sets, `PATH=VALUE`, in
+    /// variable order, each path once ([`OptimizeReport::overrides`]).
+    fn overrides(&self, x: &[f64], point: &PointResult) -> Vec<String> {
+        let mut out: Vec<(String, f64)> = Vec::new();
+        let mut put = |path: &str, v: f64| {
+            if let Some(e) = out.iter_mut().find(|(p, _)| p == path) {
+                e.1 = v;
+            } else {
+                out.push((path.to_string(), v));
+            }
+        };
+        let derived = |i: usize| point.derived.get(i).copied().unwrap_or(f64::NAN);
+        for (v, &xk) in self.variables.iter().zip(x) {
+            match &v.quantity {
+                Quantity::Field(p) => put(p, xk),
+                Quantity::WsOverWref => put("contact.slider_bed.stiffness", derived(0)),
+                Quantity::WdOverWs | Quantity::WdOverWref => {
+                    put("contact.bed_damper.stiffness", derived(1))
+                }
+                Quantity::MdOverMb => {
+                    put("damper.mass", derived(2));
+                    put("contact.bed_damper.stiffness", derived(1));
+                }
+            }
+        }
+        // A ratio derives its field from the point's other fields: the field's final value
+        // is the point's own (e.g. `damper.mass` with `wd/ws` gives K_d = m_d ω_d²).
+        for (p, v) in out.iter_mut() {
+            match p.as_str() {
+                "contact.slider_bed.stiffness" => *v = derived(0),
+                "contact.bed_damper.stiffness" => *v = derived(1),
+                "damper.mass" => *v = derived(2),
+                "slider.mass" => *v = derived(3),
+                _ => {}
+            }
+        }
+        out.into_iter().map(|(p, v)| format!("{p}={v:e}")).collect()
+    }
+
     /// Runs the search (see the module docs).
     pub fn run(&self) -> Result<OptimizeReport> {
         self.run_with_progress(&|_, _| {})
@@ -404,7 +534,8 @@ impl OptimizeStudy {
             r
         };
         let metric = self.objective.metric();
-        let n = self.variables.len();
+        let order = self.search_order();
+        let n = order.len();
         let min = self.min_simulations();
         if self.max_simulations < min {
             return Err(Error::Input {
@@ -421,19 +552,40 @@ impl OptimizeStudy {
                 ),
             });
         }
-        // The search's share of the budget: the optimum's run and the comparison come after.
-        let search_budget = self.max_simulations - 2;
-        let f = |u: &[f64]| -> f64 {
-            let x: Vec<f64> = (0..n).map(|k| self.search_to_value(k, u[k])).collect();
-            eval(&qs_all, &x).metric(metric)
+        // The neighbour check (2 per free variable) runs when the budget holds it on top of
+        // the minimum; the optimum's run and the comparison come after the search.
+        let check_runs = 2 * n;
+        let checked = n > 0 && self.max_simulations >= min + check_runs;
+        let search_budget = self.max_simulations - 2 - if checked { check_runs } else { 0 };
+        // Every objective value the search saw (for the flatness test).
+        let seen = std::sync::Mutex::new(Vec::<f64>::new());
+        // A point in the variables' order from the free variables' search coordinates (in
+        // `order`); a fixed variable is its bound.
+        let to_x = |u: &[f64]| -> Vec<f64> {
+            let mut x: Vec<f64> = self.variables.iter().map(|v| v.lower).collect();
+            for (j, &k) in order.iter().enumerate() {
+                x[k] = self.search_to_value(k, u[j]);
+            }
+            x
         };
-        let lo: Vec<f64> = (0..n)
-            .map(|k| self.value_to_search(k, self.variables[k].lower))
+        let f = |u: &[f64]| -> f64 {
+            let v = eval(&qs_all, &to_x(u)).metric(metric);
+            if let Ok(mut s) = seen.lock() {
+                s.push(v);
+            }
+            v
+        };
+        let lo: Vec<f64> = order
+            .iter()
+            .map(|&k| self.value_to_search(k, self.variables[k].lower))
             .collect();
-        let hi: Vec<f64> = (0..n)
-            .map(|k| self.value_to_search(k, self.variables[k].upper))
+        let hi: Vec<f64> = order
+            .iter()
+            .map(|&k| self.value_to_search(k, self.variables[k].upper))
             .collect();
-        let (u_best, simulations, failures, converged) = if n == 1 {
+        let (u_best, simulations, failures, converged) = if n == 0 {
+            (Vec::new(), 0, 0, true)
+        } else if n == 1 {
             let m = SCAN_POINTS;
             let grid: Vec<f64> = (0..m)
                 .map(|i| lo[0] + (hi[0] - lo[0]) * i as f64 / (m - 1) as f64)
@@ -445,7 +597,7 @@ impl OptimizeStudy {
                 .min_by(|&a, &b| vals[a].total_cmp(&vals[b]))
             else {
                 return Err(self.failure(
-                    &[self.search_to_value(0, grid[0])],
+                    &to_x(&[grid[0]]),
                     &format!("all {m} points of the initial scan failed"),
                     "the first scan point",
                 ));
@@ -470,15 +622,17 @@ impl OptimizeStudy {
                 r.converged,
             )
         } else {
-            let x0: Vec<f64> = (0..n)
-                .map(|k| {
+            let m_b = self.bed_mass_kg.or_else(|| self.model.bed_mass());
+            let x0: Vec<f64> = order
+                .iter()
+                .enumerate()
+                .map(|(j, &k)| {
                     let v = &self.variables[k];
-                    let m_b = self.bed_mass_kg.or_else(|| self.model.bed_mass());
                     let c = current_value(&self.model, &v.quantity, m_b)
                         .filter(|c| c.is_finite() && *c > v.lower && *c < v.upper);
                     match c {
                         Some(c) => self.value_to_search(k, c),
-                        None => 0.5 * (lo[k] + hi[k]),
+                        None => 0.5 * (lo[j] + hi[j]),
                     }
                 })
                 .collect();
@@ -495,9 +649,9 @@ impl OptimizeStudy {
             let r = minimize_box(f, &x0, &lo, &hi, &opts)?;
             (r.x, r.evaluations, r.failures, r.converged)
         };
-        let optimum: Vec<f64> = (0..n).map(|k| self.search_to_value(k, u_best[k])).collect();
-        let point = eval(&qs_all, &optimum);
-        let objective_value = point.metric(metric);
+        let mut optimum = to_x(&u_best);
+        let mut point = eval(&qs_all, &optimum);
+        let mut objective_value = point.metric(metric);
         if !objective_value.is_finite() {
             if point.error.is_some() {
                 return Err(self.failure(
@@ -511,6 +665,140 @@ impl OptimizeStudy {
                 format!("no valid design found: {metric} is undefined at the best point"),
             ));
         }
+        let mut simulations = simulations + 1;
+
+        // The neighbour check: what the optimum is.
+        let mut neighbours = Vec::new();
+        let mut at_bound = Vec::new();
+        let mut lower_neighbour: Option<(Vec<f64>, PointResult, f64, usize)> = None;
+        if checked {
+            for (j, &k) in order.iter().enumerate() {
+                let h = NEIGHBOUR_STEP * (hi[j] - lo[j]);
+                for (side, sign) in [("lower", -1.0), ("upper", 1.0)] {
+                    let t = (u_best[j] + sign * h).clamp(lo[j], hi[j]);
+                    let mut x = optimum.clone();
+                    x[k] = self.search_to_value(k, t);
+                    if x[k] == optimum[k] {
+                        at_bound.push(format!("{} ({side})", self.variables[k].quantity.name()));
+                        continue;
+                    }
+                    let p = eval(&qs_all, &x);
+                    simulations += 1;
+                    let fv = p.metric(metric);
+                    neighbours.push(Neighbour {
+                        variable: self.variables[k].quantity.name(),
+                        value: x[k],
+                        objective: fv,
+                    });
+                    let lower = fv < objective_value - 1e-12 * objective_value.abs();
+                    if lower && lower_neighbour.as_ref().is_none_or(|b| fv < b.2) {
+                        lower_neighbour = Some((x, p, fv, neighbours.len() - 1));
+                    }
+                }
+            }
+        } else if n > 0 {
+            // Without the check, a bound is still a bound.
+            for (j, &k) in order.iter().enumerate() {
+                for (side, b) in [("lower", lo[j]), ("upper", hi[j])] {
+                    if u_best[j] == b {
+                        at_bound.push(format!("{} ({side})", self.variables[k].quantity.name()));
+                    }
+                }
+            }
+        }
+        let mut values: Vec<f64> = seen.into_inner().unwrap_or_default();
+        values.push(objective_value);
+        values.extend(neighbours.iter().map(|nb| nb.objective));
+        let finite: Vec<f64> = values.into_iter().filter(|v| v.is_finite()).collect();
+        let (f_min, f_max) = finite
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        let names: Vec<String> = order
+            .iter()
+            .map(|&k| self.variables[k].quantity.name())
+            .collect();
+        let method = if n == 1 {
+            format!("a {SCAN_POINTS}-point scan over the bounds, then Brent's method in the best scan interval")
+        } else {
+            "a bounded Nelder-Mead search from the model's point and 2 seeded random starts, with restarts and a coordinate polish".to_string()
+        };
+        let step_text = format!(
+            "±{} % of each variable's range{}",
+            100.0 * NEIGHBOUR_STEP,
+            if order.iter().any(|&k| self.variables[k].log) {
+                " (in ln x for a log variable)"
+            } else {
+                ""
+            }
+        );
+        let (verdict, statement) = if n == 0 {
+            (
+                Verdict::Fixed,
+                "every variable is fixed (LO = HI): this is the objective at that point; nothing was searched".to_string(),
+            )
+        } else if finite.len() > 1 && f_max - f_min <= 1e-12 * f_max.abs().max(f_min.abs()) {
+            (
+                Verdict::Flat,
+                format!(
+                    "the objective is flat: {metric} = {objective_value:e} at all {} points evaluated (spread {:e}): it does not depend on {} within the bounds, and any value there is as good as the one reported",
+                    finite.len(),
+                    f_max - f_min,
+                    names.join(", ")
+                ),
+            )
+        } else if let Some((x, p, fv, i)) = lower_neighbour {
+            let nb = &neighbours[i];
+            let s = format!(
+                "not a verified local minimum: the search ({}) ended at {metric} = {objective_value:e}, and its neighbour {} = {:e} gives {fv:e}, lower; reported is that neighbour. Raise --max-simulations, or narrow --bounds around it",
+                if converged { "converged" } else { "budget reached" },
+                nb.variable,
+                nb.value
+            );
+            optimum = x;
+            point = p;
+            objective_value = fv;
+            (Verdict::NotAMinimum, s)
+        } else if !checked {
+            (
+                Verdict::NotChecked,
+                format!(
+                    "not checked: the budget (--max-simulations {}) left no simulations for the {check_runs} neighbours (give at least {}); found by {method}",
+                    self.max_simulations,
+                    min + check_runs
+                ),
+            )
+        } else if !at_bound.is_empty() {
+            (
+                Verdict::OnBound,
+                format!(
+                    "a minimum on the bound{}: {}; every neighbour inside the bounds ({step_text}) gives a higher {metric}, so the objective falls towards the bound and lower values may lie beyond it (widen --bounds if the model allows)",
+                    if at_bound.len() == 1 { "" } else { "s" },
+                    at_bound.join(", ")
+                ),
+            )
+        } else {
+            let rise = neighbours
+                .iter()
+                .map(|nb| nb.objective / objective_value - 1.0)
+                .fold(f64::INFINITY, f64::min);
+            (
+                Verdict::LocalMinimum,
+                format!(
+                    "a local minimum: each of the {} neighbours ({step_text}) gives a higher {metric} (smallest rise {:.3e} relative); found by {method}; not shown to be the global minimum",
+                    neighbours.len(),
+                    rise
+                ),
+            )
+        };
+        let local_check = LocalCheck {
+            verdict,
+            step_fraction: NEIGHBOUR_STEP,
+            neighbours,
+            at_bound,
+            statement,
+        };
         // The paper's rule at the optimum's other variables.
         let mut qs: Vec<&Quantity> = Vec::new();
         let mut vals: Vec<f64> = Vec::new();
@@ -531,18 +819,21 @@ impl OptimizeStudy {
         } else {
             (f64::NAN, 0)
         };
+        let overrides = self.overrides(&optimum, &point);
         Ok(OptimizeReport {
             objective: self.objective,
             metric,
             variables: self.variables.clone(),
             optimum,
             objective_value,
-            simulations: simulations + 1 + rule_runs,
+            simulations: simulations + rule_runs,
             failures,
             converged,
             wd_over_ws_at_optimum: point.metric("wd_over_ws"),
             objective_at_wd_equal_ws: rule,
             point,
+            local_check,
+            overrides,
         })
     }
 }

@@ -929,6 +929,10 @@ impl MachineReport {
                             r.simulations,
                             if r.converged { "" } else { " (budget reached)" }
                         ),
+                        serde_json::to_value(r.local_check.verdict)
+                            .ok()
+                            .and_then(|v| v.as_str().map(str::to_string))
+                            .unwrap_or_default(),
                     ]
                 })
                 .collect();
@@ -943,6 +947,7 @@ impl MachineReport {
                     "objective with ω_d = ω_s".into(),
                     "rule vs best (%)".into(),
                     "simulations".into(),
+                    "what the best is (neighbours ±0.1 % of ln range)".into(),
                 ],
                 rows,
                 ..Default::default()
@@ -975,25 +980,41 @@ impl MachineReport {
                     .iter()
                     .chain(&mc.metric_stats)
                     .map(|s| {
+                        let ci = |(a, b): (f64, f64)| {
+                            if a.is_finite() && b.is_finite() {
+                                format!("{} – {}", sig(a, 4), sig(b, 4))
+                            } else {
+                                "too few samples".to_string()
+                            }
+                        };
                         vec![
                             s.name.clone(),
+                            s.count.to_string(),
                             sig(s.mean, 4),
+                            ci(s.mean_ci95),
                             sig(s.std, 3),
                             sig(s.p5, 4),
                             sig(s.p50, 4),
                             sig(s.p95, 4),
+                            ci((
+                                s.p95_ci95.0.unwrap_or(f64::NAN),
+                                s.p95_ci95.1.unwrap_or(f64::NAN),
+                            )),
                         ]
                     })
                     .collect();
                 blocks.push(Block::Table(Table {
-                    caption: "Sample statistics (units in the names: N/m, m/s², N; energy_ratio is E_p+/E_s−, 1)".into(),
+                    caption: "Sample statistics, estimates from n samples with 95 % confidence intervals (mean: Student t; P95: order statistics) (units in the names: N/m, m/s², N; energy_ratio is E_p+/E_s−, 1)".into(),
                     header: vec![
                         "quantity".into(),
+                        "n".into(),
                         "mean".into(),
+                        "mean, 95 % CI".into(),
                         "std".into(),
                         "P5".into(),
                         "P50".into(),
                         "P95".into(),
+                        "P95, 95 % CI".into(),
                     ],
                     rows,
                     ..Default::default()
