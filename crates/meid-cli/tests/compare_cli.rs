@@ -284,3 +284,27 @@ fn montecarlo_is_reproducible_across_thread_counts() {
         .unwrap();
     assert_eq!(bad.status.code(), Some(2));
 }
+
+/// `compare` says how exact its time peaks are: exact with `exact`, estimates with `dopri5`
+/// (which also reach the report's captions through the same field).
+#[test]
+fn compare_states_how_exact_its_peaks_are() {
+    for (method, start) in [
+        ("exact", "exact, on the continuous"),
+        ("dopri5", "estimates on dopri5"),
+    ] {
+        let out = common::meid()
+            .arg("compare")
+            .arg(common::paper_example())
+            .args([
+                "--set",
+                &format!("simulation.method=\"{method}\""),
+                "--json",
+            ])
+            .output()
+            .unwrap();
+        let v = common::ok_json(out);
+        let acc = v["peak_accuracy"].as_str().expect("peak_accuracy");
+        assert!(acc.starts_with(start), "{method}: {acc}");
+    }
+}

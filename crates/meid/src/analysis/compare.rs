@@ -385,6 +385,8 @@ pub struct ComparisonResult {
     pub bands: Vec<Band>,
     pub cases: Vec<CaseResult>,
     pub reductions: Vec<Reduction>,
+    /// How exact the time peaks are ([`crate::analysis::energy::peak_accuracy`]).
+    pub peak_accuracy: String,
 }
 
 /// A comparison you build from a model and run. See the module docs.
@@ -689,6 +691,7 @@ impl Comparison {
             bands,
             cases,
             reductions,
+            peak_accuracy: crate::analysis::energy::peak_accuracy(&opts),
         })
     }
 
@@ -1240,6 +1243,7 @@ impl ComparisonResult {
                 .collect(),
             reductions: self.reductions.clone(),
             paper: PAPER_FIGURES.to_vec(),
+            peak_accuracy: self.peak_accuracy.clone(),
         }
     }
 
@@ -1375,4 +1379,6 @@ pub struct ComparisonSummary {
     pub bands: Vec<BandRow>,
     pub reductions: Vec<Reduction>,
     pub paper: Vec<PaperFigure>,
+    /// How exact the time peaks are: `exact` to round-off, `dopri5` to its tolerance.
+    pub peak_accuracy: String,
 }

@@ -501,13 +501,14 @@ pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Res
             &stem,
             &format!("{w} against time, three cases"),
             format!(
-                "{} {} ({}) after one blow, one panel per case on a common scale: without damper, with the impact damper and with the added mass; the first {} s of the {} s record (output samples at {} Hz; the peaks in the tables are exact, located on the continuous solution).",
+                "{} {} ({}) after one blow, one panel per case on a common scale: without damper, with the impact damper and with the added mass; the first {} s of the {} s record (output samples at {} Hz; the peaks in the tables are located on the continuous solution: {}).",
                 capitalise(w),
                 if ch == Channel::Acceleration { "a_B" } else { "F" },
                 ch.unit(),
                 sig(shown, 3),
                 plain(record_s),
-                plain(r.sample_rate_hz)
+                plain(r.sample_rate_hz),
+                r.peak_accuracy
             ),
             &[&histories],
         ));
@@ -602,7 +603,10 @@ pub fn case_peaks_table(r: &ComparisonResult) -> Table {
         })
         .collect();
     Table {
-        caption: "Exact peaks of one blow (located on the continuous solution, not on the samples) and the share of the blow's energy left in the machine".into(),
+        caption: format!(
+            "Peaks of one blow (located on the continuous solution, not on the samples: {}) and the share of the blow's energy left in the machine",
+            r.peak_accuracy
+        ),
         header: vec![
             "case".into(),
             "peak |a_B| (m/s²), time peak".into(),
