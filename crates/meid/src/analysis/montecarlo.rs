@@ -86,10 +86,22 @@ impl Distribution {
             .split(',')
             .map(|a| a.trim().parse::<f64>().map_err(|_| bad()))
             .collect::<Result<_>>()?;
-        if args.len() != 2 || args.iter().any(|a| !a.is_finite()) {
+        if args.len() != 2 {
             return Err(bad());
         }
         let (a, b) = (args[0], args[1]);
+        if let Some(v) = args.iter().find(|a| !a.is_finite()) {
+            let which = match name.as_str() {
+                "normal" => ["mean", "std"],
+                "lognormal" => ["mean", "cov"],
+                "uniform" => ["low", "high"],
+                _ => return Err(bad()),
+            }[if a.is_finite() { 1 } else { 0 }];
+            return Err(Error::invalid(
+                "distribution",
+                format!("'{t}': {which} must be a finite number (got {v})"),
+            ));
+        }
         let d = match name.as_str() {
             "normal" => Distribution::Normal { mean: a, std: b },
             "lognormal" => Distribution::LogNormal { mean: a, cov: b },
@@ -823,6 +835,25 @@ pub fn histogram_outline(values: &[f64], bins: usize) -> (Vec<f64>, Vec<f64>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A non-finite parameter is named (before: the generic "expected normal(mean,std), …").
+    #[test]
+    fn a_non_finite_parameter_is_named() {
+        for (text, want) in [
+            ("normal(nan,5)", "mean must be a finite number (got NaN)"),
+            ("normal(3,inf)", "std must be a finite number (got inf)"),
+            ("lognormal(-inf,0.1)", "mean must be a finite number (got -inf)"),
+            ("uniform(3,nan)", "high must be a finite number (got NaN)"),
+        ] {
+            let e = Distribution::parse(text).expect_err(text).to_string();
+            assert!(e.contains(want), "{text}: {e}");
+        }
+        assert!(Distribution::parse("weibull(nan,1)")
+            .expect_err("unknown")
+            .to_string()
+            .contains("expected normal(mean,std)"));
+        assert!(Distribution::parse("normal(1,2)").is_ok());
+    }
 
     /// t(0.975, ν) from statistical tables (Fisher & Yates; R `qt(0.975, nu)`): 12.706205,
     /// 4.302653, 3.182446, 2.262157, 2.042272, 1.983972, 1.962339, 1.960201; the exact sums
