@@ -323,12 +323,7 @@ fn summarise(sweep: &Sweep, r: &SweepResult, metric: &str, elapsed: f64, files: 
     // the floor force's peak over the run comes tens of ms later (on the lumped example
     // 0.18 N during the collision against 69 N over 0.5 s). Said beside the numbers.
     let peak = |m: &str| m.starts_with("peak_") || shown.iter().any(|c| c.starts_with("peak_"));
-    if sweep.options.stop_at_collision_end
-        && !sweep.vary.iter().any(|v| {
-            v.quantity == meid::analysis::sweep::Quantity::Field("simulation.duration".into())
-        })
-        && peak(metric)
-    {
+    if collision_only(sweep) && peak(metric) {
         println!(
             "  note: each run stops at the end of the collision, so the peak_* columns are peaks during the collision only (not `meid simulate`'s peaks over the run); give --duration S to run every point for S seconds"
         );
@@ -363,9 +358,31 @@ fn metric_label(m: &str) -> String {
     meid::analysis::sweep::metric_label(m)
 }
 
-/// The metric in words for a title: its axis label without the unit.
-fn metric_name(m: &str) -> String {
-    let l = metric_label(m);
+/// True when every run stops at the end of the collision (no `--duration`, nor a varied
+/// `simulation.duration`): the `peak_*` metrics are then peaks during the collision only.
+fn collision_only(sweep: &Sweep) -> bool {
+    sweep.options.stop_at_collision_end
+        && !sweep.vary.iter().any(|v| {
+            v.quantity == meid::analysis::sweep::Quantity::Field("simulation.duration".into())
+        })
+}
+
+/// A picture's label of `metric`: [`metric_label`], with "during the collision" before the unit
+/// for a `peak_*` metric of runs that stop there ("peak floor force during the collision (N)").
+fn picture_label(sweep: &Sweep, metric: &str) -> String {
+    let l = metric_label(metric);
+    if !(metric.starts_with("peak_") && collision_only(sweep)) {
+        return l;
+    }
+    match l.rfind(" (") {
+        Some(i) => format!("{} during the collision{}", &l[..i], &l[i..]),
+        None => format!("{l} during the collision"),
+    }
+}
+
+/// The metric in words for a picture's title: its [`picture_label`] without the unit.
+fn metric_name(sweep: &Sweep, m: &str) -> String {
+    let l = picture_label(sweep, m);
     match l.rfind(" (") {
         Some(i) => l[..i].to_string(),
         None => l,
@@ -433,9 +450,13 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                 return Ok(out);
             };
             let plot = LinePlot {
-                title: format!("{} over {}", metric_name(metric), vary[0].quantity.symbol()),
+                title: format!(
+                    "{} over {}",
+                    metric_name(sweep, metric),
+                    vary[0].quantity.symbol()
+                ),
                 x_label: label(&vary[0].quantity, w_ref),
-                y_label: metric_label(metric),
+                y_label: picture_label(sweep, metric),
                 x_log: vary[0].spacing == Spacing::Log,
                 y_log: false,
                 series: (0..ncases)
@@ -474,9 +495,13 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                 }
             }
             let plot = LinePlot {
-                title: format!("{} over {}", metric_name(metric), vary[0].quantity.symbol()),
+                title: format!(
+                    "{} over {}",
+                    metric_name(sweep, metric),
+                    vary[0].quantity.symbol()
+                ),
                 x_label: label(&vary[0].quantity, w_ref),
-                y_label: metric_label(metric),
+                y_label: picture_label(sweep, metric),
                 x_log: vary[0].spacing == Spacing::Log,
                 series,
                 ..Default::default()
@@ -534,7 +559,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                 let prefix = case_prefix(k);
                 let what = format!(
                     "{} over {} and {}",
-                    metric_name(metric),
+                    metric_name(sweep, metric),
                     q0.symbol(),
                     q1.symbol()
                 );
@@ -553,7 +578,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                     y_log: vary[1].spacing == Spacing::Log,
                     contour_levels,
                     overlay_lines,
-                    colorbar_label: metric_label(metric),
+                    colorbar_label: picture_label(sweep, metric),
                     ..Default::default()
                 };
                 let name = match sweep.cases.get(k) {

@@ -430,3 +430,38 @@ fn report_tables_are_the_numbers_of_report_json() {
     }
     assert!(html.contains("estimates from n samples with 95 % confidence intervals"));
 }
+
+/// The sweep's picture of a `peak_*` metric says "during the collision" on its axis and title
+/// when the runs stop there, and not when `--duration` runs them on.
+#[test]
+fn sweep_pictures_say_peaks_are_during_the_collision() {
+    for (tag, extra, during) in [
+        ("collision", &[][..], true),
+        ("duration", &["--duration", "0.1"][..], false),
+    ] {
+        let d = common::tmpdir("s12-sweep-picture", tag);
+        let out = meid()
+            .arg("sweep")
+            .arg(paper_example())
+            .args([
+                "--vary",
+                "wd/ws=0.5,1,2",
+                "--metric",
+                "peak_floor_force_n",
+                "-q",
+                "-o",
+            ])
+            .arg(&d)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", common::stderr(&out));
+        let svg = std::fs::read_to_string(d.join("peak_floor_force_n_curve.svg")).unwrap();
+        assert_eq!(
+            svg.contains("peak floor force during the collision (N)"),
+            during,
+            "{tag}"
+        );
+        assert!(svg.contains("peak floor force"), "{tag}");
+    }
+}

@@ -842,7 +842,10 @@ mod tests {
         for (text, want) in [
             ("normal(nan,5)", "mean must be a finite number (got NaN)"),
             ("normal(3,inf)", "std must be a finite number (got inf)"),
-            ("lognormal(-inf,0.1)", "mean must be a finite number (got -inf)"),
+            (
+                "lognormal(-inf,0.1)",
+                "mean must be a finite number (got -inf)",
+            ),
             ("uniform(3,nan)", "high must be a finite number (got NaN)"),
         ] {
             let e = Distribution::parse(text).expect_err(text).to_string();
