@@ -9,7 +9,7 @@ use meid::measure::calibrate::{
     Settings,
 };
 use meid::measure::mapping::parse_channel_flags;
-use meid::measure::validate::read_measured;
+use meid::measure::validate::read_measured_noting;
 
 use crate::args::{PrintArgs, RunArgs};
 use crate::measure::ProcessingArgs;
@@ -88,7 +88,12 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
     let p = a.processing.processing(model.spec.measurement.as_ref())?;
     let flags = parse_channel_flags(&a.channel, &model.spec.points.measurement)?;
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
-    let cases = read_measured(&a.measured, None)?;
+    let (cases, passed_over) = read_measured_noting(&a.measured, None)?;
+    if !a.print.quiet {
+        for n in &passed_over {
+            crate::ui::warning(n);
+        }
+    }
     let problem = Problem::new(&model, params, &cases, &p, &flags, settings)?;
     let c = calibrate(&problem)?;
     if let Some(set) = set {

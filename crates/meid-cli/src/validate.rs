@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 
 use meid::measure::mapping::parse_channel_flags;
-use meid::measure::validate::{read_measured, validate};
+use meid::measure::validate::{read_measured_noting, validate};
 
 use crate::args::{PrintArgs, RunArgs};
 use crate::measure::ProcessingArgs;
@@ -41,7 +41,12 @@ pub fn run(a: ValidateArgs) -> Result<()> {
     let p = a.processing.processing(model.spec.measurement.as_ref())?;
     let flags = parse_channel_flags(&a.channel, &model.spec.points.measurement)?;
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
-    let cases = read_measured(&a.measured, None)?;
+    let (cases, passed_over) = read_measured_noting(&a.measured, None)?;
+    if !a.print.quiet {
+        for n in &passed_over {
+            crate::ui::warning(n);
+        }
+    }
     let v = validate(&model, &cases, &p, &flags)?;
     if let Some(set) = set {
         meid::io::write_json(&set.path("validation.json"), &v)?;

@@ -611,4 +611,23 @@ fn force_window_on_the_hammer_only_semicolon_csv_and_a_microphone_passed_over() 
             && e.contains("passed over"),
         "{e}"
     );
+    // `validate` and `calibrate` read the same file and warn of the same channel (they said
+    // nothing of it).
+    for cmd in [
+        vec!["validate"],
+        vec!["calibrate", "--fit", "contact.slider_bed.stiffness"],
+    ] {
+        let o = meid()
+            .args(&cmd)
+            .arg(paper_example())
+            .arg("--measured")
+            .arg(&u)
+            .output()
+            .unwrap();
+        let e = stderr(&o);
+        assert!(
+            e.contains("specific data type 15 (pressure, unit 'Pa')") && e.contains("passed over"),
+            "{cmd:?}: {e}"
+        );
+    }
 }

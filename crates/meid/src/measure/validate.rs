@@ -74,14 +74,26 @@ pub fn read_measured(
     args: &[String],
     base_dir: Option<&std::path::Path>,
 ) -> Result<Vec<MeasuredCase>> {
+    Ok(read_measured_noting(args, base_dir)?.0)
+}
+
+/// [`read_measured`], with the channels the readers passed over (of quantities meid does not
+/// process, such as a microphone's pressure; [`super::read_records_noting`]), one line each
+/// naming the file: `meid validate` and `meid calibrate` warn of them as `meid measure` does.
+pub fn read_measured_noting(
+    args: &[String],
+    base_dir: Option<&std::path::Path>,
+) -> Result<(Vec<MeasuredCase>, Vec<String>)> {
     let mut cases: Vec<MeasuredCase> = Vec::new();
+    let mut passed_over = Vec::new();
     for a in args {
         let (case, path) = split_case(a);
         let path = match base_dir {
             Some(d) if path.is_relative() => d.join(path),
             _ => path,
         };
-        let records = super::read_records(&path)?;
+        let (records, passed) = super::read_records_noting(&path)?;
+        passed_over.extend(passed);
         let name = path.display().to_string();
         match cases.iter_mut().find(|c| c.case == case) {
             Some(c) => {
@@ -95,7 +107,7 @@ pub fn read_measured(
             }),
         }
     }
-    Ok(cases)
+    Ok((cases, passed_over))
 }
 
 /// One mode of one channel.
