@@ -143,6 +143,20 @@ fn closed_form_peaks() -> (f64, f64) {
     )
 }
 
+/// The four shipped examples.
+const EXAMPLES: [&str; 4] = [
+    "paper-lumped",
+    "paper-soft-base",
+    "paper-stiff-base",
+    "paper-no-base",
+];
+
+/// The shipped example `name` (`examples/{name}.toml`) with `--set` overrides.
+fn example(name: &str, sets: &[String]) -> Model {
+    let path = format!("{}/../../examples/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    Model::from_file(path.as_ref(), sets).expect("example")
+}
+
 #[test]
 fn peaks_match_the_closed_form_at_any_output_rate() {
     let (acc, force) = closed_form_peaks();
@@ -174,16 +188,10 @@ fn peaks_match_the_closed_form_at_any_output_rate() {
 /// Every summary peak of the four examples is the same at 100 Hz and at 2 MHz output.
 #[test]
 fn example_peaks_do_not_depend_on_the_output_rate() {
-    for name in [
-        "paper-lumped",
-        "paper-soft-base",
-        "paper-stiff-base",
-        "paper-no-base",
-    ] {
-        let path = format!("{}/../../examples/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    for name in EXAMPLES {
         let mut peaks = Vec::new();
         for rate in [100.0, 2e6] {
-            let m = Model::from_file(path.as_ref(), &[]).expect("example");
+            let m = example(name, &[]);
             let sys = m.impact_system(Case::Damper).expect("system");
             let mut o = m.options();
             o.sample_rate = Some(rate);
@@ -245,14 +253,8 @@ fn dopri5_peaks_are_estimates_within_the_integration_tolerance() {
         .summary;
     assert_eq!(exact.peak_accuracy, "exact, on the continuous solution");
 
-    for name in [
-        "paper-lumped",
-        "paper-soft-base",
-        "paper-stiff-base",
-        "paper-no-base",
-    ] {
-        let path = format!("{}/../../examples/{name}.toml", env!("CARGO_MANIFEST_DIR"));
-        let m = Model::from_file(path.as_ref(), &[]).expect("example");
+    for name in EXAMPLES {
+        let m = example(name, &[]);
         let sys = m.impact_system(Case::Damper).expect("system");
         let mut o = m.options();
         o.sample_rate = None;
@@ -278,11 +280,7 @@ fn dopri5_peaks_are_estimates_within_the_integration_tolerance() {
 #[test]
 fn a_dopri5_tolerance_too_large_for_the_motion_is_named() {
     use meid::integrate::Method;
-    let path = format!(
-        "{}/../../examples/paper-lumped.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let m = Model::from_file(path.as_ref(), &["slider.velocity=1e-12".to_string()]).expect("model");
+    let m = example("paper-lumped", &["slider.velocity=1e-12".to_string()]);
     let sys = m.impact_system(Case::Damper).expect("system");
     let mut o = m.options();
     o.method = Method::Dopri5;

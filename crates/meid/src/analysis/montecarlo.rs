@@ -90,24 +90,21 @@ impl Distribution {
             return Err(bad());
         }
         let (a, b) = (args[0], args[1]);
-        if let Some(v) = args.iter().find(|a| !a.is_finite()) {
-            let which = match name.as_str() {
-                "normal" => ["mean", "std"],
-                "lognormal" => ["mean", "cov"],
-                "uniform" => ["low", "high"],
-                _ => return Err(bad()),
-            }[if a.is_finite() { 1 } else { 0 }];
-            return Err(Error::invalid(
-                "distribution",
-                format!("'{t}': {which} must be a finite number (got {v})"),
-            ));
-        }
-        let d = match name.as_str() {
-            "normal" => Distribution::Normal { mean: a, std: b },
-            "lognormal" => Distribution::LogNormal { mean: a, cov: b },
-            "uniform" => Distribution::Uniform { low: a, high: b },
+        let (d, names) = match name.as_str() {
+            "normal" => (Distribution::Normal { mean: a, std: b }, ["mean", "std"]),
+            "lognormal" => (Distribution::LogNormal { mean: a, cov: b }, ["mean", "cov"]),
+            "uniform" => (Distribution::Uniform { low: a, high: b }, ["low", "high"]),
             _ => return Err(bad()),
         };
+        if let Some(i) = args.iter().position(|v| !v.is_finite()) {
+            return Err(Error::invalid(
+                "distribution",
+                format!(
+                    "'{t}': {} must be a finite number (got {})",
+                    names[i], args[i]
+                ),
+            ));
+        }
         d.validate()?;
         Ok(d)
     }
