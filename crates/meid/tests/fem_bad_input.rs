@@ -226,3 +226,74 @@ fn node_count_beyond_the_file_is_refused() {
         "{msg}"
     );
 }
+
+/// A model in mm-t-s units (the Euler-Bernoulli cantilever of `tests/data/eb_cantilever.toml`
+/// with nodes in mm, E = 2.1e5 N/mm², ρ = 7.85e-9 t/mm³, A in mm², I in mm⁴) was accepted as SI:
+/// the same frequencies (16.7103 Hz), but a bar of 3.1e-3 "kg" instead of 3.14 kg, effective
+/// masses 0.002 "kg" and a tip flexibility of 0.119 "m/N" (L³/3EI = 1.19e-4 m/N in SI), silently
+/// coupled to the slider's 0.1 kg. Now refused at the material, naming SI; so are E given in MPa
+/// or GPa next to ρ in kg/m³ (wave speed sqrt(E/ρ) 5.2 or 0.16 m/s), in the general model, a
+/// Gmsh mesh and the machine.
+#[test]
+fn materials_in_other_unit_systems_are_refused() {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let si = std::fs::read_to_string(data.join("eb_cantilever.toml")).unwrap();
+    let dir = std::env::temp_dir().join(format!("meid-units-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mm = si
+        .replace("[1.0, 0.0, 0.0]", "[1000.0, 0.0, 0.0]")
+        .replace("youngs_modulus = 2.1e11", "youngs_modulus = 2.1e5")
+        .replace("density = 7850.0", "density = 7.85e-9")
+        .replace(
+            "area = 4.0e-4, iy = 1.3333333333333333e-8, iz = 1.3333333333333333e-8, j = 2.25e-8",
+            "area = 400.0, iy = 13333.333333333334, iz = 13333.333333333334, j = 22500.0",
+        );
+    assert_ne!(mm, si);
+    let mpa = si.replace("youngs_modulus = 2.1e11", "youngs_modulus = 2.1e5");
+    let gpa = si.replace("youngs_modulus = 2.1e11", "youngs_modulus = 210.0");
+    let path = dir.join("m.toml");
+    for (text, key, what) in [
+        (&mm, "structure.fem.model.material.density", "7.85e-9 kg/m³"),
+        (
+            &mpa,
+            "structure.fem.model.material.youngs_modulus",
+            "5.1722e0 m/s",
+        ),
+        (
+            &gpa,
+            "structure.fem.model.material.youngs_modulus",
+            "1.6356e-1 m/s",
+        ),
+    ] {
+        std::fs::write(&path, text).unwrap();
+        let e = meid::model::Model::from_file(&path, &[]).unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, Error::Input { .. }), "{msg}");
+        assert!(
+            msg.contains(key) && msg.contains(what) && msg.contains("SI units"),
+            "{msg}"
+        );
+    }
+    // The SI file still reads.
+    std::fs::write(&path, &si).unwrap();
+    meid::model::Model::from_file(&path, &[]).unwrap();
+    // The machine's materials, through --set.
+    let soft = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/paper-soft-base.toml");
+    for (set, key) in [
+        (
+            "structure.fem.machine.column_material={ youngs_modulus = 2.06e5, poisson_ratio = 0.3, density = 7.85e-9 }",
+            "structure.fem.machine.column_material.density",
+        ),
+        (
+            "structure.fem.machine.bed.material={ youngs_modulus = 2.06e5, poisson_ratio = 0.3, density = 7850.0 }",
+            "structure.fem.machine.bed.material.youngs_modulus",
+        ),
+    ] {
+        let e = meid::model::Model::from_file(&soft, &[set.to_string()]).unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, Error::Input { .. }), "{msg}");
+        assert!(msg.contains(key) && msg.contains("SI units"), "{set}: {msg}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

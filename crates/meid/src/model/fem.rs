@@ -778,6 +778,81 @@ pub(super) fn check_material(m: &MaterialSpec, field: &str, src: &Source) -> Res
             return Err(src.error(&f, format!("{f} must be {range} (got {})", crate::num(v))));
         }
     }
+    check_material_units(m, field, src)
+}
+
+/// Lightest solid meid accepts as a structural density, kg/m³ (silica aerogel, the lightest
+/// solid made, is ~1 kg/m³; steel 7850).
+pub const MIN_SOLID_DENSITY_KG_PER_M3: f64 = 1.0;
+/// Range of the bar wave speed `c = sqrt(E/ρ)` of solids, m/s: soft rubber ~30 m/s (E = 1 MPa,
+/// ρ = 1100 kg/m³), diamond ~17,300 m/s (E = 1050 GPa, ρ = 3510 kg/m³), steel 5,100 m/s.
+pub const SOLID_WAVE_SPEED_RANGE_M_PER_S: [f64; 2] = [10.0, 2.0e4];
+
+/// Refuses a material (given as valid positive numbers) whose values are those of another unit
+/// system: meid's FE models are SI (m, kg, Pa, kg/m³), and a model in mm-t-s (steel:
+/// E = 2.1e5 N/mm², ρ = 7.85e-9 t/mm³), or with E in MPa or GPa next to ρ in kg/m³, gives the
+/// same frequencies as in SI when every input follows the same system, but masses, effective
+/// masses, flexibilities and the coupling to the slider's and damper's kg and m/s wrong by powers
+/// of 1000. Checked: `ρ ≥ MIN_SOLID_DENSITY_KG_PER_M3` and the bar wave speed
+/// `c = sqrt(E/ρ)` within [`SOLID_WAVE_SPEED_RANGE_M_PER_S`] (mm-t-s steel: c = 5.2e6 "m/s";
+/// E in MPa with ρ in kg/m³: c = 5.2 m/s).
+pub(super) fn check_material_units(m: &MaterialSpec, field: &str, src: &Source) -> Result<()> {
+    let si = "meid's FE models are in SI units: m, kg, s, N, Pa, kg/m³ (steel: youngs_modulus = 2.1e11, density = 7850); a model in mm-t-s (E = 2.1e5, density = 7.85e-9) must be converted";
+    if m.density < MIN_SOLID_DENSITY_KG_PER_M3 {
+        let f = format!("{field}.density");
+        return Err(src.error(
+            &f,
+            format!(
+                "{f} = {} kg/m³ is lighter than any solid (>= {} kg/m³); {si}",
+                crate::num(m.density),
+                crate::num(MIN_SOLID_DENSITY_KG_PER_M3)
+            ),
+        ));
+    }
+    let c = (m.youngs_modulus / m.density).sqrt();
+    let [lo, hi] = SOLID_WAVE_SPEED_RANGE_M_PER_S;
+    if !(lo..=hi).contains(&c) {
+        let f = format!("{field}.youngs_modulus");
+        return Err(src.error(
+            &f,
+            format!(
+                "{f} = {} Pa with density = {} kg/m³ gives a wave speed sqrt(E/ρ) = {c:.4e} m/s, outside that of solids ({lo:e} to {hi:e} m/s); {si}",
+                crate::num(m.youngs_modulus),
+                crate::num(m.density)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The unit check of [`check_material_units`] on the materials of a `[structure.fem.machine]`
+/// (`material`, `column_material`, `bed.material`, `base.material`). A material whose values are
+/// not positive is left to the machine's own validation, which names it.
+fn check_machine_units(m: &MachineFileSpec, src: &Source) -> Result<()> {
+    let base = "structure.fem.machine";
+    let mats = [
+        (m.material.as_ref(), format!("{base}.material")),
+        (
+            m.column_material.as_ref(),
+            format!("{base}.column_material"),
+        ),
+        (
+            m.bed.as_ref().and_then(|b| b.material.as_ref()),
+            format!("{base}.bed.material"),
+        ),
+        (
+            m.base.as_ref().and_then(|b| b.material.as_ref()),
+            format!("{base}.base.material"),
+        ),
+    ];
+    for (mat, field) in mats {
+        if let Some(mat) = mat {
+            let positive = |v: f64| v.is_finite() && v > 0.0;
+            if positive(mat.density) && positive(mat.youngs_modulus) {
+                check_material_units(mat, &field, src)?;
+            }
+        }
+    }
     Ok(())
 }
 
@@ -873,6 +948,7 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
 /// ([`MachineSpec::generate`]); errors name the machine's fields.
 pub fn machine_general(m: &MachineFileSpec, src: &Source) -> Result<super::general::GeneralSpec> {
     let field = "structure.fem.machine";
+    check_machine_units(m, src)?;
     machine_spec(m)
         .and_then(|ms| ms.generate())
         .map(|g| g.spec)
@@ -885,6 +961,7 @@ pub fn build_model(spec: &FemSpec, src: &Source) -> Result<FeModel> {
         (None, None, Some(g)) => super::general::build(g, src),
         (Some(m), None, None) => {
             let field = "structure.fem.machine";
+            check_machine_units(m, src)?;
             let ms = machine_spec(m).map_err(|e| locate(e, field, src, Some(m)))?;
             ms.build()
                 .map(|mach| mach.model)
