@@ -1426,6 +1426,7 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
                 points: &score_points,
                 psi: &psi,
                 static_flexibility: &static_flexibility,
+                n_dofs: model.n_dofs(),
             },
             warnings,
         )
@@ -1608,6 +1609,8 @@ struct AutoInput<'a> {
     points: &'a [String],
     psi: &'a BTreeMap<String, Vec<f64>>,
     static_flexibility: &'a BTreeMap<String, f64>,
+    /// DOFs of the reduced model: as many modes as the structure has.
+    n_dofs: usize,
 }
 
 /// `select = "auto"` (module docs): every participating mode up to the cutoff, then, above it,
@@ -1664,7 +1667,8 @@ fn auto_select(
     let mut selected: Vec<usize> = (0..nm)
         .filter(|&i| a.freq[i] <= cutoff_hz && moves(i))
         .collect();
-    if nm > 0 && a.freq[nm - 1] < cutoff_hz {
+    // Every mode of the structure computed (nm = DOFs): none can be missing.
+    if nm > 0 && nm < a.n_dofs && a.freq[nm - 1] < cutoff_hz {
         warnings.push(format!(
             "{base}.count: the {nm} computed modes stop at {:.4} Hz, below the \"auto\" cutoff \
              {cutoff_hz:.4} Hz ({AUTO_CUTOFF_FACTOR} times the highest contact frequency): \
