@@ -883,12 +883,28 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
         ));
     }
     let mut mesh = Mesh::new();
-    g.add_to_mesh(
-        &mut mesh,
-        material(&ms.material, Material::STEEL),
-        ms.thickness,
-    )
-    .map_err(|e| src.error(&format!("{base}.file"), format!("{}: {e}", path.display())))?;
+    let map = g
+        .add_to_mesh(
+            &mut mesh,
+            material(&ms.material, Material::STEEL),
+            ms.thickness,
+        )
+        .map_err(|e| src.error(&format!("{base}.file"), format!("{}: {e}", path.display())))?;
+    let pairs = super::general::coincident_node_pairs(&mesh);
+    if let Some(&(i, j)) = pairs.first() {
+        let name = |m: usize| match map.iter().position(|&x| x == Some(m)) {
+            Some(k) => format!("node {} of {}", g.node_tags[k], ms.file),
+            None => format!("node {m}"),
+        };
+        let f = format!("{base}.file");
+        return Err(src.error(
+            &f,
+            format!(
+                "{f}: {}",
+                super::general::coincident_message(&name(i), &name(j), mesh.nodes[i], pairs.len())
+            ),
+        ));
+    }
     let group = |name: &str, field: &str, mesh: &Mesh| -> Result<Vec<usize>> {
         mesh.point(name)
             .map(|v| v.to_vec())
