@@ -1617,6 +1617,37 @@ fn sparse_residuals(model: &FeModel, modes: &DenseModes, which: &[usize]) -> Vec
         .collect()
 }
 
+/// Relative gap `|ω_i − ω_j| ≤ DEGENERATE_TOLERANCE · ω_j` under which two modes share an
+/// eigenvalue (a repeated eigenvalue of a symmetric structure comes out of either solver with
+/// a spread of ~1e-12; the closest distinct pair of the tests, FV2's 17.6808/17.7094 Hz, is
+/// 1.6e-3 apart).
+pub const DEGENERATE_TOLERANCE: f64 = 1e-8;
+
+/// For each mode (ascending ω), the range of modes sharing its eigenvalue: consecutive modes
+/// within [`DEGENERATE_TOLERANCE`] of the cluster's first, or all rigid-body modes (ω = 0).
+fn degenerate_clusters(omega: &[f64]) -> Vec<std::ops::Range<usize>> {
+    let n = omega.len();
+    let mut out = vec![0..0; n];
+    let mut start = 0;
+    while start < n {
+        let w0 = omega[start];
+        let mut end = start + 1;
+        while end < n && (omega[end] - w0).abs() <= DEGENERATE_TOLERANCE * omega[end].abs() {
+            end += 1;
+        }
+        if w0 == 0.0 {
+            while end < n && omega[end] == 0.0 {
+                end += 1;
+            }
+        }
+        for r in out.iter_mut().take(end).skip(start) {
+            *r = start..end;
+        }
+        start = end;
+    }
+    out
+}
+
 /// What [`auto_select`] ranks modes by.
 struct AutoInput<'a> {
     scores: &'a [f64],
@@ -1672,11 +1703,17 @@ fn auto_select(
         .iter()
         .map(|(p, v)| (p, v.iter().fold(0.0_f64, |x, y| x.max(y * y))))
         .collect();
-    let moves = |i: usize| {
+    let moves_alone = |i: usize| {
         a.psi
             .iter()
             .any(|(p, v)| v[i] * v[i] > NEGLIGIBLE_SCORE * peak[p])
     };
+    // A repeated eigenvalue's modes are one eigenspace, in which each solver returns its own
+    // basis (the square cantilever's bending pair: one mode moving the tip's z and one not, or
+    // both moving it): the space is kept or left out whole, so that what is kept does not
+    // depend on the basis (dense selected 9 modes, Lanczos 12, of the same 20).
+    let cluster = degenerate_clusters(a.omega);
+    let moves = |i: usize| cluster[i].clone().any(moves_alone);
     // Shares are checked at every point of the truncation table (the role points) and at the
     // score points.
     let share_points: Vec<&String> = a.psi.keys().collect();
@@ -1723,14 +1760,22 @@ fn auto_select(
     let limit = spec.auto_count.unwrap_or(usize::MAX);
     let mut added = 0;
     for i in extra {
+        if selected.contains(&i) {
+            continue;
+        }
         let short = share_points
             .iter()
             .any(|p| share(&selected, p).is_some_and(|s| s < truncation::SHARE_WARNING));
         if !short || added >= limit {
             break;
         }
-        selected.push(i);
-        added += 1;
+        // The whole eigenspace of a repeated eigenvalue.
+        for j in cluster[i].clone() {
+            if !selected.contains(&j) {
+                selected.push(j);
+                added += 1;
+            }
+        }
     }
     if selected.is_empty() {
         return Err(src.error(
