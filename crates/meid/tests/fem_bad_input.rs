@@ -426,3 +426,32 @@ sample_rate = 20000.0
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A frame section given in mm² and mm⁴ next to lengths in m (the 1 m cantilever of
+/// `tests/data/eb_cantilever.toml` with `area = 400, iy = iz = 13333.3`): before, accepted as a
+/// 400 m² bar (radius of gyration 5.77 m on a 1 m member) with 16.7103 Hz; now refused at
+/// `frames[0]`, naming L/r and the SI units. The SI section reads.
+#[test]
+fn a_frame_shorter_than_its_radius_of_gyration_is_refused() {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let si = std::fs::read_to_string(data.join("eb_cantilever.toml")).unwrap();
+    let mm = si.replace(
+        "area = 4.0e-4, iy = 1.3333333333333333e-8, iz = 1.3333333333333333e-8, j = 2.25e-8",
+        "area = 400.0, iy = 13333.333333333334, iz = 13333.333333333334, j = 22500.0",
+    );
+    assert_ne!(mm, si);
+    let dir = std::env::temp_dir().join(format!("meid-slender-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("m.toml");
+    std::fs::write(&path, &mm).unwrap();
+    let e = meid::model::Model::from_file(&path, &[]).unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, Error::Input { .. }), "{msg}");
+    assert!(
+        msg.contains("structure.fem.model.frames[0]") && msg.contains("L/r = 1.732e-1"),
+        "{msg}"
+    );
+    std::fs::write(&path, &si).unwrap();
+    meid::model::Model::from_file(&path, &[]).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -651,6 +651,7 @@ pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> 
                 ));
             }
         }
+        check_slenderness(&b, &field, f, &segs)?;
         let mut rel: Vec<[[bool; 6]; 2]> = vec![[[false; 6]; 2]; segs.len()];
         for (ri, r) in f.releases.iter().enumerate() {
             let rfield = format!("{field}.releases[{ri}]");
@@ -812,6 +813,61 @@ pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> 
     }
     check_coincident_nodes(&b, spec)?;
     Ok((b.mesh, [d[0] / norm, d[1] / norm, d[2] / norm]))
+}
+
+/// Least slenderness `L/r` of a frame member (`r = sqrt(max(iy, iz)/area)` its radius of
+/// gyration): a member shorter than its radius of gyration is no beam (Euler-Bernoulli needs
+/// `L/r` of ~10 and more; the paper's columns have 31, NAFEMS FV2's arms 139); such a section is
+/// a unit slip (area in mm² or I in m⁴ next to lengths in m: `area = 400, iy = 13333` on a 1 m
+/// member gives `L/r = 0.17`).
+pub const MIN_FRAME_SLENDERNESS: f64 = 1.0;
+
+/// Refuses a frame entry whose member (an inline chain's segment `nodes[k]`–`nodes[k+1]`, or a
+/// Gmsh curve set's extent) is shorter than [`MIN_FRAME_SLENDERNESS`] radii of gyration.
+fn check_slenderness(
+    b: &Builder<'_>,
+    field: &str,
+    f: &FrameSpec,
+    segs: &[[usize; 2]],
+) -> Result<()> {
+    let r = (f.iy.max(f.iz) / f.area).sqrt();
+    let dist = |a: [f64; 3], c: [f64; 3]| (0..3).map(|k| (a[k] - c[k]).powi(2)).sum::<f64>().sqrt();
+    let member = match &f.nodes {
+        // The shortest member of the chain (segments between consecutive given nodes).
+        Some(chain) => chain
+            .windows(2)
+            .filter_map(|p| Some((b.inline.get(p[0])?, b.inline.get(p[1])?)))
+            .map(|(&a, &c)| dist(b.mesh.nodes[a], b.mesh.nodes[c]))
+            .fold(f64::INFINITY, f64::min),
+        // A Gmsh curve set: its extent (the bounding-box diagonal of its nodes).
+        None => {
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            for &n in segs.iter().flatten() {
+                let p = b.mesh.nodes[n];
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+            dist(lo, hi)
+        }
+    };
+    if member.is_finite() && r.is_finite() && member < MIN_FRAME_SLENDERNESS * r {
+        return Err(b.err(
+            field,
+            format!(
+                "a member {} m long with a radius of gyration sqrt(max(iy, iz)/area) = {} m (area = {} m², iy = {} m⁴, iz = {} m⁴) is no beam (L/r = {:.3e} < {}); lengths are in m, area in m², iy, iz, j in m⁴ (a 20 mm square: area = 4e-4, iy = iz = 1.333e-8); a short stiff connection is a rigid link",
+                crate::num(member),
+                crate::num(r),
+                crate::num(f.area),
+                crate::num(f.iy),
+                crate::num(f.iz),
+                member / r,
+                crate::num(MIN_FRAME_SLENDERNESS)
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Two nodes of elements closer than this times the model's size (bounding-box diagonal) are
