@@ -211,3 +211,27 @@ fn bad_added_mass_settings_are_clear_errors() {
         .to_string();
     assert!(e.contains("did you mean `point`"), "{e}");
 }
+
+/// An added mass at a point no mode moves: the root of the clamped cantilever
+/// (`tests/data/eb_cantilever.toml`, ψ(root) = 0 in every mode). Before: accepted, and the
+/// added-mass case was the bare structure (same frequencies, same response) under the name of an
+/// absorber. Now refused at `added_mass.point`; at the tip it reads.
+#[test]
+fn an_added_mass_at_a_point_that_does_not_move_is_refused() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/eb_cantilever.toml");
+    let set = |p: &str| {
+        vec![
+            "added_mass.mass=1.0".to_string(),
+            format!("added_mass.point=\"{p}\""),
+        ]
+    };
+    let e = Model::from_file(&path, &set("root")).unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, Error::Input { .. }), "{msg}");
+    assert!(
+        msg.contains("added_mass.point: 'root' does not move in any retained mode"),
+        "{msg}"
+    );
+    Model::from_file(&path, &set("tip")).unwrap();
+}

@@ -226,3 +226,232 @@ fn node_count_beyond_the_file_is_refused() {
         "{msg}"
     );
 }
+
+/// A model in mm-t-s units (the Euler-Bernoulli cantilever of `tests/data/eb_cantilever.toml`
+/// with nodes in mm, E = 2.1e5 N/mm², ρ = 7.85e-9 t/mm³, A in mm², I in mm⁴) was accepted as SI:
+/// the same frequencies (16.7103 Hz), but a bar of 3.1e-3 "kg" instead of 3.14 kg, effective
+/// masses 0.002 "kg" and a tip flexibility of 0.119 "m/N" (L³/3EI = 1.19e-4 m/N in SI), silently
+/// coupled to the slider's 0.1 kg. Now refused at the material, naming SI; so are E given in MPa
+/// or GPa next to ρ in kg/m³ (wave speed sqrt(E/ρ) 5.2 or 0.16 m/s), in the general model, a
+/// Gmsh mesh and the machine.
+#[test]
+fn materials_in_other_unit_systems_are_refused() {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let si = std::fs::read_to_string(data.join("eb_cantilever.toml")).unwrap();
+    let dir = std::env::temp_dir().join(format!("meid-units-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mm = si
+        .replace("[1.0, 0.0, 0.0]", "[1000.0, 0.0, 0.0]")
+        .replace("youngs_modulus = 2.1e11", "youngs_modulus = 2.1e5")
+        .replace("density = 7850.0", "density = 7.85e-9")
+        .replace(
+            "area = 4.0e-4, iy = 1.3333333333333333e-8, iz = 1.3333333333333333e-8, j = 2.25e-8",
+            "area = 400.0, iy = 13333.333333333334, iz = 13333.333333333334, j = 22500.0",
+        );
+    assert_ne!(mm, si);
+    let mpa = si.replace("youngs_modulus = 2.1e11", "youngs_modulus = 2.1e5");
+    let gpa = si.replace("youngs_modulus = 2.1e11", "youngs_modulus = 210.0");
+    let path = dir.join("m.toml");
+    for (text, key, what) in [
+        (&mm, "structure.fem.model.material.density", "7.85e-9 kg/m³"),
+        (
+            &mpa,
+            "structure.fem.model.material.youngs_modulus",
+            "5.1722e0 m/s",
+        ),
+        (
+            &gpa,
+            "structure.fem.model.material.youngs_modulus",
+            "1.6356e-1 m/s",
+        ),
+    ] {
+        std::fs::write(&path, text).unwrap();
+        let e = meid::model::Model::from_file(&path, &[]).unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, Error::Input { .. }), "{msg}");
+        assert!(
+            msg.contains(key) && msg.contains(what) && msg.contains("SI units"),
+            "{msg}"
+        );
+    }
+    // The SI file still reads.
+    std::fs::write(&path, &si).unwrap();
+    meid::model::Model::from_file(&path, &[]).unwrap();
+    // The machine's materials, through --set.
+    let soft = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/paper-soft-base.toml");
+    for (set, key) in [
+        (
+            "structure.fem.machine.column_material={ youngs_modulus = 2.06e5, poisson_ratio = 0.3, density = 7.85e-9 }",
+            "structure.fem.machine.column_material.density",
+        ),
+        (
+            "structure.fem.machine.bed.material={ youngs_modulus = 2.06e5, poisson_ratio = 0.3, density = 7850.0 }",
+            "structure.fem.machine.bed.material.youngs_modulus",
+        ),
+    ] {
+        let e = meid::model::Model::from_file(&soft, &[set.to_string()]).unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, Error::Input { .. }), "{msg}");
+        assert!(msg.contains(key) && msg.contains("SI units"), "{set}: {msg}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A 4 × 2 quad plate 0.4 × 0.2 m (MSH 2.2), clamped on x = 0 (group "x0"), "tip" the node at
+/// (0.4, 0.1) m, whose middle column of nodes (x = 0.2 m, tags 3, 8, 13) is duplicated when
+/// `crack`: the right half's quads use nodes 16, 17, 18, copies of them (a mesh of two surfaces
+/// Gmsh did not fuse). Point groups "p3", "p8", "p13", "p16", "p17", "p18" name those nodes.
+fn plate_msh(crack: bool) -> String {
+    let (nx, ny) = (4usize, 2usize);
+    let tag = |i: usize, j: usize| j * (nx + 1) + i + 1;
+    let dup = |j: usize| (nx + 1) * (ny + 1) + j + 1;
+    let mut s = String::from("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n9\n");
+    s.push_str("1 1 \"x0\"\n2 2 \"plate\"\n0 3 \"tip\"\n");
+    let named = [3usize, 8, 13, 16, 17, 18];
+    for (k, t) in named.iter().enumerate() {
+        writeln!(s, "0 {} \"p{t}\"", 4 + k).unwrap();
+    }
+    s.push_str("$EndPhysicalNames\n");
+    let n = (nx + 1) * (ny + 1) + ny + 1;
+    writeln!(s, "$Nodes\n{n}").unwrap();
+    for j in 0..=ny {
+        for i in 0..=nx {
+            writeln!(s, "{} {} {} 0", tag(i, j), i as f64 * 0.1, j as f64 * 0.1).unwrap();
+        }
+    }
+    for j in 0..=ny {
+        // Uncut: the copies are placed off the plate (and used by no element).
+        let y = j as f64 * 0.1;
+        let z = if crack { 0.0 } else { 1.0 };
+        writeln!(s, "{} 0.2 {y} {z}", dup(j)).unwrap();
+    }
+    s.push_str("$EndNodes\n");
+    let mut els = Vec::new();
+    for j in 0..ny {
+        els.push(format!("1 2 1 1 {} {}", tag(0, j), tag(0, j + 1)));
+    }
+    els.push(format!("15 2 3 3 {}", tag(nx, 1)));
+    if crack {
+        for (k, t) in named.iter().enumerate() {
+            els.push(format!("15 2 {} {} {t}", 4 + k, 4 + k));
+        }
+    }
+    for j in 0..ny {
+        for i in 0..nx {
+            // The right half (i >= 2) takes the copies of the x = 0.2 m nodes.
+            let c = |ii: usize, jj: usize| {
+                if crack && i >= 2 && ii == 2 {
+                    dup(jj)
+                } else {
+                    tag(ii, jj)
+                }
+            };
+            els.push(format!(
+                "3 2 2 2 {} {} {} {}",
+                c(i, j),
+                c(i + 1, j),
+                c(i + 1, j + 1),
+                c(i, j + 1)
+            ));
+        }
+    }
+    writeln!(s, "$Elements\n{}", els.len()).unwrap();
+    for (k, e) in els.iter().enumerate() {
+        writeln!(s, "{} {e}", k + 1).unwrap();
+    }
+    s.push_str("$EndElements\n");
+    s
+}
+
+/// Duplicate nodes cut a Gmsh plate in two. Before: read without a word; the clamped plate had
+/// six 0 Hz modes (its right half floating), `meid modes` exited 0 with a truncation table of
+/// G_PP = 3.983e-8 m/N, modal "-0.000000e0", share "-0.000 %". Now refused in both the general
+/// model and `[structure.fem.mesh]`, naming the file, both Gmsh node tags and the point; joined
+/// by rigid links (a cut that is meant) it reads, and so does the uncut plate.
+#[test]
+fn coincident_unjoined_nodes_are_refused() {
+    let dir = std::env::temp_dir().join(format!("meid-coincident-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("crack.msh"), plate_msh(true)).unwrap();
+    std::fs::write(dir.join("plate.msh"), plate_msh(false)).unwrap();
+    let tail = r#"[points]
+bed_contact = "O_b"
+measurement = "B"
+[slider]
+mass = 0.1
+velocity = 0.1
+[contact.slider_bed]
+law = "linear"
+stiffness = 1.0e6
+damping = 0.0
+release = "force"
+[simulation]
+method = "exact"
+duration = 0.02
+sample_rate = 20000.0
+"#;
+    let head = "name = \"plate\"\n[structure]\nreference_mode = 1\n[structure.fem]\nselect = [1]\ncount = 4\n";
+    let pts = "points = { O_b = \"tip\", B = \"tip\" }\n";
+    let general = |file: &str, extra: &str| {
+        format!("{head}[structure.fem.model]\nmesh = \"{file}\"\nshells = [{{ set = \"plate\", thickness = 0.01 }}]\nconstraints = [{{ set = \"x0\", dofs = [\"all\"] }}]\n{extra}{pts}{tail}")
+    };
+    let mesh = |file: &str| {
+        format!("{head}[structure.fem.mesh]\nfile = \"{file}\"\nthickness = 0.01\nfixed = [\"x0\"]\n{pts}{tail}")
+    };
+    let path = dir.join("m.toml");
+    for (text, key) in [
+        (general("crack.msh", ""), "structure.fem.model.mesh"),
+        (mesh("crack.msh"), "structure.fem.mesh.file"),
+    ] {
+        std::fs::write(&path, &text).unwrap();
+        let e = meid::model::Model::from_file(&path, &[]).unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, Error::Input { .. }), "{msg}");
+        assert!(
+            msg.contains(key)
+                && msg.contains("node 3 of crack.msh and node 16 of crack.msh")
+                && msg.contains("[0.2, 0, 0] m (3 such pair(s)"),
+            "{msg}"
+        );
+    }
+    let joined = "rigid_links = [{ master = \"p3\", slaves = \"p16\" }, { master = \"p8\", slaves = \"p17\" }, { master = \"p13\", slaves = \"p18\" }]\n";
+    for text in [
+        general("plate.msh", ""),
+        mesh("plate.msh"),
+        general("crack.msh", joined),
+    ] {
+        std::fs::write(&path, &text).unwrap();
+        meid::model::Model::from_file(&path, &[]).unwrap();
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A frame section given in mm² and mm⁴ next to lengths in m (the 1 m cantilever of
+/// `tests/data/eb_cantilever.toml` with `area = 400, iy = iz = 13333.3`): before, accepted as a
+/// 400 m² bar (radius of gyration 5.77 m on a 1 m member) with 16.7103 Hz; now refused at
+/// `frames[0]`, naming L/r and the SI units. The SI section reads.
+#[test]
+fn a_frame_shorter_than_its_radius_of_gyration_is_refused() {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let si = std::fs::read_to_string(data.join("eb_cantilever.toml")).unwrap();
+    let mm = si.replace(
+        "area = 4.0e-4, iy = 1.3333333333333333e-8, iz = 1.3333333333333333e-8, j = 2.25e-8",
+        "area = 400.0, iy = 13333.333333333334, iz = 13333.333333333334, j = 22500.0",
+    );
+    assert_ne!(mm, si);
+    let dir = std::env::temp_dir().join(format!("meid-slender-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("m.toml");
+    std::fs::write(&path, &mm).unwrap();
+    let e = meid::model::Model::from_file(&path, &[]).unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, Error::Input { .. }), "{msg}");
+    assert!(
+        msg.contains("structure.fem.model.frames[0]") && msg.contains("L/r = 1.732e-1"),
+        "{msg}"
+    );
+    std::fs::write(&path, &si).unwrap();
+    meid::model::Model::from_file(&path, &[]).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+}

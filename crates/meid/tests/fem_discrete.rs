@@ -111,3 +111,82 @@ fn rotary_inertia_on_torsion_spring() {
     let modes = FeModel::assemble(mesh).unwrap().solve_dense().unwrap();
     assert!(((modes.omega_rad_per_s[0] / (kt / izz).sqrt()) - 1.0).abs() < 1e-10);
 }
+
+/// A chain of N = 3 equal point masses m on springs k (ground–1–2–3, z only) as a model file:
+/// the fixed-free chain's closed form `ω_j = 2 sqrt(k/m) sin((2j−1)π/(2(2N+1)))` and the static
+/// flexibilities `G_33 = N/k` (the tip), `G_11 = 1/k`, all modes retained (share 1).
+///
+/// Before: a note said the five spring ends "are inf to inf times the stiffness the elements
+/// give those DOFs ... they act as constraints; constrain those DOFs instead" (the springs are
+/// the structure: constraining them leaves nothing), and with `count` ≥ the 3 DOFs a warning
+/// said "the 3 computed modes stop at 28.6787 Hz, below the auto cutoff: modes in between may
+/// be missing; raise structure.fem.count" (every mode of the structure was computed).
+#[test]
+fn spring_mass_chain_from_a_model_file_is_exact_and_unflagged() {
+    let (m, k) = (1.0_f64, 1.0e4_f64);
+    let dir = std::env::temp_dir().join(format!("meid-chain-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("chain.toml");
+    let lateral = r#"dofs = ["ux", "uy", "rx", "ry", "rz"]"#;
+    std::fs::write(
+        &path,
+        format!(
+            r#"name = "chain"
+[structure]
+reference_mode = 1
+[structure.fem]
+select = "auto"
+count = 10
+[structure.fem.model]
+nodes = [[0, 0, 0], [0, 0, 1], [0, 0, 2]]
+sets = {{ a = [0], b = [1], c = [2] }}
+springs = [{{ node = 0, stiffness = [0, 0, {k:e}, 0, 0, 0] }}, {{ node = 0, to = 1, stiffness = [0, 0, {k:e}, 0, 0, 0] }}, {{ node = 1, to = 2, stiffness = [0, 0, {k:e}, 0, 0, 0] }}]
+masses = [{{ node = 0, mass = {m:e} }}, {{ node = 1, mass = {m:e} }}, {{ node = 2, mass = {m:e} }}]
+constraints = [{{ set = "a", {lateral} }}, {{ set = "b", {lateral} }}, {{ set = "c", {lateral} }}]
+points = {{ O_b = "c", B = "a" }}
+[points]
+bed_contact = "O_b"
+measurement = "B"
+[slider]
+mass = 0.1
+velocity = 0.1
+[contact.slider_bed]
+law = "linear"
+stiffness = 1.0e6
+damping = 0.0
+release = "force"
+[simulation]
+method = "exact"
+duration = 0.02
+sample_rate = 20000.0
+"#
+        ),
+    )
+    .unwrap();
+    let (_, an) = meid::model::fem::from_file_with_analysis(&path, &[], None).unwrap();
+    let an = an.unwrap();
+    let n = 3.0;
+    for (j, f) in an.table.frequency_hz.iter().enumerate() {
+        let w = 2.0
+            * (k / m).sqrt()
+            * ((2.0 * (j as f64 + 1.0) - 1.0) * std::f64::consts::PI / (2.0 * (2.0 * n + 1.0)))
+                .sin();
+        let fe = w / (2.0 * std::f64::consts::PI);
+        assert!(close(*f, fe), "mode {}: {f} Hz vs {fe} Hz", j + 1);
+    }
+    assert_eq!(an.table.frequency_hz.len(), 3);
+    assert_eq!(an.selected, vec![0, 1, 2]);
+    let g = &an.modal.static_flexibility;
+    assert!(close(g["O_b"], n / k), "{g:?}");
+    assert!(close(g["B"], 1.0 / k), "{g:?}");
+    assert!(
+        an.modal
+            .notes
+            .iter()
+            .all(|s| !s.contains("act as constraints")),
+        "{:?}",
+        an.modal.notes
+    );
+    assert!(an.modal.warnings.is_empty(), "{:?}", an.modal.warnings);
+    std::fs::remove_dir_all(&dir).ok();
+}

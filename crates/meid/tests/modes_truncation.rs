@@ -416,3 +416,45 @@ fn elastic_convention_matches_the_full_modal_sum() {
     assert_eq!((r0, r1), (3, 0));
     assert!((g0 - g1).abs() <= 1e-10 * g1, "{g0} vs {g1}");
 }
+
+/// `select = "auto"` on a square-section cantilever (`tests/data/eb_cantilever.toml`, 20 modes):
+/// every bending eigenvalue is a pair (y and z bending), whose basis each solver picks its own
+/// way. Before: the dense solver kept modes [2, 3, 4, 6, 7, 8, 10, 13, 14] (one of a pair moving
+/// the tip's z, its partner by 2.4e-5 or nothing) and Lanczos [1, 2, 3, 4, 5, 6, 7, 8, 10, 11,
+/// 13, 14]: the modes kept depended on the solver. Now each pair is kept whole, by both solvers
+/// alike; the captured flexibility is the same (the tip's L³/3EI = 1.190476e-4 m/N, exact).
+#[test]
+fn auto_keeps_a_repeated_eigenvalue_whole_whatever_the_solver() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/eb_cantilever.toml");
+    let run = |solver: &str| {
+        let over = vec![
+            "structure.fem.select=\"auto\"".to_string(),
+            format!("structure.fem.solver=\"{solver}\""),
+        ];
+        let (_, an) = fem::from_file_with_analysis(&path, &over, Some(20)).unwrap();
+        an.unwrap()
+    };
+    let (d, l) = (run("dense"), run("lanczos"));
+    assert_eq!(d.selected, l.selected);
+    // Whole pairs: the bending modes 1-8 (four pairs) and the 10/11 pair, 13/14 pair.
+    assert_eq!(d.selected, vec![0, 1, 2, 3, 4, 5, 6, 7, 9, 10, 12, 13]);
+    let (e, i, len) = (2.1e11_f64, 1.3333333333333333e-8_f64, 1.0_f64);
+    let g = len.powi(3) / (3.0 * e * i);
+    for an in [&d, &l] {
+        let row = &an.modal.truncation(&[("O_b".into(), vec![])])[0];
+        assert!(
+            (row.static_flexibility_m_per_n - g).abs() <= 1e-9 * g,
+            "{row:?}"
+        );
+        assert!(row.captured_share > 0.999, "{row:?}");
+    }
+    let (rd, rl) = (
+        &d.modal.truncation(&[("O_b".into(), vec![])])[0],
+        &l.modal.truncation(&[("O_b".into(), vec![])])[0],
+    );
+    assert!(
+        (rd.modal_flexibility_m_per_n - rl.modal_flexibility_m_per_n).abs()
+            <= 1e-9 * rd.modal_flexibility_m_per_n,
+        "{rd:?} {rl:?}"
+    );
+}

@@ -54,14 +54,16 @@ pub struct TruncationRow {
     pub captured_share: f64,
 }
 
-/// `Σ_{ω_i > 0} ψ_i²/ω_i²` (m/N) for mode-shape values `psi` (1/√kg) and frequencies `omega`.
+/// `Σ_{ω_i > 0} ψ_i²/ω_i²` (m/N) for mode-shape values `psi` (1/√kg) and frequencies `omega`;
+/// `+0` when no retained mode is elastic (summed from `+0.0`: `Iterator::sum` of no `f64` is
+/// `−0.0`, which the table printed as "-0.000000e0" and a share of "-0.000 %").
 pub fn modal_flexibility(omega_rad_per_s: &[f64], psi: &[f64]) -> f64 {
     omega_rad_per_s
         .iter()
         .zip(psi)
         .filter(|(w, _)| **w > 0.0)
         .map(|(w, p)| p * p / (w * w))
-        .sum()
+        .fold(0.0, |acc, x| acc + x)
 }
 
 impl ModalModel {
@@ -273,6 +275,26 @@ mod tests {
     fn sparse(n: usize, e: &[(usize, usize, f64)]) -> SparseColMat<usize, f64> {
         let t: Vec<_> = e.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
         SparseColMat::try_new_from_triplets(n, n, &t).unwrap()
+    }
+
+    /// Only rigid-body modes retained (a free piece of a mesh cut by duplicate nodes kept its
+    /// six 0 Hz modes): the modal flexibility is +0 and the table prints "0.000000e0" and
+    /// "0.000 %", not the "-0.000000e0" / "-0.000 %" an empty `f64` sum (−0.0) gave.
+    #[test]
+    fn no_elastic_mode_retained_is_a_positive_zero() {
+        let m = modal_flexibility(&[0.0, 0.0], &[0.9, 0.7]);
+        assert!(m == 0.0 && m.is_sign_positive(), "{m:?}");
+        let g = 3.983281e-8;
+        let row = TruncationRow {
+            point: "O_b".into(),
+            roles: vec!["bed_contact".into()],
+            static_flexibility_m_per_n: g,
+            modal_flexibility_m_per_n: m,
+            captured_share: m / g,
+        };
+        let text = to_text(&[row]);
+        assert!(!text.contains("-0"), "{text}");
+        assert!(text.contains(" 0.000 %"), "{text}");
     }
 
     /// Fixed-free chain of three springs k: the tip flexibility is 3/k, the middle 2/k.

@@ -778,6 +778,81 @@ pub(super) fn check_material(m: &MaterialSpec, field: &str, src: &Source) -> Res
             return Err(src.error(&f, format!("{f} must be {range} (got {})", crate::num(v))));
         }
     }
+    check_material_units(m, field, src)
+}
+
+/// Lightest solid meid accepts as a structural density, kg/m³ (silica aerogel, the lightest
+/// solid made, is ~1 kg/m³; steel 7850).
+pub const MIN_SOLID_DENSITY_KG_PER_M3: f64 = 1.0;
+/// Range of the bar wave speed `c = sqrt(E/ρ)` of solids, m/s: soft rubber ~30 m/s (E = 1 MPa,
+/// ρ = 1100 kg/m³), diamond ~17,300 m/s (E = 1050 GPa, ρ = 3510 kg/m³), steel 5,100 m/s.
+pub const SOLID_WAVE_SPEED_RANGE_M_PER_S: [f64; 2] = [10.0, 2.0e4];
+
+/// Refuses a material (given as valid positive numbers) whose values are those of another unit
+/// system: meid's FE models are SI (m, kg, Pa, kg/m³), and a model in mm-t-s (steel:
+/// E = 2.1e5 N/mm², ρ = 7.85e-9 t/mm³), or with E in MPa or GPa next to ρ in kg/m³, gives the
+/// same frequencies as in SI when every input follows the same system, but masses, effective
+/// masses, flexibilities and the coupling to the slider's and damper's kg and m/s wrong by powers
+/// of 1000. Checked: `ρ ≥ MIN_SOLID_DENSITY_KG_PER_M3` and the bar wave speed
+/// `c = sqrt(E/ρ)` within [`SOLID_WAVE_SPEED_RANGE_M_PER_S`] (mm-t-s steel: c = 5.2e6 "m/s";
+/// E in MPa with ρ in kg/m³: c = 5.2 m/s).
+pub(super) fn check_material_units(m: &MaterialSpec, field: &str, src: &Source) -> Result<()> {
+    let si = "meid's FE models are in SI units: m, kg, s, N, Pa, kg/m³ (steel: youngs_modulus = 2.1e11, density = 7850); a model in mm-t-s (E = 2.1e5, density = 7.85e-9) must be converted";
+    if m.density < MIN_SOLID_DENSITY_KG_PER_M3 {
+        let f = format!("{field}.density");
+        return Err(src.error(
+            &f,
+            format!(
+                "{f} = {} kg/m³ is lighter than any solid (>= {} kg/m³); {si}",
+                crate::num(m.density),
+                crate::num(MIN_SOLID_DENSITY_KG_PER_M3)
+            ),
+        ));
+    }
+    let c = (m.youngs_modulus / m.density).sqrt();
+    let [lo, hi] = SOLID_WAVE_SPEED_RANGE_M_PER_S;
+    if !(lo..=hi).contains(&c) {
+        let f = format!("{field}.youngs_modulus");
+        return Err(src.error(
+            &f,
+            format!(
+                "{f} = {} Pa with density = {} kg/m³ gives a wave speed sqrt(E/ρ) = {c:.4e} m/s, outside that of solids ({lo:e} to {hi:e} m/s); {si}",
+                crate::num(m.youngs_modulus),
+                crate::num(m.density)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The unit check of [`check_material_units`] on the materials of a `[structure.fem.machine]`
+/// (`material`, `column_material`, `bed.material`, `base.material`). A material whose values are
+/// not positive is left to the machine's own validation, which names it.
+fn check_machine_units(m: &MachineFileSpec, src: &Source) -> Result<()> {
+    let base = "structure.fem.machine";
+    let mats = [
+        (m.material.as_ref(), format!("{base}.material")),
+        (
+            m.column_material.as_ref(),
+            format!("{base}.column_material"),
+        ),
+        (
+            m.bed.as_ref().and_then(|b| b.material.as_ref()),
+            format!("{base}.bed.material"),
+        ),
+        (
+            m.base.as_ref().and_then(|b| b.material.as_ref()),
+            format!("{base}.base.material"),
+        ),
+    ];
+    for (mat, field) in mats {
+        if let Some(mat) = mat {
+            let positive = |v: f64| v.is_finite() && v > 0.0;
+            if positive(mat.density) && positive(mat.youngs_modulus) {
+                check_material_units(mat, &field, src)?;
+            }
+        }
+    }
     Ok(())
 }
 
@@ -808,12 +883,28 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
         ));
     }
     let mut mesh = Mesh::new();
-    g.add_to_mesh(
-        &mut mesh,
-        material(&ms.material, Material::STEEL),
-        ms.thickness,
-    )
-    .map_err(|e| src.error(&format!("{base}.file"), format!("{}: {e}", path.display())))?;
+    let map = g
+        .add_to_mesh(
+            &mut mesh,
+            material(&ms.material, Material::STEEL),
+            ms.thickness,
+        )
+        .map_err(|e| src.error(&format!("{base}.file"), format!("{}: {e}", path.display())))?;
+    let pairs = super::general::coincident_node_pairs(&mesh);
+    if let Some(&(i, j)) = pairs.first() {
+        let name = |m: usize| match map.iter().position(|&x| x == Some(m)) {
+            Some(k) => format!("node {} of {}", g.node_tags[k], ms.file),
+            None => format!("node {m}"),
+        };
+        let f = format!("{base}.file");
+        return Err(src.error(
+            &f,
+            format!(
+                "{f}: {}",
+                super::general::coincident_message(&name(i), &name(j), mesh.nodes[i], pairs.len())
+            ),
+        ));
+    }
     let group = |name: &str, field: &str, mesh: &Mesh| -> Result<Vec<usize>> {
         mesh.point(name)
             .map(|v| v.to_vec())
@@ -873,6 +964,7 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
 /// ([`MachineSpec::generate`]); errors name the machine's fields.
 pub fn machine_general(m: &MachineFileSpec, src: &Source) -> Result<super::general::GeneralSpec> {
     let field = "structure.fem.machine";
+    check_machine_units(m, src)?;
     machine_spec(m)
         .and_then(|ms| ms.generate())
         .map(|g| g.spec)
@@ -885,6 +977,7 @@ pub fn build_model(spec: &FemSpec, src: &Source) -> Result<FeModel> {
         (None, None, Some(g)) => super::general::build(g, src),
         (Some(m), None, None) => {
             let field = "structure.fem.machine";
+            check_machine_units(m, src)?;
             let ms = machine_spec(m).map_err(|e| locate(e, field, src, Some(m)))?;
             ms.build()
                 .map(|mach| mach.model)
@@ -1349,6 +1442,7 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
                 points: &score_points,
                 psi: &psi,
                 static_flexibility: &static_flexibility,
+                n_dofs: model.n_dofs(),
             },
             warnings,
         )
@@ -1523,6 +1617,37 @@ fn sparse_residuals(model: &FeModel, modes: &DenseModes, which: &[usize]) -> Vec
         .collect()
 }
 
+/// Relative gap `|ω_i − ω_j| ≤ DEGENERATE_TOLERANCE · ω_j` under which two modes share an
+/// eigenvalue (a repeated eigenvalue of a symmetric structure comes out of either solver with
+/// a spread of ~1e-12; the closest distinct pair of the tests, FV2's 17.6808/17.7094 Hz, is
+/// 1.6e-3 apart).
+pub const DEGENERATE_TOLERANCE: f64 = 1e-8;
+
+/// For each mode (ascending ω), the range of modes sharing its eigenvalue: consecutive modes
+/// within [`DEGENERATE_TOLERANCE`] of the cluster's first, or all rigid-body modes (ω = 0).
+fn degenerate_clusters(omega: &[f64]) -> Vec<std::ops::Range<usize>> {
+    let n = omega.len();
+    let mut out = vec![0..0; n];
+    let mut start = 0;
+    while start < n {
+        let w0 = omega[start];
+        let mut end = start + 1;
+        while end < n && (omega[end] - w0).abs() <= DEGENERATE_TOLERANCE * omega[end].abs() {
+            end += 1;
+        }
+        if w0 == 0.0 {
+            while end < n && omega[end] == 0.0 {
+                end += 1;
+            }
+        }
+        for r in out.iter_mut().take(end).skip(start) {
+            *r = start..end;
+        }
+        start = end;
+    }
+    out
+}
+
 /// What [`auto_select`] ranks modes by.
 struct AutoInput<'a> {
     scores: &'a [f64],
@@ -1531,6 +1656,8 @@ struct AutoInput<'a> {
     points: &'a [String],
     psi: &'a BTreeMap<String, Vec<f64>>,
     static_flexibility: &'a BTreeMap<String, f64>,
+    /// DOFs of the reduced model: as many modes as the structure has.
+    n_dofs: usize,
 }
 
 /// `select = "auto"` (module docs): every participating mode up to the cutoff, then, above it,
@@ -1576,18 +1703,25 @@ fn auto_select(
         .iter()
         .map(|(p, v)| (p, v.iter().fold(0.0_f64, |x, y| x.max(y * y))))
         .collect();
-    let moves = |i: usize| {
+    let moves_alone = |i: usize| {
         a.psi
             .iter()
             .any(|(p, v)| v[i] * v[i] > NEGLIGIBLE_SCORE * peak[p])
     };
+    // A repeated eigenvalue's modes are one eigenspace, in which each solver returns its own
+    // basis (the square cantilever's bending pair: one mode moving the tip's z and one not, or
+    // both moving it): the space is kept or left out whole, so that what is kept does not
+    // depend on the basis (dense selected 9 modes, Lanczos 12, of the same 20).
+    let cluster = degenerate_clusters(a.omega);
+    let moves = |i: usize| cluster[i].clone().any(moves_alone);
     // Shares are checked at every point of the truncation table (the role points) and at the
     // score points.
     let share_points: Vec<&String> = a.psi.keys().collect();
     let mut selected: Vec<usize> = (0..nm)
         .filter(|&i| a.freq[i] <= cutoff_hz && moves(i))
         .collect();
-    if nm > 0 && a.freq[nm - 1] < cutoff_hz {
+    // Every mode of the structure computed (nm = DOFs): none can be missing.
+    if nm > 0 && nm < a.n_dofs && a.freq[nm - 1] < cutoff_hz {
         warnings.push(format!(
             "{base}.count: the {nm} computed modes stop at {:.4} Hz, below the \"auto\" cutoff \
              {cutoff_hz:.4} Hz ({AUTO_CUTOFF_FACTOR} times the highest contact frequency): \
@@ -1626,14 +1760,22 @@ fn auto_select(
     let limit = spec.auto_count.unwrap_or(usize::MAX);
     let mut added = 0;
     for i in extra {
+        if selected.contains(&i) {
+            continue;
+        }
         let short = share_points
             .iter()
             .any(|p| share(&selected, p).is_some_and(|s| s < truncation::SHARE_WARNING));
         if !short || added >= limit {
             break;
         }
-        selected.push(i);
-        added += 1;
+        // The whole eigenspace of a repeated eigenvalue.
+        for j in cluster[i].clone() {
+            if !selected.contains(&j) {
+                selected.push(j);
+                added += 1;
+            }
+        }
     }
     if selected.is_empty() {
         return Err(src.error(

@@ -651,6 +651,7 @@ pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> 
                 ));
             }
         }
+        check_slenderness(&b, &field, f, &segs)?;
         let mut rel: Vec<[[bool; 6]; 2]> = vec![[[false; 6]; 2]; segs.len()];
         for (ri, r) in f.releases.iter().enumerate() {
             let rfield = format!("{field}.releases[{ri}]");
@@ -810,5 +811,201 @@ pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> 
     if !(norm.is_finite() && norm > 0.0) {
         return Err(b.err("impact_direction", "must be a nonzero finite vector"));
     }
+    check_coincident_nodes(&b, spec)?;
     Ok((b.mesh, [d[0] / norm, d[1] / norm, d[2] / norm]))
+}
+
+/// Least slenderness `L/r` of a frame member (`r = sqrt(max(iy, iz)/area)` its radius of
+/// gyration): a member shorter than its radius of gyration is no beam (Euler-Bernoulli needs
+/// `L/r` of ~10 and more; the paper's columns have 31, NAFEMS FV2's arms 139); such a section is
+/// a unit slip (area in mm² or I in m⁴ next to lengths in m: `area = 400, iy = 13333` on a 1 m
+/// member gives `L/r = 0.17`).
+pub const MIN_FRAME_SLENDERNESS: f64 = 1.0;
+
+/// Refuses a frame entry whose member (an inline chain's segment `nodes[k]`–`nodes[k+1]`, or a
+/// Gmsh curve set's extent) is shorter than [`MIN_FRAME_SLENDERNESS`] radii of gyration.
+fn check_slenderness(
+    b: &Builder<'_>,
+    field: &str,
+    f: &FrameSpec,
+    segs: &[[usize; 2]],
+) -> Result<()> {
+    let r = (f.iy.max(f.iz) / f.area).sqrt();
+    let dist = |a: [f64; 3], c: [f64; 3]| (0..3).map(|k| (a[k] - c[k]).powi(2)).sum::<f64>().sqrt();
+    let member = match &f.nodes {
+        // The shortest member of the chain (segments between consecutive given nodes).
+        Some(chain) => chain
+            .windows(2)
+            .filter_map(|p| Some((b.inline.get(p[0])?, b.inline.get(p[1])?)))
+            .map(|(&a, &c)| dist(b.mesh.nodes[a], b.mesh.nodes[c]))
+            .fold(f64::INFINITY, f64::min),
+        // A Gmsh curve set: its extent (the bounding-box diagonal of its nodes).
+        None => {
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            for &n in segs.iter().flatten() {
+                let p = b.mesh.nodes[n];
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+            dist(lo, hi)
+        }
+    };
+    if member.is_finite() && r.is_finite() && member < MIN_FRAME_SLENDERNESS * r {
+        return Err(b.err(
+            field,
+            format!(
+                "a member {} m long with a radius of gyration sqrt(max(iy, iz)/area) = {} m (area = {} m², iy = {} m⁴, iz = {} m⁴) is no beam (L/r = {:.3e} < {}); lengths are in m, area in m², iy, iz, j in m⁴ (a 20 mm square: area = 4e-4, iy = iz = 1.333e-8); a short stiff connection is a rigid link",
+                crate::num(member),
+                crate::num(r),
+                crate::num(f.area),
+                crate::num(f.iy),
+                crate::num(f.iz),
+                member / r,
+                crate::num(MIN_FRAME_SLENDERNESS)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Two nodes of elements closer than this times the model's size (bounding-box diagonal) are
+/// the same point.
+pub const COINCIDENT_NODE_TOLERANCE: f64 = 1e-9;
+
+/// Refuses two element nodes at the same point (within [`COINCIDENT_NODE_TOLERANCE`] × the
+/// bounding-box diagonal) that no spring, dashpot or rigid link joins: the elements on either
+/// side share no DOF there, so the structure is cut along them (a Gmsh mesh of surfaces that
+/// were not fused, or whose duplicate nodes were not removed). Such a cut left the free part of a
+/// clamped plate with six 0 Hz modes and a truncation table over them. The error names both
+/// nodes (Gmsh tags or `nodes[i]`), where they are and what to do.
+fn check_coincident_nodes(b: &Builder<'_>, spec: &GeneralSpec) -> Result<()> {
+    let pairs = coincident_node_pairs(&b.mesh);
+    let Some(&(i, j)) = pairs.first() else {
+        return Ok(());
+    };
+    // A mesh node's name in the input: `nodes[k]` (inline), Gmsh node tag, or a frame's
+    // `divisions` node.
+    let name = |m: usize| -> String {
+        if let Some(k) = b.inline.iter().position(|&x| x == m) {
+            return format!("nodes[{k}]");
+        }
+        if let (Some(g), Some(k)) = (&b.gmsh, b.gmap.iter().position(|&x| x == Some(m))) {
+            return format!(
+                "node {} of {}",
+                g.node_tags[k],
+                spec.mesh.as_deref().unwrap_or("the mesh")
+            );
+        }
+        format!("node {m} (made by a frame's `divisions`)")
+    };
+    let field = if spec.mesh.is_some() { "mesh" } else { "nodes" };
+    Err(b.err(
+        field,
+        coincident_message(&name(i), &name(j), b.mesh.nodes[i], pairs.len()),
+    ))
+}
+
+/// The error text for coincident nodes `a` and `b` at `p` (`count` pairs in all).
+pub(super) fn coincident_message(a: &str, b: &str, p: [f64; 3], count: usize) -> String {
+    format!(
+        "{a} and {b} are at the same point [{}, {}, {}] m ({count} such pair(s) in all) but no element, spring or rigid link joins them: the structure is cut there. Merge them (Gmsh: fuse the surfaces, or `Coherence Mesh;` / gmsh.model.mesh.removeDuplicateNodes() before saving), or join them with `rigid_links` or `springs` if the cut is meant",
+        crate::num(p[0]),
+        crate::num(p[1]),
+        crate::num(p[2]),
+    )
+}
+
+/// Pairs `(i, j)`, `i < j`, ascending, of nodes of elements (frames, shells, triangles) within
+/// [`COINCIDENT_NODE_TOLERANCE`] × the bounding-box diagonal of each other that no spring,
+/// dashpot or rigid link joins.
+pub(super) fn coincident_node_pairs(mesh: &Mesh) -> Vec<(usize, usize)> {
+    let n = mesh.nodes.len();
+    let mut in_element = vec![false; n];
+    for f in &mesh.frames {
+        f.nodes.iter().for_each(|&i| in_element[i] = true);
+    }
+    for s in &mesh.shells {
+        s.nodes.iter().for_each(|&i| in_element[i] = true);
+    }
+    for t in &mesh.triangles {
+        t.nodes.iter().for_each(|&i| in_element[i] = true);
+    }
+    let nodes: Vec<usize> = (0..n).filter(|&i| in_element[i]).collect();
+    if nodes.len() < 2 {
+        return Vec::new();
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for &i in &nodes {
+        for k in 0..3 {
+            lo[k] = lo[k].min(mesh.nodes[i][k]);
+            hi[k] = hi[k].max(mesh.nodes[i][k]);
+        }
+    }
+    let diag = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    if !(diag.is_finite() && diag > 0.0) {
+        return Vec::new();
+    }
+    let tol = COINCIDENT_NODE_TOLERANCE * diag;
+    // Grid of cells of side `tol`: a pair within `tol` lies in neighbouring cells.
+    let cell = |p: [f64; 3]| -> [i64; 3] {
+        std::array::from_fn(|k| ((p[k] - lo[k]) / tol).floor() as i64)
+    };
+    let mut grid: std::collections::HashMap<[i64; 3], Vec<usize>> =
+        std::collections::HashMap::new();
+    for &i in &nodes {
+        grid.entry(cell(mesh.nodes[i])).or_default().push(i);
+    }
+    let mut joined: std::collections::HashSet<(usize, usize)> = std::collections::HashSet::new();
+    let mut join = |a: usize, c: usize| {
+        joined.insert((a.min(c), a.max(c)));
+    };
+    for s in &mesh.springs {
+        if let Some(o) = s.other {
+            join(s.node, o);
+        }
+    }
+    for d in &mesh.dashpots {
+        if let Some(o) = d.other {
+            join(d.node, o);
+        }
+    }
+    for l in &mesh.rigid_links {
+        let all: Vec<usize> = std::iter::once(l.master)
+            .chain(l.slaves.iter().copied())
+            .collect();
+        for (x, &a) in all.iter().enumerate() {
+            for &c in &all[x + 1..] {
+                join(a, c);
+            }
+        }
+    }
+    let mut pairs: Vec<(usize, usize)> = Vec::new();
+    for &i in &nodes {
+        let c = cell(mesh.nodes[i]);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let Some(v) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else {
+                        continue;
+                    };
+                    for &j in v {
+                        if j <= i {
+                            continue;
+                        }
+                        let dist = (0..3)
+                            .map(|k| (mesh.nodes[i][k] - mesh.nodes[j][k]).powi(2))
+                            .sum::<f64>()
+                            .sqrt();
+                        if dist <= tol && !joined.contains(&(i, j)) {
+                            pairs.push((i, j));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    pairs.sort_unstable();
+    pairs
 }

@@ -279,6 +279,21 @@ impl Model {
                 ));
             }
         }
+        // An added mass at a point no retained mode moves (a clamped support: ψ = 0 in every
+        // mode) changes nothing; the added-mass case would silently be the bare machine.
+        if let Some(point) = s.added_mass.as_ref().and_then(|a| a.point.as_ref()) {
+            if let Some(psi) = self.structure.points.get(point) {
+                if psi.iter().all(|v| *v == 0.0) {
+                    return Err(src.error(
+                        "added_mass.point",
+                        format!(
+                            "added_mass.point: '{point}' does not move in any retained mode (ψ = 0 along the impact direction in all {} of them: a fixed support), so a mass there changes nothing and the added-mass case would be the bare structure; give a point that moves",
+                            psi.len()
+                        ),
+                    ));
+                }
+            }
+        }
         check_magnitudes(s, src)?;
         let (m_s, v_s) = (s.slider.mass, s.slider.velocity);
         let e_s = 0.5 * m_s * v_s * v_s;

@@ -596,7 +596,7 @@ pub struct StiffSpring {
     /// The spring's stiffness (N/m or N·m/rad).
     pub stiffness: f64,
     /// `k / K_own`, K_own the diagonal stiffness of the elements (not the springs) at the DOF;
-    /// infinite when the elements give none.
+    /// when the elements give none, `k / (K_ii − k)`, the other springs' stiffness there.
     pub ratio: f64,
 }
 
@@ -609,7 +609,10 @@ impl FeModel {
     /// `≲ 1/ratio` of what the structure alone would let it, i.e. the spring acts as a constraint,
     /// and its stiffness only spreads the spectrum (the eigenvalues it adds are ~`k/m` of the
     /// node, far above the structure's). DOFs that are not independent (fixed, rigid-link
-    /// slaves) are skipped. Sorted by descending ratio.
+    /// slaves) are skipped. On a DOF no element stiffens, the spring is compared with the other
+    /// springs there, `k / (K_ii − k) ≥ ratio`; a spring that is the DOF's only stiffness is
+    /// never a constraint (without it the DOF is a mechanism: a chain of point masses and
+    /// springs). Sorted by descending ratio.
     pub fn constraint_like_springs(&self, ratio: f64) -> Vec<StiffSpring> {
         let n = self.n_dofs();
         let mut diag = vec![0.0; n];
@@ -643,7 +646,19 @@ impl FeModel {
                 } else {
                     0.0
                 };
-                let r = if own > 0.0 { k / own } else { f64::INFINITY };
+                // No element stiffens the DOF (a discrete spring-mass model, a point mass on a
+                // spring): compared with the other springs there, `K_ii − k`. A spring that is
+                // the DOF's only stiffness holds what would be a mechanism: no constraint.
+                let r = if own > 0.0 {
+                    k / own
+                } else {
+                    let other = diag[j] - k;
+                    if other > f64::EPSILON * diag[j] {
+                        k / other
+                    } else {
+                        0.0
+                    }
+                };
                 (r >= ratio).then_some(StiffSpring {
                     spring,
                     node,
