@@ -918,8 +918,8 @@ pub(super) fn coincident_message(a: &str, b: &str, p: [f64; 3], count: usize) ->
 }
 
 /// Pairs `(i, j)`, `i < j`, ascending, of nodes of elements (frames, shells, triangles) within
-/// [`COINCIDENT_NODE_TOLERANCE`] × the bounding-box diagonal of each other that no spring,
-/// dashpot or rigid link joins.
+/// [`COINCIDENT_NODE_TOLERANCE`] × the bounding-box diagonal of each other that no chain of
+/// springs, dashpots or rigid links connects.
 pub(super) fn coincident_node_pairs(mesh: &Mesh) -> Vec<(usize, usize)> {
     let n = mesh.nodes.len();
     let mut in_element = vec![false; n];
@@ -957,9 +957,21 @@ pub(super) fn coincident_node_pairs(mesh: &Mesh) -> Vec<(usize, usize)> {
     for &i in &nodes {
         grid.entry(cell(mesh.nodes[i])).or_default().push(i);
     }
-    let mut joined: std::collections::HashSet<(usize, usize)> = std::collections::HashSet::new();
+    // Nodes joined by springs, dashpots or rigid links, as connected groups (union-find with
+    // path halving): a rigid link of `s` slaves costs `s` unions, not `s²/2` pairs.
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
     let mut join = |a: usize, c: usize| {
-        joined.insert((a.min(c), a.max(c)));
+        if a < n && c < n {
+            let (ra, rc) = (root(&mut parent, a), root(&mut parent, c));
+            parent[ra.max(rc)] = ra.min(rc);
+        }
     };
     for s in &mesh.springs {
         if let Some(o) = s.other {
@@ -972,13 +984,8 @@ pub(super) fn coincident_node_pairs(mesh: &Mesh) -> Vec<(usize, usize)> {
         }
     }
     for l in &mesh.rigid_links {
-        let all: Vec<usize> = std::iter::once(l.master)
-            .chain(l.slaves.iter().copied())
-            .collect();
-        for (x, &a) in all.iter().enumerate() {
-            for &c in &all[x + 1..] {
-                join(a, c);
-            }
+        for &c in &l.slaves {
+            join(l.master, c);
         }
     }
     let mut pairs: Vec<(usize, usize)> = Vec::new();
@@ -998,7 +1005,7 @@ pub(super) fn coincident_node_pairs(mesh: &Mesh) -> Vec<(usize, usize)> {
                             .map(|k| (mesh.nodes[i][k] - mesh.nodes[j][k]).powi(2))
                             .sum::<f64>()
                             .sqrt();
-                        if dist <= tol && !joined.contains(&(i, j)) {
+                        if dist <= tol && root(&mut parent, i) != root(&mut parent, j) {
                             pairs.push((i, j));
                         }
                     }
