@@ -260,3 +260,75 @@ fn compare_refuses_frequencies_below_the_record_resolution() {
     assert!(out.contains("0.14-0.18"), "{out}");
     assert!(!out.contains(" 0 Hz") && !out.contains("0.0-0.0"), "{out}");
 }
+
+/// `meid blows` printed the last blow's levels as "the steady" levels to 4 decimals: 110.5651 N
+/// after 10 blows, 110.5272 N after 40 (the train still moving by 0.08 N a blow). It now says
+/// they are blow N's levels, an estimate, with the last blow-to-blow change beside them; that
+/// change bounds the distance to the 40-blow level here.
+#[test]
+fn blows_steady_levels_are_given_as_estimates_with_their_last_change() {
+    let e = example();
+    let text = ok(meid()
+        .args(["blows", &e, "--blows", "10"])
+        .output()
+        .unwrap());
+    let line = text
+        .lines()
+        .find(|l| l.contains("steady"))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(line.contains("blow 10's levels, an estimate"), "{line}");
+    let after = |key: &str| -> (f64, f64) {
+        let rest = &line[line.find(key).unwrap() + key.len()..];
+        let mut w = rest.split_whitespace();
+        let level: f64 = w.next().unwrap().parse().unwrap();
+        w.next(); // unit
+        assert_eq!(w.next(), Some("±"), "{line}");
+        (level, w.next().unwrap().parse().unwrap())
+    };
+    let (force, df) = after("floor force ");
+    let (acc, da) = after("bed acceleration ");
+    let j = ok_json(
+        meid()
+            .args(["blows", &e, "--blows", "40", "--json"])
+            .output()
+            .unwrap(),
+    );
+    let f40 = j["steady"]["peak_floor_force_n"].as_f64().unwrap();
+    let a40 = j["steady"]["peak_bed_acceleration_m_per_s2"]
+        .as_f64()
+        .unwrap();
+    assert!((force - 110.5651).abs() < 1e-4 && (f40 - 110.5272).abs() < 1e-4);
+    assert!((force - f40).abs() <= df, "{force} ± {df} vs {f40}");
+    assert!((acc - a40).abs() <= da, "{acc} ± {da} vs {a40}");
+}
+
+/// A rate so low that one blow alone exceeds the run-length limit used to say "Reduce the
+/// number of blows (--blows) to at most 0"; it now names the rate to give.
+#[test]
+fn blows_too_slow_a_rate_names_the_lowest_valid_rate() {
+    let e = example();
+    let err = refused(&["blows", &e, "--rate-bpm", "0.0001", "--blows", "3"]);
+    assert!(!err.contains("at most 0"), "{err}");
+    assert!(err.contains("Give --rate-bpm at least"), "{err}");
+    let r_min: f64 = err
+        .rsplit("at least ")
+        .next()
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    // The rate named runs (one blow of 60/R_min s is within the limit).
+    let o = meid()
+        .args([
+            "blows",
+            &e,
+            "--rate-bpm",
+            &r_min.to_string(),
+            "--blows",
+            "1",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+}

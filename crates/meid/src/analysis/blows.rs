@@ -281,6 +281,27 @@ pub fn run_blows_progress(
     // ([`integrate::check_cost`]) over its whole simulated time `N · T`.
     if let Some((rate, what)) = integrate::fastest_rate(sys) {
         let periods = blow.blows as f64 * interval * rate / (2.0 * std::f64::consts::PI);
+        if periods > integrate::MAX_PERIODS
+            && interval * rate / (2.0 * std::f64::consts::PI) > integrate::MAX_PERIODS
+        {
+            // One blow alone is too long: the rate is too low (more blows would not help).
+            let t_max = integrate::MAX_PERIODS * 2.0 * std::f64::consts::PI / rate;
+            let r_min = 60.0 / t_max;
+            let scale = 10f64.powi(3 - r_min.log10().floor() as i32);
+            let r_min = (r_min * scale).ceil() / scale;
+            return Err(Error::invalid(
+                "stroke rate (--rate-bpm)",
+                format!(
+                    "one blow every {interval} s (--rate-bpm {}) would span {:.2e} periods of \
+                     the fastest time scale (2π/{rate:.3e} s, set by {what}); the limit is {:e} \
+                     per run. Give --rate-bpm at least {}",
+                    crate::num(blow.rate_bpm),
+                    interval * rate / (2.0 * std::f64::consts::PI),
+                    integrate::MAX_PERIODS,
+                    crate::num(r_min)
+                ),
+            ));
+        }
         if periods > integrate::MAX_PERIODS {
             return Err(Error::invalid(
                 "blows",
