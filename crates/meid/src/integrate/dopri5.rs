@@ -1469,7 +1469,8 @@ pub fn solve_from(
     };
 
     // Emit t = 0.
-    if let Some(g) = grid.as_mut() {
+    // (With a phase φ > 0 the first sample, at φ, comes from the steps.)
+    if let Some(g) = grid.as_mut().filter(|g| g.phase == 0.0) {
         obs.sample(0.0, &y[..nx], mode);
         g.next = 1;
     }
