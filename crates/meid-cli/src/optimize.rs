@@ -42,7 +42,7 @@ pub struct OptimizeArgs {
     #[arg(long, value_name = "N")]
     max_simulations: Option<usize>,
     /// Points per variable of the grid searched before the local refinement, both bounds
-    /// included (N^n simulations for n variables; default 33 for two variables, 15 for three,
+    /// included (N^n simulations for n variables; default 33 for two variables, 16 for three,
     /// 9 for one: the scan before Brent). A basin narrower than about two grid cells can be
     /// missed; a larger N costs N^n simulations.
     #[arg(long, value_name = "N")]

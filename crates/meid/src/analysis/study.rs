@@ -13,7 +13,7 @@
 //!   Brent, a local method, against the other local minima of impact metrics.
 //! * Several (n): a global search in the box, [`super::optimize::minimize_box_global`]: a
 //!   grid of `N` points per variable evenly spaced in the search coordinate, both bounds
-//!   included (`Nⁿ` simulations, [`default_grid_points`]: 33 per variable for two, 15 for
+//!   included (`Nⁿ` simulations, [`default_grid_points`]: 33 per variable for two, 16 for
 //!   three; run in parallel, the result independent of the thread count), then the bounded
 //!   Nelder-Mead with restarts and coordinate polish of [`super::optimize::minimize_box`]
 //!   from each of the best [`GLOBAL_STARTS`] grid points lower than all their grid
@@ -67,8 +67,8 @@ pub const MAX_GRID_SIMULATIONS: usize = 1_000_000;
 pub const LOCAL_BUDGET: usize = 800;
 
 /// Grid points per variable when none are given: [`SCAN_POINTS`] for one variable; for n ≥ 2
-/// the largest `N ≤ 33` with `Nⁿ ≤ 4096` (33 for two variables, 1089 simulations; 15 for
-/// three, 3375), at least 3.
+/// the largest `N ≤ 33` with `Nⁿ ≤ 4096` (33 for two variables, 1089 simulations; 16 for
+/// three, 4096), at least 3.
 pub fn default_grid_points(n: usize) -> usize {
     if n <= 1 {
         return SCAN_POINTS;
