@@ -19,7 +19,7 @@ fn example() -> String {
     paper_example().display().to_string()
 }
 
-/// `blows --rate-bpm 1e6`: a blow every 50 µs (1e6 /min, rounded to one sample at 20 kHz)
+/// `blows --rate-bpm 1e6`: a blow every 60 µs (1e6 /min; the interval is 60/R exactly)
 /// against a collision of 0.678 ms used to exit 0 with "—" for every η and negative gaps.
 /// Now exit 2 naming the interval, the collision's duration and the largest valid rate; the
 /// duration printed is the end of blow 1's collision that a train at that largest rate
@@ -30,20 +30,21 @@ fn blows_refuses_a_stroke_interval_shorter_than_the_collision() {
     let e = example();
     let err = refused(&["blows", &e, "--rate-bpm", "1e6", "--blows", "4"]);
     assert!(err.contains("shorter than the collision"), "{err}");
-    assert!(err.contains("a blow every 5e-5 s"), "{err}");
+    assert!(err.contains("a blow every 6e-5 s"), "{err}");
     assert!(err.contains("--rate-bpm 1000000"), "{err}");
     assert!(err.contains("lasts 0.00067811 s"), "{err}");
-    assert!(err.contains("at most 85710"), "{err}");
+    // 60 / 6.7811e-4 s = 88481 /min, rounded down to 4 digits.
+    assert!(err.contains("at most 88480"), "{err}");
     let j = ok_json(
         meid()
-            .args(["blows", &e, "--rate-bpm", "85710", "--blows", "4", "--json"])
+            .args(["blows", &e, "--rate-bpm", "88480", "--blows", "4", "--json"])
             .output()
             .unwrap(),
     );
     let blows = j["blows"].as_array().unwrap();
     let t_c = blows[0]["collision_end_s"].as_f64().unwrap();
     assert!((t_c - 6.7811e-4).abs() < 5e-9, "collision end {t_c} s");
-    assert!((j["interval_s"].as_f64().unwrap() - 7e-4).abs() < 1e-15);
+    assert_eq!(j["interval_s"].as_f64().unwrap(), 60.0 / 88480.0);
     for (k, b) in blows.iter().enumerate() {
         let eta = b["energy_ratio"].as_f64();
         assert!(
@@ -54,7 +55,7 @@ fn blows_refuses_a_stroke_interval_shorter_than_the_collision() {
         // the collision ends inside its interval
         let end = b["collision_end_s"].as_f64().unwrap() - b["start_s"].as_f64().unwrap();
         assert!(
-            end > 0.0 && end <= 7e-4,
+            end > 0.0 && end <= 60.0 / 88480.0,
             "blow {}: collision {end} s",
             k + 1
         );
@@ -65,14 +66,15 @@ fn blows_refuses_a_stroke_interval_shorter_than_the_collision() {
     // the bare machine: a shorter collision (0.498 ms), its own limit
     let err = refused(&["blows", &e, "--rate-bpm", "1e6", "--case", "none"]);
     assert!(
-        err.contains("lasts 0.00049783 s") && err.contains("at most 120000"),
+        err.contains("lasts 0.00049783 s") && err.contains("at most 120500"),
         "{err}"
     );
 }
 
-/// A damper gap is never negative: at 185 /min with a two-way dashpot the bed is against the
-/// returned damper when blow 7 strikes (contact closed, compression 5.4e-8 m), which used to
-/// be reported as a gap of −5.4e-8 m; the gap is now 0 there and ≥ 0 everywhere.
+/// A damper gap is never negative: at 185 /min with a two-way dashpot (then run with the
+/// interval rounded to 0.32435 s; now 60/R exactly, so 184.99 /min, T = 0.324342 s) the bed is
+/// against the returned damper when blow 7 strikes (contact closed), which used to be reported
+/// as a gap of −5.4e-8 m; the gap is now 0 there and ≥ 0 everywhere.
 #[test]
 fn damper_gaps_are_never_negative() {
     let e = example();
@@ -82,7 +84,7 @@ fn damper_gaps_are_never_negative() {
                 "blows",
                 &e,
                 "--rate-bpm",
-                "185",
+                "184.99",
                 "--blows",
                 "8",
                 "--set",
@@ -257,4 +259,76 @@ fn compare_refuses_frequencies_below_the_record_resolution() {
     assert!(out.contains("0.16 Hz") && out.contains("0.315 Hz"), "{out}");
     assert!(out.contains("0.14-0.18"), "{out}");
     assert!(!out.contains(" 0 Hz") && !out.contains("0.0-0.0"), "{out}");
+}
+
+/// `meid blows` printed the last blow's levels as "the steady" levels to 4 decimals: 110.5651 N
+/// after 10 blows, 110.5272 N after 40 (the train still moving by 0.08 N a blow). It now says
+/// they are blow N's levels, an estimate, with the last blow-to-blow change beside them; that
+/// change bounds the distance to the 40-blow level here.
+#[test]
+fn blows_steady_levels_are_given_as_estimates_with_their_last_change() {
+    let e = example();
+    let text = ok(meid()
+        .args(["blows", &e, "--blows", "10"])
+        .output()
+        .unwrap());
+    let line = text
+        .lines()
+        .find(|l| l.contains("steady"))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(line.contains("blow 10's levels, an estimate"), "{line}");
+    let after = |key: &str| -> (f64, f64) {
+        let rest = &line[line.find(key).unwrap() + key.len()..];
+        let mut w = rest.split_whitespace();
+        let level: f64 = w.next().unwrap().parse().unwrap();
+        w.next(); // unit
+        assert_eq!(w.next(), Some("±"), "{line}");
+        (level, w.next().unwrap().parse().unwrap())
+    };
+    let (force, df) = after("floor force ");
+    let (acc, da) = after("bed acceleration ");
+    let j = ok_json(
+        meid()
+            .args(["blows", &e, "--blows", "40", "--json"])
+            .output()
+            .unwrap(),
+    );
+    let f40 = j["steady"]["peak_floor_force_n"].as_f64().unwrap();
+    let a40 = j["steady"]["peak_bed_acceleration_m_per_s2"]
+        .as_f64()
+        .unwrap();
+    assert!((force - 110.5651).abs() < 1e-4 && (f40 - 110.5272).abs() < 1e-4);
+    assert!((force - f40).abs() <= df, "{force} ± {df} vs {f40}");
+    assert!((acc - a40).abs() <= da, "{acc} ± {da} vs {a40}");
+}
+
+/// A rate so low that one blow alone exceeds the run-length limit used to say "Reduce the
+/// number of blows (--blows) to at most 0"; it now names the rate to give.
+#[test]
+fn blows_too_slow_a_rate_names_the_lowest_valid_rate() {
+    let e = example();
+    let err = refused(&["blows", &e, "--rate-bpm", "0.0001", "--blows", "3"]);
+    assert!(!err.contains("at most 0"), "{err}");
+    assert!(err.contains("Give --rate-bpm at least"), "{err}");
+    let r_min: f64 = err
+        .rsplit("at least ")
+        .next()
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    // The rate named runs (one blow of 60/R_min s is within the limit).
+    let o = meid()
+        .args([
+            "blows",
+            &e,
+            "--rate-bpm",
+            &r_min.to_string(),
+            "--blows",
+            "1",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
 }

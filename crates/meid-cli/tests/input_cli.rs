@@ -124,25 +124,49 @@ fn optimize_bounds_outside_the_domain_and_budgets_too_small_are_refused() {
     ]));
     assert!(e.contains("given twice"), "{e}");
     // Used to run 18 simulations whatever the budget.
-    for (over, max, min) in [
-        ("wd/ws", "0", "12"),
-        ("wd/ws", "1", "12"),
-        ("wd/ws,md/mb", "4", "5"),
+    // Two variables: the 33×33 grid, one simplex and those two (1094); with --grid 2, 9.
+    for (over, max, min, grid) in [
+        ("wd/ws", "0", "12", "9"),
+        ("wd/ws", "1", "12", "9"),
+        ("wd/ws,md/mb", "4", "1094", "33"),
+        ("wd/ws,md/mb", "8", "9", "2"),
     ] {
-        let e = refused(run(&["--over", over, "--max-simulations", max]));
+        let e = refused(run(&[
+            "--over",
+            over,
+            "--max-simulations",
+            max,
+            "--grid",
+            grid,
+        ]));
         assert!(
             e.contains(&format!("--max-simulations {max}"))
                 && e.contains(&format!("needs at least {min}")),
             "{e}"
         );
     }
+    // A grid of fewer than 2 points, or of more than 1e6 simulations, is refused up front.
+    for (grid, says) in [("1", "at least 2 points"), ("1001", "at most 1000 points")] {
+        let e = refused(run(&["--over", "wd/ws,md/mb", "--grid", grid]));
+        assert!(
+            e.contains(&format!("--grid {grid}")) && e.contains(says),
+            "{e}"
+        );
+    }
     // A budget at the minimum is honoured exactly.
-    for (over, max) in [("wd/ws", 12), ("wd/ws,md/mb", 5), ("wd/ws,md/mb", 30)] {
+    for (over, max, grid) in [
+        ("wd/ws", 12, "9"),
+        ("wd/ws,md/mb", 9, "2"),
+        ("wd/ws,md/mb", 30, "3"),
+        ("wd/ws,md/mb", 1094, "33"),
+    ] {
         let v = common::ok_json(run(&[
             "--over",
             over,
             "--max-simulations",
             &max.to_string(),
+            "--grid",
+            grid,
             "--json",
         ]));
         let n = v["simulations"].as_u64().unwrap();

@@ -8,7 +8,8 @@
 //! (Brent 1973, ch. 5); tests use that bound.
 
 use meid::analysis::optimize::{
-    brent_minimize, minimize_box, BrentOptions, MinimumNd, NelderMeadOptions,
+    brent_minimize, minimize_box, minimize_box_global, BrentOptions, GlobalOptions, MinimumNd,
+    NelderMeadOptions,
 };
 
 fn brent_bound(x: f64, o: &BrentOptions) -> f64 {
@@ -280,4 +281,90 @@ fn random_starts_find_the_global_minimum() {
     assert!((multi.x[0] - x_star).abs() < 1e-6, "x = {:?}", multi.x);
     assert!(multi.x[1].abs() < 1e-6);
     assert!(multi.f < single.f);
+}
+
+/// A narrow deep Gaussian well inside the box and a broad shallower well of compact support
+/// centred on the bound x = 1, covering most of the box: f = −exp(−|x − c₁|²/(2σ²))
+/// − 0.7 max(0, 1 − |x − c₂|²/R²)², c₁ = (0.1, 0.9), σ = 0.035, c₂ = (1, 0.1), R = 1.
+/// |c₁ − c₂| = 1.204 > R, so at c₁ the broad well is 0 with zero gradient: the global minimum
+/// is exactly x* = c₁, f* = −1 (the broad well's depth is 0.7 and the Gaussian is below e⁻¹⁶
+/// inside its support).
+fn two_wells(v: &[f64]) -> f64 {
+    let r1 = (v[0] - 0.1).powi(2) + (v[1] - 0.9).powi(2);
+    let r2 = (v[0] - 1.0).powi(2) + (v[1] - 0.1).powi(2);
+    -(-r1 / (2.0 * 0.035 * 0.035)).exp() - 0.7 * (1.0 - r2).max(0.0).powi(2)
+}
+
+/// The options `meid optimize` used for two variables before the grid (session 12): one
+/// start at the box centre and 2 seeded random starts.
+fn old_study_options() -> NelderMeadOptions {
+    NelderMeadOptions {
+        initial_step: 0.2,
+        x_tolerance: 1e-5,
+        f_tolerance: 1e-9,
+        max_evaluations: 400,
+        max_restarts: 5,
+        random_starts: 2,
+        seed: 4,
+        polish: true,
+    }
+}
+
+fn global_options() -> GlobalOptions {
+    GlobalOptions {
+        grid_points: 33,
+        starts: 4,
+        max_evaluations: 33 * 33 + 800,
+        local: NelderMeadOptions {
+            random_starts: 0,
+            ..old_study_options()
+        },
+    }
+}
+
+#[test]
+fn grid_search_finds_the_narrow_global_well_the_local_search_misses() {
+    let (lo, hi) = ([0.0, 0.0], [1.0, 1.0]);
+    // The local multi-start search of the old optimiser ends in the broad well on the bound.
+    let old = minimize_box(two_wells, &[0.5, 0.5], &lo, &hi, &old_study_options()).unwrap();
+    assert!(old.f > -0.9, "old search found {:?} f = {}", old.x, old.f);
+    let m = minimize_box_global(two_wells, &lo, &hi, &global_options()).unwrap();
+    assert!((m.x[0] - 0.1).abs() < 1e-4, "x = {:?}", m.x);
+    assert!((m.x[1] - 0.9).abs() < 1e-4, "x = {:?}", m.x);
+    assert!((m.f + 1.0).abs() < 1e-8, "f = {}", m.f);
+    assert_eq!(m.grid_evaluations, 33 * 33);
+    assert!(m.evaluations <= 33 * 33 + 800);
+    assert!(m.searches.len() >= 2, "the broad well is a second start");
+    // Same answer, and the same evaluation count, on one thread and on two.
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| minimize_box_global(two_wells, &lo, &hi, &global_options()).unwrap())
+    };
+    assert_eq!(on(1), m);
+    assert_eq!(on(2), m);
+}
+
+#[test]
+fn grid_search_refuses_a_budget_that_cannot_hold_its_grid() {
+    let (lo, hi) = ([0.0, 0.0], [1.0, 1.0]);
+    let o = GlobalOptions {
+        max_evaluations: 33 * 33 + 2,
+        ..global_options()
+    };
+    let e = minimize_box_global(two_wells, &lo, &hi, &o).unwrap_err();
+    assert!(e.to_string().contains("33^2"), "{e}");
+    let o = GlobalOptions {
+        grid_points: 1,
+        ..global_options()
+    };
+    assert!(minimize_box_global(two_wells, &lo, &hi, &o).is_err());
+    let o = GlobalOptions {
+        grid_points: usize::MAX,
+        ..global_options()
+    };
+    assert!(minimize_box_global(two_wells, &lo, &hi, &o).is_err());
+    assert!(minimize_box_global(|_x: &[f64]| f64::NAN, &lo, &hi, &global_options()).is_err());
 }

@@ -3,8 +3,11 @@
 //!
 //! # Formulation
 //!
-//! Blow `k` (`k = 0..N-1`) starts at `t_k = k T`, `T = 60 / rate` s (rounded to a whole number
-//! of output samples so the concatenated record stays uniformly sampled). It is the impact
+//! Blow `k` (`k = 0..N-1`) starts at `t_k = k T`, `T = 60 / rate` s exactly (it used to be
+//! rounded to whole output samples, so every number depended on `--rate`: at 70 /min the
+//! floor force of blow 6 was 82.33 N at 20 kHz and 82.93 N at 300 Hz). The record stays on
+//! one uniform grid `t = i/f_s`: blow `k` is sampled from its strike with the phase
+//! `⌈t_k f_s⌉/f_s − t_k` ([`crate::integrate::Options::sample_phase_s`]). It is the impact
 //! engine run over `[0, T]` ([`crate::integrate::solve_from`]) from the final state of blow
 //! `k-1` with the slider replaced: `z_s = u_b(O_b) = ψ(O_b)ᵀq` (just touching, overlap 0) and
 //! `ż_s = v_s`. The first blow starts from rest ([`ImpactSystem::initial_state`]), so one
@@ -135,22 +138,30 @@ pub struct BlowsRun {
     pub solutions: Vec<Solution>,
 }
 
-/// The blow interval for a stroke rate, rounded to whole output samples when sampling.
-pub fn blow_interval_s(rate_bpm: f64, sample_rate_hz: Option<f64>) -> Result<f64> {
+/// The blow interval for a stroke rate, `T = 60/R` s exactly (the output sample rate does
+/// not change it: the samples of each blow are put on the train's grid instead, see the
+/// module docs; `_sample_rate_hz` is kept for callers).
+pub fn blow_interval_s(rate_bpm: f64, _sample_rate_hz: Option<f64>) -> Result<f64> {
     if !(rate_bpm.is_finite() && rate_bpm > 0.0) {
         return Err(Error::invalid(
             "rate_bpm",
             format!("the stroke rate must be > 0 blows per minute (got {rate_bpm})"),
         ));
     }
-    let t = 60.0 / rate_bpm;
-    Ok(match sample_rate_hz {
-        Some(fs) if fs.is_finite() && fs > 0.0 => {
-            let n = (t * fs).round().max(1.0);
-            n / fs
-        }
-        _ => t,
-    })
+    Ok(60.0 / rate_bpm)
+}
+
+/// The phase `φ_k = ⌈t_k f_s⌉/f_s − t_k ∈ [0, 1/f_s)` of the first train sample `i/f_s` at or
+/// after the strike `t_k` ([`Options::sample_phase_s`]); a phase below 1e-9/f_s (rounding of a
+/// strike on the grid) is 0, so that sample is the previous blow's last one (dropped).
+fn strike_phase(t_k: f64, fs: f64) -> f64 {
+    let dt = 1.0 / fs;
+    let phase = (t_k * fs).ceil() / fs - t_k;
+    if phase < 1e-9 * dt || phase >= dt * (1.0 - 1e-9) {
+        0.0
+    } else {
+        phase
+    }
 }
 
 fn relative_change(a: f64, b: f64) -> f64 {
@@ -270,6 +281,27 @@ pub fn run_blows_progress(
     // ([`integrate::check_cost`]) over its whole simulated time `N · T`.
     if let Some((rate, what)) = integrate::fastest_rate(sys) {
         let periods = blow.blows as f64 * interval * rate / (2.0 * std::f64::consts::PI);
+        if periods > integrate::MAX_PERIODS
+            && interval * rate / (2.0 * std::f64::consts::PI) > integrate::MAX_PERIODS
+        {
+            // One blow alone is too long: the rate is too low (more blows would not help).
+            let t_max = integrate::MAX_PERIODS * 2.0 * std::f64::consts::PI / rate;
+            let r_min = 60.0 / t_max;
+            let scale = 10f64.powi(3 - r_min.log10().floor() as i32);
+            let r_min = (r_min * scale).ceil() / scale;
+            return Err(Error::invalid(
+                "stroke rate (--rate-bpm)",
+                format!(
+                    "one blow every {interval} s (--rate-bpm {}) would span {:.2e} periods of \
+                     the fastest time scale (2π/{rate:.3e} s, set by {what}); the limit is {:e} \
+                     per run. Give --rate-bpm at least {}",
+                    crate::num(blow.rate_bpm),
+                    interval * rate / (2.0 * std::f64::consts::PI),
+                    integrate::MAX_PERIODS,
+                    crate::num(r_min)
+                ),
+            ));
+        }
         if periods > integrate::MAX_PERIODS {
             return Err(Error::invalid(
                 "blows",
@@ -349,7 +381,11 @@ pub fn run_blows_progress(
         let ed0 = damper_energy(&x0);
         let mut rec = Recorder::new(sys).starting_at(&x0);
         let o_blow = if record {
-            o
+            let phase = o.sample_rate.map_or(0.0, |fs| strike_phase(t0, fs));
+            Options {
+                sample_phase_s: phase,
+                ..o
+            }
         } else {
             Options {
                 sample_rate: None,
@@ -439,8 +475,7 @@ pub fn run_blows_progress(
 /// blow would strike a slider still on the bed, and the blow's η, peaks and damper gap would
 /// mean nothing. The collision's duration `t_c` is found by running blow `k` on from its strike
 /// `x0` until the collision ends (at most `max(simulation.duration, T)`); the largest valid
-/// stroke rate is then `R_max = 60 / T_min`, with `T_min = t_c` rounded up to whole output
-/// samples (the interval is rounded to whole samples, [`blow_interval_s`]).
+/// stroke rate is then `R_max = 60 / t_c` (rounded down to 4 digits).
 fn collision_longer_than_interval(
     sys: &ImpactSystem,
     opts: &Options,
@@ -460,21 +495,16 @@ fn collision_longer_than_interval(
         .ok()
         .and_then(|s| s.collision_end.map(|c| c.t));
     let sig = |v: f64| crate::num(format!("{v:.4e}").parse().unwrap_or(v));
-    let fs = opts.sample_rate.filter(|f| f.is_finite() && *f > 0.0);
     let head = format!(
-        "blow {} is not over when the next blow is due: a blow every {} s (--rate-bpm {}{}) is \
+        "blow {} is not over when the next blow is due: a blow every {} s (--rate-bpm {}) is \
          shorter than the collision",
         k + 1,
         sig(interval),
         crate::num(rate_bpm),
-        fs.map_or(String::new(), |fs| format!(
-            ", the interval rounded to whole samples at {} Hz",
-            crate::num(fs)
-        ))
     );
     let msg = match t_c {
         Some(t_c) => {
-            let t_min = fs.map_or(t_c, |fs| (t_c * fs).ceil().max(1.0) / fs);
+            let t_min = t_c;
             // Rounded down to 4 significant digits, so that the rate printed is valid.
             let r_max = 60.0 / t_min;
             let scale = 10f64.powi(3 - r_max.log10().floor() as i32);
@@ -711,11 +741,16 @@ sample_rate = 20000.0
             )),
             "{e}"
         );
-        assert!(e.contains("at most 171400"), "{e}");
-        let r = train(171_400.0).unwrap();
-        assert!((r.interval_s - 3.5e-4).abs() < 1e-15, "{}", r.interval_s);
+        // R_max = 60/t_c rounded down to 4 digits (it was 60/(t_c rounded up to whole
+        // samples), the interval being rounded to samples).
+        let r_max = 60.0 / t_c;
+        let scale = 10f64.powi(3 - r_max.log10().floor() as i32);
+        let r_max = (r_max * scale).floor() / scale;
+        assert!(e.contains(&format!("at most {}", crate::num(r_max))), "{e}");
+        let r = train(r_max).unwrap();
+        assert_eq!(r.interval_s, 60.0 / r_max);
         assert!(r.blows.iter().all(|b| b.energy_ratio.is_some()));
-        // 6 samples per blow (0.3 ms < t_c): refused
+        // 0.3 ms < t_c: refused
         assert!(train(60.0 / 3e-4).is_err());
     }
 

@@ -24,6 +24,16 @@
 //!   one-dimensional Brent polish along each coordinate make the search robust; extra
 //!   starting points drawn uniformly in the box from a seeded SplitMix64 generator give a
 //!   deterministic multi-start.
+//! * Global search in the box ([`minimize_box_global`]): a deterministic grid of `N` points
+//!   per variable (`u_i = i/(N−1)`, i = 0..N−1, in box-normalised coordinates; `Nⁿ`
+//!   evaluations, run in parallel and collected in grid order, so the result does not depend
+//!   on the thread count), then [`minimize_box`] from each of the best few grid points that
+//!   are lower than all their `3ⁿ − 1` grid neighbours (distinct basins), the best result
+//!   kept. A local method alone ends in the basin of its start; the grid finds every basin
+//!   wider than about two grid cells (A. Törn, A. Žilinskas, *Global Optimization*, LNCS 350,
+//!   Springer 1989, ch. 2: "multistart from the best points of a sample").
+
+use rayon::prelude::*;
 
 use crate::rng::SplitMix64;
 use crate::{Error, Result};
@@ -695,4 +705,243 @@ where
             ),
         )),
     }
+}
+
+/// Options of [`minimize_box_global`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GlobalOptions {
+    /// Grid points per variable, `N ≥ 2` (the grid has `Nⁿ` points, both bounds included).
+    pub grid_points: usize,
+    /// Local searches: started from the best this many grid points that are lower than all
+    /// their grid neighbours (fewer if the grid has fewer such points).
+    pub starts: usize,
+    /// Evaluation budget over the grid and all local searches; the budget left after the
+    /// grid is shared equally by the starts (so each search, and the result, is the same
+    /// whatever the thread count).
+    pub max_evaluations: usize,
+    /// The local search ([`minimize_box`]); its `max_evaluations` is replaced by each
+    /// start's share, and its `initial_step` by `max(one grid cell, 1/(N−1))` capped at 0.5.
+    pub local: NelderMeadOptions,
+}
+
+/// One local search of [`minimize_box_global`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct LocalSearch {
+    /// The grid point it started from, and its value.
+    pub start: Vec<f64>,
+    pub f_start: f64,
+    /// Where it ended, and its value.
+    pub x: Vec<f64>,
+    pub f: f64,
+    /// Its evaluations.
+    pub evaluations: usize,
+    pub converged: bool,
+}
+
+/// Result of [`minimize_box_global`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct GlobalMinimum {
+    /// Best point over the grid and every local search.
+    pub x: Vec<f64>,
+    /// Objective at `x`.
+    pub f: f64,
+    /// Evaluations in all: the grid's plus every local search's.
+    pub evaluations: usize,
+    /// Evaluations of the grid, `Nⁿ`.
+    pub grid_evaluations: usize,
+    /// Grid points per variable.
+    pub grid_points: usize,
+    /// Failed evaluations (grid and local searches).
+    pub failures: usize,
+    /// `true` if the local search that gave `x` met its tolerances.
+    pub converged: bool,
+    /// The local searches, best start first.
+    pub searches: Vec<LocalSearch>,
+}
+
+/// `Nⁿ`, or `None` on overflow.
+pub fn grid_size(grid_points: usize, n: usize) -> Option<usize> {
+    let n = u32::try_from(n).ok()?;
+    grid_points.checked_pow(n)
+}
+
+/// The grid indices of point `idx` (first variable slowest).
+fn grid_indices(mut idx: usize, n: usize, points: usize) -> Vec<usize> {
+    let mut out = vec![0; n];
+    for k in (0..n).rev() {
+        out[k] = idx % points;
+        idx /= points;
+    }
+    out
+}
+
+/// Minimises `f(x)` over the box `lower ≤ x ≤ upper` globally within the resolution of a
+/// grid: evaluates the `Nⁿ` grid points `x = lower + (i/(N−1))·(upper − lower)` (in parallel,
+/// on the current rayon pool), takes the grid points lower than all their `3ⁿ − 1` grid
+/// neighbours (ties broken by grid order), the best `starts` of them, runs [`minimize_box`]
+/// from each (in parallel, each with an equal share of the budget left) and returns the
+/// lowest point found. Deterministic: the same for any thread count. `f` must be
+/// `Fn + Sync` (it is called from several threads).
+pub fn minimize_box_global<F, R>(
+    f: F,
+    lower: &[f64],
+    upper: &[f64],
+    options: &GlobalOptions,
+) -> Result<GlobalMinimum>
+where
+    F: Fn(&[f64]) -> R + Sync,
+    R: ObjectiveValue,
+{
+    let n = lower.len();
+    if n == 0 || upper.len() != n {
+        return Err(Error::invalid(
+            "bounds",
+            format!(
+                "needs as many lower as upper bounds, at least one; got {} and {}",
+                n,
+                upper.len()
+            ),
+        ));
+    }
+    for i in 0..n {
+        let (lo, hi) = (lower[i], upper[i]);
+        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            return Err(Error::invalid(
+                "bounds",
+                format!("variable {i}: needs finite lower < upper, got [{lo}, {hi}]"),
+            ));
+        }
+    }
+    let points = options.grid_points;
+    if points < 2 {
+        return Err(Error::invalid(
+            "grid_points",
+            format!("needs at least 2 points per variable (both bounds), got {points}"),
+        ));
+    }
+    if options.starts < 1 {
+        return Err(Error::invalid("starts", "needs at least one local search"));
+    }
+    let total = grid_size(points, n)
+        .filter(|&t| t.checked_add(n + 1).is_some_and(|m| m <= options.max_evaluations))
+        .ok_or_else(|| {
+            Error::invalid(
+                "max_evaluations",
+                format!(
+                    "{} evaluations cannot hold a grid of {points}^{n} points and one simplex ({} more)",
+                    options.max_evaluations,
+                    n + 1
+                ),
+            )
+        })?;
+    let width: Vec<f64> = lower.iter().zip(upper).map(|(l, u)| u - l).collect();
+    let to_x = |idx: &[usize]| -> Vec<f64> {
+        idx.iter()
+            .zip(lower)
+            .zip(upper)
+            .zip(&width)
+            .map(|(((&i, &lo), &hi), &w)| {
+                if i + 1 == points {
+                    hi
+                } else {
+                    lo + w * (i as f64 / (points - 1) as f64)
+                }
+            })
+            .collect()
+    };
+    let values: Vec<f64> = (0..total)
+        .into_par_iter()
+        .map(|idx| {
+            f(&to_x(&grid_indices(idx, n, points)))
+                .into_value()
+                .unwrap_or(f64::INFINITY)
+        })
+        .collect();
+    let grid_failures = values.iter().filter(|v| !v.is_finite()).count();
+    // Grid points lower than every grid neighbour, (value, index) ordered.
+    let below = |a: usize, b: usize| (values[a], a) < (values[b], b);
+    let mut minima: Vec<usize> = (0..total)
+        .filter(|&idx| values[idx].is_finite())
+        .filter(|&idx| {
+            let ind = grid_indices(idx, n, points);
+            let stencil = grid_size(3, n).unwrap_or(0);
+            (0..stencil).all(|s| {
+                let mut nb = 0usize;
+                let mut code = s;
+                for &i in &ind {
+                    let d = code % 3;
+                    code /= 3;
+                    let j = i + d;
+                    if j == 0 || j > points {
+                        return true; // outside the grid
+                    }
+                    nb = nb * points + (j - 1);
+                }
+                nb == idx || below(idx, nb)
+            })
+        })
+        .collect();
+    if minima.is_empty() {
+        return Err(Error::numerical(
+            "global box search",
+            format!("all {total} grid evaluations failed; no feasible point found"),
+        ));
+    }
+    minima.sort_by(|&a, &b| values[a].total_cmp(&values[b]).then(a.cmp(&b)));
+    minima.truncate(options.starts);
+    let share = (options.max_evaluations - total) / minima.len();
+    let step = (1.0 / (points - 1) as f64).min(0.5);
+    let local = NelderMeadOptions {
+        initial_step: step,
+        max_evaluations: share,
+        ..options.local
+    };
+    let runs: Vec<(usize, Option<MinimumNd>)> = minima
+        .par_iter()
+        .map(|&idx| {
+            let x0 = to_x(&grid_indices(idx, n, points));
+            if share < n + 1 {
+                return (idx, None);
+            }
+            (
+                idx,
+                minimize_box(|x: &[f64]| f(x), &x0, lower, upper, &local).ok(),
+            )
+        })
+        .collect();
+    let mut best: (Vec<f64>, f64, bool) = (
+        to_x(&grid_indices(minima[0], n, points)),
+        values[minima[0]],
+        false,
+    );
+    let mut evaluations = total;
+    let mut failures = grid_failures;
+    let mut searches = Vec::new();
+    for (idx, run) in runs {
+        let start = to_x(&grid_indices(idx, n, points));
+        let Some(m) = run else { continue };
+        evaluations += m.evaluations;
+        failures += m.failures;
+        if m.f < best.1 {
+            best = (m.x.clone(), m.f, m.converged);
+        }
+        searches.push(LocalSearch {
+            start,
+            f_start: values[idx],
+            x: m.x,
+            f: m.f,
+            evaluations: m.evaluations,
+            converged: m.converged,
+        });
+    }
+    Ok(GlobalMinimum {
+        x: best.0,
+        f: best.1,
+        evaluations,
+        grid_evaluations: total,
+        grid_points: points,
+        failures,
+        converged: best.2,
+        searches,
+    })
 }

@@ -11,9 +11,16 @@
 //!   coordinate) over the bounds, then Brent's method ([`super::optimize::brent_minimize`],
 //!   Brent 1973 ch. 5) on the two scan intervals around the best scan point. The scan guards
 //!   Brent, a local method, against the other local minima of impact metrics.
-//! * Several: the bounded Nelder-Mead with restarts and coordinate polish of
-//!   [`super::optimize::minimize_box`], started from the model's values (clipped to the
-//!   box) plus seeded random starts.
+//! * Several (n): a global search in the box, [`super::optimize::minimize_box_global`]: a
+//!   grid of `N` points per variable evenly spaced in the search coordinate, both bounds
+//!   included (`Nⁿ` simulations, [`default_grid_points`]: 33 per variable for two, 16 for
+//!   three; run in parallel, the result independent of the thread count), then the bounded
+//!   Nelder-Mead with restarts and coordinate polish of [`super::optimize::minimize_box`]
+//!   from each of the best [`GLOBAL_STARTS`] grid points lower than all their grid
+//!   neighbours, the lowest result kept. A local search alone ends in the basin it starts
+//!   in: the floor force over `wd/ws, md/mb` on the lumped example has about 24 basins on a
+//!   161² grid, and the search from the model's point ended at 26.03 N on md/mb = 2 while
+//!   24.56 N lies inside the box at ω_d/ω_s = 0.377, m_d/m_b = 1.20.
 //!
 //! Objectives: `energy` = E_p+/E_s− at the end of the collision (Eq. 10 over Eq. 11; the
 //! run stops there); `bed-accel` = peak |a_B| (m/s²) and `floor-force` = peak floor force (N)
@@ -32,7 +39,9 @@
 
 use serde::Serialize;
 
-use super::optimize::{brent_minimize, minimize_box, BrentOptions, NelderMeadOptions};
+use super::optimize::{
+    brent_minimize, minimize_box_global, BrentOptions, GlobalOptions, NelderMeadOptions,
+};
 use super::sweep::{
     check_bed_mass, check_quantities, evaluate, evaluate_cached, failure_error, field_kind,
     FieldKind, PointResult, Quantity,
@@ -41,8 +50,34 @@ use crate::integrate::Options;
 use crate::model::{Model, StructureCache};
 use crate::{Error, Result};
 
-/// Points of the coarse scan before Brent in one variable.
+/// Points of the coarse scan before Brent in one variable (the default grid for one
+/// variable).
 pub const SCAN_POINTS: usize = 9;
+
+/// Local searches after the grid, for two or more variables: from the best this many grid
+/// points lower than their grid neighbours ([`super::optimize::GlobalOptions::starts`]).
+pub const GLOBAL_STARTS: usize = 4;
+
+/// The largest grid the optimiser accepts (`--grid N` with `Nⁿ` above it is refused before
+/// anything runs).
+pub const MAX_GRID_SIMULATIONS: usize = 1_000_000;
+
+/// Simulations for the local searches and checks on top of the grid when no budget is given
+/// ([`OptimizeStudy::budget`]).
+pub const LOCAL_BUDGET: usize = 800;
+
+/// Grid points per variable when none are given: [`SCAN_POINTS`] for one variable; for n ≥ 2
+/// the largest `N ≤ 33` with `Nⁿ ≤ 4096` (33 for two variables, 1089 simulations; 16 for
+/// three, 4096), at least 3.
+pub fn default_grid_points(n: usize) -> usize {
+    if n <= 1 {
+        return SCAN_POINTS;
+    }
+    (3..=33)
+        .rev()
+        .find(|&p| super::optimize::grid_size(p, n).is_some_and(|t| t <= 4096))
+        .unwrap_or(3)
+}
 
 /// The neighbour check's step ([`LocalCheck`]): a fraction of each variable's box width in
 /// the search coordinate (`ln x` for a log variable), 1000 times the Brent tolerance.
@@ -185,8 +220,10 @@ pub struct OptimizeStudy {
     pub options: Options,
     /// m_b (kg) for `md/mb`, when given; `None`: each point's [`Model::bed_mass`].
     pub bed_mass_kg: Option<f64>,
-    /// Evaluation budget.
-    pub max_simulations: usize,
+    /// Simulation budget (grid included); `None`: [`OptimizeStudy::budget`]'s default.
+    pub max_simulations: Option<usize>,
+    /// Grid points per variable; `None`: [`default_grid_points`].
+    pub grid_points: Option<usize>,
 }
 
 /// The result of [`OptimizeStudy::run`].
@@ -199,9 +236,19 @@ pub struct OptimizeReport {
     pub optimum: Vec<f64>,
     /// The objective there.
     pub objective_value: f64,
-    /// Simulations run (including failed ones): the search's, the optimum's own run and the
-    /// w_d = w_s comparison; never more than [`OptimizeStudy::max_simulations`].
+    /// Simulations run (including failed ones): the grid's, the local search's, the
+    /// optimum's own run and the w_d = w_s comparison; never more than `max_simulations`.
     pub simulations: usize,
+    /// The budget the search ran with ([`OptimizeStudy::budget`]).
+    pub max_simulations: usize,
+    /// What was searched: grid points per variable (the one-variable scan's points).
+    pub grid_points_per_variable: usize,
+    /// Simulations of the grid (`grid_points_per_variable`ⁿ over the n free variables).
+    pub grid_simulations: usize,
+    /// Local searches run from the best grid points (Brent: 1; none when all are fixed).
+    pub local_searches: usize,
+    /// The search in words (grid, local method, starts).
+    pub method: String,
     pub failures: usize,
     pub converged: bool,
     /// w_d/w_s at the optimum.
@@ -401,7 +448,8 @@ impl OptimizeStudy {
             objective,
             options,
             bed_mass_kg,
-            max_simulations: 400,
+            max_simulations: None,
+            grid_points: None,
         })
     }
 
@@ -425,10 +473,38 @@ impl OptimizeStudy {
         let n = self.search_order().len();
         let search = match n {
             0 => 0,
-            1 => SCAN_POINTS + 1,
-            _ => n + 1,
+            1 => self.grid() + 1,
+            _ => self.grid_total().saturating_add(n + 1),
         };
-        search + 2
+        search.saturating_add(2)
+    }
+
+    /// Grid points per variable: the given ones or [`default_grid_points`].
+    pub fn grid(&self) -> usize {
+        self.grid_points
+            .unwrap_or_else(|| default_grid_points(self.search_order().len()))
+    }
+
+    /// Simulations of the grid: `grid()ⁿ` for n ≥ 2 free variables (saturating), `grid()`
+    /// for one, 0 for none.
+    pub fn grid_total(&self) -> usize {
+        match self.search_order().len() {
+            0 => 0,
+            1 => self.grid(),
+            n => super::optimize::grid_size(self.grid(), n).unwrap_or(usize::MAX),
+        }
+    }
+
+    /// The simulation budget: `max_simulations`, or by default 400 for one variable and
+    /// the grid plus [`LOCAL_BUDGET`] for several.
+    pub fn budget(&self) -> usize {
+        self.max_simulations.unwrap_or_else(|| {
+            if self.search_order().len() <= 1 {
+                400
+            } else {
+                self.grid_total().saturating_add(LOCAL_BUDGET)
+            }
+        })
     }
 
     fn value_to_search(&self, k: usize, x: f64) -> f64 {
@@ -516,6 +592,28 @@ impl OptimizeStudy {
         &self,
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<OptimizeReport> {
+        let budget = self.budget();
+        let grid = self.grid();
+        if grid < 2 {
+            return Err(Error::Input {
+                location: format!("--grid {grid}"),
+                message: "the grid needs at least 2 points per variable (both bounds)".into(),
+            });
+        }
+        let n_free = self.search_order().len();
+        if n_free >= 1 && self.grid_total() > MAX_GRID_SIMULATIONS {
+            return Err(Error::Input {
+                location: format!("--grid {grid}"),
+                message: format!(
+                    "a grid of {grid}^{n_free} points is more than {MAX_GRID_SIMULATIONS} simulations; give at most {} points per variable",
+                    (2..=grid)
+                        .rev()
+                        .find(|&p| super::optimize::grid_size(p, n_free)
+                            .is_some_and(|t| t <= MAX_GRID_SIMULATIONS))
+                        .unwrap_or(2)
+                ),
+            });
+        }
         let cache = StructureCache::new();
         let count = std::sync::atomic::AtomicUsize::new(0);
         let qs_all: Vec<&Quantity> = self.variables.iter().map(|v| &v.quantity).collect();
@@ -530,33 +628,33 @@ impl OptimizeStudy {
                 Some(&cache),
             );
             let d = count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            progress(d.min(self.max_simulations), self.max_simulations);
+            progress(d.min(budget), budget);
             r
         };
         let metric = self.objective.metric();
         let order = self.search_order();
         let n = order.len();
         let min = self.min_simulations();
-        if self.max_simulations < min {
+        if budget < min {
             return Err(Error::Input {
-                location: format!("--max-simulations {}", self.max_simulations),
+                location: format!("--max-simulations {budget}"),
                 message: format!(
-                    "{} simulations are too few: with {n} variable{} the search needs at least {min} ({}, the optimum's own run and the w_d = w_s comparison)",
-                    self.max_simulations,
+                    "{budget} simulations are too few: with {n} variable{} the search needs at least {min} ({}, the optimum's own run and the w_d = w_s comparison){}",
                     if n == 1 { "" } else { "s" },
                     if n == 1 {
-                        format!("a {SCAN_POINTS}-point scan and one Brent step")
+                        format!("a {grid}-point scan and one Brent step")
                     } else {
-                        format!("one simplex of {} points", n + 1)
-                    }
+                        format!("a grid of {grid}^{n} = {} points and one simplex of {} points", self.grid_total(), n + 1)
+                    },
+                    if n >= 2 { "; give a larger --max-simulations or a smaller --grid" } else { "" }
                 ),
             });
         }
         // The neighbour check (2 per free variable) runs when the budget holds it on top of
         // the minimum; the optimum's run and the comparison come after the search.
         let check_runs = 2 * n;
-        let checked = n > 0 && self.max_simulations >= min + check_runs;
-        let search_budget = self.max_simulations - 2 - if checked { check_runs } else { 0 };
+        let checked = n > 0 && budget >= min + check_runs;
+        let search_budget = budget - 2 - if checked { check_runs } else { 0 };
         // Every objective value the search saw (for the flatness test).
         let seen = std::sync::Mutex::new(Vec::<f64>::new());
         // A point in the variables' order from the free variables' search coordinates (in
@@ -583,10 +681,10 @@ impl OptimizeStudy {
             .iter()
             .map(|&k| self.value_to_search(k, self.variables[k].upper))
             .collect();
-        let (u_best, simulations, failures, converged) = if n == 0 {
-            (Vec::new(), 0, 0, true)
+        let (u_best, simulations, failures, converged, local_searches) = if n == 0 {
+            (Vec::new(), 0, 0, true, 0)
         } else if n == 1 {
-            let m = SCAN_POINTS;
+            let m = grid;
             let grid: Vec<f64> = (0..m)
                 .map(|i| lo[0] + (hi[0] - lo[0]) * i as f64 / (m - 1) as f64)
                 .collect();
@@ -620,34 +718,27 @@ impl OptimizeStudy {
                 m + r.evaluations,
                 scan_fail + r.failures,
                 r.converged,
+                1,
             )
         } else {
-            let m_b = self.bed_mass_kg.or_else(|| self.model.bed_mass());
-            let x0: Vec<f64> = order
-                .iter()
-                .enumerate()
-                .map(|(j, &k)| {
-                    let v = &self.variables[k];
-                    let c = current_value(&self.model, &v.quantity, m_b)
-                        .filter(|c| c.is_finite() && *c > v.lower && *c < v.upper);
-                    match c {
-                        Some(c) => self.value_to_search(k, c),
-                        None => 0.5 * (lo[j] + hi[j]),
-                    }
-                })
-                .collect();
-            let opts = NelderMeadOptions {
-                initial_step: 0.2,
-                x_tolerance: 1e-5,
-                f_tolerance: 1e-9,
+            let opts = GlobalOptions {
+                grid_points: grid,
+                starts: GLOBAL_STARTS,
                 max_evaluations: search_budget,
-                max_restarts: 5,
-                random_starts: 2,
-                seed: 4,
-                polish: true,
+                local: NelderMeadOptions {
+                    initial_step: 0.2,
+                    x_tolerance: 1e-5,
+                    f_tolerance: 1e-9,
+                    max_evaluations: search_budget,
+                    max_restarts: 5,
+                    random_starts: 0,
+                    seed: 4,
+                    polish: true,
+                },
             };
-            let r = minimize_box(f, &x0, &lo, &hi, &opts)?;
-            (r.x, r.evaluations, r.failures, r.converged)
+            let r = minimize_box_global(f, &lo, &hi, &opts)?;
+            let searches = r.searches.len();
+            (r.x, r.evaluations, r.failures, r.converged, searches)
         };
         let mut optimum = to_x(&u_best);
         let mut point = eval(&qs_all, &optimum);
@@ -719,10 +810,14 @@ impl OptimizeStudy {
             .iter()
             .map(|&k| self.variables[k].quantity.name())
             .collect();
-        let method = if n == 1 {
-            format!("a {SCAN_POINTS}-point scan over the bounds, then Brent's method in the best scan interval")
-        } else {
-            "a bounded Nelder-Mead search from the model's point and 2 seeded random starts, with restarts and a coordinate polish".to_string()
+        let method = match n {
+            0 => "nothing searched (every variable fixed)".to_string(),
+            1 => format!("a {grid}-point scan over the bounds, then Brent's method in the best scan interval"),
+            _ => format!(
+                "a {} grid over the box ({} simulations), then a bounded Nelder-Mead search with restarts and a coordinate polish from each of the best {local_searches} grid points lower than their neighbours",
+                vec![grid.to_string(); n].join("×"),
+                self.grid_total()
+            ),
         };
         let step_text = format!(
             "±{} % of each variable's range{}",
@@ -764,8 +859,7 @@ impl OptimizeStudy {
             (
                 Verdict::NotChecked,
                 format!(
-                    "not checked: the budget (--max-simulations {}) left no simulations for the {check_runs} neighbours (give at least {}); found by {method}",
-                    self.max_simulations,
+                    "not checked: the budget (--max-simulations {budget}) left no simulations for the {check_runs} neighbours (give at least {}); found by {method}",
                     min + check_runs
                 ),
             )
@@ -786,7 +880,7 @@ impl OptimizeStudy {
             (
                 Verdict::LocalMinimum,
                 format!(
-                    "a local minimum: each of the {} neighbours ({step_text}) gives a higher {metric} (smallest rise {:.3e} relative); found by {method}; not shown to be the global minimum",
+                    "a local minimum: each of the {} neighbours ({step_text}) gives a higher {metric} (smallest rise {:.3e} relative); found by {method}; the lowest found, global to the grid's resolution (a basin narrower than about two grid cells can be missed)",
                     neighbours.len(),
                     rise
                 ),
@@ -827,6 +921,11 @@ impl OptimizeStudy {
             optimum,
             objective_value,
             simulations: simulations + rule_runs,
+            max_simulations: budget,
+            grid_points_per_variable: if n == 0 { 0 } else { grid },
+            grid_simulations: self.grid_total(),
+            local_searches,
+            method,
             failures,
             converged,
             wd_over_ws_at_optimum: point.metric("wd_over_ws"),

@@ -1400,7 +1400,7 @@ pub fn solve_from(
     let t_end = opts.duration;
     selector.observe(&y[..nx]);
     let mut mode = selector.select(&rhs, &y[..nx], Mode(0), &mut sides);
-    let mut grid = Grid::new(opts.sample_rate);
+    let mut grid = Grid::new(opts);
     let mut k: [Vec<f64>; 7] = std::array::from_fn(|_| vec![0.0; ny]);
     let mut ytmp = vec![0.0; ny];
     let mut ynew = vec![0.0; ny];
@@ -1469,7 +1469,8 @@ pub fn solve_from(
     };
 
     // Emit t = 0.
-    if let Some(g) = grid.as_mut() {
+    // (With a phase φ > 0 the first sample, at φ, comes from the steps.)
+    if let Some(g) = grid.as_mut().filter(|g| g.phase == 0.0) {
         obs.sample(0.0, &y[..nx], mode);
         g.next = 1;
     }

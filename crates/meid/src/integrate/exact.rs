@@ -87,7 +87,7 @@ pub fn solve_from(
     let n_ind = selector.indicators().len();
     // Closed forms of the modes that stay long, built on first use.
     let mut cache: [Option<ModeData>; MODES] = Default::default();
-    let mut grid = Grid::new(opts.sample_rate);
+    let mut grid = Grid::new(opts);
     let t_end = opts.duration;
 
     let mut x = x0.to_vec();

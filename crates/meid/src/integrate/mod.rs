@@ -58,6 +58,10 @@ pub struct Options {
     pub duration: f64,
     /// Output sample rate (Hz); `None` for no samples.
     pub sample_rate: Option<f64>,
+    /// Time of the first output sample (s), `0 ≤ φ < 1/sample_rate`: samples at
+    /// `t_j = φ + j/f_s`. A train of blows ([`crate::analysis::blows`]) starts each blow at
+    /// its exact strike time and puts its samples on the train's grid `i/f_s` with it.
+    pub sample_phase_s: f64,
     /// Stop at the end of the collision instead of the end of `duration`.
     pub stop_at_collision_end: bool,
     /// Relative tolerance (dopri5).
@@ -78,6 +82,7 @@ impl Default for Options {
             method: Method::Exact,
             duration: 0.5,
             sample_rate: Some(20_000.0),
+            sample_phase_s: 0.0,
             stop_at_collision_end: false,
             rtol: 1e-8,
             atol: 1e-14,
@@ -278,6 +283,16 @@ pub fn solve_from(
                 format!("must be > 0 Hz (got {r})"),
             ));
         }
+        let phase = opts.sample_phase_s;
+        if !(phase >= 0.0 && phase < 1.0 / r) {
+            return Err(Error::invalid(
+                "sample_phase_s",
+                format!(
+                    "must lie in [0, 1/sample_rate) = [0, {}) s (got {phase})",
+                    1.0 / r
+                ),
+            ));
+        }
     }
     check_cost(sys, opts)?;
     match opts.method {
@@ -406,17 +421,21 @@ pub fn fastest_rate(sys: &ImpactSystem) -> Option<(f64, RateSource)> {
 pub(crate) struct Grid {
     pub dt: f64,
     pub next: u64,
+    /// Time of sample 0 ([`Options::sample_phase_s`]).
+    pub phase: f64,
 }
 
 impl Grid {
-    pub fn new(rate: Option<f64>) -> Option<Self> {
-        rate.map(|r| Grid {
+    /// The output grid of `opts`: `t_j = φ + j/f_s`, or `None` without samples.
+    pub fn new(opts: &Options) -> Option<Self> {
+        opts.sample_rate.map(|r| Grid {
             dt: 1.0 / r,
             next: 0,
+            phase: opts.sample_phase_s,
         })
     }
     #[inline]
     pub fn time(&self, j: u64) -> f64 {
-        j as f64 * self.dt
+        self.phase + j as f64 * self.dt
     }
 }
