@@ -6,8 +6,10 @@
 //! * the simulated blow starts at rest: `pre-trigger` seconds of zeros are put before t = 0
 //!   (exact: nothing moves before the blow), and the record is taken from the trigger found by
 //!   the same rule on the same channel as in the measurement;
-//! * per mapped channel: the sample peak of the blow-averaged records, the peak error
-//!   `100 (peak_meas − peak_sim)/peak_sim` %;
+//! * per mapped channel: the sample peak of the blow-averaged records, each record less its
+//!   baseline (the median of its pre-trigger samples: an accelerometer's bias, a force cell's
+//!   preload; the simulation starts at rest, baseline 0), the peak error
+//!   `100 (peak_meas − peak_sim)/peak_sim` %, and the baseline removed;
 //! * per dominant mode of the simulated case, on the responses (not on the blow, the input)
 //!   (a mode with ω > 0 below 0.45 f_s whose simulated
 //!   ESD peak lies within 30 dB of the channel's strongest): the largest bin of each ESD within
@@ -132,9 +134,12 @@ pub struct ChannelComparison {
     /// The measured channel's name.
     pub measured_name: String,
     pub unit: String,
-    /// Sample peaks of the blow-averaged records.
+    /// Sample peaks `max_n |x̄_n|` of the blow-averaged records, each record less its
+    /// baseline ([`super::process::average_blows`]).
     pub simulated_peak: f64,
     pub measured_peak: f64,
+    /// The baselines removed from the measured records (the simulated ones start at rest: 0).
+    pub measured_baseline: super::process::BaselineRemoved,
     pub peak_error_percent: f64,
     pub level_reference: String,
     pub modes: Vec<ModeComparison>,
@@ -412,8 +417,10 @@ fn one_case(
         let s = sim_record(c)?;
         let ms = blow_spectrum(&r.values, c.role(), fs, &mb, p, Some(n_fft))?;
         let ss = blow_spectrum(&s.values, c.role(), fs, &sb, &sp, Some(n_fft))?;
-        let ma = super::process::average_blows(&r.values, &mb.starts, n)?;
-        let sa = super::process::average_blows(&s.values, &sb.starts, n)?;
+        // Each record less its baseline (a bias, a preload): like the simulation, at rest.
+        let ma = super::process::average_blows(&r.values, &mb)?;
+        let sa = super::process::average_blows(&s.values, &sb)?;
+        let measured_baseline = super::process::baseline_removed(&r.values, &mb)?;
         let peak = |v: &[f64]| v.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
         let (mp, spk) = (peak(&ma), peak(&sa));
         let (rref, rtext) = esd_reference(r.quantity);
@@ -457,6 +464,7 @@ fn one_case(
             unit: r.unit().to_string(),
             simulated_peak: spk,
             measured_peak: mp,
+            measured_baseline,
             peak_error_percent: 100.0 * (mp - spk) / spk,
             level_reference: rtext,
             modes: rows,
@@ -526,6 +534,11 @@ impl Validation {
                     "  {} ('{}'): sample peak measured {:.5e} {u}, simulated {:.5e} {u}, error {:+.2} %",
                     ch.channel.label(), ch.measured_name, ch.measured_peak, ch.simulated_peak, ch.peak_error_percent, u = ch.unit
                 );
+                let _ = writeln!(
+                    s,
+                    "    measured baseline removed: {}",
+                    ch.measured_baseline.describe(&ch.unit)
+                );
                 for m in &ch.modes {
                     let _ = writeln!(
                         s,
@@ -553,7 +566,7 @@ impl Validation {
                 );
             }
         }
-        let _ = writeln!(s, "levels: dB re 1 (SI unit)²·s/Hz; frequencies ± half a padded bin; peaks are sample peaks of the blow-averaged records");
+        let _ = writeln!(s, "levels: dB re 1 (SI unit)²·s/Hz; frequencies ± half a padded bin; peaks are sample peaks of the blow-averaged records, each record less its baseline (the median of its pre-trigger samples)");
         s
     }
 
