@@ -115,6 +115,19 @@ fn a_simulation_validates_against_itself_to_zero_error() {
     let names: Vec<&str> = b.modes.iter().map(|m| m.mode.as_str()).collect();
     assert_eq!(names, vec!["mode 1 (6.35 Hz)", "mode 2 (283.00 Hz)"]);
     assert!(v.to_text().contains("case none"));
+    // The spectra's resolution is stated beside the frequencies it limits (brief s13-lab: the
+    // text said only "frequencies ± half a padded bin", a grid of at most 0.5 % of 6.35 Hz,
+    // while a record of about 0.5 s resolves 2 Hz: the 6.35 Hz mode reads 6.18-6.22 Hz in the
+    // lumped example's 0.48 s record, as the pre-trigger goes from 0 to 0.01 s).
+    let n = (c.record_s * FS).round();
+    assert_eq!(c.frequency_resolution_hz, FS / n);
+    assert!(c.padded_bin_hz <= 0.005 * 6.35 && c.padded_bin_hz > 0.0);
+    assert!(
+        v.to_text()
+            .contains(&format!("spectral resolution 1/T = {:.4} Hz", FS / n)),
+        "{}",
+        v.to_text()
+    );
 }
 
 #[test]
