@@ -53,6 +53,7 @@ fn measure_json_has_the_issue_fields_and_sample_peaks() {
         "sample_rate_hz",
         "peak",
         "peak_time_s",
+        "baseline",
         "blows",
         "blows_averaged",
         "record_s",

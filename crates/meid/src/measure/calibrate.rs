@@ -18,7 +18,9 @@
 //! same channel mapping, trigger rule, pre-trigger, record length, windows); the model of case
 //! `c` is simulated at the measurement's sample rate, at rest for the pre-trigger, and its
 //! record taken from the trigger found by the same rule on the same channel. Residuals of
-//! mapped channel `k` (measured blow average `m_k`, simulated record `s_k(p)`):
+//! mapped channel `k` (measured blow average `m_k`, each blow record less its baseline, the
+//! median of its pre-trigger samples, as the simulated record `s_k(p)`, which starts at rest:
+//! a transducer's bias or preload is not fitted as motion; [`super::process`], Baseline):
 //!
 //! ```text
 //! time histories (default):  r_kj = (s_kj(p) − m_kj) / rms(m_k),      j = 1 … N samples
@@ -59,7 +61,20 @@
 //! s² = S(p̂) / (m − n),   Cov(p̂) ≈ s² (J_pᵀ J_p)⁻¹,   p̂_i ± t_{0.975, m−n} √Cov_ii
 //! ```
 //!
-//! the linearised (Gauss-Newton) 95 % interval. It assumes independent residuals of equal
+//! the linearised (Gauss-Newton) 95 % interval, plus, for time-history residuals, the
+//! uncertainty of the baselines removed from the measured records: each channel's blow average
+//! lost `b̄_k = (1/B) Σ_b b_b`, medians of `P` pre-trigger samples whose error is one constant
+//! over all of the channel's residuals (not white: with 100 pre-trigger samples and 10 blows
+//! it weighs ten times the white noise on the direction of a constant). With `σ_k` the spread
+//! of the pre-trigger samples about their baselines, `u_k` the indicator of channel `k`'s
+//! residuals and `C = (J_pᵀ J_p)⁻¹`,
+//!
+//! ```text
+//! var(b̄_k) ≈ (π/2) σ_k² / (P B)       (the variance of a median of P normal samples, over B blows)
+//! Cov(p̂) ≈ s² C + C (Σ_k var(b̄_k)/rms(m_k)² · g_k g_kᵀ) C,   g_k = J_pᵀ u_k
+//! ```
+//!
+//! It assumes independent residuals of equal
 //! variance: exact for white measurement noise on the samples (the synthetic test), but the
 //! residual of a real machine is also model error, correlated from sample to sample, and the
 //! interval is then narrower than the true uncertainty. **The intervals are estimates**; a
@@ -297,9 +312,12 @@ struct ChannelTarget {
     channel: SimChannel,
     measured_name: String,
     unit: String,
-    /// Blow-averaged measured record.
+    /// Blow-averaged measured record, each record less its baseline.
     average: Vec<f64>,
     rms: f64,
+    /// `var(b̄)`: the variance of the mean baseline removed (module docs, Confidence
+    /// intervals; 0 when none was removed).
+    baseline_variance: f64,
     /// Measured ESD (spectrum residuals) and the bins used.
     spectrum: Vec<f64>,
     bins: std::ops::Range<usize>,
@@ -315,6 +333,31 @@ struct CaseTarget {
     trigger: SimChannel,
     processing: Processing,
     channels: Vec<ChannelTarget>,
+}
+
+/// `var(b̄) ≈ (π/2) σ² / (P B)`: the variance of the mean over `B` blow records of their
+/// baselines, each the median of `P` pre-trigger samples, `σ²` the pooled variance of those
+/// samples about their records' means (module docs, Confidence intervals); 0 when no baseline
+/// is removed (fewer than [`super::process::MIN_BASELINE_SAMPLES`] pre-trigger samples).
+fn baseline_variance(x: &[f64], blows: &super::process::Blows) -> Result<f64> {
+    let pre = blows.pretrigger;
+    if pre < super::process::MIN_BASELINE_SAMPLES || pre > blows.length || blows.starts.is_empty() {
+        return Ok(0.0);
+    }
+    let mut ss = 0.0;
+    for &s in &blows.starts {
+        let seg = x.get(s..s + pre).ok_or_else(|| {
+            Error::invalid(
+                "blows",
+                format!("the record from sample {s} runs past the end"),
+            )
+        })?;
+        let mean = seg.iter().sum::<f64>() / pre as f64;
+        ss += seg.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>();
+    }
+    let b = blows.starts.len() as f64;
+    let var = ss / (b * (pre as f64 - 1.0));
+    Ok(std::f64::consts::FRAC_PI_2 * var / (pre as f64 * b))
 }
 
 /// The least-squares problem: the measured targets and how a model is evaluated against them.
@@ -368,7 +411,9 @@ impl<'a> Problem<'a> {
             let mut channels = Vec::new();
             for (&c, &i) in &mb.map {
                 let r = &m.records[i];
-                let average = average_blows(&r.values, &mb.blows.starts, n)?;
+                // Less each record's baseline, as the simulation's (at rest: 0).
+                let average = average_blows(&r.values, &mb.blows)?;
+                let baseline_variance = baseline_variance(&r.values, &mb.blows)?;
                 let rms = (average.iter().map(|x| x * x).sum::<f64>() / n as f64).sqrt();
                 if !(rms > 0.0 && rms.is_finite()) {
                     return Err(Error::Input {
@@ -418,6 +463,7 @@ impl<'a> Problem<'a> {
                     unit: r.unit().to_string(),
                     average,
                     rms,
+                    baseline_variance,
                     spectrum,
                     bins,
                     floor,
@@ -475,7 +521,7 @@ impl<'a> Problem<'a> {
             let mut per = Vec::with_capacity(ct.channels.len());
             for ch in &ct.channels {
                 let s = sim.record(ch.channel)?;
-                let sa = average_blows(&s.values, &sim.blows.starts, ct.n)?;
+                let sa = average_blows(&s.values, &sim.blows)?;
                 match self.settings.residual {
                     ResidualKind::TimeHistory => {
                         r.extend(sa.iter().zip(&ch.average).map(|(s, m)| (s - m) / ch.rms));
@@ -1032,11 +1078,47 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
         .iter()
         .map(|&i| free.iter().map(|&j| dot(&jp[i], &jp[j])).collect())
         .collect();
+    // The baselines' share (module docs): Σ_k var(b̄_k)/rms_k² g_k g_kᵀ over the free values,
+    // g_k the sums of J_p's rows of channel k (time-history residuals only: a constant leaves
+    // the ESD above DC as it is).
+    let mut baseline_term = vec![vec![0.0; free.len()]; free.len()];
+    if problem.settings.residual == ResidualKind::TimeHistory {
+        let mut row = 0;
+        for ct in &problem.cases {
+            for ch in &ct.channels {
+                let rows = row..row + ct.n;
+                row += ct.n;
+                if ch.baseline_variance <= 0.0 {
+                    continue;
+                }
+                let w = ch.baseline_variance / (ch.rms * ch.rms);
+                let g: Vec<f64> = free
+                    .iter()
+                    .map(|&i| jp[i].get(rows.clone()).map_or(0.0, |r| r.iter().sum()))
+                    .collect();
+                for (a, ga) in g.iter().enumerate() {
+                    for (b, gb) in g.iter().enumerate() {
+                        baseline_term[a][b] += w * ga * gb;
+                    }
+                }
+            }
+        }
+    }
+    // Cov = s² C + C B C over the free values (C = (J_pᵀ J_p)⁻¹).
     let cov: Option<Vec<Vec<f64>>> = spd_inverse(&a).map(|c| {
+        let k = free.len();
+        let cb: Vec<Vec<f64>> = (0..k)
+            .map(|a| {
+                (0..k)
+                    .map(|b| (0..k).map(|l| c[a][l] * baseline_term[l][b]).sum())
+                    .collect()
+            })
+            .collect();
         let mut full = vec![vec![f64::NAN; n]; n];
         for (a, &i) in free.iter().enumerate() {
             for (b, &j) in free.iter().enumerate() {
-                full[i][j] = c[a][b];
+                let cbc: f64 = (0..k).map(|l| cb[a][l] * c[l][b]).sum();
+                full[i][j] = s2 * c[a][b] + cbc;
             }
         }
         full
@@ -1047,7 +1129,7 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
         let v = values[i];
         let at_bound = out.x[i] <= lo[i] || out.x[i] >= hi[i];
         let se = match &cov {
-            Some(c) if !at_bound && c[i][i] >= 0.0 => (s2 * c[i][i]).sqrt(),
+            Some(c) if !at_bound && c[i][i] >= 0.0 => c[i][i].sqrt(),
             _ => f64::NAN,
         };
         estimates.push(Estimate {

@@ -37,12 +37,26 @@
 //! ([`record_baseline`]; a simulated record, at rest before the blow, has 0). A DC offset (a
 //! transducer's bias or preload, an amplifier's drift) would otherwise leak into the low bins
 //! under a Hann or exponential window and could be the "dominant" line. The time averages and
-//! sample peaks are of the records as measured.
+//! the peaks are of the records less their baselines too, as a test lab reads them (a
+//! simulated history starts at rest, baseline 0: measured and simulated compare like with
+//! like):
+//!
+//! ```text
+//! b_b = median(x_b[0 .. pre])            (pre ≥ 16 samples; else b_b = 0, nothing removed)
+//! x̄_n = (1/B) Σ_b (x_b[n] − b_b)         the time average
+//! peak = x_b[n] − b_b at the (b, n) of the largest |x_b[n] − b_b|, with its sign and time
+//! ```
+//!
+//! The baselines removed are reported per channel ([`BaselineRemoved`]: their mean
+//! `(1/B) Σ_b b_b`, which the time average lost, their range over the blows, and the number of
+//! pre-trigger samples each is the median of). A peak read from samples is a **sample peak**:
+//! the signal between samples may go higher; a sinusoid of frequency `f` sampled at `f_s` is
+//! read at no less than `cos(π f/f_s)` of its amplitude.
 //!
 //! # Averaging
 //!
-//! * in time: `x̄_n = (1/B) Σ_b x_b[n]` over the B complete blow records (aligned on the trigger
-//!   sample), for overlays;
+//! * in time: `x̄_n = (1/B) Σ_b (x_b[n] − b_b)` over the B complete blow records (aligned on
+//!   the trigger sample, each less its baseline `b_b`), for overlays;
 //! * in frequency: the energy spectral density is the mean of the blows' ESDs,
 //!   `Ē_k = (1/B) Σ_b E_{b,k}` with `E_{b,k} = 2|Δt Σ_n w_n x_b[n] e^{−2πikn/N}|²`
 //!   ([`crate::analysis::spectrum::esd_fft`]'s scaling; unit²·s/Hz). Levels are
@@ -412,33 +426,114 @@ pub fn require_complete(b: &Blows, n: usize, fs: f64, channel: &str, origin: &st
     })
 }
 
-/// `(1/B) Σ_b x[s_b .. s_b + len]`: the time average of the blow records.
-pub fn average_blows(x: &[f64], starts: &[usize], len: usize) -> Result<Vec<f64>> {
+/// The baselines removed from one channel's blow records (module docs, Baseline), in the
+/// channel's SI unit.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct BaselineRemoved {
+    /// `(1/B) Σ_b b_b`: the mean of the records' baselines, what the time average lost.
+    pub mean: f64,
+    /// The smallest and largest `b_b` over the records (their spread: drift between blows).
+    pub min: f64,
+    pub max: f64,
+    /// Pre-trigger samples each `b_b` is the median of; 0 when the pre-trigger holds fewer than
+    /// [`MIN_BASELINE_SAMPLES`] (nothing removed: the records are as measured).
+    pub samples: usize,
+}
+
+impl BaselineRemoved {
+    /// One line for reports, e.g. `+3.0000e0 m/s^2 (median of 100 pre-trigger samples)`, or
+    /// why none was removed.
+    pub fn describe(&self, unit: &str) -> String {
+        if self.samples == 0 {
+            format!("none removed (pre-trigger under {MIN_BASELINE_SAMPLES} samples: peaks and averages include any DC offset)")
+        } else if self.min == self.max {
+            format!(
+                "{:+.4e} {unit} (median of {} pre-trigger samples)",
+                self.mean, self.samples
+            )
+        } else {
+            format!(
+                "{:+.4e} {unit} on average, {:+.4e} … {:+.4e} over the blows (medians of {} pre-trigger samples)",
+                self.mean, self.min, self.max, self.samples
+            )
+        }
+    }
+}
+
+/// The baseline `b_b` of each blow record `x[s_b .. s_b + L]` ([`record_baseline`]).
+pub fn blow_baselines(x: &[f64], blows: &Blows) -> Result<Vec<f64>> {
+    check_starts(x.len(), &blows.starts, blows.length)?;
+    Ok(blows
+        .starts
+        .iter()
+        .map(|&s| record_baseline(&x[s..s + blows.length], blows.pretrigger))
+        .collect())
+}
+
+/// What [`blow_baselines`] removes from a channel, summed up.
+pub fn baseline_removed(x: &[f64], blows: &Blows) -> Result<BaselineRemoved> {
+    let b = blow_baselines(x, blows)?;
+    let samples = if blows.pretrigger >= MIN_BASELINE_SAMPLES && blows.pretrigger <= blows.length {
+        blows.pretrigger
+    } else {
+        0
+    };
+    let (min, max) = b
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, c), &v| {
+            (a.min(v), c.max(v))
+        });
+    let (min, max) = if b.is_empty() { (0.0, 0.0) } else { (min, max) };
+    Ok(BaselineRemoved {
+        mean: if b.is_empty() {
+            0.0
+        } else {
+            b.iter().sum::<f64>() / b.len() as f64
+        },
+        min,
+        max,
+        samples,
+    })
+}
+
+/// `x̄_n = (1/B) Σ_b (x[s_b + n] − b_b)`: the time average of the blow records, each less its
+/// baseline `b_b` ([`record_baseline`]; module docs, Baseline).
+pub fn average_blows(x: &[f64], blows: &Blows) -> Result<Vec<f64>> {
+    let (starts, len) = (&blows.starts, blows.length);
     if starts.is_empty() {
         return Err(Error::invalid(
             "blows",
             "no complete blow record to average",
         ));
     }
-    check_starts(x.len(), starts, len)?;
+    let baselines = blow_baselines(x, blows)?;
     let mut acc = vec![0.0; len];
-    for &s in starts {
-        let seg = x.get(s..s.saturating_add(len)).ok_or_else(|| {
-            Error::invalid(
-                "blows",
-                format!(
-                    "the record from sample {s} ({len} samples) runs past the end ({} samples)",
-                    x.len()
-                ),
-            )
-        })?;
-        for (a, v) in acc.iter_mut().zip(seg) {
-            *a += v;
+    for (&s, &b) in starts.iter().zip(&baselines) {
+        // (In range: `blow_baselines` checked the starts.)
+        for (a, v) in acc.iter_mut().zip(&x[s..s + len]) {
+            *a += v - b;
         }
     }
-    let b = starts.len() as f64;
-    acc.iter_mut().for_each(|a| *a /= b);
+    let n = starts.len() as f64;
+    acc.iter_mut().for_each(|a| *a /= n);
     Ok(acc)
+}
+
+/// The sample peak of the blow records less their baselines: `x[i] − b_b` at the sample `i` of
+/// the largest `|x[s_b + n] − b_b|` over the records (the first such sample), with its sign
+/// (module docs, Baseline). Returns `(value, i)`.
+pub fn blow_peak(x: &[f64], blows: &Blows) -> Result<(f64, usize)> {
+    let baselines = blow_baselines(x, blows)?;
+    let mut best = (0.0_f64, blows.starts.first().copied().unwrap_or(0));
+    for (&s, &b) in blows.starts.iter().zip(&baselines) {
+        for (i, v) in x[s..s + blows.length].iter().enumerate() {
+            let d = v - b;
+            if d.abs() > best.0.abs() {
+                best = (d, s + i);
+            }
+        }
+    }
+    Ok(best)
 }
 
 /// Every blow record `[s, s + len)` lies in a channel of `n` samples (checked before anything
@@ -851,10 +946,14 @@ pub struct ChannelSummary {
     pub unit: String,
     pub samples: usize,
     pub sample_rate_hz: f64,
-    /// Largest `|x|` over the samples (a sample peak: the true peak between samples may be
-    /// higher).
+    /// The sample peak of the averaged blow records less their baselines, with its sign:
+    /// `x_i − b_b` at the sample of the largest `|x_i − b_b|` ([`blow_peak`]; the signal between
+    /// samples may go higher). With no blow found, of the whole record as measured.
     pub peak: f64,
+    /// The time of that sample in the file (s).
     pub peak_time_s: f64,
+    /// The baselines removed from the blow records before peaks, averages and spectra.
+    pub baseline: BaselineRemoved,
     /// Blows detected on the trigger channel of the file.
     pub blows: usize,
     /// Blows whose records were averaged (0: no blow was found, the spectrum is the whole
@@ -962,14 +1061,9 @@ pub fn process_channel(
             message: format!("channel '{}': needs at least 2 samples", r.name),
         });
     }
-    let (k, peak) = r.values.iter().enumerate().fold((0, 0.0_f64), |b, (i, v)| {
-        if v.abs() > b.1 {
-            (i, v.abs())
-        } else {
-            b
-        }
-    });
-    let average = average_blows(&r.values, &blows.starts, blows.length)?;
+    let (peak, k) = blow_peak(&r.values, blows)?;
+    let baseline = baseline_removed(&r.values, blows)?;
+    let average = average_blows(&r.values, blows)?;
     let mut spectrum = blow_spectrum(&r.values, role, fs, blows, p, None)?;
     let window = if p.force_window && role == Role::Excitation {
         format!(
@@ -1002,6 +1096,7 @@ pub fn process_channel(
             sample_rate_hz: fs,
             peak,
             peak_time_s: r.time_at(k),
+            baseline,
             blows: found,
             blows_averaged: averaged,
             record_s: blows.length as f64 / fs,
@@ -1115,7 +1210,7 @@ mod tests {
         assert_eq!(b.length, 1000);
         // The last blow's record (2490..3490) runs past the end: counted, not averaged.
         assert_eq!(b.starts, vec![490, 1490]);
-        let avg = average_blows(&x, &b.starts, b.length).unwrap();
+        let avg = average_blows(&x, &b).unwrap();
         assert_eq!(avg[10], 10.0);
         let p = Processing {
             record_s: Some(0.4),

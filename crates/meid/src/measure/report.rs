@@ -39,13 +39,14 @@ pub fn summary_text(files: &[String], channels: &[ProcessedChannel]) -> String {
     let _ = writeln!(out, "meid measure — {}", files.join(", "));
     let _ = writeln!(
         out,
-        "  {:<24} {:<6} {:>9} {:>10} {:>13} {:>10} {:>6} {:>8} {:>11} {:>9}",
+        "  {:<24} {:<6} {:>9} {:>10} {:>13} {:>10} {:>12} {:>6} {:>8} {:>11} {:>9}",
         "channel",
         "unit",
         "samples",
         "rate (Hz)",
         "sample peak",
         "at (s)",
+        "baseline",
         "blows",
         "averaged",
         "dominant",
@@ -59,21 +60,43 @@ pub fn summary_text(files: &[String], channels: &[ProcessedChannel]) -> String {
         };
         let _ = writeln!(
             out,
-            "  {:<24} {:<6} {:>9} {:>10.1} {:>13.5e} {:>10.6} {:>6} {:>8} {line}",
+            "  {:<24} {:<6} {:>9} {:>10.1} {:>+13.5e} {:>10.6} {:>+12.4e} {:>6} {:>8} {line}",
             s.name,
             s.unit,
             s.samples,
             s.sample_rate_hz,
             s.peak,
             s.peak_time_s,
+            s.baseline.mean,
             s.blows,
             s.blows_averaged,
         );
     }
     let _ = writeln!(
         out,
-        "  peaks are sample peaks (the largest |x| among the samples; the signal between samples may go higher);"
+        "  peaks are sample peaks, with their sign: the largest |x − b| among the samples of the averaged blow records, b each record's baseline; the signal between samples may go higher (a sinusoid of frequency f reads at least cos(π f/f_s) of its amplitude);"
     );
+    let removed = channels
+        .iter()
+        .filter(|c| c.summary.blows_averaged > 0)
+        .map(|c| c.summary.baseline.samples)
+        .next();
+    match removed {
+        Some(0) => {
+            let _ = writeln!(
+                out,
+                "  baseline: none removed, the pre-trigger holds fewer than {} samples (peaks and averages include any DC offset: give a longer --pretrigger);",
+                super::process::MIN_BASELINE_SAMPLES
+            );
+        }
+        Some(k) => {
+            let _ = writeln!(
+                out,
+                "  baseline: the median of each blow record's {k} pre-trigger samples (a transducer's bias or preload), removed before peaks, averages and spectra; the column is its mean over the blows;"
+            );
+        }
+        None => {}
+    }
     if let Some(c) = channels.iter().find(|c| c.summary.blows_averaged > 0) {
         let _ = writeln!(
             out,
@@ -195,7 +218,8 @@ pub fn bands_csv(channels: &[ProcessedChannel]) -> Result<Vec<u8>> {
     Ok(s.into_bytes())
 }
 
-/// `time_s,<name>_<unit>` of one channel's blow-averaged record (time from the record start).
+/// `time_s,<name>_<unit>` of one channel's blow-averaged record (time from the record start),
+/// each blow record less its baseline ([`super::process::average_blows`]).
 pub fn average_csv(c: &ProcessedChannel) -> Vec<u8> {
     let dt = 1.0 / c.summary.sample_rate_hz;
     let mut s = format!("time_s,average_{}\n", c.summary.unit);
@@ -257,7 +281,14 @@ pub fn plots(dir: &Path, stem: &str, c: &ProcessedChannel) -> Result<()> {
         dir.join(format!("{stem}_average")),
         &LinePlot {
             title: if c.spectrum.averages > 0 {
-                format!("{}: blow-averaged record", c.summary.name)
+                if c.summary.baseline.samples > 0 {
+                    format!(
+                        "{}: blow-averaged record, less its baseline ({:+.4e} {})",
+                        c.summary.name, c.summary.baseline.mean, c.summary.unit
+                    )
+                } else {
+                    format!("{}: blow-averaged record", c.summary.name)
+                }
             } else {
                 format!("{}: the whole record (no blow found)", c.summary.name)
             },

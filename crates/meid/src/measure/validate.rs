@@ -6,15 +6,18 @@
 //! * the simulated blow starts at rest: `pre-trigger` seconds of zeros are put before t = 0
 //!   (exact: nothing moves before the blow), and the record is taken from the trigger found by
 //!   the same rule on the same channel as in the measurement;
-//! * per mapped channel: the sample peak of the blow-averaged records, the peak error
-//!   `100 (peak_meas − peak_sim)/peak_sim` %;
+//! * per mapped channel: the sample peak of the blow-averaged records, each record less its
+//!   baseline (the median of its pre-trigger samples: an accelerometer's bias, a force cell's
+//!   preload; the simulation starts at rest, baseline 0), the peak error
+//!   `100 (peak_meas − peak_sim)/peak_sim` %, and the baseline removed;
 //! * per dominant mode of the simulated case, on the responses (not on the blow, the input)
 //!   (a mode with ω > 0 below 0.45 f_s whose simulated
 //!   ESD peak lies within 30 dB of the channel's strongest): the largest bin of each ESD within
 //!   ±10 % of the mode's frequency; frequency error `f_meas − f_sim` (Hz, %), level difference
 //!   `L_meas − L_sim` (dB re 1 (SI unit)²·s/Hz). Spectra are zero-padded so that a bin is at most
 //!   0.5 % of the lowest mode's frequency (at most 64× the record): frequencies are read ± half a
-//!   padded bin, and the resolution stays 1/T of the record;
+//!   padded bin on that grid, and the resolution stays 1/T of the record (both reported: a
+//!   mode with few cycles in the record reads biased, alike measured and simulated);
 //! * when both the bare machine and the damper are measured: the measured reductions
 //!   `L_none − L_damper` (sample peaks, `20 log10`; ESD peaks at each mode, `10 log10`) beside
 //!   the simulated ones computed the same way — the paper's section 5 comparison.
@@ -132,9 +135,12 @@ pub struct ChannelComparison {
     /// The measured channel's name.
     pub measured_name: String,
     pub unit: String,
-    /// Sample peaks of the blow-averaged records.
+    /// Sample peaks `max_n |x̄_n|` of the blow-averaged records, each record less its
+    /// baseline ([`super::process::average_blows`]).
     pub simulated_peak: f64,
     pub measured_peak: f64,
+    /// The baselines removed from the measured records (the simulated ones start at rest: 0).
+    pub measured_baseline: super::process::BaselineRemoved,
     pub peak_error_percent: f64,
     pub level_reference: String,
     pub modes: Vec<ModeComparison>,
@@ -162,6 +168,12 @@ pub struct CaseComparison {
     pub trigger: String,
     pub record_s: f64,
     pub pretrigger_s: f64,
+    /// The spectra's resolution `1/T` (Hz, `T` the record length): peaks closer than this do
+    /// not separate, and a mode with few cycles in the record reads biased (alike in the
+    /// measurement and the simulation).
+    pub frequency_resolution_hz: f64,
+    /// The zero-padded grid the peaks are read on (Hz): a frequency is ± half of it on the grid.
+    pub padded_bin_hz: f64,
     pub channels: Vec<ChannelComparison>,
 }
 
@@ -412,8 +424,10 @@ fn one_case(
         let s = sim_record(c)?;
         let ms = blow_spectrum(&r.values, c.role(), fs, &mb, p, Some(n_fft))?;
         let ss = blow_spectrum(&s.values, c.role(), fs, &sb, &sp, Some(n_fft))?;
-        let ma = super::process::average_blows(&r.values, &mb.starts, n)?;
-        let sa = super::process::average_blows(&s.values, &sb.starts, n)?;
+        // Each record less its baseline (a bias, a preload): like the simulation, at rest.
+        let ma = super::process::average_blows(&r.values, &mb)?;
+        let sa = super::process::average_blows(&s.values, &sb)?;
+        let measured_baseline = super::process::baseline_removed(&r.values, &mb)?;
         let peak = |v: &[f64]| v.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
         let (mp, spk) = (peak(&ma), peak(&sa));
         let (rref, rtext) = esd_reference(r.quantity);
@@ -457,6 +471,7 @@ fn one_case(
             unit: r.unit().to_string(),
             simulated_peak: spk,
             measured_peak: mp,
+            measured_baseline,
             peak_error_percent: 100.0 * (mp - spk) / spk,
             level_reference: rtext,
             modes: rows,
@@ -475,6 +490,8 @@ fn one_case(
         trigger: tr.name.clone(),
         record_s: n as f64 / fs,
         pretrigger_s: pre as f64 / fs,
+        frequency_resolution_hz: fs / n as f64,
+        padded_bin_hz: fs / n_fft as f64,
         channels,
     })
 }
@@ -509,6 +526,15 @@ fn reductions(cases: &[CaseComparison]) -> Vec<ReductionRow> {
     out
 }
 
+/// `v`, or 0 when it prints as 0.00 (two decimals): a round-off of −1e-14 % is no "−0.00 %".
+fn no_negative_zero(v: f64) -> f64 {
+    if (100.0 * v).round() == 0.0 {
+        0.0
+    } else {
+        v
+    }
+}
+
 impl Validation {
     /// The report as text.
     pub fn to_text(&self) -> String {
@@ -517,20 +543,25 @@ impl Validation {
         for c in &self.cases {
             let _ = writeln!(
                 s,
-                "case {} ({}): {} blows detected on '{}', {} averaged; record {:.4} s from {:.4} s before the trigger, {} Hz",
-                c.case, c.files.join(", "), c.blows_detected, c.trigger, c.blows_averaged, c.record_s, c.pretrigger_s, c.sample_rate_hz
+                "case {} ({}): {} blows detected on '{}', {} averaged; record {:.4} s from {:.4} s before the trigger, {} Hz; spectral resolution 1/T = {:.4} Hz, peaks read on a {:.4} Hz padded grid",
+                c.case, c.files.join(", "), c.blows_detected, c.trigger, c.blows_averaged, c.record_s, c.pretrigger_s, c.sample_rate_hz, c.frequency_resolution_hz, c.padded_bin_hz
             );
             for ch in &c.channels {
                 let _ = writeln!(
                     s,
                     "  {} ('{}'): sample peak measured {:.5e} {u}, simulated {:.5e} {u}, error {:+.2} %",
-                    ch.channel.label(), ch.measured_name, ch.measured_peak, ch.simulated_peak, ch.peak_error_percent, u = ch.unit
+                    ch.channel.label(), ch.measured_name, ch.measured_peak, ch.simulated_peak, no_negative_zero(ch.peak_error_percent), u = ch.unit
+                );
+                let _ = writeln!(
+                    s,
+                    "    measured baseline removed: {}",
+                    ch.measured_baseline.describe(&ch.unit)
                 );
                 for m in &ch.modes {
                     let _ = writeln!(
                         s,
                         "    {:<22} f measured {:>9.3} Hz, simulated {:>9.3} Hz ({:+.2} %); ESD level {:>8.2} vs {:>8.2} dB ({:+.2} dB)",
-                        m.mode, m.measured_frequency_hz, m.simulated_frequency_hz, m.frequency_error_percent, m.measured_level_db, m.simulated_level_db, m.level_difference_db
+                        m.mode, m.measured_frequency_hz, m.simulated_frequency_hz, no_negative_zero(m.frequency_error_percent), m.measured_level_db, m.simulated_level_db, no_negative_zero(m.level_difference_db)
                     );
                 }
             }
@@ -553,7 +584,7 @@ impl Validation {
                 );
             }
         }
-        let _ = writeln!(s, "levels: dB re 1 (SI unit)²·s/Hz; frequencies ± half a padded bin; peaks are sample peaks of the blow-averaged records");
+        let _ = writeln!(s, "levels: dB re 1 (SI unit)²·s/Hz; frequencies: the largest bin within ±10 % of the mode, ± half a padded bin on that grid, but resolved only to 1/T: a mode with few cycles in the record reads biased, alike measured and simulated; peaks are sample peaks of the blow-averaged records, each record less its baseline (the median of its pre-trigger samples)");
         s
     }
 
@@ -648,5 +679,20 @@ impl Validation {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::no_negative_zero;
+
+    /// A deviation that is round-off prints +0.00, not −0.00 (brief s13-lab: `meid validate`
+    /// of a CSV with offsets printed "error -0.00 %" for a bed acceleration that agreed).
+    #[test]
+    fn round_off_prints_as_plus_zero() {
+        assert_eq!(format!("{:+.2}", no_negative_zero(-6e-14)), "+0.00");
+        assert_eq!(format!("{:+.2}", no_negative_zero(-0.004)), "+0.00");
+        assert_eq!(format!("{:+.2}", no_negative_zero(-0.005)), "-0.01");
+        assert_eq!(format!("{:+.2}", no_negative_zero(0.38)), "+0.38");
     }
 }
