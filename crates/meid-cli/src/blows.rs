@@ -50,7 +50,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
     let progress = |done: usize, _total: usize| bar.set_position(done as u64);
     let r = match &set {
         Some(set) => {
-            let interval = meid::analysis::blows::blow_interval_s(a.rate_bpm, opts.sample_rate)?;
+            let interval = meid::analysis::blows::blow_interval_s(a.rate_bpm)?;
             let rows =
                 a.blows as f64 * meid::analysis::energy::sample_count(interval, opts.sample_rate);
             meid::limits::check_memory(

@@ -140,8 +140,8 @@ pub struct BlowsRun {
 
 /// The blow interval for a stroke rate, `T = 60/R` s exactly (the output sample rate does
 /// not change it: the samples of each blow are put on the train's grid instead, see the
-/// module docs; `_sample_rate_hz` is kept for callers).
-pub fn blow_interval_s(rate_bpm: f64, _sample_rate_hz: Option<f64>) -> Result<f64> {
+/// module docs).
+pub fn blow_interval_s(rate_bpm: f64) -> Result<f64> {
     if !(rate_bpm.is_finite() && rate_bpm > 0.0) {
         return Err(Error::invalid(
             "rate_bpm",
@@ -162,6 +162,14 @@ fn strike_phase(t_k: f64, fs: f64) -> f64 {
     } else {
         phase
     }
+}
+
+/// A stroke rate rounded to 4 significant digits, up (`up`) or down, so that the rate printed
+/// is still on the valid side of a limit.
+fn rate_4_digits(r: f64, up: bool) -> f64 {
+    let scale = 10f64.powi(3 - r.log10().floor() as i32);
+    let v = r * scale;
+    (if up { v.ceil() } else { v.floor() }) / scale
 }
 
 fn relative_change(a: f64, b: f64) -> f64 {
@@ -185,7 +193,7 @@ pub fn run_blows(
     record: bool,
 ) -> Result<BlowsRun> {
     if record {
-        let interval = blow_interval_s(blow.rate_bpm, opts.sample_rate)?;
+        let interval = blow_interval_s(blow.rate_bpm)?;
         let n = blow.blows as f64 * super::energy::sample_count(interval, opts.sample_rate);
         crate::limits::check_memory(
             &format!(
@@ -200,7 +208,7 @@ pub fn run_blows(
     }
     let mut history = record.then(History::default);
     if let Some(h) = history.as_mut() {
-        let interval = blow_interval_s(blow.rate_bpm, opts.sample_rate)?;
+        let interval = blow_interval_s(blow.rate_bpm)?;
         let n = blow.blows as f64 * super::energy::sample_count(interval, opts.sample_rate);
         h.reserve(n as usize + 2);
     }
@@ -276,7 +284,7 @@ pub fn run_blows_progress(
             format!("must be > 0 (got {})", blow.steady_tolerance),
         ));
     }
-    let interval = blow_interval_s(blow.rate_bpm, opts.sample_rate)?;
+    let interval = blow_interval_s(blow.rate_bpm)?;
     // The train is one run chained: the same time bound as a single run
     // ([`integrate::check_cost`]) over its whole simulated time `N · T`.
     if let Some((rate, what)) = integrate::fastest_rate(sys) {
@@ -286,9 +294,7 @@ pub fn run_blows_progress(
         {
             // One blow alone is too long: the rate is too low (more blows would not help).
             let t_max = integrate::MAX_PERIODS * 2.0 * std::f64::consts::PI / rate;
-            let r_min = 60.0 / t_max;
-            let scale = 10f64.powi(3 - r_min.log10().floor() as i32);
-            let r_min = (r_min * scale).ceil() / scale;
+            let r_min = rate_4_digits(60.0 / t_max, true);
             return Err(Error::invalid(
                 "stroke rate (--rate-bpm)",
                 format!(
@@ -504,18 +510,15 @@ fn collision_longer_than_interval(
     );
     let msg = match t_c {
         Some(t_c) => {
-            let t_min = t_c;
             // Rounded down to 4 significant digits, so that the rate printed is valid.
-            let r_max = 60.0 / t_min;
-            let scale = 10f64.powi(3 - r_max.log10().floor() as i32);
-            let r_max = (r_max * scale).floor() / scale;
+            let r_max = rate_4_digits(60.0 / t_c, false);
             format!(
                 "{head} (the collision of blow {} lasts {} s, until both contacts open). \
                  Give --rate-bpm at most {} (one blow per {} s)",
                 k + 1,
                 sig(t_c),
                 crate::num(r_max),
-                sig(t_min)
+                sig(t_c)
             )
         }
         None => format!(

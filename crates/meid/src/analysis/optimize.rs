@@ -549,6 +549,19 @@ fn coordinate_polish<F, R>(
     }
 }
 
+/// Every variable's bounds finite with `lower < upper`.
+fn check_box(lower: &[f64], upper: &[f64]) -> Result<()> {
+    for (i, (&lo, &hi)) in lower.iter().zip(upper).enumerate() {
+        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            return Err(Error::invalid(
+                "bounds",
+                format!("variable {i}: needs finite lower < upper, got [{lo}, {hi}]"),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Minimises `f(x)` over the box `lower ≤ x ≤ upper` from `x0`, by Nelder-Mead simplex
 /// searches in box-normalised coordinates with projection onto the box, restarts from the
 /// best point, a coordinate-wise Brent polish and optional seeded random extra starts (see
@@ -582,14 +595,9 @@ where
             ),
         ));
     }
+    check_box(lower, upper)?;
     for i in 0..n {
         let (lo, hi, x) = (lower[i], upper[i], x0[i]);
-        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-            return Err(Error::invalid(
-                "bounds",
-                format!("variable {i}: needs finite lower < upper, got [{lo}, {hi}]"),
-            ));
-        }
         if !(x >= lo && x <= hi) {
             return Err(Error::invalid(
                 "x0",
@@ -803,15 +811,7 @@ where
             ),
         ));
     }
-    for i in 0..n {
-        let (lo, hi) = (lower[i], upper[i]);
-        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-            return Err(Error::invalid(
-                "bounds",
-                format!("variable {i}: needs finite lower < upper, got [{lo}, {hi}]"),
-            ));
-        }
-    }
+    check_box(lower, upper)?;
     let points = options.grid_points;
     if points < 2 {
         return Err(Error::invalid(
@@ -860,11 +860,11 @@ where
     let grid_failures = values.iter().filter(|v| !v.is_finite()).count();
     // Grid points lower than every grid neighbour, (value, index) ordered.
     let below = |a: usize, b: usize| (values[a], a) < (values[b], b);
+    let stencil = grid_size(3, n).unwrap_or(0);
     let mut minima: Vec<usize> = (0..total)
         .filter(|&idx| values[idx].is_finite())
         .filter(|&idx| {
             let ind = grid_indices(idx, n, points);
-            let stencil = grid_size(3, n).unwrap_or(0);
             (0..stencil).all(|s| {
                 let mut nb = 0usize;
                 let mut code = s;

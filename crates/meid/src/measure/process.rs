@@ -470,70 +470,102 @@ pub fn blow_baselines(x: &[f64], blows: &Blows) -> Result<Vec<f64>> {
         .collect())
 }
 
-/// What [`blow_baselines`] removes from a channel, summed up.
-pub fn baseline_removed(x: &[f64], blows: &Blows) -> Result<BaselineRemoved> {
-    let b = blow_baselines(x, blows)?;
-    let samples = if blows.pretrigger >= MIN_BASELINE_SAMPLES && blows.pretrigger <= blows.length {
-        blows.pretrigger
-    } else {
-        0
-    };
-    let (min, max) = b
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, c), &v| {
-            (a.min(v), c.max(v))
-        });
-    let (min, max) = if b.is_empty() { (0.0, 0.0) } else { (min, max) };
-    Ok(BaselineRemoved {
-        mean: if b.is_empty() {
-            0.0
-        } else {
-            b.iter().sum::<f64>() / b.len() as f64
-        },
-        min,
-        max,
-        samples,
-    })
+/// The blow records of one channel with their baselines `b_b` ([`record_baseline`], found
+/// once): the time average, the sample peak and what was removed all use the same `b_b`.
+#[derive(Debug, Clone)]
+pub struct BlowRecords<'a> {
+    x: &'a [f64],
+    blows: &'a Blows,
+    baselines: Vec<f64>,
 }
 
-/// `x̄_n = (1/B) Σ_b (x[s_b + n] − b_b)`: the time average of the blow records, each less its
-/// baseline `b_b` ([`record_baseline`]; module docs, Baseline).
-pub fn average_blows(x: &[f64], blows: &Blows) -> Result<Vec<f64>> {
-    let (starts, len) = (&blows.starts, blows.length);
-    if starts.is_empty() {
-        return Err(Error::invalid(
-            "blows",
-            "no complete blow record to average",
-        ));
+impl<'a> BlowRecords<'a> {
+    /// The records of `x` at `blows` (every record checked to lie in `x`).
+    pub fn new(x: &'a [f64], blows: &'a Blows) -> Result<Self> {
+        Ok(Self {
+            x,
+            blows,
+            baselines: blow_baselines(x, blows)?,
+        })
     }
-    let baselines = blow_baselines(x, blows)?;
-    let mut acc = vec![0.0; len];
-    for (&s, &b) in starts.iter().zip(&baselines) {
-        // (In range: `blow_baselines` checked the starts.)
-        for (a, v) in acc.iter_mut().zip(&x[s..s + len]) {
-            *a += v - b;
+
+    /// Record `b` with its baseline.
+    fn records(&self) -> impl Iterator<Item = (usize, &'a [f64], f64)> + '_ {
+        let len = self.blows.length;
+        self.blows
+            .starts
+            .iter()
+            .zip(&self.baselines)
+            .map(move |(&s, &b)| (s, &self.x[s..s + len], b))
+    }
+
+    /// What the baselines remove from the channel, summed up.
+    pub fn removed(&self) -> BaselineRemoved {
+        let (blows, b) = (self.blows, &self.baselines);
+        let samples =
+            if blows.pretrigger >= MIN_BASELINE_SAMPLES && blows.pretrigger <= blows.length {
+                blows.pretrigger
+            } else {
+                0
+            };
+        let (min, max) = b
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, c), &v| {
+                (a.min(v), c.max(v))
+            });
+        let (min, max) = if b.is_empty() { (0.0, 0.0) } else { (min, max) };
+        BaselineRemoved {
+            mean: if b.is_empty() {
+                0.0
+            } else {
+                b.iter().sum::<f64>() / b.len() as f64
+            },
+            min,
+            max,
+            samples,
         }
     }
-    let n = starts.len() as f64;
-    acc.iter_mut().for_each(|a| *a /= n);
-    Ok(acc)
-}
 
-/// The sample peak of the blow records less their baselines: `x[i] − b_b` at the sample `i` of
-/// the largest `|x[s_b + n] − b_b|` over the records (the first such sample), with its sign
-/// (module docs, Baseline). Returns `(value, i)`.
-pub fn blow_peak(x: &[f64], blows: &Blows) -> Result<(f64, usize)> {
-    let baselines = blow_baselines(x, blows)?;
-    let mut best = (0.0_f64, blows.starts.first().copied().unwrap_or(0));
-    for (&s, &b) in blows.starts.iter().zip(&baselines) {
-        for (i, v) in x[s..s + blows.length].iter().enumerate() {
-            let d = v - b;
-            if d.abs() > best.0.abs() {
-                best = (d, s + i);
+    /// `x̄_n = (1/B) Σ_b (x[s_b + n] − b_b)`: the time average of the blow records, each less
+    /// its baseline (module docs, Baseline).
+    pub fn average(&self) -> Result<Vec<f64>> {
+        if self.blows.starts.is_empty() {
+            return Err(Error::invalid(
+                "blows",
+                "no complete blow record to average",
+            ));
+        }
+        let mut acc = vec![0.0; self.blows.length];
+        for (_, rec, b) in self.records() {
+            for (a, v) in acc.iter_mut().zip(rec) {
+                *a += v - b;
             }
         }
+        let n = self.blows.starts.len() as f64;
+        acc.iter_mut().for_each(|a| *a /= n);
+        Ok(acc)
     }
-    Ok(best)
+
+    /// The sample peak of the records less their baselines: `x[i] − b_b` at the sample `i` of
+    /// the largest `|x[s_b + n] − b_b|` over the records (the first such sample), with its
+    /// sign (module docs, Baseline). Returns `(value, i)`.
+    pub fn peak(&self) -> (f64, usize) {
+        let mut best = (0.0_f64, self.blows.starts.first().copied().unwrap_or(0));
+        for (s, rec, b) in self.records() {
+            for (i, v) in rec.iter().enumerate() {
+                let d = v - b;
+                if d.abs() > best.0.abs() {
+                    best = (d, s + i);
+                }
+            }
+        }
+        best
+    }
+}
+
+/// The time average of the blow records, each less its baseline ([`BlowRecords::average`]).
+pub fn average_blows(x: &[f64], blows: &Blows) -> Result<Vec<f64>> {
+    BlowRecords::new(x, blows)?.average()
 }
 
 /// Every blow record `[s, s + len)` lies in a channel of `n` samples (checked before anything
@@ -947,7 +979,7 @@ pub struct ChannelSummary {
     pub samples: usize,
     pub sample_rate_hz: f64,
     /// The sample peak of the averaged blow records less their baselines, with its sign:
-    /// `x_i − b_b` at the sample of the largest `|x_i − b_b|` ([`blow_peak`]; the signal between
+    /// `x_i − b_b` at the sample of the largest `|x_i − b_b|` ([`BlowRecords::peak`]; the signal between
     /// samples may go higher). With no blow found, of the whole record as measured.
     pub peak: f64,
     /// The time of that sample in the file (s).
@@ -1061,9 +1093,10 @@ pub fn process_channel(
             message: format!("channel '{}': needs at least 2 samples", r.name),
         });
     }
-    let (peak, k) = blow_peak(&r.values, blows)?;
-    let baseline = baseline_removed(&r.values, blows)?;
-    let average = average_blows(&r.values, blows)?;
+    let records = BlowRecords::new(&r.values, blows)?;
+    let (peak, k) = records.peak();
+    let baseline = records.removed();
+    let average = records.average()?;
     let mut spectrum = blow_spectrum(&r.values, role, fs, blows, p, None)?;
     let window = if p.force_window && role == Role::Excitation {
         format!(

@@ -425,9 +425,10 @@ fn one_case(
         let ms = blow_spectrum(&r.values, c.role(), fs, &mb, p, Some(n_fft))?;
         let ss = blow_spectrum(&s.values, c.role(), fs, &sb, &sp, Some(n_fft))?;
         // Each record less its baseline (a bias, a preload): like the simulation, at rest.
-        let ma = super::process::average_blows(&r.values, &mb)?;
+        let measured = super::process::BlowRecords::new(&r.values, &mb)?;
+        let ma = measured.average()?;
         let sa = super::process::average_blows(&s.values, &sb)?;
-        let measured_baseline = super::process::baseline_removed(&r.values, &mb)?;
+        let measured_baseline = measured.removed();
         let peak = |v: &[f64]| v.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
         let (mp, spk) = (peak(&ma), peak(&sa));
         let (rref, rtext) = esd_reference(r.quantity);
