@@ -455,3 +455,72 @@ fn a_frame_shorter_than_its_radius_of_gyration_is_refused() {
     meid::model::Model::from_file(&path, &[]).unwrap();
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A shell thickness in mm next to coordinates in m: before, `thickness = 10` (10 mm meant) on
+/// the 0.4 × 0.2 m plate was read as a 10 m thick plate, 2.2e5 times stiffer in bending, and
+/// the machine's bed with `thickness = 20` likewise; now refused at the thickness, naming t/L
+/// and the unit. Covered: `[structure.fem.model]` shells, `[structure.fem.mesh]` and the
+/// machine's plates. 0.2 (half the plate's 0.447 m diagonal, a block rather than a shell, but
+/// below the limit) still reads.
+#[test]
+fn a_shell_thicker_than_half_its_surface_is_refused() {
+    let dir = std::env::temp_dir().join(format!("meid-thick-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("plate.msh"), plate_msh(false)).unwrap();
+    let tail = r#"[points]
+bed_contact = "O_b"
+measurement = "B"
+[slider]
+mass = 0.1
+velocity = 0.1
+[contact.slider_bed]
+law = "linear"
+stiffness = 1.0e6
+damping = 0.0
+release = "force"
+[simulation]
+method = "exact"
+duration = 0.02
+sample_rate = 20000.0
+"#;
+    let head = "name = \"plate\"\n[structure]\nreference_mode = 1\n[structure.fem]\nselect = [1]\ncount = 4\n";
+    let pts = "points = { O_b = \"tip\", B = \"tip\" }\n";
+    let general = |t: f64| {
+        format!("{head}[structure.fem.model]\nmesh = \"plate.msh\"\nshells = [{{ set = \"plate\", thickness = {t:?} }}]\nconstraints = [{{ set = \"x0\", dofs = [\"all\"] }}]\n{pts}{tail}")
+    };
+    let mesh = |t: f64| {
+        format!("{head}[structure.fem.mesh]\nfile = \"plate.msh\"\nthickness = {t:?}\nfixed = [\"x0\"]\n{pts}{tail}")
+    };
+    let path = dir.join("m.toml");
+    for (text, key) in [
+        (general(10.0), "structure.fem.model.shells[0].thickness"),
+        (mesh(10.0), "structure.fem.mesh.thickness"),
+    ] {
+        std::fs::write(&path, &text).unwrap();
+        let e = meid::model::Model::from_file(&path, &[]).unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, Error::Input { .. }), "{msg}");
+        assert!(
+            msg.contains(key) && msg.contains("t/L = 22.361") && msg.contains("20 mm is 0.02"),
+            "{msg}"
+        );
+    }
+    for text in [general(0.2), mesh(0.2), general(0.01)] {
+        std::fs::write(&path, &text).unwrap();
+        meid::model::Model::from_file(&path, &[]).unwrap();
+    }
+    let soft = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/paper-soft-base.toml");
+    let e = meid::model::Model::from_file(
+        &soft,
+        &["structure.fem.machine.bed.thickness=20".to_string()],
+    )
+    .unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, Error::Input { .. }), "{msg}");
+    assert!(
+        msg.contains("structure.fem.machine.bed.thickness") && msg.contains("t/L = 39.288"),
+        "{msg}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -13,7 +13,8 @@
 //! finite-element model and a user's table of measured or imported modes all end here.
 //!
 //! Submodules: [`check`] (every computed set of modes checked against stated bounds; rigid-body
-//! modes from the problem itself), [`dense`] (dense generalised symmetric eigen-solver), [`lanczos`]
+//! modes from the problem itself), [`dense`] (dense generalised symmetric eigen-solver), [`eigenspace`] (repeated eigenvalues: a
+//! basis of their eigenspace that does not depend on the solver), [`lanczos`]
 //! (sparse shift-invert block Lanczos for large models), [`truncation`] (the static flexibility
 //! a set of retained modes captures at the named points), [`conditioning`] (spreads double
 //! precision cannot carry).
@@ -25,6 +26,7 @@
 pub mod check;
 pub mod conditioning;
 pub mod dense;
+pub mod eigenspace;
 pub(crate) mod kernels;
 pub mod lanczos;
 pub mod truncation;

@@ -46,7 +46,10 @@
 //! the rule "auto" had before: the `auto_count` (default 2) modes with the largest
 //! participation score `s_i = Σ_A ψ_i(A)²` (A = `contact_points`, default the named points)
 //! among those up to `auto_max_hz` — it can drop a low mode; the truncation table then shows
-//! what it lost. [`FemAnalysis`] carries the scores so `meid modes` can show why.
+//! what it lost. [`FemAnalysis`] carries the scores so `meid modes` can show why. The modes of
+//! a repeated eigenvalue get a basis that does not depend on the solver
+//! ([`crate::modal::eigenspace`]; one mode more than `count` is solved for it) and are kept
+//! together by "auto" and "participation".
 //!
 //! //! **Rayleigh damping** `C = αM + βK` gives the modal damping `D_ii = α + β ω_i²`.
 
@@ -605,6 +608,9 @@ fn check_plate_scale(p: &PlateSpec, key: &str) -> Result<()> {
     }
     let mass = mat.density_kg_per_m3 * p.length_x_m * p.length_y_m * p.thickness_m;
     let t = p.thickness_m;
+    if let Some(msg) = super::general::thickness_fault(t, p.length_x_m.hypot(p.length_y_m)) {
+        return Err(Error::invalid(format!("{key}.thickness"), msg));
+    }
     let d =
         mat.youngs_modulus_pa * t * t * t / (12.0 * (1.0 - mat.poisson_ratio * mat.poisson_ratio));
     if !d.is_normal() {
@@ -890,6 +896,13 @@ fn mesh_model(ms: &MeshFileSpec, src: &Source) -> Result<FeModel> {
             ms.thickness,
         )
         .map_err(|e| src.error(&format!("{base}.file"), format!("{}: {e}", path.display())))?;
+    let extent = super::general::bounding_diagonal(mesh.nodes.iter().copied());
+    if let Some(msg) = super::general::thickness_fault(ms.thickness, extent) {
+        return Err(src.error(
+            &format!("{base}.thickness"),
+            format!("{base}.thickness: {msg} (the mesh {})", ms.file),
+        ));
+    }
     let pairs = super::general::coincident_node_pairs(&mesh);
     if let Some(&(i, j)) = pairs.first() {
         let name = |m: usize| match map.iter().position(|&x| x == Some(m)) {
@@ -1348,10 +1361,19 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             ));
         }
     }
-    let (modes, solver) =
-        solve_modes(&model, spec.solver, count).map_err(|e| unsolvable(e, src))?;
-    let table = model.mode_table(&modes)?;
-    let nm = modes.omega_rad_per_s.len();
+    // One mode more than asked when the solver can compute it: a repeated eigenvalue cut by
+    // `count` (its partner the next mode) then gets the canonical basis of its whole eigenspace
+    // too, so that the mode kept does not depend on the solver; the extra mode is dropped below.
+    let wanted = count.min(n_dofs);
+    let mut solved = (count + 1).min(n_dofs);
+    if lanczos {
+        solved = solved.min(lanczos_max_modes(
+            n_dofs,
+            LanczosOptions::default().block_size,
+        ));
+    }
+    let (mut modes, solver) =
+        solve_modes(&model, spec.solver, solved.max(wanted)).map_err(|e| unsolvable(e, src))?;
     let mut warnings = Vec::new();
 
     // The points that rank modes: `contact_points`, else the model's named points with a role.
@@ -1378,6 +1400,33 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             .filter(|p| model.mesh.points.contains_key(p))
             .collect(),
     };
+    // A repeated eigenvalue's modes: the basis of its eigenspace that does not depend on the
+    // solver (dense and Lanczos return different rotations of it), led by the direction that
+    // moves the first score point most (`modal::eigenspace`).
+    let mut probes: Vec<Vec<f64>> = Vec::new();
+    let mut probed = std::collections::BTreeSet::new();
+    for p in score_points
+        .iter()
+        .chain(ctx.role_points.iter().map(|(p, _)| p))
+    {
+        if model.mesh.points.contains_key(p) && probed.insert(p.clone()) {
+            probes.push(model.point_functional(p)?);
+        }
+    }
+    crate::modal::eigenspace::canonical_basis(&mut modes.shapes, &modes.omega_rad_per_s, &probes);
+    // The last wanted mode's eigenspace, when it continues past `count`.
+    let cut_cluster = (modes.omega_rad_per_s.len() > wanted && wanted > 0)
+        .then(|| crate::modal::eigenspace::degenerate_clusters(&modes.omega_rad_per_s))
+        .map(|c| c[wanted - 1].clone())
+        .filter(|c| c.end > wanted);
+    if modes.omega_rad_per_s.len() > wanted {
+        modes.eigenvalues.truncate(wanted);
+        modes.omega_rad_per_s.truncate(wanted);
+        modes.shapes = modes.shapes.subcols(0, wanted).to_owned();
+        modes.rigid_body_modes = modes.omega_rad_per_s.iter().filter(|w| **w == 0.0).count();
+    }
+    let nm = modes.omega_rad_per_s.len();
+    let table = model.mode_table(&modes)?;
     let mut psi: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     let mut functionals = Vec::new();
     for p in score_points
@@ -1451,7 +1500,7 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
         None => auto(&mut warnings)?,
         Some(SelectSpec::Keyword(k)) if k == "auto" => auto(&mut warnings)?,
         Some(SelectSpec::Keyword(k)) if k == "participation" => {
-            participation_select(spec, src, &scores, freq, &score_points)?
+            participation_select(spec, src, &scores, freq, &modes.omega_rad_per_s, &score_points)?
         }
         Some(SelectSpec::Keyword(k)) => {
             return Err(src.error(
@@ -1494,6 +1543,45 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
     selected.sort_unstable();
     selected.dedup();
     let ns = selected.len();
+    let mut cluster = crate::modal::eigenspace::degenerate_clusters(&modes.omega_rad_per_s);
+    if let Some(c) = &cut_cluster {
+        // Its members beyond `count` were computed, and dropped: the pair is cut.
+        for r in cluster.iter_mut().skip(c.start) {
+            *r = c.clone();
+        }
+    }
+    for (i, c) in cluster.iter().enumerate() {
+        if c.start != i || c.len() < 2 {
+            continue;
+        }
+        let kept: Vec<usize> = c
+            .clone()
+            .filter(|j| selected.binary_search(j).is_ok())
+            .collect();
+        if !kept.is_empty() && kept.len() < c.len() {
+            let one = |v: &[usize]| {
+                v.iter()
+                    .map(|j| (j + 1).to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            let all: Vec<usize> = c.clone().collect();
+            warnings.push(format!(
+                "{base}.select keeps mode(s) {} of the modes {} that share one eigenvalue ({:.6} Hz): \
+                 which direction within their eigenspace is kept is meid's canonical basis \
+                 (docs/fem.md, \"Repeated eigenvalues\"), not a property of the structure; select \
+                 all of them{}",
+                one(&kept),
+                one(&all),
+                freq[c.start],
+                if c.end > nm {
+                    format!(" (raise {base}.count to {} to compute them)", c.end)
+                } else {
+                    String::new()
+                }
+            ));
+        }
+    }
 
     // Damping.
     let zeta = match (&spec.damping_ratios, &spec.rayleigh) {
@@ -1526,6 +1614,32 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
                 crate::num(*z)
             ),
         ));
+    }
+    // Per-mode ratios that differ within a repeated eigenvalue damp one direction of its
+    // eigenspace more than another: which one is the basis's choice, not the structure's.
+    for (i, c) in cluster.iter().enumerate() {
+        let z: Vec<(usize, f64)> = selected
+            .iter()
+            .zip(&zeta)
+            .filter(|(j, _)| c.start == i && c.contains(j))
+            .map(|(j, z)| (*j, *z))
+            .collect();
+        if z.len() > 1 && z.iter().any(|(_, v)| *v != z[0].1) {
+            warnings.push(format!(
+                "{base}.damping_ratios: the modes {} share one eigenvalue ({:.6} Hz) but get \
+                 different ratios ({}): the damping then depends on meid's canonical basis of \
+                 their eigenspace (docs/fem.md, \"Repeated eigenvalues\"); give them one ratio",
+                z.iter()
+                    .map(|(j, _)| (j + 1).to_string())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                freq[i],
+                z.iter()
+                    .map(|(_, v)| v.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
     }
     let mut modal = model.modal_model(&modes, &selected, &zeta)?;
     if let Some([a, b]) = spec.rayleigh {
@@ -1617,37 +1731,6 @@ fn sparse_residuals(model: &FeModel, modes: &DenseModes, which: &[usize]) -> Vec
         .collect()
 }
 
-/// Relative gap `|ω_i − ω_j| ≤ DEGENERATE_TOLERANCE · ω_j` under which two modes share an
-/// eigenvalue (a repeated eigenvalue of a symmetric structure comes out of either solver with
-/// a spread of ~1e-12; the closest distinct pair of the tests, FV2's 17.6808/17.7094 Hz, is
-/// 1.6e-3 apart).
-pub const DEGENERATE_TOLERANCE: f64 = 1e-8;
-
-/// For each mode (ascending ω), the range of modes sharing its eigenvalue: consecutive modes
-/// within [`DEGENERATE_TOLERANCE`] of the cluster's first, or all rigid-body modes (ω = 0).
-fn degenerate_clusters(omega: &[f64]) -> Vec<std::ops::Range<usize>> {
-    let n = omega.len();
-    let mut out = vec![0..0; n];
-    let mut start = 0;
-    while start < n {
-        let w0 = omega[start];
-        let mut end = start + 1;
-        while end < n && (omega[end] - w0).abs() <= DEGENERATE_TOLERANCE * omega[end].abs() {
-            end += 1;
-        }
-        if w0 == 0.0 {
-            while end < n && omega[end] == 0.0 {
-                end += 1;
-            }
-        }
-        for r in out.iter_mut().take(end).skip(start) {
-            *r = start..end;
-        }
-        start = end;
-    }
-    out
-}
-
 /// What [`auto_select`] ranks modes by.
 struct AutoInput<'a> {
     scores: &'a [f64],
@@ -1712,7 +1795,7 @@ fn auto_select(
     // basis (the square cantilever's bending pair: one mode moving the tip's z and one not, or
     // both moving it): the space is kept or left out whole, so that what is kept does not
     // depend on the basis (dense selected 9 modes, Lanczos 12, of the same 20).
-    let cluster = degenerate_clusters(a.omega);
+    let cluster = crate::modal::eigenspace::degenerate_clusters(a.omega);
     let moves = |i: usize| cluster[i].clone().any(moves_alone);
     // Shares are checked at every point of the truncation table (the role points) and at the
     // score points.
@@ -1795,12 +1878,15 @@ fn auto_select(
 
 /// `select = "participation"`: the `auto_count` modes (default 2) with the largest participation
 /// score up to `auto_max_hz` (the rule "auto" had before; it can drop a low mode that carries
-/// a point's flexibility, which the truncation table then shows).
+/// a point's flexibility, which the truncation table then shows). The modes of a repeated
+/// eigenvalue are ranked by their summed score and kept whole, so the count can be exceeded by
+/// the rest of a pair.
 fn participation_select(
     spec: &FemSpec,
     src: &Source,
     scores: &[f64],
     freq: &[f64],
+    omega: &[f64],
     points: &[String],
 ) -> Result<(Vec<usize>, Selection)> {
     let base = "structure.fem";
@@ -1818,9 +1904,22 @@ fn participation_select(
         ));
     }
     let max_hz = spec.auto_max_hz.unwrap_or(f64::INFINITY);
-    let mut cand: Vec<usize> = (0..scores.len()).filter(|&i| freq[i] <= max_hz).collect();
-    cand.sort_by(|&a, &b| scores[b].total_cmp(&scores[a]));
-    cand.truncate(count);
+    // A repeated eigenvalue's modes are ranked and kept together, by the score of the whole
+    // eigenspace (the sum over its modes, the same in any basis of it): which member of a pair
+    // would rank first depends on the basis, not on the structure.
+    let cluster = crate::modal::eigenspace::degenerate_clusters(omega);
+    let cluster_score = |i: usize| cluster[i].clone().map(|j| scores[j]).sum::<f64>();
+    let mut firsts: Vec<usize> = (0..scores.len())
+        .filter(|&i| freq[i] <= max_hz && cluster[i].start == i)
+        .collect();
+    firsts.sort_by(|&a, &b| cluster_score(b).total_cmp(&cluster_score(a)));
+    let mut cand: Vec<usize> = Vec::new();
+    for i in firsts {
+        if cand.len() >= count {
+            break;
+        }
+        cand.extend(cluster[i].clone().filter(|&j| freq[j] <= max_hz));
+    }
     if cand.is_empty() {
         return Err(src.error(
             &format!("{base}.auto_max_hz"),

@@ -528,6 +528,16 @@ pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> 
                 "has no elements: give `set` (a Gmsh physical surface), `quads` or `triangles`",
             ));
         }
+        let extent = bounding_diagonal(
+            quads
+                .iter()
+                .flatten()
+                .chain(tris.iter().flatten())
+                .map(|&n| b.mesh.nodes[n]),
+        );
+        if let Some(msg) = thickness_fault(s.thickness, extent) {
+            return Err(b.err(&format!("{field}.thickness"), msg));
+        }
         for q in quads {
             let mut el = ShellElement::new(q, mat, s.thickness);
             el.shear_factor = kappa;
@@ -868,6 +878,41 @@ fn check_slenderness(
         ));
     }
     Ok(())
+}
+
+/// Largest shell thickness over the extent of its surface (the bounding-box diagonal of its
+/// elements' nodes): a "shell" thicker than half its own extent is no shell (Kirchhoff and
+/// Mindlin plates need `t/L` of ~1/10 and less; the paper's bed has 0.053 of its diagonal); such
+/// a thickness is a unit slip (`thickness = 20` for 20 mm on a surface measured in m).
+pub const MAX_SHELL_THICKNESS_RATIO: f64 = 0.5;
+
+/// The diagonal (m) of the bounding box of `points` (0 for none).
+pub(crate) fn bounding_diagonal(points: impl Iterator<Item = [f64; 3]>) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if lo[0] > hi[0] {
+        return 0.0;
+    }
+    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// Why a shell thickness `t` (m) cannot belong to a surface of extent `extent` (m, its
+/// bounding-box diagonal): more than [`MAX_SHELL_THICKNESS_RATIO`] of it.
+pub(crate) fn thickness_fault(t: f64, extent: f64) -> Option<String> {
+    (extent > 0.0 && t > MAX_SHELL_THICKNESS_RATIO * extent).then(|| {
+        format!(
+            "a shell {} m thick on a surface {} m across (its bounding-box diagonal) is no shell (t/L = {:.3} > {}); thickness is in m, like the lengths and coordinates (20 mm is 0.02)",
+            crate::num(t),
+            crate::num(extent),
+            t / extent,
+            crate::num(MAX_SHELL_THICKNESS_RATIO)
+        )
+    })
 }
 
 /// Two nodes of elements closer than this times the model's size (bounding-box diagonal) are

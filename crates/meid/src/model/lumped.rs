@@ -381,6 +381,7 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
     let mut modes = dense::solve(sys.k.as_ref(), sys.mass_matrix().as_ref())?;
     // The sign convention of every computed mode: largest entry positive.
     dense::orient_modes(&mut modes.shapes);
+    crate::modal::eigenspace::canonical_basis(&mut modes.shapes, &modes.omega_rad_per_s, &[]);
     let zeta_path = format!("{base}.damping_ratios");
     let zeta = match &l.damping_ratios {
         Some(Ratios::PerMode(v)) if nd < n && v.len() == n => {
