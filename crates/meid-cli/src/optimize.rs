@@ -35,16 +35,15 @@ pub struct OptimizeArgs {
     set: SetArgs,
     /// Simulation budget: at most this many simulations run (the grid, the local searches,
     /// the optimum's own run, the w_d = w_s comparison and the check of the optimum's 2n
-    /// neighbours included); default 400 for one variable, the grid + 800 for several;
-    /// refused below the method's minimum (12 for one variable: a 9-point scan, one Brent
-    /// step and those two; grid + n + 3 for n variables); the neighbour check runs when 2n
-    /// more remain.
+    /// neighbours included); default the grid + 800; refused below the method's minimum
+    /// (grid + 3 for one variable: the scan, one Brent step and those two; grid + n + 3 for
+    /// n variables); the neighbour check runs when 2n more remain.
     #[arg(long, value_name = "N")]
     max_simulations: Option<usize>,
     /// Points per variable of the grid searched before the local refinement, both bounds
-    /// included (N^n simulations for n variables; default 33 for two variables, 16 for three,
-    /// 9 for one: the scan before Brent). A basin narrower than about two grid cells can be
-    /// missed; a larger N costs N^n simulations.
+    /// included (N^n simulations for n variables; default 33 for one or two variables, 16 for
+    /// three). A basin narrower than about two grid cells can be missed; a larger N costs N^n
+    /// simulations.
     #[arg(long, value_name = "N")]
     grid: Option<usize>,
     /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, the

@@ -25,7 +25,15 @@ fn subcommands() -> Vec<(&'static str, Vec<String>)> {
         ("compare", v(&["compare", "--duration", "0.2"])),
         (
             "optimize",
-            v(&["optimize", "--over", "wd/ws", "--max-simulations", "12"]),
+            v(&[
+                "optimize",
+                "--over",
+                "wd/ws",
+                "--grid",
+                "9",
+                "--max-simulations",
+                "12",
+            ]),
         ),
         ("blows", v(&["blows", "--blows", "2"])),
         (

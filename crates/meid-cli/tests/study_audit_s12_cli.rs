@@ -212,7 +212,7 @@ fn optimize_says_what_the_optimum_is() {
     assert_eq!(rep["objective_value"], sim["energy_ratio"]);
 
     // A budget at the minimum has no room for the check, and says so.
-    let rep = optimize(&["--over", "wd/ws", "--max-simulations", "12"]);
+    let rep = optimize(&["--over", "wd/ws", "--grid", "9", "--max-simulations", "12"]);
     assert_eq!(rep["local_check"]["verdict"], "not-checked");
     assert!(rep["simulations"].as_u64().unwrap() <= 12);
 }

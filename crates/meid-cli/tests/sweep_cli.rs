@@ -354,7 +354,15 @@ fn bed_mass_flag_for_sweep_and_optimize() {
     let o = meid()
         .arg("optimize")
         .arg(&model)
-        .args(["--over", "md/mb", "--max-simulations", "12", "--json"])
+        .args([
+            "--over",
+            "md/mb",
+            "--grid",
+            "9",
+            "--max-simulations",
+            "12",
+            "--json",
+        ])
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
@@ -366,6 +374,8 @@ fn bed_mass_flag_for_sweep_and_optimize() {
             .args([
                 "--bounds",
                 "md/mb=0.2..0.8",
+                "--grid",
+                "9",
                 "--max-simulations",
                 "12",
                 "--json",

@@ -475,3 +475,70 @@ fn bad_mappings_are_clear_errors() {
     assert_eq!(m.structure.labels, vec!["mode 2 (240.0000 Hz)".to_string()]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// An imported mode kept without its partner of the same frequency (a repeated eigenvalue, in
+/// the basis the FE program chose) is warned about, naming both; keeping both, or a file
+/// without such a pair, warns of nothing. Before, nothing was said, and the direction kept was
+/// the FE program's arbitrary choice.
+#[test]
+fn keeping_one_mode_of_a_repeated_pair_is_warned_about() {
+    let dir = tmp("pair");
+    let mut out = Vec::new();
+    let nodes = [
+        Node {
+            label: 7,
+            xyz: [0.0; 3],
+        },
+        Node {
+            label: 9,
+            xyz: [1.0, 0.0, 0.0],
+        },
+    ];
+    uff::write_2411(&mut out, &nodes).unwrap();
+    for (k, (f, a, b)) in [
+        (6.25, 0.125, 0.5),
+        (240.0, -0.25, 0.0625),
+        (240.0, 0.3, -0.1),
+    ]
+    .iter()
+    .enumerate()
+    {
+        uff::write_55(
+            &mut out,
+            &Mode {
+                number: k as i64 + 1,
+                frequency_hz: *f,
+                modal_mass: 1.0,
+                damping_ratio: 0.0,
+                name: format!("mode {}", k + 1),
+                id_lines: Vec::new(),
+                shapes: vec![(7, [0.0, 0.0, *a]), (9, [0.0, 0.0, *b])],
+            },
+        )
+        .unwrap();
+    }
+    std::fs::write(dir.join("m.uff"), out).unwrap();
+    let m = imported(
+        &dir,
+        &format!("file = \"m.uff\"\n{POINTS}\nselect = [1, 2]"),
+    )
+    .unwrap();
+    assert!(
+        m.structure
+            .warnings
+            .iter()
+            .any(|w| w.contains("keeps mode 2 of")
+                && w.contains("not mode(s) 3 at the same frequency")),
+        "{:?}",
+        m.structure.warnings
+    );
+    for sel in ["select = [1, 2, 3]", "select = [1]"] {
+        let m = imported(&dir, &format!("file = \"m.uff\"\n{POINTS}\n{sel}")).unwrap();
+        assert!(
+            m.structure.warnings.is_empty(),
+            "{sel}: {:?}",
+            m.structure.warnings
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -136,3 +136,88 @@ fn two_variable_search_finds_the_inside_floor_force_minimum() {
         assert_eq!(t.simulations, r.simulations);
     }
 }
+
+/// One variable: the energy ratio over m_d/m_b in 0.1-4 on the soft-base FE example. A fine
+/// scan (257 points, then Brent) puts its minimum at m_d/m_b = 1.9422, 0.0059388; the former
+/// default, a 9-point scan (points 1.585 apart in ratio) and Brent around the best scan point
+/// only, reported 0.0064016 at the bound 4 and called it a local minimum (its "upper
+/// neighbour" was the bound itself, 1.3e-14 relative higher). Now the default 33-point scan and
+/// Brent around each scan basin find the inside minimum, a minimum that is on a bound is called
+/// so, and the result does not depend on the thread count.
+#[test]
+fn one_variable_search_finds_the_basin_a_coarse_scan_misses() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-soft-base.toml");
+    let m = Model::from_file(&path, &[]).unwrap();
+    let study = |grid: Option<usize>| {
+        let mut s = OptimizeStudy::new(
+            m.clone(),
+            vec![(Quantity::MdOverMb, Some((0.1, 4.0)))],
+            Objective::Energy,
+        )
+        .unwrap();
+        s.grid_points = grid;
+        s
+    };
+    let fine = study(Some(257)).run().unwrap();
+    assert!(
+        (fine.optimum[0] - 1.9422).abs() < 1e-3 && (fine.objective_value - 0.0059388).abs() < 1e-7,
+        "{:?} {}",
+        fine.optimum,
+        fine.objective_value
+    );
+    let r = study(None).run().unwrap();
+    assert_eq!(r.grid_points_per_variable, 33);
+    assert!(
+        (r.optimum[0] - fine.optimum[0]).abs() < 1e-4
+            && (r.objective_value - fine.objective_value).abs() <= 1e-9 * fine.objective_value,
+        "{:?} {} against {:?} {}",
+        r.optimum,
+        r.objective_value,
+        fine.optimum,
+        fine.objective_value
+    );
+    assert_eq!(
+        r.local_check.verdict,
+        meid::analysis::study::Verdict::LocalMinimum,
+        "{}",
+        r.local_check.statement
+    );
+    // Brent from every scan basin: even 9 scan points now reach it.
+    let coarse = study(Some(9)).run().unwrap();
+    assert!((coarse.objective_value - fine.objective_value).abs() <= 1e-9 * fine.objective_value);
+    // A minimum on a bound is called one: the lumped example's energy ratio over m_d/m_b in
+    // 0.1-4 falls towards 4 (Brent ends at 3.999999999999999, whose "upper neighbour" was the
+    // bound: "local-minimum" before).
+    let lumped = OptimizeStudy::new(
+        model(),
+        vec![(Quantity::MdOverMb, Some((0.1, 4.0)))],
+        Objective::Energy,
+    )
+    .unwrap()
+    .run()
+    .unwrap();
+    assert!(
+        (lumped.optimum[0] - 4.0).abs() < 1e-9,
+        "{:?}",
+        lumped.optimum
+    );
+    assert_eq!(
+        lumped.local_check.verdict,
+        meid::analysis::study::Verdict::OnBound,
+        "{}",
+        lumped.local_check.statement
+    );
+    assert_eq!(
+        lumped.local_check.at_bound,
+        vec!["md/mb (upper)".to_string()]
+    );
+    for threads in [1, 2] {
+        let t = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| study(None).run().unwrap());
+        assert_eq!(t.optimum, r.optimum, "{threads} threads");
+        assert_eq!(t.objective_value.to_bits(), r.objective_value.to_bits());
+    }
+}

@@ -53,6 +53,10 @@ use crate::{Error, Result};
 /// `mass_normalised = true` (UFF 55 writes 6 significant digits).
 pub const MASS_TOLERANCE: f64 = 1e-4;
 
+/// Relative frequency difference under which two modes of a file share one eigenvalue: the
+/// file's own precision (UFF 55 writes frequencies with 6 significant digits, E13.5).
+pub const REPEATED_TOLERANCE: f64 = 1e-5;
+
 /// One mode as a file gives it, in the file's units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FileMode {
@@ -403,6 +407,31 @@ pub fn build(
         ),
     );
     model.notes = notes;
+    // A mode kept without a file mode of the same frequency (to the file's precision): one
+    // direction of a repeated eigenvalue, whose basis the FE program chose.
+    for m in &kept {
+        let partners: Vec<String> = modes
+            .iter()
+            .filter(|o| {
+                o.number != m.number
+                    && !kept.iter().any(|k| k.number == o.number)
+                    && (o.frequency_hz - m.frequency_hz).abs()
+                        <= REPEATED_TOLERANCE * m.frequency_hz.abs()
+            })
+            .map(|o| o.number.to_string())
+            .collect();
+        if !partners.is_empty() {
+            model.warnings.push(format!(
+                "{BASE}.select keeps mode {} of {file} but not mode(s) {} at the same frequency \
+                 ({:.6} Hz, within {REPEATED_TOLERANCE:e}): a repeated eigenvalue, whose basis \
+                 (which direction each mode takes) is the FE program's choice, not a property of \
+                 the structure; keep all of them",
+                m.number,
+                partners.join(", "),
+                m.frequency_hz
+            ));
+        }
+    }
     model.validate().map_err(|e| match e {
         Error::InvalidValue { field, message } => {
             src.error(BASE, format!("{BASE}: {field}: {message}"))
