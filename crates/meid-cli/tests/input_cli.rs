@@ -281,3 +281,31 @@ fn tiny_masses_and_thicknesses_fail_naming_the_field() {
         assert!(e.contains(field), "{set}: {e}");
     }
 }
+
+/// The dense solver refused for its memory (a cost bounded up front) is reported at
+/// `structure.fem.solver`, as it is, exit 2. Before, it was wrapped as "the finite-element
+/// model cannot be solved" with a hint to check the thicknesses, densities and moduli for
+/// underflow, which have nothing to do with it. (`--max-memory` is set low so that the test
+/// does not depend on the machine: the soft-base machine's dense solve, 505 MB, against 100 MB.)
+#[test]
+fn a_dense_solve_over_the_memory_limit_names_the_solver_not_the_values() {
+    let e = refused(
+        meid()
+            .arg("modes")
+            .arg(example_file("paper-soft-base.toml"))
+            .args([
+                "--max-memory",
+                "100MB",
+                "--set",
+                "structure.fem.solver=\"dense\"",
+            ])
+            .output()
+            .unwrap(),
+    );
+    assert!(
+        e.contains("structure.fem.solver: the dense eigen-solver (")
+            && e.contains("--max-memory")
+            && !e.contains("underflow"),
+        "{e}"
+    );
+}

@@ -1280,6 +1280,11 @@ pub fn lanczos_max_modes(n: usize, block: usize) -> usize {
 /// the solver refused come from the plates' and columns' sizes, materials and masses.
 fn unsolvable(e: Error, src: &Source) -> Error {
     match e {
+        // A cost refused up front (the dense solver's memory): the solver field, as it is; the
+        // model's values are not at fault.
+        Error::InvalidValue { field, message } if field == "structure.fem.solver" => {
+            src.error(&field, format!("{field}: {message}"))
+        }
         e @ Error::Numerical { .. } if e.to_string().contains("what to change:") => src.error(
             "structure.fem",
             format!("structure.fem: the finite-element model cannot be solved ({e})"),
