@@ -364,18 +364,9 @@ fn plate_msh(crack: bool) -> String {
     s
 }
 
-/// Duplicate nodes cut a Gmsh plate in two. Before: read without a word; the clamped plate had
-/// six 0 Hz modes (its right half floating), `meid modes` exited 0 with a truncation table of
-/// G_PP = 3.983e-8 m/N, modal "-0.000000e0", share "-0.000 %". Now refused in both the general
-/// model and `[structure.fem.mesh]`, naming the file, both Gmsh node tags and the point; joined
-/// by rigid links (a cut that is meant) it reads, and so does the uncut plate.
-#[test]
-fn coincident_unjoined_nodes_are_refused() {
-    let dir = std::env::temp_dir().join(format!("meid-coincident-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("crack.msh"), plate_msh(true)).unwrap();
-    std::fs::write(dir.join("plate.msh"), plate_msh(false)).unwrap();
-    let tail = r#"[points]
+/// The impact part of the plate models below: O_b and B at the plate's "tip".
+const PLATE_TAIL: &str = r#"points = { O_b = "tip", B = "tip" }
+[points]
 bed_contact = "O_b"
 measurement = "B"
 [slider]
@@ -391,14 +382,34 @@ method = "exact"
 duration = 0.02
 sample_rate = 20000.0
 "#;
-    let head = "name = \"plate\"\n[structure]\nreference_mode = 1\n[structure.fem]\nselect = [1]\ncount = 4\n";
-    let pts = "points = { O_b = \"tip\", B = \"tip\" }\n";
-    let general = |file: &str, extra: &str| {
-        format!("{head}[structure.fem.model]\nmesh = \"{file}\"\nshells = [{{ set = \"plate\", thickness = 0.01 }}]\nconstraints = [{{ set = \"x0\", dofs = [\"all\"] }}]\n{extra}{pts}{tail}")
-    };
-    let mesh = |file: &str| {
-        format!("{head}[structure.fem.mesh]\nfile = \"{file}\"\nthickness = 0.01\nfixed = [\"x0\"]\n{pts}{tail}")
-    };
+
+const PLATE_HEAD: &str =
+    "name = \"plate\"\n[structure]\nreference_mode = 1\n[structure.fem]\nselect = [1]\ncount = 4\n";
+
+/// A model of the Gmsh plate `file` ([`plate_msh`]) as `[structure.fem.model]` shells of
+/// thickness `t` (m), clamped on "x0", with `extra` lines in the table.
+fn plate_model_general(file: &str, t: f64, extra: &str) -> String {
+    format!("{PLATE_HEAD}[structure.fem.model]\nmesh = \"{file}\"\nshells = [{{ set = \"plate\", thickness = {t:?} }}]\nconstraints = [{{ set = \"x0\", dofs = [\"all\"] }}]\n{extra}{PLATE_TAIL}")
+}
+
+/// The same plate as `[structure.fem.mesh]`.
+fn plate_model_mesh(file: &str, t: f64) -> String {
+    format!("{PLATE_HEAD}[structure.fem.mesh]\nfile = \"{file}\"\nthickness = {t:?}\nfixed = [\"x0\"]\n{PLATE_TAIL}")
+}
+
+/// Duplicate nodes cut a Gmsh plate in two. Before: read without a word; the clamped plate had
+/// six 0 Hz modes (its right half floating), `meid modes` exited 0 with a truncation table of
+/// G_PP = 3.983e-8 m/N, modal "-0.000000e0", share "-0.000 %". Now refused in both the general
+/// model and `[structure.fem.mesh]`, naming the file, both Gmsh node tags and the point; joined
+/// by rigid links (a cut that is meant) it reads, and so does the uncut plate.
+#[test]
+fn coincident_unjoined_nodes_are_refused() {
+    let dir = std::env::temp_dir().join(format!("meid-coincident-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("crack.msh"), plate_msh(true)).unwrap();
+    std::fs::write(dir.join("plate.msh"), plate_msh(false)).unwrap();
+    let general = |file: &str, extra: &str| plate_model_general(file, 0.01, extra);
+    let mesh = |file: &str| plate_model_mesh(file, 0.01);
     let path = dir.join("m.toml");
     for (text, key) in [
         (general("crack.msh", ""), "structure.fem.model.mesh"),
@@ -467,30 +478,8 @@ fn a_shell_thicker_than_half_its_surface_is_refused() {
     let dir = std::env::temp_dir().join(format!("meid-thick-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("plate.msh"), plate_msh(false)).unwrap();
-    let tail = r#"[points]
-bed_contact = "O_b"
-measurement = "B"
-[slider]
-mass = 0.1
-velocity = 0.1
-[contact.slider_bed]
-law = "linear"
-stiffness = 1.0e6
-damping = 0.0
-release = "force"
-[simulation]
-method = "exact"
-duration = 0.02
-sample_rate = 20000.0
-"#;
-    let head = "name = \"plate\"\n[structure]\nreference_mode = 1\n[structure.fem]\nselect = [1]\ncount = 4\n";
-    let pts = "points = { O_b = \"tip\", B = \"tip\" }\n";
-    let general = |t: f64| {
-        format!("{head}[structure.fem.model]\nmesh = \"plate.msh\"\nshells = [{{ set = \"plate\", thickness = {t:?} }}]\nconstraints = [{{ set = \"x0\", dofs = [\"all\"] }}]\n{pts}{tail}")
-    };
-    let mesh = |t: f64| {
-        format!("{head}[structure.fem.mesh]\nfile = \"plate.msh\"\nthickness = {t:?}\nfixed = [\"x0\"]\n{pts}{tail}")
-    };
+    let general = |t: f64| plate_model_general("plate.msh", t, "");
+    let mesh = |t: f64| plate_model_mesh("plate.msh", t);
     let path = dir.join("m.toml");
     for (text, key) in [
         (general(10.0), "structure.fem.model.shells[0].thickness"),

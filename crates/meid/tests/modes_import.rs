@@ -264,6 +264,17 @@ fn uff_written_by_meid_reads_back_and_runs_the_same_study() {
 }
 
 fn write_modes(path: &Path, modal_mass: f64, shape_scale: f64) {
+    write_uff(
+        path,
+        &[(6.25, 0.125, 0.5), (240.0, -0.25, 0.0625)],
+        modal_mass,
+        shape_scale,
+    );
+}
+
+/// A UFF file of nodes 7 and 9 and one dataset 55 per `(frequency Hz, ψ_7, ψ_9)` (z only, times
+/// `shape_scale`), numbered from 1.
+fn write_uff(path: &Path, modes: &[(f64, f64, f64)], modal_mass: f64, shape_scale: f64) {
     let mut out = Vec::new();
     uff::write_2411(
         &mut out,
@@ -279,10 +290,7 @@ fn write_modes(path: &Path, modal_mass: f64, shape_scale: f64) {
         ],
     )
     .unwrap();
-    for (k, (f, a, b)) in [(6.25, 0.125, 0.5), (240.0, -0.25, 0.0625)]
-        .iter()
-        .enumerate()
-    {
+    for (k, (f, a, b)) in modes.iter().enumerate() {
         uff::write_55(
             &mut out,
             &Mode {
@@ -483,41 +491,16 @@ fn bad_mappings_are_clear_errors() {
 #[test]
 fn keeping_one_mode_of_a_repeated_pair_is_warned_about() {
     let dir = tmp("pair");
-    let mut out = Vec::new();
-    let nodes = [
-        Node {
-            label: 7,
-            xyz: [0.0; 3],
-        },
-        Node {
-            label: 9,
-            xyz: [1.0, 0.0, 0.0],
-        },
-    ];
-    uff::write_2411(&mut out, &nodes).unwrap();
-    for (k, (f, a, b)) in [
-        (6.25, 0.125, 0.5),
-        (240.0, -0.25, 0.0625),
-        (240.0, 0.3, -0.1),
-    ]
-    .iter()
-    .enumerate()
-    {
-        uff::write_55(
-            &mut out,
-            &Mode {
-                number: k as i64 + 1,
-                frequency_hz: *f,
-                modal_mass: 1.0,
-                damping_ratio: 0.0,
-                name: format!("mode {}", k + 1),
-                id_lines: Vec::new(),
-                shapes: vec![(7, [0.0, 0.0, *a]), (9, [0.0, 0.0, *b])],
-            },
-        )
-        .unwrap();
-    }
-    std::fs::write(dir.join("m.uff"), out).unwrap();
+    write_uff(
+        &dir.join("m.uff"),
+        &[
+            (6.25, 0.125, 0.5),
+            (240.0, -0.25, 0.0625),
+            (240.0, 0.3, -0.1),
+        ],
+        1.0,
+        1.0,
+    );
     let m = imported(
         &dir,
         &format!("file = \"m.uff\"\n{POINTS}\nselect = [1, 2]"),

@@ -166,43 +166,34 @@ mod tests {
     use super::*;
     use crate::rng::SplitMix64 as Rng;
 
-    /// A random orthogonal `m × m` matrix (Gram-Schmidt of Gaussian columns).
-    fn random_orthogonal(rng: &mut Rng, m: usize) -> Mat<f64> {
-        let mut q = Mat::from_fn(m, m, |_, _| rng.next_normal());
-        for j in 0..m {
+    /// `cols` orthonormal columns of length `rows` (Gram-Schmidt of Gaussian columns); with
+    /// `rows = cols` a random orthogonal matrix.
+    fn random_orthonormal(rng: &mut Rng, rows: usize, cols: usize) -> Mat<f64> {
+        let mut q = Mat::from_fn(rows, cols, |_, _| rng.next_normal());
+        for j in 0..cols {
             for i in 0..j {
-                let d: f64 = (0..m).map(|r| q[(r, i)] * q[(r, j)]).sum();
-                for r in 0..m {
+                let d: f64 = (0..rows).map(|r| q[(r, i)] * q[(r, j)]).sum();
+                for r in 0..rows {
                     q[(r, j)] -= d * q[(r, i)];
                 }
             }
-            let nn: f64 = (0..m).map(|r| q[(r, j)].powi(2)).sum::<f64>().sqrt();
-            for r in 0..m {
+            let nn: f64 = (0..rows).map(|r| q[(r, j)].powi(2)).sum::<f64>().sqrt();
+            for r in 0..rows {
                 q[(r, j)] /= nn;
             }
         }
         q
     }
 
+    fn random_orthogonal(rng: &mut Rng, m: usize) -> Mat<f64> {
+        random_orthonormal(rng, m, m)
+    }
+
     /// Orthonormal columns `Φ` (n × 6) with eigenvalues [0, 0, 0, 5, 7, 7] (a rigid-body triple,
     /// a simple mode and a pair).
     fn shapes(rng: &mut Rng, n: usize) -> (Mat<f64>, Vec<f64>) {
-        let g = Mat::from_fn(n, n, |_, _| rng.next_normal());
-        let mut q = g.clone();
-        for j in 0..6 {
-            for i in 0..j {
-                let d: f64 = (0..n).map(|r| q[(r, i)] * q[(r, j)]).sum();
-                for r in 0..n {
-                    q[(r, j)] -= d * q[(r, i)];
-                }
-            }
-            let nn: f64 = (0..n).map(|r| q[(r, j)].powi(2)).sum::<f64>().sqrt();
-            for r in 0..n {
-                q[(r, j)] /= nn;
-            }
-        }
         (
-            q.subcols(0, 6).to_owned(),
+            random_orthonormal(rng, n, 6),
             vec![0.0, 0.0, 0.0, 5.0, 7.0, 7.0 * (1.0 + 1e-12)],
         )
     }
