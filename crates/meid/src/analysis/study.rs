@@ -514,8 +514,16 @@ impl OptimizeStudy {
         }
     }
 
+    /// The variable's value at search coordinate `u`; a bound's own coordinate gives the bound
+    /// exactly (`exp(ln 4)` is 3.9999999999999996, which an optimum on the bound 4 printed).
     fn search_to_value(&self, k: usize, u: f64) -> f64 {
         let v = &self.variables[k];
+        if u == self.value_to_search(k, v.upper) {
+            return v.upper;
+        }
+        if u == self.value_to_search(k, v.lower) {
+            return v.lower;
+        }
         let x = if v.log { u.exp() } else { u };
         x.clamp(v.lower, v.upper)
     }
@@ -688,7 +696,14 @@ impl OptimizeStudy {
             // points lower than both their neighbours (distinct basins), the lowest kept.
             let m = grid;
             let grid: Vec<f64> = (0..m)
-                .map(|i| lo[0] + (hi[0] - lo[0]) * i as f64 / (m - 1) as f64)
+                .map(|i| {
+                    // The last point is the upper bound itself (lo + (hi − lo) need not be hi).
+                    if i + 1 == m {
+                        hi[0]
+                    } else {
+                        lo[0] + (hi[0] - lo[0]) * i as f64 / (m - 1) as f64
+                    }
+                })
                 .collect();
             let vals: Vec<f64> = grid.par_iter().map(|&u| f(&[u])).collect();
             let scan_fail = vals.iter().filter(|v| !v.is_finite()).count();
@@ -736,6 +751,16 @@ impl OptimizeStudy {
                     converged = r.converged;
                 } else if ib == minima[0] {
                     converged = r.converged;
+                }
+            }
+            // A search that ends within half the neighbour step of a bound, no lower than the
+            // bound's own scan value beyond round-off, ends on the bound (Brent converges to
+            // within its tolerance of a bound, not onto it).
+            for end in [0, m - 1] {
+                if (u_best - grid[end]).abs() < 0.5 * NEIGHBOUR_STEP * (hi[0] - lo[0])
+                    && vals[end] <= f_best + 1e-12 * f_best.abs()
+                {
+                    u_best = grid[end];
                 }
             }
             (vec![u_best], evaluations, failures, converged, minima.len())
