@@ -9,7 +9,7 @@ use std::path::Path;
 use meid::analysis::energy::simulate;
 use meid::io::uff;
 use meid::measure::calibrate::{
-    calibrate, calibrated_model_text, parameters, Problem, ResidualKind, Settings,
+    calibrate, calibrated_model_text, parameters, Calibration, Problem, ResidualKind, Settings,
 };
 use meid::measure::process::Processing;
 use meid::measure::validate::MeasuredCase;
@@ -110,6 +110,22 @@ fn value(m: &Model, path: &str) -> f64 {
     p[0].start
 }
 
+/// Calibrates `paths` of `start` against `meas` (default bounds, the test processing).
+fn fit(start: &Model, paths: &[&str], meas: MeasuredCase, settings: Settings) -> Calibration {
+    let paths: Vec<String> = paths.iter().map(|s| s.to_string()).collect();
+    let params = parameters(start, &paths, &BTreeMap::new()).unwrap();
+    let problem = Problem::new(
+        start,
+        params,
+        &[meas],
+        &processing(),
+        &BTreeMap::new(),
+        settings,
+    )
+    .unwrap();
+    calibrate(&problem).unwrap()
+}
+
 #[test]
 fn calibration_recovers_known_ks_kd_and_damping_within_its_intervals() {
     let truth = model(&[]);
@@ -121,18 +137,7 @@ fn calibration_recovers_known_ks_kd_and_damping_within_its_intervals() {
         format!("{KD}={:e}", known[1] * 0.75),
         format!("{ZETA}={:e}", known[2] * 1.6),
     ]);
-    let paths: Vec<String> = [KS, KD, ZETA].iter().map(|s| s.to_string()).collect();
-    let params = parameters(&start, &paths, &BTreeMap::new()).unwrap();
-    let problem = Problem::new(
-        &start,
-        params,
-        &[meas],
-        &processing(),
-        &BTreeMap::new(),
-        Settings::default(),
-    )
-    .unwrap();
-    let c = calibrate(&problem).unwrap();
+    let c = fit(&start, &[KS, KD, ZETA], meas, Settings::default());
     eprintln!("{}", c.to_text());
     assert!(c.converged, "{:?}", c.convergence);
     for (e, k) in c.parameters.iter().zip(known) {
@@ -174,7 +179,9 @@ fn calibration_recovers_known_ks_kd_and_damping_within_its_intervals() {
         c.sigma
     );
     // The calibrated model file reads back with the estimates.
-    let text = calibrated_model_text(&start, problem.parameters(), &c.values()).unwrap();
+    let paths: Vec<String> = [KS, KD, ZETA].iter().map(|s| s.to_string()).collect();
+    let params = parameters(&start, &paths, &BTreeMap::new()).unwrap();
+    let text = calibrated_model_text(&start, &params, &c.values()).unwrap();
     let back = Model::from_text("calibrated.toml", text, &[]).unwrap();
     for e in &c.parameters {
         assert_eq!(value(&back, &e.path), e.value, "{}", e.path);
@@ -187,7 +194,6 @@ fn spectrum_residuals_recover_the_damping_ratio() {
     let zeta = value(&truth, ZETA);
     let meas = measured(&truth, 0.02, 5, "spectrum");
     let start = model(&[format!("{ZETA}={:e}", zeta * 2.0)]);
-    let params = parameters(&start, &[ZETA.to_string()], &BTreeMap::new()).unwrap();
     let settings = Settings {
         residual: ResidualKind::Spectrum {
             lower_hz: 200.0,
@@ -195,16 +201,7 @@ fn spectrum_residuals_recover_the_damping_ratio() {
         },
         ..Settings::default()
     };
-    let problem = Problem::new(
-        &start,
-        params,
-        &[meas],
-        &processing(),
-        &BTreeMap::new(),
-        settings,
-    )
-    .unwrap();
-    let c = calibrate(&problem).unwrap();
+    let c = fit(&start, &[ZETA], meas, settings);
     eprintln!("{}", c.to_text());
     let e = &c.parameters[0];
     assert!(c.converged, "{:?}", c.convergence);
@@ -273,17 +270,7 @@ fn values_outside_the_structure_reuse_its_modes_and_are_recovered() {
     let known = value(&truth, CD);
     let meas = measured(&truth, 0.05, 3, "cd");
     let start = model(&[format!("{CD}={:e}", known * 1.5)]);
-    let params = parameters(&start, &[CD.to_string()], &BTreeMap::new()).unwrap();
-    let problem = Problem::new(
-        &start,
-        params,
-        &[meas],
-        &processing(),
-        &BTreeMap::new(),
-        Settings::default(),
-    )
-    .unwrap();
-    let c = calibrate(&problem).unwrap();
+    let c = fit(&start, &[CD], meas, Settings::default());
     assert_eq!(c.structures_built, 0);
     let e = &c.parameters[0];
     assert!(c.converged, "{:?}", c.convergence);
@@ -303,19 +290,8 @@ fn a_value_the_data_do_not_depend_on_is_named_not_identifiable() {
     let ks = value(&truth, KS);
     let meas = measured_case(&truth, Case::NoDamper, 0.05, 21, "bare");
     let start = model(&[format!("{KS}={:e}", ks * 1.2)]);
-    let paths: Vec<String> = [KS, KD].iter().map(|s| s.to_string()).collect();
-    let params = parameters(&start, &paths, &BTreeMap::new()).unwrap();
-    let kd_start = params[1].start;
-    let problem = Problem::new(
-        &start,
-        params,
-        &[meas],
-        &processing(),
-        &BTreeMap::new(),
-        Settings::default(),
-    )
-    .unwrap();
-    let c = calibrate(&problem).unwrap();
+    let kd_start = parameters(&start, &[KD.to_string()], &BTreeMap::new()).unwrap()[0].start;
+    let c = fit(&start, &[KS, KD], meas, Settings::default());
     let text = c.to_text();
     eprintln!("{text}");
     let (k, d) = (&c.parameters[0], &c.parameters[1]);
@@ -356,20 +332,9 @@ fn a_dc_offset_on_the_measurement_is_not_fitted() {
         r.values.iter_mut().for_each(|v| *v += 0.3 * rms);
     }
     let start = model(&[format!("{CD}={:e}", known * 1.5)]);
-    let fit = |meas: MeasuredCase| {
-        let params = parameters(&start, &[CD.to_string()], &BTreeMap::new()).unwrap();
-        let problem = Problem::new(
-            &start,
-            params,
-            &[meas],
-            &processing(),
-            &BTreeMap::new(),
-            Settings::default(),
-        )
-        .unwrap();
-        calibrate(&problem).unwrap().parameters[0].clone()
-    };
-    let (a, b) = (fit(clean), fit(biased));
+    let fit_cd =
+        |meas: MeasuredCase| fit(&start, &[CD], meas, Settings::default()).parameters[0].clone();
+    let (a, b) = (fit_cd(clean), fit_cd(biased));
     assert!(
         (a.value - b.value).abs() <= 1e-6 * a.value,
         "c_d {} N·s/m without offset, {} with",

@@ -81,7 +81,7 @@ pub fn degenerate_clusters(omega: &[f64]) -> Vec<std::ops::Range<usize>> {
 pub fn canonical_basis(
     shapes: &mut Mat<f64>,
     omega: &[f64],
-    probes: &[Vec<f64>],
+    probes: &[&[f64]],
 ) -> Vec<std::ops::Range<usize>> {
     let m = omega.len().min(shapes.ncols());
     let clusters = degenerate_clusters(&omega[..m]);
@@ -100,17 +100,22 @@ pub fn canonical_basis(
 }
 
 /// [`canonical_basis`] on the columns `cols` of one cluster.
-fn canonical_cluster(shapes: &mut Mat<f64>, cols: std::ops::Range<usize>, probes: &[Vec<f64>]) {
+fn canonical_cluster(shapes: &mut Mat<f64>, cols: std::ops::Range<usize>, probes: &[&[f64]]) {
     let n = shapes.nrows();
     for j in cols.clone() {
         let free = j..cols.end;
-        let row = |r: usize| -> Vec<f64> { free.clone().map(|c| shapes[(r, c)]).collect() };
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let max_row = (0..n).fold(0.0_f64, |a, r| a.max(norm(&row(r))));
+        let row_norm = |r: usize| {
+            free.clone()
+                .map(|c| shapes[(r, c)].powi(2))
+                .sum::<f64>()
+                .sqrt()
+        };
+        let max_row = (0..n).fold(0.0_f64, |a, r| a.max(row_norm(r)));
         if max_row == 0.0 {
             return;
         }
-        let on_probe = |f: &Vec<f64>| -> Option<Vec<f64>> {
+        let on_probe = |f: &&[f64]| -> Option<Vec<f64>> {
             if f.len() != n {
                 return None;
             }
@@ -122,11 +127,11 @@ fn canonical_cluster(shapes: &mut Mat<f64>, cols: std::ops::Range<usize>, probes
             (norm(&y) >= PROBE_FLOOR * l1 * max_row).then_some(y)
         };
         let tie = (1.0 - PIVOT_TIE) * max_row;
-        let Some(y) = probes
-            .iter()
-            .find_map(on_probe)
-            .or_else(|| (0..n).map(row).find(|v| norm(v) >= tie))
-        else {
+        let Some(y) = probes.iter().find_map(on_probe).or_else(|| {
+            (0..n)
+                .find(|&r| row_norm(r) >= tie)
+                .map(|r| free.clone().map(|c| shapes[(r, c)]).collect())
+        }) else {
             return;
         };
         let len = norm(&y);
@@ -295,7 +300,7 @@ mod tests {
                 }
             }
             let live: Vec<f64> = (0..n).map(|_| rng.next_normal()).collect();
-            let probes = vec![dead.clone(), live.clone()];
+            let probes: Vec<&[f64]> = vec![&dead, &live];
             let mut a = phi.clone();
             canonical_basis(&mut a, &omega, &probes);
             let on = |x: &Mat<f64>, f: &[f64], j: usize| -> f64 {

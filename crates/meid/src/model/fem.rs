@@ -1408,16 +1408,18 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
     // A repeated eigenvalue's modes: the basis of its eigenspace that does not depend on the
     // solver (dense and Lanczos return different rotations of it), led by the direction that
     // moves the first score point most (`modal::eigenspace`).
-    let mut probes: Vec<Vec<f64>> = Vec::new();
-    let mut probed = std::collections::BTreeSet::new();
+    // The functionals of the score points, then of the role points (each once, in that order):
+    // the probes of the canonical basis, then the points' ψ.
+    let mut functionals: Vec<(String, Vec<f64>)> = Vec::new();
     for p in score_points
         .iter()
         .chain(ctx.role_points.iter().map(|(p, _)| p))
     {
-        if model.mesh.points.contains_key(p) && probed.insert(p.clone()) {
-            probes.push(model.point_functional(p)?);
+        if model.mesh.points.contains_key(p) && !functionals.iter().any(|(q, _)| q == p) {
+            functionals.push((p.clone(), model.point_functional(p)?));
         }
     }
+    let probes: Vec<&[f64]> = functionals.iter().map(|(_, f)| f.as_slice()).collect();
     crate::modal::eigenspace::canonical_basis(&mut modes.shapes, &modes.omega_rad_per_s, &probes);
     // The last wanted mode's eigenspace, when it continues past `count`.
     let cut_cluster = (modes.omega_rad_per_s.len() > wanted && wanted > 0)
@@ -1432,22 +1434,15 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
     }
     let nm = modes.omega_rad_per_s.len();
     let table = model.mode_table(&modes)?;
-    let mut psi: BTreeMap<String, Vec<f64>> = BTreeMap::new();
-    let mut functionals = Vec::new();
-    for p in score_points
+    let psi: BTreeMap<String, Vec<f64>> = functionals
         .iter()
-        .chain(ctx.role_points.iter().map(|(p, _)| p))
-    {
-        if psi.contains_key(p) || !model.mesh.points.contains_key(p) {
-            continue;
-        }
-        let f = model.point_functional(p)?;
-        let v: Vec<f64> = (0..nm)
-            .map(|i| (0..f.len()).map(|j| f[j] * modes.shapes[(j, i)]).sum())
-            .collect();
-        psi.insert(p.clone(), v);
-        functionals.push((p.clone(), f));
-    }
+        .map(|(p, f)| {
+            let v: Vec<f64> = (0..nm)
+                .map(|i| (0..f.len()).map(|j| f[j] * modes.shapes[(j, i)]).sum())
+                .collect();
+            (p.clone(), v)
+        })
+        .collect();
     let mut scores = vec![0.0; nm];
     for p in &score_points {
         for (s, v) in scores.iter_mut().zip(&psi[p]) {

@@ -841,26 +841,16 @@ fn check_slenderness(
     segs: &[[usize; 2]],
 ) -> Result<()> {
     let r = (f.iy.max(f.iz) / f.area).sqrt();
-    let dist = |a: [f64; 3], c: [f64; 3]| (0..3).map(|k| (a[k] - c[k]).powi(2)).sum::<f64>().sqrt();
     let member = match &f.nodes {
         // The shortest member of the chain (segments between consecutive given nodes).
         Some(chain) => chain
             .windows(2)
             .filter_map(|p| Some((b.inline.get(p[0])?, b.inline.get(p[1])?)))
-            .map(|(&a, &c)| dist(b.mesh.nodes[a], b.mesh.nodes[c]))
+            .map(|(&a, &c)| distance(b.mesh.nodes[a], b.mesh.nodes[c]))
             .fold(f64::INFINITY, f64::min),
         // A Gmsh curve set: its extent (the bounding-box diagonal of its nodes).
-        None => {
-            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-            for &n in segs.iter().flatten() {
-                let p = b.mesh.nodes[n];
-                for k in 0..3 {
-                    lo[k] = lo[k].min(p[k]);
-                    hi[k] = hi[k].max(p[k]);
-                }
-            }
-            dist(lo, hi)
-        }
+        None => bounding_box(segs.iter().flatten().map(|&n| b.mesh.nodes[n]))
+            .map_or(f64::INFINITY, |(lo, hi)| distance(lo, hi)),
     };
     if member.is_finite() && r.is_finite() && member < MIN_FRAME_SLENDERNESS * r {
         return Err(b.err(
@@ -886,8 +876,8 @@ fn check_slenderness(
 /// a thickness is a unit slip (`thickness = 20` for 20 mm on a surface measured in m).
 pub const MAX_SHELL_THICKNESS_RATIO: f64 = 0.5;
 
-/// The diagonal (m) of the bounding box of `points` (0 for none).
-pub(crate) fn bounding_diagonal(points: impl Iterator<Item = [f64; 3]>) -> f64 {
+/// The bounding box `(lo, hi)` of `points` (`None` for none).
+fn bounding_box(points: impl Iterator<Item = [f64; 3]>) -> Option<([f64; 3], [f64; 3])> {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for p in points {
         for k in 0..3 {
@@ -895,10 +885,17 @@ pub(crate) fn bounding_diagonal(points: impl Iterator<Item = [f64; 3]>) -> f64 {
             hi[k] = hi[k].max(p[k]);
         }
     }
-    if lo[0] > hi[0] {
-        return 0.0;
-    }
-    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+    (lo[0] <= hi[0]).then_some((lo, hi))
+}
+
+/// The distance (m) between two points.
+fn distance(a: [f64; 3], c: [f64; 3]) -> f64 {
+    (0..3).map(|k| (a[k] - c[k]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// The diagonal (m) of the bounding box of `points` (0 for none).
+pub(crate) fn bounding_diagonal(points: impl Iterator<Item = [f64; 3]>) -> f64 {
+    bounding_box(points).map_or(0.0, |(lo, hi)| distance(lo, hi))
 }
 
 /// Why a shell thickness `t` (m) cannot belong to a surface of extent `extent` (m, its
@@ -981,14 +978,10 @@ pub(super) fn coincident_node_pairs(mesh: &Mesh) -> Vec<(usize, usize)> {
     if nodes.len() < 2 {
         return Vec::new();
     }
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for &i in &nodes {
-        for k in 0..3 {
-            lo[k] = lo[k].min(mesh.nodes[i][k]);
-            hi[k] = hi[k].max(mesh.nodes[i][k]);
-        }
-    }
-    let diag = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    let Some((lo, hi)) = bounding_box(nodes.iter().map(|&i| mesh.nodes[i])) else {
+        return Vec::new();
+    };
+    let diag = distance(lo, hi);
     if !(diag.is_finite() && diag > 0.0) {
         return Vec::new();
     }
