@@ -103,6 +103,16 @@ def write(d):
                                      modal_m=4.0, modal_damp_vis=0.02, modal_damp_his=0.0, node_nums=np.array([1, 2, 3]),
                                      r1=np.zeros(3), r2=np.zeros(3), r3=2.0 * np.array(psi[k]), id1=f"mode {k}"))
     u.write_sets(sets, mode="overwrite")
+    # The same modes in mm, tonne, s, N, declared by a dataset 164 (length factor 1000, force 1:
+    # 1 kg = 1e-3 t): shapes mass-normalised in mm/sqrt(t), psi * 1000 / sqrt(1e-3).
+    path = os.path.join(d, "modes_mm.uff")
+    u = pyuff.UFF(path)
+    sets = [pyuff.prepare_164(units_code=9, units_description="mm t s N", temp_mode=1, length=1000.0, force=1.0, temp=1.0, temp_offset=273.15), nodes]
+    for k, f in [(1, 12.5), (2, 310.0)]:
+        sets.append(pyuff.prepare_55(model_type=1, analysis_type=2, data_ch=2, spec_data_type=8, load_case=1, mode_n=k, freq=f,
+                                     modal_m=1.0, modal_damp_vis=0.02, modal_damp_his=0.0, node_nums=np.array([1, 2, 3]),
+                                     r1=np.zeros(3), r2=np.zeros(3), r3=np.array(psi[k]) * 1e3 / np.sqrt(1e-3), id1=f"mode {k}"))
+    u.write_sets(sets, mode="overwrite")
     expected["modes_scaled.uff"] = {"frequency_hz": [12.5, 310.0], "damping_ratio": 0.02,
                                     "psi": {"n1": [psi[1][0], psi[2][0]], "n2": [psi[1][1], psi[2][1]], "n3": [psi[1][2], psi[2][2]]}}
     with open(os.path.join(d, "expected.json"), "w") as f:
@@ -116,6 +126,8 @@ def read(path):
             out.append({"type": 58, "name": s["id1"].strip(), "unit": s["ordinate_axis_units_lab"].strip(),
                         "x_unit": s["abscissa_axis_units_lab"].strip(), "x": [float(v) for v in s["x"]],
                         "data": [float(v) for v in s["data"]], "node": int(s["rsp_node"]), "dir": int(s["rsp_dir"])})
+        elif s["type"] == 164:
+            out.append({"type": 164, "units_code": int(s["units_code"]), "length": float(s["length"]), "force": float(s["force"])})
         elif s["type"] == 2411:
             out.append({"type": 2411, "nodes": [[int(a), float(b), float(c), float(e)] for a, b, c, e in zip(s["node_nums"], s["x"], s["y"], s["z"])]})
         elif s["type"] == 55:

@@ -35,6 +35,7 @@ pub struct BlowsArgs {
 
 pub fn run(a: BlowsArgs) -> Result<()> {
     let model = a.run.load(&a.model, None)?;
+    crate::warn_model(&model, &a.print);
     let sys = model.impact_system(a.case.parse()?)?;
     let opts = model.options();
     let b = BlowOptions {

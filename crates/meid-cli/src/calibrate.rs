@@ -71,6 +71,7 @@ fn parse_band(s: &str) -> Result<ResidualKind> {
 
 pub fn run(a: CalibrateArgs) -> Result<()> {
     let model = a.run.load(&a.model, None)?;
+    crate::warn_model(&model, &a.print);
     let paths = parse_fit(&a.fit)?;
     let bounds = parse_bounds(&a.bounds)?;
     let params = parameters(&model, &paths, &bounds)?;

@@ -56,6 +56,7 @@ pub struct CompareArgs {
 
 pub fn run(a: CompareArgs) -> Result<()> {
     let model = a.run.load(&a.model, None)?;
+    crate::warn_model(&model, &a.print);
     let spectrum: SpectrumMethod = a.spectrum.parse()?;
     if spectrum == SpectrumMethod::Exact && (a.window != "rect" || a.tau.is_some()) {
         anyhow::bail!(

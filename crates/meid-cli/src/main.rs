@@ -175,6 +175,18 @@ pub(crate) fn error_chain(e: &anyhow::Error) -> String {
     out
 }
 
+/// Prints the model's warnings on stderr (the structure's own, captured flexibility shares
+/// below 95 %, frequency spreads the propagator resolves only approximately:
+/// [`meid::model::Model::diagnostics`]) before a run, unless `--quiet`: they hold whatever the
+/// run gives, and when it fails they often say why.
+pub(crate) fn warn_model(model: &Model, print: &args::PrintArgs) {
+    if !print.quiet {
+        for w in &model.diagnostics().warnings {
+            ui::warning(w);
+        }
+    }
+}
+
 /// Loads a model with `--set` overrides and the common run options folded in as overrides.
 pub(crate) fn load(
     path: &Path,

@@ -24,7 +24,7 @@ pub struct ModesArgs {
     /// Also write the reduced stiffness and mass matrices as K.mtx and M.mtx (needs -o).
     #[arg(long)]
     export_matrices: bool,
-    /// Also write DIR/modes.uff: nodes (UFF dataset 2411) and one dataset 55 per mode
+    /// Also write DIR/modes.uff: units (UFF dataset 164, SI), nodes (2411) and one dataset 55 per mode
     /// (mass-normalised shapes), for test-lab tools (needs -o). Lumped/tabulated models: node k
     /// is the k-th named point by name, as the psi columns of modes.csv (docs/measure.md).
     #[arg(long, requires = "output")]

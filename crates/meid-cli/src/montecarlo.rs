@@ -58,6 +58,7 @@ fn prepare(a: &MonteCarloArgs) -> Result<MonteCarlo> {
         a.duration,
         None,
     )?;
+    crate::warn_model(&model, &a.print);
     let inputs = a
         .vary
         .iter()

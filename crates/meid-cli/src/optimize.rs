@@ -60,6 +60,7 @@ pub struct OptimizeArgs {
 
 pub fn run(a: OptimizeArgs) -> Result<()> {
     let model = load(&a.model, &a.set.set, None, None, None)?;
+    crate::warn_model(&model, &a.print);
     let over: Vec<Quantity> = a
         .over
         .iter()

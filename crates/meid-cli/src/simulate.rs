@@ -34,6 +34,7 @@ pub struct SimulateArgs {
 
 pub fn run(a: SimulateArgs) -> Result<()> {
     let model = a.run.load(&a.model, a.duration)?;
+    crate::warn_model(&model, &a.print);
     let sys = model.impact_system(a.case.parse()?)?;
     let opts = model.options();
     // With -o, the history is streamed into the output set's history.csv (constant memory);
@@ -67,11 +68,6 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     };
     let s = &s;
     let diag = model.diagnostics();
-    if !a.print.quiet {
-        for w in &diag.warnings {
-            crate::ui::warning(w);
-        }
-    }
     // The summary's fields, then `truncation`, `notes` and `warnings`.
     let mut out = serde_json::to_value(s)?;
     if let (serde_json::Value::Object(o), serde_json::Value::Object(d)) =

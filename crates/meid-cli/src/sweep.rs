@@ -75,6 +75,7 @@ fn prepare(a: &SweepArgs) -> Result<Sweep> {
         );
     }
     let model = load(&a.model, &a.set.set, None, a.duration, None)?;
+    crate::warn_model(&model, &a.print);
     let vary = a
         .vary
         .iter()

@@ -38,6 +38,7 @@ pub struct ValidateArgs {
 
 pub fn run(a: ValidateArgs) -> Result<()> {
     let model = a.run.load(&a.model, None)?;
+    crate::warn_model(&model, &a.print);
     let p = a.processing.processing(model.spec.measurement.as_ref())?;
     let flags = parse_channel_flags(&a.channel, &model.spec.points.measurement)?;
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;

@@ -483,3 +483,34 @@ fn version_names_crate_version_and_commit() {
         ),
     }
 }
+
+/// The model's warnings (here: the no-base machine's retained modes carry 65.23 % of the
+/// static flexibility at B) are printed on stderr by every study subcommand, once, before its
+/// run — not only by `simulate` after a successful one — and not with `-q`.
+#[test]
+fn every_study_prints_the_models_warnings() {
+    let d = tmpdir("conv", "warnings");
+    let no_base = common::example_file("paper-no-base.toml")
+        .display()
+        .to_string();
+    let paper = paper_example().display().to_string();
+    for (name, args) in subcommands() {
+        if name == "modes" {
+            continue;
+        }
+        let args: Vec<String> = args
+            .into_iter()
+            .map(|a| if a == paper { no_base.clone() } else { a })
+            .collect();
+        let out = in_dir(&d, &args).output().unwrap();
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        let e = stderr(&out);
+        assert_eq!(
+            e.matches("65.23 % of the static flexibility at point 'B'").count(),
+            1,
+            "{name}: {e}"
+        );
+        let out = in_dir(&d, &args).arg("-q").output().unwrap();
+        assert!(out.stderr.is_empty(), "{name} -q: {}", stderr(&out));
+    }
+}

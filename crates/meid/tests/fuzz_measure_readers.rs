@@ -34,6 +34,16 @@ fn valid_uff(binary: bool) -> Vec<u8> {
         values: &v,
     };
     uff::write_58(&mut out, &ch, binary).unwrap();
+    uff::write_164(
+        &mut out,
+        &uff::Units {
+            code: 9,
+            description: "mm t s N".into(),
+            length: 1000.0,
+            force: 1.0,
+        },
+    )
+    .unwrap();
     uff::write_2411(
         &mut out,
         &[Node {
@@ -52,6 +62,7 @@ fn valid_uff(binary: bool) -> Vec<u8> {
             name: "m".into(),
             id_lines: Vec::new(),
             shapes: vec![(1, [0.0, 0.0, 0.14])],
+            units: None,
         },
     )
     .unwrap();

@@ -9,13 +9,15 @@
 //!   shapes: shear deformation changes the tip value by up to 0.3 % on the fourth mode;
 //! * UFF 2411 + 55 written by meid from a known modal model and read back; modal masses other
 //!   than 1 rescale, a missing modal mass is refused unless stated, a contradiction is refused;
+//!   a file in mm-t-s that says so in its dataset 164 is converted, a `units` that contradicts
+//!   it is refused;
 //! * every study runs on imported modes: a simulation with its energy balance, and the same
 //!   results as the model the modes came from.
 
 use std::path::{Path, PathBuf};
 
 use meid::analysis::energy::simulate;
-use meid::io::uff::{self, Mode, Node};
+use meid::io::uff::{self, Mode, Node, Units};
 use meid::model::{Case, Model};
 
 fn data(p: &str) -> PathBuf {
@@ -304,6 +306,7 @@ fn write_uff(path: &Path, modes: &[(f64, f64, f64)], modal_mass: f64, shape_scal
                     (7, [0.0, 0.0, a * shape_scale]),
                     (9, [0.0, 0.0, b * shape_scale]),
                 ],
+                units: None,
             },
         )
         .unwrap();
@@ -523,5 +526,207 @@ fn keeping_one_mode_of_a_repeated_pair_is_warned_about() {
             m.structure.warnings
         );
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The lumped machine's modes written in mm, tonne, s, N with a dataset 164 that says so
+/// (length factor 1000, force factor 1: the mass factor is 1e-3 per kg), each shape at twice
+/// its mass-normalised value with modal mass 4 t·mm²/mm²: `ψ_file = 2 ψ_SI · 1000 / √1e-3`.
+fn write_mm_t_s(path: &Path, src: &Model, units: &[Units]) {
+    let s = &src.structure;
+    let to_file = 2.0 * 1e3 / 1e-3f64.sqrt();
+    let mut out = Vec::new();
+    uff::write_2411(
+        &mut out,
+        &[
+            Node {
+                label: 7,
+                xyz: [0.0; 3],
+            },
+            Node {
+                label: 9,
+                xyz: [1000.0, 0.0, 0.0],
+            },
+        ],
+    )
+    .unwrap();
+    let n = s.len();
+    for i in 0..n {
+        // A new dataset 164 before each mode, when `units` has one per mode.
+        if let Some(u) = units.get(i) {
+            uff::write_164(&mut out, u).unwrap();
+        }
+        uff::write_55(
+            &mut out,
+            &Mode {
+                number: i as i64 + 1,
+                frequency_hz: s.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI),
+                modal_mass: 4.0,
+                damping_ratio: s.damping[i * n + i] / (2.0 * s.omega_rad_per_s[i]),
+                name: format!("mode {}", i + 1),
+                id_lines: Vec::new(),
+                shapes: vec![
+                    (7, [0.0, 0.0, s.point("bed").unwrap()[i] * to_file]),
+                    (9, [0.0, 0.0, s.point("base").unwrap()[i] * to_file]),
+                ],
+                units: None,
+            },
+        )
+        .unwrap();
+    }
+    std::fs::write(path, out).unwrap();
+}
+
+fn mm_t_s() -> Units {
+    Units {
+        code: 9,
+        description: "mm t s N".into(),
+        length: 1000.0,
+        force: 1.0,
+    }
+}
+
+/// A UFF file that declares mm-t-s in its dataset 164 is converted without being told: the
+/// same ψ (to dataset 55's 6 digits) and the same study as the SI model. Before, it was read
+/// as SI: ψ 6.3e4 times too large, a bed of 2.5e-9 kg effective mass.
+#[test]
+fn a_uff_unit_dataset_converts_the_modes_it_declares() {
+    let src = lumped();
+    let dir = tmp("units164");
+    write_mm_t_s(&dir.join("mm.uff"), &src, &[mm_t_s()]);
+    let body = "file = \"mm.uff\"\npoints = { bed = 7, base = 9 }\nimpact_direction = [0, 0, 1]";
+    let m = imported(&dir, body).unwrap();
+    let (a, b) = (&src.structure, &m.structure);
+    for i in 0..a.len() {
+        for p in ["bed", "base"] {
+            let (x, y) = (a.point(p).unwrap()[i], b.point(p).unwrap()[i]);
+            assert!(rel(x, y) < 5e-6, "{p} mode {i}: {x} vs {y}");
+        }
+    }
+    assert!(
+        b.notes
+            .iter()
+            .any(|n| n.contains("converted from the file's units")
+                && n.contains("unit code 9")
+                && n.contains("length factor 1000")),
+        "{:?}",
+        b.notes
+    );
+    let ra = simulate(
+        &src.impact_system(Case::Damper).unwrap(),
+        &src.options(),
+        false,
+    )
+    .unwrap();
+    let rb = simulate(&m.impact_system(Case::Damper).unwrap(), &m.options(), false).unwrap();
+    assert!(
+        rel(
+            ra.summary.energy_ratio.unwrap(),
+            rb.summary.energy_ratio.unwrap()
+        ) < 1e-4
+    );
+    assert!(
+        rel(
+            ra.summary.peak_bed_acceleration_m_per_s2,
+            rb.summary.peak_bed_acceleration_m_per_s2
+        ) < 1e-4
+    );
+    // `units` that agree with the file are accepted; one that contradicts it is refused.
+    let same = imported(&dir, &format!("{body}\nunits = \"mm-t-s\"")).unwrap();
+    assert_eq!(
+        same.structure.point("bed").unwrap(),
+        b.point("bed").unwrap()
+    );
+    let e = imported(&dir, &format!("{body}\nunits = \"m-kg-s\""))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("structure.modes.units")
+            && e.contains("contradicts")
+            && e.contains("unit code 9"),
+        "{e}"
+    );
+    // meid's own export declares SI: `units = "mm-t-s"` on it is refused too.
+    std::fs::write(
+        dir.join("si.uff"),
+        uff::modes_uff_points(&src.structure).unwrap(),
+    )
+    .unwrap();
+    let e = imported(
+        &dir,
+        "file = \"si.uff\"\npoints = { bed = 2, base = 1 }\nimpact_direction = [0, 0, 1]\nunits = \"mm-t-s\"",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("contradicts") && e.contains("unit code 1"),
+        "{e}"
+    );
+    // Modes of one file under two unit systems: refused, naming both.
+    write_mm_t_s(&dir.join("mixed.uff"), &src, &[mm_t_s(), Units::si()]);
+    let e = imported(&dir, &body.replace("mm.uff", "mixed.uff"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("mode 1") && e.contains("mode 2") && e.contains("one unit system"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A file in mm-t-s that does not say so (no dataset 164, as a CalculiX `.frd` never does) read
+/// as SI makes the bed 1e9 times too light: a warning names the struck point's effective mass,
+/// its ratio to the slider's and `units = "mm-t-s"`; with `units` given, or on the SI file,
+/// there is none.
+#[test]
+fn modes_in_undeclared_mm_t_s_are_warned_about() {
+    let src = lumped();
+    let dir = tmp("undeclared");
+    write_mm_t_s(&dir.join("mm.uff"), &src, &[]);
+    let body = "file = \"mm.uff\"\npoints = { bed = 7, base = 9 }\nimpact_direction = [0, 0, 1]";
+    let m = imported(&dir, body).unwrap();
+    let w = m.structure.warnings.join("\n");
+    // 1/Σψ² at the bed: 1/(ψ₁² + ψ₂²) in SI, 1e-9 of it (×2² from the file's modal mass 4
+    // divided back out) when read as SI.
+    let s2: f64 = src
+        .structure
+        .point("bed")
+        .unwrap()
+        .iter()
+        .map(|v| v * v)
+        .sum();
+    let wrong = 1e-9 / s2;
+    assert!(
+        w.contains("'bed'")
+            && w.contains(&format!("{:.3e}", wrong)[..4])
+            && w.contains("units = \"mm-t-s\""),
+        "{w} (effective mass read as SI: {wrong:e} kg)"
+    );
+    let ok = imported(&dir, &format!("{body}\nunits = \"mm-t-s\"")).unwrap();
+    assert!(
+        ok.structure.warnings.iter().all(|w| !w.contains("mm-t-s")),
+        "{:?}",
+        ok.structure.warnings
+    );
+    for (a, b) in ok
+        .structure
+        .point("bed")
+        .unwrap()
+        .iter()
+        .zip(src.structure.point("bed").unwrap())
+    {
+        assert!(rel(*a, *b) < 5e-6);
+    }
+    std::fs::write(
+        dir.join("si.uff"),
+        uff::modes_uff_points(&src.structure).unwrap(),
+    )
+    .unwrap();
+    let si = imported(
+        &dir,
+        "file = \"si.uff\"\npoints = { bed = 2, base = 1 }\nimpact_direction = [0, 0, 1]",
+    )
+    .unwrap();
+    assert!(si.structure.warnings.iter().all(|w| !w.contains("mm-t-s")));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -235,6 +235,7 @@ fn pyuff_reads_what_meid_writes() {
         name: "bed".into(),
         id_lines: vec!["written by meid".into()],
         shapes: vec![(1, [0.0, 0.0, 0.2835]), (2, [0.0, 0.0, -0.0691897])],
+        units: None,
     };
     let mut out = Vec::new();
     uff::write_2411(&mut out, &nodes).unwrap();
@@ -286,6 +287,12 @@ fn pyuff_reads_the_lumped_node_names() {
     let sets = read.as_array().unwrap();
     let names: Vec<&String> = s.points.keys().collect();
     assert_eq!(names, ["base", "bed"]);
+    // Dataset 164 first: SI.
+    assert_eq!(sets[0]["type"], 164);
+    assert_eq!(sets[0]["units_code"], 1);
+    assert_eq!(sets[0]["length"].as_f64(), Some(1.0));
+    assert_eq!(sets[0]["force"].as_f64(), Some(1.0));
+    let sets = &sets[1..];
     let nodes = sets[0]["nodes"].as_array().unwrap();
     assert_eq!(nodes.len(), 2);
     for (k, row) in nodes.iter().enumerate() {
@@ -401,5 +408,32 @@ duration = 0.02
     let sys = m.impact_system(meid::model::Case::AsSpecified).unwrap();
     let run = meid::analysis::energy::simulate(&sys, &m.options(), false).unwrap();
     assert!(run.summary.energy_balance_residual.unwrap() < 1e-9);
+    // The same modes in mm-t-s, declared by pyuff's dataset 164: converted to the same ψ
+    // (to dataset 55's 6 digits), without `units` in the model.
+    let mm = meid::model::Model::from_text(
+        &dir.join("model.toml").display().to_string(),
+        text.replace("modes_scaled.uff", "modes_mm.uff"),
+        &[],
+    )
+    .unwrap();
+    for p in ["n1", "n2", "n3"] {
+        for (a, b) in mm
+            .structure
+            .point(p)
+            .unwrap()
+            .iter()
+            .zip(s.point(p).unwrap())
+        {
+            assert!(close(*a, *b, 5e-6), "{p}: {a} vs {b}");
+        }
+    }
+    assert!(
+        mm.structure
+            .notes
+            .iter()
+            .any(|n| n.contains("unit code 9") && n.contains("length factor 1000")),
+        "{:?}",
+        mm.structure.notes
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

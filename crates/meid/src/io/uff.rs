@@ -61,6 +61,63 @@ pub struct Mode {
     pub id_lines: Vec<String>,
     /// `(node, [x, y, z] translations)` (the first three values of each node).
     pub shapes: Vec<(i64, [f64; 3])>,
+    /// The unit system of the dataset 164 before this one in the file (`None`: no dataset 164
+    /// before it, the UFF default, SI). The values above are as written, in those units.
+    pub units: Option<Units>,
+}
+
+/// Dataset 164: the unit system of the datasets that follow it.
+///
+/// | record | format | fields |
+/// |---|---|---|
+/// | 1 | I10,20A1,I10 | unit code (1 SI, 2 BG, 3 MG, 4 BA, 5 MM, 6 CM, 7 IN, 8 GM, 9 user), description, temperature mode |
+/// | 2 | 3D25.17 | length, force and temperature factors |
+/// | 3 | D25.17 | temperature offset |
+///
+/// The factors convert the file's units to SI by division: a length `x` in the file is
+/// `x / length` m, a force `f` is `f / force` N. Time is always in seconds, so the file's mass
+/// unit is its force unit · s² / its length unit and a mass `m` is `m / mass()` kg with
+/// `mass() = force / length` (mm, tonne, s, N: length 1000, force 1, mass 0.001).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Units {
+    pub code: i64,
+    pub description: String,
+    pub length: f64,
+    pub force: f64,
+}
+
+impl Units {
+    /// SI: m, N (kg, s), code 1.
+    pub fn si() -> Self {
+        Self {
+            code: 1,
+            description: "SI".into(),
+            length: 1.0,
+            force: 1.0,
+        }
+    }
+
+    /// The mass factor: the file's mass unit per kg (`force / length`).
+    pub fn mass(&self) -> f64 {
+        self.force / self.length
+    }
+
+    /// The same length and force factors to 1e-9 relative (the codes and texts aside).
+    pub fn same_factors(&self, other: &Units) -> bool {
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+        close(self.length, other.length) && close(self.force, other.force)
+    }
+
+    /// E.g. `dataset 164 unit code 9 ('mm t s N': length factor 1000, force factor 1)`.
+    pub fn describe(&self) -> String {
+        format!(
+            "dataset 164 unit code {} ('{}': length factor {}, force factor {})",
+            self.code,
+            self.description,
+            crate::num(self.length),
+            crate::num(self.force)
+        )
+    }
 }
 
 /// What a UFF file held that meid reads.
@@ -177,7 +234,7 @@ impl<R: BufRead> Parser<'_, R> {
     fn run(&mut self) -> Result<UffFile> {
         let mut out = UffFile::default();
         let mut ordinal = 0usize;
-        let mut unit_code: Option<i64> = None;
+        let mut units: Option<Units> = None;
         // Between datasets: blank lines, then "-1".
         while let Some(l) = self.line()? {
             if l.trim().is_empty() {
@@ -235,6 +292,7 @@ impl<R: BufRead> Parser<'_, R> {
                         kind: if binary { "58b" } else { "58" },
                         line: start,
                     };
+                    let unit_code = units.as_ref().map(|u| u.code);
                     match self.dataset_58(ds, &h, binary, unit_code)? {
                         Ok(r) => out.records.push(r),
                         Err(why) => out.skipped.push(format!(
@@ -257,7 +315,10 @@ impl<R: BufRead> Parser<'_, R> {
                         line: start,
                     };
                     match self.dataset_55(ds)? {
-                        Ok(m) => out.modes.push(m),
+                        Ok(mut m) => {
+                            m.units = units.clone();
+                            out.modes.push(m)
+                        }
                         Err(why) => out.skipped.push(format!(
                             "dataset {ordinal} (55 at line {start}): {why}"
                         )),
@@ -270,11 +331,7 @@ impl<R: BufRead> Parser<'_, R> {
                         line: start,
                     };
                     let lines = self.skip_to_end(ds)?;
-                    // Record 1: unit code (I10), description, temperature mode.
-                    unit_code = lines
-                        .first()
-                        .and_then(|l| l.split_whitespace().next())
-                        .and_then(|t| t.parse::<i64>().ok());
+                    units = Some(self.dataset_164(ds, &lines)?);
                 }
                 (n, false) => {
                     let ds = Ds {
@@ -882,6 +939,48 @@ impl<R: BufRead> Parser<'_, R> {
         }
     }
 
+    /// Dataset 164's records 1 and 2 ([`Units`]) from its lines.
+    fn dataset_164(&self, ds: Ds, lines: &[String]) -> Result<Units> {
+        let r1 = lines.first().map_or("", String::as_str);
+        let code_s = cols(r1, 0, 10).trim().to_string();
+        let Ok(code) = code_s.parse::<i64>() else {
+            return Err(self.err(
+                Some(ds),
+                Some("record 1"),
+                ds.line + 2,
+                format!("unit code (columns 1-10): expected a whole number (1 SI, 5 MM, 9 user, ...), got '{code_s}'"),
+            ));
+        };
+        let description = cols(r1, 10, 30).trim().to_string();
+        let r2 = lines.get(1).map_or("", String::as_str);
+        // Whitespace-separated when possible (pyuff writes %25.16e with D), else 3D25.17.
+        let ws: Vec<f64> = r2.split_whitespace().filter_map(parse_f).collect();
+        let f: Vec<f64> = if ws.len() == 3 {
+            ws
+        } else {
+            (0..3)
+                .filter_map(|k| parse_f(cols(r2, 25 * k, 25 * (k + 1)).trim()))
+                .collect()
+        };
+        match f[..] {
+            [length, force, _] if length.is_finite() && length > 0.0 && force.is_finite() && force > 0.0 => Ok(Units {
+                code,
+                description,
+                length,
+                force,
+            }),
+            _ => Err(self.err(
+                Some(ds),
+                Some("record 2"),
+                ds.line + 3,
+                format!(
+                    "expected three unit factors (length, force, temperature; 3D25.17) with length and force finite and > 0 (SI: 1 1 1; mm-t-s: 1000 1 1), got '{}'",
+                    clip(r2)
+                ),
+            )),
+        }
+    }
+
     fn dataset_55(&mut self, ds: Ds) -> Result<std::result::Result<Mode, String>> {
         let mut id = Vec::new();
         for k in 1..=5 {
@@ -966,6 +1065,7 @@ impl<R: BufRead> Parser<'_, R> {
                 .map(str::to_string)
                 .collect(),
             shapes,
+            units: None,
         }))
     }
 }
@@ -1252,6 +1352,33 @@ fn capitalise(s: &str) -> String {
 }
 
 /// Writes dataset 2411 (nodes, double precision: 4I10 then 1P3D25.16, here `%25.16e`).
+/// Writes dataset 164 (the unit system of the datasets after it, [`Units`]): records 1-3 as
+/// pyuff writes them (`%10i%20s%10i`, then the factors `%25.16e` with a `D` exponent; the
+/// temperature factor 1, mode 1 (absolute), offset 273.15).
+pub fn write_164<W: Write>(w: &mut W, units: &Units) -> std::io::Result<()> {
+    writeln!(w, "{:>6}\n{:>6}{:74}", -1, 164, "")?;
+    let description: String = units
+        .description
+        .chars()
+        .filter(|c| !c.is_control())
+        .take(20)
+        .collect();
+    writeln!(w, "{:>10}{description:>20}{:>10}", units.code, 1)?;
+    let d = |x: f64| {
+        // Rust writes `1e3` as `1.0000000000000000e3`: the exponent gets its sign and two digits.
+        let t = format!("{x:.16e}");
+        let (m, e) = t.split_once('e').unwrap_or((&t, "0"));
+        let e: i32 = e.parse().unwrap_or(0);
+        format!(
+            "{:>25}",
+            format!("{m}D{}{:02}", if e < 0 { '-' } else { '+' }, e.abs())
+        )
+    };
+    writeln!(w, "{}{}{}", d(units.length), d(units.force), d(1.0))?;
+    writeln!(w, "{}", d(273.15))?;
+    writeln!(w, "{:>6}", -1)
+}
+
 pub fn write_2411<W: Write>(w: &mut W, nodes: &[Node]) -> std::io::Result<()> {
     writeln!(w, "{:>6}\n{:>6}{:74}", -1, 2411, "")?;
     for n in nodes {
@@ -1394,7 +1521,15 @@ fn point_id_lines(labels: &[(i64, String)]) -> Vec<String> {
     lines
 }
 
-/// Dataset 2411 + one dataset 55 per mode of a modal model's named points. A lumped or
+/// The unit system meid's mode exports declare (dataset 164, code 1).
+fn si_units() -> Units {
+    Units {
+        description: "SI - m, N, kg, s".into(),
+        ..Units::si()
+    }
+}
+
+/// Dataset 164 (SI) + 2411 + one dataset 55 per mode of a modal model's named points. A lumped or
 /// tabulated model has no geometry: node `k` is the `k`-th named point in name order
 /// ([`point_node_labels`], the column order of `modes.csv`), placed at x = k − 1 m, y = z = 0
 /// (coordinates for display only). Its z translation is the signed mass-normalised shape value
@@ -1414,6 +1549,7 @@ pub fn modes_uff_points(m: &crate::modal::ModalModel) -> Result<Vec<u8>> {
     let id_lines = point_id_lines(&labels);
     let n = m.omega_rad_per_s.len();
     let mut out = Vec::new();
+    write_164(&mut out, &si_units()).map_err(|e| Error::io("UFF output", e))?;
     write_2411(&mut out, &nodes).map_err(|e| Error::io("UFF output", e))?;
     for i in 0..n {
         let w = m.omega_rad_per_s[i];
@@ -1433,13 +1569,14 @@ pub fn modes_uff_points(m: &crate::modal::ModalModel) -> Result<Vec<u8>> {
                 .iter()
                 .map(|(label, p)| (*label, [0.0, 0.0, m.points[p][i]]))
                 .collect(),
+            units: Some(si_units()),
         };
         write_55(&mut out, &mode).map_err(|e| Error::io("UFF output", e))?;
     }
     Ok(out)
 }
 
-/// Dataset 2411 (every mesh node, label = index + 1, coordinates in m) + one dataset 55 per
+/// Dataset 164 (SI) + 2411 (every mesh node, label = index + 1, coordinates in m) + one dataset 55 per
 /// computed mode (nodal translations of the mass-normalised shapes, modal mass 1) of an FE
 /// analysis; `zeta[i]` the modal damping ratios (missing: 0).
 pub fn modes_uff_fe(
@@ -1458,6 +1595,7 @@ pub fn modes_uff_fe(
         })
         .collect();
     let mut out = Vec::new();
+    write_164(&mut out, &si_units()).map_err(|e| Error::io("UFF output", e))?;
     write_2411(&mut out, &nodes).map_err(|e| Error::io("UFF output", e))?;
     for i in 0..modes.omega_rad_per_s.len() {
         let t = super::vtk::mode_translations(model, modes, i)?;
@@ -1477,6 +1615,7 @@ pub fn modes_uff_fe(
                 .enumerate()
                 .map(|(k, v)| (k as i64 + 1, *v))
                 .collect(),
+            units: Some(si_units()),
         };
         write_55(&mut out, &mode).map_err(|e| Error::io("UFF output", e))?;
     }
@@ -1746,12 +1885,62 @@ mod tests {
             name: "mode 2".into(),
             id_lines: vec!["written by meid".into(), "second line".into()],
             shapes: vec![(1, [0.0, 0.0, 0.25]), (7, [0.0, 0.0, -0.125])],
+            units: Some(Units {
+                code: 9,
+                description: "mm t s N".into(),
+                length: 1000.0,
+                force: 1.0,
+            }),
         };
         let mut buf = Vec::new();
+        write_164(&mut buf, mode.units.as_ref().unwrap()).unwrap();
         write_2411(&mut buf, &nodes).unwrap();
         write_55(&mut buf, &mode).unwrap();
+        let text = String::from_utf8(buf.clone()).unwrap();
+        // pyuff's layout (`%10i%20s%10i`, `%25.16e` with D exponents).
+        assert!(text.contains(
+            "         9            mm t s N         1\n   1.0000000000000000D+03   1.0000000000000000D+00   1.0000000000000000D+00\n   2.7314999999999998D+02\n"
+        ), "{text}");
         let f = parse_uff(&buf[..], "m.unv", None).unwrap();
         assert_eq!(f.nodes, nodes);
         assert_eq!(f.modes, vec![mode]);
+        // Without a dataset 164 a mode has no units (the UFF default, SI).
+        let mut plain = Vec::new();
+        write_55(&mut plain, &f.modes[0]).unwrap();
+        let g = parse_uff(&plain[..], "p.unv", None).unwrap();
+        assert_eq!(g.modes[0].units, None);
+    }
+
+    #[test]
+    fn a_unit_dataset_without_usable_factors_is_refused() {
+        for (record2, what) in [
+            (
+                "   0.0000000000000000D+00   1.0000000000000000D+00   1.0000000000000000D+00",
+                "record 2",
+            ),
+            ("   1.0D+03", "record 2"),
+        ] {
+            let text = format!(
+                "    -1\n   164\n         5    mm (milli newton)         1\n{record2}\n   2.7314999999999998D+02\n    -1\n"
+            );
+            let e = parse_uff(text.as_bytes(), "u.unv", None)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains(what) && e.contains("line 4") && e.contains("unit factors"),
+                "{e}"
+            );
+        }
+        let e = parse_uff(
+            "    -1\n   164\n       SI\n    -1\n".as_bytes(),
+            "u.unv",
+            None,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("record 1") && e.contains("line 3") && e.contains("unit code"),
+            "{e}"
+        );
     }
 }

@@ -174,17 +174,27 @@ pub fn propagator_findings(
         out.warnings.push((
             c.field.clone(),
             format!(
-                "{} = {:.3e} N/m: while this contact is closed ({:.4e} Hz), {} lie below the \
-                 closed-form propagator's relative resolution {PROPAGATOR_NULL_TOL:.0e} and are \
-                 propagated as free bodies; this is exact only for contacts much shorter than \
+                "{} = {:.3e} N/m: while this contact is closed ({:.4e} Hz), {} {} below the \
+                 closed-form propagator's relative resolution {PROPAGATOR_NULL_TOL:.0e} and {} \
+                 propagated as {}; this is exact only for contacts much shorter than \
                  1/(2π·{:.4} Hz) = {:.3e} s. Check the energy-balance residual, or lower the \
-                 stiffness to ~1e3 times the structure's",
+                 stiffness until the closed contact's frequency is below {:.4e} Hz \
+                 (√(1/{PROPAGATOR_NULL_TOL:.0e}) times {:.4} Hz)",
                 c.field,
                 c.stiffness,
                 hz(lc),
                 names.join(", "),
+                if names.len() == 1 { "lies" } else { "lie" },
+                if names.len() == 1 { "is" } else { "are" },
+                if names.len() == 1 {
+                    "a free body"
+                } else {
+                    "free bodies"
+                },
                 hz(hi),
-                1.0 / hi.sqrt()
+                1.0 / hi.sqrt(),
+                hz(hi) / PROPAGATOR_NULL_TOL.sqrt(),
+                hz(hi)
             ),
         ));
     }

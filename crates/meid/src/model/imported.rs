@@ -22,7 +22,8 @@
 //! ```
 //!
 //! with `s = 1` for a file in m, kg, s and `s = 1e-3/√1e3` for one in mm, tonne, s
-//! (`units = "mm-t-s"`: a displacement in mm per √t is 1e-3 m per √(1e3 kg)). Dividing by
+//! (`units = "mm-t-s"`, or the file's dataset 164: a displacement in mm per √t is 1e-3 m per
+//! √(1e3 kg)). Dividing by
 //! `√m_k` makes the shapes mass-normalised, `ψ_kᵀ M ψ_k = 1`, which is what paper Eq. 9
 //! and every meid study assume.
 //!
@@ -36,8 +37,15 @@
 //!   `1PGM`): refused, unless `mass_normalised = true` states that the shapes are
 //!   mass-normalised; a note then records that assumption.
 //!
-//! Units are not in the files meid reads here: they are the file's (SI unless
-//! `units = "mm-t-s"`). The force to the floor and the static flexibility are not in the
+//! # Units
+//!
+//! A UFF file may declare its unit system (dataset 164: length and force factors to SI, time
+//! in s, so the mass factor is force/length, [`uff::Units`]). The shapes are then converted
+//! from the file's length per √(file mass) to m/√kg, `s = √(mass factor) / length factor`,
+//! and a note says so. `units` in the model is checked against it: a contradiction (e.g.
+//! `units = "mm-t-s"` for a file whose dataset 164 says SI) is refused, and so is a file whose
+//! modes follow different datasets 164. A `.frd` file, or a UFF file without dataset 164,
+//! carries no units: they are SI unless `units = "mm-t-s"`. The force to the floor and the static flexibility are not in the
 //! files either: an imported model has no floor force and no truncation table (unknown
 //! flexibility).
 
@@ -70,6 +78,8 @@ pub struct FileMode {
     pub damping_ratio: Option<f64>,
     /// `(node label, [ux, uy, uz])`.
     pub shapes: Vec<(i64, [f64; 3])>,
+    /// The unit system the file declares for this mode (UFF dataset 164), if any.
+    pub units: Option<uff::Units>,
 }
 
 /// The modes of a UFF file's datasets 55 (real normal modes). A modal mass of 0 (or not
@@ -83,6 +93,7 @@ pub fn modes_from_uff(f: &uff::UffFile) -> Vec<FileMode> {
             modal_mass: (m.modal_mass.is_finite() && m.modal_mass > 0.0).then_some(m.modal_mass),
             damping_ratio: m.damping_ratio.is_finite().then_some(m.damping_ratio),
             shapes: m.shapes.clone(),
+            units: m.units.clone(),
         })
         .collect()
 }
@@ -97,6 +108,7 @@ pub fn modes_from_frd(f: &frd::FrdFile) -> Vec<FileMode> {
             modal_mass: m.generalised_mass.filter(|g| g.is_finite() && *g > 0.0),
             damping_ratio: None,
             shapes: m.displacements.clone(),
+            units: None,
         })
         .collect()
 }
@@ -128,8 +140,29 @@ fn format_of(spec: &ModesFileSpec, path: &Path, src: &Source) -> Result<&'static
     }
 }
 
+/// How many times lighter than the slider the structure's effective mass at the struck point
+/// may be before an import whose file does not state its units is warned about: a file in
+/// mm-t-s read as SI makes every effective mass 1e9 times too small (a 10 kg bed struck by a
+/// 1.2 kg slider, ratio 0.12, reads as 1.2e8).
+pub const UNIT_SUSPICION_RATIO: f64 = 1e6;
+
+/// The slider meid's import checks the units against: its mass (kg) and the point it strikes.
+#[derive(Debug, Clone, Copy)]
+pub struct Struck<'a> {
+    pub slider_mass_kg: f64,
+    pub point: &'a str,
+}
+
 /// Reads `[structure.modes]`'s file (relative to the model file) and builds the modal model.
-pub fn modal_model(spec: &ModesFileSpec, src: &Source) -> Result<ModalModel> {
+/// When neither the model (`units`) nor the file (UFF dataset 164) states the units and the
+/// modes make the struck point's effective mass `1/Σ_k ψ_k(O_b)²` more than
+/// [`UNIT_SUSPICION_RATIO`] times lighter than the slider, a warning asks whether the file is
+/// in mm-t-s.
+pub fn modal_model(
+    spec: &ModesFileSpec,
+    src: &Source,
+    struck: Option<Struck<'_>>,
+) -> Result<ModalModel> {
     let dir = Path::new(&src.name)
         .parent()
         .map(Path::to_path_buf)
@@ -167,7 +200,107 @@ pub fn modal_model(spec: &ModesFileSpec, src: &Source) -> Result<ModalModel> {
         }
         return Err(src.error("structure.modes.file", msg));
     }
-    build(&modes, spec, &path.display().to_string(), src)
+    let file = path.display().to_string();
+    let mut model = build(&modes, spec, &file, src)?;
+    let declared = spec.units.is_some() || modes.iter().any(|m| m.units.is_some());
+    if let (false, Some(st)) = (declared, struck) {
+        let s2: f64 = model
+            .points
+            .get(st.point)
+            .map_or(0.0, |psi| psi.iter().map(|v| v * v).sum());
+        let ratio = st.slider_mass_kg * s2;
+        if s2 > 0.0 && ratio > UNIT_SUSPICION_RATIO {
+            model.warnings.push(format!(
+                "structure.modes: the modes of {file} give the struck point '{}' an effective mass 1/Σψ² = {:.4e} kg, {:.3e} times lighter than the {} kg slider, and neither the file (no UFF dataset 164) nor the model (structure.modes.units) states their units: a file in mm-t-s read as SI has every effective mass 1e9 times too small. If the FE model was in mm, tonne, s, give units = \"mm-t-s\"",
+                st.point,
+                1.0 / s2,
+                ratio,
+                crate::num(st.slider_mass_kg)
+            ));
+        }
+    }
+    Ok(model)
+}
+
+/// The factor from the file's shape units (length per √mass) to m/√kg, and the note that
+/// says where the units came from when they are not SI: `units` in the model, else the
+/// file's dataset 164, else SI. A `units` that contradicts the file's dataset 164, or modes
+/// of one file under different datasets 164, are refused.
+fn unit_scale(
+    modes: &[FileMode],
+    spec: &ModesFileSpec,
+    file: &str,
+    src: &Source,
+) -> Result<(f64, Option<String>)> {
+    const BASE: &str = "structure.modes";
+    let given = match spec.units.as_deref() {
+        None => None,
+        Some("m-kg-s") | Some("SI") => Some(uff::Units::si()),
+        Some("mm-t-s") => Some(uff::Units {
+            code: 9,
+            description: "mm-t-s".into(),
+            length: 1e3,
+            force: 1.0,
+        }),
+        Some(other) => {
+            return Err(src.error(
+                &format!("{BASE}.units"),
+                format!("{BASE}.units: unknown unit system '{other}'; valid: \"m-kg-s\" (SI, default), \"mm-t-s\" (mm, tonne, s, N); leave it out to use the file's dataset 164"),
+            ))
+        }
+    };
+    // The file's: one unit system for all its modes (a mode before any dataset 164 is SI).
+    let declared = modes.iter().find_map(|m| m.units.as_ref().map(|u| (m, u)));
+    if let Some((first, fu)) = declared {
+        let si = uff::Units::si();
+        if let Some(m) = modes
+            .iter()
+            .find(|m| !fu.same_factors(m.units.as_ref().unwrap_or(&si)))
+        {
+            let describe = |u: Option<&uff::Units>| {
+                u.map_or("no dataset 164 (SI)".to_string(), uff::Units::describe)
+            };
+            return Err(src.error(
+                &format!("{BASE}.file"),
+                format!(
+                    "{file}: mode {} follows {} and mode {} {}: meid reads one unit system per file; export all modes in one",
+                    first.number,
+                    describe(Some(fu)),
+                    m.number,
+                    describe(m.units.as_ref())
+                ),
+            ));
+        }
+    }
+    let from_file = declared.map(|(_, u)| u);
+    let (units, whence) = match (given, from_file) {
+        (Some(g), Some(f)) if !g.same_factors(f) => {
+            return Err(src.error(
+                &format!("{BASE}.units"),
+                format!(
+                    "{BASE}.units = \"{}\" (length factor {}, force factor {} per SI unit) contradicts {file}'s {}: leave units out to use the file's, or correct the file",
+                    spec.units.as_deref().unwrap_or(""),
+                    crate::num(g.length),
+                    crate::num(g.force),
+                    f.describe()
+                ),
+            ))
+        }
+        (Some(g), _) => (
+            g,
+            format!("{BASE}.units = \"{}\"", spec.units.as_deref().unwrap_or("")),
+        ),
+        (None, Some(f)) => (f.clone(), format!("{file}'s {}", f.describe())),
+        (None, None) => (uff::Units::si(), String::new()),
+    };
+    // ψ in file length per √(file mass): ψ_SI = ψ · √(mass factor) / length factor.
+    let scale = units.mass().sqrt() / units.length;
+    let note = (scale != 1.0).then(|| {
+        format!(
+            "{BASE}: shapes converted from the file's units to m/√kg (× {scale:e}), as {whence} says"
+        )
+    });
+    Ok((scale, note))
 }
 
 /// The modal model of `modes` (read from `file`) as `spec` maps them (module docs).
@@ -178,17 +311,8 @@ pub fn build(
     src: &Source,
 ) -> Result<ModalModel> {
     const BASE: &str = "structure.modes";
-    // Unit system.
-    let scale = match spec.units.as_deref() {
-        None | Some("m-kg-s") | Some("SI") => 1.0,
-        Some("mm-t-s") => 1e-3 / 1e3f64.sqrt(),
-        Some(other) => {
-            return Err(src.error(
-                &format!("{BASE}.units"),
-                format!("{BASE}.units: unknown unit system '{other}'; valid: \"m-kg-s\" (SI, default), \"mm-t-s\" (mm, tonne, s, N)"),
-            ))
-        }
-    };
+    // Unit system (module docs): `units`, else the file's dataset 164, else SI.
+    let (scale, unit_note) = unit_scale(modes, spec, file, src)?;
     // Direction.
     let d = spec.impact_direction.unwrap_or([0.0, 0.0, -1.0]);
     let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
@@ -321,10 +445,8 @@ pub fn build(
             "{BASE}: shapes divided by √(modal mass) given in {file} (modal masses {lo:e} to {hi:e}) to make them mass-normalised"
         ));
     }
-    if scale != 1.0 {
-        notes.push(format!(
-            "{BASE}: shapes converted from mm/√t to m/√kg (× {scale:e}), units = \"mm-t-s\""
-        ));
+    if let Some(note) = unit_note {
+        notes.push(note);
     }
     // Damping.
     let zeta = match &spec.damping_ratios {

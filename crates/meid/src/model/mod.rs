@@ -616,7 +616,11 @@ fn build_structure(spec: &ModelSpec, src: &Source) -> Result<ModalModel> {
         return fem::modal_model(f, src, &ctx);
     }
     if let Some(m) = &st.modes {
-        return imported::modal_model(m, src);
+        let struck = imported::Struck {
+            slider_mass_kg: spec.slider.mass,
+            point: &spec.points.bed_contact,
+        };
+        return imported::modal_model(m, src, Some(struck));
     }
     Err(src.error(
         "structure",
