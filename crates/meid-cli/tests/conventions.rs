@@ -506,7 +506,8 @@ fn every_study_prints_the_models_warnings() {
         assert!(out.status.success(), "{name}: {}", stderr(&out));
         let e = stderr(&out);
         assert_eq!(
-            e.matches("65.23 % of the static flexibility at point 'B'").count(),
+            e.matches("65.23 % of the static flexibility at point 'B'")
+                .count(),
             1,
             "{name}: {e}"
         );
