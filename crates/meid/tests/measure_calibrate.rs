@@ -350,3 +350,43 @@ fn a_dc_offset_on_the_measurement_is_not_fitted() {
         "known {known}, {b:?}"
     );
 }
+
+/// Noise-free measurements (the model's own history, 13 digits through binary UFF): the
+/// statistical interval shrinks to round-off (standard errors ~1e-12 relative), far inside
+/// the solver's stopping tolerance (xtol 1e-8). The interval adds the Gauss-Newton step left
+/// at the estimate: it contains the known values, and that step is the solver's actual
+/// distance to them. Before, K_s's interval was ±0.005 N/m around a value 0.32 N/m (7e-9
+/// relative) from the truth, and excluded it.
+#[test]
+fn noise_free_measurements_give_intervals_that_hold_the_known_values() {
+    let truth = model(&[]);
+    let known = [value(&truth, KS), value(&truth, KD)];
+    let meas = measured(&truth, 0.0, 1, "noise-free");
+    let start = model(&[
+        format!("{KS}={:e}", known[0] * 1.2),
+        format!("{KD}={:e}", known[1] * 0.8),
+    ]);
+    let c = fit(&start, &[KS, KD], meas, Settings::default());
+    assert!(c.converged, "{:?}", c.convergence);
+    for (e, k) in c.parameters.iter().zip(known) {
+        let error = (e.value - k).abs();
+        assert!(
+            e.ci95_low <= k && k <= e.ci95_high,
+            "{}: {k} outside [{}, {}] (value {}, se {:e}, solver step {:e})",
+            e.path,
+            e.ci95_low,
+            e.ci95_high,
+            e.value,
+            e.standard_error,
+            e.solver_step
+        );
+        // The step is the remaining error (to 10 % of it, or round-off of the value).
+        assert!(
+            (e.solver_step - error).abs() <= 0.1 * error + 1e-12 * k,
+            "{}: solver step {:e}, error {error:e}",
+            e.path,
+            e.solver_step
+        );
+        assert!(e.relative_half_width < 1e-6, "{}", e.relative_half_width);
+    }
+}
