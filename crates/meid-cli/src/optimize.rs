@@ -132,10 +132,15 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
         ),
     };
     println!(
-        "meid optimize — minimise {} ({method}; {} of at most {} simulations in {elapsed:.2} s{})",
+        "meid optimize — minimise {} ({method}; {} of at most {} simulations in {}{})",
         rep.metric,
         rep.simulations,
         rep.max_simulations,
+        if elapsed >= 0.1 {
+            format!("{elapsed:.2} s")
+        } else {
+            format!("{:.2} ms", 1e3 * elapsed)
+        },
         if rep.converged {
             ""
         } else {
