@@ -9,7 +9,8 @@ use std::path::Path;
 use meid::analysis::energy::simulate;
 use meid::io::uff;
 use meid::measure::calibrate::{
-    calibrate, calibrated_model_text, parameters, Calibration, Problem, ResidualKind, Settings,
+    calibrate, calibrated_model_text, parameters, Calibration, Estimate, Problem, ResidualKind,
+    Settings,
 };
 use meid::measure::process::Processing;
 use meid::measure::validate::MeasuredCase;
@@ -126,6 +127,20 @@ fn fit(start: &Model, paths: &[&str], meas: MeasuredCase, settings: Settings) ->
     calibrate(&problem).unwrap()
 }
 
+/// The known value `k` lies in `e`'s 95 % interval.
+fn assert_within(e: &Estimate, k: f64) {
+    assert!(
+        e.ci95_low <= k && k <= e.ci95_high,
+        "{}: known {k:e} outside [{:e}, {:e}] (estimate {:e}, standard error {:e}, solver step {:e})",
+        e.path,
+        e.ci95_low,
+        e.ci95_high,
+        e.value,
+        e.standard_error,
+        e.solver_step
+    );
+}
+
 #[test]
 fn calibration_recovers_known_ks_kd_and_damping_within_its_intervals() {
     let truth = model(&[]);
@@ -142,14 +157,7 @@ fn calibration_recovers_known_ks_kd_and_damping_within_its_intervals() {
     assert!(c.converged, "{:?}", c.convergence);
     for (e, k) in c.parameters.iter().zip(known) {
         assert!(!e.at_bound, "{e:?}");
-        assert!(
-            e.ci95_low <= k && k <= e.ci95_high,
-            "{}: known {k:e} outside [{:e}, {:e}] (estimate {:e})",
-            e.path,
-            e.ci95_low,
-            e.ci95_high,
-            e.value
-        );
+        assert_within(e, k);
         assert!(
             e.relative_half_width < 0.10 && e.relative_half_width > 0.0,
             "{}: ±{:.2} %",
@@ -370,16 +378,7 @@ fn noise_free_measurements_give_intervals_that_hold_the_known_values() {
     assert!(c.converged, "{:?}", c.convergence);
     for (e, k) in c.parameters.iter().zip(known) {
         let error = (e.value - k).abs();
-        assert!(
-            e.ci95_low <= k && k <= e.ci95_high,
-            "{}: {k} outside [{}, {}] (value {}, se {:e}, solver step {:e})",
-            e.path,
-            e.ci95_low,
-            e.ci95_high,
-            e.value,
-            e.standard_error,
-            e.solver_step
-        );
+        assert_within(e, k);
         // The step is the remaining error (to 10 % of it, or round-off of the value).
         assert!(
             (e.solver_step - error).abs() <= 0.1 * error + 1e-12 * k,

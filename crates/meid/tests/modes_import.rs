@@ -277,6 +277,16 @@ fn write_modes(path: &Path, modal_mass: f64, shape_scale: f64) {
 /// A UFF file of nodes 7 and 9 and one dataset 55 per `(frequency Hz, ψ_7, ψ_9)` (z only, times
 /// `shape_scale`), numbered from 1.
 fn write_uff(path: &Path, modes: &[(f64, f64, f64)], modal_mass: f64, shape_scale: f64) {
+    let modes: Vec<[f64; 4]> = modes
+        .iter()
+        .map(|(f, a, b)| [*f, 0.0, a * shape_scale, b * shape_scale])
+        .collect();
+    write_nodes_7_9(path, &modes, modal_mass, &[]);
+}
+
+/// A UFF file of nodes 7 and 9 and one dataset 55 per `[frequency Hz, damping ratio, z at 7,
+/// z at 9]`, numbered from 1, mode k after a dataset 164 `units[k]` when there is one.
+fn write_nodes_7_9(path: &Path, modes: &[[f64; 4]], modal_mass: f64, units: &[Units]) {
     let mut out = Vec::new();
     uff::write_2411(
         &mut out,
@@ -292,20 +302,20 @@ fn write_uff(path: &Path, modes: &[(f64, f64, f64)], modal_mass: f64, shape_scal
         ],
     )
     .unwrap();
-    for (k, (f, a, b)) in modes.iter().enumerate() {
+    for (k, [f, zeta, a, b]) in modes.iter().enumerate() {
+        if let Some(u) = units.get(k) {
+            uff::write_164(&mut out, u).unwrap();
+        }
         uff::write_55(
             &mut out,
             &Mode {
                 number: k as i64 + 1,
                 frequency_hz: *f,
                 modal_mass,
-                damping_ratio: 0.0,
+                damping_ratio: *zeta,
                 name: format!("mode {}", k + 1),
                 id_lines: Vec::new(),
-                shapes: vec![
-                    (7, [0.0, 0.0, a * shape_scale]),
-                    (9, [0.0, 0.0, b * shape_scale]),
-                ],
+                shapes: vec![(7, [0.0, 0.0, *a]), (9, [0.0, 0.0, *b])],
                 units: None,
             },
         )
@@ -535,46 +545,19 @@ fn keeping_one_mode_of_a_repeated_pair_is_warned_about() {
 fn write_mm_t_s(path: &Path, src: &Model, units: &[Units]) {
     let s = &src.structure;
     let to_file = 2.0 * 1e3 / 1e-3f64.sqrt();
-    let mut out = Vec::new();
-    uff::write_2411(
-        &mut out,
-        &[
-            Node {
-                label: 7,
-                xyz: [0.0; 3],
-            },
-            Node {
-                label: 9,
-                xyz: [1000.0, 0.0, 0.0],
-            },
-        ],
-    )
-    .unwrap();
     let n = s.len();
-    for i in 0..n {
-        // A new dataset 164 before each mode, when `units` has one per mode.
-        if let Some(u) = units.get(i) {
-            uff::write_164(&mut out, u).unwrap();
-        }
-        uff::write_55(
-            &mut out,
-            &Mode {
-                number: i as i64 + 1,
-                frequency_hz: s.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI),
-                modal_mass: 4.0,
-                damping_ratio: s.damping[i * n + i] / (2.0 * s.omega_rad_per_s[i]),
-                name: format!("mode {}", i + 1),
-                id_lines: Vec::new(),
-                shapes: vec![
-                    (7, [0.0, 0.0, s.point("bed").unwrap()[i] * to_file]),
-                    (9, [0.0, 0.0, s.point("base").unwrap()[i] * to_file]),
-                ],
-                units: None,
-            },
-        )
-        .unwrap();
-    }
-    std::fs::write(path, out).unwrap();
+    let modes: Vec<[f64; 4]> = (0..n)
+        .map(|i| {
+            let w = s.omega_rad_per_s[i];
+            [
+                w / (2.0 * std::f64::consts::PI),
+                s.damping[i * n + i] / (2.0 * w),
+                s.point("bed").unwrap()[i] * to_file,
+                s.point("base").unwrap()[i] * to_file,
+            ]
+        })
+        .collect();
+    write_nodes_7_9(path, &modes, 4.0, units);
 }
 
 fn mm_t_s() -> Units {
