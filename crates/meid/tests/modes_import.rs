@@ -667,10 +667,18 @@ fn modes_in_undeclared_mm_t_s_are_warned_about() {
     let dir = tmp("undeclared");
     write_mm_t_s(&dir.join("mm.uff"), &src, &[]);
     let body = "file = \"mm.uff\"\npoints = { bed = 7, base = 9 }\nimpact_direction = [0, 0, 1]";
+    let suspicion = |m: &Model| -> Vec<String> {
+        m.diagnostics()
+            .warnings
+            .into_iter()
+            .filter(|w| w.contains("units = \"mm-t-s\""))
+            .collect()
+    };
     let m = imported(&dir, body).unwrap();
-    let w = m.structure.warnings.join("\n");
-    // 1/Σψ² at the bed: 1/(ψ₁² + ψ₂²) in SI, 1e-9 of it (×2² from the file's modal mass 4
-    // divided back out) when read as SI.
+    let w = suspicion(&m);
+    assert_eq!(w.len(), 1, "{w:?}");
+    // 1/Σψ² at the bed read as SI: 1e-9 of the SI model's (the file's modal mass 4 divided
+    // back out), quoted to 5 digits.
     let s2: f64 = src
         .structure
         .point("bed")
@@ -678,19 +686,34 @@ fn modes_in_undeclared_mm_t_s_are_warned_about() {
         .iter()
         .map(|v| v * v)
         .sum();
-    let wrong = 1e-9 / s2;
+    let quoted: f64 = w[0]
+        .split("1/Σψ² = ")
+        .nth(1)
+        .and_then(|t| t.split(" kg").next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("no effective mass in: {}", w[0]));
     assert!(
-        w.contains("'bed'")
-            && w.contains(&format!("{:.3e}", wrong)[..4])
-            && w.contains("units = \"mm-t-s\""),
-        "{w} (effective mass read as SI: {wrong:e} kg)"
+        rel(quoted, 1e-9 / s2) < 1e-4,
+        "{quoted:e} vs {:e}",
+        1e-9 / s2
     );
+    assert!(
+        w[0].contains("'bed'") && w[0].contains("1.2 kg slider"),
+        "{}",
+        w[0]
+    );
+    // The check reads the slider of the model at hand: a 1e-3 kg slider is no longer 1e6
+    // times heavier than the (wrong) bed.
+    let light = Model::from_text(
+        &dir.join("model.toml").display().to_string(),
+        format!("[structure.modes]\n{body}\n{LUMPED_TAIL}").replace("mass = 1.2", "mass = 1e-3"),
+        &[],
+    )
+    .unwrap();
+    assert!(suspicion(&light).is_empty(), "{:?}", suspicion(&light));
+    // Units stated by the model: converted, no warning.
     let ok = imported(&dir, &format!("{body}\nunits = \"mm-t-s\"")).unwrap();
-    assert!(
-        ok.structure.warnings.iter().all(|w| !w.contains("mm-t-s")),
-        "{:?}",
-        ok.structure.warnings
-    );
+    assert!(suspicion(&ok).is_empty());
     for (a, b) in ok
         .structure
         .point("bed")
@@ -700,16 +723,44 @@ fn modes_in_undeclared_mm_t_s_are_warned_about() {
     {
         assert!(rel(*a, *b) < 5e-6);
     }
-    std::fs::write(
-        dir.join("si.uff"),
-        uff::modes_uff_points(&src.structure).unwrap(),
-    )
-    .unwrap();
-    let si = imported(
-        &dir,
-        "file = \"si.uff\"\npoints = { bed = 2, base = 1 }\nimpact_direction = [0, 0, 1]",
-    )
-    .unwrap();
-    assert!(si.structure.warnings.iter().all(|w| !w.contains("mm-t-s")));
+    // The same modes in SI without a dataset 164: unstated, but plausible.
+    let n = src.structure.len();
+    let si: Vec<[f64; 4]> = (0..n)
+        .map(|i| {
+            let s = &src.structure;
+            [
+                s.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI),
+                0.01,
+                s.point("bed").unwrap()[i],
+                s.point("base").unwrap()[i],
+            ]
+        })
+        .collect();
+    write_nodes_7_9(&dir.join("si.uff"), &si, 1.0, &[]);
+    let m = imported(&dir, &body.replace("mm.uff", "si.uff")).unwrap();
+    assert!(m.structure.unstated_units.is_some());
+    assert!(suspicion(&m).is_empty(), "{:?}", suspicion(&m));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Modes after a dataset 164 meid cannot read have unknown units: the import is refused,
+/// naming the dataset, rather than read as SI.
+#[test]
+fn modes_after_an_unreadable_unit_dataset_are_refused() {
+    let dir = tmp("bad164");
+    let mut text = String::from(
+        "    -1\n   164\n         9            mm t s N         1\n   1.0D+03\n    -1\n",
+    );
+    write_modes(&dir.join("m.uff"), 1.0, 1.0);
+    text.push_str(&std::fs::read_to_string(dir.join("m.uff")).unwrap());
+    std::fs::write(dir.join("bad.uff"), text).unwrap();
+    let e = imported(&dir, &format!("file = \"bad.uff\"\n{POINTS}"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("model.toml:2")
+            && e.contains("follows the dataset 164 at line 1, which meid could not read"),
+        "{e}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

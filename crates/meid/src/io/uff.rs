@@ -1,5 +1,6 @@
 //! Universal File Format (UFF/UNV) datasets: 58 (function at nodal DOF) in ASCII and binary
-//! (58b), 2411 (nodes, double precision) and 55 (data at nodes: normal modes), read and written.
+//! (58b), 2411 (nodes, double precision), 55 (data at nodes: normal modes) and 164 (units),
+//! read and written.
 //!
 //! # Layout read and written (I-DEAS/SDRC Universal File definitions)
 //!
@@ -100,6 +101,11 @@ impl Units {
     /// The mass factor: the file's mass unit per kg (`force / length`).
     pub fn mass(&self) -> f64 {
         self.force / self.length
+    }
+
+    /// Both factors finite (an unreadable dataset 164 leaves them NaN).
+    pub fn known(&self) -> bool {
+        self.length.is_finite() && self.force.is_finite()
     }
 
     /// The same length and force factors to 1e-9 relative (the codes and texts aside).
@@ -331,7 +337,22 @@ impl<R: BufRead> Parser<'_, R> {
                         line: start,
                     };
                     let lines = self.skip_to_end(ds)?;
-                    units = Some(self.dataset_164(ds, &lines)?);
+                    units = Some(match self.dataset_164(ds, &lines) {
+                        Ok(u) => u,
+                        // Unreadable: the datasets after it have unknown units (NaN
+                        // factors), which only what needs them refuses.
+                        Err(e) => {
+                            out.skipped.push(format!(
+                                "{e}; the units of the datasets after it are unknown"
+                            ));
+                            Units {
+                                code: 0,
+                                description: format!("dataset 164 at line {start}"),
+                                length: f64::NAN,
+                                force: f64::NAN,
+                            }
+                        }
+                    });
                 }
                 (n, false) => {
                     let ds = Ds {
@@ -1351,7 +1372,6 @@ fn capitalise(s: &str) -> String {
     }
 }
 
-/// Writes dataset 2411 (nodes, double precision: 4I10 then 1P3D25.16, here `%25.16e`).
 /// Writes dataset 164 (the unit system of the datasets after it, [`Units`]): records 1-3 as
 /// pyuff writes them (`%10i%20s%10i`, then the factors `%25.16e` with a `D` exponent; the
 /// temperature factor 1, mode 1 (absolute), offset 273.15).
@@ -1360,7 +1380,14 @@ pub fn write_164<W: Write>(w: &mut W, units: &Units) -> std::io::Result<()> {
     let description: String = units
         .description
         .chars()
-        .filter(|c| !c.is_control())
+        // Byte columns: ASCII only.
+        .map(|c| {
+            if c.is_ascii() && !c.is_control() {
+                c
+            } else {
+                '?'
+            }
+        })
         .take(20)
         .collect();
     writeln!(w, "{:>10}{description:>20}{:>10}", units.code, 1)?;
@@ -1379,6 +1406,7 @@ pub fn write_164<W: Write>(w: &mut W, units: &Units) -> std::io::Result<()> {
     writeln!(w, "{:>6}", -1)
 }
 
+/// Writes dataset 2411 (nodes, double precision: 4I10 then 1P3D25.16, here `%25.16e`).
 pub fn write_2411<W: Write>(w: &mut W, nodes: &[Node]) -> std::io::Result<()> {
     writeln!(w, "{:>6}\n{:>6}{:74}", -1, 2411, "")?;
     for n in nodes {
@@ -1912,35 +1940,39 @@ mod tests {
     }
 
     #[test]
-    fn a_unit_dataset_without_usable_factors_is_refused() {
-        for (record2, what) in [
+    fn an_unreadable_unit_dataset_is_passed_over_and_leaves_units_unknown() {
+        let mode = Mode {
+            number: 1,
+            frequency_hz: 10.0,
+            modal_mass: 1.0,
+            damping_ratio: 0.0,
+            name: "m".into(),
+            id_lines: Vec::new(),
+            shapes: vec![(1, [0.0, 0.0, 0.5])],
+            units: None,
+        };
+        let mut after = Vec::new();
+        write_55(&mut after, &mode).unwrap();
+        let after = String::from_utf8(after).unwrap();
+        for (records, what) in [
             (
-                "   0.0000000000000000D+00   1.0000000000000000D+00   1.0000000000000000D+00",
-                "record 2",
+                "         5    mm (milli newton)         1\n   0.0000000000000000D+00   1.0000000000000000D+00   1.0000000000000000D+00\n   2.7314999999999998D+02\n",
+                ["record 2", "line 4", "unit factors"],
             ),
-            ("   1.0D+03", "record 2"),
+            (
+                "         5    mm (milli newton)         1\n   1.0D+03\n",
+                ["record 2", "line 4", "unit factors"],
+            ),
+            ("       SI\n", ["record 1", "line 3", "unit code"]),
         ] {
-            let text = format!(
-                "    -1\n   164\n         5    mm (milli newton)         1\n{record2}\n   2.7314999999999998D+02\n    -1\n"
-            );
-            let e = parse_uff(text.as_bytes(), "u.unv", None)
-                .unwrap_err()
-                .to_string();
-            assert!(
-                e.contains(what) && e.contains("line 4") && e.contains("unit factors"),
-                "{e}"
-            );
+            let text = format!("    -1\n   164\n{records}    -1\n{after}");
+            let f = parse_uff(text.as_bytes(), "u.unv", None).unwrap();
+            let skipped = f.skipped.join("\n");
+            for w in what {
+                assert!(skipped.contains(w) && skipped.contains("unknown"), "{skipped}");
+            }
+            let u = f.modes[0].units.as_ref().unwrap();
+            assert!(!u.known(), "{u:?}");
         }
-        let e = parse_uff(
-            "    -1\n   164\n       SI\n    -1\n".as_bytes(),
-            "u.unv",
-            None,
-        )
-        .unwrap_err()
-        .to_string();
-        assert!(
-            e.contains("record 1") && e.contains("line 3") && e.contains("unit code"),
-            "{e}"
-        );
     }
 }

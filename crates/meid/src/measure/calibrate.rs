@@ -1123,7 +1123,8 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
         }
     }
     // Cov = s² C + C B C over the free values (C = (J_pᵀ J_p)⁻¹).
-    let cov: Option<Vec<Vec<f64>>> = spd_inverse(&a).map(|c| {
+    let c_inv = spd_inverse(&a);
+    let cov: Option<Vec<Vec<f64>>> = c_inv.as_ref().map(|c| {
         let k = free.len();
         let cb: Vec<Vec<f64>> = (0..k)
             .map(|a| {
@@ -1145,7 +1146,7 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
     // solver stops on a relative step or cost decrease (xtol, ftol), which on data with little
     // noise is far wider than the statistical interval.
     let mut solver_step = vec![f64::NAN; n];
-    if let Some(c) = spd_inverse(&a) {
+    if let Some(c) = &c_inv {
         let g: Vec<f64> = free.iter().map(|&i| dot(&jp[i], &r1)).collect();
         for (k, &i) in free.iter().enumerate() {
             solver_step[i] = c[k].iter().zip(&g).map(|(c, g)| c * g).sum::<f64>().abs();

@@ -170,6 +170,8 @@ pub fn propagator_findings(
         let Some(hi) = affected.iter().map(|(_, l)| *l).reduce(f64::max) else {
             continue;
         };
+        // Every affected mode is resolved once the contact's λ is within 1/tol of the lowest.
+        let lo = affected.iter().map(|(_, l)| *l).fold(hi, f64::min);
         let names: Vec<&str> = affected.iter().map(|(n, _)| n.as_str()).collect();
         out.warnings.push((
             c.field.clone(),
@@ -193,8 +195,8 @@ pub fn propagator_findings(
                 },
                 hz(hi),
                 1.0 / hi.sqrt(),
-                hz(hi) / PROPAGATOR_NULL_TOL.sqrt(),
-                hz(hi)
+                hz(lo) / PROPAGATOR_NULL_TOL.sqrt(),
+                hz(lo)
             ),
         ));
     }

@@ -73,6 +73,11 @@ pub struct ModalModel {
     /// every node of the bed contact point is on them (`Mesh::mass_of`, computed from the
     /// mesh the modes came from); `None` otherwise.
     pub bed_mass_kg: Option<f64>,
+    /// The file of imported modes (`[structure.modes]`) when neither it (UFF dataset 164) nor
+    /// the model (`structure.modes.units`) states their units: read as SI, and checked
+    /// against the slider by [`crate::model::Model::diagnostics`]. `None` for every other
+    /// structure (SI by construction) and for stated units.
+    pub unstated_units: Option<String>,
 }
 
 impl ModalModel {
@@ -100,6 +105,7 @@ impl ModalModel {
             notes: Vec::new(),
             warnings: Vec::new(),
             bed_mass_kg: None,
+            unstated_units: None,
         })
     }
 
@@ -194,6 +200,7 @@ impl ModalModel {
             warnings: self.warnings.clone(),
             // The bare structure's bed, as the mass ratio md/mb means it.
             bed_mass_kg: self.bed_mass_kg,
+            unstated_units: self.unstated_units.clone(),
         })
     }
 

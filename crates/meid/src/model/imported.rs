@@ -146,23 +146,29 @@ fn format_of(spec: &ModesFileSpec, path: &Path, src: &Source) -> Result<&'static
 /// 1.2 kg slider, ratio 0.12, reads as 1.2e8).
 pub const UNIT_SUSPICION_RATIO: f64 = 1e6;
 
-/// The slider meid's import checks the units against: its mass (kg) and the point it strikes.
-#[derive(Debug, Clone, Copy)]
-pub struct Struck<'a> {
-    pub slider_mass_kg: f64,
-    pub point: &'a str,
+/// The warning for imported modes whose units nothing states (`structure.unstated_units`)
+/// when they make the struck point's effective mass `1/Σ_k ψ_k(P)²` more than
+/// [`UNIT_SUSPICION_RATIO`] times lighter than the slider (`slider_mass_kg`, striking `point`).
+pub fn unit_suspicion(structure: &ModalModel, slider_mass_kg: f64, point: &str) -> Option<String> {
+    let file = structure.unstated_units.as_ref()?;
+    let s2: f64 = structure
+        .points
+        .get(point)
+        .map_or(0.0, |psi| psi.iter().map(|v| v * v).sum());
+    let ratio = slider_mass_kg * s2;
+    (s2 > 0.0 && ratio > UNIT_SUSPICION_RATIO).then(|| {
+        format!(
+            "structure.modes: the modes of {file} give the struck point '{point}' an effective mass 1/Σψ² = {:.4e} kg, {ratio:.3e} times lighter than the {} kg slider, and neither the file (no UFF dataset 164) nor the model (structure.modes.units) states their units: a file in mm-t-s read as SI has every effective mass 1e9 times too small. If the FE model was in mm, tonne, s, give units = \"mm-t-s\"",
+            1.0 / s2,
+            crate::num(slider_mass_kg)
+        )
+    })
 }
 
 /// Reads `[structure.modes]`'s file (relative to the model file) and builds the modal model.
-/// When neither the model (`units`) nor the file (UFF dataset 164) states the units and the
-/// modes make the struck point's effective mass `1/Σ_k ψ_k(O_b)²` more than
-/// [`UNIT_SUSPICION_RATIO`] times lighter than the slider, a warning asks whether the file is
-/// in mm-t-s.
-pub fn modal_model(
-    spec: &ModesFileSpec,
-    src: &Source,
-    struck: Option<Struck<'_>>,
-) -> Result<ModalModel> {
+/// When neither the model (`units`) nor the file (UFF dataset 164) states the units, the
+/// model's `unstated_units` names the file ([`unit_suspicion`]).
+pub fn modal_model(spec: &ModesFileSpec, src: &Source) -> Result<ModalModel> {
     let dir = Path::new(&src.name)
         .parent()
         .map(Path::to_path_buf)
@@ -203,21 +209,8 @@ pub fn modal_model(
     let file = path.display().to_string();
     let mut model = build(&modes, spec, &file, src)?;
     let declared = spec.units.is_some() || modes.iter().any(|m| m.units.is_some());
-    if let (false, Some(st)) = (declared, struck) {
-        let s2: f64 = model
-            .points
-            .get(st.point)
-            .map_or(0.0, |psi| psi.iter().map(|v| v * v).sum());
-        let ratio = st.slider_mass_kg * s2;
-        if s2 > 0.0 && ratio > UNIT_SUSPICION_RATIO {
-            model.warnings.push(format!(
-                "structure.modes: the modes of {file} give the struck point '{}' an effective mass 1/Σψ² = {:.4e} kg, {:.3e} times lighter than the {} kg slider, and neither the file (no UFF dataset 164) nor the model (structure.modes.units) states their units: a file in mm-t-s read as SI has every effective mass 1e9 times too small. If the FE model was in mm, tonne, s, give units = \"mm-t-s\"",
-                st.point,
-                1.0 / s2,
-                ratio,
-                crate::num(st.slider_mass_kg)
-            ));
-        }
+    if !declared {
+        model.unstated_units = Some(file);
     }
     Ok(model)
 }
@@ -249,6 +242,19 @@ fn unit_scale(
             ))
         }
     };
+    if let Some(m) = modes
+        .iter()
+        .find(|m| m.units.as_ref().is_some_and(|u| !u.known()))
+    {
+        return Err(src.error(
+            &format!("{BASE}.file"),
+            format!(
+                "{file}: mode {} follows the {}, which meid could not read, so its units are unknown: correct that dataset 164 (records 1-2: unit code, then length, force and temperature factors), or remove it and give {BASE}.units",
+                m.number,
+                m.units.as_ref().map_or(String::new(), |u| u.description.clone())
+            ),
+        ));
+    }
     // The file's: one unit system for all its modes (a mode before any dataset 164 is SI).
     let declared = modes.iter().find_map(|m| m.units.as_ref().map(|u| (m, u)));
     if let Some((first, fu)) = declared {

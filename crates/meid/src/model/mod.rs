@@ -616,11 +616,7 @@ fn build_structure(spec: &ModelSpec, src: &Source) -> Result<ModalModel> {
         return fem::modal_model(f, src, &ctx);
     }
     if let Some(m) = &st.modes {
-        let struck = imported::Struck {
-            slider_mass_kg: spec.slider.mass,
-            point: &spec.points.bed_contact,
-        };
-        return imported::modal_model(m, src, Some(struck));
+        return imported::modal_model(m, src);
     }
     Err(src.error(
         "structure",
@@ -643,8 +639,10 @@ pub struct Diagnostics {
 impl Model {
     /// The truncation table of the role points (O_b, O_f, B), the structure's notes, and the
     /// warnings: the structure's own, captured shares below 95 %
-    /// ([`crate::modal::truncation::SHARE_WARNING`]), and frequency spreads the closed-form
-    /// propagator resolves only approximately ([`crate::modal::conditioning`]).
+    /// ([`crate::modal::truncation::SHARE_WARNING`]), frequency spreads the closed-form
+    /// propagator resolves only approximately ([`crate::modal::conditioning`]), and imported
+    /// modes of unstated units that make the struck point implausibly light
+    /// ([`imported::unit_suspicion`]).
     pub fn diagnostics(&self) -> Diagnostics {
         let ctx = fem::ReductionContext::of(&self.spec);
         let truncation = self.structure.truncation(&ctx.role_points);
@@ -657,6 +655,13 @@ impl Model {
         for (field, message) in self.propagator_findings().warnings {
             warnings.push(format!("{}: {message}", self.source.locate(&field)));
         }
+        // Here, not with the structure: it reads the slider, which the structure cache's key
+        // leaves out.
+        warnings.extend(imported::unit_suspicion(
+            &self.structure,
+            self.spec.slider.mass,
+            &self.spec.points.bed_contact,
+        ));
         Diagnostics {
             truncation,
             notes: self.structure.notes.clone(),
