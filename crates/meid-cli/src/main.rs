@@ -180,8 +180,13 @@ pub(crate) fn error_chain(e: &anyhow::Error) -> String {
 /// [`meid::model::Model::diagnostics`]) before a run, unless `--quiet`: they hold whatever the
 /// run gives, and when it fails they often say why.
 pub(crate) fn warn_model(model: &Model, print: &args::PrintArgs) {
+    warn_diagnostics(&model.diagnostics(), print);
+}
+
+/// [`warn_model`] for diagnostics the caller keeps (`simulate` writes them out too).
+pub(crate) fn warn_diagnostics(diag: &meid::model::Diagnostics, print: &args::PrintArgs) {
     if !print.quiet {
-        for w in &model.diagnostics().warnings {
+        for w in &diag.warnings {
             ui::warning(w);
         }
     }

@@ -34,7 +34,8 @@ pub struct SimulateArgs {
 
 pub fn run(a: SimulateArgs) -> Result<()> {
     let model = a.run.load(&a.model, a.duration)?;
-    crate::warn_model(&model, &a.print);
+    let diag = model.diagnostics();
+    crate::warn_diagnostics(&diag, &a.print);
     let sys = model.impact_system(a.case.parse()?)?;
     let opts = model.options();
     // With -o, the history is streamed into the output set's history.csv (constant memory);
@@ -67,7 +68,6 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         }
     };
     let s = &s;
-    let diag = model.diagnostics();
     // The summary's fields, then `truncation`, `notes` and `warnings`.
     let mut out = serde_json::to_value(s)?;
     if let (serde_json::Value::Object(o), serde_json::Value::Object(d)) =

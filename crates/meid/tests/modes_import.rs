@@ -207,6 +207,11 @@ fn imported(dir: &Path, body: &str) -> meid::Result<Model> {
     Model::from_text(&dir.join("model.toml").display().to_string(), text, &[])
 }
 
+/// The error of [`imported`], which must refuse.
+fn refused(dir: &Path, body: &str) -> String {
+    imported(dir, body).unwrap_err().to_string()
+}
+
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / a.abs().max(b.abs())
 }
@@ -351,12 +356,10 @@ fn modal_masses_other_than_one_rescale_the_shapes() {
     let want = 0.125 * 1e-3 / 1e3f64.sqrt();
     assert!(rel(m.structure.point("bed").unwrap()[0], want) < 1e-15);
     // The file says 4, the model says 1: refused, naming the field.
-    let e = imported(
+    let e = refused(
         &dir,
         &format!("file = \"m.uff\"\n{POINTS}\nmass_normalised = true"),
-    )
-    .unwrap_err()
-    .to_string();
+    );
     assert!(
         e.contains("structure.modes.mass_normalised = true") && e.contains("4e0"),
         "{e}"
@@ -368,9 +371,7 @@ fn modal_masses_other_than_one_rescale_the_shapes() {
 fn a_missing_modal_mass_is_refused_unless_stated() {
     let dir = tmp("nomass");
     write_modes(&dir.join("m.uff"), 0.0, 1.0);
-    let e = imported(&dir, &format!("file = \"m.uff\"\n{POINTS}"))
-        .unwrap_err()
-        .to_string();
+    let e = refused(&dir, &format!("file = \"m.uff\"\n{POINTS}"));
     assert!(
         e.contains("model.toml")
             && e.contains("m.uff: mode 1 has no modal mass")
@@ -427,7 +428,7 @@ fn frd_generalised_mass_rescales_and_a_missing_one_is_refused() {
         .map(|l| format!("{l}\n"))
         .collect();
     std::fs::write(dir.join("c.frd"), no_gm).unwrap();
-    let e = imported(&dir, base).unwrap_err().to_string();
+    let e = refused(&dir, base);
     assert!(e.contains("no modal mass") && e.contains("1PGM"), "{e}");
     let c = imported(&dir, &format!("{base}\nmass_normalised = true")).unwrap();
     assert_eq!(
@@ -481,7 +482,7 @@ fn bad_mappings_are_clear_errors() {
         ),
     ];
     for (body, want) in cases {
-        let e = imported(&dir, body).unwrap_err().to_string();
+        let e = refused(&dir, body);
         for w in *want {
             assert!(e.contains(w), "{body}: {e} (wanted '{w}')");
         }
@@ -620,9 +621,7 @@ fn a_uff_unit_dataset_converts_the_modes_it_declares() {
         same.structure.point("bed").unwrap(),
         b.point("bed").unwrap()
     );
-    let e = imported(&dir, &format!("{body}\nunits = \"m-kg-s\""))
-        .unwrap_err()
-        .to_string();
+    let e = refused(&dir, &format!("{body}\nunits = \"m-kg-s\""));
     assert!(
         e.contains("structure.modes.units")
             && e.contains("contradicts")
@@ -635,21 +634,17 @@ fn a_uff_unit_dataset_converts_the_modes_it_declares() {
         uff::modes_uff_points(&src.structure).unwrap(),
     )
     .unwrap();
-    let e = imported(
+    let e = refused(
         &dir,
         "file = \"si.uff\"\npoints = { bed = 2, base = 1 }\nimpact_direction = [0, 0, 1]\nunits = \"mm-t-s\"",
-    )
-    .unwrap_err()
-    .to_string();
+    );
     assert!(
         e.contains("contradicts") && e.contains("unit code 1"),
         "{e}"
     );
     // Modes of one file under two unit systems: refused, naming both.
     write_mm_t_s(&dir.join("mixed.uff"), &src, &[mm_t_s(), Units::si()]);
-    let e = imported(&dir, &body.replace("mm.uff", "mixed.uff"))
-        .unwrap_err()
-        .to_string();
+    let e = refused(&dir, &body.replace("mm.uff", "mixed.uff"));
     assert!(
         e.contains("mode 1") && e.contains("mode 2") && e.contains("one unit system"),
         "{e}"
@@ -754,9 +749,7 @@ fn modes_after_an_unreadable_unit_dataset_are_refused() {
     write_modes(&dir.join("m.uff"), 1.0, 1.0);
     text.push_str(&std::fs::read_to_string(dir.join("m.uff")).unwrap());
     std::fs::write(dir.join("bad.uff"), text).unwrap();
-    let e = imported(&dir, &format!("file = \"bad.uff\"\n{POINTS}"))
-        .unwrap_err()
-        .to_string();
+    let e = refused(&dir, &format!("file = \"bad.uff\"\n{POINTS}"));
     assert!(
         e.contains("model.toml:2")
             && e.contains("follows the dataset 164 at line 1, which meid could not read"),

@@ -166,8 +166,6 @@ pub fn unit_suspicion(structure: &ModalModel, slider_mass_kg: f64, point: &str) 
 }
 
 /// Reads `[structure.modes]`'s file (relative to the model file) and builds the modal model.
-/// When neither the model (`units`) nor the file (UFF dataset 164) states the units, the
-/// model's `unstated_units` names the file ([`unit_suspicion`]).
 pub fn modal_model(spec: &ModesFileSpec, src: &Source) -> Result<ModalModel> {
     let dir = Path::new(&src.name)
         .parent()
@@ -206,25 +204,28 @@ pub fn modal_model(spec: &ModesFileSpec, src: &Source) -> Result<ModalModel> {
         }
         return Err(src.error("structure.modes.file", msg));
     }
-    let file = path.display().to_string();
-    let mut model = build(&modes, spec, &file, src)?;
-    let declared = spec.units.is_some() || modes.iter().any(|m| m.units.is_some());
-    if !declared {
-        model.unstated_units = Some(file);
-    }
-    Ok(model)
+    build(&modes, spec, &path.display().to_string(), src)
 }
 
-/// The factor from the file's shape units (length per √mass) to m/√kg, and the note that
-/// says where the units came from when they are not SI: `units` in the model, else the
-/// file's dataset 164, else SI. A `units` that contradicts the file's dataset 164, or modes
-/// of one file under different datasets 164, are refused.
+/// The unit system of an import: where it came from and what it does to the shapes.
+struct UnitChoice {
+    /// From the file's shape units (length per √mass) to m/√kg.
+    scale: f64,
+    /// Where the units came from, when they are not SI.
+    note: Option<String>,
+    /// `units` in the model or a dataset 164 in the file says what they are (else: read as SI).
+    stated: bool,
+}
+
+/// The units of an import: `units` in the model, else the file's dataset 164, else SI. A
+/// `units` that contradicts the file's dataset 164, or modes of one file under different
+/// datasets 164, are refused.
 fn unit_scale(
     modes: &[FileMode],
     spec: &ModesFileSpec,
     file: &str,
     src: &Source,
-) -> Result<(f64, Option<String>)> {
+) -> Result<UnitChoice> {
     const BASE: &str = "structure.modes";
     let given = match spec.units.as_deref() {
         None => None,
@@ -279,6 +280,7 @@ fn unit_scale(
         }
     }
     let from_file = declared.map(|(_, u)| u);
+    let stated = given.is_some() || from_file.is_some();
     let (units, whence) = match (given, from_file) {
         (Some(g), Some(f)) if !g.same_factors(f) => {
             return Err(src.error(
@@ -306,10 +308,16 @@ fn unit_scale(
             "{BASE}: shapes converted from the file's units to m/√kg (× {scale:e}), as {whence} says"
         )
     });
-    Ok((scale, note))
+    Ok(UnitChoice {
+        scale,
+        note,
+        stated,
+    })
 }
 
-/// The modal model of `modes` (read from `file`) as `spec` maps them (module docs).
+/// The modal model of `modes` (read from `file`) as `spec` maps them (module docs). When
+/// neither the model (`units`) nor the file (UFF dataset 164) states the units, its
+/// `unstated_units` names the file ([`unit_suspicion`]).
 pub fn build(
     modes: &[FileMode],
     spec: &ModesFileSpec,
@@ -318,7 +326,8 @@ pub fn build(
 ) -> Result<ModalModel> {
     const BASE: &str = "structure.modes";
     // Unit system (module docs): `units`, else the file's dataset 164, else SI.
-    let (scale, unit_note) = unit_scale(modes, spec, file, src)?;
+    let units = unit_scale(modes, spec, file, src)?;
+    let scale = units.scale;
     // Direction.
     let d = spec.impact_direction.unwrap_or([0.0, 0.0, -1.0]);
     let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
@@ -451,9 +460,7 @@ pub fn build(
             "{BASE}: shapes divided by √(modal mass) given in {file} (modal masses {lo:e} to {hi:e}) to make them mass-normalised"
         ));
     }
-    if let Some(note) = unit_note {
-        notes.push(note);
-    }
+    notes.extend(units.note);
     // Damping.
     let zeta = match &spec.damping_ratios {
         Some(_) => super::lumped::ratios(
@@ -493,6 +500,7 @@ pub fn build(
         .map(|m| 2.0 * std::f64::consts::PI * m.frequency_hz)
         .collect();
     let mut model = ModalModel::with_damping_ratios(omega, &zeta)?;
+    model.unstated_units = (!units.stated).then(|| file.to_string());
     // Shapes at the points.
     for (point, node) in &spec.points {
         let mut values = Vec::with_capacity(n);
