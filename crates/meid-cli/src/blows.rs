@@ -19,9 +19,18 @@ pub struct BlowsArgs {
     /// (else exit 2, naming the largest valid rate); the machine need not be at rest.
     #[arg(long, value_name = "R", default_value_t = 60.0)]
     rate_bpm: f64,
-    /// Relative blow-to-blow change that counts as steady.
+    /// Relative blow-to-blow change that counts as steady (the march's table).
     #[arg(long, value_name = "FRACTION", default_value_t = 0.01)]
     tolerance: f64,
+    /// Only the direct periodic steady state of each case (no march): the fixed point of the
+    /// blow-to-blow map, its regime and Floquet multipliers (docs/studies.md, "Production").
+    #[arg(long)]
+    steady: bool,
+    /// A stroke-rate map instead: the steady state of every case at each rate of
+    /// LO..HI:N (or LO..HI:N:log, or R1,R2,…) blows/min; with -o, rates.csv, rates.json and
+    /// a picture of the dB changes against the rate.
+    #[arg(long, value_name = "LO..HI:N", conflicts_with = "steady")]
+    rates: Option<String>,
     #[command(flatten)]
     case: CaseArg,
     /// Write blows.csv, blows.json, history.csv and pictures into DIR.
@@ -36,7 +45,24 @@ pub struct BlowsArgs {
 pub fn run(a: BlowsArgs) -> Result<()> {
     let model = a.run.load(&a.model, None)?;
     crate::warn_model(&model, &a.print);
-    let sys = model.impact_system(a.case.parse()?)?;
+    if let Some(spec) = &a.rates {
+        return crate::production::rate_map(&a.model, &model, spec, a.output.as_deref(), &a.print);
+    }
+    meid::analysis::blows::blow_interval_s(a.rate_bpm).map_err(|_| {
+        meid::Error::invalid(
+            "--rate-bpm",
+            format!(
+                "the stroke rate must be a finite number > 0 blows per minute (got {})",
+                a.rate_bpm
+            ),
+        )
+    })?;
+    let case = a.case.parse()?;
+    let prod = crate::production::cases(&model, case, a.rate_bpm, &a.print)?;
+    if a.steady {
+        return crate::production::steady_only(&prod, a.output.as_deref(), &a.print);
+    }
+    let sys = model.impact_system(case)?;
     let opts = model.options();
     let b = BlowOptions {
         blows: a.blows,
@@ -97,7 +123,11 @@ pub fn run(a: BlowsArgs) -> Result<()> {
         }
     };
     let out = serde_json::json!({
+        "rate_bpm": a.rate_bpm,
         "interval_s": r.interval_s,
+        "verdict": prod.production.verdict,
+        "steady_state": prod.selected,
+        "production": prod.production,
         "blows": r.blows,
         "steady": r.steady,
         "damper_gap_at_next_strike_m": r.damper_gap_at_next_strike_m,
@@ -191,8 +221,10 @@ pub fn run(a: BlowsArgs) -> Result<()> {
     if a.print.json {
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else if a.print.human() {
+        crate::production::print_production(&prod.production);
+        println!();
         println!(
-            "meid blows — {} blows every {:.6} s ({} /min)",
+            "The march from rest: {} blows every {:.6} s ({} /min)",
             a.blows, r.interval_s, a.rate_bpm
         );
         println!("  blow  E_p+/E_s-   peak accel (m/s²)  peak floor force (N)  machine energy at strike (J)  damper gap (mm)");

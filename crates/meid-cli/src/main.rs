@@ -39,6 +39,7 @@ mod montecarlo;
 mod optimize;
 mod outputs;
 mod paper;
+mod production;
 mod progress;
 mod report;
 mod shard;

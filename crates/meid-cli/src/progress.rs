@@ -20,3 +20,14 @@ pub fn bar(quiet: bool, total: usize, unit: &str) -> ProgressBar {
     );
     b
 }
+
+/// A spinner named `what` for a step of unknown length, hidden like [`bar`].
+pub fn spinner(quiet: bool, what: &str) -> ProgressBar {
+    if quiet || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::new_spinner();
+    b.set_message(what.to_string());
+    b.enable_steady_tick(std::time::Duration::from_millis(120));
+    b
+}

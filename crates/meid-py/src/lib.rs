@@ -990,6 +990,54 @@ fn evaluate<'py>(
     Ok(y)
 }
 
+/// The machine in production at `rate_bpm` (`meid blows --json`'s object, as JSON text): the
+/// verdict, the periodic steady state of `case` (`steady_state`) and of every case
+/// (`production`); without `steady`, also the march of `blows` blows from rest.
+#[pyfunction]
+#[pyo3(signature = (model, rate_bpm=60.0, steady=true, case="as-specified".to_string(), blows=10))]
+fn blows_json(
+    py: Python<'_>,
+    model: &Model,
+    rate_bpm: f64,
+    steady: bool,
+    case: String,
+    blows: usize,
+) -> PyResult<String> {
+    use meid::analysis::production;
+    use meid::analysis::steady::{steady_state, SteadyOptions};
+    let case: Case = case.parse().map_err(err)?;
+    py.detach(|| -> meid::Result<String> {
+        let m = &model.inner;
+        meid::analysis::blows::blow_interval_s(rate_bpm)?;
+        let so = SteadyOptions::default();
+        let p = production::production(m, rate_bpm, &so, true)?;
+        let sys = m.impact_system(case)?;
+        let selected = steady_state(&sys, &m.options(), &SteadyOptions { rate_bpm, ..so })?;
+        let mut out = serde_json::json!({
+            "rate_bpm": rate_bpm,
+            "interval_s": p.interval_s,
+            "verdict": p.verdict,
+            "steady_state": selected,
+            "production": p,
+        });
+        if !steady {
+            let b = meid::analysis::blows::BlowOptions {
+                blows,
+                rate_bpm,
+                ..Default::default()
+            };
+            let r = meid::analysis::blows::run_blows(&sys, &m.options(), &b, false)?;
+            out["blows"] = serde_json::to_value(&r.blows)
+                .map_err(|e| meid::Error::numerical("blows", e.to_string()))?;
+            out["steady"] = serde_json::to_value(&r.steady)
+                .map_err(|e| meid::Error::numerical("blows", e.to_string()))?;
+            out["damper_gap_at_next_strike_m"] = r.damper_gap_at_next_strike_m.into();
+        }
+        serde_json::to_string(&out).map_err(|e| meid::Error::numerical("blows", e.to_string()))
+    })
+    .map_err(err)
+}
+
 /// The memory limit (bytes) every run checks its estimate against before it allocates: by
 /// default half the physical memory; `set_max_memory` changes it for this process.
 #[pyfunction]
@@ -1043,6 +1091,7 @@ fn _meid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep_columns, m)?)?;
     m.add_function(wrap_pyfunction!(montecarlo_columns, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(blows_json, m)?)?;
     m.add_function(wrap_pyfunction!(metric_names, m)?)?;
     m.add_function(wrap_pyfunction!(max_memory, m)?)?;
     m.add_function(wrap_pyfunction!(set_max_memory, m)?)?;

@@ -347,44 +347,12 @@ pub fn run_blows_progress(
     }
     let mut o = *opts;
     o.duration = interval;
-    let n = sys.n_modes();
-    let nd = sys.dofs();
-    let e_s = 0.5 * sys.slider.mass * sys.slider.velocity.powi(2);
-    let damper_energy = |x: &[f64]| -> f64 {
-        match &sys.damper {
-            Some(d) => {
-                let vd = x[nd + sys.damper_index()];
-                let r = dot(sys.relative_vector(Switch::Dashpot), &x[..nd]);
-                0.5 * d.mass * vd * vd + 0.5 * d.stiffness * r * r
-            }
-            None => 0.0,
-        }
-    };
-    let damper_gap = |x: &[f64]| -> Option<f64> {
-        sys.damper
-            .as_ref()
-            // A gap is ≥ 0: with the contact closed (the bed against the damper, overlap
-            // δ = u_b − z_d > 0) it is 0; δ is the penalty contact's compression (δ = F/K_d for
-            // a linear law), not a distance between the bodies. (`max` also turns −0 into 0.)
-            .map(|_| (-dot(sys.relative_vector(Switch::BedDamper), &x[..nd])).max(0.0))
-    };
     let mut x0 = sys.initial_state();
     let mut reports = Vec::with_capacity(blow.blows);
     let mut dissipated_before = 0.0;
     let mut solutions = Vec::with_capacity(if keep_solutions { blow.blows } else { 0 });
     for k in 0..blow.blows {
         let t0 = k as f64 * interval;
-        // Energies at the strike, in the mode the contacts are in (overlap > 0 = closed).
-        let mut mode0 = Mode(0);
-        for s in [Switch::SliderBed, Switch::BedDamper] {
-            if s == Switch::BedDamper && sys.damper.is_none() {
-                continue;
-            }
-            let d = dot(sys.relative_vector(s), &x0[..nd]);
-            mode0 = mode0.with(s, d > 0.0);
-        }
-        let e0 = EnergyTerms::at(sys, mode0, &x0);
-        let ed0 = damper_energy(&x0);
         let mut rec = Recorder::new(sys).starting_at(&x0);
         let o_blow = if record {
             let phase = o.sample_rate.map_or(0.0, |fs| strike_phase(t0, fs));
@@ -398,71 +366,23 @@ pub fn run_blows_progress(
                 ..o
             }
         };
-        let sol = integrate::solve_from(sys, &x0, &o_blow, &mut rec)?;
-        // The blow's energy balance: what was stored at the strike = what is stored at its
-        // end + what it dissipated.
-        let e_end = EnergyTerms::at(sys, sol.mode_final, &sol.x_final);
-        // (With a constant slider force, plus its work W_F = F (z_s − z_s0).)
-        let balance = Balance::new(
-            sol.t_final,
-            e0.total(),
-            sys.force_work(&x0, &sol.x_final),
-            &e_end,
-            sol.totals.dissipated,
-        );
-        check_run(sys, &o_blow, &sol, &[balance])?;
-        let Some(end) = sol.collision_end.as_ref() else {
-            return Err(collision_longer_than_interval(
-                sys,
-                opts,
-                &x0,
-                k,
-                interval,
-                blow.rate_bpm,
-            ));
-        };
-        let energy_ratio = {
-            let vs = end.x[nd + sys.slider_index()];
-            let es_after = 0.5 * sys.slider.mass * vs * vs;
-            // The slider force's work during the collision counts as energy put in (as in
-            // `energy::simulate`); 0 without a force.
-            let w = sys.force_work(&x0, &end.x);
-            (e_s + w - es_after - (damper_energy(&end.x) - ed0)) / (e_s + w)
-        };
-        reports.push(BlowReport {
-            blow: k + 1,
-            start_s: t0,
-            energy_ratio: Some(energy_ratio),
-            collision_end_s: Some(t0 + end.t),
-            machine_energy_at_strike_j: e0.ke_machine + e0.pe_machine,
-            damper_energy_at_strike_j: ed0,
-            damper_gap_at_strike_m: damper_gap(&x0),
-            damper_contact_time_s: sys.damper.as_ref().map(|_| sol.totals.closed_time[1]),
-            peak_bed_acceleration_m_per_s2: sol
-                .totals
-                .peaks
-                .get(Channel::BedAcceleration)
-                .abs_peak(),
-            peak_floor_force_n: sol.totals.peaks.get(Channel::FloorForce).abs_peak(),
-            peak_contact_force_slider_bed_n: end.totals.peak_force(0),
-        });
+        let done = one_blow(sys, &o_blow, opts, &x0, k, t0, blow.rate_bpm, &mut rec)?;
         if let Some(sink) = on_history.as_mut() {
             // The recorder counts dissipation as E_s− − Σ stored; add what was stored at the
             // strike besides the fresh slider, and what earlier blows dissipated.
-            let offset = e0.total() - e_s + dissipated_before;
+            let offset = done.stored_at_strike_j - done.blow_energy_j + dissipated_before;
             let mut h = History::default();
             append(&mut h, std::mem::take(&mut rec.history), t0, k > 0, offset);
             sink(&h)?;
         }
+        let sol = done.solution;
+        reports.push(done.report);
         dissipated_before += sol.totals.dissipated;
         // The next strike: same structure and damper state, a fresh slider touching the bed.
-        x0 = sol.x_final.clone();
+        x0 = next_strike(sys, &sol.x_final);
         if keep_solutions {
             solutions.push(sol);
         }
-        let phi_b = &sys.points.bed_contact;
-        x0[sys.slider_index()] = dot(phi_b, &x0[..n]);
-        x0[nd + sys.slider_index()] = sys.slider.velocity;
         progress(k + 1, blow.blows);
     }
     let steady = steady_state(&reports, blow.steady_tolerance);
@@ -470,9 +390,138 @@ pub fn run_blows_progress(
         interval_s: interval,
         blows: reports,
         steady,
-        damper_gap_at_next_strike_m: damper_gap(&x0),
+        damper_gap_at_next_strike_m: damper_gap(sys, &x0),
         history: None,
         solutions,
+    })
+}
+
+/// One blow simulated ([`one_blow`]): its report, its run, and the energies that place its
+/// history in a train.
+pub(crate) struct BlowDone {
+    pub report: BlowReport,
+    pub solution: Solution,
+    /// Everything stored at the strike, the fresh slider included (J).
+    pub stored_at_strike_j: f64,
+    /// The fresh slider's kinetic energy `E_s− = ½ m_s v_s²` (J).
+    pub blow_energy_j: f64,
+}
+
+/// The damper's energy `E_d = ½ m_d ż_d² + ½ k_d (z_d − u_f)²` (J) at state `x`; 0 without a
+/// damper.
+pub(crate) fn damper_energy(sys: &ImpactSystem, x: &[f64]) -> f64 {
+    let nd = sys.dofs();
+    match &sys.damper {
+        Some(d) => {
+            let vd = x[nd + sys.damper_index()];
+            let r = dot(sys.relative_vector(Switch::Dashpot), &x[..nd]);
+            0.5 * d.mass * vd * vd + 0.5 * d.stiffness * r * r
+        }
+        None => 0.0,
+    }
+}
+
+/// The gap `max(z_d − u_b(O_b), 0)` between damper and bed at state `x` (m); `None` without a
+/// damper. A gap is ≥ 0: with the contact closed (the bed against the damper, overlap
+/// δ = u_b − z_d > 0) it is 0; δ is the penalty contact's compression (δ = F/K_d for a linear
+/// law), not a distance between the bodies. (`max` also turns −0 into 0.)
+pub(crate) fn damper_gap(sys: &ImpactSystem, x: &[f64]) -> Option<f64> {
+    let nd = sys.dofs();
+    sys.damper
+        .as_ref()
+        .map(|_| (-dot(sys.relative_vector(Switch::BedDamper), &x[..nd])).max(0.0))
+}
+
+/// The state at the next strike from the state `x` at the end of a blow: structure and damper
+/// unchanged, the rebounded slider replaced by a fresh one just touching the bed,
+/// `z_s = u_b(O_b) = ψ(O_b)ᵀq` (overlap 0), `ż_s = v_s`.
+pub(crate) fn next_strike(sys: &ImpactSystem, x: &[f64]) -> Vec<f64> {
+    let n = sys.n_modes();
+    let nd = sys.dofs();
+    let mut x0 = x.to_vec();
+    x0[sys.slider_index()] = dot(&sys.points.bed_contact, &x0[..n]);
+    x0[nd + sys.slider_index()] = sys.slider.velocity;
+    x0
+}
+
+/// Blow `k` (0-based, struck at `t0` in the train) from the strike state `x0`, with the run
+/// options `o_blow` (duration = the blow interval) and `observer` on its output grid: the
+/// blow's energy balance is checked, a collision not over at the next strike refused
+/// ([`collision_longer_than_interval`], with the user's `opts`), and η_k and the peaks
+/// reported (module docs).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn one_blow(
+    sys: &ImpactSystem,
+    o_blow: &Options,
+    opts: &Options,
+    x0: &[f64],
+    k: usize,
+    t0: f64,
+    rate_bpm: f64,
+    observer: &mut dyn integrate::Observer,
+) -> Result<BlowDone> {
+    let nd = sys.dofs();
+    let e_s = 0.5 * sys.slider.mass * sys.slider.velocity.powi(2);
+    // Energies at the strike, in the mode the contacts are in (overlap > 0 = closed).
+    let mut mode0 = Mode(0);
+    for s in [Switch::SliderBed, Switch::BedDamper] {
+        if s == Switch::BedDamper && sys.damper.is_none() {
+            continue;
+        }
+        let d = dot(sys.relative_vector(s), &x0[..nd]);
+        mode0 = mode0.with(s, d > 0.0);
+    }
+    let e0 = EnergyTerms::at(sys, mode0, x0);
+    let ed0 = damper_energy(sys, x0);
+    let sol = integrate::solve_from(sys, x0, o_blow, observer)?;
+    // The blow's energy balance: what was stored at the strike = what is stored at its
+    // end + what it dissipated.
+    let e_end = EnergyTerms::at(sys, sol.mode_final, &sol.x_final);
+    // (With a constant slider force, plus its work W_F = F (z_s − z_s0).)
+    let balance = Balance::new(
+        sol.t_final,
+        e0.total(),
+        sys.force_work(x0, &sol.x_final),
+        &e_end,
+        sol.totals.dissipated,
+    );
+    check_run(sys, o_blow, &sol, &[balance])?;
+    let Some(end) = sol.collision_end.as_ref() else {
+        return Err(collision_longer_than_interval(
+            sys,
+            opts,
+            x0,
+            k,
+            o_blow.duration,
+            rate_bpm,
+        ));
+    };
+    let energy_ratio = {
+        let vs = end.x[nd + sys.slider_index()];
+        let es_after = 0.5 * sys.slider.mass * vs * vs;
+        // The slider force's work during the collision counts as energy put in (as in
+        // `energy::simulate`); 0 without a force.
+        let w = sys.force_work(x0, &end.x);
+        (e_s + w - es_after - (damper_energy(sys, &end.x) - ed0)) / (e_s + w)
+    };
+    let report = BlowReport {
+        blow: k + 1,
+        start_s: t0,
+        energy_ratio: Some(energy_ratio),
+        collision_end_s: Some(t0 + end.t),
+        machine_energy_at_strike_j: e0.ke_machine + e0.pe_machine,
+        damper_energy_at_strike_j: ed0,
+        damper_gap_at_strike_m: damper_gap(sys, x0),
+        damper_contact_time_s: sys.damper.as_ref().map(|_| sol.totals.closed_time[1]),
+        peak_bed_acceleration_m_per_s2: sol.totals.peaks.get(Channel::BedAcceleration).abs_peak(),
+        peak_floor_force_n: sol.totals.peaks.get(Channel::FloorForce).abs_peak(),
+        peak_contact_force_slider_bed_n: end.totals.peak_force(0),
+    };
+    Ok(BlowDone {
+        report,
+        solution: sol,
+        stored_at_strike_j: e0.total(),
+        blow_energy_j: e_s,
     })
 }
 

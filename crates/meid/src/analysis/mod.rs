@@ -7,8 +7,10 @@ pub mod esd;
 pub mod montecarlo;
 pub mod octave;
 pub mod optimize;
+pub mod production;
 pub mod quadrature;
 pub mod spectrum;
+pub mod steady;
 pub mod study;
 pub mod sweep;
 

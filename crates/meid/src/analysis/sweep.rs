@@ -272,18 +272,99 @@ pub struct Vary {
     pub values: Vec<f64>,
 }
 
-fn parse_number(s: &str, spec: &str) -> Result<f64> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| Error::invalid("vary", format!("`{spec}`: `{}` is not a number", s.trim())))?;
+fn parse_number(s: &str, spec: &str, field: &str) -> Result<f64> {
+    let v: f64 = s.trim().parse().map_err(|_| {
+        Error::invalid(
+            field,
+            format!(
+                "`{spec}`: `{}` is not a number (a range is A..B:N or A..B:N:log, a list v1,v2,…)",
+                s.trim()
+            ),
+        )
+    })?;
     if !v.is_finite() {
         return Err(Error::invalid(
-            "vary",
+            field,
             format!("`{spec}`: values must be finite, got `{}`", s.trim()),
         ));
     }
     Ok(v)
+}
+
+/// The values of a range or list `rhs` (`A..B:N`, `A..B:N:log` or `v1,v2,…`; module docs);
+/// `spec` is quoted in errors, which are reported at `field`.
+pub fn parse_values(rhs: &str, spec: &str, field: &str) -> Result<(Spacing, Vec<f64>)> {
+    let (spacing, values) = if let Some((a, rest)) = rhs.split_once("..") {
+        let parts: Vec<&str> = rest.split(':').collect();
+        let (b, n, log) = match parts.as_slice() {
+            [b, n] => (*b, *n, false),
+            [b, n, s] if s.trim() == "log" => (*b, *n, true),
+            [_, _, s] => {
+                return Err(Error::invalid(
+                    field,
+                    format!("`{spec}`: unknown spacing `{}` (only `log`)", s.trim()),
+                ))
+            }
+            _ => {
+                return Err(Error::invalid(
+                    field,
+                    format!("`{spec}`: a range needs a count: A..B:N or A..B:N:log"),
+                ))
+            }
+        };
+        let a = parse_number(a, spec, field)?;
+        let b = parse_number(b, spec, field)?;
+        let n: usize = n.trim().parse().map_err(|_| {
+            Error::invalid(
+                field,
+                format!("`{spec}`: the count `{}` is not a whole number", n.trim()),
+            )
+        })?;
+        if n < 2 {
+            return Err(Error::invalid(
+                field,
+                format!("`{spec}`: a range needs N >= 2 points (got {n}); give a single value as NAME=VALUE"),
+            ));
+        }
+        if a >= b {
+            return Err(Error::invalid(
+                field,
+                format!("`{spec}`: a range needs A < B (got {a}..{b})"),
+            ));
+        }
+        if log && a <= 0.0 {
+            return Err(Error::invalid(
+                field,
+                format!("`{spec}`: a log range needs A > 0 (got {a})"),
+            ));
+        }
+        crate::limits::check_memory(
+            &format!("`{spec}`: {n} values (8 B each)"),
+            8.0 * n as f64,
+            field,
+            "the count N of the range",
+        )?;
+        let values: Vec<f64> = (0..n)
+            .map(|i| {
+                let t = i as f64 / (n - 1) as f64;
+                if i == n - 1 {
+                    b
+                } else if log {
+                    (a.ln() + t * (b.ln() - a.ln())).exp()
+                } else {
+                    a + t * (b - a)
+                }
+            })
+            .collect();
+        (if log { Spacing::Log } else { Spacing::Linear }, values)
+    } else {
+        let values = rhs
+            .split(',')
+            .map(|s| parse_number(s, spec, field))
+            .collect::<Result<Vec<f64>>>()?;
+        (Spacing::List, values)
+    };
+    Ok((spacing, values))
 }
 
 impl Vary {
@@ -302,76 +383,7 @@ impl Vary {
                 format!("`{spec}`: no values; {usage}"),
             ));
         }
-        let (spacing, values) = if let Some((a, rest)) = rhs.split_once("..") {
-            let parts: Vec<&str> = rest.split(':').collect();
-            let (b, n, log) = match parts.as_slice() {
-                [b, n] => (*b, *n, false),
-                [b, n, s] if s.trim() == "log" => (*b, *n, true),
-                [_, _, s] => {
-                    return Err(Error::invalid(
-                        "vary",
-                        format!("`{spec}`: unknown spacing `{}` (only `log`)", s.trim()),
-                    ))
-                }
-                _ => {
-                    return Err(Error::invalid(
-                        "vary",
-                        format!("`{spec}`: a range needs a count: A..B:N or A..B:N:log"),
-                    ))
-                }
-            };
-            let a = parse_number(a, spec)?;
-            let b = parse_number(b, spec)?;
-            let n: usize = n.trim().parse().map_err(|_| {
-                Error::invalid(
-                    "vary",
-                    format!("`{spec}`: the count `{}` is not a whole number", n.trim()),
-                )
-            })?;
-            if n < 2 {
-                return Err(Error::invalid(
-                    "vary",
-                    format!("`{spec}`: a range needs N >= 2 points (got {n}); give a single value as NAME=VALUE"),
-                ));
-            }
-            if a >= b {
-                return Err(Error::invalid(
-                    "vary",
-                    format!("`{spec}`: a range needs A < B (got {a}..{b})"),
-                ));
-            }
-            if log && a <= 0.0 {
-                return Err(Error::invalid(
-                    "vary",
-                    format!("`{spec}`: a log range needs A > 0 (got {a})"),
-                ));
-            }
-            crate::limits::check_memory(
-                &format!("`{spec}`: {n} values (8 B each)"),
-                8.0 * n as f64,
-                "vary",
-                "the count N of the range",
-            )?;
-            let values: Vec<f64> = (0..n)
-                .map(|i| {
-                    let t = i as f64 / (n - 1) as f64;
-                    if i == n - 1 {
-                        b
-                    } else if log {
-                        (a.ln() + t * (b.ln() - a.ln())).exp()
-                    } else {
-                        a + t * (b - a)
-                    }
-                })
-                .collect();
-            (if log { Spacing::Log } else { Spacing::Linear }, values)
-        } else {
-            let values = rhs
-                .split(',')
-                .map(|s| parse_number(s, spec))
-                .collect::<Result<Vec<f64>>>()?;
-            (Spacing::List, values)
-        };
+        let (spacing, values) = parse_values(rhs, spec, "vary")?;
         if !matches!(quantity, Quantity::Field(_)) && values.iter().any(|&v| v <= 0.0) {
             return Err(Error::invalid(
                 "vary",
