@@ -308,7 +308,7 @@ fn rates_picture(stem: &Path, rows: &[RateRow], best: Option<f64>) -> Result<()>
     if let Some(b) = best {
         markers.push(Marker {
             x: b,
-            label: format!("damper returns up to {} /min", meid::num(b)),
+            label: format!("damper returns up to {:.4} /min", b),
         });
     }
     for i in 1..d.len() {
