@@ -109,6 +109,7 @@ pub(crate) enum Command {
 }
 
 fn main() -> ExitCode {
+    outputs::on_signal_clean_up();
     // `--color` is read before clap so that clap's own messages follow it.
     let color = ui::ColorChoice::from_args(std::env::args_os());
     ui::init_color(color);

@@ -5,10 +5,12 @@
 //! Shard K of N (1 ≤ K ≤ N) of a study of T points or samples computes the indices
 //! `⌊(K−1)T/N⌋ .. ⌊KT/N⌋` — from the specification alone, with no coordination. Its `-o DIR`
 //! holds `shard.json` (the command's arguments, its working directory, K, N, the index range
-//! and the study's fingerprint) and `shard.csv` (the rows in exact round-trip form). `meid merge
+//! and the study's fingerprint) and `shard.csv` (the rows in exact round-trip form, each
+//! followed by its checksum, `meid::input::seal_row`; the header gains `row_fnv1a`). `meid merge
 //! DIR... -o OUT` reads the arguments back, rebuilds the study the same way, checks that every
-//! shard belongs to it (same fingerprint) and that the shards cover every index exactly once,
-//! and writes OUT as the unsharded command would.
+//! shard belongs to it (same fingerprint), that every row matches its checksum and that the
+//! shards cover every index exactly once, and writes OUT as the unsharded command would. A
+//! row edited or cut short is refused, naming the file and line.
 
 use std::path::{Path, PathBuf};
 
@@ -80,7 +82,7 @@ pub fn write(
     let set = crate::outputs::begin(dir)?;
     let cwd = std::env::current_dir().context("cannot read the working directory")?;
     let desc = json!({
-        "meid_shard": 1,
+        "meid_shard": 2,
         "command": command,
         "args": study_args(),
         "cwd": cwd,
@@ -92,7 +94,17 @@ pub fn write(
         "fingerprint": fingerprint,
     });
     meid::io::write_json(&set.staging().join("shard.json"), &desc)?;
-    meid::io::write_atomic(&set.staging().join("shard.csv"), rows)?;
+    let mut sealed = String::with_capacity(rows.len() + rows.len() / 4);
+    for (i, line) in String::from_utf8_lossy(rows).lines().enumerate() {
+        if i == 0 {
+            sealed.push_str(line);
+            sealed.push_str(",row_fnv1a");
+        } else {
+            sealed.push_str(&meid::input::seal_row(line));
+        }
+        sealed.push('\n');
+    }
+    meid::io::write_atomic(&set.staging().join("shard.csv"), sealed.as_bytes())?;
     Ok(set.commit(&format!("{command} --shard"))?)
 }
 
@@ -106,18 +118,20 @@ pub struct ShardFiles {
     pub end: usize,
     pub total: usize,
     pub fingerprint: String,
+    /// `shard.csv` without the row checksums (each verified), lines as in the file.
     pub rows: Vec<u8>,
 }
 
 /// Reads `DIR/shard.json` and `DIR/shard.csv`.
 pub fn read(dir: &Path) -> Result<ShardFiles> {
     let jp = dir.join("shard.json");
-    let text = std::fs::read_to_string(&jp).with_context(|| {
-        format!(
-            "{}: not a shard (no readable shard.json; write shards with --shard K/N -o DIR)",
+    if !jp.exists() {
+        bail!(
+            "{}: not a shard (no shard.json; write shards with --shard K/N -o DIR)",
             dir.display()
-        )
-    })?;
+        );
+    }
+    let text = meid::input::read_text(&jp)?;
     let v: serde_json::Value =
         serde_json::from_str(&text).with_context(|| format!("{}", jp.display()))?;
     let bad = |f: &str| anyhow::anyhow!("{}: field `{f}` missing or invalid", jp.display());
@@ -130,8 +144,13 @@ pub fn read(dir: &Path) -> Result<ShardFiles> {
     let u = |f: &str| -> Result<usize> {
         Ok(v.get(f).and_then(|x| x.as_u64()).ok_or_else(|| bad(f))? as usize)
     };
-    if v.get("meid_shard").and_then(|x| x.as_u64()) != Some(1) {
-        bail!("{}: not a meid shard (version 1)", jp.display());
+    match v.get("meid_shard").and_then(|x| x.as_u64()) {
+        Some(2) => {}
+        Some(1) => bail!(
+            "{}: a shard of an older meid (version 1, rows without checksums, which cannot be verified); run the shard again",
+            jp.display()
+        ),
+        _ => bail!("{}: not a meid shard (`meid_shard` must be 2)", jp.display()),
     }
     let args = v
         .get("args")
@@ -141,7 +160,7 @@ pub fn read(dir: &Path) -> Result<ShardFiles> {
         .map(|x| x.as_str().map(String::from).ok_or_else(|| bad("args")))
         .collect::<Result<Vec<_>>>()?;
     let cp = dir.join("shard.csv");
-    let rows = std::fs::read(&cp).with_context(|| format!("cannot read {}", cp.display()))?;
+    let rows = unseal(&cp, &meid::input::read_bytes(&cp)?)?;
     Ok(ShardFiles {
         dir: dir.to_path_buf(),
         command: s("command")?,
@@ -153,6 +172,44 @@ pub fn read(dir: &Path) -> Result<ShardFiles> {
         fingerprint: s("fingerprint")?,
         rows,
     })
+}
+
+/// The lines of `shard.csv` (`data`) without their checksums: the header without its
+/// `row_fnv1a` column, every row checked against its checksum (an edited or cut row is
+/// refused, naming `path` and the line).
+fn unseal(path: &Path, data: &[u8]) -> Result<Vec<u8>> {
+    let text = std::str::from_utf8(data)
+        .map_err(|_| anyhow::anyhow!("{}: not UTF-8 text", path.display()))?;
+    let mut out = String::with_capacity(text.len());
+    for (i, line) in text.split_inclusive('\n').enumerate() {
+        let Some(line) = line.strip_suffix('\n') else {
+            bail!(
+                "{}:{}: the last line is cut short (no newline); run the shard again",
+                path.display(),
+                i + 1
+            );
+        };
+        let plain = if i == 0 {
+            line.strip_suffix(",row_fnv1a").ok_or_else(|| {
+                anyhow::anyhow!(
+                    "{}:1: the header does not end with the checksum column `row_fnv1a`",
+                    path.display()
+                )
+            })?
+        } else {
+            meid::input::unseal_row(line).ok_or_else(|| {
+                anyhow::anyhow!(
+                    "{}:{}: the row does not match its checksum (edited or damaged: '{}'); run the shard again",
+                    path.display(),
+                    i + 1,
+                    meid::input::clip(line)
+                )
+            })?
+        };
+        out.push_str(plain);
+        out.push('\n');
+    }
+    Ok(out.into_bytes())
 }
 
 /// `meid merge`.

@@ -80,7 +80,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
             // The same numbers as history.csv (read back from it), one dataset 58 per channel.
             let records = meid::io::csv_records::read_csv(&set.path("history.csv"))?;
             let mut f = meid::io::AtomicFile::create(&set.path("history.uff"))?;
-            meid::io::uff::write_records(&mut f, &records, false)?;
+            meid::io::uff::write_records(&mut f, &records, false, &set.path("history.uff"))?;
             f.commit()?;
         }
         meid::io::write_json(&set.path("summary.json"), &out)?;

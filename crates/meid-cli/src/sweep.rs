@@ -253,6 +253,14 @@ pub fn merge(a: SweepArgs, shards: &[crate::shard::ShardFiles]) -> Result<()> {
                     i + 1
                 )
             })?;
+            if let Err(why) = meid::analysis::sweep::check_cells(&p, sweep.cases.len().max(1)) {
+                bail!(
+                    "{}:{}: point {}: {why}, which a run does not write; run the shard again",
+                    s.dir.join("shard.csv").display(),
+                    i + 1,
+                    p.index
+                );
+            }
             if p.index < s.first || p.index >= s.end {
                 bail!(
                     "{}:{}: point {} is outside the shard's range {}..{}",

@@ -23,6 +23,7 @@
 pub mod analysis;
 pub mod error;
 pub mod impact;
+pub mod input;
 pub mod integrate;
 pub mod io;
 pub mod limits;

@@ -286,3 +286,173 @@ fn valid_inputs_are_accepted() {
     // impact_direction defaults to -z.
     assert_eq!(m.point("O_b").unwrap(), &[0.798, 0.798]);
 }
+
+/// Deleting any one line of a valid .frd either is refused or keeps every mode: a block whose
+/// closing ` -3` is gone must not swallow the next block (and its mode) unnoticed.
+#[test]
+fn a_deleted_frd_line_never_loses_a_mode_silently() {
+    let lines: Vec<&str> = FRD.lines().collect();
+    for k in 0..lines.len() {
+        let mut text: Vec<&str> = lines.clone();
+        let gone = text.remove(k);
+        let joined = text.join("\n") + "\n";
+        if let Ok(f) = frd::parse_frd(joined.as_bytes(), "d.frd") {
+            assert_eq!(
+                f.modes.len(),
+                2,
+                "line {} ('{gone}') deleted: {} modes read without an error",
+                k + 1,
+                f.modes.len()
+            );
+        }
+    }
+}
+
+// Issue 27, item 6: a 2411 node is read only in the global displacement coordinate system
+// (0 or 1); any other number in field 3 is refused, whatever the other fields hold.
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    #[test]
+    fn uff_nodes_are_read_only_in_the_global_system(cs in -3i64..40, export in 0i64..5, colour in 0i64..20) {
+        let mut buf = Vec::new();
+        uff::write_2411(&mut buf, &[Node { label: 9, xyz: [0.0, 1.0, 2.0] }]).unwrap();
+        let text = String::from_utf8(buf).unwrap().replace(
+            "         9         1         1        11",
+            &format!("{:>10}{export:>10}{cs:>10}{colour:>10}", 9),
+        );
+        let r = uff::parse_uff(text.as_bytes(), "cs.unv", None);
+        prop_assert_eq!(r.is_ok(), cs == 0 || cs == 1, "{:?}", r);
+    }
+}
+
+// Issue 27, item 5: two triangles of one surface meeting consistently on an edge, and a third
+// on that edge at any apex and in either direction: always refused (an edge of one surface
+// joins at most two elements).
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    #[test]
+    fn a_third_triangle_on_an_edge_is_refused(x in -2.0f64..2.0, y in -2.0f64..2.0, z in -0.5f64..0.5, flip in any::<bool>(), order in 0usize..3) {
+        use meid::structure::tri3::check_orientation;
+        let nodes = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [x, y, z],
+        ];
+        let third: Vec<usize> = if flip { vec![0, 2, 4] } else { vec![2, 0, 4] };
+        let mut tris: Vec<&[usize]> = vec![&[0, 1, 2], &[0, 2, 3]];
+        tris.insert(order.min(2), &third);
+        prop_assert!(check_orientation(&tris, &nodes).is_some());
+    }
+}
+
+/// Issue 27, item 13: every reader refuses a device, a directory and a FIFO by kind, naming the path.
+#[test]
+fn every_reader_refuses_special_files_by_kind() {
+    type Reader = fn(&std::path::Path) -> Result<(), String>;
+    #[cfg_attr(not(feature = "parquet"), allow(unused_mut))]
+    let mut readers: Vec<(&str, Reader)> = vec![
+        ("model", |p| {
+            meid::model::Model::from_file(p, &[])
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }),
+        ("gmsh", |p| {
+            meid::structure::gmsh::read_msh(p)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }),
+        ("uff", |p| {
+            meid::io::uff::read_uff(p)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }),
+        ("frd", |p| {
+            meid::io::frd::read_frd(p)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }),
+        ("csv", |p| {
+            meid::io::csv_records::read_csv(p)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }),
+        ("mtx", |p| {
+            meid::io::matrix_market::read(p)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }),
+    ];
+    #[cfg(feature = "parquet")]
+    readers.push(("parquet", |p| {
+        meid::io::parquet::read_records(p)
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    }));
+    let d = std::env::temp_dir().join(format!("meid-trust3-special-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let fifo = d.join("fifo");
+    let have_fifo = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    for (name, read) in readers {
+        let mut cases: Vec<(std::path::PathBuf, &str)> = vec![
+            (std::path::PathBuf::from("/dev/zero"), "a character device"),
+            (std::path::PathBuf::from("/dev/null"), "a character device"),
+            (d.clone(), "a directory"),
+        ];
+        if have_fifo {
+            cases.push((fifo.clone(), "a FIFO"));
+        }
+        for (p, kind) in cases {
+            let e = read(&p).unwrap_err();
+            assert!(
+                e.contains(&p.display().to_string())
+                    && e.contains(kind)
+                    && e.contains("not a regular file"),
+                "{name} on {}: {e}",
+                p.display()
+            );
+        }
+    }
+    std::fs::remove_dir_all(&d).ok();
+}
+
+// Issue 27, item 3: any change of the bytes of a modes file a model reads changes the model's
+// file fingerprint (when the changed file still loads).
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    #[test]
+    fn a_changed_modes_file_changes_the_fingerprint(at in any::<usize>(), byte in any::<u8>()) {
+        let d = std::env::temp_dir().join(format!("meid-fuzz-fp-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let lumped = meid::model::Model::from_text(
+            "paper-lumped.toml",
+            include_str!("../../../examples/paper-lumped.toml").to_string(),
+            &[],
+        )
+        .unwrap();
+        let good = uff::modes_uff_points(&lumped.structure).unwrap();
+        let model = d.join("m.toml");
+        std::fs::write(
+            &model,
+            "[structure]\nreference_mode = 1\n[structure.modes]\nfile = \"modes.uff\"\npoints = { base = 1, bed = 2 }\nimpact_direction = [0, 0, 1]\n[points]\nbed_contact = \"bed\"\nmeasurement = \"bed\"\n[slider]\nmass = 1.2\nvelocity = 1.2\n[contact.slider_bed]\nstiffness = 4.3e7\n",
+        )
+        .unwrap();
+        std::fs::write(d.join("modes.uff"), &good).unwrap();
+        let base = meid::model::Model::from_file(&model, &[]).unwrap().files_fingerprint();
+        let mut bad = good.clone();
+        let i = at % bad.len();
+        prop_assume!(bad[i] != byte);
+        bad[i] = byte;
+        std::fs::write(d.join("modes.uff"), &bad).unwrap();
+        if let Ok(m) = meid::model::Model::from_file(&model, &[]) {
+            prop_assert_ne!(m.files_fingerprint(), base);
+        }
+    }
+}

@@ -451,3 +451,67 @@ fn distributions_that_draw_infinity_are_refused() {
     let d = Distribution::parse("uniform(-3,5)").unwrap();
     assert_eq!(d.mean(), 1.0);
 }
+
+// Issue 27: `model expand` refuses exactly what a model load refuses (item 8), on `--set`
+// mutations of the FE soft base (each case solves the machine once or twice: few cases).
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    #[test]
+    fn model_expand_refuses_what_a_load_refuses(
+        sets in prop::collection::vec(set_override(leaf_paths(FE_SOFT_BASE)), 1..2)
+    ) {
+        use meid::model::Model;
+        let load = Model::from_text("paper-soft-base.toml", FE_SOFT_BASE.to_string(), &sets);
+        let expand = meid::model::expand::expand_text("paper-soft-base.toml", FE_SOFT_BASE, &sets);
+        match (&load, &expand) {
+            (Err(a), Err(b)) => prop_assert_eq!(a.to_string(), b.to_string()),
+            (Ok(_), Ok(text)) => {
+                // The expanded file loads too.
+                prop_assert!(Model::from_text("x.toml", text.clone(), &[]).is_ok());
+            }
+            // A set that removes the machine: expand refuses, a load may run.
+            (Ok(_), Err(e)) => prop_assert!(e.to_string().contains("structure"), "{e}"),
+            (Err(e), Ok(_)) => prop_assert!(false, "expand wrote a model the load refuses: {e}"),
+        }
+    }
+}
+
+/// A small sweep of the lumped example and its journal (fresh run).
+fn journal_sweep(dir: &std::path::Path) -> (meid::analysis::sweep::Sweep, String, Vec<u8>) {
+    use meid::analysis::sweep::{Sweep, Vary};
+    let m = meid::model::Model::from_text("paper-lumped.toml", LUMPED.to_string(), &[]).unwrap();
+    let s = Sweep::new(m, vec![Vary::parse("damper.mass=2,3.5,5").unwrap()]).unwrap();
+    std::fs::create_dir_all(dir).unwrap();
+    let j = dir.join("j.csv");
+    let r = s.run_resumable(&j, false, &|_, _| {}).unwrap();
+    (s, r.csv(), std::fs::read(&j).unwrap())
+}
+
+// Issue 27, item 4: whatever bytes of a sweep journal's rows are changed, `--resume` gives the
+// table of a fresh run, byte for byte: a changed row fails its checksum (or its cells are
+// refused) and is computed again; nothing of an edited row reaches the table.
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn an_edited_journal_resumes_to_the_fresh_table(edits in prop::collection::vec(byte_edit(), 1..4)) {
+        let dir = std::env::temp_dir().join(format!("meid-fuzz-journal-{}", std::process::id()));
+        let (s, want, journal) = journal_sweep(&dir);
+        // Keep the first line and the header: edit the rows.
+        let head = journal
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| **b == b'\n')
+            .nth(1)
+            .map(|(i, _)| i + 1)
+            .unwrap();
+        let mut rows = apply_bytes(&journal[head..], &edits);
+        let mut text = journal[..head].to_vec();
+        text.append(&mut rows);
+        let j = dir.join("j.csv");
+        std::fs::write(&j, &text).unwrap();
+        let r = s.run_resumable(&j, true, &|_, _| {}).unwrap();
+        prop_assert_eq!(r.csv(), want);
+    }
+}

@@ -87,7 +87,7 @@ fn measured_case(m: &Model, case: Case, noise: f64, seed: u64, tag: &str) -> Mea
     let path =
         std::env::temp_dir().join(format!("meid-calibrate-{}-{tag}.uff", std::process::id()));
     let mut f = std::fs::File::create(&path).unwrap();
-    uff::write_records(&mut f, &records, true).unwrap();
+    uff::write_records(&mut f, &records, true, &path).unwrap();
     drop(f);
     let back = uff::read_uff(&path).unwrap().records;
     let _ = std::fs::remove_file(&path);

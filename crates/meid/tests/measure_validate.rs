@@ -62,7 +62,7 @@ fn measured(m: &Model, case: Case, acc_scale: f64, tag: &str) -> MeasuredCase {
     ];
     let path = std::env::temp_dir().join(format!("meid-validate-{}-{tag}.uff", std::process::id()));
     let mut f = std::fs::File::create(&path).unwrap();
-    uff::write_records(&mut f, &records, true).unwrap();
+    uff::write_records(&mut f, &records, true, &path).unwrap();
     drop(f);
     let back = uff::read_uff(&path).unwrap().records;
     let _ = std::fs::remove_file(&path);

@@ -490,6 +490,23 @@ impl Comparison {
                 "the comparison needs an output sample rate > 0 Hz",
             ));
         }
+        // A record shorter than one sampling interval holds a single sample: no spectrum, no
+        // level (the dB values would be -inf or NaN).
+        let record_s = self.record_s();
+        if record_s * fs < 1.0 {
+            return Err(Error::invalid(
+                if o.blows > 1 { "blows" } else { "duration" },
+                format!(
+                    "the {} s record is shorter than one sampling interval 1/f_s = {} s \
+                     (simulation.sample_rate = {} Hz): lengthen the record (--duration, or \
+                     --blows × 60/--rate-bpm) to at least {} s, or raise the rate (--rate)",
+                    crate::num(record_s),
+                    crate::num(1.0 / fs),
+                    crate::num(fs),
+                    crate::num(1.0 / fs)
+                ),
+            ));
+        }
         Ok(fs)
     }
 

@@ -512,16 +512,18 @@ impl MonteCarlo {
             + 24.0 * values
     }
 
-    /// A fingerprint of everything that determines the samples (model, inputs, seed, count):
+    /// A fingerprint of everything that determines the samples (model, the content of the
+    /// files it refers to, inputs, seed, count):
     /// FNV-1a 64 over their text; shards of one study have the same.
     pub fn fingerprint(&self) -> String {
         let text = format!(
-            "{}|{:?}|{}|{}|{}",
+            "{}|{:?}|{}|{}|{}{}",
             serde_json::to_string(&self.model.spec).unwrap_or_default(),
             self.inputs,
             self.seed,
             self.samples,
-            self.model.source.text
+            self.model.source.text,
+            self.model.files_fingerprint()
         );
         let mut h: u64 = 0xcbf2_9ce4_8422_2325;
         for b in text.bytes() {
@@ -712,7 +714,7 @@ pub fn samples_exact_csv(samples: &[Sample], inputs: usize) -> Result<Vec<u8>> {
 }
 
 /// Reads [`samples_exact_csv`] back (`inputs` inputs per sample); `what` names the file in
-/// errors.
+/// errors. A non-finite input or an infinite metric is refused (a run writes neither).
 pub fn read_samples_exact_csv(bytes: &[u8], inputs: usize, what: &str) -> Result<Vec<Sample>> {
     let bad = |line: u64, m: String| Error::Input {
         location: format!("{what}:{line}"),
@@ -745,6 +747,25 @@ pub fn read_samples_exact_csv(bytes: &[u8], inputs: usize, what: &str) -> Result
             }
             Some(m)
         };
+        // A run draws finite inputs and writes no infinite metric (NaN where undefined).
+        if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+            return Err(bad(
+                line,
+                format!(
+                    "sample {index}: an input is {}, which a run never draws",
+                    crate::num(*v)
+                ),
+            ));
+        }
+        if let Some(v) = metrics.iter().flatten().find(|v| v.is_infinite()) {
+            return Err(bad(
+                line,
+                format!(
+                    "sample {index}: a metric is {}, which a run never writes",
+                    crate::num(*v)
+                ),
+            ));
+        }
         let e = &rec[width - 1];
         out.push(Sample {
             index,

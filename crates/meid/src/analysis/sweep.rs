@@ -882,7 +882,7 @@ impl Sweep {
         indices: &[usize],
         progress: &(dyn Fn(usize, usize) + Sync),
         already: usize,
-        journal: Option<&Mutex<std::fs::File>>,
+        journal: Option<(&Path, &Mutex<std::fs::File>)>,
     ) -> (Vec<PointResult>, Option<Error>) {
         let total = self.len();
         let done = std::sync::atomic::AtomicUsize::new(already);
@@ -891,15 +891,13 @@ impl Sweep {
             .par_iter()
             .map(|&i| {
                 let r = self.run_point(i);
-                if let Some(j) = journal {
-                    let line = self.row(&r);
+                if let Some((path, j)) = journal {
+                    let mut line = crate::input::seal_row(self.row(&r).trim_end_matches('\n'));
+                    line.push('\n');
                     if let Ok(mut f) = j.lock() {
                         if let Err(e) = f.write_all(line.as_bytes()).and_then(|_| f.flush()) {
                             if let Ok(mut je) = journal_error.lock() {
-                                je.get_or_insert(Error::numerical(
-                                    "sweep journal",
-                                    format!("cannot write: {e}"),
-                                ));
+                                je.get_or_insert(Error::io(path, e));
                             }
                         }
                     }
@@ -953,20 +951,19 @@ impl Sweep {
         format_row(r)
     }
 
-    fn header(&self) -> String {
-        let mut s = self.columns().join(",");
-        s.push('\n');
-        s
-    }
-
-    /// A fingerprint of everything that determines the results (model spec, grid, options):
-    /// FNV-1a 64 over their JSON/debug text. A journal from another sweep is refused.
+    /// A fingerprint of everything that determines the results (model spec and text, the
+    /// content of the files it refers to, grid, options): FNV-1a 64 over their JSON/debug
+    /// text. A journal or shard from another sweep is refused.
     fn fingerprint(&self) -> String {
         let mut text = serde_json::to_string(&self.model.spec).unwrap_or_default();
         let _ = write!(
             text,
-            "|{:?}|{:?}|{:?}|{}",
-            self.vary, self.options, self.bed_mass_kg, self.model.source.text
+            "|{:?}|{:?}|{:?}|{}{}",
+            self.vary,
+            self.options,
+            self.bed_mass_kg,
+            self.model.source.text,
+            self.model.files_fingerprint()
         );
         if !self.cases.is_empty() {
             let _ = write!(text, "|cases {:?}", self.cases);
@@ -979,10 +976,25 @@ impl Sweep {
         format!("{h:016x}")
     }
 
+    /// The journal's first line: its format version and this sweep's fingerprint.
+    fn journal_first_line(&self) -> String {
+        format!("# meid sweep journal v2 {}\n", self.fingerprint())
+    }
+
+    /// The journal's header: the columns of `sweep.csv` and the row checksum.
+    fn journal_header(&self) -> String {
+        let mut s = self.columns().join(",");
+        s.push_str(",row_fnv1a\n");
+        s
+    }
+
     /// Runs the sweep keeping a journal: every finished point is appended (and flushed) to
-    /// `journal` as its CSV row, so an interrupted sweep loses no finished point. With
-    /// `resume`, the rows already in the journal are reused (a truncated last line is
-    /// dropped) and only the missing points are computed. The journal is kept; delete it
+    /// `journal` as its CSV row followed by the row's checksum ([`crate::input::seal_row`]),
+    /// so an interrupted sweep loses no finished point. With `resume`, the rows already in the
+    /// journal whose checksum matches and whose cells are what a run writes
+    /// ([`check_cells`]) are reused; a row cut short, edited or holding a non-finite value
+    /// where a run writes none is dropped and its point computed again. A journal of another
+    /// sweep (fingerprint) or of an older format is refused. The journal is kept; delete it
     /// after [`SweepResult::write`] if wanted.
     pub fn run_resumable(
         &self,
@@ -991,86 +1003,53 @@ impl Sweep {
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<SweepResult> {
         let total = self.len();
-        let first = format!("# meid sweep journal v1 {}\n", self.fingerprint());
-        let header = self.header();
+        let first = self.journal_first_line();
+        let header = self.journal_header();
         let mut known: Vec<Option<PointResult>> = vec![None; total];
-        let mut valid_prefix = 0usize;
-        if resume {
-            if let Ok(bytes) = std::fs::read(journal) {
-                let text = String::from_utf8_lossy(&bytes);
-                // A journal without a finished point (empty, or cut within its first two
-                // lines, whichever sweep wrote them) holds nothing to resume: start afresh.
-                let lines = text
-                    .split_inclusive('\n')
-                    .filter(|l| l.ends_with('\n'))
-                    .count();
-                let nothing = lines <= 2
-                    && (text.is_empty()
-                        || text.starts_with("# meid sweep journal")
-                        || format!("{first}{header}").starts_with(&*text));
-                if nothing {
-                    // Falls through with valid_prefix = 0: a fresh journal.
-                } else if !text.starts_with(&first) {
-                    return Err(Error::invalid(
-                        "resume",
-                        format!(
-                            "{} is the journal of a different sweep (model, --vary or options changed); remove it or drop --resume",
-                            journal.display()
-                        ),
-                    ));
-                } else {
-                    let mut offset = first.len();
-                    let body = &text[first.len()..];
-                    for line in body.split_inclusive('\n') {
-                        if !line.ends_with('\n') {
-                            break; // truncated by an interruption
-                        }
-                        if line == header {
-                            offset += line.len();
-                            continue;
-                        }
-                        match self.parse_row(line.trim_end_matches('\n')) {
-                            Some(r) if r.index < total => {
-                                let i = r.index;
-                                known[i] = Some(r);
-                            }
-                            _ => break,
-                        }
-                        offset += line.len();
-                    }
-                    valid_prefix = offset;
-                }
-            }
-        }
-        // (Re)write the journal: the kept prefix, or a fresh header.
-        let file = if valid_prefix > 0 {
-            let f = std::fs::OpenOptions::new()
-                .write(true)
-                .open(journal)
-                .map_err(|e| Error::io(journal, e))?;
-            f.set_len(valid_prefix as u64)
-                .map_err(|e| Error::io(journal, e))?;
-            let mut f = std::fs::OpenOptions::new()
-                .append(true)
-                .open(journal)
-                .map_err(|e| Error::io(journal, e))?;
-            f.flush().map_err(|e| Error::io(journal, e))?;
-            f
+        let kept = if resume {
+            self.read_journal(journal, &mut known)?
         } else {
-            if let Some(dir) = journal.parent().filter(|p| !p.as_os_str().is_empty()) {
-                std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+            None
+        };
+        // (Re)write the journal: the kept rows, or a fresh header.
+        let file = match kept {
+            Some(JournalKept::Prefix(len)) => {
+                let f = std::fs::OpenOptions::new()
+                    .write(true)
+                    .open(journal)
+                    .map_err(|e| Error::io(journal, e))?;
+                f.set_len(len as u64).map_err(|e| Error::io(journal, e))?;
+                std::fs::OpenOptions::new()
+                    .append(true)
+                    .open(journal)
+                    .map_err(|e| Error::io(journal, e))?
             }
-            let mut f = std::fs::File::create(journal).map_err(|e| Error::io(journal, e))?;
-            f.write_all(first.as_bytes())
-                .and_then(|_| f.write_all(header.as_bytes()))
-                .and_then(|_| f.flush())
-                .map_err(|e| Error::io(journal, e))?;
-            f
+            Some(JournalKept::Rows(rows)) => {
+                let mut text = format!("{first}{header}");
+                text.push_str(&rows);
+                crate::io::write_atomic(journal, text.as_bytes())?;
+                std::fs::OpenOptions::new()
+                    .append(true)
+                    .open(journal)
+                    .map_err(|e| Error::io(journal, e))?
+            }
+            None => {
+                if let Some(dir) = journal.parent().filter(|p| !p.as_os_str().is_empty()) {
+                    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+                }
+                let mut f = std::fs::File::create(journal).map_err(|e| Error::io(journal, e))?;
+                f.write_all(first.as_bytes())
+                    .and_then(|_| f.write_all(header.as_bytes()))
+                    .and_then(|_| f.flush())
+                    .map_err(|e| Error::io(journal, e))?;
+                f
+            }
         };
         let missing: Vec<usize> = (0..total).filter(|&i| known[i].is_none()).collect();
         let already = total - missing.len();
         let lock = Mutex::new(file);
-        let (fresh, journal_error) = self.run_indices(&missing, progress, already, Some(&lock));
+        let (fresh, journal_error) =
+            self.run_indices(&missing, progress, already, Some((journal, &lock)));
         if let Some(e) = journal_error {
             return Err(e);
         }
@@ -1086,6 +1065,83 @@ impl Sweep {
             spec: self.spec(),
             points,
         })
+    }
+
+    /// Reads the rows of a journal into `known` (see [`Sweep::run_resumable`]); `None` when
+    /// there is nothing to resume (no journal, or one without a finished row).
+    fn read_journal(
+        &self,
+        journal: &Path,
+        known: &mut [Option<PointResult>],
+    ) -> Result<Option<JournalKept>> {
+        let first = self.journal_first_line();
+        let header = self.journal_header();
+        let bytes = match crate::input::read_bytes(journal) {
+            Ok(b) => b,
+            Err(Error::Io { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => {
+                return Ok(None)
+            }
+            Err(e) => return Err(e),
+        };
+        let text = String::from_utf8_lossy(&bytes);
+        // A journal without a finished point (empty, or cut within its first two lines,
+        // whichever sweep wrote them) holds nothing to resume: start afresh.
+        let lines = text
+            .split_inclusive('\n')
+            .filter(|l| l.ends_with('\n'))
+            .count();
+        if lines <= 2
+            && (text.is_empty()
+                || text.starts_with("# meid sweep journal")
+                || format!("{first}{header}").starts_with(&*text))
+        {
+            return Ok(None);
+        }
+        if text.starts_with("# meid sweep journal v1 ") {
+            return Err(Error::Input {
+                location: journal.display().to_string(),
+                message: "a sweep journal of an older meid (format v1, rows without checksums, which cannot be verified); drop --resume and give --force to compute the sweep afresh".into(),
+            });
+        }
+        if !text.starts_with(&first) {
+            return Err(Error::invalid(
+                "resume",
+                format!(
+                    "{} is the journal of a different sweep (model, a file it reads, --vary or options changed); remove it or drop --resume",
+                    journal.display()
+                ),
+            ));
+        }
+        let total = known.len();
+        let mut offset = first.len();
+        let mut good = String::new();
+        let mut dropped = false;
+        for line in text[first.len()..].split_inclusive('\n') {
+            if !line.ends_with('\n') {
+                break; // cut short by an interruption
+            }
+            if line == header {
+                offset += line.len();
+                continue;
+            }
+            let row = crate::input::unseal_row(line.trim_end_matches('\n'));
+            match row.and_then(|r| self.parse_row(r)) {
+                Some(r) if r.index < total && check_cells(&r, self.cases.len().max(1)).is_ok() => {
+                    let i = r.index;
+                    known[i] = Some(r);
+                    good.push_str(line);
+                    if !dropped {
+                        offset += line.len();
+                    }
+                }
+                _ => dropped = true,
+            }
+        }
+        Ok(Some(if dropped {
+            JournalKept::Rows(good)
+        } else {
+            JournalKept::Prefix(offset)
+        }))
     }
 
     /// Parses a journal row ([`Sweep::row`] without its newline); `None` if it does not fit
@@ -1128,6 +1184,51 @@ impl Sweep {
             },
         })
     }
+}
+
+/// What of a journal is kept on resuming.
+enum JournalKept {
+    /// Its first `n` bytes (every complete row was good).
+    Prefix(usize),
+    /// These rows (with their newlines) after a fresh first line and header: some rows were
+    /// dropped.
+    Rows(String),
+}
+
+/// Checks that the cells of a row read back (journal, shard) are what a run writes: no
+/// infinite value anywhere; a NaN only where a run writes one — every cell of a failed point,
+/// the derived K_d and m_d and the ratios `wd_over_ws`, `ws_over_w_ref` of a model without
+/// them; a run's own metrics (the energy ratio, energies, forces, ...) of a point that did
+/// not fail are finite or empty. `cases` is the number of cases (1 without `--cases`). The
+/// error names the first offending column.
+pub fn check_cells(r: &PointResult, cases: usize) -> std::result::Result<(), String> {
+    let bad = |what: &str, v: f64| Err(format!("{what} is {}", crate::num(v)));
+    for (k, v) in r.values.iter().enumerate() {
+        if !v.is_finite() {
+            return bad(&format!("varied value {}", k + 1), *v);
+        }
+    }
+    for (k, v) in r.derived.iter().enumerate() {
+        if v.is_infinite() || (v.is_nan() && r.error.is_none() && (k == 0 || k == 3)) {
+            return bad(DERIVED[k], *v);
+        }
+    }
+    if r.metrics.len() != METRICS.len() * cases {
+        return Err(format!(
+            "{} metric cells, expected {}",
+            r.metrics.len(),
+            METRICS.len() * cases
+        ));
+    }
+    let own = METRICS.len() - 2;
+    for (k, m) in r.metrics.iter().enumerate() {
+        let Some(v) = *m else { continue };
+        let name = METRICS[k % METRICS.len()];
+        if v.is_infinite() || (v.is_nan() && r.error.is_none() && k % METRICS.len() < own) {
+            return bad(name, v);
+        }
+    }
+    Ok(())
 }
 
 fn csv_quote(s: &str) -> String {

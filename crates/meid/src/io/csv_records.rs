@@ -17,7 +17,7 @@ use crate::{Error, Result};
 
 /// Reads a CSV file of time histories (module docs).
 pub fn read_csv(path: &Path) -> Result<Vec<Record>> {
-    let f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let (f, _) = crate::input::open(path)?;
     parse_csv(std::io::BufReader::new(f), &path.display().to_string())
 }
 
@@ -132,8 +132,10 @@ pub fn parse_csv<R: std::io::Read>(reader: R, file: &str) -> Result<Vec<Record>>
                 err(
                     line,
                     format!(
-                        "column {} ({name}): expected a number, got '{field}'",
-                        k + 1
+                        "column {} ({}): expected a number, got '{}'",
+                        k + 1,
+                        crate::input::clip(name),
+                        crate::input::clip(field)
                     ),
                 )
             })?;
@@ -178,8 +180,9 @@ pub(crate) fn column_kinds(
         }
         let Some((n, q, f)) = split_csv_name(name) else {
             return Err(format!(
-                "column {} '{name}': the name does not end in a unit meid knows; expected NAME_UNIT with UNIT one of s, ms, us, m_per_s2, mm_per_s2, g, mg, m_per_s, mm_per_s, m, mm, um, in, n, kn, lbf (e.g. time_s, accel_B_m_per_s2, accel_B_g, force_floor_n)",
-                k + 1
+                "column {} '{}': the name does not end in a unit meid knows; expected NAME_UNIT with UNIT one of s, ms, us, m_per_s2, mm_per_s2, g, mg, m_per_s, mm_per_s, m, mm, um, in, n, kn, lbf (e.g. time_s, accel_B_m_per_s2, accel_B_g, force_floor_n)",
+                k + 1,
+                crate::input::clip(name)
             ));
         };
         if q == Quantity::Time {

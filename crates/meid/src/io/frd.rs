@@ -18,7 +18,7 @@
 //! | `    2C` | `(1X,'   2','C',18X,I12,37X,I1)` | nodes block: number of nodes, format (0 short, 1 long, 2 binary) |
 //! | ` -1` | `(1X,I2,I5/I10,3E12.5)` | node label (5 columns in format 0, 10 in format 1) and x, y, z |
 //! | ` -3` | | end of a block |
-//! | `    3C` | | elements block (passed over to its ` -3`) |
+//! | `    3C` | | elements block: its ` -1`/` -2` lines are passed over to its ` -3`; any other line before the ` -3` is an error |
 //! | `    1P…` | `1PSTEP`, `1PGM` (generalised mass φᵀMφ), `1PGK` (generalised stiffness), `1PMODE` (mode number) | step parameters |
 //! | `  100C` | `(1X,'  100','C',6A1,E12.5,I12,20A1,I2,I5,10A1,I2)` | results block: set name, **value** (the frequency in cycles per time unit for a frequency step), number of nodes, text, analysis type (2 = frequency), step, analysis name, format |
 //! | ` -4` | `(1X,I2,2X,8A1,2I5)` | result name (`DISP`), number of components |
@@ -71,7 +71,7 @@ pub const MAX_LINE: u64 = 1 << 16;
 
 /// Reads a CalculiX `.frd` file (see the module docs).
 pub fn read_frd(path: &Path) -> Result<FrdFile> {
-    let f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let (f, _) = crate::input::open(path)?;
     parse_frd(
         std::io::BufReader::with_capacity(1 << 16, f),
         &path.display().to_string(),
@@ -353,11 +353,25 @@ impl<R: BufRead> Parser<'_, R> {
         }
     }
 
+    /// Passes over a block's data lines (` -1`, ` -2`) to its closing ` -3`. Any other line
+    /// means the block does not end where the format says (its ` -3` is missing): an error
+    /// naming the line, never a silent skip into the next block.
     fn skip_block(&mut self, block: Block) -> Result<()> {
         loop {
             let l = self.need_line(block)?;
-            if cols(&l, 0, 3).trim() == "-3" {
-                return Ok(());
+            match cols(&l, 0, 3).trim() {
+                "-3" => return Ok(()),
+                "-1" | "-2" => {}
+                _ => {
+                    return Err(self.err(
+                        Some(block),
+                        self.line_no,
+                        format!(
+                            "expected a data line (' -1', ' -2') or the block end ' -3', got '{}': the block's closing ' -3' is missing",
+                            clip(&l)
+                        ),
+                    ))
+                }
             }
         }
     }
@@ -543,14 +557,7 @@ fn parse_f(s: &str) -> Option<f64> {
     s.replace(['D', 'd'], "E").parse::<f64>().ok()
 }
 
-fn clip(s: &str) -> String {
-    const MAX: usize = 80;
-    if s.chars().count() <= MAX {
-        s.to_string()
-    } else {
-        format!("{}…", s.chars().take(MAX).collect::<String>())
-    }
-}
+use crate::input::clip;
 
 #[cfg(test)]
 mod tests {
@@ -613,6 +620,25 @@ mod tests {
         let e = parse_frd(bad.as_bytes(), "t.frd").unwrap_err().to_string();
         assert!(e.contains("line 21"), "{e}");
         assert!(e.contains("expected a DISP line"), "{e}");
+    }
+
+    #[test]
+    fn an_elements_block_without_its_closing_line_is_an_error_naming_the_line() {
+        // Without the ` -3` after the elements, the old reader passed over the step
+        // parameters and the first mode's header up to that mode's ` -3`, losing the mode.
+        let bad = SMALL.replacen(
+            " -2         1         2\n -3\n",
+            " -2         1         2\n",
+            1,
+        );
+        assert_ne!(bad, SMALL);
+        let e = parse_frd(bad.as_bytes(), "t.frd").unwrap_err().to_string();
+        assert!(
+            e.contains("t.frd: block 3C (elements) starting at line 7, line 10"),
+            "{e}"
+        );
+        assert!(e.contains("closing ' -3' is missing"), "{e}");
+        assert!(e.contains("1PSTEP"), "{e}");
     }
 
     #[test]

@@ -17,7 +17,6 @@
 //! Hand-written: the format is a few lines of text, and the crates that read it
 //! (`sprs`, `matrixmarket-rs`) would pull in another sparse type.
 
-use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 
@@ -96,7 +95,7 @@ fn tokens(line: &str) -> Vec<(usize, &str)> {
 /// Reads a Matrix Market coordinate file (`real` or `integer`, `symmetric` or `general`).
 /// A symmetric file is returned with both triangles stored.
 pub fn read(path: &Path) -> Result<SparseColMat<usize, f64>> {
-    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let (file, _) = crate::input::open(path)?;
     let mut lines = BufReader::new(file).lines().enumerate();
     let mut next_line = || -> Result<Option<(usize, String)>> {
         match lines.next() {
@@ -124,7 +123,10 @@ pub fn read(path: &Path) -> Result<SparseColMat<usize, f64>> {
                 path,
                 hline,
                 tok.0,
-                format!("`{}` is not supported; expected `{w}`", tok.1),
+                format!(
+                    "`{}` is not supported; expected `{w}`",
+                    crate::input::clip(&tok.1)
+                ),
             ));
         }
     }
@@ -136,7 +138,7 @@ pub fn read(path: &Path) -> Result<SparseColMat<usize, f64>> {
             h[3].0,
             format!(
                 "field `{}` is not supported; expected `real` or `integer`",
-                h[3].1
+                crate::input::clip(&h[3].1)
             ),
         ));
     }
@@ -151,7 +153,7 @@ pub fn read(path: &Path) -> Result<SparseColMat<usize, f64>> {
                 h[4].0,
                 format!(
                     "symmetry `{}` is not supported; expected `symmetric` or `general`",
-                    h[4].1
+                    crate::input::clip(&h[4].1)
                 ),
             ))
         }
@@ -193,7 +195,7 @@ pub fn read(path: &Path) -> Result<SparseColMat<usize, f64>> {
                 path,
                 sline,
                 *col,
-                format!("`{t}` is not a non-negative integer"),
+                format!("`{}` is not a non-negative integer", crate::input::clip(t)),
             )
         })?;
     }
@@ -241,7 +243,10 @@ pub fn read(path: &Path) -> Result<SparseColMat<usize, f64>> {
                     path,
                     no,
                     col,
-                    format!("`{s}` is not a positive integer index"),
+                    format!(
+                        "`{}` is not a positive integer index",
+                        crate::input::clip(s)
+                    ),
                 )
             })?;
             if v == 0 || v > lim {
@@ -255,9 +260,14 @@ pub fn read(path: &Path) -> Result<SparseColMat<usize, f64>> {
             idx[k] = v - 1;
         }
         let (col, s) = tk[2];
-        let v: f64 = s
-            .parse()
-            .map_err(|_| input_error(path, no, col, format!("`{s}` is not a number")))?;
+        let v: f64 = s.parse().map_err(|_| {
+            input_error(
+                path,
+                no,
+                col,
+                format!("`{}` is not a number", crate::input::clip(s)),
+            )
+        })?;
         if !v.is_finite() {
             return Err(input_error(path, no, col, format!("`{s}` is not finite")));
         }

@@ -274,6 +274,7 @@ impl OutputSet {
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
         let staging = dir.join(format!(".meid-staging.{}.{n}", std::process::id()));
         std::fs::create_dir(&staging).map_err(|e| Error::io(&staging, e))?;
+        live_staging(|l| l.push(staging.clone()));
         Ok(OutputSet {
             dir: dir.to_path_buf(),
             staging,
@@ -301,6 +302,7 @@ impl OutputSet {
         let staging = std::mem::take(&mut self.staging);
         let result = commit_set(&self.dir, &staging, command);
         let _ = std::fs::remove_dir_all(&staging);
+        live_staging(|l| l.retain(|p| *p != staging));
         result
     }
 }
@@ -309,8 +311,35 @@ impl Drop for OutputSet {
     fn drop(&mut self) {
         if !self.staging.as_os_str().is_empty() {
             let _ = std::fs::remove_dir_all(&self.staging);
+            live_staging(|l| l.retain(|p| *p != self.staging));
         }
     }
+}
+
+/// The staging directories of this process's output sets not yet committed or dropped.
+static LIVE_STAGING: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn live_staging<T>(f: impl FnOnce(&mut Vec<PathBuf>) -> T) -> T {
+    let mut g = LIVE_STAGING
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    f(&mut g)
+}
+
+/// Removes the staging directories of every output set of this process not yet committed
+/// (for a process about to end on a signal, whose destructors will not run: an interrupted
+/// run leaves no `.meid-staging.PID.N` behind). Returns the directories removed.
+pub fn remove_live_staging() -> Vec<PathBuf> {
+    let dirs = live_staging(std::mem::take);
+    for d in &dirs {
+        // Worker threads may still create files in it: a few attempts.
+        for _ in 0..5 {
+            if std::fs::remove_dir_all(d).is_ok() || !d.exists() {
+                break;
+            }
+        }
+    }
+    dirs
 }
 
 /// Removes the staging directories `.meid-staging.PID.N` in `dir` left by killed runs: those

@@ -158,7 +158,7 @@ pub fn read_records(path: &Path) -> Result<Vec<crate::measure::Record>> {
         location: file.clone(),
         message,
     };
-    let f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let (f, _) = crate::input::open(path)?;
     let builder = ParquetRecordBatchReaderBuilder::try_new(f)
         .map_err(|e| bad(format!("not a Parquet file meid can read: {e}")))?;
     let names: Vec<String> = builder

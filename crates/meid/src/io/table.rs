@@ -78,12 +78,7 @@ pub fn unit_of_column(name: &str) -> &'static str {
 
 /// FNV-1a 64 of `bytes` as 16 hex digits (a content hash for identification, not security).
 pub fn fnv1a_hex(bytes: &[u8]) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in bytes {
-        h ^= u64::from(*b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    format!("{h:016x}")
+    crate::input::fnv1a_hex(bytes)
 }
 
 /// The model facts every table carries: `meid_version`, `model` (the file as given),

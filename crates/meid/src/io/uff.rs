@@ -139,8 +139,8 @@ pub struct UffFile {
 
 /// Reads a UFF file (see the module docs).
 pub fn read_uff(path: &Path) -> Result<UffFile> {
-    let f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    let len = f.metadata().map(|m| m.len()).ok();
+    let (f, len) = crate::input::open(path)?;
+    let len = Some(len);
     let name = path.display().to_string();
     parse_uff(std::io::BufReader::with_capacity(1 << 16, f), &name, len)
 }
@@ -642,6 +642,13 @@ impl<R: BufRead> Parser<'_, R> {
             if !(dx.is_finite() && dx > 0.0 && x0.is_finite()) {
                 return Err(self.err(Some(ds), Some("record 7"), r7_line, format!("even abscissa with minimum {x0} and increment {dx}: expected a finite minimum and an increment > 0")));
             }
+            // The record's times in SI, its length N·Δt and its rate must be finite numbers:
+            // an increment of 1e308 s makes the length of two samples infinite.
+            let end = (x0 + n as f64 * dx) * xf;
+            let rate = 1.0 / (dx * xf);
+            if !((x0 * xf).is_finite() && end.is_finite() && rate.is_finite() && rate > 0.0) {
+                return Err(self.err(Some(ds), Some("record 7"), r7_line, format!("even abscissa with minimum {} and increment {} ({xu}) over {n} points: the record's end (minimum + N·increment = {} s) or its sample rate ({} Hz) is not a finite number; expected an increment in {xu} that gives finite times (e.g. 1.953125E-05 s for 51.2 kHz)", crate::num(x0), crate::num(dx), crate::num(end), crate::num(rate))));
+            }
             (
                 Abscissa::Even {
                     start_s: x0 * xf,
@@ -655,6 +662,9 @@ impl<R: BufRead> Parser<'_, R> {
             for c in values.chunks_exact(2) {
                 t.push(c[0] * xf);
                 y.push(c[1]);
+            }
+            if let Some(k) = t.iter().position(|v| !v.is_finite()) {
+                return Err(self.err(Some(ds), Some("record 12"), r7_line + 5, format!("uneven abscissa: the time of point {} is {} s, not a finite number; expected times in {xu} that stay finite in seconds", k + 1, crate::num(t[k]))));
             }
             if let Some(k) = t
                 .windows(2)
@@ -940,6 +950,33 @@ impl<R: BufRead> Parser<'_, R> {
                         ),
                     )
                 })?;
+            // Field 3: the displacement coordinate system, in which the node's data (dataset
+            // 55's shapes) are given. meid reads them as global: 0 or 1 (the global part
+            // system, which meid and pyuff write); a local system (defined by a dataset 2420
+            // meid does not read) or none at all is refused, never read as global.
+            let ints: Vec<Option<i64>> = l1.split_whitespace().map(|t| t.parse().ok()).collect();
+            match ints.get(2) {
+                Some(Some(0 | 1)) => {}
+                Some(Some(cs)) => {
+                    return Err(self.err(
+                        Some(ds),
+                        Some("record 1"),
+                        n1,
+                        format!("node {label}: displacement coordinate system {cs} is a local system; meid reads node data in the global system (0 or 1) and does not convert: export the nodes and mode shapes in global coordinates"),
+                    ))
+                }
+                _ => {
+                    return Err(self.err(
+                        Some(ds),
+                        Some("record 1"),
+                        n1,
+                        format!(
+                            "node {label}: no displacement coordinate system (field 3 of 4I10: node label, export system, displacement system, colour), got '{}'; give 1 (global)",
+                            clip(&l1)
+                        ),
+                    ))
+                }
+            }
             let l2 = self.need_line(ds, "record 2")?;
             let xyz: Vec<f64> = l2.split_whitespace().filter_map(parse_f).collect();
             if xyz.len() != 3 || xyz.iter().any(|v| !v.is_finite()) {
@@ -1035,6 +1072,33 @@ impl<R: BufRead> Parser<'_, R> {
                 "expected 2 4 load-case mode-number, then frequency, modal mass, damping ratio"
                     .into(),
             ));
+        }
+        // Record 7 declares the number of integer (NINT) and real (NRDV) values that follow:
+        // the data must hold exactly that many.
+        let (nint, nrdv) = (r7v[0], r7v[1]);
+        if usize::try_from(nint).ok() != Some(r7v.len() - 2) {
+            return Err(self.err(
+                Some(ds),
+                Some("record 7"),
+                self.line_no - 1,
+                format!(
+                    "declares {nint} integer values (NINT, field 1) but holds {}: '{}'",
+                    r7v.len() - 2,
+                    clip(&r7)
+                ),
+            ));
+        }
+        let mut r8v = r8v;
+        if usize::try_from(nrdv).ok() != Some(r8v.len()) {
+            // Fixed 13-column fields (numbers touching).
+            r8v = r8
+                .as_bytes()
+                .chunks(13)
+                .filter_map(|c| parse_f(String::from_utf8_lossy(c).trim()))
+                .collect();
+        }
+        if usize::try_from(nrdv).ok() != Some(r8v.len()) {
+            return Err(self.err(Some(ds), Some("record 8"), self.line_no, format!("record 7 declares {nrdv} real values (NRDV, field 2) but record 8 holds {}: '{}'", r8v.len(), clip(&r8))));
         }
         let mut shapes = Vec::new();
         loop {
@@ -1174,14 +1238,7 @@ fn foreign_ordinate(line: &str) -> Option<String> {
     None
 }
 
-fn clip(s: &str) -> String {
-    let t: String = s.chars().take(60).collect();
-    if t.len() < s.len() {
-        format!("{t}…")
-    } else {
-        t
-    }
-}
+use crate::input::clip;
 
 fn function_name(t: i64) -> &'static str {
     match t {
@@ -1467,8 +1524,14 @@ pub fn write_55<W: Write>(w: &mut W, mode: &Mode) -> std::io::Result<()> {
 }
 
 /// Writes evenly sampled records as datasets 58, one per record, in order; the response node
-/// is the record's position (1-based) unless the record names its point.
-pub fn write_records<W: Write>(w: &mut W, records: &[Record], binary: bool) -> Result<()> {
+/// is the record's position (1-based) unless the record names its point. `file` names the
+/// destination in errors (a full disk is reported as that file's error).
+pub fn write_records<W: Write>(
+    w: &mut W,
+    records: &[Record],
+    binary: bool,
+    file: &Path,
+) -> Result<()> {
     for (k, r) in records.iter().enumerate() {
         let (start_s, step_s) = r.even()?;
         let point = r.point.clone().unwrap_or(PointRef {
@@ -1484,7 +1547,7 @@ pub fn write_records<W: Write>(w: &mut W, records: &[Record], binary: bool) -> R
             step_s,
             values: &r.values,
         };
-        write_58(w, &ch, binary).map_err(|e| Error::io("UFF output", e))?;
+        write_58(w, &ch, binary).map_err(|e| Error::io(file, e))?;
     }
     Ok(())
 }
@@ -1577,8 +1640,8 @@ pub fn modes_uff_points(m: &crate::modal::ModalModel) -> Result<Vec<u8>> {
     let id_lines = point_id_lines(&labels);
     let n = m.omega_rad_per_s.len();
     let mut out = Vec::new();
-    write_164(&mut out, &si_units()).map_err(|e| Error::io("UFF output", e))?;
-    write_2411(&mut out, &nodes).map_err(|e| Error::io("UFF output", e))?;
+    write_164(&mut out, &si_units()).map_err(|e| Error::io("modes.uff (in memory)", e))?;
+    write_2411(&mut out, &nodes).map_err(|e| Error::io("modes.uff (in memory)", e))?;
     for i in 0..n {
         let w = m.omega_rad_per_s[i];
         let d = m.damping.get(i * n + i).copied().unwrap_or(0.0);
@@ -1599,7 +1662,7 @@ pub fn modes_uff_points(m: &crate::modal::ModalModel) -> Result<Vec<u8>> {
                 .collect(),
             units: Some(si_units()),
         };
-        write_55(&mut out, &mode).map_err(|e| Error::io("UFF output", e))?;
+        write_55(&mut out, &mode).map_err(|e| Error::io("modes.uff (in memory)", e))?;
     }
     Ok(out)
 }
@@ -1623,8 +1686,8 @@ pub fn modes_uff_fe(
         })
         .collect();
     let mut out = Vec::new();
-    write_164(&mut out, &si_units()).map_err(|e| Error::io("UFF output", e))?;
-    write_2411(&mut out, &nodes).map_err(|e| Error::io("UFF output", e))?;
+    write_164(&mut out, &si_units()).map_err(|e| Error::io("modes.uff (in memory)", e))?;
+    write_2411(&mut out, &nodes).map_err(|e| Error::io("modes.uff (in memory)", e))?;
     for i in 0..modes.omega_rad_per_s.len() {
         let t = super::vtk::mode_translations(model, modes, i)?;
         let mode = Mode {
@@ -1645,7 +1708,7 @@ pub fn modes_uff_fe(
                 .collect(),
             units: Some(si_units()),
         };
-        write_55(&mut out, &mode).map_err(|e| Error::io("UFF output", e))?;
+        write_55(&mut out, &mode).map_err(|e| Error::io("modes.uff (in memory)", e))?;
     }
     Ok(out)
 }
@@ -1937,6 +2000,133 @@ mod tests {
         write_55(&mut plain, &f.modes[0]).unwrap();
         let g = parse_uff(&plain[..], "p.unv", None).unwrap();
         assert_eq!(g.modes[0].units, None);
+    }
+
+    /// A 2411 node in a local displacement coordinate system (or with none given) is refused,
+    /// naming the node: its shapes would be read in the wrong axes. 0 and 1 (global) read.
+    #[test]
+    fn nodes_in_a_local_or_undefined_coordinate_system_are_refused() {
+        let nodes = vec![Node {
+            label: 5,
+            xyz: [0.0, 0.5, 1.25],
+        }];
+        let mut buf = Vec::new();
+        write_2411(&mut buf, &nodes).unwrap();
+        let text = String::from_utf8(buf).unwrap();
+        let line = "         5         1         1        11";
+        assert!(text.contains(line), "{text}");
+        for (cs, ok) in [("0", true), ("1", true), ("3", false)] {
+            let t = text.replace(line, &format!("         5         1{cs:>10}        11"));
+            let r = parse_uff(t.as_bytes(), "n.unv", None);
+            assert_eq!(r.is_ok(), ok, "{cs}: {r:?}");
+            if !ok {
+                let e = r.unwrap_err().to_string();
+                assert!(
+                    e.contains("record 1")
+                        && e.contains("node 5: displacement coordinate system 3 is a local system"),
+                    "{e}"
+                );
+            }
+        }
+        let t = text.replace(line, "         5");
+        let e = parse_uff(t.as_bytes(), "n.unv", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("node 5: no displacement coordinate system"),
+            "{e}"
+        );
+    }
+
+    /// Record 7 of a dataset 55 declares NINT integer and NRDV real values: data that hold
+    /// another number are refused, naming the record.
+    #[test]
+    fn a_mode_whose_value_counts_disagree_with_record_7_is_refused() {
+        let mode = Mode {
+            number: 1,
+            frequency_hz: 10.0,
+            modal_mass: 1.0,
+            damping_ratio: 0.0,
+            name: "m".into(),
+            id_lines: Vec::new(),
+            shapes: vec![(1, [0.0, 0.0, 0.5])],
+            units: None,
+        };
+        let mut buf = Vec::new();
+        write_55(&mut buf, &mode).unwrap();
+        let text = String::from_utf8(buf).unwrap();
+        assert!(parse_uff(text.as_bytes(), "m.unv", None).is_ok());
+        let r7 = "         2         4         1         1";
+        assert!(text.contains(r7), "{text}");
+        let bad = text.replace(r7, "         2         5         1         1");
+        let e = parse_uff(bad.as_bytes(), "m.unv", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("record 8") && e.contains("declares 5 real values (NRDV"),
+            "{e}"
+        );
+        let bad = text.replace(r7, "         3         4         1         1");
+        let e = parse_uff(bad.as_bytes(), "m.unv", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("record 7") && e.contains("declares 3 integer values"),
+            "{e}"
+        );
+    }
+
+    /// An even abscissa whose increment makes the record's times infinite (1e308 s over two
+    /// points) is refused, naming the increment (before: read, and `measure` printed "inf").
+    #[test]
+    fn an_increment_that_makes_times_infinite_is_refused() {
+        let text = format!(
+            "{}  1.00000e+00  2.00000e+00\n    -1\n",
+            header("g", 12, 2, 1)
+        )
+        .replace("1.00000e-03", "1.00000e+308");
+        let e = parse_uff(text.as_bytes(), "s.uff", None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("record 7") && e.contains("increment 1e308"),
+            "{e}"
+        );
+        let ok = format!(
+            "{}  1.00000e+00  2.00000e+00\n    -1\n",
+            header("g", 12, 2, 1)
+        );
+        assert!(parse_uff(ok.as_bytes(), "s.uff", None).is_ok());
+    }
+
+    /// A write error (a full disk) names the file written.
+    #[test]
+    fn a_write_error_names_the_file() {
+        struct Full;
+        impl std::io::Write for Full {
+            fn write(&mut self, _: &[u8]) -> std::io::Result<usize> {
+                Err(std::io::Error::from_raw_os_error(28))
+            }
+            fn flush(&mut self) -> std::io::Result<()> {
+                Ok(())
+            }
+        }
+        let r = Record {
+            name: "bed_acceleration".into(),
+            quantity: Quantity::Acceleration,
+            source_unit: "m/s^2".into(),
+            point: None,
+            abscissa: Abscissa::Even {
+                start_s: 0.0,
+                step_s: 1e-3,
+            },
+            values: vec![0.0, 1.0],
+            origin: "test".into(),
+        };
+        let e = write_records(&mut Full, &[r], false, Path::new("out/history.uff"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("out/history.uff: "), "{e}");
     }
 
     #[test]

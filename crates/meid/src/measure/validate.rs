@@ -431,6 +431,22 @@ fn one_case(
         let measured_baseline = measured.removed();
         let peak = |v: &[f64]| v.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
         let (mp, spk) = (peak(&ma), peak(&sa));
+        let peak_error_percent = 100.0 * (mp - spk) / spk;
+        if !mp.is_finite() || (spk > 0.0 && !peak_error_percent.is_finite()) {
+            return Err(Error::Input {
+                location: r.origin.clone(),
+                message: format!(
+                    "channel '{}' ({}): the measured sample peak {} {u} is {} times the simulated {} {u}, so the peak error ({} %) is not a finite number; a sample of this size is not a measurement in {u}: check the file's values and unit label",
+                    r.name,
+                    c.label(),
+                    crate::num(mp),
+                    crate::num(mp / spk),
+                    crate::num(spk),
+                    crate::num(peak_error_percent),
+                    u = r.unit()
+                ),
+            });
+        }
         let (rref, rtext) = esd_reference(r.quantity);
         let mut rows = Vec::new();
         let strongest = modes
@@ -473,7 +489,7 @@ fn one_case(
             simulated_peak: spk,
             measured_peak: mp,
             measured_baseline,
-            peak_error_percent: 100.0 * (mp - spk) / spk,
+            peak_error_percent,
             level_reference: rtext,
             modes: rows,
             measured_average: ma,

@@ -231,10 +231,24 @@ impl ModalModel {
             ));
         }
         for (name, v) in &self.points {
-            if v.len() != n || v.iter().any(|x| !x.is_finite()) {
+            if v.len() != n {
                 return Err(Error::invalid(
                     format!("point {name}"),
-                    format!("needs {n} finite mode-shape values (got {})", v.len()),
+                    format!(
+                        "{} mode-shape values for the {n} modes: give one value (1/√kg) per mode",
+                        v.len()
+                    ),
+                ));
+            }
+            if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+                return Err(Error::invalid(
+                    format!("point {name}"),
+                    format!(
+                        "the mode-shape value of mode {} ({} Hz) is {}: every value must be a finite number (1/√kg)",
+                        k + 1,
+                        crate::num(self.omega_rad_per_s[k] / (2.0 * std::f64::consts::PI)),
+                        crate::num(v[k])
+                    ),
                 ));
             }
         }

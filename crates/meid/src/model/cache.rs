@@ -128,10 +128,17 @@ impl Model {
     ) -> Result<Model> {
         check_magnitudes(&spec, &source)?;
         let structure = self.structure_for(&spec, &source, cache)?;
+        let paths = super::referenced_paths(&spec, &source.name);
+        let files = if paths.iter().eq(self.files.iter().map(|f| &f.path)) {
+            self.files.clone()
+        } else {
+            super::input_files(paths)?
+        };
         let model = Model {
             spec,
             structure,
             source,
+            files,
         };
         model.validate()?;
         Ok(model)

@@ -16,7 +16,9 @@ use super::{fem, source, spec_from_table, Source};
 use crate::{Error, Result};
 
 /// The model file `name` (text `text`, with `--set` `overrides` applied) with its
-/// `[structure.fem.machine]` replaced by the `[structure.fem.model]` it generates.
+/// `[structure.fem.machine]` replaced by the `[structure.fem.model]` it generates. The model
+/// is loaded first, with every check [`super::Model::from_text`] makes: a model meid refuses
+/// is refused here too, with the same error.
 pub fn expand_text(name: &str, text: &str, overrides: &[String]) -> Result<String> {
     let mut table: toml::Table =
         toml::from_str(text).map_err(|e| source::toml_error(name, text, &e))?;
@@ -36,6 +38,10 @@ pub fn expand_text(name: &str, text: &str, overrides: &[String]) -> Result<Strin
             format!("{name}: has no [structure.fem.machine] to expand (only the parametric machine is a generator; [structure.fem.model] is already the general model)"),
         ));
     };
+    // Every check of a model load (values, structure, contacts, damper), with the same
+    // messages: an expanded file is never written from a model meid refuses (a negative
+    // stiffness or a NaN mass given through `--set`).
+    super::Model::from_text(name, text.to_string(), overrides)?;
     let general = fem::machine_general(machine, &src)?;
     if let Some(fem) = table
         .get_mut("structure")
@@ -62,7 +68,7 @@ pub fn expand_text(name: &str, text: &str, overrides: &[String]) -> Result<Strin
 
 /// [`expand_text`] on a file.
 pub fn expand_file(path: &Path, overrides: &[String]) -> Result<String> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = crate::input::read_text(path)?;
     expand_text(&path.display().to_string(), &text, overrides)
 }
 

@@ -1542,6 +1542,12 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
     };
     selected.sort_unstable();
     selected.dedup();
+    if selected.is_empty() {
+        return Err(src.error(
+            &format!("{base}.select"),
+            format!("{base}.select keeps no mode: select at least one of the {nm} modes computed (a list of mode numbers 1..={nm}, \"auto\", \"participation\" or {{ band_hz = [lo, hi] }})"),
+        ));
+    }
     let ns = selected.len();
     let mut cluster = crate::modal::eigenspace::degenerate_clusters(&modes.omega_rad_per_s);
     if let Some(c) = &cut_cluster {
@@ -1641,7 +1647,15 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             ));
         }
     }
-    let mut modal = model.modal_model(&modes, &selected, &zeta)?;
+    let mut modal = model
+        .modal_model(&modes, &selected, &zeta)
+        .map_err(|e| match e {
+            Error::InvalidValue { field, message } => src.error(
+                base,
+                format!("{base}: the selected modes: {field}: {message}"),
+            ),
+            e => e,
+        })?;
     if let Some([a, b]) = spec.rayleigh {
         if !(a.is_finite() && b.is_finite() && a >= 0.0 && b >= 0.0) {
             return Err(src.error(
@@ -1950,7 +1964,7 @@ pub fn from_file_with_analysis(
     overrides: &[String],
     count: Option<usize>,
 ) -> Result<(Model, Option<FemAnalysis>)> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = crate::input::read_text(path)?;
     from_text_with_analysis(&path.display().to_string(), text, overrides, count)
 }
 

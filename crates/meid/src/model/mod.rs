@@ -116,6 +116,51 @@ pub struct Model {
     /// The bare structure (no added mass), as modes.
     pub structure: ModalModel,
     pub source: Source,
+    /// The files the model reads besides its own text ([`referenced_paths`]), with their
+    /// content's size and hash when the model was built.
+    pub files: Vec<InputFile>,
+}
+
+/// A file a model reads besides its own text (a Gmsh mesh, a UFF or CalculiX `.frd` modes
+/// file) as it was when the model was built: its size and the FNV-1a 64 of its bytes
+/// ([`crate::input::digest`]). Studies put these in their fingerprint, so results computed
+/// from another version of the file are never taken for this model's.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct InputFile {
+    /// The path as the model resolves it (relative to the model file's directory).
+    pub path: std::path::PathBuf,
+    pub bytes: u64,
+    /// 16 hex digits.
+    pub fnv1a: String,
+}
+
+/// The files a model of `spec` read from `source_name` refers to, resolved as the readers do
+/// (relative to the model file's directory): `structure.fem.mesh.file`,
+/// `structure.fem.model.mesh` and `structure.modes.file`.
+pub fn referenced_paths(spec: &ModelSpec, source_name: &str) -> Vec<std::path::PathBuf> {
+    let dir = Path::new(source_name)
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default();
+    let st = &spec.structure;
+    let fem = st.fem.as_ref();
+    fem.and_then(|f| f.mesh.as_ref().map(|m| m.file.as_str()))
+        .into_iter()
+        .chain(fem.and_then(|f| f.model.as_ref().and_then(|g| g.mesh.as_deref())))
+        .chain(st.modes.as_ref().map(|m| m.file.as_str()))
+        .map(|f| dir.join(f))
+        .collect()
+}
+
+/// [`InputFile`]s of `paths`, read now.
+fn input_files(paths: Vec<std::path::PathBuf>) -> Result<Vec<InputFile>> {
+    paths
+        .into_iter()
+        .map(|path| {
+            let (bytes, fnv1a) = crate::input::digest(&path)?;
+            Ok(InputFile { path, bytes, fnv1a })
+        })
+        .collect()
 }
 
 /// Which absorber to build the impact system with (for comparisons).
@@ -152,7 +197,7 @@ impl std::str::FromStr for Case {
 impl Model {
     /// Reads and validates a model file, applying `--set PATH=VALUE` overrides in order.
     pub fn from_file(path: &Path, overrides: &[String]) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::input::read_text(path)?;
         Self::from_text(&path.display().to_string(), text, overrides)
     }
 
@@ -190,13 +235,30 @@ impl Model {
         // 3. Values.
         check_magnitudes(&spec, &src)?;
         let structure = build(&spec, &src)?;
+        let files = input_files(referenced_paths(&spec, &src.name))?;
         let model = Model {
             spec,
             structure,
             source: src,
+            files,
         };
         model.validate()?;
         Ok(model)
+    }
+
+    /// The content of the files the model refers to, for a study's fingerprint: empty for a
+    /// model without such files, else `|files ` and `size:fnv1a` of each, in
+    /// [`referenced_paths`] order.
+    pub fn files_fingerprint(&self) -> String {
+        if self.files.is_empty() {
+            return String::new();
+        }
+        let each: Vec<String> = self
+            .files
+            .iter()
+            .map(|f| format!("{}:{}", f.bytes, f.fnv1a))
+            .collect();
+        format!("|files {}", each.join(","))
     }
 
     /// Attaches a file position to errors about a field.

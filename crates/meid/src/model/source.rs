@@ -166,7 +166,7 @@ pub fn toml_error_message(name: &str, text: &str, e: &toml::de::Error, message: 
     if let Some(s) = e.span() {
         let (l, _) = line_col(text, s.start);
         if let Some(line) = text.lines().nth(l - 1) {
-            message.push_str(&format!("\n  | {line}"));
+            message.push_str(&format!("\n  | {}", crate::input::clip(line)));
         }
     }
     Error::Input { location, message }

@@ -179,11 +179,14 @@ struct Lex<'a> {
 }
 
 fn lossy(b: &[u8]) -> String {
-    let s = String::from_utf8_lossy(&b[..b.len().min(40)]).into_owned();
-    if b.len() > 40 {
-        format!("{s}…")
+    // At most 4 bytes per character: enough bytes for the clipped text and its `…`.
+    let keep = b.len().min(4 * crate::input::CLIP_CHARS + 4);
+    let s = String::from_utf8_lossy(&b[..keep]);
+    let c = crate::input::clip(&s);
+    if keep < b.len() && !c.ends_with('…') {
+        format!("{c}…")
     } else {
-        s
+        c
     }
 }
 
@@ -606,7 +609,7 @@ fn dim_name(dim: i64) -> &'static str {
 /// Reads a `.msh` file: MSH 4.1 ASCII or binary, or MSH 2.2 ASCII.
 pub fn read_msh(path: impl AsRef<Path>) -> Result<GmshMesh> {
     let path = path.as_ref();
-    let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let data = crate::input::read_bytes(path)?;
     parse_msh_bytes(&data, &path.display().to_string())
 }
 
@@ -1003,7 +1006,8 @@ fn read_element(
                 return Err(lx.err(
                     nloc,
                     format!(
-                        "element {tag} (in {desc}) refers to node '{text}', which is not in $Nodes"
+                        "element {tag} (in {desc}) refers to node '{}', which is not in $Nodes",
+                        crate::input::clip(&text)
                     ),
                 ))
             }

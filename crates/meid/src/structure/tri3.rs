@@ -318,8 +318,10 @@ pub struct OrientationFault {
 
 /// Checks that the elements of one surface (polygons as node lists, positions `x`) are
 /// consistently oriented: two elements sharing an edge must run it in opposite directions, and
-/// their normals must not be folded back onto each other (`n₁·n₂ < -0.9`). Returns the first
-/// fault found.
+/// their normals must not be folded back onto each other (`n₁·n₂ < -0.9`). Every pair of
+/// elements on an edge is checked, so an edge of one surface holds at most two elements (a
+/// third runs it in the same direction as one of them: it overlaps that one). Returns the
+/// first fault found.
 pub fn check_orientation(elements: &[&[usize]], x: &[V3]) -> Option<OrientationFault> {
     let normal = |e: &[usize]| -> V3 {
         let p = |i: usize| x[e[i % e.len()]];
@@ -333,33 +335,33 @@ pub fn check_orientation(elements: &[&[usize]], x: &[V3]) -> Option<OrientationF
         }
         unit(nrm).unwrap_or([0.0; 3])
     };
-    let mut seen: HashMap<[usize; 2], (usize, bool)> = HashMap::new();
+    // Every element met on an edge so far, with its direction along it: an element is checked
+    // against each of them (an edge of three elements, the third overlapping one of the
+    // others, runs the edge in the same direction as one of them).
+    let mut seen: HashMap<[usize; 2], Vec<(usize, bool)>> = HashMap::new();
     for (ei, e) in elements.iter().enumerate() {
         for k in 0..e.len() {
             let (a, b) = (e[k], e[(k + 1) % e.len()]);
             let key = [a.min(b), a.max(b)];
             let forward = a < b;
-            match seen.get(&key) {
-                Some(&(other, fwd)) => {
-                    if fwd == forward {
-                        return Some(OrientationFault {
-                            elements: [other, ei],
-                            edge: [a, b],
-                            same_direction: true,
-                        });
-                    }
-                    if dot(normal(elements[other]), normal(e)) < -0.9 {
-                        return Some(OrientationFault {
-                            elements: [other, ei],
-                            edge: [a, b],
-                            same_direction: false,
-                        });
-                    }
+            let on_edge = seen.entry(key).or_default();
+            for &(other, fwd) in on_edge.iter() {
+                if fwd == forward {
+                    return Some(OrientationFault {
+                        elements: [other, ei],
+                        edge: [a, b],
+                        same_direction: true,
+                    });
                 }
-                None => {
-                    seen.insert(key, (ei, forward));
+                if dot(normal(elements[other]), normal(e)) < -0.9 {
+                    return Some(OrientationFault {
+                        elements: [other, ei],
+                        edge: [a, b],
+                        same_direction: false,
+                    });
                 }
             }
+            on_edge.push((ei, forward));
         }
     }
     None
@@ -452,5 +454,18 @@ mod tests {
         let folded: [&[usize]; 2] = [&[0, 1, 2], &[0, 2, 4]];
         let f = check_orientation(&folded, &x).unwrap();
         assert!(!f.same_direction && f.elements == [0, 1], "{f:?}");
+        // Edge 0-2 shared by three triangles: the third, (0, 2, 4), runs it against the first
+        // (0, 1, 2) as a neighbour should, but in the same direction as the second (0, 2, 3),
+        // which it overlaps (node 4 lies on node 3's side of the edge).
+        let x3: Vec<V3> = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.3, 0.7, 0.0],
+        ];
+        let three: [&[usize]; 3] = [&[0, 1, 2], &[0, 2, 3], &[0, 2, 4]];
+        let f = check_orientation(&three, &x3).unwrap();
+        assert!(f.same_direction && f.elements == [1, 2], "{f:?}");
     }
 }

@@ -56,9 +56,21 @@ pub fn check_uff(bytes: &[u8]) {
         for r in &f.records {
             assert!(r.values.iter().all(|v| v.is_finite()));
             assert!(r.values.len() as u64 <= bytes.len() as u64);
-            if let Abscissa::Uneven(t) = &r.abscissa {
-                assert_eq!(t.len(), r.values.len());
-                assert!(t.windows(2).all(|w| w[1] > w[0]));
+            match &r.abscissa {
+                Abscissa::Uneven(t) => {
+                    assert_eq!(t.len(), r.values.len());
+                    assert!(t.windows(2).all(|w| w[1] > w[0]));
+                    assert!(t.iter().all(|v| v.is_finite()));
+                }
+                // Every sample's time, the record's end and the rate are finite numbers.
+                Abscissa::Even { start_s, step_s } => {
+                    let last = start_s + r.values.len() as f64 * step_s;
+                    assert!(
+                        start_s.is_finite() && last.is_finite(),
+                        "{start_s} {step_s}"
+                    );
+                    assert!(*step_s > 0.0 && (1.0 / step_s).is_finite(), "{step_s}");
+                }
             }
         }
     }
