@@ -224,9 +224,12 @@ fn paper_page_figures_table_and_closed_forms() {
     // table's vibration power reduction (another path: the comparison), Eq. 24 rises after the
     // collision while the machine's own energy decays.
     let physics = json["physics"].as_array().unwrap();
-    let finding = |id: &str| physics.iter().filter(move |f| f["id"] == id);
+    let finding = |id: &str| -> Vec<&serde_json::Value> {
+        physics.iter().filter(|f| f["id"] == id).collect()
+    };
     let value = |id: &str, name: &str| {
         finding(id)
+            .into_iter()
             .flat_map(|f| f["values"].as_array().unwrap().iter())
             .find(|v| v[0] == name)
             .map(|v| v[1].as_f64().unwrap())
@@ -239,7 +242,7 @@ fn paper_page_figures_table_and_closed_forms() {
         "eq24",
         "damper-mass",
     ] {
-        assert!(finding(id).count() > 0, "no finding {id}");
+        assert!(!finding(id).is_empty(), "no finding {id}");
     }
     let fe_db = value("bed-strike-mass", "FE: vibration power reduction at S");
     assert!(
