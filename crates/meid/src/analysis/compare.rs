@@ -538,7 +538,8 @@ impl Comparison {
                             .structure
                             .mode_numbers
                             .get(i)
-                            .map_or(i + 1, |k| *k),
+                            .copied()
+                            .unwrap_or(i + 1),
                     )
                 })
             });
@@ -566,7 +567,8 @@ impl Comparison {
                 .structure
                 .mode_numbers
                 .get(i)
-                .map_or(i + 1, |k| *k);
+                .copied()
+                .unwrap_or(i + 1);
             out.push(ModeSpec::Index(i, format!("mode {number} (bed)")));
         }
         out

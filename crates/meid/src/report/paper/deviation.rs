@@ -545,6 +545,7 @@ fn eta_md1(machines: &[Machine]) -> Vec<DeviationRow> {
         .collect()
 }
 
+#[allow(clippy::too_many_arguments)]
 fn row(
     number: &str,
     paper_value: f64,
@@ -749,22 +750,7 @@ fn timing_rows(machines: &[Machine], studies: &[MachineStudy]) -> Vec<DeviationR
     let (lq, fq) = (q_offset(ls), fe.and_then(|(_, s)| q_offset(s)));
     let mut out = Vec::new();
     for mb in super::physics::RETUNED_BEDS_KG {
-        let offset = (|| -> Option<f64> {
-            let (k_c, k_f) =
-                super::machines::two_mode_springs(mb, super::machines::BASE_MASS_KG, 6.35, 283.0)
-                    .ok()?;
-            let mut m = l.clone();
-            m.model = l
-                .rebuilt(&[
-                    format!("structure.lumped.masses=[{{ name = \"bed\", mass = {mb:e} }}, {{ name = \"base\", mass = {:e} }}]", super::machines::BASE_MASS_KG),
-                    format!("structure.lumped.springs[0].stiffness={k_c:e}"),
-                    format!("structure.lumped.springs[1].stiffness={k_f:e}"),
-                ])
-                .ok()?;
-            let h =
-                super::studies::history_at(&m, "Q", super::machines::WS_OVER_W6_S, 2.0e6).ok()?;
-            Some((h.pe_kd_peak_s - h.slider_leaves_s) / h.slider_leaves_s)
-        })();
+        let offset = retuned_q_offset(l, mb);
         out.push(row(
             "q-timing",
             0.0,
@@ -781,4 +767,23 @@ fn timing_rows(machines: &[Machine], studies: &[MachineStudy]) -> Vec<DeviationR
         ));
     }
     out
+}
+
+/// (t(PE_Kd max) − t(slider leaves))/t(slider leaves) at Q on the soft lumped machine `l`
+/// re-tuned to 6.35 / 283 Hz with a bed of `mb` kg over the same base.
+fn retuned_q_offset(l: &Machine, mb: f64) -> Option<f64> {
+    use super::machines::{two_mode_springs, BASE_MASS_KG};
+    let (k_c, k_f) = two_mode_springs(mb, BASE_MASS_KG, 6.35, 283.0).ok()?;
+    let mut m = l.clone();
+    m.model = l
+        .rebuilt(&[
+            format!(
+                "structure.lumped.masses=[{{ name = \"bed\", mass = {mb:e} }}, {{ name = \"base\", mass = {BASE_MASS_KG:e} }}]"
+            ),
+            format!("structure.lumped.springs[0].stiffness={k_c:e}"),
+            format!("structure.lumped.springs[1].stiffness={k_f:e}"),
+        ])
+        .ok()?;
+    let h = super::studies::history_at(&m, "Q", WS_OVER_W6_S, 2.0e6).ok()?;
+    Some((h.pe_kd_peak_s - h.slider_leaves_s) / h.slider_leaves_s)
 }
