@@ -297,6 +297,9 @@ fn summarise(sweep: &Sweep, r: &SweepResult, metric: &str, elapsed: f64, files: 
         elapsed,
         r.failures()
     );
+    if let Some(m) = &r.spec.reference_mode {
+        println!("  {}", m.describe());
+    }
     let names: Vec<String> = sweep.vary.iter().map(|v| v.quantity.name()).collect();
     let mut shown: Vec<String> = Vec::new();
     for m in [metric, "energy_ratio"] {
@@ -351,11 +354,12 @@ fn summarise(sweep: &Sweep, r: &SweepResult, metric: &str, elapsed: f64, files: 
 
 /// Axis label in the paper's terms with unit (`ω_d/ω_s (1)`, `K_s (N/m)`), ω_ref named
 /// by its mode and frequency when the reference is known.
-fn label(q: &Quantity, w_ref: Option<f64>) -> String {
+fn label(q: &Quantity, w_ref: Option<f64>, number: Option<usize>) -> String {
     let l = q.axis_label();
+    let mode = number.map_or(String::new(), |k| format!(", mode {k}"));
     match (q, w_ref) {
         (Quantity::WsOverWref | Quantity::WdOverWref, Some(w)) => format!(
-            "{l}, ω_ref = {} rad/s ({} Hz)",
+            "{l}, ω_ref = {} rad/s ({} Hz{mode})",
             meid::plot::axis::fmt_tick(&w),
             meid::plot::axis::fmt_tick(&(w / (2.0 * std::f64::consts::PI)))
         ),
@@ -446,6 +450,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
     };
     let stem = metric.replace('/', "_");
     let w_ref = r.spec.reference_omega_rad_per_s;
+    let number = r.spec.reference_mode.as_ref().map(|m| m.number);
     // No picture of a metric undefined at every point (e.g. the energy ratio when no run
     // reached the end of the collision); the summary says so.
     let defined =
@@ -464,7 +469,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                     metric_name(sweep, metric),
                     vary[0].quantity.symbol()
                 ),
-                x_label: label(&vary[0].quantity, w_ref),
+                x_label: label(&vary[0].quantity, w_ref, number),
                 y_label: picture_label(sweep, metric),
                 x_log: vary[0].spacing == Spacing::Log,
                 y_log: false,
@@ -509,7 +514,7 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                     metric_name(sweep, metric),
                     vary[0].quantity.symbol()
                 ),
-                x_label: label(&vary[0].quantity, w_ref),
+                x_label: label(&vary[0].quantity, w_ref, number),
                 y_label: picture_label(sweep, metric),
                 x_log: vary[0].spacing == Spacing::Log,
                 series,
@@ -578,8 +583,8 @@ fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<
                     } else {
                         format!("{what}, {prefix}")
                     },
-                    x_label: label(q0, w_ref),
-                    y_label: label(q1, w_ref),
+                    x_label: label(q0, w_ref, number),
+                    y_label: label(q1, w_ref, number),
                     x,
                     y,
                     z,

@@ -133,7 +133,8 @@ fn sweep_of_a_field_names_its_symbol_and_unit_and_the_map_its_reference() {
     // The lumped example's reference mode: 39.898 rad/s, 6.35 Hz.
     assert!(
         t.iter()
-            .any(|x| x.starts_with("ω_s/ω_ref (1), ω_ref = 39.89") && x.ends_with("(6.35 Hz)")),
+            .any(|x| x.starts_with("ω_s/ω_ref (1), ω_ref = 39.89")
+                && x.ends_with("(6.35 Hz, mode 1)")),
         "{t:?}"
     );
     assert!(t.iter().any(|x| x == "ω_d = ω_s"));

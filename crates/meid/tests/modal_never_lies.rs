@@ -105,7 +105,7 @@ fn model_file(dir: &Path, n: usize, support: &str, solver: &str) -> PathBuf {
     let toml = format!(
         r#"name = "simply supported plate"
 [structure]
-reference_mode = 1
+reference_mode = 4
 [structure.fem]
 select = [4]
 count = 9

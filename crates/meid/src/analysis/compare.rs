@@ -545,22 +545,32 @@ impl Comparison {
         let n = st.len();
         let reference = self
             .model
-            .spec
-            .structure
-            .reference_mode
-            .map(|r| r - 1)
-            .or_else(|| (0..n).find(|&i| st.omega_rad_per_s[i] > 0.0));
+            .reference_mode()
+            .map(|r| (r.index, r.number))
+            .or_else(|| {
+                (0..n).find(|&i| st.omega_rad_per_s[i] > 0.0).map(|i| {
+                    (
+                        i,
+                        self.model
+                            .structure
+                            .mode_numbers
+                            .get(i)
+                            .copied()
+                            .unwrap_or(i + 1),
+                    )
+                })
+            });
         let mut out = Vec::new();
-        if let Some(r) = reference {
+        if let Some((r, number)) = reference {
             if st.omega_rad_per_s[r] > 0.0 {
-                out.push(ModeSpec::Index(r, format!("mode {} (reference)", r + 1)));
+                out.push(ModeSpec::Index(r, format!("mode {number} (reference)")));
             }
         }
         let pb = &bare.points.bed_contact;
         let pm = &bare.points.measurement;
         let mut best: Option<(usize, f64)> = None;
         for i in 0..n {
-            if Some(i) == reference || st.omega_rad_per_s[i] <= 0.0 {
+            if Some(i) == reference.map(|r| r.0) || st.omega_rad_per_s[i] <= 0.0 {
                 continue;
             }
             let w = pb[i].abs() * pm[i].abs();
@@ -569,7 +579,14 @@ impl Comparison {
             }
         }
         if let Some((i, _)) = best {
-            out.push(ModeSpec::Index(i, format!("mode {} (bed)", i + 1)));
+            let number = self
+                .model
+                .structure
+                .mode_numbers
+                .get(i)
+                .copied()
+                .unwrap_or(i + 1);
+            out.push(ModeSpec::Index(i, format!("mode {number} (bed)")));
         }
         out
     }

@@ -576,6 +576,10 @@ pub struct SweepSpec {
     pub stop_at_collision_end: bool,
     pub sample_rate_hz: Option<f64>,
     pub reference_omega_rad_per_s: Option<f64>,
+    /// The reference mode (structure number, frequency, effective mass) when the sweep varies a
+    /// ratio to ω_ref (ws/w_ref, wd/w_ref).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reference_mode: Option<crate::model::ReferenceMode>,
     pub bed_mass_kg: Option<f64>,
     /// The cases run at every point ([`case_name`]); absent without cases.
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -936,6 +940,12 @@ impl Sweep {
                     .any(|v| v.quantity == Quantity::Field("simulation.duration".into())),
             sample_rate_hz: self.options.sample_rate,
             reference_omega_rad_per_s: self.model.reference_omega(),
+            reference_mode: self
+                .vary
+                .iter()
+                .any(|v| matches!(v.quantity, Quantity::WsOverWref | Quantity::WdOverWref))
+                .then(|| self.model.reference_mode())
+                .flatten(),
             bed_mass_kg: self.bed_mass_kg.or_else(|| self.model.bed_mass()),
             cases: self
                 .cases
@@ -1361,7 +1371,7 @@ pub fn check_quantities(model: &Model, qs: &[&Quantity], bed_mass_kg: Option<f64
     if needs_ref && model.reference_omega().is_none() {
         return Err(Error::invalid(
             "vary",
-            "ws/w_ref and wd/w_ref need the model's reference mode: set structure.reference_mode",
+            "ws/w_ref and wd/w_ref need the model's reference mode: set structure.reference_mode to the structure's number of the mode (as `meid modes` lists them); without it meid takes the mode with the largest effective mass along the blow, which tabulated and imported modes do not tell",
         ));
     }
     let needs_damper =

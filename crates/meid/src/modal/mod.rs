@@ -60,6 +60,16 @@ pub struct ModalModel {
     pub floor_force: Option<FloorForce>,
     /// A label per mode for tables and plots, e.g. "mode 6".
     pub labels: Vec<String>,
+    /// The structure's number of each retained mode (1-based, ascending frequency among all
+    /// computed modes, as `meid modes` lists them): `structure.reference_mode` names a mode by
+    /// it.
+    pub mode_numbers: Vec<usize>,
+    /// Effective modal mass along the impact direction of each retained mode (kg),
+    /// `Γ_i² = (φ_iᵀ M r)²` with `r` the unit rigid translation along the impact direction
+    /// (Chopra, *Dynamics of Structures*, §13.2): the mass that moves with the mode in the
+    /// direction of the blow. `None` when the mass matrix is not known (tabulated or imported
+    /// modes).
+    pub effective_mass_kg: Option<Vec<f64>>,
     /// Static flexibility of the full (unreduced) structure along z at named points (m/N), over
     /// its elastic modes: `G_PP = Σ_{all elastic modes} ψ_i(P)²/ω_i²`, computed from the
     /// stiffness matrix (see [`truncation`]). Empty when unknown (tabulated modes).
@@ -101,6 +111,8 @@ impl ModalModel {
             points: BTreeMap::new(),
             floor_force: None,
             labels,
+            mode_numbers: (1..=n).collect(),
+            effective_mass_kg: None,
             static_flexibility: BTreeMap::new(),
             notes: Vec::new(),
             warnings: Vec::new(),
@@ -187,6 +199,8 @@ impl ModalModel {
             points,
             floor_force,
             labels: (1..=n).map(|i| format!("mode {i}")).collect(),
+            mode_numbers: (1..=n).collect(),
+            effective_mass_kg: None,
             // A rigid mass changes no stiffness: without rigid-body modes G_PP is that of the
             // bare structure, and the Ritz basis keeps ψᵀΩ⁻²ψ (Y Ω'⁻² Yᵀ = Ω⁻² for
             // YᵀΩ²Y = Ω'²), so shares carry over. With rigid-body modes the elastic

@@ -534,6 +534,10 @@ pub fn build(
         .iter()
         .map(|m| format!("mode {} ({:.4} Hz)", m.number, m.frequency_hz))
         .collect();
+    model.mode_numbers = kept
+        .iter()
+        .map(|m| usize::try_from(m.number).unwrap_or(0))
+        .collect();
     notes.insert(
         0,
         format!(

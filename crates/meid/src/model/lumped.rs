@@ -418,9 +418,17 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
             None => vec![0.0; nd],
         }
     };
+    // Γ_j = Σ_i m_i ψ_j(i): every mass translates by 1 along the line of the blow (masses held
+    // by a rigid spring to the ground have ψ = 0; merged masses share their DOF's row).
+    let mut gamma = vec![0.0; nd];
     for (i, ms) in l.masses.iter().enumerate() {
-        model.points.insert(ms.name.clone(), row(i));
+        let r = row(i);
+        for (g, v) in gamma.iter_mut().zip(&r) {
+            *g += ms.mass * v;
+        }
+        model.points.insert(ms.name.clone(), r);
     }
+    model.effective_mass_kg = Some(gamma.iter().map(|g| g * g).collect());
 
     // Force to the floor.
     let grounded: Vec<(&Element, bool)> = springs

@@ -284,12 +284,14 @@ impl Model {
     pub(crate) fn validate_settings(&self) -> Result<()> {
         let s = &self.spec;
         let src = &self.source;
-        let n = self.structure.len();
         if let Some(r) = s.structure.reference_mode {
-            if r == 0 || r > n {
+            if !self.structure.mode_numbers.contains(&r) {
                 return Err(src.error(
                     "structure.reference_mode",
-                    format!("structure.reference_mode must be between 1 and {n} (the retained modes), got {r}"),
+                    format!(
+                        "structure.reference_mode = {r} is not a retained mode of the structure: it names a mode by the structure's number (as `meid modes` lists them); the retained modes are {}",
+                        self.retained_modes_text()
+                    ),
                 ));
             }
         }
@@ -529,12 +531,92 @@ impl Model {
         }
     }
 
-    /// ω_ref (rad/s): the reference mode's frequency, if the model names one.
+    /// ω_ref (rad/s): the reference mode's frequency ([`Model::reference_mode`]).
     pub fn reference_omega(&self) -> Option<f64> {
-        self.spec
-            .structure
-            .reference_mode
-            .map(|r| self.structure.omega_rad_per_s[r - 1])
+        self.reference_mode().map(|r| r.omega_rad_per_s)
+    }
+
+    /// The reference mode ω_ref of the ratios ω_s/ω_ref and ω_d/ω_ref: the retained mode
+    /// `structure.reference_mode` names by the structure's mode number; not given, the
+    /// retained mode with the largest effective modal mass along the blow, `Γ_i² = (φ_iᵀ M r)²`
+    /// (the mode the machine bounces in as a whole: the rigid-body mode on a floating base, the
+    /// bed mode without one), among the modes that vibrate (ω > 0). `None` when the file names
+    /// none and the effective masses are not known (tabulated or imported modes).
+    pub fn reference_mode(&self) -> Option<ReferenceMode> {
+        let st = &self.structure;
+        let (index, given) = match self.spec.structure.reference_mode {
+            Some(r) => (st.mode_numbers.iter().position(|&k| k == r)?, true),
+            None => {
+                let m = st.effective_mass_kg.as_ref()?;
+                let best = (0..st.len())
+                    .filter(|&i| st.omega_rad_per_s[i] > 0.0 && m[i].is_finite())
+                    .max_by(|&a, &b| m[a].total_cmp(&m[b]))?;
+                (best, false)
+            }
+        };
+        let w = st.omega_rad_per_s[index];
+        let psi = st
+            .points
+            .get(&self.spec.points.bed_contact)
+            .and_then(|v| v.get(index).copied())
+            .unwrap_or(f64::NAN);
+        Some(ReferenceMode {
+            number: st.mode_numbers.get(index).copied().unwrap_or(index + 1),
+            index,
+            omega_rad_per_s: w,
+            frequency_hz: w / (2.0 * std::f64::consts::PI),
+            effective_mass_kg: st.effective_mass_kg.as_ref().map(|m| m[index]),
+            strike_point: self.spec.points.bed_contact.clone(),
+            strike_point_mass_kg: 1.0 / (psi * psi),
+            given,
+        })
+    }
+
+    /// The retained modes as `5 (6.350 Hz), 10 (285.8 Hz)` for messages.
+    fn retained_modes_text(&self) -> String {
+        let st = &self.structure;
+        st.mode_numbers
+            .iter()
+            .zip(&st.omega_rad_per_s)
+            .map(|(k, w)| format!("{k} ({:.4} Hz)", w / (2.0 * std::f64::consts::PI)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// The warning when the reference mode barely moves the strike point: its mass there,
+    /// `1/ψ_ref(P)²`, more than [`REFERENCE_MASS_SPREAD`] times the smallest of the retained
+    /// modes' (the blow hardly excites the mode every ratio is scaled by).
+    fn reference_warning(&self) -> Option<String> {
+        let r = self.reference_mode()?;
+        let psi = self.structure.points.get(&r.strike_point)?;
+        let (k, lightest) = psi
+            .iter()
+            .map(|p| 1.0 / (p * p))
+            .enumerate()
+            .filter(|(_, m)| m.is_finite())
+            .min_by(|a, b| a.1.total_cmp(&b.1))?;
+        let ratio = r.strike_point_mass_kg / lightest;
+        if ratio.is_finite() && ratio <= REFERENCE_MASS_SPREAD {
+            return None;
+        }
+        let st = &self.structure;
+        let by = if r.given {
+            "structure.reference_mode"
+        } else {
+            "structure.reference_mode (not given: the largest effective mass along the blow)"
+        };
+        Some(format!(
+            "{}: {by}: the reference mode ω_ref, mode {} ({:.4} Hz), barely moves the strike point '{}': its mass there 1/ψ² = {:.4e} kg is {:.3e} times that of mode {} ({:.4} Hz, {lightest:.4e} kg), so the blow hardly excites the mode every ω_s/ω_ref and ω_d/ω_ref is scaled by. Name the mode the machine bounces in by its number in `meid modes` (retained: {})",
+            self.source.locate("structure.reference_mode"),
+            r.number,
+            r.frequency_hz,
+            r.strike_point,
+            r.strike_point_mass_kg,
+            ratio,
+            st.mode_numbers.get(k).copied().unwrap_or(k + 1),
+            st.omega_rad_per_s[k] / (2.0 * std::f64::consts::PI),
+            self.retained_modes_text()
+        ))
     }
 
     /// The added mass of the "added mass" case, `(m_a (kg), point)`: `added_mass.mass`, else the
@@ -686,6 +768,53 @@ fn build_structure(spec: &ModelSpec, src: &Source) -> Result<ModalModel> {
     ))
 }
 
+/// How many times the strike-point mass `1/ψ(P)²` of the reference mode may exceed the smallest
+/// of the retained modes' before [`Model::diagnostics`] warns that the reference barely moves
+/// the strike point.
+pub const REFERENCE_MASS_SPREAD: f64 = 100.0;
+
+/// The reference mode ω_ref of the ratios ω_s/ω_ref and ω_d/ω_ref ([`Model::reference_mode`]).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ReferenceMode {
+    /// The structure's mode number (1-based, as `meid modes` lists them).
+    pub number: usize,
+    /// Its position among the retained modes (0-based).
+    #[serde(skip)]
+    pub index: usize,
+    pub omega_rad_per_s: f64,
+    pub frequency_hz: f64,
+    /// Effective modal mass along the blow `Γ² = (φᵀ M r)²` (kg), when the mass matrix is known.
+    pub effective_mass_kg: Option<f64>,
+    /// The strike point (`points.bed_contact`).
+    pub strike_point: String,
+    /// The mode's mass at the strike point, `1/ψ(P)²` (kg): what the slider meets in this mode.
+    pub strike_point_mass_kg: f64,
+    /// Named by `structure.reference_mode` (else chosen by the largest effective mass).
+    pub given: bool,
+}
+
+impl ReferenceMode {
+    /// `ω_ref = mode 5, 6.3500 Hz (effective mass 50.99 kg, 1/ψ(O_b)² = 51.00 kg)`, printed
+    /// beside the ratios ω_s/ω_ref and ω_d/ω_ref.
+    pub fn describe(&self) -> String {
+        let eff = self
+            .effective_mass_kg
+            .map_or(String::new(), |m| format!("effective mass {m:.4} kg, "));
+        format!(
+            "ω_ref = mode {}, {:.4} Hz ({eff}1/ψ({})² = {:.4} kg{})",
+            self.number,
+            self.frequency_hz,
+            self.strike_point,
+            self.strike_point_mass_kg,
+            if self.given {
+                ""
+            } else {
+                "; chosen as the largest effective mass, structure.reference_mode not given"
+            }
+        )
+    }
+}
+
 /// What a report shows beside a model's results: how much of the structure the retained modes
 /// keep, what building it did, and what looks doubtful.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
@@ -724,6 +853,7 @@ impl Model {
             self.spec.slider.mass,
             &self.spec.points.bed_contact,
         ));
+        warnings.extend(self.reference_warning());
         Diagnostics {
             truncation,
             notes: self.structure.notes.clone(),

@@ -31,7 +31,10 @@ pub struct ModelSpec {
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq, Default)]
 #[serde(deny_unknown_fields)]
 pub struct StructureSpec {
-    /// 1-based index (in the retained modes) of the reference mode ω_ref (the paper's ω_6).
+    /// The reference mode ω_ref of the ratios ω_s/ω_ref, ω_d/ω_ref (the paper's ω_6), by the
+    /// structure's mode number (1-based, as `meid modes` lists every computed mode); it must be
+    /// a retained mode. Not given: the retained mode with the largest effective modal mass
+    /// along the blow ([`super::Model::reference_mode`]).
     #[serde(default)]
     pub reference_mode: Option<usize>,
     #[serde(default)]

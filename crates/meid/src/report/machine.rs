@@ -265,7 +265,7 @@ impl MachineReport {
         };
 
         progress(STAGES[2]);
-        let map = match Self::energy_map(&model, &modes, &options) {
+        let map = match Self::energy_map(&model, &options) {
             Ok(m) => m,
             Err(e) => {
                 notes.push(format!("energy map: {e}"));
@@ -344,11 +344,7 @@ impl MachineReport {
 
     /// The energy map study: ω_s/ω_n × ω_d/ω_n (linear contacts with a reference mode) or
     /// K_s × K_d around the design. `None` without a damper.
-    fn energy_map(
-        model: &Model,
-        modes: &ModeReport,
-        options: &MachineOptions,
-    ) -> Result<Option<EnergyMap>> {
+    fn energy_map(model: &Model, options: &MachineOptions) -> Result<Option<EnergyMap>> {
         let s = &model.spec;
         let (Some(d), Some(cd)) = (&s.damper, &s.contact.bed_damper) else {
             return Ok(None);
@@ -360,8 +356,7 @@ impl MachineReport {
             (Some(w_ref), true) if w_ref > 0.0 => {
                 let ws = (cs.stiffness / s.slider.mass).sqrt() / w_ref;
                 let wd = (cd.stiffness / d.mass).sqrt() / w_ref;
-                let r = s.structure.reference_mode.unwrap_or(1);
-                let number = modes.selected.get(r - 1).copied().unwrap_or(r);
+                let number = model.reference_mode().map_or(1, |r| r.number);
                 let mk = |q: Quantity, c: f64| Vary {
                     spec: format!("{}=grid around {c:e}", q.name()),
                     quantity: q,
@@ -586,15 +581,11 @@ impl MachineReport {
             ),
             "",
         );
-        if let Some(w) = m.reference_omega() {
+        if let Some(r) = m.reference_mode() {
             row(
                 "reference mode",
                 &self.reference_name(),
-                format!(
-                    "{} rad/s ({} Hz)",
-                    sig(w, 5),
-                    sig(w / (2.0 * std::f64::consts::PI), 4)
-                ),
+                format!("{} rad/s; {}", sig(r.omega_rad_per_s, 5), r.describe()),
                 "",
             );
         }
@@ -628,11 +619,16 @@ impl MachineReport {
                 sig(w_s, 5),
                 "rad/s",
             );
-            if let Some(w) = m.reference_omega() {
+            if let Some(r) = m.reference_mode() {
                 row(
                     "",
                     &format!("ω_s/{}", self.reference_name()),
-                    sig(w_s / w, 4),
+                    format!(
+                        "{} (ω_ref: mode {}, {} Hz)",
+                        sig(w_s / r.omega_rad_per_s, 4),
+                        r.number,
+                        sig(r.frequency_hz, 4)
+                    ),
                     "1",
                 );
             }
@@ -796,7 +792,16 @@ impl MachineReport {
                     "Energy left in the machine after one blow, E_p+/E_s− (%, paper Eq. 10, each run stopped at the end of the collision), over {xn} × {yn} on a {n} × {n} grid spanning ÷/× {} around the current design (the point marked \"design\", E_p+/E_s− = {} % there){}.",
                     figures::plain(if ratio { self.options.map_span } else { self.options.map_span.powi(2) }),
                     sig(100.0 * m.design_energy_ratio, 3),
-                    if ratio { "; the dashed line is the paper's rule ω_d = ω_s" } else { "" }
+                    if ratio {
+                        format!(
+                            "; the dashed line is the paper's rule ω_d = ω_s; {}",
+                            self.model
+                                .reference_mode()
+                                .map_or(String::new(), |r| r.describe())
+                        )
+                    } else {
+                        String::new()
+                    }
                 );
                 let fig = figures::energy_map(
                     dir,

@@ -188,6 +188,23 @@ impl FeModel {
                 )
             })
             .collect();
+        mm.mode_numbers = select.iter().map(|&s| s + 1).collect();
+        // Γ_i = φ_iᵀ M r along the impact direction d: r = d_x r_x + d_y r_y + d_z r_z.
+        let rb = self.rigid_body_vectors();
+        let d = self.impact_direction;
+        let r: Vec<f64> = (0..nd)
+            .map(|j| d[0] * rb[0][j] + d[1] * rb[1][j] + d[2] * rb[2][j])
+            .collect();
+        let mut mr = vec![0.0; nd];
+        for t in self.mass.triplet_iter() {
+            mr[t.row] += t.val * r[t.col];
+        }
+        mm.effective_mass_kg = Some(
+            select
+                .iter()
+                .map(|&s| self.dot_mode(modes, s, &mr).powi(2))
+                .collect(),
+        );
         mm.validate()?;
         Ok(mm)
     }

@@ -18,6 +18,7 @@ pub mod deviation;
 pub mod figures;
 pub mod machines;
 pub mod measures;
+pub mod physics;
 pub mod studies;
 
 use std::fmt::Write as _;
@@ -35,7 +36,7 @@ use crate::report::figures::Mark;
 use claims::{Row, Runs};
 use deviation::DeviationRow;
 use figures::Figures;
-use machines::{Base, Kind, Machine, MASS_RATIO, WD_OVER_W6_PQR, WS_OVER_W6_S};
+use machines::{Base, Kind, Machine, MASS_RATIO};
 pub use studies::Resolution;
 use studies::{MachineStudy, MapStudy};
 
@@ -48,6 +49,8 @@ pub struct OperatingPoint {
     pub omega_s_rad_per_s: f64,
     /// ω_s / ω_ref (ω_6 or ω_4 of the machine).
     pub ws_over_wref: f64,
+    /// The reference mode ω_ref: the structure's mode number, frequency, effective masses.
+    pub reference: Option<crate::model::ReferenceMode>,
     pub slider_contact_stiffness_n_per_m: f64,
     pub damper_contact_stiffness_n_per_m: f64,
     pub mass_ratio: f64,
@@ -61,6 +64,10 @@ pub struct PaperReport {
     pub operating_points: Vec<OperatingPoint>,
     pub table: Vec<Row>,
     pub deviations: Vec<DeviationRow>,
+    /// The physics behind the numbers ([`physics`]), computed by this run.
+    pub physics: Vec<physics::Finding>,
+    /// The points marked on the energy maps, E_p+/E_s− simulated at each: (machine, point).
+    pub marked_points: Vec<(String, studies::MarkedPoint)>,
     /// (paper figure, file of the picture, caption).
     pub figures: Vec<(u32, String, String)>,
 }
@@ -83,6 +90,7 @@ pub fn run(dir: &Path, res: &Resolution) -> Result<PaperReport> {
     };
     let table = claims::rows(&runs);
     let deviations = deviation::study(&machines, &studies, &table);
+    let physics = physics::findings(&machines, &studies)?;
     let mut figs = Figures::new(dir);
     draw_all(&mut figs, &machines, &studies, res)?;
     let operating_points = operating_points(&machines);
@@ -91,6 +99,16 @@ pub fn run(dir: &Path, res: &Resolution) -> Result<PaperReport> {
         operating_points,
         table,
         deviations,
+        physics,
+        marked_points: machines
+            .iter()
+            .zip(&studies)
+            .flat_map(|(m, s)| {
+                s.maps
+                    .iter()
+                    .flat_map(|map| map.marked.iter().map(|p| (m.label(), p.clone())))
+            })
+            .collect(),
         figures: figs
             .list
             .iter()
@@ -111,6 +129,7 @@ fn operating_points(machines: &[Machine]) -> Vec<OperatingPoint> {
             machine: m.label(),
             omega_s_rad_per_s: m.w_s,
             ws_over_wref: m.w_s / m.w_ref,
+            reference: m.model.reference_mode(),
             slider_contact_stiffness_n_per_m: m.model.spec.contact.slider_bed.stiffness,
             damper_contact_stiffness_n_per_m: m
                 .model
@@ -236,21 +255,32 @@ fn draw_all(
         }
         if let Some(fam) = &s.over_ws {
             let number = if m.base == Base::None { 17 } else { 5 };
+            let mut series: Vec<Series> = fam
+                .curves
+                .iter()
+                .map(|(l, y)| Series {
+                    label: l.clone(),
+                    x: fam.x.clone(),
+                    y: y.clone(),
+                    ..Default::default()
+                })
+                .collect();
+            // Without the damper (Fig. 9's curve on the same grid): no peak.
+            if let Some(none) = s.cases_over_ws.as_ref().filter(|c| c.x == fam.x) {
+                series.push(Series {
+                    label: "without damper".into(),
+                    x: none.x.clone(),
+                    y: none.curves[0].1.clone(),
+                    style: crate::plot::LineStyle::Dashed,
+                    ..Default::default()
+                });
+            }
             let p = LinePlot {
                 title: format!("E_p+/E_s− over ω_s/{r}, ω_d = ω_s ({})", m.label()),
                 x_label: format!("ω_s/{r} (1)"),
                 y_label: "E_p+/E_s− (1)".into(),
                 x_log: true,
-                series: fam
-                    .curves
-                    .iter()
-                    .map(|(l, y)| Series {
-                        label: l.clone(),
-                        x: fam.x.clone(),
-                        y: y.clone(),
-                        ..Default::default()
-                    })
-                    .collect(),
+                series,
                 ..Default::default()
             };
             let peaks = s
@@ -260,8 +290,9 @@ fn draw_all(
                 .collect::<Vec<_>>()
                 .join(", ");
             f.line(number, &format!("fig{number:02}-{}", m.tag()), &p, format!(
-                "Reproduces paper Fig. {number} on the {} model: E_p+/E_s− against ω_s/{r} with ω_d = ω_s and m_s fixed, one curve per mass ratio; {} log-spaced points. The maximum (Brent's method) lies at ω_s/{r} = {peaks}; the paper puts it near {}.",
-                m.label(), res.curve_points, if m.base == Base::None { "1" } else { "45" }
+                "Reproduces paper Fig. {number} on the {} model: E_p+/E_s− against ω_s/{r} with ω_d = ω_s and m_s fixed, one curve per mass ratio; {} log-spaced points. The maximum (Brent's method) lies at ω_s/{r} = {peaks}; the paper puts it near {}.{}",
+                m.label(), res.curve_points, if m.base == Base::None { "1" } else { "45" },
+                if s.cases_over_ws.is_some() { " Dashed: without the damper (no peak: the peak is the damper's)." } else { "" }
             ))?;
         }
         if let Some(fam) = &s.cases_over_ws {
@@ -326,32 +357,37 @@ fn draw_map(
     let r = m.base.reference();
     let hi = map.ws_over_wref[map.ws_over_wref.len() - 1]
         .min(map.wd_over_wref[map.wd_over_wref.len() - 1]);
-    let point = m.w_s / m.w_ref;
     let mut marks = Vec::new();
-    let mut marked = Vec::new();
-    if m.base == Base::Soft && (map.mass_ratio - MASS_RATIO).abs() < 1e-12 {
-        for (name, wd) in WD_OVER_W6_PQR {
-            marks.push(Mark {
-                label: name.into(),
-                x: WS_OVER_W6_S,
-                y: wd,
-            });
-            marked.push(format!(
-                "{name} = ({WS_OVER_W6_S}, {wd}): E = {:.4}",
-                map.nearest(WS_OVER_W6_S, wd)
-            ));
-        }
-    }
-    if (map.mass_ratio - MASS_RATIO).abs() < 1e-12 {
-        let name = m.base.point();
+    let mut marked: Vec<String> = Vec::new();
+    for p in &map.marked {
         marks.push(Mark {
-            label: name.into(),
-            x: point,
-            y: point,
+            label: p.name.clone(),
+            x: p.ws_over_wref,
+            y: p.wd_over_wref,
         });
+        // Points at one place (Q and S) are listed once, as "Q = S".
+        let same = |a: f64, b: f64| (a - b).abs() <= 1e-6 * a.abs().max(b.abs());
+        let twin = map.marked.iter().find(|q| {
+            q.name != p.name
+                && same(q.ws_over_wref, p.ws_over_wref)
+                && same(q.wd_over_wref, p.wd_over_wref)
+        });
+        let name = match twin {
+            Some(q)
+                if marked
+                    .iter()
+                    .any(|t| t.starts_with(&format!("{} = ", q.name))) =>
+            {
+                continue
+            }
+            Some(q) => format!("{} = {}", p.name, q.name),
+            None => p.name.clone(),
+        };
         marked.push(format!(
-            "{name} = ({point:.2}, {point:.2}): E = {:.4}",
-            map.nearest(point, point)
+            "{name} = ({}, {}): E = {:.4}",
+            crate::report::figures::plain(p.ws_over_wref),
+            crate::report::figures::plain(p.wd_over_wref),
+            p.energy_ratio
         ));
     }
     let hm = crate::report::figures::marked_heat_map(
@@ -376,12 +412,13 @@ fn draw_map(
         m.tag()
     );
     f.map(number, &stem, &hm, format!(
-        "Reproduces paper Fig. {number}{sub} on the {} model: energy left in the machine after the blow, E_p+/E_s− (Eq. 10 over Eq. 11, colour), over ω_s/{r} (slider contact, Eq. 14) and ω_d/{r} (damper contact, Eq. 15), m_d/m_b = {}; {} spanning {:.1}-{:.0}, black lines are contours, the dashed line is ω_d = ω_s. {}",
+        "Reproduces paper Fig. {number}{sub} on the {} model: energy left in the machine after the blow, E_p+/E_s− (Eq. 10 over Eq. 11, colour), over ω_s/{r} (slider contact, Eq. 14) and ω_d/{r} (damper contact, Eq. 15), m_d/m_b = {}; {} spanning {:.1}-{:.0}, black lines are contours, the dashed line is ω_d = ω_s; {r}: {}. {}",
         m.label(), map.mass_ratio, fmt_res(res), map.ws_over_wref[0], hi,
+        m.model.reference_mode().map_or("—".into(), |x| x.describe()),
         if marked.is_empty() {
             format!("No operating point is marked: they lie at m_d/m_b = {MASS_RATIO}.")
         } else {
-            format!("Marked points (labelled on the map): {}.", marked.join("; "))
+            format!("Marked points (labelled on the map), E_p+/E_s− simulated at each point itself (not read off the grid): {}.", marked.join("; "))
         }
     ))
 }
@@ -404,6 +441,7 @@ fn draw_history(
         .zip(&diss)
         .map(|(x, d)| x.ke_machine + x.pe_machine + d)
         .collect();
+    let own: Vec<f64> = e.iter().map(|x| x.ke_machine + x.pe_machine).collect();
     let series = vec![
         Series {
             label: "KE m_s (Eq. 16)".into(),
@@ -454,9 +492,15 @@ fn draw_history(
             ..Default::default()
         },
         Series {
-            label: "E_p (Eq. 24)".into(),
+            label: "E_p (Eq. 24 as written: includes the damper dashpot's losses)".into(),
             x: t.clone(),
             y: ep,
+            ..Default::default()
+        },
+        Series {
+            label: "machine's own energy KE_p + PE_p".into(),
+            x: t.clone(),
+            y: own,
             ..Default::default()
         },
     ];
@@ -566,6 +610,7 @@ fn page(r: &PaperReport, figs: &Figures, res: &Resolution) -> Page {
             "machine".into(),
             "ω_s (rad/s)".into(),
             "ω_s/ω_ref".into(),
+            "ω_ref: the structure's mode".into(),
             "K_s (N/m)".into(),
             "K_d (N/m)".into(),
             "m_d/m_b".into(),
@@ -578,6 +623,9 @@ fn page(r: &PaperReport, figs: &Figures, res: &Resolution) -> Page {
             p.machine.clone(),
             format!("{:.1}", p.omega_s_rad_per_s),
             format!("{:.3}", p.ws_over_wref),
+            p.reference
+                .as_ref()
+                .map_or("—".into(), crate::model::ReferenceMode::describe),
             format!("{:.4e}", p.slider_contact_stiffness_n_per_m),
             format!("{:.4e}", p.damper_contact_stiffness_n_per_m),
             format!("{:.4}", p.mass_ratio),
@@ -621,6 +669,15 @@ fn page(r: &PaperReport, figs: &Figures, res: &Resolution) -> Page {
             blocks,
         });
     }
+    let mut ph = Vec::new();
+    for f in &r.physics {
+        ph.push(Block::Paragraph(format!("{}. {}", f.heading, f.text)));
+    }
+    sections.push(Section {
+        id: "physics".into(),
+        heading: "What the paper leaves out: the physics behind the numbers".into(),
+        blocks: ph,
+    });
     let mut t = Table {
         caption: "The paper's numbers and claims beside meid's (lumped model and FE machine); verdict: reproduced / reproduced in shape only / not reproduced".into(),
         header: vec!["claim".into(), "paper".into(), "where in the paper".into(), "meid measure".into(), "meid lumped".into(), "meid FE".into(), "difference".into(), "verdict".into(), "reason".into()],
@@ -645,32 +702,7 @@ fn page(r: &PaperReport, figs: &Figures, res: &Resolution) -> Page {
         heading: "Paper vs meid".into(),
         blocks: vec![Block::Table(t)],
     });
-    let mut d = Table {
-        caption: "Deviation study: each candidate explanation run for each number not reproduced; 'reproduces' names the models it brings within the number's tolerance".into(),
-        header: vec!["paper number".into(), "paper".into(), "candidate".into(), "setting and measure".into(), "meid lumped".into(), "meid FE".into(), "reproduces".into()],
-        ..Default::default()
-    };
-    for row in &r.deviations {
-        d.rows.push(vec![
-            row.number.clone(),
-            format!("{} {}", row.paper_value, row.unit),
-            row.candidate.clone(),
-            row.setting.clone(),
-            opt(row.lumped, 2),
-            opt(row.fe, 2),
-            row.reproduces.clone(),
-        ]);
-        d.row_class.push(if row.reproduces == "neither" {
-            "no".into()
-        } else {
-            "ok".into()
-        });
-    }
-    sections.push(Section {
-        id: "deviation".into(),
-        heading: "Why the numbers differ: deviation study".into(),
-        blocks: vec![Block::Paragraph(deviation_summary(r)), Block::Table(d)],
-    });
+    sections.push(deviation_section(r));
     Page {
         title: "Application of Momentum Exchange Impact Dampers to Forging Machine: the paper reproduced by meid".into(),
         lead: "Generated by `meid paper`. Figures in the paper's terms: mass ratio m_d/m_b, contact frequencies ω_s = √(K_s/m_s) and ω_d = √(K_d/m_d) over the paper's reference mode (ω_6 with a floating base, ω_4 without).".into(),
@@ -678,8 +710,59 @@ fn page(r: &PaperReport, figs: &Figures, res: &Resolution) -> Page {
     }
 }
 
-/// One sentence per number not reproduced: which candidates reproduce it, or that none does.
+/// The deviation study: the summary, then the explanations by physics (and readings of the
+/// paper) apart from the matches found by a parameter search.
+fn deviation_section(r: &PaperReport) -> Section {
+    let mut blocks = vec![
+        Block::Paragraph("Two kinds of evidence are kept apart. Explanations by physics (and readings of the paper's own figures and text) test one cause with a computation that isolates it: a closed form, the curve without the damper, a model that differs in one physical property. Matches found by a parameter search try many candidates (measures, record lengths and windows, damping ratios, operating points) per number; a candidate that lands within the tolerance among many tried is weak evidence, since some hit is expected by chance. The summary gives, for each number, how many search candidates were tried and how many landed.".into()),
+        Block::Paragraph(deviation_summary(r)),
+    ];
+    for (caption, kinds) in [
+        (
+            "Explanations by physics and readings of the paper: each row tests one cause; 'reproduces' names the models it brings within the number's tolerance",
+            &[deviation::Evidence::Physics, deviation::Evidence::Reading][..],
+        ),
+        (
+            "Matches found by a parameter search: each row is one candidate of many (count per number in the summary above); a hit is weak evidence",
+            &[deviation::Evidence::Search][..],
+        ),
+    ] {
+        let mut d = Table {
+            caption: caption.into(),
+            header: vec!["paper number".into(), "paper".into(), "evidence".into(), "candidate".into(), "setting and measure".into(), "meid lumped".into(), "meid FE".into(), "reproduces".into()],
+            ..Default::default()
+        };
+        for row in r.deviations.iter().filter(|d| kinds.contains(&d.evidence)) {
+            d.rows.push(vec![
+                row.number.clone(),
+                format!("{} {}", row.paper_value, row.unit),
+                row.evidence.text().into(),
+                row.candidate.clone(),
+                row.setting.clone(),
+                opt(row.lumped, 2),
+                opt(row.fe, 2),
+                row.reproduces.clone(),
+            ]);
+            d.row_class.push(if row.reproduces == "neither" {
+                "no".into()
+            } else {
+                "ok".into()
+            });
+        }
+        blocks.push(Block::Table(d));
+    }
+    Section {
+        id: "deviation".into(),
+        heading: "Why the numbers differ: deviation study".into(),
+        blocks,
+    }
+}
+
+/// One sentence per number not reproduced: the explanations by physics (and readings of the
+/// paper) that bring it within tolerance, and how many parameter-search candidates were tried
+/// and landed (weak evidence), or that none does.
 pub fn deviation_summary(r: &PaperReport) -> String {
+    use deviation::Evidence;
     let mut ids: Vec<&str> = Vec::new();
     for d in &r.deviations {
         if !ids.contains(&d.number.as_str()) {
@@ -688,16 +771,52 @@ pub fn deviation_summary(r: &PaperReport) -> String {
     }
     let mut s = String::new();
     for id in ids {
-        let hits: Vec<String> = r
-            .deviations
+        let rows: Vec<&DeviationRow> = r.deviations.iter().filter(|d| d.number == id).collect();
+        let name = |d: &DeviationRow| format!("{} ({}; {})", d.candidate, d.setting, d.reproduces);
+        let physics: Vec<String> = rows
             .iter()
-            .filter(|d| d.number == id && d.reproduces != "neither")
-            .map(|d| format!("{} ({}; {})", d.candidate, d.setting, d.reproduces))
+            .filter(|d| d.evidence != Evidence::Search && d.reproduces != "neither")
+            .map(|d| name(d))
             .collect();
-        if hits.is_empty() {
-            let _ = write!(s, "{id}: no candidate reproduces the paper's number. ");
+        let search: Vec<&DeviationRow> = rows
+            .iter()
+            .copied()
+            .filter(|d| d.evidence == Evidence::Search)
+            .collect();
+        let landed: Vec<String> = search
+            .iter()
+            .filter(|d| d.reproduces != "neither")
+            .map(|d| name(d))
+            .collect();
+        let _ = write!(s, "{id}: ");
+        if physics.is_empty() {
+            let _ = write!(
+                s,
+                "neither physics nor a reading of the paper brings it within tolerance; "
+            );
         } else {
-            let _ = write!(s, "{id}: reproduced by {}. ", hits.join("; "));
+            let _ = write!(
+                s,
+                "within tolerance by physics or a reading of the paper: {}; ",
+                physics.join("; ")
+            );
+        }
+        if search.is_empty() {
+            let _ = write!(s, "no parameter search. ");
+        } else if landed.is_empty() {
+            let _ = write!(
+                s,
+                "none of {} parameter-search candidates lands within tolerance. ",
+                search.len()
+            );
+        } else {
+            let _ = write!(
+                s,
+                "{} of {} parameter-search candidates land within tolerance (weak evidence: a hit among many tried): {}. ",
+                landed.len(),
+                search.len(),
+                landed.join("; ")
+            );
         }
     }
     s.trim_end().to_string()

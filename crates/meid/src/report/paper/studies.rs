@@ -51,6 +51,18 @@ pub struct MapStudy {
     pub wd_over_wref: Vec<f64>,
     /// Row-major `ny × nx`: `z[j nx + i]` at `(ws[i], wd[j])`.
     pub energy_ratio: Vec<f64>,
+    /// The operating points marked on the map (P, Q = S, R on Fig. 3(a), T, U), each
+    /// simulated at its own coordinates (not read off the grid).
+    pub marked: Vec<MarkedPoint>,
+}
+
+/// A point marked on an energy map, with E_p+/E_s− simulated there.
+#[derive(Debug, Clone, Serialize)]
+pub struct MarkedPoint {
+    pub name: String,
+    pub ws_over_wref: f64,
+    pub wd_over_wref: f64,
+    pub energy_ratio: f64,
 }
 
 impl MapStudy {
@@ -197,6 +209,38 @@ fn energy_at(model: &Model, m_b: f64, qs: &[Quantity], values: &[f64]) -> f64 {
     evaluate(model, &q, values, Some(m_b), &o, 0).metric("energy_ratio")
 }
 
+/// The points marked on a map of mass ratio `r` (P, "Q = S", R on the soft base's map at
+/// m_d/m_b = 0.35; the configuration's operating point on every map at 0.35), with E_p+/E_s−
+/// simulated at each point's own (ω_s/ω_ref, ω_d/ω_ref).
+pub fn marked_points(m: &Machine, r: f64) -> Vec<MarkedPoint> {
+    if (r - MASS_RATIO).abs() > 1e-12 {
+        return Vec::new();
+    }
+    let point = m.w_s / m.w_ref;
+    let mut pts: Vec<(&str, f64, f64)> = Vec::new();
+    if m.base == Base::Soft {
+        pts.extend(
+            WD_OVER_W6_PQR
+                .iter()
+                .map(|&(name, wd)| (name, WS_OVER_W6_S, wd)),
+        );
+    }
+    pts.push((m.base.point(), point, point));
+    let qs = [
+        Quantity::WsOverWref,
+        Quantity::WdOverWref,
+        Quantity::MdOverMb,
+    ];
+    pts.into_par_iter()
+        .map(|(name, ws, wd)| MarkedPoint {
+            name: name.to_string(),
+            ws_over_wref: ws,
+            wd_over_wref: wd,
+            energy_ratio: energy_at(&m.model, m.m_b, &qs, &[ws, wd, r]),
+        })
+        .collect()
+}
+
 /// Refines the extremum of `curve` (sampled on `x`, log-spaced) by Brent's method in ln x
 /// between the neighbours of its best grid point; `sign` +1 for a minimum, −1 for a maximum.
 fn refine(x: &[f64], curve: &[f64], sign: f64, f: impl Fn(f64) -> f64) -> Result<(f64, f64)> {
@@ -257,6 +301,7 @@ pub fn run(m: &Machine, res: &Resolution) -> Result<MachineStudy> {
                 ws_over_wref: x,
                 wd_over_wref: y,
                 energy_ratio: z,
+                marked: marked_points(m, r),
             })
         })
         .collect::<Result<Vec<_>>>()?;
@@ -476,7 +521,7 @@ pub fn compare_model(
     Comparison::new(model.clone(), o).run()
 }
 
-fn history_at(
+pub fn history_at(
     m: &Machine,
     point: &'static str,
     wd_over_wref: f64,
