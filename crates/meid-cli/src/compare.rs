@@ -107,6 +107,9 @@ pub fn run(a: CompareArgs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&result.summary())?);
     } else if a.print.human() {
         println!("meid compare — {}", a.model.display());
+        for v in result.verdict() {
+            println!("  {v}");
+        }
         print!("{}", result.table_text());
         if let Some(dir) = &a.output {
             println!(

@@ -1175,6 +1175,60 @@ sample_rate = 20000.0
         assert!(failures.is_empty(), "{failures:?}");
     }
 
+    /// A period-2 regime: the lumped example at 18.5 blows/min. Its period-1 fixed point is
+    /// unstable and a march from rest settles into blows that alternate (the damper touches
+    /// the bed in both, for different times, and the floor force alternates). The steady state
+    /// is named period-2 with its two blows, and a 400-blow march from rest ends alternating
+    /// between the same two levels.
+    #[test]
+    fn a_period_two_regime_is_found_and_named() {
+        let model = example("paper-lumped");
+        let sys = model.impact_system(Case::Damper).unwrap();
+        let rate = 18.5;
+        let s = steady_state(
+            &sys,
+            &model.options(),
+            &SteadyOptions {
+                rate_bpm: rate,
+                ..SteadyOptions::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(s.regime, Regime::Period(2), "{s:?}");
+        assert_eq!(s.period_blows, Some(2));
+        assert!(s.converged && s.stable == Some(true), "{s:?}");
+        assert_eq!(s.blows.len(), 2);
+        let (f0, f1) = (s.blows[0].peak_floor_force_n, s.blows[1].peak_floor_force_n);
+        assert!(
+            (f0 - f1).abs() > 1e-3 * f0.max(f1),
+            "blows alike: {f0} {f1}"
+        );
+        assert_eq!(s.peak_floor_force_n, f0.max(f1));
+        let mut o = model.options();
+        o.sample_rate = None;
+        let march = run_blows(
+            &sys,
+            &o,
+            &BlowOptions {
+                blows: 400,
+                rate_bpm: rate,
+                steady_tolerance: 1e-9,
+            },
+            false,
+        )
+        .unwrap();
+        let n = march.blows.len();
+        let (m0, m1) = (
+            march.blows[n - 2].peak_floor_force_n,
+            march.blows[n - 1].peak_floor_force_n,
+        );
+        let pair_ok = |a: f64, b: f64| {
+            (a - f0).abs() < 1e-6 * f0 && (b - f1).abs() < 1e-6 * f1
+                || (a - f1).abs() < 1e-6 * f1 && (b - f0).abs() < 1e-6 * f0
+        };
+        assert!(pair_ok(m0, m1), "march ends {m0} {m1}, steady {f0} {f1}");
+    }
+
     fn example(name: &str) -> Model {
         let path = format!("{}/../../examples/{name}.toml", env!("CARGO_MANIFEST_DIR"));
         Model::from_file(path.as_ref(), &[]).unwrap()
