@@ -256,10 +256,7 @@ fn paper_page_figures_table_and_closed_forms() {
     );
     assert!((value("percent-db", "41.2 % as dB") - implied(41.2)).abs() < 1e-12);
     assert!((value("percent-db", "3 dB as %") - 100.0 * (1.0 - 10f64.powf(-0.3))).abs() < 1e-12);
-    let eq24 = finding("eq24").next().unwrap()["values"]
-        .as_array()
-        .unwrap()
-        .clone();
+    let eq24 = finding("eq24")[0]["values"].as_array().unwrap().clone();
     let v = |name: &str| {
         eq24.iter().find(|v| v[0] == name).unwrap()[1]
             .as_f64()
