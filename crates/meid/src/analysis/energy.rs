@@ -762,6 +762,12 @@ pub fn simulate_observed(
     opts: &Options,
     obs: Option<&mut dyn Observer>,
 ) -> Result<(Summary, Solution)> {
+    // A bed no mode moves takes no energy: the run's energy ratios would be 0/0.
+    if let Some(why) =
+        crate::modal::immovable_point("the bed contact point", &sys.points.bed_contact)
+    {
+        return Err(Error::invalid("points.bed_contact", why));
+    }
     let sol = match obs {
         Some(o) => integrate::solve(sys, opts, o)?,
         None => integrate::solve(

@@ -20,7 +20,9 @@
 //! ```
 //!
 //! The pivot is the first of the given *probes* (the named points along the impact, in the
-//! order given) that the space still moves, `‖f Φ_j‖ ≥ 10⁻⁶ Σ|f| max_r ‖Φ_j(r, ·)‖`; when none
+//! order given) that the space still moves, `‖f Φ_j‖ > 0` and `‖f Φ_j‖ ≥ 10⁻⁶ Σ|f| max_r ‖Φ_j(r, ·)‖`
+//! (a probe that reads no free DOF, `f = 0`, as at a point whose impact direction is constrained,
+//! never pivots); when none
 //! does, the first DOF `r` (in DOF order) with `‖Φ_j(r, ·)‖ ≥ (1 − 10⁻⁶) max_s ‖Φ_j(s, ·)‖`. So the
 //! first mode of a bending pair of a square column is the one that moves the impact point along
 //! the impact, and the second does not move it. The norms `‖f Φ_j‖` and the vector `Φ_j u` are
@@ -44,7 +46,7 @@ pub const DEGENERATE_TOLERANCE: f64 = 1e-8;
 /// Relative tolerance of the pivot choice: DOFs within it of the largest count as tied.
 const PIVOT_TIE: f64 = 1e-6;
 
-/// A probe `f` pivots when `‖fΦ_j‖ ≥ PROBE_FLOOR · Σ|f| · max_r ‖Φ_j(r, ·)‖`: the space moves it
+/// A probe `f` pivots when `‖fΦ_j‖ > 0` and `‖fΦ_j‖ ≥ PROBE_FLOOR · Σ|f| · max_r ‖Φ_j(r, ·)‖`: the space moves it
 /// well above round-off (module docs).
 const PROBE_FLOOR: f64 = 1e-6;
 
@@ -124,7 +126,11 @@ fn canonical_cluster(shapes: &mut Mat<f64>, cols: std::ops::Range<usize>, probes
                 .map(|c| (0..n).map(|r| f[r] * shapes[(r, c)]).sum())
                 .collect();
             let l1: f64 = f.iter().map(|x| x.abs()).sum();
-            (norm(&y) >= PROBE_FLOOR * l1 * max_row).then_some(y)
+            // A probe that reads no DOF (a point whose impact-direction DOFs are all
+            // constrained: f = 0) or that the space does not move cannot pivot: `‖fΦ_j‖ = 0`
+            // would give `u = 0/0`.
+            let moved = norm(&y);
+            (moved > 0.0 && moved >= PROBE_FLOOR * l1 * max_row).then_some(y)
         };
         let tie = (1.0 - PIVOT_TIE) * max_row;
         let Some(y) = probes.iter().find_map(on_probe).or_else(|| {
@@ -135,6 +141,9 @@ fn canonical_cluster(shapes: &mut Mat<f64>, cols: std::ops::Range<usize>, probes
             return;
         };
         let len = norm(&y);
+        if !(len > 0.0 && len.is_finite()) {
+            return;
+        }
         let u: Vec<f64> = y.iter().map(|x| x / len).collect();
         // Householder H = I − 2vvᵀ/vᵀv, v = u + s e₁ (s = sign u₁): Hu = −s e₁, so the first
         // column of ΦH is −s Φu and the pivot's values of the others, (yᵀH)_i = −s‖y‖(e₁)_i,
@@ -329,6 +338,43 @@ mod tests {
                         (a[(r, j)] - b[(r, j)]).abs() < 1e-12,
                         "trial {trial} ({r}, {j})"
                     );
+                }
+            }
+        }
+    }
+
+    /// A probe that reads no DOF (f = 0: a point whose impact direction is constrained) is
+    /// passed over, not divided by: the basis stays finite and M-orthonormal, and it is the
+    /// basis the next probe (or the DOF rule) gives.
+    #[test]
+    fn a_zero_probe_is_passed_over() {
+        let mut rng = Rng::new(5);
+        let n = 11;
+        let (phi, omega) = shapes(&mut rng, n);
+        let zero = vec![0.0; n];
+        let live: Vec<f64> = (0..n).map(|_| rng.next_normal()).collect();
+        for (with, without) in [
+            (vec![zero.as_slice()], Vec::<&[f64]>::new()),
+            (
+                vec![zero.as_slice(), live.as_slice()],
+                vec![live.as_slice()],
+            ),
+        ] {
+            let mut a = phi.clone();
+            canonical_basis(&mut a, &omega, &with);
+            let mut b = phi.clone();
+            canonical_basis(&mut b, &omega, &without);
+            for j in 0..6 {
+                for r in 0..n {
+                    assert!(a[(r, j)].is_finite(), "({r}, {j}) = {}", a[(r, j)]);
+                    assert_eq!(a[(r, j)], b[(r, j)], "({r}, {j})");
+                }
+            }
+            let g = a.transpose() * &a;
+            for i in 0..6 {
+                for j in 0..6 {
+                    let want = if i == j { 1.0 } else { 0.0 };
+                    assert!((g[(i, j)] - want).abs() < 1e-13, "{i} {j} {}", g[(i, j)]);
                 }
             }
         }

@@ -35,6 +35,28 @@ use std::collections::BTreeMap;
 
 use crate::{Error, Result};
 
+/// Why a blow at a point cannot be simulated when no retained mode moves it along the impact
+/// direction: its mode-shape values `psi` (one per mode) are all 0, so its effective mass
+/// `1 / Σ_i ψ_i²` is infinite and the slider meets an immovable point (e.g. a point whose
+/// impact-direction DOF is constrained). `what` names the point in the message. `None` when a
+/// mode moves it.
+pub fn immovable_point(what: &str, psi: &[f64]) -> Option<String> {
+    if psi.is_empty() || psi.iter().any(|v| *v != 0.0) {
+        return None;
+    }
+    let modes = match psi.len() {
+        1 => "the one retained mode".to_string(),
+        n => format!("all {n} retained modes"),
+    };
+    Some(format!(
+        "{what}: no retained mode moves it along the impact direction (ψ = 0 in {modes}), \
+         so its effective mass 1/Σψ² is infinite and a blow there meets an immovable point: the \
+         machine takes none of the blow's energy. Strike a point the structure's modes move (is \
+         the point's impact-direction DOF constrained, or are the modes that move it left out of \
+         the selection?)"
+    ))
+}
+
 /// The force to the floor as a linear function of the modal state:
 /// `F_floor = Σ_i stiffness[i] q_i + Σ_i damping[i] q̇_i` (N), positive when it pushes
 /// the floor in +z (the direction the slider moves).
@@ -143,6 +165,13 @@ impl ModalModel {
                 ),
             )
         })
+    }
+
+    /// Why a blow at `point` (the model field `field` names it) cannot be simulated when no
+    /// retained mode moves it along the impact direction ([`immovable_point`]). `None` when a
+    /// mode moves it, or when the model has no such point.
+    pub fn immovable_point(&self, field: &str, point: &str) -> Option<String> {
+        immovable_point(&format!("{field} = '{point}'"), self.points.get(point)?)
     }
 
     /// The same structure with a rigid point mass `mass_kg` fixed at point `point`, by

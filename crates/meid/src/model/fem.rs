@@ -1421,6 +1421,21 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
     }
     let probes: Vec<&[f64]> = functionals.iter().map(|(_, f)| f.as_slice()).collect();
     crate::modal::eigenspace::canonical_basis(&mut modes.shapes, &modes.omega_rad_per_s, &probes);
+    // Every output (ψ, effective masses, exported shapes) is a function of the shapes: a
+    // non-finite entry is an error here, not a NaN in modes.csv.
+    if let Some(j) =
+        (0..modes.shapes.ncols()).find(|&j| modes.shapes.col(j).iter().any(|v| !v.is_finite()))
+    {
+        return Err(Error::numerical(
+            base,
+            format!(
+                "mode {} ({:.6} Hz) has a non-finite mode-shape entry after the {solver} \
+                 eigen-solution: its shape, ψ and effective masses cannot be reported",
+                j + 1,
+                modes.omega_rad_per_s[j] / (2.0 * std::f64::consts::PI)
+            ),
+        ));
+    }
     // The last wanted mode's eigenspace, when it continues past `count`.
     let cut_cluster = (modes.omega_rad_per_s.len() > wanted && wanted > 0)
         .then(|| crate::modal::eigenspace::degenerate_clusters(&modes.omega_rad_per_s))

@@ -846,6 +846,13 @@ impl Model {
         for (field, message) in self.propagator_findings().warnings {
             warnings.push(format!("{}: {message}", self.source.locate(&field)));
         }
+        let bed = &self.spec.points.bed_contact;
+        if let Some(why) = self.structure.immovable_point("points.bed_contact", bed) {
+            warnings.push(format!(
+                "{}: {why}",
+                self.source.locate("points.bed_contact")
+            ));
+        }
         // Here, not with the structure: it reads the slider, which the structure cache's key
         // leaves out.
         warnings.extend(imported::unit_suspicion(
