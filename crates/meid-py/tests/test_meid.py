@@ -144,3 +144,20 @@ def test_model_pickles_as_its_text():
     m2 = pickle.loads(pickle.dumps(m))
     assert m2.overrides == ["damper.mass=4.0"]
     assert m2.simulate(history=False).summary == m.simulate(history=False).summary
+
+
+def test_blows_steady_state_is_the_cli_s():
+    """meid.blows(steady=True) is `meid blows --steady --json`'s object: the same steady state
+    (regime, levels, multipliers) and verdict, for the case asked."""
+    m = meid.Model.from_file(LUMPED)
+    py = meid.blows(m, 60.0, steady=True, case="damper")
+    ref = cli_json("blows", LUMPED, "--rate-bpm", "60", "--steady", "--case", "damper")
+    s = py["steady_state"]
+    for key in ["converged", "residual", "map_evaluations", "regime", "period_blows",
+                "energy_ratio", "peak_floor_force_n", "peak_bed_acceleration_m_per_s2",
+                "damper_gap_at_strike_m", "damper_touches_bed", "multipliers_abs"]:
+        assert s[key] == ref["steady_state"][key], key
+    assert s["converged"] and s["regime"] == "period-1"
+    # At 60 /min the paper's damper does not return (docs/studies.md, "Production").
+    assert s["damper_touches_bed"] is False
+    assert py["verdict"] == ref["verdict"] and "does not return" in py["verdict"][0]
