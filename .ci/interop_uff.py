@@ -73,6 +73,14 @@ def write(d):
     u = pyuff.UFF(path)
     u.write_sets([ds58("accel_u", 4, tu, yu, 12, "m/s^2", 0, even=False)], mode="overwrite")
     expected["uneven.uff"] = [{"name": "accel_u", "unit": "m/s^2", "times": list(tu), "values": list(yu)}]
+    # An even 51.2 kHz grid over 1 s written as (x, y) pairs: pyuff prints the times %13.5e (6
+    # significant digits), so its steps differ by up to ~5e-7 s, the format's rounding.
+    te = np.arange(51200) / fs
+    ye = np.sin(2 * np.pi * 283.0 * te)
+    path = os.path.join(d, "pairs_51k.uff")
+    u = pyuff.UFF(path)
+    u.write_sets([ds58("accel_p", 5, te, ye, 12, "m/s^2", 0, even=False)], mode="overwrite")
+    expected["pairs_51k.uff"] = [{"name": "accel_p", "unit": "m/s^2", "x0": 0.0, "dx": 1.0 / fs, "values": list(ye)}]
     # The same uneven record in binary (pyuff announces the points' bytes, not the pairs').
     path = os.path.join(d, "uneven_binary.uff")
     if os.path.exists(path):

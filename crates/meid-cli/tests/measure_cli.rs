@@ -247,6 +247,66 @@ fn uff_exports_read_back_and_validate_to_zero() {
     );
 }
 
+/// meid's own simulated history (history.uff and history.csv) starts with the blow, within the
+/// default 0.01 s pre-trigger: `meid measure` with default options processes it (it was refused
+/// until `--pretrigger 0`), keeping the one sample (0.00005 s at 20 kHz) the file has before the
+/// first trigger, says so in a note (text and `pretrigger_note` in the JSON), and reads the same
+/// sample peaks as `--pretrigger 0` but where the extra sample, t = 0, holds a peak (the machine
+/// is at rest then; the slider moves at 1.2 m/s).
+#[test]
+fn measure_takes_a_simulated_history_with_default_options() {
+    let d = tmpdir("measure", "default-pretrigger");
+    let ex = paper_example();
+    let run = d.join("run");
+    ok(meid()
+        .args([
+            "simulate",
+            ex.to_str().unwrap(),
+            "-o",
+            run.to_str().unwrap(),
+            "--uff",
+            "-q",
+        ])
+        .output()
+        .unwrap());
+    for file in ["history.uff", "history.csv"] {
+        let f = run.join(file);
+        let f = f.to_str().unwrap();
+        let t = ok(meid().args(["measure", f]).output().unwrap());
+        assert!(
+            t.contains("note:") && t.contains("keep the 0.000050 s the file has before it"),
+            "{file}: {t}"
+        );
+        let v: Value =
+            serde_json::from_str(&ok(meid().args(["measure", f, "--json"]).output().unwrap()))
+                .unwrap();
+        let zero: Value = serde_json::from_str(&ok(meid()
+            .args(["measure", f, "--json", "--pretrigger", "0"])
+            .output()
+            .unwrap()))
+        .unwrap();
+        for (c, z) in v.as_array().unwrap().iter().zip(zero.as_array().unwrap()) {
+            assert_eq!(c["blows_averaged"], 1, "{file}: {c}");
+            assert!(
+                (c["pretrigger_s"].as_f64().unwrap() - 5e-5).abs() < 1e-12,
+                "{file}: {c}"
+            );
+            let note = c["pretrigger_note"].as_str().unwrap();
+            assert!(
+                note.contains("'contact_force_slider_bed'") && note.contains(file),
+                "{note}"
+            );
+            assert!(z.get("pretrigger_note").is_none(), "{z}");
+            // The one extra sample, t = 0, is the machine at rest; only the slider moves then.
+            if c["peak_time_s"] != 0.0 {
+                assert_eq!(c["peak"], z["peak"], "{file}: {c} vs {z}");
+            } else {
+                assert!(c["name"].as_str().unwrap().starts_with("slider_"), "{c}");
+            }
+        }
+    }
+}
+
 /// Every CSV field of the files in `dir` other than the header and the channel names is a
 /// finite number or empty; every number in the JSON files is finite (none is null).
 fn assert_all_finite(dir: &std::path::Path) {
@@ -274,9 +334,10 @@ fn assert_all_finite(dir: &std::path::Path) {
 /// Audit (session 11): `meid measure run/history.uff --record 0.3` (and `--record 1e9`) gave
 /// the default's 283.97 Hz / 18.60 dB: the default 0.01 s pre-trigger did not fit before the
 /// blow that starts a simulated record, so the whole file was processed and called
-/// "blow-averaged". Now measure refuses as validate does, naming --pretrigger and its range;
-/// --record is honoured (283.33 Hz = 85/0.3 s, a line of the 0.3 s record); a record that fits
-/// no blow or is shorter than 16 samples is refused with the valid range.
+/// "blow-averaged". Now measure keeps the pre-trigger the record has (one sample, 0.00005 s)
+/// and says so, while validate refuses naming --pretrigger and its range; --record is honoured
+/// (283.33 Hz = 85/0.3 s, a line of the 0.3 s record); a record that fits no blow or is shorter
+/// than 16 samples is refused with the valid range.
 #[test]
 fn measure_honours_record_and_refuses_settings_that_fit_no_blow() {
     let d = tmpdir("measure", "record");
@@ -300,15 +361,15 @@ fn measure_honours_record_and_refuses_settings_that_fit_no_blow() {
         a.extend_from_slice(extra);
         meid().args(a).output().unwrap()
     };
-    // The default pre-trigger does not fit before the first blow: refused, as validate does.
+    // The default pre-trigger does not fit before the first blow: the record's own is kept,
+    // with a note.
     for extra in [&[][..], &["--record", "0.3"][..]] {
-        let o = measure(extra);
-        assert_eq!(o.status.code(), Some(2), "{extra:?}");
-        let e = stderr(&o);
+        let t = ok(measure(extra));
         assert!(
-            e.contains("give a shorter pre-trigger, between 0 and 0.000050 s")
-                && e.contains("--pretrigger"),
-            "{e}"
+            t.contains("note:")
+                && t.contains("within the pre-trigger of 0.010000 s")
+                && t.contains("keep the 0.000050 s the file has before it"),
+            "{extra:?}: {t}"
         );
     }
     let o = meid()

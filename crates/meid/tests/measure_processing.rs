@@ -208,6 +208,7 @@ fn no_complete_blow_is_an_error_not_a_panic() {
         length: 10,
         pretrigger: 0,
         level: 1.0,
+        note: None,
     };
     let p = Processing::default();
     assert!(blow_spectrum(&[0.0; 5], Role::Excitation, 1.0, &b, &p, None).is_err());
@@ -461,6 +462,7 @@ fn one_blow(n: usize) -> Blows {
         length: n,
         pretrigger: 0,
         level: 1.0,
+        note: None,
     }
 }
 

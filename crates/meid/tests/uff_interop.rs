@@ -140,6 +140,32 @@ fn meid_reads_what_pyuff_writes() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// An even 51.2 kHz grid over 1 s that pyuff writes as (x, y) pairs with its times printed
+/// `%13.5e` (6 significant digits: steps 19.5312 or 19.5313 µs, up to 5.3e-7 s off the mean near
+/// 1 s) is even within the precision it was printed with: read as even at 51.2 kHz, and
+/// `meid measure` processes it. The truly uneven record of the other test stays uneven.
+#[test]
+fn pyuff_pairs_at_51k_read_as_even() {
+    let Some(py) = python() else { return };
+    let dir = tmp("pairs");
+    script(&py, &["write", dir.to_str().unwrap()]);
+    let f = uff::read_uff(&dir.join("pairs_51k.uff")).unwrap();
+    assert_eq!(f.records.len(), 1);
+    let r = &f.records[0];
+    assert_eq!(r.values.len(), 51200);
+    let (start, step) = r.even().unwrap();
+    assert!(start.abs() <= 5e-12, "{start}");
+    assert!(close(step, 1.0 / 51200.0, 1e-9), "{step}");
+    assert!(close(r.sample_rate_hz().unwrap(), 51200.0, 1e-9));
+    let p = meid::measure::process::Processing::default();
+    let c = meid::measure::process::process_all(&f.records, &p, None, "B").unwrap();
+    assert_eq!(c[0].summary.samples, 51200);
+    let u = uff::read_uff(&dir.join("uneven.uff")).unwrap();
+    assert!(matches!(u.records[0].abscissa, Abscissa::Uneven(_)));
+    assert!(u.records[0].even().is_err());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn pyuff_reads_what_meid_writes() {
     let Some(py) = python() else { return };

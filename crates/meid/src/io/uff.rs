@@ -579,6 +579,7 @@ impl<R: BufRead> Parser<'_, R> {
                 format!("{npts} points ({count} values) announced, but only {} bytes are left in the file", self.left),
             ));
         }
+        let mut printed = Vec::new();
         let values = match bin {
             Some((little, bytes)) => {
                 // pyuff (2.5.8) announces an uneven record's points, not its (x, y) pairs: the
@@ -609,7 +610,11 @@ impl<R: BufRead> Parser<'_, R> {
                 }
                 v
             }
-            None => self.ascii_values(ds, count, ord_type, even)?,
+            None => {
+                let (v, half) = self.ascii_values(ds, count, ord_type, even)?;
+                printed = half;
+                v
+            }
         };
         if !(func_type == 1 || func_type == 0) {
             return Ok(Err(format!(
@@ -672,7 +677,14 @@ impl<R: BufRead> Parser<'_, R> {
             {
                 return Err(self.err(Some(ds), Some("record 12"), r7_line + 5, format!("uneven abscissa: time {} s at point {} does not increase to {} s at point {}", t[k], k + 1, t[k + 1], k + 2)));
             }
-            (Abscissa::Uneven(t), y)
+            // Times printed in decimal (ASCII) are even when an even grid lies within half a
+            // unit of each one's last printed digit: pyuff's E13.5 rounds 51.2 kHz steps by up
+            // to 5e-7 s, the format's rounding, not the sampling.
+            let half: Vec<f64> = printed.iter().step_by(2).map(|h| h * xf).collect();
+            match crate::measure::even_as_printed(&t, &half) {
+                Some((start_s, step_s)) => (Abscissa::Even { start_s, step_s }, y),
+                None => (Abscissa::Uneven(t), y),
+            }
         };
         let mut y = y;
         if let Some(k) = y.iter().position(|v| !v.is_finite()) {
@@ -839,7 +851,15 @@ impl<R: BufRead> Parser<'_, R> {
         Ok(v)
     }
 
-    fn ascii_values(&mut self, ds: Ds, count: u64, ord_type: i64, even: bool) -> Result<Vec<f64>> {
+    /// The `count` values of an ASCII record 12, and, for an uneven abscissa (`!even`), half a
+    /// unit of the last digit each was printed with ([`printed_half_unit`]; empty otherwise).
+    fn ascii_values(
+        &mut self,
+        ds: Ds,
+        count: u64,
+        ord_type: i64,
+        even: bool,
+    ) -> Result<(Vec<f64>, Vec<f64>)> {
         // Fixed widths of the fields, for lines whose numbers touch (no blank between).
         let widths: &[usize] = match (ord_type, even) {
             (2 | 5, _) => &[13],
@@ -848,6 +868,7 @@ impl<R: BufRead> Parser<'_, R> {
             _ => &[20],
         };
         let mut v: Vec<f64> = Vec::with_capacity(count.min(self.left / 2) as usize);
+        let mut half: Vec<f64> = Vec::new();
         let first = self.line_no + 1;
         loop {
             let Some(l) = self.line()? else {
@@ -868,7 +889,12 @@ impl<R: BufRead> Parser<'_, R> {
             let mut ok = true;
             for tok in l.split_whitespace() {
                 match parse_f(tok) {
-                    Some(x) => v.push(x),
+                    Some(x) => {
+                        v.push(x);
+                        if !even {
+                            half.push(printed_half_unit(tok));
+                        }
+                    }
                     None => {
                         ok = false;
                         break;
@@ -877,6 +903,7 @@ impl<R: BufRead> Parser<'_, R> {
             }
             if !ok {
                 v.truncate(before);
+                half.truncate(before.min(half.len()));
                 let mut at = 0usize;
                 let mut k = 0usize;
                 let bytes = l.as_bytes();
@@ -900,6 +927,9 @@ impl<R: BufRead> Parser<'_, R> {
                         ));
                     };
                     v.push(x);
+                    if !even {
+                        half.push(printed_half_unit(field.trim()));
+                    }
                     at += w;
                     k += 1;
                 }
@@ -924,7 +954,7 @@ impl<R: BufRead> Parser<'_, R> {
                 ),
             ));
         }
-        Ok(v)
+        Ok((v, half))
     }
 
     fn dataset_2411(&mut self, ds: Ds) -> Result<Vec<Node>> {
@@ -1165,6 +1195,25 @@ fn cols(line: &str, a: usize, b: usize) -> String {
 }
 
 /// A number in Fortran or C notation (`1.5E+00`, `1.5D+00`, `1.5e0`).
+/// Half a unit of the last digit of a number printed in decimal (`1.95312E-05` → 0.5e-10,
+/// `0.25` → 0.005, `12` → 0.5; Fortran's `D` exponent as `E`): the rounding the printing may
+/// have made. Infinite for a token that is not such a number (no precision to rely on).
+fn printed_half_unit(tok: &str) -> f64 {
+    let t = tok.trim_start_matches(['+', '-']);
+    let (mantissa, exponent) = match t.find(['E', 'e', 'D', 'd']) {
+        Some(i) => (&t[..i], t[i + 1..].parse::<i32>().ok()),
+        None => (t, Some(0)),
+    };
+    let Some(e) = exponent else {
+        return f64::INFINITY;
+    };
+    let decimals = match mantissa.split_once('.') {
+        Some((_, frac)) => frac.len() as i32,
+        None => 0,
+    };
+    0.5 * 10f64.powi(e.saturating_sub(decimals))
+}
+
 fn parse_f(s: &str) -> Option<f64> {
     if s.contains(['D', 'd']) {
         s.replace(['D', 'd'], "E").parse().ok()
@@ -1794,6 +1843,69 @@ mod tests {
         assert_eq!(r.values, vec![1.0, 2.0, 0.0]);
         assert_eq!(r.abscissa, Abscissa::Uneven(vec![0.0, 1e-3, 2.5e-3]));
         assert!(r.even().is_err());
+    }
+
+    /// Python's `%13.5e` (pyuff's abscissa field): 6 significant digits, an exponent of at
+    /// least two digits, right-aligned in 13 columns.
+    fn py_e(x: f64, decimals: usize, width: usize) -> String {
+        let s = format!("{x:.decimals$e}");
+        let (m, e) = s.split_once('e').unwrap();
+        let e: i32 = e.parse().unwrap();
+        let sign = if e < 0 { '-' } else { '+' };
+        format!("{:>width$}", format!("{m}e{sign}{:02}", e.abs()))
+    }
+
+    /// An ASCII dataset 58 of real double (x, y) pairs written as pyuff writes them,
+    /// `2(E13.5,E20.12)` a line (record 7: type 4, spacing 0).
+    fn pairs_58(t: &[f64], y: &[f64]) -> String {
+        let mut s = format!(
+            "    -1\n    58\nacc\nNONE\nNONE\nNONE\nNONE\n    1         0    0         0 NONE               1   3 NONE               0   0\n         4{:>10}         0  0.00000e+00  0.00000e+00  0.00000e+00\n        17    0    0    0 Time                 s                   \n        12    0    0    0 Acc                  m/s^2               \n         0    0    0    0 NONE                 NONE                \n         0    0    0    0 NONE                 NONE                \n",
+            t.len()
+        );
+        for (k, (tk, yk)) in t.iter().zip(y).enumerate() {
+            s += &py_e(*tk, 5, 13);
+            s += &py_e(*yk, 12, 20);
+            if k % 2 == 1 || k + 1 == y.len() {
+                s.push('\n');
+            }
+        }
+        s + "    -1\n"
+    }
+
+    /// pyuff writes an even 51.2 kHz grid over 1 s as (x, y) pairs with 6 significant digits in
+    /// x: its steps read 19.5312 or 19.5313 µs (up to 5.3e-7 s off near 1 s), the printing's
+    /// rounding. Even within half a unit of each time's last printed digit, it reads as even at
+    /// 51.2 kHz. A time moved by 2 units of its last digit (2e-6 s, a tenth of a step) is a grid
+    /// no printing explains: uneven, and refused for spectra.
+    #[test]
+    fn times_printed_to_six_digits_are_judged_by_their_printed_precision() {
+        assert_eq!(printed_half_unit("1.95312e-05"), 0.5e-10);
+        assert_eq!(printed_half_unit("1.0D+00"), 0.05);
+        assert_eq!(printed_half_unit("-0.25"), 0.005);
+        assert_eq!(printed_half_unit("12"), 0.5);
+        let fs = 51200.0;
+        let t: Vec<f64> = (0..51200).map(|k| k as f64 / fs).collect();
+        let y: Vec<f64> = t.iter().map(|t| (1775.0 * t).sin()).collect();
+        let text = pairs_58(&t, &y);
+        assert!(text.contains("  9.99980e-01"), "pyuff's layout");
+        let f = parse_uff(text.as_bytes(), "pyuff.uff", None).unwrap();
+        let r = &f.records[0];
+        let Abscissa::Even { start_s, step_s } = r.abscissa else {
+            panic!("{:?}", &r.abscissa);
+        };
+        assert!(start_s.abs() <= 1e-12, "{start_s}");
+        assert!((step_s * fs - 1.0).abs() <= 1e-9, "{step_s}");
+        assert!((r.sample_rate_hz().unwrap() - fs).abs() <= 1e-6 * fs);
+        for (a, b) in r.values.iter().zip(&y) {
+            assert!((a - b).abs() <= 1e-12, "{a} {b}");
+        }
+        let mut moved = t.clone();
+        moved[25600] += 2e-6;
+        let f = parse_uff(pairs_58(&moved, &y).as_bytes(), "moved.uff", None).unwrap();
+        let r = &f.records[0];
+        assert!(matches!(r.abscissa, Abscissa::Uneven(_)));
+        let e = r.even().unwrap_err().to_string();
+        assert!(e.contains("uneven") && e.contains("moved.uff"), "{e}");
     }
 
     /// Channels of quantities meid does not process, recorded beside the accelerometer (a

@@ -90,6 +90,69 @@ pub struct Record {
 /// to count as evenly sampled (ASCII files print times to 6 significant digits).
 pub const EVEN_TOLERANCE: f64 = 1e-3;
 
+/// The even grid `T_0 + k·D` that sample times printed in decimal are, when one lies within the
+/// precision they were printed with: `|t_k − (T_0 + k·D)| ≤ h_k` for every `k`, `h_k` half a
+/// unit of the last digit `t_k` was printed with (an ASCII UFF 58 prints 6 significant digits,
+/// E13.5: 51.2 kHz steps of 19.53125 µs read 19.5312 µs or 19.5313 µs, 1 µs apart near 1 s,
+/// and are still one even grid). `Some((T_0, D))` when one exists, `None` otherwise (also for
+/// fewer than 2 times, or `half` not one per time).
+///
+/// For a step `D`, the starts allowed by every sample form the interval
+/// `[max_k (t_k − h_k − kD), min_k (t_k + h_k − kD)]`; its excess
+/// `g(D) = max_k (t_k − h_k − kD) − min_k (t_k + h_k − kD)` is convex in `D` (a maximum of
+/// linear functions less a minimum of linear functions), so the grid exists exactly when the
+/// minimum of `g` over `D` is ≤ 0, found by ternary search over the steps the first and last
+/// samples allow. Each `h_k` is widened by 4 ulps of `t_k` for the decimal-to-binary conversion.
+pub fn even_as_printed(t: &[f64], half: &[f64]) -> Option<(f64, f64)> {
+    let n = t.len();
+    if n < 2 || half.len() != n || t.iter().chain(half).any(|v| !v.is_finite()) {
+        return None;
+    }
+    let h: Vec<f64> = t
+        .iter()
+        .zip(half)
+        .map(|(t, h)| h.abs() + 4.0 * f64::EPSILON * t.abs())
+        .collect();
+    let last = (n - 1) as f64;
+    let d_lo = ((t[n - 1] - h[n - 1]) - (t[0] + h[0])) / last;
+    let d_hi = ((t[n - 1] + h[n - 1]) - (t[0] - h[0])) / last;
+    if d_hi <= 0.0 {
+        return None;
+    }
+    // The starts every sample allows for step d: (lowest, highest).
+    let starts = |d: f64| {
+        t.iter().zip(&h).enumerate().fold(
+            (f64::NEG_INFINITY, f64::INFINITY),
+            |(lo, hi), (k, (t, h))| {
+                let c = t - k as f64 * d;
+                (lo.max(c - h), hi.min(c + h))
+            },
+        )
+    };
+    let excess = |d: f64| {
+        let (lo, hi) = starts(d);
+        lo - hi
+    };
+    let (mut a, mut b) = (d_lo.max(0.0), d_hi);
+    for _ in 0..200 {
+        if excess(a) <= 0.0 || b - a <= 1e-15 * b {
+            break;
+        }
+        let m1 = a + (b - a) / 3.0;
+        let m2 = b - (b - a) / 3.0;
+        if excess(m1) <= excess(m2) {
+            b = m2;
+        } else {
+            a = m1;
+        }
+    }
+    let d = [a, 0.5 * (a + b), b]
+        .into_iter()
+        .min_by(|x, y| excess(*x).total_cmp(&excess(*y)))?;
+    let (lo, hi) = starts(d);
+    (d > 0.0 && lo <= hi).then_some((0.5 * (lo + hi), d))
+}
+
 impl Record {
     /// The SI unit of the values.
     pub fn unit(&self) -> &'static str {

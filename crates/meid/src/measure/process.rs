@@ -16,9 +16,13 @@
 //! when `|x − x̃|` falls below `L`. Each blow's record starts `pre-trigger` seconds before its trigger and lasts the record
 //! length (default: the shortest interval between triggers, or up to the end for a single
 //! blow). A blow whose record would start before the first sample or end after the last is
-//! counted but not averaged. When blows are found but none of their records fits in the file,
-//! [`require_complete`] refuses with the range of pre-trigger or record length that would fit
-//! (the same rule for `meid measure`, `validate` and `calibrate`). A record must hold at least
+//! counted but not averaged. When every blow triggers within the pre-trigger of the record's
+//! start (a record that starts at the trigger, as many acquisition systems write it, or a
+//! simulated history), `meid measure` keeps the pre-trigger the record has, the time before the
+//! first trigger, and says so in a note ([`group_blows`]). When blows are found but none of their
+//! records fits in the file even so, [`require_complete`] refuses with the range of pre-trigger
+//! or record length that would fit (the same rule for `meid measure`, `validate` and
+//! `calibrate`). A record must hold at least
 //! [`MIN_RECORD_SAMPLES`] samples.
 //!
 //! # Scaling
@@ -197,6 +201,9 @@ pub struct Blows {
     pub pretrigger: usize,
     /// The absolute level used (SI), a deviation from the channel's median.
     pub level: f64,
+    /// Set when the pre-trigger asked for was shortened to the time the record has before its
+    /// first blow ([`group_blows`]): what was done, for the user.
+    pub note: Option<String>,
 }
 
 /// Finds blows on `x` sampled at `fs` (module docs).
@@ -293,6 +300,7 @@ pub fn detect_blows(x: &[f64], fs: f64, p: &Processing) -> Result<Blows> {
         length,
         pretrigger: pre,
         level,
+        note: None,
     })
 }
 
@@ -1006,6 +1014,11 @@ pub struct ChannelSummary {
     /// The window the spectrum was computed with, e.g. "rectangular", or "rectangular × force
     /// (pulse 0.0112 s, taper 0.0005 s)" on the blow's excitation with `--force-window`.
     pub window: String,
+    /// Set when the records keep a shorter pre-trigger than asked for: the first blow comes
+    /// sooner after the record's start ([`group_blows`]); says so, with both times. Left out of
+    /// the JSON when there is none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pretrigger_note: Option<String>,
 }
 
 /// A processed channel: the summary, the blow-averaged record and spectrum, the bands.
@@ -1042,10 +1055,13 @@ pub fn trigger_channel(records: &[&Record], measurement_point: &str) -> usize {
         .unwrap_or(0)
 }
 
-/// The blows of a group of records sampled together, found on `records[trigger]`. Blows
-/// found of which none fits in the file are refused ([`require_complete`], as `validate`
-/// does); when no blow is found at all, the whole record counts as one (no trigger:
-/// `triggers` empty, and [`process_channel`] reports 0 blows averaged).
+/// The blows of a group of records sampled together, found on `records[trigger]`. When no
+/// blow record fits because the first blow triggers sooner after the record's start than the
+/// pre-trigger, the records keep the pre-trigger the file has, the time before that first
+/// trigger, and [`Blows::note`] says so (a record that starts at the trigger, a simulated
+/// history). Blows found of which none fits even so are refused ([`require_complete`]); when no
+/// blow is found at all, the whole record counts as one (no trigger: `triggers` empty, and
+/// [`process_channel`] reports 0 blows averaged).
 pub fn group_blows(records: &[&Record], trigger: usize, p: &Processing) -> Result<(Blows, usize)> {
     let r = records
         .get(trigger)
@@ -1062,17 +1078,49 @@ pub fn group_blows(records: &[&Record], trigger: usize, p: &Processing) -> Resul
                 length: n,
                 pretrigger: 0,
                 level: b.level,
+                note: None,
             },
             found,
         ));
     }
-    let starts = b
-        .starts
-        .iter()
-        .copied()
-        .filter(|&s| s.checked_add(b.length).is_some_and(|e| e <= n))
-        .collect();
-    let b = Blows { starts, ..b };
+    let fits = |b: Blows| {
+        let starts = b
+            .starts
+            .iter()
+            .copied()
+            .filter(|&s| s.checked_add(b.length).is_some_and(|e| e <= n))
+            .collect();
+        Blows { starts, ..b }
+    };
+    let mut b = fits(b);
+    // Every blow triggers within the pre-trigger of the record's start (a record that starts
+    // at the trigger, a simulated history): the pre-trigger the record has, the time before its
+    // first trigger, instead of no blow at all.
+    let first = b.triggers[0];
+    if b.starts.is_empty() && first < b.pretrigger {
+        let asked = b.pretrigger;
+        let shorter = Processing {
+            pretrigger_s: first as f64 / fs,
+            ..p.clone()
+        };
+        let c = fits(detect_blows(&r.values, fs, &shorter)?);
+        if !c.starts.is_empty() {
+            b = Blows {
+                note: Some(format!(
+                    "{}: the first blow on '{}' triggers {:.6} s after the record's start, within \
+                     the pre-trigger of {:.6} s: its records keep the {:.6} s the file has before \
+                     it (a pre-trigger under {MIN_BASELINE_SAMPLES} samples removes no baseline; \
+                     --pretrigger or [measurement] pretrigger_s sets it)",
+                    r.origin,
+                    r.name,
+                    first as f64 / fs,
+                    asked as f64 / fs,
+                    c.pretrigger as f64 / fs
+                )),
+                ..c
+            };
+        }
+    }
     require_complete(&b, n, fs, &r.name, &r.origin)?;
     Ok((b, found))
 }
@@ -1138,6 +1186,7 @@ pub fn process_channel(
             dominant_level_db: de,
             clipped_samples: clipped_samples(&r.values),
             window,
+            pretrigger_note: blows.note.clone(),
         },
         quantity: r.quantity,
         origin: r.origin.clone(),

@@ -116,6 +116,24 @@ pub fn summary_text(files: &[String], channels: &[ProcessedChannel]) -> String {
         out,
         "  levels are dB re 1 (SI unit)²·s/Hz (1 (m/s^2)²·s/Hz, 1 N²·s/Hz)."
     );
+    for n in notes(channels) {
+        let _ = writeln!(out, "  note: {n}");
+    }
+    out
+}
+
+/// The notes of a `meid measure` run, each once: a pre-trigger shortened to the time a record
+/// has before its first blow ([`super::process::group_blows`]).
+pub fn notes(channels: &[ProcessedChannel]) -> Vec<&str> {
+    let mut out: Vec<&str> = Vec::new();
+    for n in channels
+        .iter()
+        .filter_map(|c| c.summary.pretrigger_note.as_deref())
+    {
+        if !out.contains(&n) {
+            out.push(n);
+        }
+    }
     out
 }
 

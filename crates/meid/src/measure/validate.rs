@@ -348,6 +348,7 @@ pub(crate) fn simulated_blow(
             length: n,
             pretrigger: pre,
             level: 0.0,
+            note: None,
         },
         processing: sp,
     };
@@ -368,6 +369,7 @@ pub(crate) fn simulated_blow(
         length: n,
         pretrigger: pre,
         level: sb0.level,
+        note: None,
     };
     Ok(out)
 }
