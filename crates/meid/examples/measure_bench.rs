@@ -71,7 +71,7 @@ fn write(path: &Path) {
         });
     }
     let mut f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
-    uff::write_records(&mut f, &records, true, &path).unwrap();
+    uff::write_records(&mut f, &records, true, path).unwrap();
 }
 
 fn read(path: &Path) {

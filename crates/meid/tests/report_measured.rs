@@ -52,7 +52,7 @@ fn write_measurement(m: &Model, case: Case, path: &Path) {
         })
         .collect();
     let mut f = std::fs::File::create(path).unwrap();
-    uff::write_records(&mut f, &records, true, &path).unwrap();
+    uff::write_records(&mut f, &records, true, path).unwrap();
 }
 
 /// Small studies: the section under test does not depend on them.

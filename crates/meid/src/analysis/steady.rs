@@ -513,12 +513,11 @@ struct Fixed {
     rejected: usize,
 }
 
+/// `P^k(y)`, its Jacobian, the k blows' reports and their switching sequences.
+type PeriodEval = (Vec<f64>, Mat<f64>, Vec<BlowReport>, Vec<Vec<Mode>>);
+
 /// `P^k(y)`, its Jacobian, the blows' reports and switching sequences.
-fn eval_k(
-    map: &mut Map,
-    y: &[f64],
-    k: usize,
-) -> Result<(Vec<f64>, Mat<f64>, Vec<BlowReport>, Vec<Vec<Mode>>)> {
+fn eval_k(map: &mut Map, y: &[f64], k: usize) -> Result<PeriodEval> {
     let d = map.dim();
     let mut z = y.to_vec();
     let mut jac = Mat::<f64>::identity(d, d);
@@ -1057,8 +1056,8 @@ sample_rate = 20000.0
     /// m_s → 0 limit.)
     #[test]
     fn steady_state_of_the_struck_mounted_mass_matches_the_closed_form() {
-        let (m, k) = (100.0, 1.0e5);
-        let period = 2.0 * std::f64::consts::PI / (k / m as f64).sqrt();
+        let (m, k) = (100.0_f64, 1.0e5_f64);
+        let period = 2.0 * std::f64::consts::PI / (k / m).sqrt();
         for (zeta, ms, cycles) in [(0.02, 0.01, 5.3), (0.05, 2.0, 3.7), (0.01, 0.5, 2.0)] {
             let p = Mounted {
                 m,

@@ -125,7 +125,7 @@ pub fn read(path: &Path) -> Result<SparseColMat<usize, f64>> {
                 tok.0,
                 format!(
                     "`{}` is not supported; expected `{w}`",
-                    crate::input::clip(&tok.1)
+                    crate::input::clip(tok.1)
                 ),
             ));
         }
@@ -138,7 +138,7 @@ pub fn read(path: &Path) -> Result<SparseColMat<usize, f64>> {
             h[3].0,
             format!(
                 "field `{}` is not supported; expected `real` or `integer`",
-                crate::input::clip(&h[3].1)
+                crate::input::clip(h[3].1)
             ),
         ));
     }
@@ -153,7 +153,7 @@ pub fn read(path: &Path) -> Result<SparseColMat<usize, f64>> {
                 h[4].0,
                 format!(
                     "symmetry `{}` is not supported; expected `symmetric` or `general`",
-                    crate::input::clip(&h[4].1)
+                    crate::input::clip(h[4].1)
                 ),
             ))
         }

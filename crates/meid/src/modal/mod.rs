@@ -69,7 +69,7 @@ pub struct FloorForce {
 }
 
 /// A structure reduced to its modes. All vectors have one entry per retained mode.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct ModalModel {
     /// Natural circular frequencies ω_i (rad/s), ascending. Rigid-body modes are exactly 0.
     pub omega_rad_per_s: Vec<f64>,
