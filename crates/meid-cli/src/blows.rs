@@ -58,8 +58,8 @@ pub fn run(a: BlowsArgs) -> Result<()> {
         )
     })?;
     let case = a.case.parse()?;
-    let prod = crate::production::cases(&model, case, a.rate_bpm, &a.print)?;
     if a.steady {
+        let prod = crate::production::cases(&model, case, a.rate_bpm, &a.print)?;
         return crate::production::steady_only(&prod, a.output.as_deref(), &a.print);
     }
     let sys = model.impact_system(case)?;
@@ -122,6 +122,9 @@ pub fn run(a: BlowsArgs) -> Result<()> {
             r.context("blow train failed")?
         }
     };
+    // The steady states after the march: the march's own refusals (a collision longer than
+    // the interval, a run too long) come first, as they name the blow that failed.
+    let prod = crate::production::cases(&model, case, a.rate_bpm, &a.print)?;
     let out = serde_json::json!({
         "rate_bpm": a.rate_bpm,
         "interval_s": r.interval_s,

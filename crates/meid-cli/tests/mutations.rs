@@ -259,6 +259,12 @@ fn names_field(stderr: &str, m: &Mutation, segs: &[Seg]) -> bool {
     if stderr.contains(&m.path) {
         return true;
     }
+    // A mutation of the structure that changes which modes are retained leaves the file's
+    // `structure.reference_mode` (a structure mode number) naming a mode no longer kept: the
+    // error names that dependent field and lists the retained modes, which is what to fix.
+    if stderr.contains("structure.reference_mode") && stderr.contains("the retained modes are") {
+        return true;
+    }
     // The array holding a mutated element (`damping_ratios` for `damping_ratios[1]`).
     if let Some(Seg::Index(_)) = segs.last() {
         let parent = path_text(&segs[..segs.len() - 1]);

@@ -162,7 +162,7 @@ fn touches(
 
 /// The largest stroke rate at or below `rate_bpm` at which the damper touches the bed in every
 /// steady blow: if it does at `rate_bpm`, that rate; else the rate is halved until it does
-/// (down to `rate_bpm / 64`), then the bracket is bisected in log-rate to 0.5 %. The search
+/// (down to `rate_bpm / 64`, or the lowest rate the run-length limit allows), then the bracket is bisected in log-rate to 0.5 %. The search
 /// assumes one change from returning to not returning inside the bracket; a rate-dependent
 /// comb filter can make returning non-monotonic in the rate, so the answer is the edge of the
 /// bracket found, not a guarantee for every lower rate.
@@ -201,8 +201,15 @@ pub fn return_rate(
     let mut hi = rate_bpm;
     let mut lo = rate_bpm / 2.0;
     loop {
-        if touches(sys, opts, so, lo)? {
-            break;
+        // A rate whose blow exceeds the run-length limit ([`crate::integrate::check_cost`]) ends the
+        // search there: the lowest rate tried is reported.
+        match touches(sys, opts, so, lo) {
+            Ok(true) => break,
+            Ok(false) => {}
+            Err(_) => {
+                out.lowest_rate_bpm = hi;
+                return Ok(out);
+            }
         }
         hi = lo;
         lo /= 2.0;
@@ -212,7 +219,7 @@ pub fn return_rate(
     }
     while hi / lo > 1.0 + resolution {
         let mid = (lo * hi).sqrt();
-        if touches(sys, opts, so, mid)? {
+        if touches(sys, opts, so, mid).unwrap_or(false) {
             lo = mid;
         } else {
             hi = mid;
