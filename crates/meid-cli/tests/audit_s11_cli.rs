@@ -272,9 +272,10 @@ fn blows_steady_levels_are_given_as_estimates_with_their_last_change() {
         .args(["blows", &e, "--blows", "10"])
         .output()
         .unwrap());
+    // The march's line (the production verdict and steady states come before it).
     let line = text
         .lines()
-        .find(|l| l.contains("steady"))
+        .find(|l| l.trim_start().starts_with("steady ("))
         .unwrap_or_else(|| panic!("{text}"));
     assert!(line.contains("blow 10's levels, an estimate"), "{line}");
     let after = |key: &str| -> (f64, f64) {
