@@ -136,87 +136,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
         "damper_gap_at_next_strike_m": r.damper_gap_at_next_strike_m,
     });
     if let Some(set) = &set {
-        let dir = set.staging();
-        let mut w = String::from("blow,start_s,energy_ratio,machine_energy_at_strike_j,damper_energy_at_strike_j,peak_bed_acceleration_m_per_s2,peak_floor_force_n,peak_contact_force_slider_bed_n,damper_gap_at_strike_m,damper_contact_time_s\n");
-        let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.9e}"));
-        for x in &r.blows {
-            w.push_str(&format!(
-                "{},{:.9e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{},{}\n",
-                x.blow,
-                x.start_s,
-                opt(x.energy_ratio),
-                x.machine_energy_at_strike_j,
-                x.damper_energy_at_strike_j,
-                x.peak_bed_acceleration_m_per_s2,
-                x.peak_floor_force_n,
-                x.peak_contact_force_slider_bed_n,
-                opt(x.damper_gap_at_strike_m),
-                opt(x.damper_contact_time_s)
-            ));
-        }
-        meid::io::write_atomic(&dir.join("blows.csv"), w.as_bytes())?;
-        meid::io::write_json(&dir.join("blows.json"), &out)?;
-        let [time_s, accel, floor] = std::mem::take(&mut pictured);
-        for (stem, title, label, y) in [
-            (
-                "acceleration-time",
-                "bed acceleration at B",
-                "acceleration (m/s²)",
-                accel,
-            ),
-            ("floor-force-time", "force to the floor", "force (N)", floor),
-        ] {
-            plot::line_plot(
-                dir.join(stem),
-                &LinePlot {
-                    title: format!("{title}, {} blows at {} /min", a.blows, a.rate_bpm),
-                    x_label: "time (s)".into(),
-                    y_label: label.into(),
-                    series: vec![Series {
-                        label: String::new(),
-                        x: time_s.clone(),
-                        y,
-                        ..Default::default()
-                    }],
-                    ..LinePlot::default()
-                },
-            )?;
-        }
-        let n: Vec<f64> = r.blows.iter().map(|x| x.blow as f64).collect();
-        let first_f = r.blows.first().map_or(1.0, |x| x.peak_floor_force_n);
-        let first_a = r
-            .blows
-            .first()
-            .map_or(1.0, |x| x.peak_bed_acceleration_m_per_s2);
-        plot::line_plot(
-            dir.join("blow-levels"),
-            &LinePlot {
-                title: "peak levels per blow (relative to the first blow)".into(),
-                x_label: "blow number (1)".into(),
-                y_label: "peak / first blow's peak (1)".into(),
-                series: vec![
-                    Series {
-                        label: "floor force".into(),
-                        x: n.clone(),
-                        y: r.blows
-                            .iter()
-                            .map(|x| x.peak_floor_force_n / first_f)
-                            .collect(),
-                        ..Default::default()
-                    },
-                    Series {
-                        label: "bed acceleration".into(),
-                        x: n,
-                        y: r.blows
-                            .iter()
-                            .map(|x| x.peak_bed_acceleration_m_per_s2 / first_a)
-                            .collect(),
-                        ..Default::default()
-                    },
-                ],
-                ..LinePlot::default()
-            },
-        )?;
+        write_march(set.staging(), &a, &r, &out, std::mem::take(&mut pictured))?;
     }
     if let Some(set) = set {
         set.commit("blows")?;
@@ -226,50 +146,146 @@ pub fn run(a: BlowsArgs) -> Result<()> {
     } else if a.print.human() {
         crate::production::print_production(&prod.production);
         println!();
-        println!(
-            "The march from rest: {} blows every {:.6} s ({} /min)",
-            a.blows, r.interval_s, a.rate_bpm
-        );
-        println!("  blow  E_p+/E_s-   peak accel (m/s²)  peak floor force (N)  machine energy at strike (J)  damper gap (mm)");
-        for x in &r.blows {
-            println!(
-                "  {:>4}  {:>9}  {:>17.4}  {:>20.4}  {:>28.4e}  {:>15}",
-                x.blow,
-                x.energy_ratio.map_or("—".into(), |v| format!("{v:.5}")),
-                x.peak_bed_acceleration_m_per_s2,
-                x.peak_floor_force_n,
-                x.machine_energy_at_strike_j,
-                x.damper_gap_at_strike_m
-                    .map_or("—".into(), |g| format!("{:.4}", g * 1e3))
-            );
-        }
-        let s = &r.steady;
-        match s.from_blow {
-            // The levels printed are the last blow's: an estimate of the steady level, which
-            // they approach to about the last blow-to-blow change (10 blows of the lumped
-            // example: 110.5651 N, 40 blows: 110.5272 N; last change 0.082 N).
-            Some(k) => println!(
-                "  steady (blow-to-blow changes < {}) from blow {k}; blow {}'s levels, an estimate of the steady levels to about the last change: floor force {:.4} N ± {:.2e} N, bed acceleration {:.4} m/s² ± {:.2e} m/s² (more blows give more digits)",
-                a.tolerance,
-                r.blows.len(),
-                s.peak_floor_force_n,
-                last_change(&r.blows, |b| b.peak_floor_force_n),
-                s.peak_bed_acceleration_m_per_s2,
-                last_change(&r.blows, |b| b.peak_bed_acceleration_m_per_s2)
-            ),
-            None => println!(
-                "  not steady after {} blows: last changes floor {:.2e}, acceleration {:.2e}, energy ratio {:.2e}",
-                a.blows,
-                s.last_change_peak_floor_force,
-                s.last_change_peak_bed_acceleration,
-                s.last_change_energy_ratio
-            ),
-        }
-        if let Some(hint) = damper_hint(&r) {
-            println!("  {hint}");
-        }
+        print_march(&a, &r);
     }
     Ok(())
+}
+
+/// blows.csv, blows.json and the pictures of the march into the staging directory `dir`.
+fn write_march(
+    dir: &std::path::Path,
+    a: &BlowsArgs,
+    r: &meid::analysis::blows::BlowsRun,
+    out: &serde_json::Value,
+    pictured: [Vec<f64>; 3],
+) -> Result<()> {
+    let mut w = String::from("blow,start_s,energy_ratio,machine_energy_at_strike_j,damper_energy_at_strike_j,peak_bed_acceleration_m_per_s2,peak_floor_force_n,peak_contact_force_slider_bed_n,damper_gap_at_strike_m,damper_contact_time_s\n");
+    let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.9e}"));
+    for x in &r.blows {
+        w.push_str(&format!(
+            "{},{:.9e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{},{}\n",
+            x.blow,
+            x.start_s,
+            opt(x.energy_ratio),
+            x.machine_energy_at_strike_j,
+            x.damper_energy_at_strike_j,
+            x.peak_bed_acceleration_m_per_s2,
+            x.peak_floor_force_n,
+            x.peak_contact_force_slider_bed_n,
+            opt(x.damper_gap_at_strike_m),
+            opt(x.damper_contact_time_s)
+        ));
+    }
+    meid::io::write_atomic(&dir.join("blows.csv"), w.as_bytes())?;
+    meid::io::write_json(&dir.join("blows.json"), out)?;
+    let [time_s, accel, floor] = pictured;
+    for (stem, title, label, y) in [
+        (
+            "acceleration-time",
+            "bed acceleration at B",
+            "acceleration (m/s²)",
+            accel,
+        ),
+        ("floor-force-time", "force to the floor", "force (N)", floor),
+    ] {
+        plot::line_plot(
+            dir.join(stem),
+            &LinePlot {
+                title: format!("{title}, {} blows at {} /min", a.blows, a.rate_bpm),
+                x_label: "time (s)".into(),
+                y_label: label.into(),
+                series: vec![Series {
+                    label: String::new(),
+                    x: time_s.clone(),
+                    y,
+                    ..Default::default()
+                }],
+                ..LinePlot::default()
+            },
+        )?;
+    }
+    let n: Vec<f64> = r.blows.iter().map(|x| x.blow as f64).collect();
+    let first_f = r.blows.first().map_or(1.0, |x| x.peak_floor_force_n);
+    let first_a = r
+        .blows
+        .first()
+        .map_or(1.0, |x| x.peak_bed_acceleration_m_per_s2);
+    plot::line_plot(
+        dir.join("blow-levels"),
+        &LinePlot {
+            title: "peak levels per blow (relative to the first blow)".into(),
+            x_label: "blow number (1)".into(),
+            y_label: "peak / first blow's peak (1)".into(),
+            series: vec![
+                Series {
+                    label: "floor force".into(),
+                    x: n.clone(),
+                    y: r.blows
+                        .iter()
+                        .map(|x| x.peak_floor_force_n / first_f)
+                        .collect(),
+                    ..Default::default()
+                },
+                Series {
+                    label: "bed acceleration".into(),
+                    x: n,
+                    y: r.blows
+                        .iter()
+                        .map(|x| x.peak_bed_acceleration_m_per_s2 / first_a)
+                        .collect(),
+                    ..Default::default()
+                },
+            ],
+            ..LinePlot::default()
+        },
+    )?;
+    Ok(())
+}
+
+/// The march's table, its steady line and the damper hint.
+fn print_march(a: &BlowsArgs, r: &meid::analysis::blows::BlowsRun) {
+    println!(
+        "The march from rest: {} blows every {:.6} s ({} /min)",
+        a.blows, r.interval_s, a.rate_bpm
+    );
+    println!("  blow  E_p+/E_s-   peak accel (m/s²)  peak floor force (N)  machine energy at strike (J)  damper gap (mm)");
+    for x in &r.blows {
+        println!(
+            "  {:>4}  {:>9}  {:>17.4}  {:>20.4}  {:>28.4e}  {:>15}",
+            x.blow,
+            x.energy_ratio.map_or("—".into(), |v| format!("{v:.5}")),
+            x.peak_bed_acceleration_m_per_s2,
+            x.peak_floor_force_n,
+            x.machine_energy_at_strike_j,
+            x.damper_gap_at_strike_m
+                .map_or("—".into(), |g| format!("{:.4}", g * 1e3))
+        );
+    }
+    let s = &r.steady;
+    match s.from_blow {
+        // The levels printed are the last blow's: an estimate of the steady level, which
+        // they approach to about the last blow-to-blow change (10 blows of the lumped
+        // example: 110.5651 N, 40 blows: 110.5272 N; last change 0.082 N).
+        Some(k) => println!(
+            "  steady (blow-to-blow changes < {}) from blow {k}; blow {}'s levels, an estimate of the steady levels to about the last change: floor force {:.4} N ± {:.2e} N, bed acceleration {:.4} m/s² ± {:.2e} m/s² (more blows give more digits)",
+            a.tolerance,
+            r.blows.len(),
+            s.peak_floor_force_n,
+            last_change(&r.blows, |b| b.peak_floor_force_n),
+            s.peak_bed_acceleration_m_per_s2,
+            last_change(&r.blows, |b| b.peak_bed_acceleration_m_per_s2)
+        ),
+        None => println!(
+            "  not steady after {} blows: last changes floor {:.2e}, acceleration {:.2e}, energy ratio {:.2e}",
+            a.blows,
+            s.last_change_peak_floor_force,
+            s.last_change_peak_bed_acceleration,
+            s.last_change_energy_ratio
+        ),
+    }
+    if let Some(hint) = damper_hint(r) {
+        println!("  {hint}");
+    }
 }
 
 /// Below this gap (m) the damper counts as back against the bed (10 µm: far below the bed's
