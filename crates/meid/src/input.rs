@@ -78,13 +78,18 @@ fn open_within(path: &Path, limit: u64) -> Result<(std::fs::File, u64)> {
     let file = match file {
         Some(f) if meta.file_type().is_file() => f,
         _ => {
-            return Err(Error::Input {
-                location: path.display().to_string(),
-                message: format!(
-                    "is {}, not a regular file; give a file (a device or pipe has no size to check and may never end)",
-                    kind_of(meta.file_type())
-                ),
-            })
+            // An I/O error (Python: an OSError; a directory: IsADirectoryError's kind), with
+            // the message saying what to give instead.
+            let kind = if meta.file_type().is_dir() {
+                std::io::ErrorKind::IsADirectory
+            } else {
+                std::io::ErrorKind::InvalidInput
+            };
+            let message = format!(
+                "is {}, not a regular file; give a file (a device or pipe has no size to check and may never end)",
+                kind_of(meta.file_type())
+            );
+            return Err(Error::io(path, std::io::Error::new(kind, message)));
         }
     };
     let len = meta.len();
