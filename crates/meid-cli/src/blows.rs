@@ -31,6 +31,13 @@ pub struct BlowsArgs {
     /// a picture of the dB changes against the rate.
     #[arg(long, value_name = "LO..HI:N", conflicts_with = "steady")]
     rates: Option<String>,
+    /// A damper-return map instead: over one or two quantities (repeat --vary, as in `meid
+    /// sweep`: e.g. --vary damper.stiffness=1e3..1e5:9:log --vary damper.damping=50..1000:9:log),
+    /// each design's steady state at --rate-bpm: whether the damper returns before every strike,
+    /// and its steady floor force and bed acceleration against no damper; with -o,
+    /// return-map.csv, return-map.json and a picture.
+    #[arg(long, value_name = "SPEC", conflicts_with_all = ["steady", "rates"])]
+    vary: Vec<String>,
     #[command(flatten)]
     case: CaseArg,
     /// Write blows.csv, blows.json, history.csv and pictures into DIR.
@@ -57,6 +64,16 @@ pub fn run(a: BlowsArgs) -> Result<()> {
             ),
         )
     })?;
+    if !a.vary.is_empty() {
+        return crate::return_map::run(
+            &a.model,
+            &model,
+            &a.vary,
+            a.rate_bpm,
+            a.output.as_deref(),
+            &a.print,
+        );
+    }
     let case = a.case.parse()?;
     if a.steady {
         let prod = crate::production::cases(&model, case, a.rate_bpm, &a.print)?;

@@ -42,6 +42,7 @@ mod paper;
 mod production;
 mod progress;
 mod report;
+mod return_map;
 mod shard;
 mod shell;
 mod simulate;

@@ -51,6 +51,11 @@ pub struct OptimizeArgs {
     /// docs/studies.md).
     #[arg(long, value_name = "KG")]
     bed_mass: Option<f64>,
+    /// Optimise for production at this stroke rate (blows/min): the objective on the steady
+    /// blow of the periodic blow train, and only designs whose damper returns to the bed
+    /// before every strike are feasible (docs/studies.md, "Production").
+    #[arg(long, value_name = "R")]
+    rate_bpm: Option<f64>,
     /// Write the report (optimize.json: variables, bounds, optimum, objective values) into DIR.
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
@@ -98,6 +103,9 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
     let mut study =
         OptimizeStudy::with_bed_mass(model, vars, Objective::parse(&a.objective)?, a.bed_mass)?;
+    if let Some(r) = a.rate_bpm {
+        study = study.with_stroke_rate(r)?;
+    }
     study.max_simulations = a.max_simulations;
     study.grid_points = a.grid;
     let t0 = std::time::Instant::now();
@@ -132,8 +140,12 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
         ),
     };
     println!(
-        "meid optimize — minimise {} ({method}; {} of at most {} simulations in {}{})",
+        "meid optimize — minimise {}{} ({method}; {} of at most {} simulations in {}{})",
         rep.metric,
+        rep.rate_bpm.map_or(String::new(), |r| format!(
+            " of the steady blow at {} blows/min",
+            meid::num(r)
+        )),
         rep.simulations,
         rep.max_simulations,
         if elapsed >= 0.1 {
@@ -187,6 +199,19 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
     println!("  reproduce: {reproduce}");
     if rep.failures > 0 {
         println!("  failed simulations                {}", rep.failures);
+    }
+    if let (Some(rate), Some(st)) = (rep.rate_bpm, &rep.steady_state) {
+        println!(
+            "  at {} blows/min (steady blow)     {}, damper {}; {} design(s) refused: their damper does not return",
+            meid::num(rate),
+            st.regime.name(),
+            match st.damper_touches_bed {
+                Some(true) => "touches the bed before every strike",
+                Some(false) => "does not return",
+                None => "absent",
+            },
+            rep.infeasible.unwrap_or(0)
+        );
     }
     if let Some(dir) = &a.output {
         println!("  wrote {}", dir.join("optimize.json").display());

@@ -9,6 +9,7 @@ pub mod octave;
 pub mod optimize;
 pub mod production;
 pub mod quadrature;
+pub mod return_map;
 pub mod spectrum;
 pub mod steady;
 pub mod study;

@@ -33,6 +33,14 @@
 //! The paper's rule (section 4.1: the best damper has w_d = w_s) is evaluated at the
 //! optimum's other variables with `wd/ws = 1`.
 //!
+//! **At a stroke rate** ([`OptimizeStudy::with_stroke_rate`], `meid optimize --rate-bpm R`)
+//! the objective is the **steady blow's** ([`super::steady`]: the periodic steady state of the
+//! blow train at `R` blows/min, the mean energy ratio or the largest peak over its period), not
+//! the first blow's, and a design whose damper does not touch the bed in every steady blow (or
+//! whose train does not settle) is **infeasible**: it counts as `+∞` (an extreme barrier) and is
+//! tallied apart from failed simulations. The first blow is still simulated for the other
+//! metrics of the point.
+//!
 //! The free variables are searched in the order of their names (the result does not depend
 //! on the order they were given in); a variable with `LO = HI` is held fixed. After the
 //! search, each free variable is moved by ±[`NEIGHBOUR_STEP`] of its range in the search
@@ -49,7 +57,7 @@ use super::optimize::{
 };
 use super::sweep::{
     check_bed_mass, check_quantities, evaluate, evaluate_cached, failure_error, field_kind,
-    FieldKind, PointResult, Quantity,
+    FieldKind, PointResult, Quantity, METRICS,
 };
 use crate::integrate::Options;
 use crate::model::{Model, StructureCache};
@@ -228,7 +236,16 @@ pub struct OptimizeStudy {
     pub max_simulations: Option<usize>,
     /// Grid points per variable; `None`: [`default_grid_points`].
     pub grid_points: Option<usize>,
+    /// The stroke rate (blows/min) of [`OptimizeStudy::with_stroke_rate`]; `None`: one blow.
+    pub rate_bpm: Option<f64>,
 }
+
+/// The objective metrics a stroke rate replaces by the steady blow's.
+const STEADY_METRICS: [&str; 3] = [
+    "energy_ratio",
+    "peak_bed_acceleration_m_per_s2",
+    "peak_floor_force_n",
+];
 
 /// The result of [`OptimizeStudy::run`].
 #[derive(Debug, Clone, Serialize)]
@@ -259,8 +276,19 @@ pub struct OptimizeReport {
     pub wd_over_ws_at_optimum: f64,
     /// The objective with w_d = w_s (other variables at the optimum); NaN if it failed.
     pub objective_at_wd_equal_ws: f64,
-    /// The whole point at the optimum (every metric).
+    /// The whole point at the optimum (every metric; with a stroke rate the objective metrics
+    /// are the steady blow's).
     pub point: PointResult,
+    /// The stroke rate the objective was taken at (blows/min); absent for one blow.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rate_bpm: Option<f64>,
+    /// Designs refused because their damper does not return at the stroke rate (or their
+    /// train did not settle); not in `failures`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub infeasible: Option<usize>,
+    /// The optimum's steady state at the stroke rate.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub steady_state: Option<super::steady::SteadyState>,
     /// What the optimum is, from a check of its neighbours ([`LocalCheck`]).
     pub local_check: LocalCheck,
     /// The model fields the optimum sets, `PATH=VALUE` (shortest round-trip numbers): `meid
@@ -454,7 +482,103 @@ impl OptimizeStudy {
             bed_mass_kg,
             max_simulations: None,
             grid_points: None,
+            rate_bpm: None,
         })
+    }
+
+    /// The study at a stroke rate (module docs): the objective on the steady blow at
+    /// `rate_bpm` blows/min, with the constraint that the damper returns.
+    pub fn with_stroke_rate(mut self, rate_bpm: f64) -> Result<Self> {
+        super::blows::blow_interval_s(rate_bpm).map_err(|e| match e {
+            Error::InvalidValue { message, .. } => Error::Input {
+                location: format!("--rate-bpm {rate_bpm}"),
+                message,
+            },
+            other => other,
+        })?;
+        // The steady state needs the whole blow, not just the collision.
+        self.options = self.model.options();
+        self.rate_bpm = Some(rate_bpm);
+        Ok(self)
+    }
+
+    /// The steady state at the stroke rate of the design `x` (`qs = x`).
+    fn steady_of(
+        &self,
+        rate_bpm: f64,
+        qs: &[&Quantity],
+        x: &[f64],
+        cache: Option<&StructureCache>,
+    ) -> Result<super::steady::SteadyState> {
+        let pm = super::sweep::point_model_cached(&self.model, qs, x, self.bed_mass_kg, cache)?;
+        let sys = pm.model.impact_system(crate::model::Case::AsSpecified)?;
+        let so = super::steady::SteadyOptions {
+            rate_bpm,
+            ..Default::default()
+        };
+        super::steady::steady_state(&sys, &pm.model.options(), &so)
+    }
+
+    /// With a stroke rate: `r` (the point's first-blow result) with its objective metrics
+    /// replaced by the steady blow's, or NaN and the reason in `r.error` when the design is
+    /// infeasible (then `true`: module docs). Without one, `r` as it is.
+    fn at_stroke_rate(
+        &self,
+        qs: &[&Quantity],
+        x: &[f64],
+        mut r: PointResult,
+        cache: Option<&StructureCache>,
+    ) -> (PointResult, bool) {
+        let Some(rate) = self.rate_bpm else {
+            return (r, false);
+        };
+        if r.error.is_some() {
+            return (r, false);
+        }
+        let set = |r: &mut PointResult, values: [f64; 3]| {
+            for (name, v) in STEADY_METRICS.iter().zip(values) {
+                if let Some(i) = METRICS.iter().position(|m| m == name) {
+                    if let Some(cell) = r.metrics.get_mut(i) {
+                        *cell = Some(v);
+                    }
+                }
+            }
+        };
+        match self.steady_of(rate, qs, x, cache) {
+            Err(e) => {
+                set(&mut r, [f64::NAN; 3]);
+                r.error = Some(format!("the steady state at {rate} blows/min: {e}"));
+                (r, false)
+            }
+            Ok(st) if !st.converged || st.damper_touches_bed == Some(false) => {
+                set(&mut r, [f64::NAN; 3]);
+                r.error = Some(if st.converged {
+                    format!(
+                        "infeasible: at {rate} blows/min the damper does not return (gap {:.3e} m at a strike of the {} steady state)",
+                        st.damper_gap_at_strike_m.unwrap_or(f64::NAN),
+                        st.regime.name()
+                    )
+                } else {
+                    format!(
+                        "infeasible: at {rate} blows/min the blow train does not settle ({}, residual {:.2e})",
+                        st.regime.name(),
+                        st.residual
+                    )
+                });
+                (r, true)
+            }
+            Ok(st) => {
+                set(
+                    &mut r,
+                    [
+                        st.energy_ratio,
+                        st.peak_bed_acceleration_m_per_s2,
+                        st.peak_floor_force_n,
+                    ],
+                );
+                (r, false)
+            }
+        }
     }
 
     /// The free variables (not fixed by `LO = HI`) in the order the search takes them: by
@@ -531,7 +655,8 @@ impl OptimizeStudy {
     /// Simulates a point given in the variables' own units.
     pub fn evaluate(&self, x: &[f64]) -> PointResult {
         let qs: Vec<&Quantity> = self.variables.iter().map(|v| &v.quantity).collect();
-        evaluate(&self.model, &qs, x, self.bed_mass_kg, &self.options, 0)
+        let r = evaluate(&self.model, &qs, x, self.bed_mass_kg, &self.options, 0);
+        self.at_stroke_rate(&qs, x, r, None).0
     }
 
     /// The error of the failed point `x` (with its kind, see [`failure_error`]).
@@ -623,6 +748,7 @@ impl OptimizeStudy {
         }
         let cache = StructureCache::new();
         let count = std::sync::atomic::AtomicUsize::new(0);
+        let infeasible = std::sync::atomic::AtomicUsize::new(0);
         let qs_all: Vec<&Quantity> = self.variables.iter().map(|v| &v.quantity).collect();
         let eval = |qs: &[&Quantity], x: &[f64]| -> PointResult {
             let r = evaluate_cached(
@@ -634,6 +760,10 @@ impl OptimizeStudy {
                 0,
                 Some(&cache),
             );
+            let (r, refused) = self.at_stroke_rate(qs, x, r, Some(&cache));
+            if refused {
+                infeasible.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            }
             let d = count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             progress(d.min(budget), budget);
             r
@@ -784,6 +914,7 @@ impl OptimizeStudy {
             let searches = r.searches.len();
             (r.x, r.evaluations, r.failures, r.converged, searches)
         };
+        let search_infeasible = infeasible.load(std::sync::atomic::Ordering::Relaxed);
         let mut optimum = to_x(&u_best);
         let mut point = eval(&qs_all, &optimum);
         let mut objective_value = point.metric(metric);
@@ -960,6 +1091,11 @@ impl OptimizeStudy {
             (f64::NAN, 0)
         };
         let overrides = self.overrides(&optimum, &point);
+        let infeasible = infeasible.into_inner();
+        let steady_state = match self.rate_bpm {
+            Some(rate) => Some(self.steady_of(rate, &qs_all, &optimum, Some(&cache))?),
+            None => None,
+        };
         Ok(OptimizeReport {
             objective: self.objective,
             metric,
@@ -972,11 +1108,14 @@ impl OptimizeStudy {
             grid_simulations: self.grid_total(),
             local_searches,
             method,
-            failures,
+            failures: failures.saturating_sub(search_infeasible),
             converged,
             wd_over_ws_at_optimum: point.metric("wd_over_ws"),
             objective_at_wd_equal_ws: rule,
             point,
+            rate_bpm: self.rate_bpm,
+            infeasible: self.rate_bpm.map(|_| infeasible),
+            steady_state,
             local_check,
             overrides,
         })

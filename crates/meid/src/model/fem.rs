@@ -1380,6 +1380,8 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
     let (mut modes, solver) =
         solve_modes(&model, spec.solver, solved.max(wanted)).map_err(|e| unsolvable(e, src))?;
     let mut warnings = Vec::new();
+    let extent = super::general::bounding_diagonal(model.mesh.nodes.iter().copied());
+    warnings.extend(super::plausible::extent_slip(extent, base, src));
 
     // The points that rank modes: `contact_points`, else the model's named points with a role.
     let score_points: Vec<String> = match &spec.contact_points {

@@ -29,6 +29,7 @@ pub mod fem;
 pub mod general;
 pub mod imported;
 mod lumped;
+mod plausible;
 pub mod source;
 pub mod spec;
 pub mod strict;
@@ -833,7 +834,8 @@ impl Model {
     /// ([`crate::modal::truncation::SHARE_WARNING`]), frequency spreads the closed-form
     /// propagator resolves only approximately ([`crate::modal::conditioning`]), and imported
     /// modes of unstated units that make the struck point implausibly light
-    /// ([`imported::unit_suspicion`]).
+    /// ([`imported::unit_suspicion`]), and typed values no machine has, with their likely unit
+    /// slip ([`plausible`]).
     pub fn diagnostics(&self) -> Diagnostics {
         let ctx = fem::ReductionContext::of(&self.spec);
         let truncation = self.structure.truncation(&ctx.role_points);
@@ -861,6 +863,7 @@ impl Model {
             &self.spec.points.bed_contact,
         ));
         warnings.extend(self.reference_warning());
+        warnings.extend(plausible::unit_slips(&self.spec, &self.source));
         Diagnostics {
             truncation,
             notes: self.structure.notes.clone(),
