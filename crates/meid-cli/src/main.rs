@@ -145,7 +145,11 @@ fn main() -> ExitCode {
         Command::Measure(a) => measure::run(a),
         Command::Validate(a) => validate::run(a),
         Command::Calibrate(a) => calibrate::run(a),
-        Command::Merge(a) => shard::merge(a),
+        Command::Merge(a) => shard::merge(a, |name, command, shards| match (name, command) {
+            ("sweep", Command::Sweep(args)) => Some(sweep::merge(args, shards)),
+            ("montecarlo", Command::Montecarlo(args)) => Some(montecarlo::merge(args, shards)),
+            _ => None,
+        }),
         Command::Completions(a) => shell::completions(a),
         Command::Man(a) => shell::man(a),
     };

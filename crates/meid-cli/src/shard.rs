@@ -225,7 +225,15 @@ pub struct MergeArgs {
     print: crate::args::PrintArgs,
 }
 
-pub fn merge(a: MergeArgs) -> Result<()> {
+/// `meid merge`: the shards read and checked to be one study's, the study's command line
+/// rebuilt (with the merge's `-o` and print flags) and its working directory entered; then
+/// `merge_study` runs the study's own merge. It is given the shards' command name and their
+/// parsed command line and answers `None` when that is no sharded study: this module writes
+/// and reads shards for any study and knows none of them.
+pub fn merge(
+    a: MergeArgs,
+    merge_study: impl FnOnce(&str, crate::Command, &[ShardFiles]) -> Option<Result<()>>,
+) -> Result<()> {
     let shards = a
         .shards
         .iter()
@@ -265,11 +273,13 @@ pub fn merge(a: MergeArgs) -> Result<()> {
             first.cwd.display()
         )
     })?;
-    match (first.command.as_str(), cli.command) {
-        ("sweep", crate::Command::Sweep(args)) => crate::sweep::merge(args, &shards),
-        ("montecarlo", crate::Command::Montecarlo(args)) => crate::montecarlo::merge(args, &shards),
-        (c, _) => bail!("{}: cannot merge shards of `{c}`", first.dir.display()),
-    }
+    merge_study(&first.command, cli.command, &shards).unwrap_or_else(|| {
+        bail!(
+            "{}: cannot merge shards of `{}`",
+            first.dir.display(),
+            first.command
+        )
+    })
 }
 
 /// Checks that `shards` (whose fingerprints must be `fingerprint`) cover `0..total` exactly

@@ -10,9 +10,35 @@
 //! | impact | [`impact`] | slider, bed, damper, unilateral contacts: the piecewise-linear system (Eqs. 1-8) |
 //! | time | [`integrate`] | exact event-driven propagation; Dormand-Prince 5(4) with event location |
 //! | studies | [`analysis`] | energies (Eqs. 10-24), spectra, sweeps, optimisation, comparisons |
-//! | output | [`io`], [`plot`] | CSV/JSON/VTK files written atomically, PNG/SVG pictures |
+//! | measured data | [`record`], [`measure`] | records in SI; blows, spectra, validation, calibration |
+//! | output | [`io`], [`plot`] | file formats (CSV/JSON/VTK/UFF/Parquet, written atomically), PNG/SVG pictures |
 //! | reports | [`report`] | self-contained HTML pages (figures with captions, tables) |
 //! | limits | [`limits`] | memory estimated and checked before a run allocates |
+//!
+//! ## Layers
+//!
+//! Each stage imports only the stages on the lines below its own, so no module imports a
+//! module that imports it back (the `meid` command and the Python package sit on top):
+//!
+//! | layer | modules | may import |
+//! |---|---|---|
+//! | 9 reports | [`report`] | everything below |
+//! | 8 measured data | [`measure`] | `analysis`, `model`, `io`, `record`, `plot`, `impact` and the base |
+//! | 7 studies | [`analysis`] | `model`, `integrate`, `impact`, `io`, `modal`, `plot` and the base |
+//! | 6 model files | [`model`] | `integrate`, `impact`, `io` (its readers), `structure`, `modal` and the base |
+//! | 5 time | [`integrate`] | `impact`, `modal` and the base |
+//! | 4 impact system | [`impact`] | `modal` and the base |
+//! | 4 formats | [`io`] | `structure`, `modal`, `record` and the base: formats only, no study or model type |
+//! | 3 structure | [`structure`] | `modal` and the base |
+//! | 2 modes, pictures, records | [`modal`], [`plot`], [`record`] | the base |
+//! | 1 base | [`error`], [`input`], [`limits`], [`rng`] | one another, downwards (`input` → `limits` → `error`) |
+//!
+//! Two imports run up across the layers, each from one file and through data types alone:
+//! [`structure::machine`], the generator of the paper's machine, emits the general model
+//! ([`model::general::GeneralSpec`], with [`model::material`] and [`model::source::Source`]),
+//! which [`model::fem`] calls it for; and [`model::spec`] holds the model file's
+//! `[measurement]` section, [`measure::mapping::MeasurementSpec`]. Neither file is imported
+//! back by what it imports.
 //!
 //! Units are SI throughout (m, kg, s, N, rad/s unless a name says Hz).
 //! The library never prints; progress is reported through callbacks.
@@ -31,6 +57,7 @@ pub mod measure;
 pub mod modal;
 pub mod model;
 pub mod plot;
+pub mod record;
 pub mod report;
 pub mod rng;
 pub mod structure;

@@ -213,6 +213,15 @@ impl History {
     }
 }
 
+impl crate::io::HistoryRows for History {
+    fn samples(&self) -> usize {
+        self.time_s.len()
+    }
+    fn row(&self, i: usize) -> [f64; 21] {
+        History::row(self, i)
+    }
+}
+
 /// Memory of one sample of a [`History`]: 13 `f64` series and the 7 energy terms.
 pub const HISTORY_SAMPLE_BYTES: f64 = 20.0 * 8.0;
 

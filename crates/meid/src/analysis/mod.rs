@@ -14,5 +14,6 @@ pub mod spectrum;
 pub mod steady;
 pub mod study;
 pub mod sweep;
+pub mod table;
 
 pub use energy::{simulate, EnergyTerms, History, Run, Summary};

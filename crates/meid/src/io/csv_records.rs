@@ -2,7 +2,7 @@
 //! then one row per sample.
 //!
 //! A column name is `NAME_UNIT` with a unit suffix of
-//! [`crate::measure::units::CSV_SUFFIXES`]: `time_s`, `accel_B_m_per_s2`, `accel_B_g`,
+//! [`crate::record::units::CSV_SUFFIXES`]: `time_s`, `accel_B_m_per_s2`, `accel_B_g`,
 //! `force_floor_n`, `force_floor_kn`, `bed_velocity_mm_per_s` ... The channel's name is the
 //! column's name without the suffix (`accel_B`). Exactly one column is a time (`_s`, `_ms`,
 //! `_us`); meid's own `history.csv` reads as is (its energy columns, `_j`, are passed over).
@@ -11,8 +11,8 @@
 
 use std::path::Path;
 
-use crate::measure::units::{split_csv_name, Quantity};
-use crate::measure::{Abscissa, Record, EVEN_TOLERANCE};
+use crate::record::units::{split_csv_name, Quantity};
+use crate::record::{Abscissa, Record, EVEN_TOLERANCE};
 use crate::{Error, Result};
 
 /// Reads a CSV file of time histories (module docs).

@@ -16,7 +16,6 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use crate::analysis::History;
 use crate::{Error, Result};
 
 /// A file written through a temporary beside it and renamed into place by [`Self::commit`].
@@ -196,12 +195,22 @@ impl<W: Write> HistoryWriter<W> {
     }
 }
 
+/// A time history as [`history_csv`] writes it: its samples, each the values of
+/// [`HISTORY_COLUMNS`] in order (the simulation's `analysis::History` is one). This module
+/// knows the file format; the history knows its quantities.
+pub trait HistoryRows {
+    /// Number of samples.
+    fn samples(&self) -> usize;
+    /// Sample `i` in [`HISTORY_COLUMNS`] order.
+    fn row(&self, i: usize) -> [f64; 21];
+}
+
 /// Time histories as CSV text: one header row of `quantity_unit` names, then one row per
 /// sample. `machine_energy_j` is Eq. (24): `KE_p + PE_p + dissipated`.
-pub fn history_csv(h: &History) -> Result<Vec<u8>> {
+pub fn history_csv<H: HistoryRows + ?Sized>(h: &H) -> Result<Vec<u8>> {
     let err = |e: std::io::Error| Error::numerical("csv", e.to_string());
     let mut w = HistoryWriter::new(Vec::new()).map_err(err)?;
-    for i in 0..h.time_s.len() {
+    for i in 0..h.samples() {
         w.row(&h.row(i)).map_err(err)?;
     }
     w.into_inner().map_err(err)
@@ -209,11 +218,11 @@ pub fn history_csv(h: &History) -> Result<Vec<u8>> {
 
 /// Writes [`history_csv`] of `h` to `path` atomically, row by row (no copy of the text in
 /// memory).
-pub fn write_history_csv(path: &Path, h: &History) -> Result<()> {
+pub fn write_history_csv<H: HistoryRows + ?Sized>(path: &Path, h: &H) -> Result<()> {
     let mut f = AtomicFile::create(path)?;
     {
         let mut w = HistoryWriter::new(&mut f).map_err(|e| Error::io(path, e))?;
-        for i in 0..h.time_s.len() {
+        for i in 0..h.samples() {
             w.row(&h.row(i)).map_err(|e| Error::io(path, e))?;
         }
         w.into_inner().map_err(|e| Error::io(path, e))?;

@@ -151,7 +151,7 @@ fn numbers(a: &dyn arrow_array::Array) -> Option<Vec<Option<f64>>> {
 /// over), of any numeric type (double, float, integers; converted to `f64`). A column of
 /// another type, a null, a non-finite value or one that overflows in SI is refused naming the
 /// file, the column and the row (counted from 1 over the whole file).
-pub fn read_records(path: &Path) -> Result<Vec<crate::measure::Record>> {
+pub fn read_records(path: &Path) -> Result<Vec<crate::record::Record>> {
     use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
     let file = path.display().to_string();
     let bad = |message: String| Error::Input {
@@ -299,7 +299,7 @@ mod tests {
         let r = read_records(&path).unwrap();
         assert_eq!(r.len(), 2);
         assert_eq!(r[0].name, "accel_B");
-        assert_eq!(r[0].quantity, crate::measure::Quantity::Acceleration);
+        assert_eq!(r[0].quantity, crate::record::Quantity::Acceleration);
         assert_eq!(r[0].values[rows - 1], accel(rows - 1) * 9.80665);
         assert_eq!(r[1].values[rows - 1], (rows - 1) as f64 * 1e3);
         assert_eq!(r[1].origin, format!("{}, column 4", path.display()));

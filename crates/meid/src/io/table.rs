@@ -3,6 +3,8 @@
 //! A [`Table`] is the same rows as the study's CSV, with a type and an SI unit per column and
 //! the file-level facts (meid version, model hash, seed, ...) that make the table
 //! self-describing. [`crate::io::parquet`] (cargo feature `parquet`) writes it as Parquet.
+//! This module knows the format only: the studies build their tables
+//! ([`crate::analysis::table`]).
 
 /// The values of one column.
 #[derive(Debug, Clone, PartialEq)]
@@ -79,132 +81,6 @@ pub fn unit_of_column(name: &str) -> &'static str {
 /// FNV-1a 64 of `bytes` as 16 hex digits (a content hash for identification, not security).
 pub fn fnv1a_hex(bytes: &[u8]) -> String {
     crate::input::fnv1a_hex(bytes)
-}
-
-/// The model facts every table carries: `meid_version`, `model` (the file as given),
-/// `model_hash` ([`fnv1a_hex`] of the model file's text), `overrides` (`--set`, JSON list).
-pub fn model_metadata(model: &crate::model::Model) -> Vec<(String, String)> {
-    let overrides: Vec<String> = model
-        .source
-        .overrides
-        .iter()
-        .map(|(p, v)| format!("{p}={v}"))
-        .collect();
-    vec![
-        ("meid_version".into(), env!("CARGO_PKG_VERSION").to_string()),
-        ("model".into(), model.source.name.clone()),
-        ("model_hash".into(), fnv1a_hex(model.source.text.as_bytes())),
-        (
-            "overrides".into(),
-            serde_json::to_string(&overrides).unwrap_or_else(|_| "[]".into()),
-        ),
-    ]
-}
-
-impl crate::analysis::sweep::Sweep {
-    /// `result` (this sweep's) as a [`Table`]: the columns of `sweep.csv` — `index` (u64), the
-    /// varied values, K_s, K_d, m_d, m_s and every metric (f64; null where the CSV field is
-    /// empty, NaN for a failed point), `error` (text, null when the point ran) — with units,
-    /// and the metadata of [`model_metadata`] plus `command` = `sweep`, `fingerprint` (the
-    /// shards' study fingerprint) and `sweep` (`sweep.json`'s spec as JSON).
-    pub fn table(&self, result: &crate::analysis::sweep::SweepResult) -> Table {
-        let points = &result.points;
-        let mut columns = vec![Column {
-            name: "index".into(),
-            unit: Some("1".into()),
-            data: ColumnData::U64(points.iter().map(|p| p.index as u64).collect()),
-        }];
-        for (k, v) in self.vary.iter().enumerate() {
-            columns.push(Column {
-                name: v.quantity.name(),
-                unit: v.quantity.unit().map(str::to_string),
-                data: ColumnData::F64(points.iter().map(|p| p.values.get(k).copied()).collect()),
-            });
-        }
-        for (k, name) in crate::analysis::sweep::DERIVED.iter().enumerate() {
-            columns.push(Column {
-                name: name.to_string(),
-                unit: Some(unit_of_column(name).into()),
-                data: ColumnData::F64(points.iter().map(|p| p.derived.get(k).copied()).collect()),
-            });
-        }
-        let names = self.columns();
-        let first_metric = 1 + self.vary.len() + crate::analysis::sweep::DERIVED.len();
-        let metric_names = &names[first_metric..names.len() - 1];
-        for (k, name) in metric_names.iter().enumerate() {
-            columns.push(Column {
-                name: name.clone(),
-                unit: Some(unit_of_column(name).into()),
-                data: ColumnData::F64(
-                    points
-                        .iter()
-                        .map(|p| p.metrics.get(k).copied().flatten())
-                        .collect(),
-                ),
-            });
-        }
-        columns.push(Column {
-            name: "error".into(),
-            unit: None,
-            data: ColumnData::Str(points.iter().map(|p| p.error.clone()).collect()),
-        });
-        let mut metadata = model_metadata(&self.model);
-        metadata.push(("command".into(), "sweep".into()));
-        metadata.push(("fingerprint".into(), self.fingerprint_text()));
-        metadata.push((
-            "sweep".into(),
-            serde_json::to_string(&result.spec).unwrap_or_default(),
-        ));
-        Table { columns, metadata }
-    }
-}
-
-impl crate::analysis::montecarlo::MonteCarlo {
-    /// `result` (this study's) as a [`Table`]: the columns of `samples.csv` — `sample` (u64),
-    /// the drawn inputs, the metrics (f64, null for a failed sample), `error` (text, null when
-    /// the sample ran) — with units, and the metadata of [`model_metadata`] plus `command` =
-    /// `montecarlo`, `seed`, `samples`, `inputs` (JSON) and `fingerprint`. The values are the
-    /// exact f64 (`samples.csv` prints 13 significant digits).
-    pub fn table(&self, result: &crate::analysis::montecarlo::MonteCarloResult) -> Table {
-        use crate::analysis::montecarlo::METRICS;
-        let s = &result.samples;
-        let mut columns = vec![Column {
-            name: "sample".into(),
-            unit: Some("1".into()),
-            data: ColumnData::U64(s.iter().map(|x| x.index as u64).collect()),
-        }];
-        for (k, u) in result.inputs.iter().enumerate() {
-            columns.push(Column {
-                name: u.path.clone(),
-                unit: crate::analysis::sweep::Quantity::Field(u.path.clone())
-                    .unit()
-                    .map(str::to_string),
-                data: ColumnData::F64(s.iter().map(|x| x.inputs.get(k).copied()).collect()),
-            });
-        }
-        for (k, name) in METRICS.iter().enumerate() {
-            columns.push(Column {
-                name: name.to_string(),
-                unit: Some(unit_of_column(name).into()),
-                data: ColumnData::F64(s.iter().map(|x| x.metrics.map(|m| m[k])).collect()),
-            });
-        }
-        columns.push(Column {
-            name: "error".into(),
-            unit: None,
-            data: ColumnData::Str(s.iter().map(|x| x.error.clone()).collect()),
-        });
-        let mut metadata = model_metadata(&self.model);
-        metadata.push(("command".into(), "montecarlo".into()));
-        metadata.push(("seed".into(), result.seed.to_string()));
-        metadata.push(("samples".into(), s.len().to_string()));
-        metadata.push((
-            "inputs".into(),
-            serde_json::to_string(&result.inputs).unwrap_or_default(),
-        ));
-        metadata.push(("fingerprint".into(), self.fingerprint()));
-        Table { columns, metadata }
-    }
 }
 
 #[cfg(test)]

@@ -19,7 +19,7 @@
 //! | 8-11 | I10,3I5,2(1X,20A1) | abscissa / ordinate / ordinate denominator / z axis: specific data type (17 time, 12 acceleration, 13 force, ...), length, force, temperature unit exponents, axis label, **unit label** |
 //! | 12 | | data: even real N values; uneven real N pairs (x, y); complex twice (ASCII: single 6E13.5, double 4E20.12; uneven double 2(E13.5,E20.12)) |
 //!
-//! Units are read from the unit label of records 8 and 9 ([`crate::measure::units`]); a label
+//! Units are read from the unit label of records 8 and 9 ([`crate::record::units`]); a label
 //! `NONE` or blank falls back to the SI unit of the specific data type (the SI system, unit
 //! code 1, is the UFF default when no dataset 164 says otherwise); a file whose dataset 164
 //! names another unit system must label its axes. A unit neither label nor type identifies
@@ -35,8 +35,8 @@
 use std::io::{BufRead, Read, Write};
 use std::path::Path;
 
-use crate::measure::units::{parse_unit, Quantity, ACCEPTED_UNITS};
-use crate::measure::{Abscissa, PointRef, Record};
+use crate::record::units::{parse_unit, Quantity, ACCEPTED_UNITS};
+use crate::record::{Abscissa, PointRef, Record};
 use crate::{Error, Result};
 
 /// A node of dataset 2411 (coordinates in m as written).
@@ -681,7 +681,7 @@ impl<R: BufRead> Parser<'_, R> {
             // unit of each one's last printed digit: pyuff's E13.5 rounds 51.2 kHz steps by up
             // to 5e-7 s, the format's rounding, not the sampling.
             let half: Vec<f64> = printed.iter().step_by(2).map(|h| h * xf).collect();
-            match crate::measure::even_as_printed(&t, &half) {
+            match crate::record::even_as_printed(&t, &half) {
                 Some((start_s, step_s)) => (Abscissa::Even { start_s, step_s }, y),
                 None => (Abscissa::Uneven(t), y),
             }

@@ -26,8 +26,9 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+pub use super::by_name;
 use super::process::{Level, Processing};
-use super::{Quantity, Record, SimChannel};
+use super::{Record, SimChannel};
 use crate::analysis::spectrum::TransientWindow;
 use crate::{Error, Result};
 
@@ -291,48 +292,10 @@ fn with_article(w: &str) -> String {
     }
 }
 
-/// The simulated channel a record is by its name alone (module docs), if any.
-pub fn by_name(r: &Record, point: &str) -> Option<SimChannel> {
-    let lower = r.name.to_ascii_lowercase();
-    for c in SimChannel::ALL {
-        let base = c
-            .column()
-            .rsplit_once(if c == SimChannel::BedAcceleration {
-                "_m_per_s2"
-            } else {
-                "_n"
-            })
-            .map(|x| x.0)
-            .unwrap_or("");
-        if lower == base && r.quantity == c.quantity() {
-            return Some(c);
-        }
-    }
-    let words: Vec<&str> = r.name.split(['_', ' ', '-', ':', '.']).collect();
-    match r.quantity {
-        Quantity::Acceleration if words.iter().any(|w| *w == "B" || *w == point) => {
-            Some(SimChannel::BedAcceleration)
-        }
-        Quantity::Force if words.iter().any(|w| w.eq_ignore_ascii_case("floor")) => {
-            Some(SimChannel::FloorForce)
-        }
-        Quantity::Force
-            if words.iter().any(|w| {
-                ["blow", "hammer", "slider"]
-                    .iter()
-                    .any(|k| w.eq_ignore_ascii_case(k))
-            }) =>
-        {
-            Some(SimChannel::BlowForce)
-        }
-        _ => None,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::measure::Abscissa;
+    use crate::measure::{Abscissa, Quantity};
 
     fn rec(name: &str, q: Quantity) -> Record {
         Record {

@@ -1042,7 +1042,7 @@ pub fn trigger_channel(records: &[&Record], measurement_point: &str) -> usize {
     let named = |c: SimChannel| {
         records
             .iter()
-            .position(|r| super::mapping::by_name(r, measurement_point) == Some(c))
+            .position(|r| super::by_name(r, measurement_point) == Some(c))
     };
     named(SimChannel::BlowForce)
         .or_else(|| named(SimChannel::BedAcceleration))
@@ -1218,7 +1218,7 @@ pub fn groups(records: &[Record]) -> Vec<Vec<usize>> {
 /// Processes every record; blows are found per group on the channel named `trigger` when the
 /// group has it, else on its [`trigger_channel`] (`point`: the model's measurement point name,
 /// for finding B by name). The excitation of a group (the one channel the force window applies
-/// to) is the force named as the blow ([`super::mapping::by_name`]: `blow`, `hammer`,
+/// to) is the force named as the blow ([`super::by_name`]: `blow`, `hammer`,
 /// `slider` …), else the `trigger` channel when it is a force; every other channel is a
 /// response.
 pub fn process_all(
@@ -1252,7 +1252,7 @@ pub fn process_all(
         let (blows, found) = group_blows(&members, t, p)?;
         let excitation = members
             .iter()
-            .position(|r| super::mapping::by_name(r, point) == Some(super::SimChannel::BlowForce))
+            .position(|r| super::by_name(r, point) == Some(super::SimChannel::BlowForce))
             .or_else(|| {
                 (trigger.is_some_and(|name| members[t].name == name)
                     && members[t].quantity == Quantity::Force)

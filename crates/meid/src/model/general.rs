@@ -44,13 +44,13 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::fem::{check_material, parse_dofs, ConstraintSpec, MaterialSpec};
+use super::material::{check_material, MaterialSpec};
 use super::Source;
 use crate::structure::{
     Dashpot, FeModel, FrameElement, Material, Mesh, MeshPart, PointMass, RigidLink, Section,
     ShellElement, Spring, TriShellElement,
 };
-use crate::Result;
+use crate::{Error, Result};
 
 /// A node by inline index, a node set by name, or a list of inline node indices.
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
@@ -220,6 +220,51 @@ struct Builder<'a> {
     inline: Vec<usize>,
     sets: BTreeMap<String, Vec<usize>>,
 }
+
+/// Zero displacement of some DOFs at every node of a set.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ConstraintSpec {
+    /// Node set (Gmsh physical group or `[structure.fem.model]` set).
+    pub set: String,
+    /// Any of "ux", "uy", "uz", "rx", "ry", "rz", or "all", "translations", "rotations".
+    pub dofs: Vec<String>,
+}
+
+/// The DOFs a list of names gives (`field` names the list in errors).
+pub fn parse_dofs(names: &[String], field: &str) -> Result<Vec<crate::structure::Dof>> {
+    use crate::structure::Dof;
+    let mut out = Vec::new();
+    if names.is_empty() {
+        return Err(Error::invalid(
+            field,
+            "is empty; give some of \"ux\", \"uy\", \"uz\", \"rx\", \"ry\", \"rz\", \"all\", \"translations\", \"rotations\"",
+        ));
+    }
+    for n in names {
+        match n.as_str() {
+            "all" => out.extend(Dof::ALL),
+            "translations" => out.extend(Dof::TRANSLATIONS),
+            "rotations" => out.extend(Dof::ROTATIONS),
+            other => match crate::structure::DOF_NAMES.iter().position(|d| *d == other) {
+                Some(i) => out.push(Dof::ALL[i]),
+                None => {
+                    return Err(Error::invalid(
+                        field,
+                        format!("unknown DOF '{other}'; valid: ux, uy, uz, rx, ry, rz, all, translations, rotations"),
+                    ))
+                }
+            },
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    Ok(out)
+}
+
+/// The part label of the bed in a general model (`part = "bed"`): its mass is the bed mass m_b
+/// of `md/mb` ([`super::Model::bed_mass`]).
+pub const BED_PART: &str = "bed";
 
 const BASE: &str = "structure.fem.model";
 

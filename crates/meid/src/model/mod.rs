@@ -29,6 +29,7 @@ pub mod fem;
 pub mod general;
 pub mod imported;
 mod lumped;
+pub mod material;
 mod plausible;
 pub mod source;
 pub mod spec;
@@ -37,6 +38,7 @@ pub mod strict;
 use std::path::Path;
 
 pub use cache::{StructureCache, StructureKey};
+pub use general::BED_PART;
 pub use source::Source;
 pub use spec::*;
 
@@ -670,10 +672,6 @@ impl Model {
         None
     }
 }
-
-/// The part label of the bed in a general model (`part = "bed"`): its mass is the bed mass m_b
-/// of `md/mb` ([`Model::bed_mass`]).
-pub const BED_PART: &str = "bed";
 
 /// Reads a model file's text strictly ([`strict`]): errors name the file, line, column and
 /// field, in the model's terms.

@@ -6,7 +6,7 @@
 //! powers of 1000. Values no machine has are flagged here as **warnings**, not errors: an
 //! unusual machine may be real, and a warning names the field, the value, what machines have,
 //! and the likely slip. (FE materials are checked more strictly, as errors, by
-//! `fem::check_material_units`: a density and a Young's modulus together say their unit system.)
+//! `material::check_material_units`: a density and a Young's modulus together say their unit system.)
 //!
 //! The bounds, each wide of every machine the field covers:
 //! - **slider velocity** above [`MAX_BLOW_VELOCITY_M_PER_S`]: drop and counterblow hammers strike

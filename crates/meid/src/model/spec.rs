@@ -4,6 +4,9 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+use super::general::ConstraintSpec;
+use super::material::MaterialSpec;
+
 /// A whole model file.
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -42,7 +45,7 @@ pub struct StructureSpec {
     #[serde(default)]
     pub modal: Option<ModalSpec>,
     #[serde(default)]
-    pub fem: Option<super::fem::FemSpec>,
+    pub fem: Option<FemSpec>,
     /// `[structure.modes]`: modes read from a file another tool wrote (UFF 55 + 2411, CalculiX
     /// `.frd`; [`super::imported`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -402,4 +405,303 @@ fn default_atol() -> f64 {
 }
 fn default_max_events() -> u64 {
     crate::integrate::DEFAULT_MAX_EVENTS as u64
+}
+
+/// `[structure.fem]`: the parametric machine or a Gmsh mesh, reduced to selected modes.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct FemSpec {
+    /// The parametric machine (paper Fig. 1).
+    #[serde(default)]
+    pub machine: Option<MachineFileSpec>,
+    /// A Gmsh `.msh` 4.1 quad mesh.
+    #[serde(default)]
+    pub mesh: Option<MeshFileSpec>,
+    /// The general model (nodes, shells, frames, discrete elements, constraints).
+    #[serde(default)]
+    pub model: Option<super::general::GeneralSpec>,
+    /// Mode selection: "auto" (default, module docs), "participation", a list of 1-based mode
+    /// numbers, or `{ band_hz = [lo, hi] }`.
+    #[serde(default)]
+    pub select: Option<SelectSpec>,
+    /// "auto": most modes added above the cutoff (default no limit); "participation": modes
+    /// kept (default 2).
+    #[serde(default)]
+    pub auto_count: Option<usize>,
+    /// "auto": the cutoff (Hz; default 3 × the highest contact frequency); "participation":
+    /// the highest frequency considered (default: all computed modes).
+    #[serde(default)]
+    pub auto_max_hz: Option<f64>,
+    /// Points whose motion ranks modes (default: the model's O_b, O_f and B, those in the mesh).
+    #[serde(default)]
+    pub contact_points: Option<Vec<String>>,
+    /// Modal damping ratio, one value or one per selected mode (default 0).
+    #[serde(default)]
+    pub damping_ratios: Option<Ratios>,
+    /// Rayleigh damping `[alpha (1/s), beta (s)]`: `D_ii = α + β ω_i²`.
+    #[serde(default)]
+    pub rayleigh: Option<[f64; 2]>,
+    /// "dense" or "lanczos"; default dense below 1000 DOF.
+    #[serde(default)]
+    pub solver: Option<SolverSpec>,
+    /// Number of lowest modes computed (default 30; all for dense if fewer DOFs).
+    #[serde(default)]
+    pub count: Option<usize>,
+}
+
+/// Mode selection.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum SelectSpec {
+    /// "auto".
+    Keyword(String),
+    /// 1-based mode numbers.
+    Indices(Vec<usize>),
+    /// `{ band_hz = [lo, hi] }`.
+    Band { band_hz: [f64; 2] },
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum SolverSpec {
+    Dense,
+    Lanczos,
+}
+
+/// A rectangular plate centred on the z axis (m).
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PlateFileSpec {
+    pub length_x: f64,
+    pub length_y: f64,
+    pub thickness: f64,
+    #[serde(default)]
+    pub material: Option<MaterialSpec>,
+}
+
+/// Column cross-section (m, m², m⁴): a solid circle, a tube, a solid rectangle, or given values.
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SectionFileSpec {
+    #[serde(default)]
+    pub diameter: Option<f64>,
+    /// Tube wall (with `diameter`).
+    #[serde(default)]
+    pub wall: Option<f64>,
+    #[serde(default)]
+    pub width: Option<f64>,
+    #[serde(default)]
+    pub depth: Option<f64>,
+    #[serde(default)]
+    pub area: Option<f64>,
+    #[serde(default)]
+    pub iy: Option<f64>,
+    #[serde(default)]
+    pub iz: Option<f64>,
+    #[serde(default)]
+    pub j: Option<f64>,
+}
+
+impl<'de> Deserialize<'de> for SelectSpec {
+    /// A keyword, a list of mode numbers or `{ band_hz = [lo, hi] }`; anything else is refused
+    /// naming the three forms.
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = SelectSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(
+                    "\"auto\", \"participation\", a list of 1-based mode numbers (e.g. [6, 10]) or { band_hz = [lo, hi] }",
+                )
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<SelectSpec, E> {
+                Ok(SelectSpec::Keyword(v.to_string()))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<SelectSpec, A::Error> {
+                let mut out = Vec::new();
+                while let Some(i) = seq.next_element::<usize>()? {
+                    out.push(i);
+                }
+                Ok(SelectSpec::Indices(out))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                map: A,
+            ) -> Result<SelectSpec, A::Error> {
+                #[derive(Deserialize)]
+                #[serde(deny_unknown_fields)]
+                struct Band {
+                    band_hz: [f64; 2],
+                }
+                let b = Band::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+                Ok(SelectSpec::Band { band_hz: b.band_hz })
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// One value for x, y, z or three.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum PerDirection {
+    All(f64),
+    Xyz([f64; 3]),
+}
+
+impl<'de> Deserialize<'de> for PerDirection {
+    /// A number or `[x, y, z]` (exactly three numbers).
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = PerDirection;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a number (the same for x, y and z) or [x, y, z] (three numbers)")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<PerDirection, E> {
+                Ok(PerDirection::All(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<PerDirection, E> {
+                Ok(PerDirection::All(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<PerDirection, E> {
+                Ok(PerDirection::All(v as f64))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                seq: A,
+            ) -> Result<PerDirection, A::Error> {
+                let v = super::spec::numbers(seq)?;
+                match v[..] {
+                    [x, y, z] => Ok(PerDirection::Xyz([x, y, z])),
+                    _ => Err(serde::de::Error::invalid_length(
+                        v.len(),
+                        &"[x, y, z] (exactly three numbers)",
+                    )),
+                }
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+impl PerDirection {
+    /// The values along x, y and z (one value for all three when one is given).
+    pub(crate) fn xyz(&self) -> [f64; 3] {
+        match self {
+            PerDirection::All(v) => [*v; 3],
+            PerDirection::Xyz(v) => *v,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum SupportSpec {
+    FloatingBase,
+    FixedColumns,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AddedMassFileSpec {
+    /// "bed" or "base".
+    pub plate: String,
+    /// From the plate centre (m).
+    pub offset: [f64; 2],
+    /// kg.
+    pub mass: f64,
+    /// `[Ixx, Iyy, Izz]` (kg·m²).
+    #[serde(default)]
+    pub inertia: Option<[f64; 3]>,
+}
+
+/// `[structure.fem.machine]`: parameters of [`MachineSpec`]; omitted ones keep its defaults.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct MachineFileSpec {
+    #[serde(default)]
+    pub elements_per_side: Option<usize>,
+    #[serde(default)]
+    pub material: Option<MaterialSpec>,
+    #[serde(default)]
+    pub bed: Option<PlateFileSpec>,
+    #[serde(default)]
+    pub column: Option<SectionFileSpec>,
+    #[serde(default)]
+    pub column_material: Option<MaterialSpec>,
+    /// m.
+    #[serde(default)]
+    pub column_length: Option<f64>,
+    /// m from the bed edges.
+    #[serde(default)]
+    pub column_inset: Option<f64>,
+    #[serde(default)]
+    pub column_elements: Option<usize>,
+    #[serde(default)]
+    pub support: Option<SupportSpec>,
+    #[serde(default)]
+    pub base: Option<PlateFileSpec>,
+    /// N/m per spring, one value or `[x, y, z]`.
+    #[serde(default)]
+    pub spring_stiffness: Option<PerDirection>,
+    /// N·s/m per spring.
+    #[serde(default)]
+    pub spring_damping: Option<PerDirection>,
+    /// m from the base edges.
+    #[serde(default)]
+    pub spring_inset: Option<f64>,
+    /// Accelerometer B from the bed centre (m).
+    #[serde(default)]
+    pub b_offset: Option<[f64; 2]>,
+    #[serde(default)]
+    pub added_masses: Vec<AddedMassFileSpec>,
+    #[serde(default)]
+    pub spiders: Option<bool>,
+    /// Half-size of the square column footprint tied rigidly to each plate (m, default 0.02).
+    #[serde(default)]
+    pub spider_half_size: Option<f64>,
+}
+
+/// `[structure.fem.mesh]`: a Gmsh quad mesh (shells of one thickness and material).
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MeshFileSpec {
+    /// `.msh` path, relative to the model file's directory.
+    pub file: String,
+    /// m.
+    pub thickness: f64,
+    #[serde(default)]
+    pub material: Option<MaterialSpec>,
+    /// Model point name → physical group name (e.g. `O_b = "contact"`); groups keep their own
+    /// names as well.
+    #[serde(default)]
+    pub points: BTreeMap<String, String>,
+    /// Physical groups clamped (all six DOFs); the floor force is their reaction.
+    #[serde(default)]
+    pub fixed: Vec<String>,
+    /// Constraints on a subset of DOFs: `{ set = "edges", dofs = ["uz"] }` (a hard simple
+    /// support); the floor force includes their reactions.
+    #[serde(default)]
+    pub constraints: Vec<ConstraintSpec>,
+    /// Springs to ground at every node of a group: `{ group = "feet", stiffness = [kx, ky, kz] }`.
+    #[serde(default)]
+    pub springs: Vec<GroupSpringSpec>,
+    /// Impact direction (unit vector the slider moves along); default `[0, 0, -1]`.
+    #[serde(default)]
+    pub impact_direction: Option<[f64; 3]>,
+}
+
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct GroupSpringSpec {
+    pub group: String,
+    /// N/m per node.
+    pub stiffness: PerDirection,
+    /// N·s/m per node.
+    #[serde(default)]
+    pub damping: Option<PerDirection>,
 }

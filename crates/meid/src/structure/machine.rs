@@ -43,11 +43,12 @@ use super::frame::Section;
 use super::material::Material;
 #[cfg(doc)]
 use super::mesh::Mesh;
-use crate::model::fem::{ConstraintSpec, MaterialSpec};
 use crate::model::general::{
-    DashpotSpec, FrameSpec, GeneralSpec, MassSpec, NodeRef, RigidLinkSpec, ShellSpec, SpringSpec,
+    ConstraintSpec, DashpotSpec, FrameSpec, GeneralSpec, MassSpec, NodeRef, RigidLinkSpec,
+    ShellSpec, SpringSpec, BED_PART,
 };
-use crate::model::BED_PART;
+use crate::model::material::MaterialSpec;
+use crate::model::source::Source;
 use crate::{Error, Result};
 
 /// A rectangular plate centred on the z axis.
@@ -325,7 +326,7 @@ impl MachineSpec {
     /// mesh, as for a user's `[structure.fem.model]`.
     pub fn build(&self) -> Result<Machine> {
         let g = self.generate()?;
-        let src = crate::model::Source {
+        let src = Source {
             name: "[structure.fem.machine]".to_string(),
             text: String::new(),
             overrides: Vec::new(),
