@@ -8,7 +8,9 @@
 //! and the likely slip. (FE materials are checked more strictly, as errors, by
 //! `material::check_material_units`: a density and a Young's modulus together say their unit system.)
 //!
-//! The bounds, each wide of every machine the field covers:
+//! A spring or a contact is flagged only when the unit slip named would make its value plausible
+//! (a spring softer still is no slip; the propagator's conditioning check names springs too soft
+//! to resolve). The bounds, each wide of every machine the field covers:
 //! - **slider velocity** above [`MAX_BLOW_VELOCITY_M_PER_S`]: drop and counterblow hammers strike
 //!   at 3–10 m/s, high-energy-rate hammers up to about 20–25 m/s, presses slower (the usual
 //!   figures of forging handbooks); 1200 typed for 1200 mm/s is 1.2 m/s;
@@ -121,7 +123,9 @@ fn sags(spec: &ModelSpec, found: &mut Vec<(String, String)>) {
             return;
         }
         let sag = m * G_M_PER_S2 / k;
-        if sag > MAX_STATIC_SAG_M {
+        // Only when N/mm explains it (a spring softer still is no unit slip: the propagator's
+        // conditioning check names a spring too soft to resolve).
+        if sag > MAX_STATIC_SAG_M && sag / 1e3 <= MAX_STATIC_SAG_M {
             found.push((
                 field.to_string(),
                 format!(
@@ -195,7 +199,12 @@ fn contacts(spec: &ModelSpec, found: &mut Vec<(String, String)>) {
             continue;
         }
         let delta = v * (m / c.stiffness).sqrt();
-        if delta > MAX_CONTACT_COMPRESSION_M && !found.iter().any(|(f, _)| *f == mass_field) {
+        // Only when N/mm explains it (K × 1000 compresses √1000 times less).
+        let explained = delta / 1e3_f64.sqrt() <= MAX_CONTACT_COMPRESSION_M;
+        if delta > MAX_CONTACT_COMPRESSION_M
+            && explained
+            && !found.iter().any(|(f, _)| *f == mass_field)
+        {
             found.push((
                 field.to_string(),
                 format!(
@@ -306,6 +315,9 @@ mod tests {
         assert_eq!(slips(&["damper.mass=51"]), Vec::<String>::new());
         assert_eq!(slips(&["damper.mass=51.01"]).len(), 1);
         assert_eq!(slips(&["slider.velocity=50"]), Vec::<String>::new());
+        // Softer than any unit slip explains: left to the propagator's conditioning check.
+        assert_eq!(slips(&["damper.stiffness=1e-6"]), Vec::<String>::new());
+        assert_eq!(slips(&["contact.slider_bed.stiffness=1e-2"]), Vec::<String>::new());
         assert_eq!(slips(&["slider.velocity=50.001"]).len(), 1);
     }
 }
