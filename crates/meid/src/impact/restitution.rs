@@ -162,7 +162,7 @@ fn bisect(mut lo: f64, mut hi: f64, f: impl Fn(f64) -> f64) -> f64 {
 /// `x = 3/2 α v_in = ξ v_in ≥ 0` (module docs: `x − ln(1 + x) = −e x − ln(1 − e x)`);
 /// `x = +∞` gives 0. Independent of the exponent, stiffness and masses.
 pub fn e_of_x(x: f64) -> Result<f64> {
-    if !(x >= 0.0) {
+    if x.is_nan() || x < 0.0 {
         return Err(Error::invalid(
             "x",
             format!("x = 3/2 α v_in must be ≥ 0 (got {})", crate::num(x)),

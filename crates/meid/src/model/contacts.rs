@@ -197,9 +197,9 @@ impl Model {
         };
         if let Some((name, v, unit)) = given {
             return fail(format!(
-                "{field} = {} and {path}.{name} = {} {unit} are both given; give one of them: restitution sets {name} itself",
-                crate::num(e),
-                crate::num(v)
+                "given together with {path}.{name} = {} {unit}; give one of them (restitution = {} sets {name} itself)",
+                crate::num(v),
+                crate::num(e)
             ));
         }
         if which == ContactName::BedDamper && spec.law == LawSpec::HuntCrossley {

@@ -14,6 +14,7 @@
 //! | `stiffness` (hertz) / (hunt-crossley, exponent n) | N/m^1.5 / N/m^n |
 //! | `damping` (dashpots, contacts) | N·s/m |
 //! | `alpha` (hunt-crossley) | s/m |
+//! | `restitution` (contacts, sets `damping` or `alpha`: [`contacts`]) | 1 |
 //! | `damping_ratios` | 1 (fraction of critical) |
 //! | `frequencies_hz` | Hz |
 //! | `shapes` (mass-normalised) | 1/√kg |
