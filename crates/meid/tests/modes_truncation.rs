@@ -319,9 +319,10 @@ fn contact_frequencies_match_closed_forms() {
     let mut c = ContactSpec {
         law: LawSpec::Linear,
         stiffness: 4.3e7,
-        damping: 0.0,
+        damping: None,
         exponent: None,
-        alpha: 0.0,
+        alpha: None,
+        restitution: None,
         release: ReleaseSpec::Force,
     };
     let w = contact_omega(&c, 1.2, 3.0).unwrap();

@@ -40,10 +40,14 @@
 //!   i.e. while the damper moves back towards the bed; the damper moves away from the bed freely.
 //!   [`DashpotKind::TwoWay`] makes it act always.
 //!
+//! The restitution a contact law gives a free two-body impact, and the damping that gives a
+//! requested one: [`restitution`].
+//!
 //! Between switches the system is linear and time invariant (for [`ContactLaw::Linear`]);
 //! [`crate::integrate`] propagates it exactly. Hertz and Hunt-Crossley laws need `dopri5`.
 
 mod channels;
+pub mod restitution;
 
 pub use channels::{Channel, ChannelMap, CHANNELS, N_CHANNELS};
 
@@ -60,7 +64,8 @@ pub enum ContactLaw {
     /// `f = K δ^{3/2}` (K in N/m^1.5): Hertz contact of curved surfaces.
     Hertz { stiffness: f64 },
     /// Hunt-Crossley: `f = K δ^n (1 + 3/2 α δ̇)` (K in N/m^n, α in s/m); `n = 1.5` for Hertzian
-    /// geometry. The coefficient of restitution is about `1 − α v₀` for small `α v₀`.
+    /// geometry. The coefficient of restitution of a free impact at approach velocity `v₀` is
+    /// about `1 − α v₀` for small `α v₀`; exactly [`restitution::e_of_x`] of `x = 3/2 α v₀`.
     HuntCrossley {
         stiffness: f64,
         exponent: f64,

@@ -14,6 +14,7 @@
 //! | `stiffness` (hertz) / (hunt-crossley, exponent n) | N/m^1.5 / N/m^n |
 //! | `damping` (dashpots, contacts) | N·s/m |
 //! | `alpha` (hunt-crossley) | s/m |
+//! | `restitution` (contacts, sets `damping` or `alpha`: [`contacts`]) | 1 |
 //! | `damping_ratios` | 1 (fraction of critical) |
 //! | `frequencies_hz` | Hz |
 //! | `shapes` (mass-normalised) | 1/√kg |
@@ -24,6 +25,7 @@
 //! the valid range; unknown keys get a did-you-mean.
 
 mod cache;
+pub mod contacts;
 pub mod expand;
 pub mod fem;
 pub mod general;
@@ -38,13 +40,12 @@ pub mod strict;
 use std::path::Path;
 
 pub use cache::{StructureCache, StructureKey};
+pub use contacts::{ContactName, ContactSetting};
 pub use general::BED_PART;
 pub use source::Source;
 pub use spec::*;
 
-use crate::impact::{
-    Absorber, Contact, ContactLaw, Damper, DashpotKind, ImpactSystem, Release, Slider,
-};
+use crate::impact::{Absorber, Damper, DashpotKind, ImpactSystem, Slider};
 use crate::integrate::{Method, Options};
 use crate::modal::ModalModel;
 use crate::{Error, Result};
@@ -434,9 +435,9 @@ impl Model {
             mass: s.slider.mass,
             velocity: s.slider.velocity,
         };
-        let slider_bed =
-            contact(&s.contact.slider_bed).map_err(|e| self.prefix(e, "contact.slider_bed"))?;
-        let damper = match (&s.damper, &s.contact.bed_damper) {
+        let slider_bed = self.slider_bed_setting()?.contact;
+        let bed_damper = self.contact_setting(ContactName::BedDamper)?;
+        let damper = match (&s.damper, bed_damper) {
             (Some(d), Some(c)) => Some((
                 Damper {
                     mass: d.mass,
@@ -447,7 +448,7 @@ impl Model {
                         DashpotKindSpec::TwoWay => DashpotKind::TwoWay,
                     },
                 },
-                contact(c).map_err(|e| self.prefix(e, "contact.bed_damper"))?,
+                c.contact,
             )),
             _ => None,
         };
@@ -708,34 +709,6 @@ pub fn spec_from_table(table: toml::Table, src: &Source) -> Result<ModelSpec> {
     })
 }
 
-fn contact(c: &ContactSpec) -> Result<Contact> {
-    let law = match c.law {
-        LawSpec::Linear => ContactLaw::Linear {
-            stiffness: c.stiffness,
-            damping: c.damping,
-        },
-        LawSpec::Hertz => ContactLaw::Hertz {
-            stiffness: c.stiffness,
-        },
-        LawSpec::HuntCrossley => ContactLaw::HuntCrossley {
-            stiffness: c.stiffness,
-            exponent: c.exponent.unwrap_or(1.5),
-            alpha: c.alpha,
-        },
-    };
-    if c.law != LawSpec::Linear && c.damping != 0.0 {
-        return Err(Error::invalid(
-            "damping",
-            "only the linear law takes `damping`; hunt-crossley uses `alpha`",
-        ));
-    }
-    let release = match c.release {
-        ReleaseSpec::Force => Release::Force,
-        ReleaseSpec::Overlap => Release::Overlap,
-    };
-    Ok(Contact { law, release })
-}
-
 fn build_structure(spec: &ModelSpec, src: &Source) -> Result<ModalModel> {
     let st = &spec.structure;
     let given = usize::from(st.lumped.is_some())
@@ -862,9 +835,11 @@ impl Model {
         ));
         warnings.extend(self.reference_warning());
         warnings.extend(plausible::unit_slips(&self.spec, &self.source));
+        let mut notes = self.structure.notes.clone();
+        notes.extend(self.contact_notes());
         Diagnostics {
             truncation,
-            notes: self.structure.notes.clone(),
+            notes,
             warnings,
         }
     }

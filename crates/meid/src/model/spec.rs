@@ -336,15 +336,21 @@ pub struct ContactSpec {
     pub law: LawSpec,
     /// K: N/m (linear), N/m^1.5 (hertz), N/m^n (hunt-crossley).
     pub stiffness: f64,
-    /// C (N·s/m), linear law only.
-    #[serde(default)]
-    pub damping: f64,
+    /// C (N·s/m), linear law only; default 0 (or set by `restitution`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping: Option<f64>,
     /// n of Hunt-Crossley (default 1.5).
     #[serde(default)]
     pub exponent: Option<f64>,
-    /// α (s/m) of Hunt-Crossley.
-    #[serde(default)]
-    pub alpha: f64,
+    /// α (s/m) of Hunt-Crossley; default 0 (or set by `restitution`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha: Option<f64>,
+    /// e ∈ (0, 1]: the coefficient of restitution of a free two-body impact through this
+    /// contact, which sets C (linear) or α (hunt-crossley) instead of giving them
+    /// ([`crate::impact::restitution`]; the masses and approach velocity used:
+    /// [`super::Model::contact_setting`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub restitution: Option<f64>,
     /// "force" (default: release when the force returns to zero) or "overlap" (Eqs. 5, 8).
     #[serde(default)]
     pub release: ReleaseSpec,

@@ -633,11 +633,19 @@ impl MachineReport {
                 );
             }
         }
-        if cs.damping != 0.0 {
+        // C_s as given, or as `restitution` set it.
+        let c_s = match m.slider_bed_setting().map(|c| c.contact.law) {
+            Ok(crate::impact::ContactLaw::Linear { damping, .. }) => damping,
+            _ => 0.0,
+        };
+        if c_s != 0.0 {
             row(
                 "slider-bed contact damping",
                 "C_s",
-                sig(cs.damping, 4),
+                match cs.restitution {
+                    Some(e) => format!("{} (from restitution e = {})", sig(c_s, 4), crate::num(e)),
+                    None => sig(c_s, 4),
+                },
                 "N·s/m",
             );
         }
