@@ -317,7 +317,10 @@ mod tests {
         assert_eq!(slips(&["slider.velocity=50"]), Vec::<String>::new());
         // Softer than any unit slip explains: left to the propagator's conditioning check.
         assert_eq!(slips(&["damper.stiffness=1e-6"]), Vec::<String>::new());
-        assert_eq!(slips(&["contact.slider_bed.stiffness=1e-2"]), Vec::<String>::new());
+        assert_eq!(
+            slips(&["contact.slider_bed.stiffness=1e-2"]),
+            Vec::<String>::new()
+        );
         assert_eq!(slips(&["slider.velocity=50.001"]).len(), 1);
     }
 }
