@@ -311,23 +311,7 @@ fn rates_picture(stem: &Path, rows: &[RateRow], best: Option<f64>) -> Result<()>
             label: format!("damper returns up to {:.4} /min", b),
         });
     }
-    for i in 1..d.len() {
-        let touch_changed = d[i].touches != d[i - 1].touches;
-        if d[i].regime != d[i - 1].regime || touch_changed {
-            markers.push(Marker {
-                x: x[i],
-                label: format!(
-                    "{}{}",
-                    d[i].regime,
-                    match d[i].touches {
-                        Some(true) => ", touches",
-                        Some(false) => ", does not touch",
-                        None => "",
-                    }
-                ),
-            });
-        }
-    }
+    let bands = regime_bands(&x, &d);
     plot::line_plot(
         stem,
         &LinePlot {
@@ -357,8 +341,53 @@ fn rates_picture(stem: &Path, rows: &[RateRow], best: Option<f64>) -> Result<()>
                 ),
             ],
             markers,
+            bands,
             ..LinePlot::default()
         },
     )?;
     Ok(())
+}
+
+/// The damper's regimes along the rates as shaded bands, one per run of rates with the same
+/// regime and touching, each reaching halfway to its neighbouring rates: green where it touches
+/// the bed in every steady blow (period-1), blue for a longer period that touches, red where it
+/// does not touch, grey for an irregular train.
+fn regime_bands(x: &[f64], d: &[DbRow]) -> Vec<plot::Band> {
+    let mut bands = Vec::new();
+    let n = x.len();
+    if n < 2 || d.iter().all(|r| r.touches.is_none()) {
+        return bands;
+    }
+    // Edges between rates (midpoints), the ends half a step out.
+    let edge = |i: usize| -> f64 {
+        if i == 0 {
+            x[0] - 0.5 * (x[1] - x[0])
+        } else if i == n {
+            x[n - 1] + 0.5 * (x[n - 1] - x[n - 2])
+        } else {
+            0.5 * (x[i - 1] + x[i])
+        }
+    };
+    let mut start = 0;
+    for i in 1..=n {
+        if i < n && d[i].regime == d[start].regime && d[i].touches == d[start].touches {
+            continue;
+        }
+        let r = &d[start];
+        let (label, color) = match (r.regime.as_str(), r.touches) {
+            ("irregular", _) => ("irregular train".to_string(), [127, 127, 127]),
+            (_, Some(false)) => ("damper does not touch the bed".to_string(), [214, 39, 40]),
+            ("period-1", Some(true)) => ("period-1, damper touches".to_string(), [44, 160, 44]),
+            (k, Some(true)) => (format!("{k}, damper touches"), [31, 119, 180]),
+            (k, None) => (k.to_string(), [127, 127, 127]),
+        };
+        bands.push(plot::Band {
+            from: edge(start).max(f64::MIN_POSITIVE),
+            to: edge(i),
+            label,
+            color,
+        });
+        start = i;
+    }
+    bands
 }

@@ -365,3 +365,62 @@ fn spectrum_plot_writes_png_and_svg() {
     };
     assert_written(&spectrum_plot(out_dir("spectrum").join("log"), &log).unwrap());
 }
+
+/// Bands: drawn behind the curves with one legend entry per label (two bands of one label give
+/// one entry), and refused when their bounds are not finite or reversed.
+#[test]
+fn bands_shade_ranges_with_one_legend_entry_per_label() {
+    use meid::plot::Band;
+    let x = linspace(10.0, 120.0, 12);
+    let plot = LinePlot {
+        title: "bands".into(),
+        x_label: "stroke rate (blows/min)".into(),
+        y_label: "change (dB)".into(),
+        series: vec![Series {
+            label: "floor force".into(),
+            x: x.clone(),
+            y: x.iter().map(|v| (v / 30.0).sin()).collect(),
+            ..Default::default()
+        }],
+        bands: vec![
+            Band {
+                from: 5.0,
+                to: 40.0,
+                label: "period-1, damper touches".into(),
+                color: [44, 160, 44],
+            },
+            Band {
+                from: 40.0,
+                to: 80.0,
+                label: "damper does not touch the bed".into(),
+                color: [214, 39, 40],
+            },
+            Band {
+                from: 80.0,
+                to: 125.0,
+                label: "period-1, damper touches".into(),
+                color: [44, 160, 44],
+            },
+        ],
+        ..LinePlot::default()
+    };
+    let files = line_plot(out_dir("bands").join("bands"), &plot).unwrap();
+    assert_written(&files);
+    let texts = meid::plot::svg_texts(&std::fs::read_to_string(&files.svg).unwrap());
+    let count = |t: &str| texts.iter().filter(|s| s.as_str() == t).count();
+    assert_eq!(count("period-1, damper touches"), 1, "{texts:?}");
+    assert_eq!(count("damper does not touch the bed"), 1, "{texts:?}");
+    let svg = std::fs::read_to_string(&files.svg).unwrap();
+    assert!(
+        svg.contains("fill=\"#2CA02C\"") || svg.contains("fill=\"#2ca02c\""),
+        "band fill missing"
+    );
+    let mut bad = plot.clone();
+    bad.bands[1].to = f64::NAN;
+    let e = line_plot(out_dir("bands").join("bad"), &bad).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("band 'damper does not touch the bed'"),
+        "{e}"
+    );
+}

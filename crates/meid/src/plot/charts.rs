@@ -501,6 +501,19 @@ pub fn line_plot(path_stem: impl AsRef<Path>, plot: &LinePlot) -> Result<PlotFil
     check_series("series", &plot.series)?;
     check_markers(&plot.markers)?;
     check_range("x_range", plot.x_range, plot.x_log)?;
+    if let Some(b) = plot
+        .bands
+        .iter()
+        .find(|b| !(b.from.is_finite() && b.to.is_finite() && b.from <= b.to))
+    {
+        return Err(Error::invalid(
+            "bands",
+            format!(
+                "band '{}' from {} to {}: needs finite bounds, from <= to",
+                b.label, b.from, b.to
+            ),
+        ));
+    }
     let drawable = |s: &Series| {
         s.x.iter()
             .zip(&s.y)
@@ -641,12 +654,39 @@ where
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
     let y_bottom = yc.range().start;
+    let y_top = yc.range().end;
+    let x_span = xc.range();
     let mut chart = frame(area, view.title, view.caption_size, view.x_area, xc, yc)?;
     axes(&mut chart, view.x_label, &p.y_label, true)?;
 
     let mut failed_x = Vec::new();
     let mut any_label = false;
     let (mut curves, mut entries, mut chars) = (Vec::new(), 0usize, 0usize);
+    let mut band_labels: Vec<&str> = Vec::new();
+    for b in &p.bands {
+        let (lo, hi) = (b.from.max(x_span.start), b.to.min(x_span.end));
+        if lo >= hi || lo.is_nan() || hi.is_nan() {
+            continue;
+        }
+        let fill = RGBColor(b.color[0], b.color[1], b.color[2])
+            .mix(0.2)
+            .filled();
+        let drawn = chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [(lo, y_bottom), (hi, y_top)],
+                fill,
+            )))
+            .map_err(e2s)?;
+        if !b.label.is_empty() && !band_labels.contains(&b.label.as_str()) {
+            band_labels.push(&b.label);
+            any_label = true;
+            entries += 1;
+            chars = chars.max(b.label.chars().count());
+            drawn
+                .label(&b.label)
+                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], fill));
+        }
+    }
     for &(k, s) in &view.series {
         let style = stroke(s, k, &PALETTE);
         let dash = dash_of(s, LineStyle::Solid);
@@ -721,6 +761,7 @@ pub fn spectrum_plot(path_stem: impl AsRef<Path>, plot: &SpectrumPlot) -> Result
         y_log: false,
         series: plot.series.clone(),
         markers: plot.markers.clone(),
+        bands: Vec::new(),
         panels: false,
         x_range: plot.x_range,
     };

@@ -70,6 +70,17 @@ pub struct Series {
     pub width: u32,
 }
 
+/// A shaded range of x, `from..to` (in the x axis' unit), drawn across the frame's height behind
+/// the curves in a light tint of `color`; its `label` is a legend entry (once per label).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Band {
+    pub from: f64,
+    pub to: f64,
+    pub label: String,
+    /// 8-bit RGB, drawn at 20 % opacity.
+    pub color: [u8; 3],
+}
+
 /// A labelled vertical line at abscissa `x` (in the x axis' unit, e.g. s), drawn across
 /// the frame as a dark dashed line with `label` written beside its top, e.g.
 /// "slider leaves" or "peak PE_Kd".
@@ -110,6 +121,8 @@ pub struct LinePlot {
     pub series: Vec<Series>,
     /// Labelled vertical lines (e.g. the instant the slider leaves).
     pub markers: Vec<Marker>,
+    /// Shaded ranges of x behind the curves (e.g. the regimes of a stroke-rate map).
+    pub bands: Vec<Band>,
     /// One panel per series, stacked top to bottom on a common x axis and a common y
     /// range, each named by its series label; for histories of several cases that would
     /// hide one another when overlaid. The title is written once above the panels.
