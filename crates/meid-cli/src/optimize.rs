@@ -125,9 +125,14 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
     if a.print.json {
         println!("{}", serde_json::to_string_pretty(&rep)?);
     }
-    if !a.print.human() {
-        return Ok(());
+    if a.print.human() {
+        print_report(&a, &rep, elapsed);
     }
+    Ok(())
+}
+
+/// The optimum in words and numbers, and how to reproduce it.
+fn print_report(a: &OptimizeArgs, rep: &meid::analysis::study::OptimizeReport, elapsed: f64) {
     let n_free = rep.variables.iter().filter(|v| !v.fixed).count();
     let method = match n_free {
         0 => "every variable fixed".to_string(),
@@ -216,5 +221,4 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
     if let Some(dir) = &a.output {
         println!("  wrote {}", dir.join("optimize.json").display());
     }
-    Ok(())
 }

@@ -157,7 +157,7 @@ fn touches(
             ..*so
         },
     )?;
-    Ok(s.converged && s.damper_touches_bed == Some(true))
+    Ok(s.damper_returns())
 }
 
 /// The largest stroke rate at or below `rate_bpm` at which the damper touches the bed in every
@@ -230,7 +230,7 @@ pub fn return_rate(
 }
 
 /// `20 log10(a/b)` (dB).
-fn db(a: f64, b: f64) -> f64 {
+pub(crate) fn db(a: f64, b: f64) -> f64 {
     20.0 * (a / b).log10()
 }
 
@@ -381,7 +381,7 @@ pub fn largest_returning_rate(rows: &[RateRow]) -> Option<f64> {
     sorted.sort_by(|a, b| a.rate_bpm.total_cmp(&b.rate_bpm));
     for r in sorted {
         let d = r.cases.iter().find(|c| c.case == CaseName::Damper.name())?;
-        if d.steady_state.converged && d.steady_state.damper_touches_bed == Some(true) {
+        if d.steady_state.damper_returns() {
             best = Some(r.rate_bpm);
         } else {
             break;

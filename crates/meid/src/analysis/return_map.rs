@@ -25,6 +25,7 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
+use super::production::db;
 use super::steady::{steady_state, SteadyOptions, SteadyState};
 use super::sweep::{point_model_cached, Quantity, Vary};
 use crate::model::{Case, Model, StructureCache};
@@ -138,7 +139,7 @@ pub fn return_map(
         None
     };
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let cells: Vec<ReturnCell> = (0..total)
+    let mut cells: Vec<ReturnCell> = (0..total)
         .into_par_iter()
         .map(|index| {
             let values = grid_values(vary, index);
@@ -151,7 +152,6 @@ pub fn return_map(
             cell
         })
         .collect();
-    let mut cells = cells;
     let sizes: Vec<usize> = vary.iter().map(|v| v.values.len()).collect();
     let robust: Vec<bool> = (0..cells.len())
         .map(|i| cells[i].returns && neighbours(&sizes, i).iter().all(|&j| cells[j].returns))
@@ -250,10 +250,9 @@ fn design(
             &own_none
         }
     };
-    let db = |a: f64, b: f64| 20.0 * (a / b).log10();
     Ok(ReturnCell {
         values: values.to_vec(),
-        returns: with.converged && with.damper_touches_bed == Some(true),
+        returns: with.damper_returns(),
         robust: false,
         regime: Some(with.regime.name()),
         converged: with.converged,

@@ -186,6 +186,14 @@ pub struct SteadyState {
     pub residual_history: Vec<(char, f64)>,
 }
 
+impl SteadyState {
+    /// The train settled (`converged`) and, with a damper, the damper touches the bed in every
+    /// blow of the period: it returns between blows. Without a damper: the train settled.
+    pub fn damper_returns(&self) -> bool {
+        self.converged && self.damper_touches_bed != Some(false)
+    }
+}
+
 /// One evaluation of `P` (one blow) with its Jacobian.
 struct Evaluation {
     p: Vec<f64>,

@@ -550,7 +550,7 @@ impl OptimizeStudy {
                 r.error = Some(format!("the steady state at {rate} blows/min: {e}"));
                 (r, false)
             }
-            Ok(st) if !st.converged || st.damper_touches_bed == Some(false) => {
+            Ok(st) if !st.damper_returns() => {
                 set(&mut r, [f64::NAN; 3]);
                 r.error = Some(if st.converged {
                     format!(
