@@ -3,7 +3,7 @@
 //! blamed on, the size and number formats of error messages, frequencies below a record's
 //! resolution in `meid compare`. (The `meid paper` row label is checked in `paper_cli.rs`.)
 
-mod common;
+use crate::common;
 
 use common::{meid, ok, ok_json, paper_example, stderr};
 

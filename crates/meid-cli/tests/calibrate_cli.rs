@@ -2,7 +2,7 @@
 //! "measurement"; from a perturbed start the fit returns the model's values, writes its output
 //! set and the calibrated model; bad --fit/--bounds exit 2 naming the path.
 
-mod common;
+use crate::common;
 
 use common::{meid, ok, paper_example, stderr, tmpdir};
 use serde_json::Value;

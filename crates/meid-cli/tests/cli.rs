@@ -1,6 +1,6 @@
 //! The `meid` command end to end: good runs and one test per class of bad input.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 use std::process::Output;

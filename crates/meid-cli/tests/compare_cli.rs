@@ -1,6 +1,6 @@
 //! `meid compare`, `meid blows` and `meid montecarlo` end to end.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 

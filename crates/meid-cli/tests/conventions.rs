@@ -2,7 +2,7 @@
 //! `NO_COLOR` are honoured, `-o`/`-q`/`--json` mean the same on every subcommand, shell
 //! completions and a manual page, and `--version` names the git commit.
 
-mod common;
+use crate::common;
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};

@@ -5,7 +5,7 @@
 //! fix the lowest frequency of `meid modes --json` differed in the 9th digit and every
 //! history sample of `meid simulate -o` in its last digits.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

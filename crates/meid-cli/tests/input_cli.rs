@@ -2,7 +2,7 @@
 //! answered in the library's terms; each is now exit code 2 with a message naming the flag or
 //! field and what would be valid.
 
-mod common;
+use crate::common;
 
 use std::process::Output;
 

@@ -1,6 +1,6 @@
 //! `meid measure`, `meid validate` and the `--uff` exports end to end.
 
-mod common;
+use crate::common;
 
 use common::{meid, ok, ok_json, paper_example, stderr, tmpdir};
 use serde_json::Value;

@@ -2,7 +2,7 @@
 //! generates; `meid modes` and `meid simulate` on the written file print what they print on
 //! the machine file (every JSON field equal); bad input exits 2 naming the file.
 
-mod common;
+use crate::common;
 
 use common::{example_file as example, meid, ok, ok_json, stderr, tmpdir};
 

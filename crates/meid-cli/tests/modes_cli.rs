@@ -1,6 +1,6 @@
 //! `meid modes` end to end: table, JSON keys, files, VTU structure, bad input.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 

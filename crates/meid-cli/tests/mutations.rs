@@ -15,7 +15,7 @@
 //! or 1e308 samples per second: bounding such runs is the "unbounded cost" part of the issue,
 //! with its own tests).
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Stdio;

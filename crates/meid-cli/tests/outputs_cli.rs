@@ -8,7 +8,7 @@
 //! closed forms of the inputs (samples × bytes per sample, DOFs × 6 KiB), stated in the
 //! messages; the measured figures are in docs/studies.md ("Cost limits").
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Output;

@@ -9,7 +9,7 @@
 //! models to 1e-6 relative: their springs are solved in closed form from the two frequencies),
 //! and the paper's arithmetic 41.2 % ↔ −10 log10(1 − 0.412) = 2.306 dB, 25.9 % ↔ 1.302 dB.
 
-mod common;
+use crate::common;
 
 use common::{meid, ok};
 

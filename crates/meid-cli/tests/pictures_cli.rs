@@ -3,7 +3,7 @@
 //! `compare` time histories in panels, the `montecarlo` histogram's mean and P95 markers.
 //! Checked on the SVG text of real runs of the lumped paper example.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -1,7 +1,7 @@
 //! The machine in production from the command line: the damper-return map (`blows --vary`),
 //! the optimum at a stroke rate (`optimize --rate-bpm`), the unit-slip warnings, and bad input.
 
-mod common;
+use crate::common;
 
 use common::{example_file, meid, ok, ok_json, stderr, tmpdir};
 

@@ -13,7 +13,7 @@
 //!   reductions equal to the simulated ones.
 //! * Bad input exits with code 2 and a message naming the option.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

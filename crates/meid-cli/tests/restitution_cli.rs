@@ -2,7 +2,7 @@
 //! and `--json` notes); a restitution outside (0, 1] or given with `damping` exits 2 naming the
 //! file, line and fields.
 
-mod common;
+use crate::common;
 
 use common::{example_file as example, meid, ok, ok_json, stderr, tmpdir};
 

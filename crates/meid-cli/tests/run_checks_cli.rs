@@ -1,7 +1,7 @@
 //! A run that breaks its own checks is an error, never a success with NaN or zero peaks
 //! (issue rows: damping 1e15, stiffness 1e30 printed 0.000 N and exited 0).
 
-mod common;
+use crate::common;
 use common::{meid, paper_example, stderr};
 
 #[test]

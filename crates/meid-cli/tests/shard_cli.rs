@@ -3,7 +3,7 @@
 //! file of its manifest); a missing or repeated shard is refused (exit code 2). Monte Carlo
 //! output on the FE example is byte-identical for RAYON_NUM_THREADS = 1 and 2.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -7,7 +7,7 @@
 //!   minimum on a bound, a flat objective, fixed variables) and `LO = HI` holds a variable
 //!   fixed instead of being refused.
 
-mod common;
+use crate::common;
 
 use common::{meid, ok_json, paper_example};
 

@@ -7,7 +7,7 @@
 //! than the collision (0.678 ms) has no energy ratio; errors at every point are reported as
 //! themselves with exit code 2; `[added_mass] point` takes the model's point names.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 

@@ -5,7 +5,7 @@
 //! refused; non-finite results become errors naming the value; `model expand` writes nothing
 //! a model load refuses; errors name the file or field.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};

@@ -7,7 +7,7 @@
 //! fuzzers (`cargo +nightly fuzz run TARGET`) search much longer. A failure prints the minimal
 //! input; proptest keeps it in `fuzz_parsers.proptest-regressions` to replay first next time.
 
-mod fuzz_support;
+use crate::fuzz_support;
 
 use std::path::PathBuf;
 

@@ -1,6 +1,6 @@
 //! Sparse shift-invert block Lanczos against closed forms and a dense reference.
 
-mod lanczos_support;
+use crate::lanczos_support;
 
 use lanczos_support::*;
 use meid::modal::lanczos::{lowest_modes, LanczosOptions};

@@ -1,8 +1,8 @@
-//! Medium-size problems (run with `cargo test --release -p meid --test lanczos_large -- --ignored`).
+//! Medium-size problems (run with `cargo test --release -p meid --test suite -- lanczos_large:: --ignored`).
 //! Timing and peak memory are measured by `examples/eig_bench.rs` under `/usr/bin/time -v`,
 //! not asserted here.
 
-mod lanczos_support;
+use crate::lanczos_support;
 
 use lanczos_support::*;
 use meid::modal::lanczos::{lowest_modes, LanczosOptions};

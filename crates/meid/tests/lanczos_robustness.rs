@@ -1,6 +1,6 @@
 //! Sparse Lanczos: automatic re-shift, user shift, input errors.
 
-mod lanczos_support;
+use crate::lanczos_support;
 
 use faer::sparse::Triplet;
 use lanczos_support::*;
