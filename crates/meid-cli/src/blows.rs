@@ -15,10 +15,11 @@ pub struct BlowsArgs {
     /// Number of blows.
     #[arg(long, value_name = "N", default_value_t = 10)]
     blows: usize,
-    /// Stroke rate (blows per minute). The interval 60/R must outlast each blow's collision
-    /// (else exit 2, naming the largest valid rate); the machine need not be at rest.
-    #[arg(long, value_name = "R", default_value_t = 60.0)]
-    rate_bpm: f64,
+    /// Stroke rate (blows per minute; default: the model's [production] rate_bpm, else 60).
+    /// The interval 60/R must outlast each blow's collision (else exit 2, naming the largest
+    /// valid rate); the machine need not be at rest.
+    #[arg(long, value_name = "R")]
+    rate_bpm: Option<f64>,
     /// Relative blow-to-blow change that counts as steady (the march's table).
     #[arg(long, value_name = "FRACTION", default_value_t = 0.01)]
     tolerance: f64,
@@ -55,35 +56,36 @@ pub fn run(a: BlowsArgs) -> Result<()> {
     if let Some(spec) = &a.rates {
         return crate::production::rate_map(&a.model, &model, spec, a.output.as_deref(), &a.print);
     }
-    meid::analysis::blows::blow_interval_s(a.rate_bpm).map_err(|_| {
-        meid::Error::invalid(
-            "--rate-bpm",
-            format!(
-                "the stroke rate must be a finite number > 0 blows per minute (got {})",
-                a.rate_bpm
-            ),
-        )
-    })?;
+    let (rate_bpm, _) =
+        meid::analysis::production::stroke_rate(&model, a.rate_bpm).map_err(|_| {
+            meid::Error::invalid(
+                "--rate-bpm",
+                format!(
+                    "the stroke rate must be a finite number > 0 blows per minute (got {})",
+                    a.rate_bpm.unwrap_or(f64::NAN)
+                ),
+            )
+        })?;
     if !a.vary.is_empty() {
         return crate::return_map::run(
             &a.model,
             &model,
             &a.vary,
-            a.rate_bpm,
+            rate_bpm,
             a.output.as_deref(),
             &a.print,
         );
     }
     let case = a.case.parse()?;
     if a.steady {
-        let prod = crate::production::cases(&model, case, a.rate_bpm, &a.print)?;
+        let prod = crate::production::cases(&model, case, rate_bpm, &a.print)?;
         return crate::production::steady_only(&prod, a.output.as_deref(), &a.print);
     }
     let sys = model.impact_system(case)?;
     let opts = model.options();
     let b = BlowOptions {
         blows: a.blows,
-        rate_bpm: a.rate_bpm,
+        rate_bpm,
         steady_tolerance: a.tolerance,
     };
     // With -o: history.csv is streamed blow by blow into the output set; only the three
@@ -94,7 +96,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
     let progress = |done: usize, _total: usize| bar.set_position(done as u64);
     let r = match &set {
         Some(set) => {
-            let interval = meid::analysis::blows::blow_interval_s(a.rate_bpm)?;
+            let interval = meid::analysis::blows::blow_interval_s(rate_bpm)?;
             let rows =
                 a.blows as f64 * meid::analysis::energy::sample_count(interval, opts.sample_rate);
             meid::limits::check_memory(
@@ -141,9 +143,9 @@ pub fn run(a: BlowsArgs) -> Result<()> {
     };
     // The steady states after the march: the march's own refusals (a collision longer than
     // the interval, a run too long) come first, as they name the blow that failed.
-    let prod = crate::production::cases(&model, case, a.rate_bpm, &a.print)?;
+    let prod = crate::production::cases(&model, case, rate_bpm, &a.print)?;
     let out = serde_json::json!({
-        "rate_bpm": a.rate_bpm,
+        "rate_bpm": rate_bpm,
         "interval_s": r.interval_s,
         "verdict": prod.production.verdict,
         "steady_state": prod.selected,
@@ -153,7 +155,14 @@ pub fn run(a: BlowsArgs) -> Result<()> {
         "damper_gap_at_next_strike_m": r.damper_gap_at_next_strike_m,
     });
     if let Some(set) = &set {
-        write_march(set.staging(), &a, &r, &out, std::mem::take(&mut pictured))?;
+        write_march(
+            set.staging(),
+            &a,
+            rate_bpm,
+            &r,
+            &out,
+            std::mem::take(&mut pictured),
+        )?;
     }
     if let Some(set) = set {
         set.commit("blows")?;
@@ -163,7 +172,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
     } else if a.print.human() {
         crate::production::print_production(&prod.production);
         println!();
-        print_march(&a, &r);
+        print_march(&a, rate_bpm, &r);
     }
     Ok(())
 }
@@ -172,6 +181,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
 fn write_march(
     dir: &std::path::Path,
     a: &BlowsArgs,
+    rate_bpm: f64,
     r: &meid::analysis::blows::BlowsRun,
     out: &serde_json::Value,
     pictured: [Vec<f64>; 3],
@@ -208,7 +218,7 @@ fn write_march(
         plot::line_plot(
             dir.join(stem),
             &LinePlot {
-                title: format!("{title}, {} blows at {} /min", a.blows, a.rate_bpm),
+                title: format!("{title}, {} blows at {} /min", a.blows, rate_bpm),
                 x_label: "time (s)".into(),
                 y_label: label.into(),
                 series: vec![Series {
@@ -260,10 +270,10 @@ fn write_march(
 }
 
 /// The march's table, its steady line and the damper hint.
-fn print_march(a: &BlowsArgs, r: &meid::analysis::blows::BlowsRun) {
+fn print_march(a: &BlowsArgs, rate_bpm: f64, r: &meid::analysis::blows::BlowsRun) {
     println!(
         "The march from rest: {} blows every {:.6} s ({} /min)",
-        a.blows, r.interval_s, a.rate_bpm
+        a.blows, r.interval_s, rate_bpm
     );
     println!("  blow  E_p+/E_s-   peak accel (m/s²)  peak floor force (N)  machine energy at strike (J)  damper gap (mm)");
     for x in &r.blows {

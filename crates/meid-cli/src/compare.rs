@@ -5,9 +5,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 
 use meid::analysis::compare::{CompareOptions, Comparison, ComparisonResult, SpectrumMethod};
+use meid::analysis::production::RateOrigin;
 use meid::analysis::spectrum::{
     TransientWindow, REF_ACCELERATION_ISO1683_M_PER_S2, REF_ACCELERATION_M_PER_S2,
 };
+use meid::model::Case;
 use meid::plot;
 use meid::report::figures;
 
@@ -27,9 +29,11 @@ pub struct CompareArgs {
     /// Number of blows (the record is then N · 60/rate s).
     #[arg(long, value_name = "N", default_value_t = 1)]
     blows: usize,
-    /// Stroke rate for --blows (blows per minute).
-    #[arg(long, value_name = "R", default_value_t = 60.0)]
-    rate_bpm: f64,
+    /// Stroke rate (blows per minute; default: the model's [production] rate_bpm). With a
+    /// rate, the verdict opens with the three cases' periodic steady blow at that rate (as
+    /// `meid blows --steady`); it is also the rate of the --blows train (60 when none is given).
+    #[arg(long, value_name = "R")]
+    rate_bpm: Option<f64>,
     /// Acceleration level reference: 1 m/s² (default) or ISO 1683's 1e-6 m/s² (ESD levels are
     /// re its square·s/Hz).
     #[arg(long, value_parser = ["1", "iso1683"], default_value = "1")]
@@ -63,8 +67,18 @@ pub fn run(a: CompareArgs) -> Result<()> {
             "--window and --tau shape the FFT of the record; add --spectrum fft (the exact spectrum needs no window)"
         );
     }
+    let (rate_bpm, origin) =
+        meid::analysis::production::stroke_rate(&model, a.rate_bpm).map_err(|_| {
+            meid::Error::invalid(
+                "--rate-bpm",
+                format!(
+                    "the stroke rate must be a finite number > 0 blows per minute (got {})",
+                    a.rate_bpm.unwrap_or(f64::NAN)
+                ),
+            )
+        })?;
     let record = if a.blows > 1 {
-        a.blows as f64 * 60.0 / a.rate_bpm
+        a.blows as f64 * 60.0 / rate_bpm
     } else {
         a.duration
     };
@@ -78,7 +92,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
     let options = CompareOptions {
         duration_s: a.duration,
         blows: a.blows,
-        rate_bpm: a.rate_bpm,
+        rate_bpm,
         spectrum,
         window,
         acceleration_reference_m_per_s2: if a.reference == "iso1683" {
@@ -90,6 +104,12 @@ pub fn run(a: CompareArgs) -> Result<()> {
         ..CompareOptions::default()
     };
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
+    // With a stroke rate, the production verdict (the steady blow) comes first.
+    let production = if origin == RateOrigin::Assumed {
+        None
+    } else {
+        Some(crate::production::cases(&model, Case::AsSpecified, rate_bpm, &a.print)?.production)
+    };
     let comparison = Comparison::new(model, options);
     let bar = crate::progress::bar(
         a.print.quiet || a.print.json,
@@ -99,14 +119,28 @@ pub fn run(a: CompareArgs) -> Result<()> {
     let result = comparison.run_with_progress(&|done, _| bar.set_position(done as u64));
     bar.finish_and_clear();
     let result = result.context("comparison failed")?;
+    let mut summary = serde_json::to_value(result.summary())?;
+    if let (Some(p), Some(obj)) = (&production, summary.as_object_mut()) {
+        obj.insert("production".into(), serde_json::to_value(p)?);
+    }
     if let Some(set) = set {
-        write_outputs(set.staging(), &result)?;
+        write_outputs(set.staging(), &result, &summary)?;
         set.commit("compare")?;
     }
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(&result.summary())?);
+        println!("{}", serde_json::to_string_pretty(&summary)?);
     } else if a.print.human() {
         println!("meid compare — {}", a.model.display());
+        if let Some(p) = &production {
+            println!(
+                "  In production at {} blows/min ({}; the periodic steady blow):",
+                meid::num(p.rate_bpm),
+                origin.describe()
+            );
+            for v in &p.verdict {
+                println!("    {v}");
+            }
+        }
         for v in result.verdict() {
             println!("  {v}");
         }
@@ -121,7 +155,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
     Ok(())
 }
 
-fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
+fn write_outputs(dir: &Path, r: &ComparisonResult, summary: &serde_json::Value) -> Result<()> {
     for c in &r.cases {
         meid::io::write_history_csv(
             &dir.join(format!("history-{}.csv", c.case.name())),
@@ -132,7 +166,7 @@ fn write_outputs(dir: &Path, r: &ComparisonResult) -> Result<()> {
     meid::io::write_atomic(&dir.join("bands.csv"), &r.bands_csv()?)?;
     meid::io::write_atomic(&dir.join("reductions.txt"), r.table_text().as_bytes())?;
     meid::io::write_atomic(&dir.join("reductions.csv"), &r.table_csv()?)?;
-    meid::io::write_json(&dir.join("reductions.json"), &r.summary())?;
+    meid::io::write_json(&dir.join("reductions.json"), summary)?;
 
     // Per channel: the time histories (paper Figs. 10/11, 13/14, 18/19), one panel per
     // case; the energy spectral densities in dB with the refined peaks; the one-third-octave

@@ -53,7 +53,8 @@ pub struct OptimizeArgs {
     bed_mass: Option<f64>,
     /// Optimise for production at this stroke rate (blows/min): the objective on the steady
     /// blow of the periodic blow train, and only designs whose damper returns to the bed
-    /// before every strike are feasible (docs/studies.md, "Production").
+    /// before every strike are feasible (docs/studies.md, "Production"). Default: the model's
+    /// [production] rate_bpm, if it has one.
     #[arg(long, value_name = "R")]
     rate_bpm: Option<f64>,
     /// Write the report (optimize.json: variables, bounds, optimum, objective values) into DIR.
@@ -101,9 +102,12 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
     }
     // The output set first: `-o FILE` is refused before the search.
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
+    let model_rate = model.stroke_rate_bpm();
     let mut study =
         OptimizeStudy::with_bed_mass(model, vars, Objective::parse(&a.objective)?, a.bed_mass)?;
-    if let Some(r) = a.rate_bpm {
+    // The stroke rate asked for, else the model's [production] rate_bpm: the operating
+    // condition the design is judged at (none: the first blow from rest, the paper's study).
+    if let Some(r) = a.rate_bpm.or(model_rate) {
         study = study.with_stroke_rate(r)?;
     }
     study.max_simulations = a.max_simulations;

@@ -19,9 +19,11 @@ pub struct ReportArgs {
     /// manifest.json into DIR (default: ./report-<model name>).
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
-    /// Stroke rate of the blow train (blows per minute; the model file has none).
-    #[arg(long, value_name = "R", default_value_t = 60.0)]
-    rate_bpm: f64,
+    /// Stroke rate of the blow train and the production steady state (blows per minute;
+    /// default: the model's [production] rate_bpm, else 60, said to be assumed). With a rate
+    /// from either, the key results lead with the steady blow at that rate.
+    #[arg(long, value_name = "R")]
+    rate_bpm: Option<f64>,
     /// Blows in the train.
     #[arg(long, value_name = "N", default_value_t = 10)]
     blows: usize,

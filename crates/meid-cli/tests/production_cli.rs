@@ -169,3 +169,84 @@ fn bad_rates_and_maps_name_the_option() {
         .output()
         .unwrap());
 }
+
+/// The lumped example with `[production] rate_bpm = R` appended, written to a fresh directory.
+fn with_stroke_rate(tag: &str, rate: &str) -> std::path::PathBuf {
+    let dir = tmpdir("production", tag);
+    let text = std::fs::read_to_string(example_file("paper-lumped.toml")).unwrap();
+    let path = dir.join("press.toml");
+    std::fs::write(&path, format!("{text}\n[production]\nrate_bpm = {rate}\n")).unwrap();
+    path
+}
+
+/// A stroke rate in the model file is the rate `blows` and `compare` judge the machine at
+/// (a command's --rate-bpm overrides it); compare then opens with the steady blow's verdict,
+/// and without any rate it says the single blow is not production.
+#[test]
+fn the_model_stroke_rate_is_the_operating_condition() {
+    let model = with_stroke_rate("rate-30", "30");
+    let steady = |extra: &[&str]| {
+        ok_json(
+            meid()
+                .arg("blows")
+                .arg(&model)
+                .args(["--steady", "--json"])
+                .args(extra)
+                .output()
+                .unwrap(),
+        )
+    };
+    assert_eq!(steady(&[])["rate_bpm"], 30.0);
+    assert_eq!(steady(&["--rate-bpm", "20"])["rate_bpm"], 20.0);
+
+    let o = meid().arg("compare").arg(&model).output().unwrap();
+    let text = ok(o);
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(
+        lines[1].starts_with("  In production at 30 blows/min (the model's [production] rate_bpm; the periodic steady blow):"),
+        "{text}"
+    );
+    let v = ok_json(
+        meid()
+            .arg("compare")
+            .arg(&model)
+            .arg("--json")
+            .output()
+            .unwrap(),
+    );
+    assert_eq!(v["production"]["rate_bpm"], 30.0, "{}", v["production"]);
+    assert_eq!(v["production"]["cases"].as_array().map(Vec::len), Some(3));
+    // The production verdict equals `blows --steady`'s at the same rate.
+    assert_eq!(v["production"]["verdict"], steady(&[])["verdict"]);
+
+    let plain = ok_json(
+        meid()
+            .arg("compare")
+            .arg(example_file("paper-lumped.toml"))
+            .args(["--json", "--blows", "3"])
+            .output()
+            .unwrap(),
+    );
+    assert!(plain.get("production").is_none(), "no rate, no production");
+    let verdict = plain["verdict"][0].as_str().unwrap();
+    assert!(
+        verdict.starts_with("Over a train of 3 blows from rest at 60 /min (the train's largest peaks), the impact damper changes"),
+        "{verdict}"
+    );
+}
+
+/// A stroke rate that is not a rate: exit 2 naming the field, its line and the valid range.
+#[test]
+fn a_bad_model_stroke_rate_names_the_field() {
+    for bad in ["0", "-60", "nan"] {
+        let model = with_stroke_rate(&format!("bad-rate-{bad}"), bad);
+        let o = meid().arg("simulate").arg(&model).output().unwrap();
+        assert_eq!(o.status.code(), Some(2), "{bad}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(
+            e.contains("production.rate_bpm must be a finite number > 0 blows per minute")
+                && e.contains("press.toml:"),
+            "{bad}: {e}"
+        );
+    }
+}

@@ -107,6 +107,21 @@ fn lumped_report_passes_the_page_check_and_reads_the_library_studies() {
         .unwrap());
     check_report(&out, true);
     let report = json(&out.join("report.json"));
+    // No stroke rate anywhere: the production line says its 60 /min is assumed, and does
+    // not lead.
+    assert_eq!(report["rate_origin"], "assumed");
+    let keys = report["key_results"].as_array().unwrap();
+    assert!(
+        keys[0].as_str().unwrap().starts_with("Energy left"),
+        "{keys:?}"
+    );
+    assert!(
+        keys.iter().any(|k| k
+            .as_str()
+            .unwrap()
+            .contains("assumed: the model gives no stroke rate")),
+        "{keys:?}"
+    );
 
     // The comparison is `meid compare`'s (same record length), bit for bit.
     let compare: serde_json::Value = serde_json::from_str(&ok(meid()
@@ -195,18 +210,26 @@ fn fe_report_passes_the_page_check() {
     let o = meid()
         .arg("report")
         .arg(example_file("paper-soft-base.toml"))
-        .args(["--map-points", "9", "--blows", "3", "-o"])
+        .args(["--map-points", "9", "--blows", "3"])
+        .args(["--set", "production.rate_bpm=60", "-o"])
         .arg(&out)
         .output()
         .unwrap();
     let text = ok(o);
     assert!(text.contains("wrote"), "{text}");
     let html = check_report(&out, false);
+    // With the model's stroke rate, the key results lead with the steady blow at that rate.
+    let report = json(&out.join("report.json"));
+    assert_eq!(report["rate_origin"], "model");
+    let first = report["key_results"][0].as_str().unwrap();
+    assert!(
+        first.starts_with("In production at 60 blows/min (the model's [production] rate_bpm; the periodic steady blow,"),
+        "{first}"
+    );
     // The FE mode table names the solver and the DOFs, and the energy map's axes name the
     // reference mode by its number in that table (the 6.35 Hz vertical rigid-body mode).
     let modes = section(&html, "modes");
     assert!(modes.contains("DOFs"), "{modes}");
-    let report = json(&out.join("report.json"));
     let n = report["energy_map"]["axes"]["reference_mode"]
         .as_u64()
         .unwrap();

@@ -990,15 +990,16 @@ fn evaluate<'py>(
     Ok(y)
 }
 
-/// The machine in production at `rate_bpm` (`meid blows --json`'s object, as JSON text): the
+/// The machine in production at `rate_bpm` (`None`: the model's `[production] rate_bpm`, else
+/// 60) (`meid blows --json`'s object, as JSON text): the
 /// verdict, the periodic steady state of `case` (`steady_state`) and of every case
 /// (`production`); without `steady`, also the march of `blows` blows from rest.
 #[pyfunction]
-#[pyo3(signature = (model, rate_bpm=60.0, steady=true, case="as-specified".to_string(), blows=10))]
+#[pyo3(signature = (model, rate_bpm=None, steady=true, case="as-specified".to_string(), blows=10))]
 fn blows_json(
     py: Python<'_>,
     model: &Model,
-    rate_bpm: f64,
+    rate_bpm: Option<f64>,
     steady: bool,
     case: String,
     blows: usize,
@@ -1008,7 +1009,7 @@ fn blows_json(
     let case: Case = case.parse().map_err(err)?;
     py.detach(|| -> meid::Result<String> {
         let m = &model.inner;
-        meid::analysis::blows::blow_interval_s(rate_bpm)?;
+        let (rate_bpm, _) = production::stroke_rate(m, rate_bpm)?;
         let so = SteadyOptions::default();
         let p = production::production(m, rate_bpm, &so, true)?;
         let sys = m.impact_system(case)?;

@@ -128,14 +128,14 @@ def _table(names, columns, errors, output: str, index: str):
 
 def blows(
     model: Model,
-    rate_bpm: float = 60.0,
+    rate_bpm: Optional[float] = None,
     *,
     steady: bool = True,
     case: str = "as-specified",
     blows: int = 10,
 ) -> Dict[str, Any]:
-    """The machine in production at ``rate_bpm`` blows/min: ``meid blows --json``'s object as a
-    dict. ``verdict`` (sentences), ``steady_state`` (the periodic steady state of ``case``:
+    """The machine in production at ``rate_bpm`` blows/min (default: the model's
+    ``[production] rate_bpm``, else 60): ``meid blows --json``'s object as a dict. ``verdict`` (sentences), ``steady_state`` (the periodic steady state of ``case``:
     ``converged``, ``residual``, ``map_evaluations``, ``regime``, ``period_blows``,
     ``energy_ratio``, ``peak_floor_force_n``, ``peak_bed_acceleration_m_per_s2``,
     ``damper_gap_at_strike_m``, ``damper_touches_bed``, ``multipliers_abs``, ...) and

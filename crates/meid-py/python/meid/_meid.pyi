@@ -85,7 +85,7 @@ def column_unit(name: str) -> Optional[str]: ...
 
 def blows_json(
     model: Model,
-    rate_bpm: float = 60.0,
+    rate_bpm: Optional[float] = None,
     steady: bool = True,
     case: str = "as-specified",
     blows: int = 10,

@@ -387,6 +387,10 @@ pub struct ComparisonResult {
     pub reductions: Vec<Reduction>,
     /// How exact the time peaks are ([`crate::analysis::energy::peak_accuracy`]).
     pub peak_accuracy: String,
+    /// Blows in the simulated record (1: one blow from rest) and their stroke rate
+    /// (blows/min, used only when `blows > 1`).
+    pub blows: usize,
+    pub rate_bpm: f64,
 }
 
 /// A comparison you build from a model and run. See the module docs.
@@ -726,6 +730,8 @@ impl Comparison {
             cases,
             reductions,
             peak_accuracy: crate::analysis::energy::peak_accuracy(&opts),
+            blows: o.blows,
+            rate_bpm: o.rate_bpm,
         })
     }
 
@@ -1232,10 +1238,19 @@ impl ComparisonResult {
         let Some(none) = get(CaseName::NoDamper) else {
             return out;
         };
+        let what = if self.blows > 1 {
+            format!(
+                "Over a train of {} blows from rest at {} /min (the train's largest peaks)",
+                self.blows,
+                crate::num(self.rate_bpm)
+            )
+        } else {
+            "For one blow from rest".to_string()
+        };
         for c in [CaseName::Damper, CaseName::AddedMass] {
             let Some(x) = get(c) else { continue };
             out.push(format!(
-                "For one blow from rest, {} changes the peak floor force by {:+.1} dB ({} N against {} N without a damper) and the peak bed acceleration by {:+.1} dB ({} against {} m/s²).",
+                "{what}, {} changes the peak floor force by {:+.1} dB ({} N against {} N without a damper) and the peak bed acceleration by {:+.1} dB ({} against {} m/s²).",
                 if c == CaseName::Damper { "the impact damper" } else { "the same mass added rigidly" },
                 db(x.peak_floor_force_n, none.peak_floor_force_n),
                 crate::num(round_sig(x.peak_floor_force_n, 4)),
@@ -1253,9 +1268,14 @@ impl ComparisonResult {
                     .map_or("—", |c| c.case.label())
             };
             out.push(format!(
-                "Lowest peak floor force: {}; lowest peak bed acceleration: {}. One blow from rest is the paper's study, not production: `meid blows --rate-bpm R` gives the steady blow at the machine's stroke rate.",
+                "Lowest peak floor force: {}; lowest peak bed acceleration: {}. {}",
                 best(|c| c.peak_floor_force_n),
                 best(|c| c.peak_bed_acceleration_m_per_s2),
+                if self.blows > 1 {
+                    "The first blows of a train from rest are not yet production: the periodic steady blow at the stroke rate is `meid blows --steady`'s (or compare's with a stroke rate: --rate-bpm or the model's [production] rate_bpm)."
+                } else {
+                    "One blow from rest is the paper's study, not production: give the stroke rate (--rate-bpm, or [production] rate_bpm in the model) for the steady blow at the machine's stroke rate."
+                }
             ));
         }
         out

@@ -32,6 +32,47 @@ use crate::integrate::Options;
 use crate::model::{Case, Model};
 use crate::{Error, Result};
 
+/// The stroke rate assumed when neither the command nor the model gives one (blows/min).
+pub const ASSUMED_RATE_BPM: f64 = 60.0;
+
+/// Where a stroke rate came from ([`stroke_rate`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RateOrigin {
+    /// Given to the command (`--rate-bpm`, an API argument).
+    Given,
+    /// The model's `[production] rate_bpm`.
+    Model,
+    /// Neither: [`ASSUMED_RATE_BPM`].
+    Assumed,
+}
+
+impl RateOrigin {
+    /// Words for a report: where the rate came from.
+    pub fn describe(self) -> &'static str {
+        match self {
+            RateOrigin::Given => "the rate asked for",
+            RateOrigin::Model => "the model's [production] rate_bpm",
+            RateOrigin::Assumed => {
+                "assumed: the model gives no stroke rate ([production] rate_bpm)"
+            }
+        }
+    }
+}
+
+/// The stroke rate (blows/min) to judge a machine at: `given` (a command's `--rate-bpm`),
+/// else the model's `[production] rate_bpm`, else [`ASSUMED_RATE_BPM`]; with its origin.
+/// Errors name `rate_bpm` when the rate is not a finite number > 0.
+pub fn stroke_rate(model: &Model, given: Option<f64>) -> Result<(f64, RateOrigin)> {
+    let (rate, origin) = match (given, model.stroke_rate_bpm()) {
+        (Some(r), _) => (r, RateOrigin::Given),
+        (None, Some(r)) => (r, RateOrigin::Model),
+        (None, None) => (ASSUMED_RATE_BPM, RateOrigin::Assumed),
+    };
+    super::blows::blow_interval_s(rate)?;
+    Ok((rate, origin))
+}
+
 /// The three cases at one stroke rate.
 #[derive(Debug, Clone, Serialize)]
 pub struct Production {

@@ -307,6 +307,17 @@ impl Model {
                 ));
             }
         }
+        if let Some(p) = &s.production {
+            if !(p.rate_bpm.is_finite() && p.rate_bpm > 0.0) {
+                return Err(src.error(
+                    "production.rate_bpm",
+                    format!(
+                        "production.rate_bpm must be a finite number > 0 blows per minute (got {})",
+                        crate::num(p.rate_bpm)
+                    ),
+                ));
+            }
+        }
         if let Some(m) = &s.measurement {
             if let Err((field, message)) = m.check(&s.points.measurement) {
                 return Err(src.error(&field, format!("{field}: {message}")));
@@ -515,6 +526,12 @@ impl Model {
             }
             other => other,
         }
+    }
+
+    /// The machine's stroke rate in production (`[production] rate_bpm`, blows per minute), if
+    /// the model gives one.
+    pub fn stroke_rate_bpm(&self) -> Option<f64> {
+        self.spec.production.as_ref().map(|p| p.rate_bpm)
     }
 
     /// Integration options from `[simulation]`.

@@ -24,6 +24,9 @@ pub struct ModelSpec {
     pub contact: ContactsSpec,
     #[serde(default)]
     pub simulation: SimulationSpec,
+    /// `[production]`: how the machine runs in production (its stroke rate).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub production: Option<ProductionSpec>,
     /// `[measurement]`: how measured channels map to meid's and how they are processed
     /// ([`crate::measure::mapping`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -395,6 +398,16 @@ impl Default for SimulationSpec {
             max_events: default_max_events(),
         }
     }
+}
+
+/// `[production]`: the machine's operating condition in production.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ProductionSpec {
+    /// The stroke rate (blows per minute): blows repeated every `60 / rate_bpm` s. With it,
+    /// `meid blows`, `compare`, `optimize` and `report` judge the damper on the periodic
+    /// steady blow at this rate (a command's `--rate-bpm` overrides it).
+    pub rate_bpm: f64,
 }
 
 fn default_duration() -> f64 {

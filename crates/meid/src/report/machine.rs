@@ -35,8 +35,10 @@ use crate::{Error, Result};
 /// Settings of a machine report.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MachineOptions {
-    /// Stroke rate of the blow train (blows per minute); the model file has no stroke rate.
-    pub rate_bpm: f64,
+    /// Stroke rate of the blow train and the production steady state (blows per minute);
+    /// `None`: the model's `[production] rate_bpm`, else 60 assumed
+    /// ([`production::stroke_rate`]).
+    pub rate_bpm: Option<f64>,
     /// Blows in the train.
     pub blows: usize,
     /// Grid points per axis of the energy map (made odd so that the design is a grid point).
@@ -66,7 +68,7 @@ pub struct MachineOptions {
 impl Default for MachineOptions {
     fn default() -> Self {
         Self {
-            rate_bpm: 60.0,
+            rate_bpm: None,
             blows: 10,
             map_points: 41,
             map_span: 3.0,
@@ -119,6 +121,9 @@ pub struct MachineReport {
     pub comparison: ComparisonResult,
     /// One train per case of the comparison.
     pub blows: Vec<(CaseName, BlowsRun)>,
+    /// The stroke rate of the train and the steady state (blows/min), and where it came from.
+    pub rate_bpm: f64,
+    pub rate_origin: production::RateOrigin,
     /// The cases in their periodic steady state at the stroke rate, with the verdict
     /// ([`production::production`]); `None` when it failed (the reason is in `notes`).
     pub production: Option<Production>,
@@ -183,14 +188,8 @@ impl MachineReport {
         options: &MachineOptions,
         progress: &dyn Fn(&str),
     ) -> Result<Self> {
-        if !(options.rate_bpm.is_finite() && options.rate_bpm > 0.0) {
-            return Err(Error::invalid(
-                "rate_bpm",
-                format!(
-                    "the stroke rate must be > 0 blows per minute (got {})",
-                    options.rate_bpm
-                ),
-            ));
+        if let Some(r) = options.rate_bpm {
+            crate::analysis::blows::blow_interval_s(r)?;
         }
         if options.blows == 0 {
             return Err(Error::invalid("blows", "needs at least one blow"));
@@ -235,6 +234,7 @@ impl MachineReport {
         }
         .with_diagnostics(model.diagnostics());
         drop(analysis);
+        let (rate_bpm, rate_origin) = production::stroke_rate(&model, options.rate_bpm)?;
         let mut notes = Vec::new();
         let mut options = options.clone();
         options.map_points |= 1;
@@ -290,7 +290,7 @@ impl MachineReport {
         let mut blows = Vec::new();
         let train = BlowOptions {
             blows: options.blows,
-            rate_bpm: options.rate_bpm,
+            rate_bpm,
             ..BlowOptions::default()
         };
         for c in comparison.cases.iter().map(|c| c.case) {
@@ -302,8 +302,7 @@ impl MachineReport {
         }
 
         let production =
-            match production::production(&model, options.rate_bpm, &SteadyOptions::default(), true)
-            {
+            match production::production(&model, rate_bpm, &SteadyOptions::default(), true) {
                 Ok(p) => Some(p),
                 Err(e) => {
                     notes.push(format!("production steady state: {e}"));
@@ -327,6 +326,8 @@ impl MachineReport {
             notes.push("optimiser: the model has no [damper] to tune".into());
         }
         Ok(MachineReport {
+            rate_bpm,
+            rate_origin,
             model_path: path.display().to_string(),
             model,
             modes,
@@ -503,9 +504,10 @@ impl MachineReport {
         }
         if let Some(p) = &self.production {
             if let (Some(n), Some(d)) = (p.case(CaseName::NoDamper), p.case(CaseName::Damper)) {
-                out.push(format!(
-                    "In production at {} blows/min (the periodic steady state, {}): peak floor force {} N without damper, {} N with it ({:+.2} dB); bed acceleration {} → {} m/s² ({:+.2} dB); the damper {} the bed in the steady blow{}.",
+                let line = format!(
+                    "In production at {} blows/min ({}; the periodic steady blow, {}): peak floor force {} N without damper, {} N with it ({:+.2} dB); bed acceleration {} → {} m/s² ({:+.2} dB); the damper {} the bed in the steady blow{}.",
                     figures::plain(p.rate_bpm),
+                    self.rate_origin.describe(),
                     d.regime.name(),
                     sig(n.peak_floor_force_n, 4),
                     sig(d.peak_floor_force_n, 4),
@@ -516,7 +518,13 @@ impl MachineReport {
                     if d.damper_touches_bed == Some(true) { "touches" } else { "does not touch" },
                     d.damper_gap_at_strike_m
                         .map_or(String::new(), |g| format!(" (gap at the strike {} mm)", sig(1e3 * g, 3)))
-                ));
+                );
+                // A stroke rate the user gave makes the steady blow the answer: it leads.
+                if self.rate_origin == production::RateOrigin::Assumed {
+                    out.push(line);
+                } else {
+                    out.insert(0, line);
+                }
             }
         }
         if let Some(mc) = &self.montecarlo {
@@ -926,7 +934,7 @@ impl MachineReport {
             Block::Paragraph(format!(
                 "{} blows at {} blows/min (interval {} s = 60/rate exactly); each blow starts from the state the previous one left, with a fresh slider at v_s. The model file has no stroke rate: it is the report's setting (meid report --rate-bpm). A single rate reads the rigid-body mode's comb filter as much as the damper (docs/studies.md, \"Repeated blows\"): check the neighbouring rates before concluding.",
                 self.options.blows,
-                figures::plain(self.options.rate_bpm),
+                figures::plain(self.rate_bpm),
                 figures::plain(interval)
             )),
             Block::Table(Table {
@@ -944,7 +952,7 @@ impl MachineReport {
                 ..Default::default()
             }),
         ];
-        for f in figures::blow_train_figures(dir, "blows", &runs, self.options.rate_bpm)? {
+        for f in figures::blow_train_figures(dir, "blows", &runs, self.rate_bpm)? {
             blocks.push(Block::Figure(f));
         }
         sections.push(Section {
@@ -1203,7 +1211,8 @@ impl MachineReport {
             "energy_map": map,
             "comparison": self.comparison.summary(),
             "blow_trains": blows,
-            "rate_bpm": self.options.rate_bpm,
+            "rate_bpm": self.rate_bpm,
+            "rate_origin": self.rate_origin,
             "optimize": self.optimize,
             "montecarlo": mc,
             "measured": self.measured,
