@@ -168,7 +168,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
         set.commit("blows")?;
     }
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        crate::json::print(&out)?;
     } else if a.print.human() {
         crate::production::print_production(&prod.production);
         println!();
@@ -204,7 +204,7 @@ fn write_march(
         ));
     }
     meid::io::write_atomic(&dir.join("blows.csv"), w.as_bytes())?;
-    meid::io::write_json(&dir.join("blows.json"), out)?;
+    meid::io::write_json(&dir.join("blows.json"), &crate::json::object(out)?)?;
     let [time_s, accel, floor] = pictured;
     for (stem, title, label, y) in [
         (

@@ -98,14 +98,14 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
     let problem = Problem::new(&model, params, &cases, &p, &flags, settings)?;
     let c = calibrate(&problem)?;
     if let Some(set) = set {
-        meid::io::write_json(&set.path("calibration.json"), &c)?;
+        meid::io::write_json(&set.path("calibration.json"), &crate::json::object(&c)?)?;
         let text = calibrated_model_text(&model, problem.parameters(), &c.values())?;
         meid::io::write_atomic(&set.path("calibrated.toml"), text.as_bytes())?;
         c.plots(set.staging())?;
         set.commit("calibrate")?;
     }
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(&c)?);
+        crate::json::print(&c)?;
     } else if a.print.human() {
         println!(
             "{} — {}",

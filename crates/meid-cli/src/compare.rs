@@ -128,7 +128,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
         set.commit("compare")?;
     }
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        crate::json::print(&summary)?;
     } else if a.print.human() {
         println!("meid compare — {}", a.model.display());
         if let Some(p) = &production {
@@ -166,7 +166,7 @@ fn write_outputs(dir: &Path, r: &ComparisonResult, summary: &serde_json::Value) 
     meid::io::write_atomic(&dir.join("bands.csv"), &r.bands_csv()?)?;
     meid::io::write_atomic(&dir.join("reductions.txt"), r.table_text().as_bytes())?;
     meid::io::write_atomic(&dir.join("reductions.csv"), &r.table_csv()?)?;
-    meid::io::write_json(&dir.join("reductions.json"), summary)?;
+    meid::io::write_json(&dir.join("reductions.json"), &crate::json::object(summary)?)?;
 
     // Per channel: the time histories (paper Figs. 10/11, 13/14, 18/19), one panel per
     // case; the energy spectral densities in dB with the refined peaks; the one-third-octave

@@ -32,6 +32,7 @@ mod args;
 mod blows;
 mod calibrate;
 mod compare;
+mod json;
 mod measure;
 mod model;
 mod modes;
@@ -192,6 +193,7 @@ pub(crate) fn warn_model(model: &Model, print: &args::PrintArgs) {
 
 /// [`warn_model`] for diagnostics the caller keeps (`simulate` writes them out too).
 pub(crate) fn warn_diagnostics(diag: &meid::model::Diagnostics, print: &args::PrintArgs) {
+    json::record(diag);
     if !print.quiet {
         for w in &diag.warnings {
             ui::warning(w);

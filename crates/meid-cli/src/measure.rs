@@ -157,7 +157,10 @@ pub fn run(a: MeasureArgs) -> Result<()> {
         }
     }
     if let Some(set) = set {
-        meid::io::write_json(&set.path("measure.json"), &summaries)?;
+        meid::io::write_json(
+            &set.path("measure.json"),
+            &crate::json::object(&serde_json::json!({ "records": summaries }))?,
+        )?;
         meid::io::write_atomic(&set.path("bands.csv"), &report::bands_csv(&channels)?)?;
         let mut taken = Vec::new();
         for c in &channels {
@@ -175,7 +178,7 @@ pub fn run(a: MeasureArgs) -> Result<()> {
         set.commit("measure")?;
     }
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(&summaries)?);
+        crate::json::print(&serde_json::json!({ "records": summaries }))?;
     } else if a.print.human() {
         let names: Vec<String> = a.files.iter().map(|f| f.display().to_string()).collect();
         print!("{}", report::summary_text(&names, &channels));

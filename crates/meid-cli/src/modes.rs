@@ -58,7 +58,7 @@ pub fn run(a: ModesArgs) -> Result<()> {
         }
     }
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        crate::json::print(&report)?;
     } else if a.print.human() {
         print!("{}", report.to_text());
     }

@@ -106,13 +106,10 @@ pub fn run(a: MonteCarloArgs) -> Result<()> {
             &rows,
         )?;
         if a.print.json {
-            println!(
-                "{}",
-                serde_json::to_string_pretty(&serde_json::json!({
-                    "shard": shard.k, "shards": shard.n, "first": range.start,
-                    "end": range.end, "total": study.samples, "files": files,
-                }))?
-            );
+            crate::json::print(&serde_json::json!({
+                "shard": shard.k, "shards": shard.n, "first": range.start,
+                "end": range.end, "total": study.samples, "files": files,
+            }))?;
         } else if a.print.human() {
             println!(
                 "meid montecarlo — shard {}/{}: samples {}..{} of {} ({} failed)",
@@ -202,7 +199,7 @@ fn output(
         meid::io::write_atomic(&dir.join("samples.csv"), &r.samples_csv()?)?;
         // samples.csv's rows with types, units and exact values (docs/studies.md, "Parquet").
         meid::io::parquet::write_parquet(&dir.join("samples.parquet"), &study.table(r))?;
-        meid::io::write_json(&dir.join("stats.json"), &stats)?;
+        meid::io::write_json(&dir.join("stats.json"), &crate::json::object(&stats)?)?;
         let values = r.metric(&a.metric)?;
         let bins = ((values.len() as f64).sqrt().ceil() as usize).clamp(5, 50);
         let (x, y) = histogram_outline(&values, bins);
@@ -254,7 +251,7 @@ fn output(
         set.commit("montecarlo")?;
     }
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(&stats)?);
+        crate::json::print(&stats)?;
     } else if a.print.human() {
         println!(
             "meid montecarlo — {} samples, seed {}, {} failed; estimates from the samples, 95 % confidence intervals below",

@@ -123,11 +123,14 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
     let rep = rep?;
     let elapsed = t0.elapsed().as_secs_f64();
     if let Some(set) = set {
-        meid::io::write_json(&set.staging().join("optimize.json"), &rep)?;
+        meid::io::write_json(
+            &set.staging().join("optimize.json"),
+            &crate::json::object(&rep)?,
+        )?;
         set.commit("optimize")?;
     }
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(&rep)?);
+        crate::json::print(&rep)?;
     }
     if a.print.human() {
         print_report(&a, &rep, elapsed);

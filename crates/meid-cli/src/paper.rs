@@ -57,7 +57,7 @@ pub fn run(a: PaperArgs) -> Result<()> {
     set.commit("paper")?;
     let elapsed = t0.elapsed().as_secs_f64();
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        crate::json::print(&report)?;
     } else if a.print.human() {
         println!(
             "meid paper — {} figures, {} table rows, {} deviation runs in {elapsed:.1} s",

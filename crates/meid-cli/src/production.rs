@@ -58,12 +58,12 @@ pub fn steady_only(prod: &Prod, output: Option<&Path>, print: &PrintArgs) -> Res
     if let Some(dir) = output {
         let set = crate::outputs::begin(dir)?;
         let staging = set.staging();
-        meid::io::write_json(&staging.join("steady.json"), &out)?;
+        meid::io::write_json(&staging.join("steady.json"), &crate::json::object(&out)?)?;
         meid::io::write_atomic(&staging.join("steady.csv"), steady_csv(p).as_bytes())?;
         set.commit("blows --steady")?;
     }
     if print.json {
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        crate::json::print(&out)?;
     } else if print.human() {
         print_production(p);
     }
@@ -175,13 +175,13 @@ pub fn rate_map(
     if let Some(dir) = output {
         let set = crate::outputs::begin(dir)?;
         let staging = set.staging();
-        meid::io::write_json(&staging.join("rates.json"), &out)?;
+        meid::io::write_json(&staging.join("rates.json"), &crate::json::object(&out)?)?;
         meid::io::write_atomic(&staging.join("rates.csv"), rates_csv(&rows).as_bytes())?;
         rates_picture(&staging.join("rates-db"), &rows, best)?;
         set.commit("blows --rates")?;
     }
     if print.json {
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        crate::json::print(&out)?;
     } else if print.human() {
         println!(
             "meid blows — stroke-rate map, {} rates: steady floor force and bed acceleration against the machine without a damper",

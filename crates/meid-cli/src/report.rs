@@ -120,7 +120,7 @@ pub fn run(a: ReportArgs) -> Result<()> {
     set.commit("report")?;
     let elapsed = t0.elapsed().as_secs_f64();
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(&report.summary_json())?);
+        crate::json::print(&report.summary_json())?;
     } else if a.print.human() {
         println!("meid report — {}", a.model.display());
         for line in report.key_results() {

@@ -46,13 +46,16 @@ pub fn run(
     if let Some(dir) = output {
         let set = crate::outputs::begin(dir)?;
         let staging = set.staging();
-        meid::io::write_json(&staging.join("return-map.json"), &out)?;
+        meid::io::write_json(
+            &staging.join("return-map.json"),
+            &crate::json::object(&out)?,
+        )?;
         meid::io::write_atomic(&staging.join("return-map.csv"), map.csv().as_bytes())?;
         picture(&staging.join("return-map"), &map)?;
         set.commit("blows --vary")?;
     }
     if print.json {
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        crate::json::print(&out)?;
     } else if print.human() {
         print_map(&map, &sentence);
     }

@@ -91,7 +91,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         set.commit("simulate")?;
     }
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        crate::json::print(&out)?;
     } else if a.print.human() {
         print_summary(&model, s, a.output.as_deref(), a.uff);
         print!("{}", meid::modal::truncation::to_text(&diag.truncation));

@@ -142,13 +142,10 @@ pub fn run(a: SweepArgs) -> Result<()> {
             rows.as_bytes(),
         )?;
         if a.print.json {
-            println!(
-                "{}",
-                serde_json::to_string_pretty(&serde_json::json!({
-                    "shard": shard.k, "shards": shard.n, "first": range.start,
-                    "end": range.end, "total": total, "files": files,
-                }))?
-            );
+            crate::json::print(&serde_json::json!({
+                "shard": shard.k, "shards": shard.n, "first": range.start,
+                "end": range.end, "total": total, "files": files,
+            }))?;
         } else if a.print.human() {
             println!(
                 "meid sweep — shard {}/{}: points {}..{} of {total} ({} failed)",
@@ -210,7 +207,7 @@ fn output(
             return Err(e.into());
         }
         if a.print.json {
-            println!("{}", serde_json::to_string_pretty(result)?);
+            crate::json::print(&result)?;
         } else if a.print.human() {
             summarise(sweep, result, &a.metric, elapsed, &[]);
             println!();
@@ -229,7 +226,7 @@ fn output(
     draw(sweep, result, &a.metric, set.staging())?;
     let files = set.commit("sweep")?;
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(result)?);
+        crate::json::print(&result)?;
     } else if a.print.human() {
         summarise(sweep, result, &a.metric, elapsed, &files);
     }
@@ -320,10 +317,29 @@ fn summarise(sweep: &Sweep, r: &SweepResult, metric: &str, elapsed: f64, files: 
                         .zip(&p.values)
                         .map(|(n, v)| format!("{n} = {v:.6}"))
                         .collect();
+                    // A minimum on the first or last value of a range may lie outside it.
+                    let edges: Vec<String> = sweep
+                        .vary
+                        .iter()
+                        .zip(&p.values)
+                        .filter(|(v, x)| {
+                            v.values.len() >= 3
+                                && (v.values.first() == Some(x) || v.values.last() == Some(x))
+                        })
+                        .map(|(v, _)| v.quantity.name())
+                        .collect();
                     println!(
-                        "  min {column:<32} {:.6e}  at {}",
+                        "  min {column:<32} {:.6e}  at {}{}",
                         r.value(i, &column),
-                        at.join(", ")
+                        at.join(", "),
+                        if edges.is_empty() {
+                            String::new()
+                        } else {
+                            format!(
+                                " (on the grid's edge in {}: the minimum may lie outside the range)",
+                                edges.join(" and ")
+                            )
+                        }
                     );
                 }
                 None => println!("  min {column:<32} — (undefined at every point; no picture)"),

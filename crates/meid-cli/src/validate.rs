@@ -50,12 +50,12 @@ pub fn run(a: ValidateArgs) -> Result<()> {
     }
     let v = validate(&model, &cases, &p, &flags)?;
     if let Some(set) = set {
-        meid::io::write_json(&set.path("validation.json"), &v)?;
+        meid::io::write_json(&set.path("validation.json"), &crate::json::object(&v)?)?;
         v.plots(set.staging())?;
         set.commit("validate")?;
     }
     if a.print.json {
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        crate::json::print(&v)?;
     } else if a.print.human() {
         println!(
             "{} — {}",

@@ -38,7 +38,7 @@ fn measure_json_has_the_issue_fields_and_sample_peaks() {
         .output()
         .unwrap());
     let v: Value = serde_json::from_str(&out).unwrap();
-    let chans = v.as_array().unwrap();
+    let chans = v["records"].as_array().unwrap();
     assert_eq!(chans.len(), 2);
     let keys: Vec<&str> = chans[0]
         .as_object()
@@ -182,7 +182,12 @@ fn uff_exports_read_back_and_validate_to_zero() {
         .output()
         .unwrap()))
     .unwrap();
-    for (x, y) in a.as_array().unwrap().iter().zip(b.as_array().unwrap()) {
+    for (x, y) in a["records"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(b["records"].as_array().unwrap())
+    {
         assert_eq!(x["name"], y["name"]);
         assert_eq!(x["peak"], y["peak"]);
         assert_eq!(x["samples"], y["samples"]);
@@ -285,7 +290,12 @@ fn measure_takes_a_simulated_history_with_default_options() {
             .output()
             .unwrap()))
         .unwrap();
-        for (c, z) in v.as_array().unwrap().iter().zip(zero.as_array().unwrap()) {
+        for (c, z) in v["records"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(zero["records"].as_array().unwrap())
+        {
             assert_eq!(c["blows_averaged"], 1, "{file}: {c}");
             assert!(
                 (c["pretrigger_s"].as_f64().unwrap() - 5e-5).abs() < 1e-12,
@@ -391,14 +401,14 @@ fn measure_honours_record_and_refuses_settings_that_fit_no_blow() {
         "--json",
     ])))
     .unwrap();
-    for c in v.as_array().unwrap() {
+    for c in v["records"].as_array().unwrap() {
         assert_eq!(c["blows_averaged"], 1, "{c}");
         assert!((c["record_s"].as_f64().unwrap() - 0.3).abs() < 1e-12, "{c}");
         assert_eq!(c["pretrigger_s"], 0.0, "{c}");
         let f = c["dominant_frequency_hz"].as_f64().unwrap();
         assert!(((f * 0.3) - (f * 0.3).round()).abs() < 1e-9, "{f}");
     }
-    let acc = &v.as_array().unwrap()[2];
+    let acc = &v["records"].as_array().unwrap()[2];
     assert_eq!(acc["name"], "bed_acceleration");
     assert!(
         (acc["dominant_frequency_hz"].as_f64().unwrap() - 85.0 / 0.3).abs() < 1e-9,
@@ -456,7 +466,7 @@ fn measure_of_huge_amplitudes_finds_the_line_and_writes_no_infinity() {
         let mut v = vec!["measure", f.to_str().unwrap()];
         v.extend_from_slice(&args);
         let j: Value = serde_json::from_str(&ok(meid().args(v).output().unwrap())).unwrap();
-        let c = &j.as_array().unwrap()[0];
+        let c = &j["records"].as_array().unwrap()[0];
         assert_eq!(c["dominant_frequency_hz"], 50.0, "{c}");
         c["dominant_level_db"].as_f64().unwrap()
     };
@@ -572,7 +582,7 @@ fn no_blow_found_is_reported_as_zero_blows_averaged() {
         .output()
         .unwrap()))
     .unwrap();
-    let a = &v.as_array().unwrap()[0];
+    let a = &v["records"].as_array().unwrap()[0];
     assert_eq!(a["blows"], 0);
     assert_eq!(a["blows_averaged"], 0);
     assert!((a["record_s"].as_f64().unwrap() - 2.0).abs() < 1e-9, "{a}");

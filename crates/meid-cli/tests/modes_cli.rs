@@ -66,18 +66,18 @@ fn fem_model_table_json_and_files() {
     let v = common::ok_json(out);
     let modes = v["modes"].as_array().unwrap();
     assert_eq!(modes.len(), 12);
-    for key in [
-        "index",
-        "frequency_hz",
-        "effective_mass_kg",
-        "psi_per_sqrt_kg",
-    ] {
+    for key in ["index", "frequency_hz", "effective_mass", "psi_per_sqrt_kg"] {
         assert!(modes[0].get(key).is_some(), "missing {key}");
     }
-    for key in ["x", "y", "z", "rx", "ry", "rz"] {
+    // Every quantity's key names its unit.
+    for key in ["x_kg", "y_kg", "z_kg", "rx_kg_m2", "ry_kg_m2", "rz_kg_m2"] {
         assert!(
-            modes[0]["effective_mass_kg"].get(key).is_some(),
+            modes[0]["effective_mass"].get(key).is_some(),
             "missing {key}"
+        );
+        assert!(
+            v["total_mass"].get(key).is_some(),
+            "missing total_mass.{key}"
         );
     }
     assert!(modes[4]["psi_per_sqrt_kg"]["O_b"].as_f64().unwrap().abs() > 0.0);

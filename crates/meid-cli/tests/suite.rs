@@ -12,6 +12,7 @@ mod compare_cli;
 mod conventions;
 mod fem_threads_cli;
 mod input_cli;
+mod json_shape;
 mod measure_cli;
 mod model_cli;
 mod modes_cli;

@@ -1596,11 +1596,19 @@ pub fn from_text_with_analysis(
 /// axes through the origin).
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct EffectiveMass {
+    /// Translations (kg).
+    #[serde(rename = "x_kg")]
     pub x: f64,
+    #[serde(rename = "y_kg")]
     pub y: f64,
+    #[serde(rename = "z_kg")]
     pub z: f64,
+    /// Rotations about the axes through the origin (kg·m²).
+    #[serde(rename = "rx_kg_m2")]
     pub rx: f64,
+    #[serde(rename = "ry_kg_m2")]
     pub ry: f64,
+    #[serde(rename = "rz_kg_m2")]
     pub rz: f64,
 }
 
@@ -1610,7 +1618,9 @@ pub struct ModeRow {
     /// 1-based mode number (ascending frequency).
     pub index: usize,
     pub frequency_hz: f64,
-    /// `None` for lumped/tabulated models (no mass matrix in global directions).
+    /// `None` for lumped/tabulated models (no mass matrix in global directions). JSON
+    /// `effective_mass`, its members named with their units.
+    #[serde(rename = "effective_mass")]
     pub effective_mass_kg: Option<EffectiveMass>,
     /// Signed mass-normalised mode-shape value ψ_i(P) along the impact direction at each named
     /// point (1/√kg): `ψ_i(P) = d · u_P(φ_i)` with `φ_iᵀ M φ_i = 1`. Within a mode the signs give
@@ -1634,7 +1644,8 @@ pub struct ModeReport {
     pub solver: String,
     /// Reduced DOFs of the FE model (0 for lumped/modal).
     pub dofs: usize,
-    /// Total `rᵀ M r` per direction (x, y, z, rx, ry, rz).
+    /// Total `rᵀ M r` per direction (x, y, z in kg; rx, ry, rz in kg·m²; JSON members named
+    /// with their units).
     pub total_mass: Option<EffectiveMass>,
     /// Relative residual of each selected mode.
     pub selected_residuals: Vec<f64>,

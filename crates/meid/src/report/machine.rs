@@ -1216,6 +1216,7 @@ impl MachineReport {
             "optimize": self.optimize,
             "montecarlo": mc,
             "measured": self.measured,
+            "warnings": self.modes.warnings,
             "notes": self.notes,
         })
     }

@@ -823,32 +823,55 @@ pub fn deviation_summary(r: &PaperReport) -> String {
 }
 
 impl PaperReport {
-    /// The paper-vs-meid table as fixed-width text (what `meid paper` prints).
+    /// The paper-vs-meid table as fixed-width text (what `meid paper` prints): every cell
+    /// whole, each column as wide as its widest cell.
     pub fn table_text(&self) -> String {
-        let mut s = String::new();
-        let _ = writeln!(
-            s,
-            "{:<16} {:>16} {:>14} {:>14}  {:<26} measure",
-            "claim", "paper", "meid lumped", "meid FE", "verdict"
-        );
-        for r in &self.table {
-            let short = |t: &str| -> String {
-                if t.chars().count() > 14 {
-                    t.chars().take(13).collect::<String>() + "…"
-                } else {
-                    t.to_string()
-                }
-            };
-            let _ = writeln!(
-                s,
-                "{:<16} {:>16} {:>14} {:>14}  {:<26} {}",
-                r.id,
-                r.paper,
-                short(&r.lumped_text),
-                short(&r.fe_text),
-                r.verdict.text(),
-                r.measure
-            );
+        let head = [
+            "claim",
+            "paper",
+            "meid lumped",
+            "meid FE",
+            "verdict",
+            "measure",
+        ];
+        let rows: Vec<[String; 6]> = self
+            .table
+            .iter()
+            .map(|r| {
+                [
+                    r.id.to_string(),
+                    r.paper.to_string(),
+                    r.lumped_text.clone(),
+                    r.fe_text.clone(),
+                    r.verdict.text().to_string(),
+                    r.measure.to_string(),
+                ]
+            })
+            .collect();
+        let mut width = head.map(|h| h.chars().count());
+        for r in &rows {
+            for (w, c) in width.iter_mut().zip(r) {
+                *w = (*w).max(c.chars().count());
+            }
+        }
+        let pad = |t: &str, w: usize, right: bool| {
+            let fill = " ".repeat(w.saturating_sub(t.chars().count()));
+            if right {
+                format!("{fill}{t}")
+            } else {
+                format!("{t}{fill}")
+            }
+        };
+        let line = |cells: [&str; 6]| {
+            let right = [false, true, true, true, false, false];
+            let parts: Vec<String> = (0..6)
+                .map(|i| pad(cells[i], if i == 5 { 0 } else { width[i] }, right[i]))
+                .collect();
+            format!("{}\n", parts.join("  ").trim_end())
+        };
+        let mut s = line(head);
+        for r in &rows {
+            s.push_str(&line([&r[0], &r[1], &r[2], &r[3], &r[4], &r[5]]));
         }
         s
     }
