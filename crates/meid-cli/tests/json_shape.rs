@@ -75,10 +75,19 @@ fn every_command_prints_one_object_with_warnings_and_notes() {
         .unwrap());
     let uff = d.join("run/history.uff");
     let uff = uff.to_str().unwrap();
-    let m = object(&["measure", uff, "--json"]);
+    // A simulated history starts with the blow: no pre-trigger fits before it.
+    let m = object(&["measure", uff, "--pretrigger", "0", "--json"]);
     assert!(
         m["records"].as_array().is_some_and(|r| !r.is_empty()),
         "{m}"
     );
-    with_slip(&["validate", model, "--measured", uff, "--json"]);
+    with_slip(&[
+        "validate",
+        model,
+        "--measured",
+        uff,
+        "--pretrigger",
+        "0",
+        "--json",
+    ]);
 }

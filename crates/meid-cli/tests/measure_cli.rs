@@ -626,7 +626,7 @@ fn force_window_on_the_hammer_only_semicolon_csv_and_a_microphone_passed_over() 
             "0.05",
         ];
         args.extend_from_slice(extra);
-        ok_json(meid().args(&args).output().unwrap())
+        ok_json(meid().args(&args).output().unwrap())["records"].clone()
     };
     let plain = run(&[]);
     let windowed = run(&["--force-window"]);

@@ -621,7 +621,21 @@ pub fn case_peaks_table(r: &ComparisonResult) -> Table {
 /// Every dB reduction of the comparison with its measure named beside it.
 pub fn reductions_table(r: &ComparisonResult) -> Table {
     let mut rows = Vec::new();
+    // The baseline against itself (0 dB) says nothing: only the other cases, grouped by
+    // measure (the order of first appearance), then by case.
+    let mut measures: Vec<&str> = Vec::new();
     for x in &r.reductions {
+        if !measures.contains(&x.measure.name()) {
+            measures.push(x.measure.name());
+        }
+    }
+    let mut shown: Vec<_> = r
+        .reductions
+        .iter()
+        .filter(|x| x.case != CaseName::NoDamper)
+        .collect();
+    shown.sort_by_key(|x| measures.iter().position(|m| *m == x.measure.name()));
+    for x in shown {
         rows.push(vec![
             x.case.label().to_string(),
             x.metric.clone(),
