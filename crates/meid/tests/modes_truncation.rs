@@ -309,7 +309,34 @@ stiffness = 1e7
     let base = d.truncation.iter().find(|r| r.point == "base").unwrap();
     assert!((bed.static_flexibility_m_per_n - (1.0 / kf + 1.0 / kc)).abs() <= 1e-13 / kf);
     assert!((base.static_flexibility_m_per_n - 1.0 / kf).abs() <= 1e-13 / kf);
-    assert!(d.warnings.is_empty() && d.notes.is_empty(), "{d:?}");
+    assert!(d.warnings.is_empty(), "{d:?}");
+    // The one note: the damper (3.5 kg) against the 10 kg the bed opposes to the blow.
+    assert!(
+        d.notes.len() == 1
+            && d.notes[0].starts_with("at O_b ('bed') the structure meets a blow as m_eff = 10 kg")
+            && d.notes[0].ends_with("m_d/m_eff = 0.35"),
+        "{d:?}"
+    );
+    // With every mode retained, Σ ψ_i(P)² = (M⁻¹)_PP: the effective mass at a point is the
+    // mass lumped there (10 kg bed, 41 kg base), and no single mode carries less.
+    for (r, mass) in [(bed, 10.0), (base, 41.0)] {
+        let m_eff = r.effective_mass_kg.unwrap();
+        assert!((m_eff - mass).abs() <= 1e-12 * mass, "{r:?}");
+        assert!(r.dominant_mode_effective_mass_kg.unwrap() >= m_eff, "{r:?}");
+    }
+    // The bed moves most in the bed mode (mode 2, 283 Hz), the base in the rigid-body mode.
+    assert_eq!(bed.dominant_mode, Some(2));
+    assert_eq!(base.dominant_mode, Some(1));
+    // Closed form of the two-mass chain: λ² m_b m_f − λ (m_b (k_c + k_f) + m_f k_c) + k_c k_f
+    // = 0; in mode λ the base moves r = (k_c − m_b λ)/k_c times the bed, and mass
+    // normalisation gives 1/ψ(bed)² = m_b + m_f r².
+    let (mb, mf) = (10.0, 41.0);
+    let (a, b, c) = (mb * mf, -(mb * (kc + kf) + mf * kc), kc * kf);
+    let lam2 = (-b + (b * b - 4.0 * a * c).sqrt()) / (2.0 * a);
+    let r = (kc - mb * lam2) / kc;
+    let want = mb + mf * r * r;
+    let got = bed.dominant_mode_effective_mass_kg.unwrap();
+    assert!((got - want).abs() <= 1e-9 * want, "{got} vs {want}");
 }
 
 /// Contact frequencies: linear √(K/m) whatever v; Hertz T_c = 2.9432 δ_max / v (the classical

@@ -67,7 +67,12 @@ fn rigid_column_is_merged_to_the_closed_form_limit() {
     // The paper's own column is not touched.
     let m = paper(&[]).unwrap();
     assert_eq!(m.structure.len(), 2);
-    assert!(m.diagnostics().notes.is_empty());
+    // Only the damper's mass ratio at O_b (m_d/m_eff), no note about the column.
+    let notes = m.diagnostics().notes;
+    assert!(
+        notes.len() == 1 && notes[0].contains("m_d/m_eff"),
+        "{notes:?}"
+    );
 }
 
 /// The merged model conserves energy and gives the rigid-limit result: the energy ratio of the
@@ -145,7 +150,11 @@ fn unresolved_spread_is_warned_about() {
     let m = paper(&[&column(1e14)]).unwrap();
     assert_eq!(m.structure.len(), 2);
     let d = m.diagnostics();
-    assert!(d.notes.is_empty(), "{:?}", d.notes);
+    assert!(
+        d.notes.len() == 1 && d.notes[0].contains("m_d/m_eff"),
+        "{:?}",
+        d.notes
+    );
     assert_eq!(d.warnings.len(), 1, "{:?}", d.warnings);
     let w = &d.warnings[0];
     assert!(

@@ -27,6 +27,19 @@
 //! frequency: a retained set that misses a mode carrying P's flexibility (say a soft bounce
 //! mode) shows a small share, whatever the mode's frequency. Below [`SHARE_WARNING`] meid warns.
 //! A model with all its modes retained (lumped) has a share of exactly 1 up to round-off.
+//!
+//! # Effective mass at a point
+//! A short blow of impulse `J` at P sets every retained mode moving at `q̇_i = ψ_i(P) J`, so P
+//! moves at `v_P = Σ_i ψ_i(P)² J`: the structure meets the blow as a mass
+//!
+//! ```text
+//! m_eff(P) = 1 / Σ_{retained} ψ_i(P)²        (kg),     per mode  m_i(P) = 1 / ψ_i(P)²,
+//! ```
+//!
+//! (the driving-point apparent mass at the instant of impact; with all modes of a lumped model
+//! retained, `Σ ψ_i(P)² = (M⁻¹)_PP` and `m_eff` is the mass lumped at P). This, not the bed's
+//! mass, is what a damper's mass should be compared with: the momentum exchange is between the
+//! damper and `m_eff`, and it is largest when `m_d / m_eff` is near 1.
 
 use faer::sparse::SparseColMatRef;
 use faer::{Mat, Par};
@@ -52,6 +65,29 @@ pub struct TruncationRow {
     pub modal_flexibility_m_per_n: f64,
     /// `modal / static` (1 when the point does not move under a static load, `G_PP = 0`).
     pub captured_share: f64,
+    /// `m_eff(P) = 1/Σ ψ_i(P)²` over the retained modes (kg; module docs); `None` when no
+    /// retained mode moves P.
+    pub effective_mass_kg: Option<f64>,
+    /// The retained mode that moves P most (largest `ψ_i(P)²`; the structure's mode number)
+    /// and its effective mass at P, `1/ψ_i(P)²` (kg).
+    pub dominant_mode: Option<usize>,
+    pub dominant_mode_effective_mass_kg: Option<f64>,
+}
+
+/// `(m_eff, dominant mode index, its 1/ψ²)` at a point with mode-shape values `psi` (module
+/// docs); `None`s where no mode moves the point.
+pub fn effective_mass(psi: &[f64]) -> (Option<f64>, Option<usize>, Option<f64>) {
+    let sum: f64 = psi.iter().map(|p| p * p).fold(0.0, |a, x| a + x);
+    let dominant = psi
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| **p != 0.0)
+        .max_by(|a, b| (a.1 * a.1).total_cmp(&(b.1 * b.1)));
+    (
+        (sum > 0.0).then(|| 1.0 / sum),
+        dominant.map(|(i, _)| i),
+        dominant.map(|(_, p)| 1.0 / (p * p)),
+    )
 }
 
 /// `Σ_{ω_i > 0} ψ_i²/ω_i²` (m/N) for mode-shape values `psi` (1/√kg) and frequencies `omega`;
@@ -78,12 +114,16 @@ impl ModalModel {
             };
             let modal = modal_flexibility(&self.omega_rad_per_s, psi);
             let share = if g > 0.0 { modal / g } else { 1.0 };
+            let (m_eff, dominant, m_dominant) = effective_mass(psi);
             rows.push(TruncationRow {
                 point: name.clone(),
                 roles: roles.clone(),
                 static_flexibility_m_per_n: g,
                 modal_flexibility_m_per_n: modal,
                 captured_share: share,
+                effective_mass_kg: m_eff,
+                dominant_mode: dominant.map(|i| self.mode_numbers.get(i).copied().unwrap_or(i + 1)),
+                dominant_mode_effective_mass_kg: m_dominant,
             });
         }
         rows
@@ -101,37 +141,50 @@ pub fn to_text(rows: &[TruncationRow]) -> String {
     let w = rows.iter().map(|r| r.point.len()).max().unwrap_or(5).max(5);
     let _ = writeln!(
         s,
-        "  {:<w$} {:>14} {:>14} {:>10}  roles",
-        "point", "G_PP m/N", "modal m/N", "share"
+        "  {:<w$} {:>14} {:>14} {:>10} {:>12} {:>20}  roles",
+        "point", "G_PP m/N", "modal m/N", "share", "m_eff kg", "mode: 1/psi^2 kg"
     );
+    let kg = |v: Option<f64>| v.map_or("—".to_string(), |m| format!("{m:.4}"));
     for r in rows {
+        let dominant = match (r.dominant_mode, r.dominant_mode_effective_mass_kg) {
+            (Some(n), Some(m)) => format!("{n}: {m:.4}"),
+            _ => "—".to_string(),
+        };
         let _ = writeln!(
             s,
-            "  {:<w$} {:>14.6e} {:>14.6e} {:>9.3} %  {}",
+            "  {:<w$} {:>14.6e} {:>14.6e} {:>9.3} % {:>12} {:>20}  {}",
             r.point,
             r.static_flexibility_m_per_n,
             r.modal_flexibility_m_per_n,
             100.0 * r.captured_share,
+            kg(r.effective_mass_kg),
+            dominant,
             r.roles.join(", ")
         );
     }
+    s.push_str("  (m_eff = 1/sum psi^2 over the retained modes: the mass the structure opposes to a blow at the point)\n");
     s
 }
 
-/// CSV: `point,roles,static_flexibility_m_per_n,modal_flexibility_m_per_n,captured_share`
-/// (roles separated by `;`).
+/// CSV: `point,roles,static_flexibility_m_per_n,modal_flexibility_m_per_n,captured_share,
+/// effective_mass_kg,dominant_mode,dominant_mode_effective_mass_kg` (roles separated by `;`;
+/// an empty field where no retained mode moves the point).
 pub fn to_csv(rows: &[TruncationRow]) -> String {
     let mut s = String::from(
-        "point,roles,static_flexibility_m_per_n,modal_flexibility_m_per_n,captured_share\n",
+        "point,roles,static_flexibility_m_per_n,modal_flexibility_m_per_n,captured_share,effective_mass_kg,dominant_mode,dominant_mode_effective_mass_kg\n",
     );
+    let opt = |v: Option<f64>| v.map_or(String::new(), |m| format!("{m:e}"));
     for r in rows {
         s.push_str(&format!(
-            "{},{},{:e},{:e},{:e}\n",
+            "{},{},{:e},{:e},{:e},{},{},{}\n",
             r.point,
             r.roles.join(";"),
             r.static_flexibility_m_per_n,
             r.modal_flexibility_m_per_n,
-            r.captured_share
+            r.captured_share,
+            opt(r.effective_mass_kg),
+            r.dominant_mode.map_or(String::new(), |n| n.to_string()),
+            opt(r.dominant_mode_effective_mass_kg)
         ));
     }
     s
@@ -291,6 +344,9 @@ mod tests {
             static_flexibility_m_per_n: g,
             modal_flexibility_m_per_n: m,
             captured_share: m / g,
+            effective_mass_kg: Some(1.0),
+            dominant_mode: Some(1),
+            dominant_mode_effective_mass_kg: Some(1.0),
         };
         let text = to_text(&[row]);
         assert!(!text.contains("-0"), "{text}");

@@ -854,11 +854,32 @@ impl Model {
         warnings.extend(plausible::unit_slips(&self.spec, &self.source));
         let mut notes = self.structure.notes.clone();
         notes.extend(self.contact_notes());
+        notes.extend(self.mass_ratio_note(&truncation));
         Diagnostics {
             truncation,
             notes,
             warnings,
         }
+    }
+
+    /// The damper's mass against the mass the structure opposes to a blow at O_b,
+    /// `m_d / m_eff(O_b)` with `m_eff = 1/Σ ψ_i(O_b)²` over the retained modes
+    /// ([`crate::modal::truncation`]): the ratio the momentum exchange depends on, which can
+    /// differ much from `m_d / m_b` (a bed mode moves only part of the bed's mass).
+    fn mass_ratio_note(&self, rows: &[crate::modal::truncation::TruncationRow]) -> Option<String> {
+        let damper = self.spec.damper.as_ref()?;
+        let bed = &self.spec.points.bed_contact;
+        let r = rows.iter().find(|r| &r.point == bed)?;
+        let m_eff = r.effective_mass_kg?;
+        let dominant = match (r.dominant_mode, r.dominant_mode_effective_mass_kg) {
+            (Some(n), Some(m)) => format!("; mode {n} alone: {} kg", crate::num(round4(m))),
+            _ => String::new(),
+        };
+        Some(format!(
+            "at O_b ('{bed}') the structure meets a blow as m_eff = {} kg (1/Σψ² over the retained modes{dominant}): m_d/m_eff = {}",
+            crate::num(round4(m_eff)),
+            crate::num(round4(damper.mass / m_eff))
+        ))
     }
 
     /// The damper spring (always acting) and the linear contacts (acting while closed) against
@@ -912,4 +933,13 @@ impl Model {
             s.simulation.duration,
         )
     }
+}
+
+/// `v` to 4 significant digits (for notes).
+fn round4(v: f64) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let scale = 10f64.powi(3 - v.abs().log10().floor() as i32);
+    (v * scale).round() / scale
 }
