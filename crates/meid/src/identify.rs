@@ -795,6 +795,7 @@ pub fn identify(d: &FrfData, s: &Settings) -> Result<Identification> {
         .into_iter()
         .filter(|g| {
             let mut orders: Vec<usize> = g.iter().map(|m| m.1).collect();
+            orders.sort_unstable();
             orders.dedup();
             orders.len() >= min_orders
         })
@@ -836,6 +837,7 @@ pub fn identify(d: &FrfData, s: &Settings) -> Result<Identification> {
                 .map(|m| -(m.0 + sw).re / (m.0 + sw).norm())
                 .collect();
             let mut orders: Vec<usize> = g.iter().map(|m| m.1).collect();
+            orders.sort_unstable();
             orders.dedup();
             (g[g.len() / 2].0, std_dev(&fr), std_dev(&zr), orders.len())
         })

@@ -11,6 +11,7 @@ mod added_mass_point;
 mod compare_checks;
 mod compare_montecarlo;
 mod dopri5_contact_laws;
+mod ema_interop;
 mod esd_checks;
 mod exact_peaks;
 mod fem_bad_input;

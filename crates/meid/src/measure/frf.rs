@@ -268,7 +268,7 @@ pub fn low_coherence(f: &[f64], coh: &[f64], min: f64, keep: usize) -> Vec<(f64,
     let mut out: Vec<(f64, f64, f64)> = Vec::new();
     let mut run: Option<(f64, f64, f64)> = None;
     for (fk, c) in f.iter().zip(coh) {
-        if !(c >= &min) {
+        if c.is_nan() || *c < min {
             let c = if c.is_nan() { 0.0 } else { *c };
             run = Some(match run {
                 Some((a, _, m)) => (a, *fk, m.min(c)),
@@ -283,6 +283,36 @@ pub fn low_coherence(f: &[f64], coh: &[f64], min: f64, keep: usize) -> Vec<(f64,
     out.truncate(keep);
     out.sort_by(|a, b| a.0.total_cmp(&b.0));
     out
+}
+
+/// The lowest coherence and its frequency (Hz).
+fn lowest(f: &[f64], coh: &[f64]) -> (f64, f64) {
+    let (mut cmin, mut cmin_f) = (f64::INFINITY, 0.0);
+    for (fk, c) in f.iter().zip(coh) {
+        if *c < cmin {
+            cmin = *c;
+            cmin_f = *fk;
+        }
+    }
+    (cmin, cmin_f)
+}
+
+/// The warning naming the channel and the bands where its coherence is below `min`, if any.
+fn coherence_warning(r: &Record, f: &[f64], coh: &[f64], min: f64) -> Option<String> {
+    let low = low_coherence(f, coh, min, 5);
+    if low.is_empty() {
+        return None;
+    }
+    let where_: Vec<String> = low
+        .iter()
+        .map(|(a, b, m)| format!("{}..{} Hz (lowest {:.3})", num(*a), num(*b), m))
+        .collect();
+    Some(format!(
+        "{}: channel '{}': coherence below {min} at {}",
+        r.origin,
+        r.name,
+        where_.join(", ")
+    ))
 }
 
 /// The FRFs of the records (all sampled together: one group), module docs. `point`: the model's
@@ -379,28 +409,9 @@ pub fn estimate(
                 ),
             });
         }
-        let (mut cmin, mut cmin_f) = (f64::INFINITY, 0.0);
-        for (fk, c) in f.iter().zip(&coh) {
-            if *c < cmin {
-                cmin = *c;
-                cmin_f = *fk;
-            }
-        }
+        let (cmin, cmin_f) = lowest(&f, &coh);
         if blows.starts.len() > 1 {
-            let low = low_coherence(&f, &coh, s.min_coherence, 5);
-            if !low.is_empty() {
-                let where_: Vec<String> = low
-                    .iter()
-                    .map(|(a, b, m)| format!("{}..{} Hz (lowest {:.3})", num(*a), num(*b), m))
-                    .collect();
-                warnings.push(format!(
-                    "{}: channel '{}': coherence below {} at {}",
-                    r.origin,
-                    r.name,
-                    s.min_coherence,
-                    where_.join(", ")
-                ));
-            }
+            warnings.extend(coherence_warning(r, &f, &coh, s.min_coherence));
         }
         channels.push(FrfChannel {
             response: r.name.clone(),
