@@ -32,6 +32,7 @@ mod args;
 mod blows;
 mod calibrate;
 mod compare;
+mod frf;
 mod json;
 mod measure;
 mod model;
@@ -97,6 +98,12 @@ pub(crate) enum Command {
     Paper(paper::PaperArgs),
     /// Read measured records (UFF 58/58b, CSV): peaks, blows, dominant spectral lines.
     Measure(measure::MeasureArgs),
+    /// Frequency response functions (H1, H2, Hv) with coherence from measured blows: CSV, UFF
+    /// 58 type 4, pictures.
+    Frf(frf::FrfArgs),
+    /// Modes from FRFs: LSCF poles with a stabilisation diagram, LSFD shapes, damping corrected
+    /// for the exponential window.
+    Identify(frf::IdentifyArgs),
     /// The simulation beside measured records: frequency, level and peak errors, reductions.
     Validate(validate::ValidateArgs),
     /// Fit model values (damping ratios, contact stiffnesses, …) to measured records: estimates
@@ -144,6 +151,8 @@ fn main() -> ExitCode {
         Command::Report(a) => report::run(a),
         Command::Paper(a) => paper::run(a),
         Command::Measure(a) => measure::run(a),
+        Command::Frf(a) => frf::run_frf(a),
+        Command::Identify(a) => frf::run_identify(a),
         Command::Validate(a) => validate::run(a),
         Command::Calibrate(a) => calibrate::run(a),
         Command::Merge(a) => shard::merge(a, |name, command, shards| match (name, command) {

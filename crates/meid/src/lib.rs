@@ -10,7 +10,8 @@
 //! | impact | [`impact`] | slider, bed, damper, unilateral contacts: the piecewise-linear system (Eqs. 1-8) |
 //! | time | [`integrate`] | exact event-driven propagation; Dormand-Prince 5(4) with event location |
 //! | studies | [`analysis`] | energies (Eqs. 10-24), spectra, sweeps, optimisation, comparisons |
-//! | measured data | [`record`], [`measure`] | records in SI; blows, spectra, validation, calibration |
+//! | measured data | [`record`], [`measure`] | records in SI; blows, spectra, FRFs, validation, calibration |
+//! | modal testing | [`identify`] | modes from FRFs: LSCF poles, stabilisation diagram, LSFD shapes |
 //! | output | [`io`], [`plot`] | file formats (CSV/JSON/VTK/UFF/Parquet, written atomically), PNG/SVG pictures |
 //! | reports | [`report`] | self-contained HTML pages (figures with captions, tables) |
 //! | limits | [`limits`] | memory estimated and checked before a run allocates |
@@ -23,14 +24,14 @@
 //! | layer | modules | may import |
 //! |---|---|---|
 //! | 9 reports | [`report`] | everything below |
-//! | 8 measured data | [`measure`] | `analysis`, `model`, `io`, `record`, `plot`, `impact` and the base |
+//! | 8 measured data | [`measure`] | `analysis`, `model`, `io`, `record`, `plot`, `impact`, `identify` and the base |
 //! | 7 studies | [`analysis`] | `model`, `integrate`, `impact`, `io`, `modal`, `plot` and the base |
 //! | 6 model files | [`model`] | `integrate`, `impact`, `io` (its readers), `structure`, `modal` and the base |
 //! | 5 time | [`integrate`] | `impact`, `modal` and the base |
 //! | 4 impact system | [`impact`] | `modal` and the base |
 //! | 4 formats | [`io`] | `structure`, `modal`, `record` and the base: formats only, no study or model type |
 //! | 3 structure | [`structure`] | `modal` and the base |
-//! | 2 modes, pictures, records | [`modal`], [`plot`], [`record`] | the base |
+//! | 2 modes, pictures, records, identification | [`modal`], [`plot`], [`record`], [`identify`] | the base |
 //! | 1 base | [`error`], [`input`], [`limits`], [`rng`] | one another, downwards (`input` → `limits` → `error`) |
 //!
 //! Two imports run up across the layers, each from one file and through data types alone:
@@ -48,6 +49,7 @@
 
 pub mod analysis;
 pub mod error;
+pub mod identify;
 pub mod impact;
 pub mod input;
 pub mod integrate;

@@ -16,6 +16,7 @@ const BASE: [&str; 5] = ["error", "input", "limits", "rng", "num"];
 fn allowed() -> BTreeMap<&'static str, Vec<&'static str>> {
     BTreeMap::from([
         ("record", vec![]),
+        ("identify", vec![]),
         ("modal", vec![]),
         ("plot", vec![]),
         ("structure", vec!["modal"]),
@@ -32,7 +33,9 @@ fn allowed() -> BTreeMap<&'static str, Vec<&'static str>> {
         ),
         (
             "measure",
-            vec!["analysis", "model", "io", "record", "plot", "impact"],
+            vec![
+                "analysis", "model", "io", "record", "plot", "impact", "identify",
+            ],
         ),
     ])
 }

@@ -133,8 +133,56 @@ pub struct UffFile {
     pub records: Vec<Record>,
     pub nodes: Vec<Node>,
     pub modes: Vec<Mode>,
+    /// Functions of dataset 58 / 58b in frequency: FRFs (type 4), coherences (6), PSDs (9).
+    pub functions: Vec<Function>,
     /// Datasets passed over, one line each (type, where, why).
     pub skipped: Vec<String>,
+}
+
+/// A dataset 58 function of frequency: an FRF (function type 4), a coherence (6) or a power
+/// spectral density (9).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Function {
+    /// 4 FRF, 6 coherence, 9 PSD.
+    pub function_type: i64,
+    /// ID line 1.
+    pub name: String,
+    /// ID lines 2-5, those neither blank nor `NONE`, trimmed.
+    pub id_lines: Vec<String>,
+    /// Response and reference (record 6).
+    pub response: PointRef,
+    pub reference: PointRef,
+    pub frequency_hz: Vec<f64>,
+    /// In SI: an FRF in (numerator SI unit)/(denominator SI unit), a PSD in (SI unit)²/Hz, a
+    /// coherence as is. A real function has zero imaginary parts.
+    pub values: Vec<num_complex::Complex64>,
+    /// The ordinate's quantity (records 9) and, for an FRF, the denominator's (record 10).
+    pub numerator: Option<Quantity>,
+    pub denominator: Option<Quantity>,
+    /// Where it came from: "FILE, dataset 3 (58 at line 120)".
+    pub origin: String,
+}
+
+/// What a dataset 58 holds for meid.
+enum Read58 {
+    Record(Record),
+    Function(Function),
+    /// Read past, with the reason.
+    Skip(String),
+}
+
+/// The header records of a dataset 58, for [`Parser::function_58`].
+struct Head58<'a> {
+    ds: Ds,
+    id: &'a [String],
+    r6: &'a str,
+    r7_line: usize,
+    axes: &'a [(String, usize)],
+    even: bool,
+    x0: f64,
+    dx: f64,
+    complex: bool,
+    unit_code: Option<i64>,
 }
 
 /// Reads a UFF file (see the module docs).
@@ -300,8 +348,9 @@ impl<R: BufRead> Parser<'_, R> {
                     };
                     let unit_code = units.as_ref().map(|u| u.code);
                     match self.dataset_58(ds, &h, binary, unit_code)? {
-                        Ok(r) => out.records.push(r),
-                        Err(why) => out.skipped.push(format!(
+                        Read58::Record(r) => out.records.push(r),
+                        Read58::Function(f) => out.functions.push(f),
+                        Read58::Skip(why) => out.skipped.push(format!(
                             "dataset {ordinal} (58 at line {start}): {why}"
                         )),
                     }
@@ -426,14 +475,15 @@ impl<R: BufRead> Parser<'_, R> {
         }
     }
 
-    /// Dataset 58 after its header line. `Ok(Err(why))`: read past, not a time response.
+    /// Dataset 58 after its header line: a time response, a function [`Function`] (FRF,
+    /// coherence, PSD), or `Skip(why)`: read past.
     fn dataset_58(
         &mut self,
         ds: Ds,
         header: &str,
         binary: bool,
         unit_code: Option<i64>,
-    ) -> Result<std::result::Result<Record, String>> {
+    ) -> Result<Read58> {
         // Binary header: 58b, byte order, fp format, ASCII lines, bytes, 0 0 0 0.
         let mut bin = None;
         if binary {
@@ -616,26 +666,41 @@ impl<R: BufRead> Parser<'_, R> {
                 v
             }
         };
+        if matches!(func_type, 4 | 6 | 9) {
+            let head = Head58 {
+                ds,
+                id: &id,
+                r6: &r6,
+                r7_line,
+                axes: &axes,
+                even,
+                x0,
+                dx,
+                complex: matches!(ord_type, 5 | 6),
+                unit_code,
+            };
+            return self.function_58(&head, func_type, values);
+        }
         if !(func_type == 1 || func_type == 0) {
-            return Ok(Err(format!(
+            return Ok(Read58::Skip(format!(
                 "function type {func_type} ({}), not a time response (1)",
                 function_name(func_type)
             )));
         }
         if matches!(ord_type, 5 | 6) {
-            return Ok(Err("complex ordinate: not a time response".into()));
+            return Ok(Read58::Skip("complex ordinate: not a time response".into()));
         }
         // Units: abscissa (record 8) and ordinate (record 9).
         let (xq, xf, xu) =
             self.axis_unit(ds, &axes[0].0, axes[0].1, "record 8 (abscissa)", unit_code)?;
         if xq != Quantity::Time {
-            return Ok(Err(format!(
+            return Ok(Read58::Skip(format!(
                 "the abscissa is {} ({xu}), not time",
                 xq.name()
             )));
         }
         if let Some(why) = foreign_ordinate(&axes[1].0) {
-            return Ok(Err(why));
+            return Ok(Read58::Skip(why));
         }
         let (q, f, u) =
             self.axis_unit(ds, &axes[1].0, axes[1].1, "record 9 (ordinate)", unit_code)?;
@@ -729,7 +794,7 @@ impl<R: BufRead> Parser<'_, R> {
                 )
             }
         };
-        Ok(Ok(Record {
+        Ok(Read58::Record(Record {
             name,
             quantity: q,
             source_unit: u,
@@ -740,6 +805,157 @@ impl<R: BufRead> Parser<'_, R> {
             }),
             abscissa,
             values: y,
+            origin: format!(
+                "{}, dataset {} ({} at line {})",
+                self.file, ds.ordinal, ds.kind, ds.line
+            ),
+        }))
+    }
+
+    /// A dataset 58 of function type 4, 6 or 9 ([`Function`]), its values read (`values`: as
+    /// record 12 holds them).
+    fn function_58(&self, h: &Head58, func_type: i64, values: Vec<f64>) -> Result<Read58> {
+        let ds = h.ds;
+        let int = |a: usize, b: usize, what: &str| -> Result<i64> {
+            let t = cols(h.r6, a, b).trim().to_string();
+            if t.is_empty() {
+                return Ok(0);
+            }
+            t.parse::<i64>().map_err(|_| {
+                self.err(
+                    Some(ds),
+                    Some("record 6"),
+                    h.r7_line - 1,
+                    format!(
+                        "{what} (columns {}-{b}): expected a whole number, got '{t}'",
+                        a + 1
+                    ),
+                )
+            })
+        };
+        let response = PointRef {
+            entity: cols(h.r6, 31, 41).trim().to_string(),
+            node: int(41, 51, "response node")?,
+            direction: int(51, 55, "response direction")?,
+        };
+        let reference = PointRef {
+            entity: cols(h.r6, 56, 66).trim().to_string(),
+            node: int(66, 76, "reference node")?,
+            direction: int(76, 80, "reference direction")?,
+        };
+        // Abscissa: frequency in Hz (specific data type 18, or a label Hz).
+        let (xl, xl_line) = (&h.axes[0].0, h.axes[0].1);
+        let xt = cols(xl, 0, 10).trim().parse::<i64>().unwrap_or(0);
+        let xu = cols(xl, 47, 67).trim().to_string();
+        let hz = xu.eq_ignore_ascii_case("hz");
+        if !(hz || ((xu.is_empty() || xu.eq_ignore_ascii_case("NONE")) && matches!(xt, 0 | 18))) {
+            return Err(self.err(Some(ds), Some("record 8 (abscissa)"), xl_line, format!("a function of type {func_type} ({}) needs a frequency abscissa in Hz (specific data type 18 or unit label 'Hz'), got data type {xt}, unit '{xu}'", function_name(func_type))));
+        }
+        let per = if h.complex { 2 } else { 1 } + usize::from(!h.even);
+        let mut f = Vec::with_capacity(values.len() / per);
+        let mut v = Vec::with_capacity(values.len() / per);
+        for (k, c) in values.chunks_exact(per).enumerate() {
+            let (x, rest) = if h.even {
+                (h.x0 + k as f64 * h.dx, c)
+            } else {
+                (c[0], &c[1..])
+            };
+            f.push(x);
+            v.push(num_complex::Complex64::new(
+                rest[0],
+                if h.complex { rest[1] } else { 0.0 },
+            ));
+        }
+        if let Some(k) = f.iter().position(|x| !x.is_finite()) {
+            return Err(self.err(
+                Some(ds),
+                Some("record 12"),
+                h.r7_line + 5,
+                format!("the frequency of point {} is not a finite number", k + 1),
+            ));
+        }
+        if let Some(k) = v
+            .iter()
+            .position(|x| !(x.re.is_finite() && x.im.is_finite()))
+        {
+            return Err(self.err(
+                Some(ds),
+                Some("record 12"),
+                h.r7_line + 5,
+                format!("point {} is not a finite number", k + 1),
+            ));
+        }
+        let (numerator, denominator, factor) = match func_type {
+            4 => {
+                if let Some(why) = foreign_ordinate(&h.axes[1].0) {
+                    return Ok(Read58::Skip(why));
+                }
+                let (qn, fnum, _) = self.axis_unit(
+                    ds,
+                    &h.axes[1].0,
+                    h.axes[1].1,
+                    "record 9 (ordinate numerator)",
+                    h.unit_code,
+                )?;
+                let (qd, fden, ud) = self.axis_unit(
+                    ds,
+                    &h.axes[2].0,
+                    h.axes[2].1,
+                    "record 10 (ordinate denominator)",
+                    h.unit_code,
+                )?;
+                if qd != Quantity::Force {
+                    return Err(self.err(Some(ds), Some("record 10 (ordinate denominator)"), h.axes[2].1, format!("an FRF's denominator must be a force (N, kN, lbf; data type 13), got {} ({ud})", qd.name())));
+                }
+                (Some(qn), Some(qd), fnum / fden)
+            }
+            9 => {
+                let line = &h.axes[1].0;
+                let ty = cols(line, 0, 10).trim().parse::<i64>().unwrap_or(0);
+                let label = cols(line, 47, 67).trim().to_string();
+                let by_type = Quantity::from_uff_data_type(ty);
+                let inner = label
+                    .trim_end_matches("/Hz")
+                    .trim_end_matches("^2")
+                    .trim_end_matches("**2")
+                    .trim_end_matches('²')
+                    .trim_start_matches('(')
+                    .trim_end_matches(')')
+                    .to_string();
+                match (label.is_empty() || label.eq_ignore_ascii_case("NONE"), by_type) {
+                    (true, Some(q)) => (Some(q), None, 1.0),
+                    _ => match crate::record::units::parse_unit(&inner) {
+                        Some((q, fu)) if by_type.is_none_or(|t| t == q) => (Some(q), None, fu * fu),
+                        _ => return Ok(Read58::Skip(format!("power spectral density in '{label}' (data type {ty}): expected (unit)^2/Hz of an acceleration, velocity, displacement or force"))),
+                    },
+                }
+            }
+            _ => (None, None, 1.0),
+        };
+        if factor != 1.0 {
+            for x in &mut v {
+                *x *= factor;
+            }
+        }
+        let keep = |l: &String| {
+            let t = l.trim();
+            (!t.is_empty() && t != "NONE").then(|| t.to_string())
+        };
+        Ok(Read58::Function(Function {
+            function_type: func_type,
+            name: keep(&h.id[0]).unwrap_or_else(|| {
+                format!(
+                    "{}:{}:{}",
+                    response.entity, response.node, response.direction
+                )
+            }),
+            id_lines: h.id[1..].iter().filter_map(keep).collect(),
+            response,
+            reference,
+            frequency_hz: f,
+            values: v,
+            numerator,
+            denominator,
             origin: format!(
                 "{}, dataset {} ({} at line {})",
                 self.file, ds.ordinal, ds.kind, ds.line
@@ -1466,6 +1682,115 @@ pub fn write_58<W: Write>(w: &mut W, ch: &Channel58, binary: bool) -> std::io::R
             line.push('\n');
             w.write_all(line.as_bytes())?;
         }
+    }
+    writeln!(w, "{:>6}", -1)
+}
+
+/// Writes a [`Function`] as one dataset 58 (ASCII): an FRF (type 4) as complex double
+/// (`4E20.12`, two values a line) with records 9 and 10 the numerator's and the denominator's SI
+/// units and data types; a coherence (6) or PSD (9) as real double. The frequencies must be
+/// even (`f_0 + kΔf`).
+pub fn write_58_function<W: Write>(w: &mut W, f: &Function) -> std::io::Result<()> {
+    let n = f.values.len();
+    if n < 2 || f.frequency_hz.len() != n {
+        return Err(std::io::Error::other(format!(
+            "function '{}': {n} values for {} frequencies (at least 2)",
+            f.name,
+            f.frequency_hz.len()
+        )));
+    }
+    let f0 = f.frequency_hz[0];
+    let df = (f.frequency_hz[n - 1] - f0) / (n - 1) as f64;
+    if !(df > 0.0 && df.is_finite())
+        || f.values
+            .iter()
+            .any(|v| !(v.re.is_finite() && v.im.is_finite()))
+    {
+        return Err(std::io::Error::other(format!(
+            "function '{}': the frequencies must increase evenly and the values be finite",
+            f.name
+        )));
+    }
+    let complex = f.function_type == 4;
+    writeln!(w, "{:>6}\n{:>6}{:74}", -1, 58, "")?;
+    let line80 = |s: &str| -> String {
+        let t: String = s.chars().filter(|c| !c.is_control()).take(80).collect();
+        format!("{t:<80}")
+    };
+    writeln!(w, "{}", line80(&f.name))?;
+    for k in 0..4 {
+        writeln!(
+            w,
+            "{}",
+            line80(f.id_lines.get(k).map_or("NONE", String::as_str))
+        )?;
+    }
+    let ent = |p: &PointRef| -> String {
+        let e: String = p
+            .entity
+            .chars()
+            .filter(|c| !c.is_whitespace())
+            .take(10)
+            .collect();
+        if e.is_empty() {
+            "NONE".into()
+        } else {
+            e
+        }
+    };
+    writeln!(
+        w,
+        "{:>5}{:>10}{:>5}{:>10} {:>10}{:>10}{:>4} {:>10}{:>10}{:>4}",
+        f.function_type,
+        0,
+        0,
+        0,
+        ent(&f.response),
+        f.response.node,
+        f.response.direction,
+        ent(&f.reference),
+        f.reference.node,
+        f.reference.direction
+    )?;
+    writeln!(
+        w,
+        "{:>10}{:>10}{:>10}{}{}{}",
+        if complex { 6 } else { 4 },
+        n,
+        1,
+        format_e13(f0),
+        format_e13(df),
+        format_e13(0.0)
+    )?;
+    writeln!(
+        w,
+        "{:>10}{:>5}{:>5}{:>5} {:<20} {:<20}",
+        18, 0, 0, 0, "Frequency", "Hz"
+    )?;
+    let axis = |w: &mut W, q: Option<Quantity>, label: &str| -> std::io::Result<()> {
+        let (ty, (le, fe, te), unit) = match q {
+            Some(q) => (q.uff_data_type(), q.uff_exponents(), q.si_unit()),
+            None => (0, (0, 0, 0), "NONE"),
+        };
+        writeln!(w, "{ty:>10}{le:>5}{fe:>5}{te:>5} {label:<20} {unit:<20}")
+    };
+    let name = |q: Option<Quantity>| q.map_or("NONE".to_string(), |q| capitalise(q.name()));
+    axis(w, f.numerator, &name(f.numerator))?;
+    axis(w, f.denominator, &name(f.denominator))?;
+    axis(w, None, "NONE")?;
+    let mut line = String::with_capacity(82);
+    let flat: Vec<f64> = if complex {
+        f.values.iter().flat_map(|v| [v.re, v.im]).collect()
+    } else {
+        f.values.iter().map(|v| v.re).collect()
+    };
+    for c in flat.chunks(4) {
+        line.clear();
+        for v in c {
+            line.push_str(&format_e(*v, 12, 20));
+        }
+        line.push('\n');
+        w.write_all(line.as_bytes())?;
     }
     writeln!(w, "{:>6}", -1)
 }

@@ -9,12 +9,17 @@
 //! * [`process`]: blow detection by a trigger, averaging over blows, force and exponential
 //!   windows, H1 frequency response and coherence, spectra and one-third-octave levels. The
 //!   same functions process simulated histories, so a comparison is like for like.
+//! * [`frf`]: H1, H2 and Hv frequency response functions with coherence over the blows, as
+//!   accelerance, mobility or receptance, for the modal identification ([`crate::identify`]);
+//!   [`identified`]: the identified modes' files and the stabilisation diagram.
 //! * [`validate`]: simulation beside measurement (frequency, level and peak errors, measured
 //!   reductions beside simulated ones).
 //! * [`calibrate`]: model values (damping ratios, contact stiffnesses, …) fitted to the
 //!   measurements by bounded least squares, with confidence intervals.
 
 pub mod calibrate;
+pub mod frf;
+pub mod identified;
 pub mod mapping;
 pub mod process;
 pub mod report;

@@ -893,10 +893,28 @@ pub struct Frf {
     pub averages: usize,
 }
 
-/// H1 and coherence from a force and a response sampled together (module docs). The force
-/// gets the force window (when `p.force_window`) times the response window, the response the
-/// response window.
-pub fn h1(force: &[f64], response: &[f64], fs: f64, blows: &Blows, p: &Processing) -> Result<Frf> {
+/// The blow-summed auto and cross spectra of a force `f` and a response `x` sampled together:
+/// `G_ff = Σ_b |F_b|²`, `G_xx = Σ_b |X_b|²`, `G_fx = Σ_b conj(F_b) X_b` per line (the one-sided
+/// lines `0 … N/2` of the record, `N` its samples), each record less its baseline, the force
+/// with the force window (when `p.force_window`) times the response window, the response with
+/// the response window (module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CrossSpectra {
+    pub frequency_hz: Vec<f64>,
+    pub gff: Vec<f64>,
+    pub gxx: Vec<f64>,
+    pub gfx: Vec<Complex<f64>>,
+    pub averages: usize,
+}
+
+/// [`CrossSpectra`] of `force` and `response` over the complete blow records of `blows`.
+pub fn cross_spectra(
+    force: &[f64],
+    response: &[f64],
+    fs: f64,
+    blows: &Blows,
+    p: &Processing,
+) -> Result<CrossSpectra> {
     if force.len() != response.len() {
         return Err(Error::invalid(
             "H1",
@@ -935,9 +953,24 @@ pub fn h1(force: &[f64], response: &[f64], fs: f64, blows: &Blows, p: &Processin
             gxx[k] += x[k].norm_sqr();
         }
     }
-    let h1 = gfx
+    Ok(CrossSpectra {
+        frequency_hz: freqs(bins, len, fs),
+        gff,
+        gxx,
+        gfx,
+        averages: blows.starts.len(),
+    })
+}
+
+/// H1 and coherence from a force and a response sampled together (module docs). The force
+/// gets the force window (when `p.force_window`) times the response window, the response the
+/// response window.
+pub fn h1(force: &[f64], response: &[f64], fs: f64, blows: &Blows, p: &Processing) -> Result<Frf> {
+    let g = cross_spectra(force, response, fs, blows, p)?;
+    let h1 = g
+        .gfx
         .iter()
-        .zip(&gff)
+        .zip(&g.gff)
         .map(|(c, f)| {
             if *f > 0.0 {
                 c / f
@@ -946,21 +979,21 @@ pub fn h1(force: &[f64], response: &[f64], fs: f64, blows: &Blows, p: &Processin
             }
         })
         .collect();
-    let coherence = (0..bins)
+    let coherence = (0..g.gff.len())
         .map(|k| {
-            let d = gff[k] * gxx[k];
+            let d = g.gff[k] * g.gxx[k];
             if d > 0.0 {
-                (gfx[k].norm_sqr() / d).min(1.0)
+                (g.gfx[k].norm_sqr() / d).min(1.0)
             } else {
                 f64::NAN
             }
         })
         .collect();
     Ok(Frf {
-        frequency_hz: freqs(bins, len, fs),
+        frequency_hz: g.frequency_hz,
         h1,
         coherence,
-        averages: blows.starts.len(),
+        averages: g.averages,
     })
 }
 
