@@ -4,7 +4,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use meid::analysis::compare::{CompareOptions, Comparison, ComparisonResult, SpectrumMethod};
+use meid::analysis::compare::{
+    CaseName, CompareOptions, Comparison, ComparisonResult, SpectrumMethod,
+};
 use meid::analysis::production::RateOrigin;
 use meid::analysis::spectrum::{
     TransientWindow, REF_ACCELERATION_ISO1683_M_PER_S2, REF_ACCELERATION_M_PER_S2,
@@ -110,6 +112,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
     } else {
         Some(crate::production::cases(&model, Case::AsSpecified, rate_bpm, &a.print)?.production)
     };
+    let model_for_foundation = model.spec.foundation.is_some().then(|| model.clone());
     let comparison = Comparison::new(model, options);
     let bar = crate::progress::bar(
         a.print.quiet || a.print.json,
@@ -119,9 +122,37 @@ pub fn run(a: CompareArgs) -> Result<()> {
     let result = comparison.run_with_progress(&|done, _| bar.set_position(done as u64));
     bar.finish_and_clear();
     let result = result.context("comparison failed")?;
+    // With a [foundation]: its checks and the receivers' for every case.
+    let mut foundations = Vec::new();
+    if let Some(m) = &model_for_foundation {
+        for c in comparison.cases() {
+            let case = match c {
+                CaseName::NoDamper => meid::model::Case::NoDamper,
+                CaseName::Damper => meid::model::Case::Damper,
+                CaseName::AddedMass => meid::model::Case::AddedMass,
+            };
+            if let Some(f) =
+                meid::foundation::assess(m, case).context("foundation assessment failed")?
+            {
+                foundations.push((c, f));
+            }
+        }
+    }
     let mut summary = serde_json::to_value(result.summary())?;
-    if let (Some(p), Some(obj)) = (&production, summary.as_object_mut()) {
-        obj.insert("production".into(), serde_json::to_value(p)?);
+    if let Some(obj) = summary.as_object_mut() {
+        if let Some(p) = &production {
+            obj.insert("production".into(), serde_json::to_value(p)?);
+        }
+        if !foundations.is_empty() {
+            let mut f = serde_json::Map::new();
+            let mut r = serde_json::Map::new();
+            for (c, fa) in &foundations {
+                f.insert(c.name().into(), serde_json::to_value(&fa.foundation)?);
+                r.insert(c.name().into(), serde_json::to_value(&fa.receivers)?);
+            }
+            obj.insert("foundation".into(), f.into());
+            obj.insert("receivers".into(), r.into());
+        }
     }
     if let Some(set) = set {
         write_outputs(set.staging(), &result, &summary)?;
@@ -145,6 +176,11 @@ pub fn run(a: CompareArgs) -> Result<()> {
             println!("  {v}");
         }
         print!("{}", result.table_text());
+        for (c, fa) in &foundations {
+            for r in &fa.receivers {
+                println!("  {}: {}", c.label(), r.verdict);
+            }
+        }
         if let Some(dir) = &a.output {
             println!(
                 "wrote histories, spectra, bands, reductions and pictures to {}",

@@ -68,12 +68,20 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         }
     };
     let s = &s;
-    // The summary's fields, then `truncation`, `notes` and `warnings`.
+    // The summary's fields, then `truncation`, `notes` and `warnings`; with a [foundation],
+    // `foundation` and `receivers`.
     let mut out = serde_json::to_value(s)?;
     if let (serde_json::Value::Object(o), serde_json::Value::Object(d)) =
         (&mut out, serde_json::to_value(&diag)?)
     {
         o.extend(d);
+    }
+    let found = meid::foundation::assess(&model, a.case.parse()?)
+        .map_err(|e| model.locate_error(e))
+        .context("foundation assessment failed")?;
+    if let (Some(f), serde_json::Value::Object(o)) = (&found, &mut out) {
+        o.insert("foundation".into(), serde_json::to_value(&f.foundation)?);
+        o.insert("receivers".into(), serde_json::to_value(&f.receivers)?);
     }
     if let Some(set) = set {
         if a.uff {
@@ -82,6 +90,9 @@ pub fn run(a: SimulateArgs) -> Result<()> {
             let mut f = meid::io::AtomicFile::create(&set.path("history.uff"))?;
             meid::io::uff::write_records(&mut f, &records, false, &set.path("history.uff"))?;
             f.commit()?;
+        }
+        if let Some(f) = found.as_ref().filter(|f| !f.receivers.is_empty()) {
+            meid::io::write_atomic(&set.path("receivers.csv"), receivers_csv(f).as_bytes())?;
         }
         meid::io::write_json(&set.path("summary.json"), &out)?;
         meid::io::write_atomic(
@@ -94,6 +105,9 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         crate::json::print(&out)?;
     } else if a.print.human() {
         print_summary(&model, s, a.output.as_deref(), a.uff);
+        if let Some(f) = &found {
+            print_foundation(f);
+        }
         print!("{}", meid::modal::truncation::to_text(&diag.truncation));
         for n in &diag.notes {
             println!("note: {n}");
@@ -212,4 +226,70 @@ fn print_summary(model: &Model, s: &analysis::Summary, out: Option<&Path>, uff: 
             if uff { " and history.uff" } else { "" }
         );
     }
+}
+
+/// The receivers' velocity histories: `time_s` and one `NAME_velocity_m_per_s` column each.
+fn receivers_csv(f: &meid::foundation::FoundationAssessment) -> String {
+    let mut out = String::from("time_s");
+    for r in &f.receivers {
+        out.push_str(&format!(
+            ",{}_velocity_m_per_s",
+            r.name.replace([',', '"', '\n'], "_")
+        ));
+    }
+    out.push('\n');
+    for (i, t) in f.time_s.iter().enumerate() {
+        out.push_str(&format!("{t:e}"));
+        for r in &f.receivers {
+            out.push_str(&format!(
+                ",{:e}",
+                r.velocity_m_per_s.get(i).copied().unwrap_or(0.0)
+            ));
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// The foundation's checks and each receiver's verdict sentence.
+fn print_foundation(f: &meid::foundation::FoundationAssessment) {
+    let r = &f.foundation;
+    println!(
+        "  foundation: block on the soil k_z = {}, c_z = {} (alone: {}, damping ratio {:.4})",
+        val(r.model.k_z_n_per_m, "N/m"),
+        val(r.model.c_z_n_s_per_m, "N·s/m"),
+        val(r.block_omega_rad_per_s, "rad/s"),
+        r.block_damping_ratio
+    );
+    for c in &r.checks {
+        print_check(c);
+    }
+    for rec in &f.receivers {
+        println!(
+            "  receiver '{}' at {} m: PPV {} (zero-crossing frequency {})",
+            rec.name,
+            meid::num(rec.distance_m),
+            val(rec.ppv_m_per_s * 1e3, "mm/s"),
+            rec.frequency_zero_crossing_hz
+                .map_or("—".to_string(), |f| val(f, "Hz"))
+        );
+        println!("    {}", rec.verdict);
+        for c in &rec.checks[1..] {
+            print_check(c);
+        }
+    }
+}
+
+fn print_check(c: &meid::foundation::Check) {
+    let margin = c
+        .margin
+        .map_or(String::new(), |m| format!(", margin {:.1} %", 100.0 * m));
+    let limit = c.limit.map_or("no limit".to_string(), |l| val(l, c.unit));
+    println!(
+        "    {:<40} {} vs {}: {}{margin}",
+        c.check,
+        val(c.value, c.unit),
+        limit,
+        c.verdict
+    );
 }

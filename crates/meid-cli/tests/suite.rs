@@ -11,6 +11,7 @@ mod cli;
 mod compare_cli;
 mod conventions;
 mod fem_threads_cli;
+mod foundation_cli;
 mod frf_cli;
 mod input_cli;
 mod json_shape;

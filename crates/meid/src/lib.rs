@@ -10,6 +10,7 @@
 //! | impact | [`impact`] | slider, bed, damper, unilateral contacts: the piecewise-linear system (Eqs. 1-8) |
 //! | time | [`integrate`] | exact event-driven propagation; Dormand-Prince 5(4) with event location |
 //! | studies | [`analysis`] | energies (Eqs. 10-24), spectra, sweeps, optimisation, comparisons |
+//! | surroundings | [`foundation`] | the block on the soil, ground vibration at receivers, DIN 4150 / ISO 2631 / IS 2974 checks |
 //! | measured data | [`record`], [`measure`] | records in SI; blows, spectra, FRFs, validation, calibration |
 //! | modal testing | [`identify`] | modes from FRFs: LSCF poles, stabilisation diagram, LSFD shapes |
 //! | output | [`io`], [`plot`] | file formats (CSV/JSON/VTK/UFF/Parquet, written atomically), PNG/SVG pictures |
@@ -25,6 +26,7 @@
 //! |---|---|---|
 //! | 9 reports | [`report`] | everything below |
 //! | 8 measured data | [`measure`] | `analysis`, `model`, `io`, `record`, `plot`, `impact`, `identify` and the base |
+//! | 8 surroundings | [`foundation`] | `analysis`, `model`, `modal` and the base |
 //! | 7 studies | [`analysis`] | `model`, `integrate`, `impact`, `io`, `modal`, `plot` and the base |
 //! | 6 model files | [`model`] | `integrate`, `impact`, `io` (its readers), `structure`, `modal` and the base |
 //! | 5 time | [`integrate`] | `impact`, `modal` and the base |
@@ -49,6 +51,7 @@
 
 pub mod analysis;
 pub mod error;
+pub mod foundation;
 pub mod identify;
 pub mod impact;
 pub mod input;

@@ -64,8 +64,8 @@ fn sdypy_ema_finds_meids_frequencies() {
         s.push_str(&format!(",re{o},im{o}"));
     }
     s.push('\n');
-    for k in 0..f.len() {
-        s.push_str(&format!("{}", f[k]));
+    for (k, fk) in f.iter().enumerate() {
+        s.push_str(&format!("{fk}"));
         for o in 0..d.outputs {
             s.push_str(&format!(",{:e},{:e}", d.h[o][k].re, d.h[o][k].im));
         }

@@ -37,6 +37,7 @@ fn allowed() -> BTreeMap<&'static str, Vec<&'static str>> {
                 "analysis", "model", "io", "record", "plot", "impact", "identify",
             ],
         ),
+        ("foundation", vec!["analysis", "model", "modal"]),
     ])
 }
 

@@ -32,6 +32,7 @@ mod fem_releases;
 mod fem_thread_determinism;
 mod fem_tri;
 mod forced_long_runs;
+mod foundation_checks;
 mod frf_files;
 mod fuzz_measure_readers;
 mod fuzz_parsers;

@@ -1,8 +1,10 @@
 //! Model files: TOML in, a validated [`Model`] out.
 //!
 //! A model names a structure, the slider, an impact damper and/or an added mass at a named
-//! point (or neither), the two contacts and the simulation settings. See `docs/model-format.md` for the full
-//! reference and `examples/paper-lumped.toml` for a complete file.
+//! point (or neither), the two contacts and the simulation settings; under a lumped structure,
+//! optionally a `[foundation]` on soil and `[[receiver]]`s around it ([`foundation`]). See
+//! `docs/model-format.md` for the full reference and `examples/paper-lumped.toml` for a complete
+//! file.
 //!
 //! # Units (SI throughout; field names carry no suffix except `frequencies_hz`)
 //!
@@ -28,6 +30,7 @@ mod cache;
 pub mod contacts;
 pub mod expand;
 pub mod fem;
+pub mod foundation;
 pub mod general;
 pub mod imported;
 mod lumped;
@@ -181,6 +184,18 @@ pub enum Case {
     AddedMass,
 }
 
+impl Case {
+    /// The name `--case` takes (`as-specified`, `none`, `damper`, `added-mass`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Case::AsSpecified => "as-specified",
+            Case::NoDamper => "none",
+            Case::Damper => "damper",
+            Case::AddedMass => "added-mass",
+        }
+    }
+}
+
 impl std::str::FromStr for Case {
     type Err = Error;
     /// `as-specified`, `none`, `damper` or `added-mass` (the CLI's `--case`).
@@ -323,6 +338,7 @@ impl Model {
                 return Err(src.error(&field, format!("{field}: {message}")));
             }
         }
+        foundation::check_receivers(s, self.foundation()?.as_ref(), src)?;
         if s.damper.is_some() && s.contact.bed_damper.is_none() {
             return Err(src.error(
                 "damper",
@@ -437,6 +453,83 @@ impl Model {
             Some((field, message)) => Err(src.error(&field, message)),
             None => Ok(()),
         }
+    }
+
+    /// The model's `[foundation]`, checked ([`foundation::Foundation::from_spec`]), with its
+    /// `anvil` and `pad` checked against the lumped structure; `None` without one.
+    pub fn foundation(&self) -> Result<Option<foundation::Foundation>> {
+        let s = &self.spec;
+        let (Some(f), Some(l)) = (&s.foundation, &s.structure.lumped) else {
+            return Ok(None);
+        };
+        let found = foundation::Foundation::from_spec(f, l, &self.source)?;
+        let src = &self.source;
+        if let Some(a) = &f.anvil {
+            if !l.masses.iter().any(|m| &m.name == a) {
+                let known: Vec<&str> = l.masses.iter().map(|m| m.name.as_str()).collect();
+                return Err(src.error(
+                    "foundation.anvil",
+                    format!(
+                        "foundation.anvil: unknown mass '{a}'; valid: {}",
+                        known.join(", ")
+                    ),
+                ));
+            }
+        }
+        if let Some(p) = &f.pad {
+            let spring = l
+                .springs
+                .iter()
+                .find(|sp| sp.name.as_deref() == Some(&p.spring));
+            match spring {
+                Some(sp) if !sp.nodes.iter().any(|n| n == "ground") => {}
+                _ => {
+                    let known: Vec<&str> = l
+                        .springs
+                        .iter()
+                        .filter(|sp| !sp.nodes.iter().any(|n| n == "ground"))
+                        .filter_map(|sp| sp.name.as_deref())
+                        .collect();
+                    return Err(src.error(
+                        "foundation.pad.spring",
+                        format!(
+                            "foundation.pad.spring: '{}' is not a named structure.lumped spring between two masses; valid: {}",
+                            p.spring,
+                            known.join(", ")
+                        ),
+                    ));
+                }
+            }
+            if !(p.area.is_finite() && p.area > 0.0) {
+                return Err(src.error(
+                    "foundation.pad.area",
+                    format!(
+                        "foundation.pad.area must be a finite number > 0 m² (got {})",
+                        crate::num(p.area)
+                    ),
+                ));
+            }
+        }
+        for (field, v, unit) in [
+            ("block_amplitude", f.allowable.block_amplitude, "m"),
+            ("anvil_amplitude", f.allowable.anvil_amplitude, "m"),
+            ("pad_stress", f.allowable.pad_stress, "Pa"),
+            ("soil_pressure", f.allowable.soil_pressure, "Pa"),
+        ] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v > 0.0) {
+                    let p = format!("foundation.allowable.{field}");
+                    return Err(src.error(
+                        &p,
+                        format!(
+                            "{p} must be a finite number > 0 {unit} (got {})",
+                            crate::num(v)
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(Some(found))
     }
 
     /// The impact system for a case.
@@ -739,6 +832,16 @@ fn build_structure(spec: &ModelSpec, src: &Source) -> Result<ModalModel> {
         ));
     }
     let ctx = fem::ReductionContext::of(spec);
+    if let Some(f) = &spec.foundation {
+        let Some(l) = &st.lumped else {
+            return Err(src.error(
+                "foundation",
+                "foundation: the block on the soil is built under a [structure.lumped] (the engine is one-axis and the soil joins a lumped mass to the ground); give the structure as masses and springs",
+            ));
+        };
+        let found = foundation::Foundation::from_spec(f, l, src)?;
+        return lumped::modal_model(&found.augment(l), src, &ctx);
+    }
     if let Some(l) = &st.lumped {
         return lumped::modal_model(l, src, &ctx);
     }

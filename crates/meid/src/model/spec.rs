@@ -31,6 +31,13 @@ pub struct ModelSpec {
     /// ([`crate::measure::mapping`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub measurement: Option<crate::measure::mapping::MeasurementSpec>,
+    /// `[foundation]`: the block on the soil under a lumped structure
+    /// ([`super::foundation`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub foundation: Option<super::foundation::FoundationSpec>,
+    /// `[[receiver]]`: where the ground vibration is checked ([`super::foundation`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub receiver: Vec<super::foundation::ReceiverSpec>,
 }
 
 /// The structure: exactly one of the forms.
