@@ -427,199 +427,253 @@ fn increasing(v: &Vary) -> Option<Vec<usize>> {
 }
 
 // `..Default::default()` on every plot literal, so that fields added to the plot API merge.
-#[allow(clippy::needless_update)]
+/// Draws the sweep's pictures of `metric` into `dir`: a curve over one varied quantity, a
+/// family of curves over two (the second a list), or one map per case over two; none when
+/// the metric is undefined at every point or an axis is not increasing.
 fn draw(sweep: &Sweep, r: &SweepResult, metric: &str, dir: &Path) -> Result<Vec<PathBuf>> {
-    let mut out = Vec::new();
     // Quantities with a single value are fixed: the picture is over the others.
     let active: Vec<usize> = (0..sweep.vary.len())
         .filter(|&k| sweep.vary[k].values.len() > 1)
         .collect();
-    let vary: Vec<&Vary> = active.iter().map(|&k| &sweep.vary[k]).collect();
-    // The cases drawn (one curve or one map each): the sweep's, or the model as specified.
-    let ncases = sweep.cases.len().max(1);
-    let column = |k: usize| -> String {
-        if DERIVED.contains(&metric) {
-            metric.to_string()
-        } else {
-            sweep.metric_column(k, metric)
-        }
+    let d = Drawing {
+        sweep,
+        r,
+        metric,
+        dir,
+        active,
+        // The cases drawn (one curve or one map each): the sweep's, or the model as specified.
+        ncases: sweep.cases.len().max(1),
+        stem: metric.replace('/', "_"),
     };
-    let value = |k: usize, i: usize, j: usize| -> f64 {
-        // Row-major index with the active quantities at (i, j) and the fixed ones at 0.
+    let vary: Vec<&Vary> = d.active.iter().map(|&k| &sweep.vary[k]).collect();
+    // No picture of a metric undefined at every point (e.g. the energy ratio when no run
+    // reached the end of the collision); the summary says so.
+    let defined =
+        (0..d.ncases).any(|k| (0..r.points.len()).any(|i| r.value(i, &d.column(k)).is_finite()));
+    if !defined {
+        return Ok(Vec::new());
+    }
+    match vary.len() {
+        1 => d.curve(vary[0]),
+        2 if vary[1].spacing == Spacing::List => d.family(vary[0], vary[1]),
+        2 => d.maps(vary[0], vary[1]),
+        _ => Ok(Vec::new()),
+    }
+}
+
+/// What the pictures of one metric of a sweep are drawn from.
+struct Drawing<'a> {
+    sweep: &'a Sweep,
+    r: &'a SweepResult,
+    metric: &'a str,
+    dir: &'a Path,
+    /// The varied quantities with more than one value (the pictures' axes).
+    active: Vec<usize>,
+    ncases: usize,
+    /// The file stem of the pictures (the metric, `/` replaced).
+    stem: String,
+}
+
+impl Drawing<'_> {
+    /// The result column of the metric in case `k`.
+    fn column(&self, k: usize) -> String {
+        if DERIVED.contains(&self.metric) {
+            self.metric.to_string()
+        } else {
+            self.sweep.metric_column(k, self.metric)
+        }
+    }
+
+    /// The metric in case `k` at the point with the active quantities at value indices
+    /// (i, j) and the fixed ones at 0 (row-major index).
+    fn value(&self, k: usize, i: usize, j: usize) -> f64 {
         let mut index = 0;
-        for (q, v) in sweep.vary.iter().enumerate() {
-            let at = match active.iter().position(|&a| a == q) {
+        for (q, v) in self.sweep.vary.iter().enumerate() {
+            let at = match self.active.iter().position(|&a| a == q) {
                 Some(0) => i,
                 Some(1) => j,
                 _ => 0,
             };
             index = index * v.values.len() + at;
         }
-        r.value(index, &column(k))
-    };
-    // A legend prefix naming the case (none without cases).
-    let case_prefix = |k: usize| -> String {
-        match sweep.cases.get(k) {
+        self.r.value(index, &self.column(k))
+    }
+
+    /// A legend prefix naming the case (none without cases).
+    fn case_prefix(&self, k: usize) -> String {
+        match self.sweep.cases.get(k) {
             Some(c) => case_label(*c).to_string(),
             None => String::new(),
         }
-    };
-    let stem = metric.replace('/', "_");
-    let w_ref = r.spec.reference_omega_rad_per_s;
-    let number = r.spec.reference_mode.as_ref().map(|m| m.number);
-    // No picture of a metric undefined at every point (e.g. the energy ratio when no run
-    // reached the end of the collision); the summary says so.
-    let defined =
-        (0..ncases).any(|k| (0..r.points.len()).any(|i| r.value(i, &column(k)).is_finite()));
-    if !defined {
-        return Ok(out);
     }
-    match vary.len() {
-        1 => {
-            let Some(ix) = increasing(vary[0]) else {
-                return Ok(out);
-            };
-            let plot = LinePlot {
-                title: format!(
-                    "{} over {}",
-                    metric_name(sweep, metric),
-                    vary[0].quantity.symbol()
-                ),
-                x_label: label(&vary[0].quantity, w_ref, number),
-                y_label: picture_label(sweep, metric),
-                x_log: vary[0].spacing == Spacing::Log,
-                y_log: false,
-                series: (0..ncases)
-                    .map(|k| Series {
-                        label: case_prefix(k),
-                        x: ix.iter().map(|&i| vary[0].values[i]).collect(),
-                        y: ix.iter().map(|&i| value(k, i, 0)).collect(),
-                        ..Default::default()
-                    })
-                    .collect(),
-                ..Default::default()
-            };
-            let f = line_plot(dir.join(format!("{stem}_curve")), &plot)?;
-            out.extend([f.png, f.svg]);
-        }
-        2 if vary[1].spacing == Spacing::List => {
-            // Families of curves: x = first quantity, one curve per listed value (and case).
-            let Some(ix) = increasing(vary[0]) else {
-                return Ok(out);
-            };
-            let mut series = Vec::new();
-            for k in 0..ncases {
-                for j in 0..vary[1].values.len() {
-                    let family = vary[1].quantity.legend_entry(vary[1].values[j]);
-                    let prefix = case_prefix(k);
-                    series.push(Series {
-                        label: if prefix.is_empty() {
-                            family
-                        } else {
-                            format!("{prefix}, {family}")
-                        },
-                        x: ix.iter().map(|&i| vary[0].values[i]).collect(),
-                        y: ix.iter().map(|&i| value(k, i, j)).collect(),
-                        ..Default::default()
-                    });
-                }
-            }
-            let plot = LinePlot {
-                title: format!(
-                    "{} over {}",
-                    metric_name(sweep, metric),
-                    vary[0].quantity.symbol()
-                ),
-                x_label: label(&vary[0].quantity, w_ref, number),
-                y_label: picture_label(sweep, metric),
-                x_log: vary[0].spacing == Spacing::Log,
-                series,
-                ..Default::default()
-            };
-            let f = line_plot(dir.join(format!("{stem}_family")), &plot)?;
-            out.extend([f.png, f.svg]);
-        }
-        2 => {
-            let (Some(ix), Some(iy)) = (increasing(vary[0]), increasing(vary[1])) else {
-                return Ok(out);
-            };
-            for k in 0..ncases {
-                let x: Vec<f64> = ix.iter().map(|&i| vary[0].values[i]).collect();
-                let y: Vec<f64> = iy.iter().map(|&j| vary[1].values[j]).collect();
-                let mut z = Vec::with_capacity(x.len() * y.len());
-                for &j in &iy {
-                    for &i in &ix {
-                        z.push(value(k, i, j));
-                    }
-                }
-                let finite: Vec<f64> = z.iter().copied().filter(|v| v.is_finite()).collect();
-                let (lo, hi) = finite
-                    .iter()
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                        (a.min(v), b.max(v))
-                    });
-                let contour_levels = meid::plot::nice_levels(lo, hi, 7);
-                let mut overlay_lines = Vec::new();
-                let (q0, q1) = (&vary[0].quantity, &vary[1].quantity);
-                let diag = matches!(
-                    (q0, q1),
-                    (Quantity::WsOverWref, Quantity::WdOverWref)
-                        | (Quantity::WdOverWref, Quantity::WsOverWref)
-                );
-                if diag {
-                    let a = x[0].max(y[0]);
-                    let b = x[x.len() - 1].min(y[y.len() - 1]);
-                    if a < b {
-                        overlay_lines.push(Series {
-                            label: "ω_d = ω_s".into(),
-                            x: vec![a, b],
-                            y: vec![a, b],
-                            ..Default::default()
-                        });
-                    }
-                }
-                if matches!(q1, Quantity::WdOverWs) {
-                    overlay_lines.push(Series {
-                        label: "ω_d = ω_s".into(),
-                        x: vec![x[0], x[x.len() - 1]],
-                        y: vec![1.0, 1.0],
-                        ..Default::default()
-                    });
-                }
-                let prefix = case_prefix(k);
-                let what = format!(
-                    "{} over {} and {}",
-                    metric_name(sweep, metric),
-                    q0.symbol(),
-                    q1.symbol()
-                );
-                let map = HeatMap {
-                    title: if prefix.is_empty() {
-                        what
-                    } else {
-                        format!("{what}, {prefix}")
-                    },
-                    x_label: label(q0, w_ref, number),
-                    y_label: label(q1, w_ref, number),
-                    x,
-                    y,
-                    z,
-                    x_log: vary[0].spacing == Spacing::Log,
-                    y_log: vary[1].spacing == Spacing::Log,
-                    contour_levels,
-                    overlay_lines,
-                    colorbar_label: picture_label(sweep, metric),
+
+    /// The axis label of a varied quantity (ratios name the reference mode).
+    fn axis(&self, q: &Quantity) -> String {
+        let number = self.r.spec.reference_mode.as_ref().map(|m| m.number);
+        label(q, self.r.spec.reference_omega_rad_per_s, number)
+    }
+
+    /// One curve per case over the one varied quantity `v`.
+    #[allow(clippy::needless_update)]
+    fn curve(&self, v: &Vary) -> Result<Vec<PathBuf>> {
+        let Some(ix) = increasing(v) else {
+            return Ok(Vec::new());
+        };
+        let plot = LinePlot {
+            title: format!(
+                "{} over {}",
+                metric_name(self.sweep, self.metric),
+                v.quantity.symbol()
+            ),
+            x_label: self.axis(&v.quantity),
+            y_label: picture_label(self.sweep, self.metric),
+            x_log: v.spacing == Spacing::Log,
+            y_log: false,
+            series: (0..self.ncases)
+                .map(|k| Series {
+                    label: self.case_prefix(k),
+                    x: ix.iter().map(|&i| v.values[i]).collect(),
+                    y: ix.iter().map(|&i| self.value(k, i, 0)).collect(),
                     ..Default::default()
-                };
-                let name = match sweep.cases.get(k) {
-                    Some(c) => format!("{stem}_map_{}", case_name(*c)),
-                    None => format!("{stem}_map"),
-                };
-                let f = heat_map(dir.join(name), &map)?;
-                out.extend([f.png, f.svg]);
+                })
+                .collect(),
+            ..Default::default()
+        };
+        let f = line_plot(self.dir.join(format!("{}_curve", self.stem)), &plot)?;
+        Ok(vec![f.png, f.svg])
+    }
+
+    /// Families of curves: x = the first quantity `v0`, one curve per listed value of `v1`
+    /// (and case).
+    #[allow(clippy::needless_update)]
+    fn family(&self, v0: &Vary, v1: &Vary) -> Result<Vec<PathBuf>> {
+        let Some(ix) = increasing(v0) else {
+            return Ok(Vec::new());
+        };
+        let mut series = Vec::new();
+        for k in 0..self.ncases {
+            for j in 0..v1.values.len() {
+                let family = v1.quantity.legend_entry(v1.values[j]);
+                let prefix = self.case_prefix(k);
+                series.push(Series {
+                    label: if prefix.is_empty() {
+                        family
+                    } else {
+                        format!("{prefix}, {family}")
+                    },
+                    x: ix.iter().map(|&i| v0.values[i]).collect(),
+                    y: ix.iter().map(|&i| self.value(k, i, j)).collect(),
+                    ..Default::default()
+                });
             }
         }
-        _ => {}
+        let plot = LinePlot {
+            title: format!(
+                "{} over {}",
+                metric_name(self.sweep, self.metric),
+                v0.quantity.symbol()
+            ),
+            x_label: self.axis(&v0.quantity),
+            y_label: picture_label(self.sweep, self.metric),
+            x_log: v0.spacing == Spacing::Log,
+            series,
+            ..Default::default()
+        };
+        let f = line_plot(self.dir.join(format!("{}_family", self.stem)), &plot)?;
+        Ok(vec![f.png, f.svg])
     }
-    Ok(out)
+
+    /// One map per case over `v0` × `v1`, with contour levels and the line ω_d = ω_s where
+    /// the axes allow it.
+    #[allow(clippy::needless_update)]
+    fn maps(&self, v0: &Vary, v1: &Vary) -> Result<Vec<PathBuf>> {
+        let (Some(ix), Some(iy)) = (increasing(v0), increasing(v1)) else {
+            return Ok(Vec::new());
+        };
+        let mut out = Vec::new();
+        for k in 0..self.ncases {
+            let x: Vec<f64> = ix.iter().map(|&i| v0.values[i]).collect();
+            let y: Vec<f64> = iy.iter().map(|&j| v1.values[j]).collect();
+            let mut z = Vec::with_capacity(x.len() * y.len());
+            for &j in &iy {
+                for &i in &ix {
+                    z.push(self.value(k, i, j));
+                }
+            }
+            let finite: Vec<f64> = z.iter().copied().filter(|v| v.is_finite()).collect();
+            let (lo, hi) = finite
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            let contour_levels = meid::plot::nice_levels(lo, hi, 7);
+            let (q0, q1) = (&v0.quantity, &v1.quantity);
+            let overlay_lines = rule_lines(q0, q1, &x, &y);
+            let prefix = self.case_prefix(k);
+            let what = format!(
+                "{} over {} and {}",
+                metric_name(self.sweep, self.metric),
+                q0.symbol(),
+                q1.symbol()
+            );
+            let map = HeatMap {
+                title: if prefix.is_empty() {
+                    what
+                } else {
+                    format!("{what}, {prefix}")
+                },
+                x_label: self.axis(q0),
+                y_label: self.axis(q1),
+                x,
+                y,
+                z,
+                x_log: v0.spacing == Spacing::Log,
+                y_log: v1.spacing == Spacing::Log,
+                contour_levels,
+                overlay_lines,
+                colorbar_label: picture_label(self.sweep, self.metric),
+                ..Default::default()
+            };
+            let name = match self.sweep.cases.get(k) {
+                Some(c) => format!("{}_map_{}", self.stem, case_name(*c)),
+                None => format!("{}_map", self.stem),
+            };
+            let f = heat_map(self.dir.join(name), &map)?;
+            out.extend([f.png, f.svg]);
+        }
+        Ok(out)
+    }
+}
+
+/// The paper's rule ω_d = ω_s on a map over `q0` × `q1` (axes `x`, `y`): the diagonal of a
+/// ω_s/ω_ref × ω_d/ω_ref map (where the axes overlap), the line ω_d/ω_s = 1 when that is the
+/// y axis.
+#[allow(clippy::needless_update)]
+fn rule_lines(q0: &Quantity, q1: &Quantity, x: &[f64], y: &[f64]) -> Vec<Series> {
+    let mut overlay_lines = Vec::new();
+    let diag = matches!(
+        (q0, q1),
+        (Quantity::WsOverWref, Quantity::WdOverWref) | (Quantity::WdOverWref, Quantity::WsOverWref)
+    );
+    if diag {
+        let a = x[0].max(y[0]);
+        let b = x[x.len() - 1].min(y[y.len() - 1]);
+        if a < b {
+            overlay_lines.push(Series {
+                label: "ω_d = ω_s".into(),
+                x: vec![a, b],
+                y: vec![a, b],
+                ..Default::default()
+            });
+        }
+    }
+    if matches!(q1, Quantity::WdOverWs) {
+        overlay_lines.push(Series {
+            label: "ω_d = ω_s".into(),
+            x: vec![x[0], x[x.len() - 1]],
+            y: vec![1.0, 1.0],
+            ..Default::default()
+        });
+    }
+    overlay_lines
 }

@@ -795,6 +795,84 @@ impl integrate::Observer for States {
     }
 }
 
+/// The continuation a run still needs: the tail-energy fraction `E_tail/(E_rec + E_tail)` of
+/// each channel (1 for a persisting or non-linear tail), the last such channel, and the time
+/// to continue, `1.1 ln(f/f_max)/(2 rate)` for a decaying tail above the rule (0: done).
+struct Tail {
+    chunk: f64,
+    fractions: Vec<f64>,
+    /// The channel whose tail does not decay, with its pole (none: a non-linear contact).
+    persistent: Option<(usize, Option<c64>)>,
+}
+
+/// [`Tail`] of the free decays `tails` after the energies `e_rec` recorded up to `t_end`
+/// (`record_end` the record's end, s).
+fn tail_continuation(
+    tails: &[TailKind],
+    e_rec: &[f64],
+    t_end: f64,
+    record_end: f64,
+    rule: &DecayRule,
+) -> Tail {
+    let nch = tails.len();
+    let mut chunk: f64 = 0.0;
+    let mut fractions = vec![0.0; nch];
+    let mut persistent = None;
+    for (ch, tk) in tails.iter().enumerate() {
+        match *tk {
+            TailKind::Decays { energy, rate } => {
+                let total = e_rec[ch] + energy;
+                fractions[ch] = if total > 0.0 { energy / total } else { 0.0 };
+                if fractions[ch] > rule.tail_energy_fraction {
+                    let r = fractions[ch] / rule.tail_energy_fraction;
+                    chunk = chunk.max(1.1 * r.ln() / (2.0 * rate));
+                }
+            }
+            TailKind::Persists(l) => {
+                fractions[ch] = 1.0;
+                persistent = Some((ch, Some(l)));
+                chunk = chunk.max((t_end - record_end).max(record_end).max(1.0));
+            }
+            TailKind::NonLinear => {
+                fractions[ch] = 1.0;
+                persistent = Some((ch, None));
+                chunk = chunk.max((t_end - record_end).max(1e-3));
+            }
+        }
+    }
+    Tail {
+        chunk,
+        fractions,
+        persistent,
+    }
+}
+
+/// Refuses a decay rule outside its ranges: `tail_energy_fraction` in (0, 1),
+/// `max_continuation_s` ≥ 0 s, `accept_energy_fraction` in [tail_energy_fraction, 1).
+fn check_rule(rule: &DecayRule) -> Result<()> {
+    if !(rule.tail_energy_fraction > 0.0 && rule.tail_energy_fraction < 1.0) {
+        return Err(Error::invalid(
+            "tail_energy_fraction",
+            format!("must lie in (0, 1) (got {})", rule.tail_energy_fraction),
+        ));
+    }
+    if rule.max_continuation_s.is_nan() || rule.max_continuation_s < 0.0 {
+        return Err(Error::invalid("max_continuation_s", "must be ≥ 0 s"));
+    }
+    if !(rule.accept_energy_fraction >= rule.tail_energy_fraction
+        && rule.accept_energy_fraction < 1.0)
+    {
+        return Err(Error::invalid(
+            "accept_energy_fraction",
+            format!(
+                "must lie in [tail_energy_fraction, 1) (got {})",
+                rule.accept_energy_fraction
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Builds exact spectra of the response channels of one system: decomposes each mode met once
 /// and reuses it for the continuation's checks and the transform.
 pub struct SpectrumBuilder<'a> {
@@ -891,26 +969,7 @@ impl<'a> SpectrumBuilder<'a> {
         traj: &mut Trajectory,
         rule: &DecayRule,
     ) -> Result<Continuation> {
-        if !(rule.tail_energy_fraction > 0.0 && rule.tail_energy_fraction < 1.0) {
-            return Err(Error::invalid(
-                "tail_energy_fraction",
-                format!("must lie in (0, 1) (got {})", rule.tail_energy_fraction),
-            ));
-        }
-        if rule.max_continuation_s.is_nan() || rule.max_continuation_s < 0.0 {
-            return Err(Error::invalid("max_continuation_s", "must be ≥ 0 s"));
-        }
-        if !(rule.accept_energy_fraction >= rule.tail_energy_fraction
-            && rule.accept_energy_fraction < 1.0)
-        {
-            return Err(Error::invalid(
-                "accept_energy_fraction",
-                format!(
-                    "must lie in [tail_energy_fraction, 1) (got {})",
-                    rule.accept_energy_fraction
-                ),
-            ));
-        }
+        check_rule(rule)?;
         let record_end = traj.end_time();
         let nch = self.channels.len();
         let mut e_rec = vec![0.0; nch];
@@ -929,31 +988,11 @@ impl<'a> SpectrumBuilder<'a> {
                 return Err(Error::invalid("trajectory", "the run has no end state"));
             };
             let tails = self.tails(mode, &x)?;
-            let mut chunk: f64 = 0.0;
-            let mut fractions = vec![0.0; nch];
-            let mut persistent = None;
-            for (ch, tk) in tails.iter().enumerate() {
-                match *tk {
-                    TailKind::Decays { energy, rate } => {
-                        let total = e_rec[ch] + energy;
-                        fractions[ch] = if total > 0.0 { energy / total } else { 0.0 };
-                        if fractions[ch] > rule.tail_energy_fraction {
-                            let r = fractions[ch] / rule.tail_energy_fraction;
-                            chunk = chunk.max(1.1 * r.ln() / (2.0 * rate));
-                        }
-                    }
-                    TailKind::Persists(l) => {
-                        fractions[ch] = 1.0;
-                        persistent = Some((ch, Some(l)));
-                        chunk = chunk.max((t_end - record_end).max(record_end).max(1.0));
-                    }
-                    TailKind::NonLinear => {
-                        fractions[ch] = 1.0;
-                        persistent = Some((ch, None));
-                        chunk = chunk.max((t_end - record_end).max(1e-3));
-                    }
-                }
-            }
+            let Tail {
+                chunk,
+                fractions,
+                persistent,
+            } = tail_continuation(&tails, &e_rec, t_end, record_end, rule);
             if chunk == 0.0 {
                 return Ok(Continuation {
                     record_end_s: record_end,
@@ -965,37 +1004,7 @@ impl<'a> SpectrumBuilder<'a> {
             }
             let done = t_end - record_end;
             if done >= rule.max_continuation_s {
-                let what = match persistent {
-                    Some((ch, Some(l))) => format!(
-                        "the {} does not decay in the final mode ({}): it sees a pole λ = {:.6e} {:+.6e}i 1/s ({:.6} Hz) with Re λ ≥ 0 (an undamped or rigid-body motion), so its Fourier transform does not exist",
-                        self.channels[ch].label(),
-                        describe_mode(self.sys, mode),
-                        l.re,
-                        l.im,
-                        l.im.abs() / (2.0 * PI)
-                    ),
-                    Some((ch, None)) => format!(
-                        "the {} is still in a non-linear contact",
-                        self.channels[ch].label()
-                    ),
-                    None => {
-                        let (ch, f) = fractions
-                            .iter()
-                            .enumerate()
-                            .fold((0, 0.0), |b, (i, &f)| if f > b.1 { (i, f) } else { b });
-                        format!(
-                            "the {}'s free decay still carries {f:.3e} of its energy (> {:e})",
-                            self.channels[ch].label(),
-                            rule.tail_energy_fraction
-                        )
-                    }
-                };
-                return Err(Error::numerical(
-                    "exact spectrum",
-                    format!(
-                        "{what} (the run was continued {done:.1} s past the record); the exact spectrum would depend on the record length. Add damping, or use the windowed FFT of the record (--spectrum fft)"
-                    ),
-                ));
+                return Err(self.not_decayed(mode, persistent, &fractions, rule, done));
             }
             // Continue by at most the time simulated so far (at least 1 s): the prediction from
             // the slowest decay rate of the current mode overshoots when a switch (the dashpot
@@ -1048,6 +1057,50 @@ impl<'a> SpectrumBuilder<'a> {
             switches += sol.events.len();
             traj.append(&sol, t_end);
         }
+    }
+
+    /// The error of a run whose free decay is still too large when the continuation reaches
+    /// `rule.max_continuation_s` (`done` s past the record): a pole with Re λ ≥ 0, a non-linear
+    /// contact still closed, or the channel with the largest tail-energy fraction.
+    fn not_decayed(
+        &self,
+        mode: Mode,
+        persistent: Option<(usize, Option<c64>)>,
+        fractions: &[f64],
+        rule: &DecayRule,
+        done: f64,
+    ) -> Error {
+        let what = match persistent {
+            Some((ch, Some(l))) => format!(
+                "the {} does not decay in the final mode ({}): it sees a pole λ = {:.6e} {:+.6e}i 1/s ({:.6} Hz) with Re λ ≥ 0 (an undamped or rigid-body motion), so its Fourier transform does not exist",
+                self.channels[ch].label(),
+                describe_mode(self.sys, mode),
+                l.re,
+                l.im,
+                l.im.abs() / (2.0 * PI)
+            ),
+            Some((ch, None)) => format!(
+                "the {} is still in a non-linear contact",
+                self.channels[ch].label()
+            ),
+            None => {
+                let (ch, f) = fractions
+                    .iter()
+                    .enumerate()
+                    .fold((0, 0.0), |b, (i, &f)| if f > b.1 { (i, f) } else { b });
+                format!(
+                    "the {}'s free decay still carries {f:.3e} of its energy (> {:e})",
+                    self.channels[ch].label(),
+                    rule.tail_energy_fraction
+                )
+            }
+        };
+        Error::numerical(
+            "exact spectrum",
+            format!(
+                "{what} (the run was continued {done:.1} s past the record); the exact spectrum would depend on the record length. Add damping, or use the windowed FFT of the record (--spectrum fft)"
+            ),
+        )
     }
 
     /// Subdivides the stretches with a non-linear contact closed, whose states are known only

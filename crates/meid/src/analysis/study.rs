@@ -49,6 +49,8 @@
 //! objective is flat; and it lists the `--set` overrides that make `meid simulate` give the
 //! same objective.
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -726,67 +728,21 @@ impl OptimizeStudy {
     ) -> Result<OptimizeReport> {
         let budget = self.budget();
         let grid = self.grid();
-        if grid < 2 {
-            return Err(Error::Input {
-                location: format!("--grid {grid}"),
-                message: "the grid needs at least 2 points per variable (both bounds)".into(),
-            });
-        }
-        let n_free = self.search_order().len();
-        if n_free >= 1 && self.grid_total() > MAX_GRID_SIMULATIONS {
-            return Err(Error::Input {
-                location: format!("--grid {grid}"),
-                message: format!(
-                    "a grid of {grid}^{n_free} points is more than {MAX_GRID_SIMULATIONS} simulations; give at most {} points per variable",
-                    (2..=grid)
-                        .rev()
-                        .find(|&p| super::optimize::grid_size(p, n_free)
-                            .is_some_and(|t| t <= MAX_GRID_SIMULATIONS))
-                        .unwrap_or(2)
-                ),
-            });
-        }
-        let cache = StructureCache::new();
-        let count = std::sync::atomic::AtomicUsize::new(0);
-        let infeasible = std::sync::atomic::AtomicUsize::new(0);
-        let qs_all: Vec<&Quantity> = self.variables.iter().map(|v| &v.quantity).collect();
-        let eval = |qs: &[&Quantity], x: &[f64]| -> PointResult {
-            let r = evaluate_cached(
-                &self.model,
-                qs,
-                x,
-                self.bed_mass_kg,
-                &self.options,
-                0,
-                Some(&cache),
-            );
-            let (r, refused) = self.at_stroke_rate(qs, x, r, Some(&cache));
-            if refused {
-                infeasible.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            }
-            let d = count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            progress(d.min(budget), budget);
-            r
+        self.check_search_size(budget, grid)?;
+        let ev = Evaluator {
+            study: self,
+            cache: StructureCache::new(),
+            count: AtomicUsize::new(0),
+            infeasible: AtomicUsize::new(0),
+            progress,
+            budget,
         };
+        let qs_all: Vec<&Quantity> = self.variables.iter().map(|v| &v.quantity).collect();
+        let eval = |qs: &[&Quantity], x: &[f64]| ev.eval(qs, x);
         let metric = self.objective.metric();
         let order = self.search_order();
         let n = order.len();
         let min = self.min_simulations();
-        if budget < min {
-            return Err(Error::Input {
-                location: format!("--max-simulations {budget}"),
-                message: format!(
-                    "{budget} simulations are too few: with {n} variable{} the search needs at least {min} ({}, the optimum's own run and the w_d = w_s comparison){}",
-                    if n == 1 { "" } else { "s" },
-                    if n == 1 {
-                        format!("a {grid}-point scan and one Brent step")
-                    } else {
-                        format!("a grid of {grid}^{n} = {} points and one simplex of {} points", self.grid_total(), n + 1)
-                    },
-                    if n >= 2 { "; give a larger --max-simulations or a smaller --grid" } else { "" }
-                ),
-            });
-        }
         // The neighbour check (2 per free variable) runs when the budget holds it on top of
         // the minimum; the optimum's run and the comparison come after the search.
         let check_runs = 2 * n;
@@ -810,290 +766,73 @@ impl OptimizeStudy {
             }
             v
         };
-        let lo: Vec<f64> = order
-            .iter()
-            .map(|&k| self.value_to_search(k, self.variables[k].lower))
-            .collect();
-        let hi: Vec<f64> = order
-            .iter()
-            .map(|&k| self.value_to_search(k, self.variables[k].upper))
-            .collect();
+        let (lo, hi) = self.search_bounds();
+        let box_ = SearchBox {
+            lo: &lo,
+            hi: &hi,
+            grid,
+            search_budget,
+        };
         let (u_best, simulations, failures, converged, local_searches) = if n == 0 {
             (Vec::new(), 0, 0, true, 0)
         } else if n == 1 {
-            // The scan (in parallel, collected in grid order: the result does not depend on the
-            // thread count), then Brent's method around each of the best `GLOBAL_STARTS` scan
-            // points lower than both their neighbours (distinct basins), the lowest kept.
-            let m = grid;
-            let grid: Vec<f64> = (0..m)
-                .map(|i| {
-                    // The last point is the upper bound itself (lo + (hi − lo) need not be hi).
-                    if i + 1 == m {
-                        hi[0]
-                    } else {
-                        lo[0] + (hi[0] - lo[0]) * i as f64 / (m - 1) as f64
-                    }
-                })
-                .collect();
-            let vals: Vec<f64> = grid.par_iter().map(|&u| f(&[u])).collect();
-            let scan_fail = vals.iter().filter(|v| !v.is_finite()).count();
-            // `i` is below its neighbour `j` (a failed neighbour is above; ties go to the
-            // first in grid order).
-            let below = |i: usize, j: usize| {
-                !vals[j].is_finite() || vals[i] < vals[j] || (vals[i] == vals[j] && i < j)
-            };
-            let mut minima: Vec<usize> = (0..m)
-                .filter(|&i| {
-                    vals[i].is_finite()
-                        && (i == 0 || below(i, i - 1))
-                        && (i + 1 == m || below(i, i + 1))
-                })
-                .collect();
-            minima.sort_by(|&a, &b| vals[a].total_cmp(&vals[b]).then(a.cmp(&b)));
-            if minima.is_empty() {
-                return Err(self.failure(
-                    &to_x(&[grid[0]]),
-                    &format!("all {m} points of the initial scan failed"),
-                    "the first scan point",
-                ));
-            }
-            // Each search gets an equal share of the budget left (at least 10 simulations:
-            // fewer starts when the budget is short), so each, and the result, is the same
-            // whatever the others do.
-            let left = search_budget - m;
-            minima.truncate(GLOBAL_STARTS.min((left / 10).max(1)));
-            let share = left / minima.len();
-            let (mut u_best, mut f_best) = (grid[minima[0]], vals[minima[0]]);
-            let (mut evaluations, mut failures, mut converged) = (m, scan_fail, true);
-            for &ib in &minima {
-                let a = grid[ib.saturating_sub(1)];
-                let b = grid[(ib + 1).min(m - 1)];
-                let opts = BrentOptions {
-                    x_tolerance: 1e-6 * (hi[0] - lo[0]),
-                    relative_tolerance: 1e-8,
-                    max_evaluations: share,
-                };
-                let r = brent_minimize(|u| f(&[u]), a, b, &opts)?;
-                evaluations += r.evaluations;
-                failures += r.failures;
-                if r.f < f_best {
-                    (u_best, f_best) = (r.x, r.f);
-                    converged = r.converged;
-                } else if ib == minima[0] {
-                    converged = r.converged;
-                }
-            }
-            // A search that ends within half the neighbour step of a bound, no lower than the
-            // bound's own scan value beyond round-off, ends on the bound (Brent converges to
-            // within its tolerance of a bound, not onto it).
-            for end in [0, m - 1] {
-                if (u_best - grid[end]).abs() < 0.5 * NEIGHBOUR_STEP * (hi[0] - lo[0])
-                    && vals[end] <= f_best + 1e-12 * f_best.abs()
-                {
-                    u_best = grid[end];
-                }
-            }
-            (vec![u_best], evaluations, failures, converged, minima.len())
+            self.scan_and_brent(&f, &to_x, &box_)?
         } else {
-            let opts = GlobalOptions {
-                grid_points: grid,
-                starts: GLOBAL_STARTS,
-                max_evaluations: search_budget,
-                local: NelderMeadOptions {
-                    initial_step: 0.2,
-                    x_tolerance: 1e-5,
-                    f_tolerance: 1e-9,
-                    max_evaluations: search_budget,
-                    max_restarts: 5,
-                    random_starts: 0,
-                    seed: 4,
-                    polish: true,
-                },
-            };
-            let r = minimize_box_global(f, &lo, &hi, &opts)?;
-            let searches = r.searches.len();
-            (r.x, r.evaluations, r.failures, r.converged, searches)
+            self.box_search(&f, &box_)?
         };
-        let search_infeasible = infeasible.load(std::sync::atomic::Ordering::Relaxed);
+        let search_infeasible = ev.infeasible.load(Ordering::Relaxed);
         let mut optimum = to_x(&u_best);
         let mut point = eval(&qs_all, &optimum);
         let mut objective_value = point.metric(metric);
         if !objective_value.is_finite() {
-            if point.error.is_some() {
-                return Err(self.failure(
-                    &optimum,
-                    &format!("no valid design found in {} simulations", simulations + 1),
-                    "the last point",
-                ));
-            }
-            return Err(Error::numerical(
-                "optimize",
-                format!("no valid design found: {metric} is undefined at the best point"),
-            ));
+            return Err(self.no_valid_design(&point, &optimum, simulations + 1));
         }
         let mut simulations = simulations + 1;
 
         // The neighbour check: what the optimum is.
-        let mut neighbours = Vec::new();
-        let mut at_bound = Vec::new();
-        let mut lower_neighbour: Option<(Vec<f64>, PointResult, f64, usize)> = None;
-        if checked {
-            for (j, &k) in order.iter().enumerate() {
-                let h = NEIGHBOUR_STEP * (hi[j] - lo[j]);
-                for (side, sign) in [("lower", -1.0), ("upper", 1.0)] {
-                    let t = (u_best[j] + sign * h).clamp(lo[j], hi[j]);
-                    let mut x = optimum.clone();
-                    x[k] = self.search_to_value(k, t);
-                    // A neighbour the bound holds to less than half the step (a search ending
-                    // within round-off of the bound) is the bound, not a neighbour.
-                    if x[k] == optimum[k] || (t - u_best[j]).abs() < 0.5 * h {
-                        at_bound.push(format!("{} ({side})", self.variables[k].quantity.name()));
-                        continue;
-                    }
-                    let p = eval(&qs_all, &x);
-                    simulations += 1;
-                    let fv = p.metric(metric);
-                    neighbours.push(Neighbour {
-                        variable: self.variables[k].quantity.name(),
-                        value: x[k],
-                        objective: fv,
-                    });
-                    let lower = fv < objective_value - 1e-12 * objective_value.abs();
-                    if lower && lower_neighbour.as_ref().is_none_or(|b| fv < b.2) {
-                        lower_neighbour = Some((x, p, fv, neighbours.len() - 1));
-                    }
-                }
-            }
-        } else if n > 0 {
+        let mut check = if checked {
+            self.neighbours(&eval, &box_, &u_best, &optimum, objective_value)
+        } else {
             // Without the check, a bound is still a bound.
-            for (j, &k) in order.iter().enumerate() {
-                for (side, b) in [("lower", lo[j]), ("upper", hi[j])] {
-                    if u_best[j] == b {
-                        at_bound.push(format!("{} ({side})", self.variables[k].quantity.name()));
-                    }
-                }
+            NeighbourCheck {
+                at_bound: self.on_bounds(&box_, &u_best),
+                ..NeighbourCheck::default()
             }
-        }
+        };
+        simulations += check.runs;
         let mut values: Vec<f64> = seen.into_inner().unwrap_or_default();
         values.push(objective_value);
-        values.extend(neighbours.iter().map(|nb| nb.objective));
+        values.extend(check.neighbours.iter().map(|nb| nb.objective));
         let finite: Vec<f64> = values.into_iter().filter(|v| v.is_finite()).collect();
-        let (f_min, f_max) = finite
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                (a.min(v), b.max(v))
-            });
-        let names: Vec<String> = order
-            .iter()
-            .map(|&k| self.variables[k].quantity.name())
-            .collect();
-        let method = match n {
-            0 => "nothing searched (every variable fixed)".to_string(),
-            1 => format!("a {grid}-point scan over the bounds, then Brent's method around each of the best {local_searches} scan points lower than their neighbours"),
-            _ => format!(
-                "a {} grid over the box ({} simulations), then a bounded Nelder-Mead search with restarts and a coordinate polish from each of the best {local_searches} grid points lower than their neighbours",
-                vec![grid.to_string(); n].join("×"),
-                self.grid_total()
-            ),
+        let method = self.method_text(grid, local_searches);
+        let search = SearchEnd {
+            objective_value,
+            converged,
+            checked,
+            budget,
+            min_runs: min + check_runs,
+            check_runs,
         };
-        let step_text = format!(
-            "±{} % of each variable's range{}",
-            100.0 * NEIGHBOUR_STEP,
-            if order.iter().any(|&k| self.variables[k].log) {
-                " (in ln x for a log variable)"
-            } else {
-                ""
+        let (verdict, statement) = self.verdict(&check, &finite, &method, &search);
+        if verdict == Verdict::NotAMinimum {
+            if let Some((x, p, fv, _)) = check.lower.take() {
+                optimum = x;
+                point = p;
+                objective_value = fv;
             }
-        );
-        let (verdict, statement) = if n == 0 {
-            (
-                Verdict::Fixed,
-                "every variable is fixed (LO = HI): this is the objective at that point; nothing was searched".to_string(),
-            )
-        } else if finite.len() > 1 && f_max - f_min <= 1e-12 * f_max.abs().max(f_min.abs()) {
-            (
-                Verdict::Flat,
-                format!(
-                    "the objective is flat: {metric} = {objective_value:e} at all {} points evaluated (spread {:e}): it does not depend on {} within the bounds, and any value there is as good as the one reported",
-                    finite.len(),
-                    f_max - f_min,
-                    names.join(", ")
-                ),
-            )
-        } else if let Some((x, p, fv, i)) = lower_neighbour {
-            let nb = &neighbours[i];
-            let s = format!(
-                "not a verified local minimum: the search ({}) ended at {metric} = {objective_value:e}, and its neighbour {} = {:e} gives {fv:e}, lower; reported is that neighbour. Raise --max-simulations, or narrow --bounds around it",
-                if converged { "converged" } else { "budget reached" },
-                nb.variable,
-                nb.value
-            );
-            optimum = x;
-            point = p;
-            objective_value = fv;
-            (Verdict::NotAMinimum, s)
-        } else if !checked {
-            (
-                Verdict::NotChecked,
-                format!(
-                    "not checked: the budget (--max-simulations {budget}) left no simulations for the {check_runs} neighbours (give at least {}); found by {method}",
-                    min + check_runs
-                ),
-            )
-        } else if !at_bound.is_empty() {
-            (
-                Verdict::OnBound,
-                format!(
-                    "a minimum on the bound{}: {}; every neighbour inside the bounds ({step_text}) gives a higher {metric}, so the objective falls towards the bound and lower values may lie beyond it (widen --bounds if the model allows)",
-                    if at_bound.len() == 1 { "" } else { "s" },
-                    at_bound.join(", ")
-                ),
-            )
-        } else {
-            let rise = neighbours
-                .iter()
-                .map(|nb| nb.objective / objective_value - 1.0)
-                .fold(f64::INFINITY, f64::min);
-            (
-                Verdict::LocalMinimum,
-                format!(
-                    "a local minimum: each of the {} neighbours ({step_text}) gives a higher {metric} (smallest rise {:.3e} relative); found by {method}; the lowest found, global to the grid's resolution (a basin narrower than about two grid cells can be missed)",
-                    neighbours.len(),
-                    rise
-                ),
-            )
-        };
+        }
         let local_check = LocalCheck {
             verdict,
             step_fraction: NEIGHBOUR_STEP,
-            neighbours,
-            at_bound,
+            neighbours: check.neighbours,
+            at_bound: check.at_bound,
             statement,
         };
-        // The paper's rule at the optimum's other variables.
-        let mut qs: Vec<&Quantity> = Vec::new();
-        let mut vals: Vec<f64> = Vec::new();
-        for (k, v) in self.variables.iter().enumerate() {
-            let is_wd = matches!(v.quantity, Quantity::WdOverWs | Quantity::WdOverWref)
-                || v.quantity == Quantity::Field("contact.bed_damper.stiffness".into());
-            if !is_wd {
-                qs.push(&v.quantity);
-                vals.push(optimum[k]);
-            }
-        }
-        let wd = Quantity::WdOverWs;
-        qs.push(&wd);
-        vals.push(1.0);
-        let (rule, rule_runs) = if self.model.spec.damper.is_some() {
-            let r = eval(&qs, &vals).metric(metric);
-            (r, 1)
-        } else {
-            (f64::NAN, 0)
-        };
+        let (rule, rule_runs) = self.rule_objective(&eval, &optimum);
         let overrides = self.overrides(&optimum, &point);
-        let infeasible = infeasible.into_inner();
+        let infeasible = ev.infeasible.into_inner();
         let steady_state = match self.rate_bpm {
-            Some(rate) => Some(self.steady_of(rate, &qs_all, &optimum, Some(&cache))?),
+            Some(rate) => Some(self.steady_of(rate, &qs_all, &optimum, Some(&ev.cache))?),
             None => None,
         };
         Ok(OptimizeReport {
@@ -1120,4 +859,459 @@ impl OptimizeStudy {
             overrides,
         })
     }
+
+    /// Refuses a search the settings cannot run: fewer than 2 grid points per variable, a grid
+    /// of more than [`MAX_GRID_SIMULATIONS`] points, or a budget below
+    /// [`OptimizeStudy::min_simulations`].
+    fn check_search_size(&self, budget: usize, grid: usize) -> Result<()> {
+        if grid < 2 {
+            return Err(Error::Input {
+                location: format!("--grid {grid}"),
+                message: "the grid needs at least 2 points per variable (both bounds)".into(),
+            });
+        }
+        let n_free = self.search_order().len();
+        if n_free >= 1 && self.grid_total() > MAX_GRID_SIMULATIONS {
+            return Err(Error::Input {
+                location: format!("--grid {grid}"),
+                message: format!(
+                    "a grid of {grid}^{n_free} points is more than {MAX_GRID_SIMULATIONS} simulations; give at most {} points per variable",
+                    (2..=grid)
+                        .rev()
+                        .find(|&p| super::optimize::grid_size(p, n_free)
+                            .is_some_and(|t| t <= MAX_GRID_SIMULATIONS))
+                        .unwrap_or(2)
+                ),
+            });
+        }
+        let n = n_free;
+        let min = self.min_simulations();
+        if budget < min {
+            return Err(Error::Input {
+                location: format!("--max-simulations {budget}"),
+                message: format!(
+                    "{budget} simulations are too few: with {n} variable{} the search needs at least {min} ({}, the optimum's own run and the w_d = w_s comparison){}",
+                    if n == 1 { "" } else { "s" },
+                    if n == 1 {
+                        format!("a {grid}-point scan and one Brent step")
+                    } else {
+                        format!("a grid of {grid}^{n} = {} points and one simplex of {} points", self.grid_total(), n + 1)
+                    },
+                    if n >= 2 { "; give a larger --max-simulations or a smaller --grid" } else { "" }
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// The free variables' bounds in search coordinates (ln x for a log variable), in
+    /// search order.
+    fn search_bounds(&self) -> (Vec<f64>, Vec<f64>) {
+        let order = self.search_order();
+        let lo: Vec<f64> = order
+            .iter()
+            .map(|&k| self.value_to_search(k, self.variables[k].lower))
+            .collect();
+        let hi: Vec<f64> = order
+            .iter()
+            .map(|&k| self.value_to_search(k, self.variables[k].upper))
+            .collect();
+        (lo, hi)
+    }
+
+    /// The search over two or more free variables: a grid over the box, then a bounded
+    /// Nelder-Mead search with restarts and a coordinate polish from each of the best
+    /// [`GLOBAL_STARTS`] grid points lower than their neighbours ([`minimize_box_global`]).
+    fn box_search(
+        &self,
+        f: &(dyn Fn(&[f64]) -> f64 + Sync),
+        box_: &SearchBox,
+    ) -> Result<SearchOutcome> {
+        let opts = GlobalOptions {
+            grid_points: box_.grid,
+            starts: GLOBAL_STARTS,
+            max_evaluations: box_.search_budget,
+            local: NelderMeadOptions {
+                initial_step: 0.2,
+                x_tolerance: 1e-5,
+                f_tolerance: 1e-9,
+                max_evaluations: box_.search_budget,
+                max_restarts: 5,
+                random_starts: 0,
+                seed: 4,
+                polish: true,
+            },
+        };
+        let r = minimize_box_global(f, box_.lo, box_.hi, &opts)?;
+        let searches = r.searches.len();
+        Ok((r.x, r.evaluations, r.failures, r.converged, searches))
+    }
+
+    /// The error when the objective is undefined at the search's best point `optimum` (its
+    /// run `point`, after `simulations` simulations).
+    fn no_valid_design(&self, point: &PointResult, optimum: &[f64], simulations: usize) -> Error {
+        if point.error.is_some() {
+            return self.failure(
+                optimum,
+                &format!("no valid design found in {simulations} simulations"),
+                "the last point",
+            );
+        }
+        let metric = self.objective.metric();
+        Error::numerical(
+            "optimize",
+            format!("no valid design found: {metric} is undefined at the best point"),
+        )
+    }
+
+    /// The search over one free variable: a scan of `grid` points (in parallel, collected in
+    /// grid order: the result does not depend on the thread count), then Brent's method around
+    /// each of the best [`GLOBAL_STARTS`] scan points lower than both their neighbours
+    /// (distinct basins), the lowest kept. Returns the best search coordinate, the
+    /// simulations, the failures, whether the best search converged and the searches run.
+    fn scan_and_brent(
+        &self,
+        f: &(dyn Fn(&[f64]) -> f64 + Sync),
+        to_x: &dyn Fn(&[f64]) -> Vec<f64>,
+        box_: &SearchBox,
+    ) -> Result<SearchOutcome> {
+        let (lo, hi) = (box_.lo, box_.hi);
+        let m = box_.grid;
+        let grid: Vec<f64> = (0..m)
+            .map(|i| {
+                // The last point is the upper bound itself (lo + (hi − lo) need not be hi).
+                if i + 1 == m {
+                    hi[0]
+                } else {
+                    lo[0] + (hi[0] - lo[0]) * i as f64 / (m - 1) as f64
+                }
+            })
+            .collect();
+        let vals: Vec<f64> = grid.par_iter().map(|&u| f(&[u])).collect();
+        let scan_fail = vals.iter().filter(|v| !v.is_finite()).count();
+        // `i` is below its neighbour `j` (a failed neighbour is above; ties go to the
+        // first in grid order).
+        let below = |i: usize, j: usize| {
+            !vals[j].is_finite() || vals[i] < vals[j] || (vals[i] == vals[j] && i < j)
+        };
+        let mut minima: Vec<usize> = (0..m)
+            .filter(|&i| {
+                vals[i].is_finite()
+                    && (i == 0 || below(i, i - 1))
+                    && (i + 1 == m || below(i, i + 1))
+            })
+            .collect();
+        minima.sort_by(|&a, &b| vals[a].total_cmp(&vals[b]).then(a.cmp(&b)));
+        if minima.is_empty() {
+            return Err(self.failure(
+                &to_x(&[grid[0]]),
+                &format!("all {m} points of the initial scan failed"),
+                "the first scan point",
+            ));
+        }
+        // Each search gets an equal share of the budget left (at least 10 simulations:
+        // fewer starts when the budget is short), so each, and the result, is the same
+        // whatever the others do.
+        let left = box_.search_budget - m;
+        minima.truncate(GLOBAL_STARTS.min((left / 10).max(1)));
+        let share = left / minima.len();
+        let (mut u_best, mut f_best) = (grid[minima[0]], vals[minima[0]]);
+        let (mut evaluations, mut failures, mut converged) = (m, scan_fail, true);
+        for &ib in &minima {
+            let a = grid[ib.saturating_sub(1)];
+            let b = grid[(ib + 1).min(m - 1)];
+            let opts = BrentOptions {
+                x_tolerance: 1e-6 * (hi[0] - lo[0]),
+                relative_tolerance: 1e-8,
+                max_evaluations: share,
+            };
+            let r = brent_minimize(|u| f(&[u]), a, b, &opts)?;
+            evaluations += r.evaluations;
+            failures += r.failures;
+            if r.f < f_best {
+                (u_best, f_best) = (r.x, r.f);
+                converged = r.converged;
+            } else if ib == minima[0] {
+                converged = r.converged;
+            }
+        }
+        // A search that ends within half the neighbour step of a bound, no lower than the
+        // bound's own scan value beyond round-off, ends on the bound (Brent converges to
+        // within its tolerance of a bound, not onto it).
+        for end in [0, m - 1] {
+            if (u_best - grid[end]).abs() < 0.5 * NEIGHBOUR_STEP * (hi[0] - lo[0])
+                && vals[end] <= f_best + 1e-12 * f_best.abs()
+            {
+                u_best = grid[end];
+            }
+        }
+        Ok((vec![u_best], evaluations, failures, converged, minima.len()))
+    }
+
+    /// The neighbour check: each free variable moved by ±[`NEIGHBOUR_STEP`] of its search
+    /// range from the optimum (`u_best` in search coordinates, `optimum` in values, objective
+    /// `objective_value` there), the others held; a neighbour the bound holds to less than
+    /// half the step is the bound. Keeps the lowest neighbour below the optimum.
+    fn neighbours(
+        &self,
+        eval: &(dyn Fn(&[&Quantity], &[f64]) -> PointResult + Sync),
+        box_: &SearchBox,
+        u_best: &[f64],
+        optimum: &[f64],
+        objective_value: f64,
+    ) -> NeighbourCheck {
+        let (lo, hi) = (box_.lo, box_.hi);
+        let metric = self.objective.metric();
+        let qs_all: Vec<&Quantity> = self.variables.iter().map(|v| &v.quantity).collect();
+        let mut out = NeighbourCheck::default();
+        for (j, &k) in self.search_order().iter().enumerate() {
+            let h = NEIGHBOUR_STEP * (hi[j] - lo[j]);
+            for (side, sign) in [("lower", -1.0), ("upper", 1.0)] {
+                let t = (u_best[j] + sign * h).clamp(lo[j], hi[j]);
+                let mut x = optimum.to_vec();
+                x[k] = self.search_to_value(k, t);
+                // A neighbour the bound holds to less than half the step (a search ending
+                // within round-off of the bound) is the bound, not a neighbour.
+                if x[k] == optimum[k] || (t - u_best[j]).abs() < 0.5 * h {
+                    out.at_bound
+                        .push(format!("{} ({side})", self.variables[k].quantity.name()));
+                    continue;
+                }
+                let p = eval(&qs_all, &x);
+                out.runs += 1;
+                let fv = p.metric(metric);
+                out.neighbours.push(Neighbour {
+                    variable: self.variables[k].quantity.name(),
+                    value: x[k],
+                    objective: fv,
+                });
+                let lower = fv < objective_value - 1e-12 * objective_value.abs();
+                if lower && out.lower.as_ref().is_none_or(|b| fv < b.2) {
+                    out.lower = Some((x, p, fv, out.neighbours.len() - 1));
+                }
+            }
+        }
+        out
+    }
+
+    /// The free variables whose search coordinate `u_best` is exactly on a bound (named with
+    /// the side), when no neighbour check ran.
+    fn on_bounds(&self, box_: &SearchBox, u_best: &[f64]) -> Vec<String> {
+        let mut at_bound = Vec::new();
+        for (j, &k) in self.search_order().iter().enumerate() {
+            for (side, b) in [("lower", box_.lo[j]), ("upper", box_.hi[j])] {
+                if u_best[j] == b {
+                    at_bound.push(format!("{} ({side})", self.variables[k].quantity.name()));
+                }
+            }
+        }
+        at_bound
+    }
+
+    /// How the search ran, in words (the report's `method`).
+    fn method_text(&self, grid: usize, local_searches: usize) -> String {
+        let n = self.search_order().len();
+        match n {
+            0 => "nothing searched (every variable fixed)".to_string(),
+            1 => format!("a {grid}-point scan over the bounds, then Brent's method around each of the best {local_searches} scan points lower than their neighbours"),
+            _ => format!(
+                "a {} grid over the box ({} simulations), then a bounded Nelder-Mead search with restarts and a coordinate polish from each of the best {local_searches} grid points lower than their neighbours",
+                vec![grid.to_string(); n].join("×"),
+                self.grid_total()
+            ),
+        }
+    }
+
+    /// What the optimum is, from the neighbour check, with the statement for the report: every
+    /// variable fixed, a flat objective (all `finite` values seen equal within 10⁻¹²), not a
+    /// minimum (a neighbour is lower; the caller reports that neighbour), not checked, a
+    /// minimum on a bound, or a local minimum.
+    fn verdict(
+        &self,
+        check: &NeighbourCheck,
+        finite: &[f64],
+        method: &str,
+        s: &SearchEnd,
+    ) -> (Verdict, String) {
+        let metric = self.objective.metric();
+        let order = self.search_order();
+        let objective_value = s.objective_value;
+        let (f_min, f_max) = finite
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        let names: Vec<String> = order
+            .iter()
+            .map(|&k| self.variables[k].quantity.name())
+            .collect();
+        let step_text = format!(
+            "±{} % of each variable's range{}",
+            100.0 * NEIGHBOUR_STEP,
+            if order.iter().any(|&k| self.variables[k].log) {
+                " (in ln x for a log variable)"
+            } else {
+                ""
+            }
+        );
+        let (neighbours, at_bound) = (&check.neighbours, &check.at_bound);
+        if order.is_empty() {
+            (
+                Verdict::Fixed,
+                "every variable is fixed (LO = HI): this is the objective at that point; nothing was searched".to_string(),
+            )
+        } else if finite.len() > 1 && f_max - f_min <= 1e-12 * f_max.abs().max(f_min.abs()) {
+            (
+                Verdict::Flat,
+                format!(
+                    "the objective is flat: {metric} = {objective_value:e} at all {} points evaluated (spread {:e}): it does not depend on {} within the bounds, and any value there is as good as the one reported",
+                    finite.len(),
+                    f_max - f_min,
+                    names.join(", ")
+                ),
+            )
+        } else if let Some((_, _, fv, i)) = &check.lower {
+            let nb = &neighbours[*i];
+            let text = format!(
+                "not a verified local minimum: the search ({}) ended at {metric} = {objective_value:e}, and its neighbour {} = {:e} gives {fv:e}, lower; reported is that neighbour. Raise --max-simulations, or narrow --bounds around it",
+                if s.converged { "converged" } else { "budget reached" },
+                nb.variable,
+                nb.value
+            );
+            (Verdict::NotAMinimum, text)
+        } else if !s.checked {
+            (
+                Verdict::NotChecked,
+                format!(
+                    "not checked: the budget (--max-simulations {}) left no simulations for the {} neighbours (give at least {}); found by {method}",
+                    s.budget, s.check_runs, s.min_runs
+                ),
+            )
+        } else if !at_bound.is_empty() {
+            (
+                Verdict::OnBound,
+                format!(
+                    "a minimum on the bound{}: {}; every neighbour inside the bounds ({step_text}) gives a higher {metric}, so the objective falls towards the bound and lower values may lie beyond it (widen --bounds if the model allows)",
+                    if at_bound.len() == 1 { "" } else { "s" },
+                    at_bound.join(", ")
+                ),
+            )
+        } else {
+            let rise = neighbours
+                .iter()
+                .map(|nb| nb.objective / objective_value - 1.0)
+                .fold(f64::INFINITY, f64::min);
+            (
+                Verdict::LocalMinimum,
+                format!(
+                    "a local minimum: each of the {} neighbours ({step_text}) gives a higher {metric} (smallest rise {:.3e} relative); found by {method}; the lowest found, global to the grid's resolution (a basin narrower than about two grid cells can be missed)",
+                    neighbours.len(),
+                    rise
+                ),
+            )
+        }
+    }
+
+    /// The objective with the paper's rule ω_d = ω_s at the optimum's other variables (any
+    /// variable setting K_d dropped), and the runs it took (none without a damper: NaN).
+    fn rule_objective(
+        &self,
+        eval: &(dyn Fn(&[&Quantity], &[f64]) -> PointResult + Sync),
+        optimum: &[f64],
+    ) -> (f64, usize) {
+        let mut qs: Vec<&Quantity> = Vec::new();
+        let mut vals: Vec<f64> = Vec::new();
+        for (k, v) in self.variables.iter().enumerate() {
+            let is_wd = matches!(v.quantity, Quantity::WdOverWs | Quantity::WdOverWref)
+                || v.quantity == Quantity::Field("contact.bed_damper.stiffness".into());
+            if !is_wd {
+                qs.push(&v.quantity);
+                vals.push(optimum[k]);
+            }
+        }
+        let wd = Quantity::WdOverWs;
+        qs.push(&wd);
+        vals.push(1.0);
+        if self.model.spec.damper.is_some() {
+            let r = eval(&qs, &vals).metric(self.objective.metric());
+            (r, 1)
+        } else {
+            (f64::NAN, 0)
+        }
+    }
+}
+
+/// A search's end: the best point in search coordinates, the simulations, the failures,
+/// whether the best search converged and the local searches run.
+type SearchOutcome = (Vec<f64>, usize, usize, bool, usize);
+
+/// The optimiser's simulations: each point run through the shared structure cache (refused
+/// when its damper does not return at the stroke rate), counted, and the count reported to
+/// `progress` against the budget.
+struct Evaluator<'a> {
+    study: &'a OptimizeStudy,
+    cache: StructureCache,
+    count: AtomicUsize,
+    /// Points refused at the stroke rate.
+    infeasible: AtomicUsize,
+    progress: &'a (dyn Fn(usize, usize) + Sync),
+    budget: usize,
+}
+
+impl Evaluator<'_> {
+    /// The point with the quantities `qs` at the values `x`.
+    fn eval(&self, qs: &[&Quantity], x: &[f64]) -> PointResult {
+        let s = self.study;
+        let r = evaluate_cached(
+            &s.model,
+            qs,
+            x,
+            s.bed_mass_kg,
+            &s.options,
+            0,
+            Some(&self.cache),
+        );
+        let (r, refused) = s.at_stroke_rate(qs, x, r, Some(&self.cache));
+        if refused {
+            self.infeasible.fetch_add(1, Ordering::Relaxed);
+        }
+        let d = self.count.fetch_add(1, Ordering::Relaxed) + 1;
+        (self.progress)(d.min(self.budget), self.budget);
+        r
+    }
+}
+
+/// The search box in search coordinates (ln x for a log variable), the grid points per
+/// variable and the simulations the search may take.
+struct SearchBox<'a> {
+    lo: &'a [f64],
+    hi: &'a [f64],
+    grid: usize,
+    search_budget: usize,
+}
+
+/// What the neighbour check found around the search's end.
+#[derive(Default)]
+struct NeighbourCheck {
+    neighbours: Vec<Neighbour>,
+    /// The variables whose neighbour on a side is the bound itself (`name (side)`).
+    at_bound: Vec<String>,
+    /// The lowest neighbour below the optimum: its point, result, objective and index in
+    /// `neighbours`.
+    lower: Option<(Vec<f64>, PointResult, f64, usize)>,
+    /// The simulations the check ran.
+    runs: usize,
+}
+
+/// How the search ended, for the verdict's statement.
+struct SearchEnd {
+    /// The objective at the search's optimum.
+    objective_value: f64,
+    converged: bool,
+    /// Whether the neighbour check ran.
+    checked: bool,
+    /// The budget (`--max-simulations`), the least that holds the check, and the check's runs.
+    budget: usize,
+    min_runs: usize,
+    check_runs: usize,
 }

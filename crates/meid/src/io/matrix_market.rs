@@ -107,57 +107,7 @@ pub fn read(path: &Path) -> Result<SparseColMat<usize, f64>> {
 
     let (hline, header) = next_line()?
         .ok_or_else(|| input_error(path, 1, 1, "empty file; expected a %%MatrixMarket header"))?;
-    let h = tokens(&header);
-    if h.len() != 5 || !h[0].1.eq_ignore_ascii_case("%%MatrixMarket") {
-        return Err(input_error(
-            path,
-            hline,
-            1,
-            "expected the header `%%MatrixMarket matrix coordinate real symmetric`",
-        ));
-    }
-    let want = ["matrix", "coordinate"];
-    for (tok, w) in h[1..3].iter().zip(want) {
-        if !tok.1.eq_ignore_ascii_case(w) {
-            return Err(input_error(
-                path,
-                hline,
-                tok.0,
-                format!(
-                    "`{}` is not supported; expected `{w}`",
-                    crate::input::clip(tok.1)
-                ),
-            ));
-        }
-    }
-    let field = h[3].1.to_ascii_lowercase();
-    if field != "real" && field != "integer" {
-        return Err(input_error(
-            path,
-            hline,
-            h[3].0,
-            format!(
-                "field `{}` is not supported; expected `real` or `integer`",
-                crate::input::clip(h[3].1)
-            ),
-        ));
-    }
-    let symmetry = h[4].1.to_ascii_lowercase();
-    let symmetric = match symmetry.as_str() {
-        "symmetric" => true,
-        "general" => false,
-        _ => {
-            return Err(input_error(
-                path,
-                hline,
-                h[4].0,
-                format!(
-                    "symmetry `{}` is not supported; expected `symmetric` or `general`",
-                    crate::input::clip(h[4].1)
-                ),
-            ))
-        }
-    };
+    let symmetric = parse_header(path, hline, &header)?;
 
     // Size line (after comments and blank lines).
     let (sline, size) = loop {
@@ -179,35 +129,7 @@ pub fn read(path: &Path) -> Result<SparseColMat<usize, f64>> {
             }
         }
     };
-    let st = tokens(&size);
-    if st.len() != 3 {
-        return Err(input_error(
-            path,
-            sline,
-            1,
-            format!("expected `rows cols entries`, found {} fields", st.len()),
-        ));
-    }
-    let mut dims = [0usize; 3];
-    for (d, (col, t)) in dims.iter_mut().zip(&st) {
-        *d = t.parse().map_err(|_| {
-            input_error(
-                path,
-                sline,
-                *col,
-                format!("`{}` is not a non-negative integer", crate::input::clip(t)),
-            )
-        })?;
-    }
-    let [nrows, ncols, nnz] = dims;
-    if symmetric && nrows != ncols {
-        return Err(input_error(
-            path,
-            sline,
-            1,
-            format!("a symmetric matrix must be square, got {nrows}x{ncols}"),
-        ));
-    }
+    let [nrows, ncols, nnz] = parse_size(path, sline, &size, symmetric)?;
 
     let mut triplets = Vec::with_capacity(if symmetric { 2 * nnz } else { nnz });
     let mut read_entries = 0usize;
@@ -235,43 +157,7 @@ pub fn read(path: &Path) -> Result<SparseColMat<usize, f64>> {
                 format!("more entries than the {nnz} announced on line {sline}"),
             ));
         }
-        let mut idx = [0usize; 2];
-        for (k, lim) in [(0, nrows), (1, ncols)] {
-            let (col, s) = tk[k];
-            let v: usize = s.parse().map_err(|_| {
-                input_error(
-                    path,
-                    no,
-                    col,
-                    format!(
-                        "`{}` is not a positive integer index",
-                        crate::input::clip(s)
-                    ),
-                )
-            })?;
-            if v == 0 || v > lim {
-                return Err(input_error(
-                    path,
-                    no,
-                    col,
-                    format!("index {v} is outside 1..={lim}"),
-                ));
-            }
-            idx[k] = v - 1;
-        }
-        let (col, s) = tk[2];
-        let v: f64 = s.parse().map_err(|_| {
-            input_error(
-                path,
-                no,
-                col,
-                format!("`{}` is not a number", crate::input::clip(s)),
-            )
-        })?;
-        if !v.is_finite() {
-            return Err(input_error(path, no, col, format!("`{s}` is not finite")));
-        }
-        let (i, j) = (idx[0], idx[1]);
+        let (i, j, v) = parse_entry(path, no, &tk, nrows, ncols)?;
         if symmetric {
             if i < j {
                 return Err(input_error(
@@ -308,6 +194,143 @@ pub fn read(path: &Path) -> Result<SparseColMat<usize, f64>> {
             format!("could not build the matrix: {e:?}"),
         )
     })
+}
+
+/// The header line `%%MatrixMarket matrix coordinate FIELD SYMMETRY` (line `hline`): FIELD
+/// `real` or `integer`, SYMMETRY `symmetric` (returns true) or `general` (false).
+fn parse_header(path: &Path, hline: usize, header: &str) -> Result<bool> {
+    let h = tokens(header);
+    if h.len() != 5 || !h[0].1.eq_ignore_ascii_case("%%MatrixMarket") {
+        return Err(input_error(
+            path,
+            hline,
+            1,
+            "expected the header `%%MatrixMarket matrix coordinate real symmetric`",
+        ));
+    }
+    let want = ["matrix", "coordinate"];
+    for (tok, w) in h[1..3].iter().zip(want) {
+        if !tok.1.eq_ignore_ascii_case(w) {
+            return Err(input_error(
+                path,
+                hline,
+                tok.0,
+                format!(
+                    "`{}` is not supported; expected `{w}`",
+                    crate::input::clip(tok.1)
+                ),
+            ));
+        }
+    }
+    let field = h[3].1.to_ascii_lowercase();
+    if field != "real" && field != "integer" {
+        return Err(input_error(
+            path,
+            hline,
+            h[3].0,
+            format!(
+                "field `{}` is not supported; expected `real` or `integer`",
+                crate::input::clip(h[3].1)
+            ),
+        ));
+    }
+    let symmetry = h[4].1.to_ascii_lowercase();
+    match symmetry.as_str() {
+        "symmetric" => Ok(true),
+        "general" => Ok(false),
+        _ => Err(input_error(
+            path,
+            hline,
+            h[4].0,
+            format!(
+                "symmetry `{}` is not supported; expected `symmetric` or `general`",
+                crate::input::clip(h[4].1)
+            ),
+        )),
+    }
+}
+
+/// The size line `rows cols entries` (line `sline`) as `[rows, cols, entries]`; a symmetric
+/// matrix must be square.
+fn parse_size(path: &Path, sline: usize, size: &str, symmetric: bool) -> Result<[usize; 3]> {
+    let st = tokens(size);
+    if st.len() != 3 {
+        return Err(input_error(
+            path,
+            sline,
+            1,
+            format!("expected `rows cols entries`, found {} fields", st.len()),
+        ));
+    }
+    let mut dims = [0usize; 3];
+    for (d, (col, t)) in dims.iter_mut().zip(&st) {
+        *d = t.parse().map_err(|_| {
+            input_error(
+                path,
+                sline,
+                *col,
+                format!("`{}` is not a non-negative integer", crate::input::clip(t)),
+            )
+        })?;
+    }
+    let [nrows, ncols, _] = dims;
+    if symmetric && nrows != ncols {
+        return Err(input_error(
+            path,
+            sline,
+            1,
+            format!("a symmetric matrix must be square, got {nrows}x{ncols}"),
+        ));
+    }
+    Ok(dims)
+}
+
+/// One entry line's tokens `row col value` (line `no`) as 0-based `(i, j, value)`: indices in
+/// 1..=rows and 1..=cols, a finite value.
+fn parse_entry(
+    path: &Path,
+    no: usize,
+    tk: &[(usize, &str)],
+    nrows: usize,
+    ncols: usize,
+) -> Result<(usize, usize, f64)> {
+    let mut idx = [0usize; 2];
+    for (k, lim) in [(0, nrows), (1, ncols)] {
+        let (col, s) = tk[k];
+        let v: usize = s.parse().map_err(|_| {
+            input_error(
+                path,
+                no,
+                col,
+                format!(
+                    "`{}` is not a positive integer index",
+                    crate::input::clip(s)
+                ),
+            )
+        })?;
+        if v == 0 || v > lim {
+            return Err(input_error(
+                path,
+                no,
+                col,
+                format!("index {v} is outside 1..={lim}"),
+            ));
+        }
+        idx[k] = v - 1;
+    }
+    let (col, s) = tk[2];
+    let v: f64 = s.parse().map_err(|_| {
+        input_error(
+            path,
+            no,
+            col,
+            format!("`{}` is not a number", crate::input::clip(s)),
+        )
+    })?;
+    if !v.is_finite() {
+        return Err(input_error(path, no, col, format!("`{s}` is not finite")));
+    }
+    Ok((idx[0], idx[1], v))
 }
 
 #[cfg(test)]

@@ -1096,9 +1096,73 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
         .iter()
         .map(|&i| free.iter().map(|&j| dot(&jp[i], &jp[j])).collect())
         .collect();
-    // The baselines' share (module docs): Σ_k var(b̄_k)/rms_k² g_k g_kᵀ over the free values,
-    // g_k the sums of J_p's rows of channel k (time-history residuals only: a constant leaves
-    // the ESD above DC as it is).
+    let baseline = baseline_term(problem, &free, &jp);
+    let c_inv = spd_inverse(&a);
+    let cov = covariance(c_inv.as_deref(), &baseline, &free, n, s2);
+    // The Gauss-Newton step left at the estimate, δ = −C J_pᵀr over the free values: the
+    // solver stops on a relative step or cost decrease (xtol, ftol), which on data with little
+    // noise is far wider than the statistical interval.
+    let mut solver_step = vec![f64::NAN; n];
+    if let Some(c) = &c_inv {
+        let g: Vec<f64> = free.iter().map(|&i| dot(&jp[i], &r1)).collect();
+        for (k, &i) in free.iter().enumerate() {
+            solver_step[i] = c[k].iter().zip(&g).map(|(c, g)| c * g).sum::<f64>().abs();
+        }
+    }
+    let t = student_t_975(dof);
+    let mut estimates = Vec::new();
+    for (i, p) in params.iter().enumerate() {
+        let at_bound = out.x[i] <= lo[i] || out.x[i] >= hi[i];
+        let se = match &cov {
+            Some(c) if !at_bound && c[i][i] >= 0.0 => c[i][i].sqrt(),
+            _ => f64::NAN,
+        };
+        let step = if se.is_nan() {
+            f64::NAN
+        } else {
+            solver_step[i]
+        };
+        estimates.push(estimate(
+            p,
+            values[i],
+            se,
+            step,
+            t,
+            at_bound,
+            identifiability[i],
+        ));
+    }
+    let correlation = match &cov {
+        Some(c) => (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| c[i][j] / (c[i][i] * c[j][j]).sqrt())
+                    .collect()
+            })
+            .collect(),
+        None => vec![vec![f64::NAN; n]; n],
+    };
+    Ok(Calibration {
+        parameters: estimates,
+        residual: problem.settings.residual,
+        residuals: m,
+        rms_residual_before: (dot(&r0, &r0) / r0.len() as f64).sqrt(),
+        rms_residual_after: (cost / m as f64).sqrt(),
+        sigma: s2.sqrt(),
+        correlation,
+        iterations: out.iterations,
+        evaluations: out.evaluations + 2,
+        convergence: out.reason,
+        converged: out.reason.converged(),
+        structures_built: problem.structures_built(),
+        channels: channel_fits(problem, &before, &after),
+    })
+}
+
+/// The baselines' share of the covariance (module docs): B = Σ_k var(b̄_k)/rms_k² g_k g_kᵀ over
+/// the `free` values, g_k the sums of J_p's rows of channel k (time-history residuals only: a
+/// constant leaves the ESD above DC as it is).
+fn baseline_term(problem: &Problem<'_>, free: &[usize], jp: &[Vec<f64>]) -> Vec<Vec<f64>> {
     let mut baseline_term = vec![vec![0.0; free.len()]; free.len()];
     if problem.settings.residual == ResidualKind::TimeHistory {
         let mut row = 0;
@@ -1122,9 +1186,19 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
             }
         }
     }
-    // Cov = s² C + C B C over the free values (C = (J_pᵀ J_p)⁻¹).
-    let c_inv = spd_inverse(&a);
-    let cov: Option<Vec<Vec<f64>>> = c_inv.as_ref().map(|c| {
+    baseline_term
+}
+
+/// Cov = s² C + C B C over the `free` values (C = (J_pᵀ J_p)⁻¹, `c_inv`; B the baselines'
+/// share), in an n × n matrix with NaN for the held values; `None` without C.
+fn covariance(
+    c_inv: Option<&[Vec<f64>]>,
+    baseline_term: &[Vec<f64>],
+    free: &[usize],
+    n: usize,
+    s2: f64,
+) -> Option<Vec<Vec<f64>>> {
+    c_inv.map(|c| {
         let k = free.len();
         let cb: Vec<Vec<f64>> = (0..k)
             .map(|a| {
@@ -1141,57 +1215,40 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
             }
         }
         full
-    });
-    // The Gauss-Newton step left at the estimate, δ = −C J_pᵀr over the free values: the
-    // solver stops on a relative step or cost decrease (xtol, ftol), which on data with little
-    // noise is far wider than the statistical interval.
-    let mut solver_step = vec![f64::NAN; n];
-    if let Some(c) = &c_inv {
-        let g: Vec<f64> = free.iter().map(|&i| dot(&jp[i], &r1)).collect();
-        for (k, &i) in free.iter().enumerate() {
-            solver_step[i] = c[k].iter().zip(&g).map(|(c, g)| c * g).sum::<f64>().abs();
-        }
+    })
+}
+
+/// One parameter's estimate `v` with its 95 % interval `v ± (t se + step)` (`t` Student's
+/// 97.5 % quantile, `se` the standard error, `step` the Gauss-Newton step left).
+fn estimate(
+    p: &FitParameter,
+    v: f64,
+    se: f64,
+    step: f64,
+    t: f64,
+    at_bound: bool,
+    identifiability: Identifiability,
+) -> Estimate {
+    let half = t * se + step;
+    Estimate {
+        path: p.path.clone(),
+        start: p.start,
+        value: v,
+        lower_bound: p.lower,
+        upper_bound: p.upper,
+        standard_error: se,
+        solver_step: step,
+        ci95_low: v - half,
+        ci95_high: v + half,
+        relative_half_width: half / v.abs(),
+        at_bound,
+        identifiability,
     }
-    let t = student_t_975(dof);
-    let mut estimates = Vec::new();
-    for (i, p) in params.iter().enumerate() {
-        let v = values[i];
-        let at_bound = out.x[i] <= lo[i] || out.x[i] >= hi[i];
-        let se = match &cov {
-            Some(c) if !at_bound && c[i][i] >= 0.0 => c[i][i].sqrt(),
-            _ => f64::NAN,
-        };
-        let step = if se.is_nan() {
-            f64::NAN
-        } else {
-            solver_step[i]
-        };
-        let half = t * se + step;
-        estimates.push(Estimate {
-            path: p.path.clone(),
-            start: p.start,
-            value: v,
-            lower_bound: p.lower,
-            upper_bound: p.upper,
-            standard_error: se,
-            solver_step: step,
-            ci95_low: v - half,
-            ci95_high: v + half,
-            relative_half_width: half / v.abs(),
-            at_bound,
-            identifiability: identifiability[i],
-        });
-    }
-    let correlation = match &cov {
-        Some(c) => (0..n)
-            .map(|i| {
-                (0..n)
-                    .map(|j| c[i][j] / (c[i][i] * c[j][j]).sqrt())
-                    .collect()
-            })
-            .collect(),
-        None => vec![vec![f64::NAN; n]; n],
-    };
+}
+
+/// Each measured channel against the simulation before and after the fit: the RMS errors
+/// `√(Σ (s − m)²/n)` and the blow-averaged records.
+fn channel_fits(problem: &Problem<'_>, before: &Simulated, after: &Simulated) -> Vec<ChannelFit> {
     let mut channels = Vec::new();
     for (ci, ct) in problem.cases.iter().enumerate() {
         for (k, ch) in ct.channels.iter().enumerate() {
@@ -1222,21 +1279,7 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
             });
         }
     }
-    Ok(Calibration {
-        parameters: estimates,
-        residual: problem.settings.residual,
-        residuals: m,
-        rms_residual_before: (dot(&r0, &r0) / r0.len() as f64).sqrt(),
-        rms_residual_after: (cost / m as f64).sqrt(),
-        sigma: s2.sqrt(),
-        correlation,
-        iterations: out.iterations,
-        evaluations: out.evaluations + 2,
-        convergence: out.reason,
-        converged: out.reason.converged(),
-        structures_built: problem.structures_built(),
-        channels,
-    })
+    channels
 }
 
 /// The calibrated model file: the model's own text with each fitted value replaced in place

@@ -406,58 +406,121 @@ pub fn build(spec: &GeneralSpec, src: &Source) -> Result<FeModel> {
 /// paper's machine ([`crate::structure::MachineSpec::generate`]). Inline nodes are the first
 /// mesh nodes, in their order; nodes of Gmsh elements and of `divisions` follow.
 pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> {
-    let gmsh = match &spec.mesh {
-        Some(file) => {
-            let dir = Path::new(&src.name)
-                .parent()
-                .map(Path::to_path_buf)
-                .unwrap_or_default();
-            Some(crate::structure::gmsh::read_msh(dir.join(file))?)
-        }
-        None => None,
-    };
-    let ng = gmsh.as_ref().map(|g| g.nodes.len()).unwrap_or(0);
-    let mut b = Builder {
-        src,
-        mesh: Mesh::new(),
-        gmsh,
-        gmap: vec![None; ng],
-        inline: Vec::new(),
-        sets: BTreeMap::new(),
-    };
-    for (i, p) in spec.nodes.iter().enumerate() {
-        if p.iter().any(|c| !c.is_finite()) {
-            return Err(b.err(&format!("nodes[{i}]"), "coordinates must be finite (m)"));
-        }
-        let x = b.mesh.add_node(*p);
-        b.inline.push(x);
-    }
-    for (name, v) in &spec.sets {
-        let mut nodes = Vec::with_capacity(v.len());
-        for &i in v {
-            nodes.push(b.inline_node(i, &format!("sets.{name}"))?);
-        }
-        if nodes.is_empty() {
-            return Err(b.err(&format!("sets.{name}"), "is empty"));
-        }
-        b.sets.insert(name.clone(), nodes);
-    }
+    let mut b = Builder::start(spec, src)?;
     let default_mat = b.material(&spec.material, Material::STEEL, "material")?;
+    b.add_shells(spec, default_mat)?;
+    b.add_frames(spec, default_mat)?;
+    b.add_discrete(spec)?;
+    b.add_links_and_constraints(spec)?;
+    b.name_points(spec)?;
+    let d = spec.impact_direction.unwrap_or([0.0, 0.0, -1.0]);
+    let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    if !(norm.is_finite() && norm > 0.0) {
+        return Err(b.err("impact_direction", "must be a nonzero finite vector"));
+    }
+    check_coincident_nodes(&b, spec)?;
+    Ok((b.mesh, [d[0] / norm, d[1] / norm, d[2] / norm]))
+}
 
-    // Shells: every Gmsh quadrangle must get exactly one section.
-    let nq = b.gmsh.as_ref().map(|g| g.quads.len()).unwrap_or(0);
-    let mut quad_section: Vec<Option<usize>> = vec![None; nq];
-    let nt = b.gmsh.as_ref().map(|g| g.triangles.len()).unwrap_or(0);
-    let mut tri_section: Vec<Option<usize>> = vec![None; nt];
-    for (si, s) in spec.shells.iter().enumerate() {
+/// Which shell section (`shells[k]`) each Gmsh quadrangle and triangle has taken so far:
+/// every one must get exactly one.
+struct ShellSections {
+    quads: Vec<Option<usize>>,
+    triangles: Vec<Option<usize>>,
+}
+
+impl<'a> Builder<'a> {
+    /// Reads the Gmsh mesh (relative to the model file), adds the inline `nodes` in their order
+    /// and resolves the inline `sets`.
+    fn start(spec: &GeneralSpec, src: &'a Source) -> Result<Self> {
+        let gmsh = match &spec.mesh {
+            Some(file) => {
+                let dir = Path::new(&src.name)
+                    .parent()
+                    .map(Path::to_path_buf)
+                    .unwrap_or_default();
+                Some(crate::structure::gmsh::read_msh(dir.join(file))?)
+            }
+            None => None,
+        };
+        let ng = gmsh.as_ref().map(|g| g.nodes.len()).unwrap_or(0);
+        let mut b = Builder {
+            src,
+            mesh: Mesh::new(),
+            gmsh,
+            gmap: vec![None; ng],
+            inline: Vec::new(),
+            sets: BTreeMap::new(),
+        };
+        for (i, p) in spec.nodes.iter().enumerate() {
+            if p.iter().any(|c| !c.is_finite()) {
+                return Err(b.err(&format!("nodes[{i}]"), "coordinates must be finite (m)"));
+            }
+            let x = b.mesh.add_node(*p);
+            b.inline.push(x);
+        }
+        for (name, v) in &spec.sets {
+            let mut nodes = Vec::with_capacity(v.len());
+            for &i in v {
+                nodes.push(b.inline_node(i, &format!("sets.{name}"))?);
+            }
+            if nodes.is_empty() {
+                return Err(b.err(&format!("sets.{name}"), "is empty"));
+            }
+            b.sets.insert(name.clone(), nodes);
+        }
+        Ok(b)
+    }
+}
+
+impl Builder<'_> {
+    /// Adds every `shells` entry's quadrangles and triangles, then refuses a Gmsh quadrangle or
+    /// triangle that no entry gave a section.
+    fn add_shells(&mut self, spec: &GeneralSpec, default_mat: Material) -> Result<()> {
+        let nq = self.gmsh.as_ref().map(|g| g.quads.len()).unwrap_or(0);
+        let nt = self.gmsh.as_ref().map(|g| g.triangles.len()).unwrap_or(0);
+        let mut taken = ShellSections {
+            quads: vec![None; nq],
+            triangles: vec![None; nt],
+        };
+        for (si, s) in spec.shells.iter().enumerate() {
+            self.add_shell(si, s, default_mat, &mut taken)?;
+        }
+        if let Some(q) = taken.quads.iter().position(|s| s.is_none()) {
+            let tag = self.gmsh.as_ref().map(|g| g.quad_tags[q]).unwrap_or(0);
+            return Err(self.err(
+                "shells",
+                format!("quadrangle {tag} of the mesh is in no `shells` set: give its physical surface a section"),
+            ));
+        }
+        if let Some(t) = taken.triangles.iter().position(|s| s.is_none()) {
+            let tag = self.gmsh.as_ref().map(|g| g.triangle_tags[t]).unwrap_or(0);
+            return Err(self.err(
+                "shells",
+                format!("triangle {tag} of the mesh is in no `shells` set: give its physical surface a section"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// One `shells[si]` entry: checks its thickness (against its own extent too), material and
+    /// shear factor κ, gathers its elements (Gmsh set, inline quads, inline triangles) and adds
+    /// them to the mesh and its part.
+    fn add_shell(
+        &mut self,
+        si: usize,
+        s: &ShellSpec,
+        default_mat: Material,
+        taken: &mut ShellSections,
+    ) -> Result<()> {
         let field = format!("shells[{si}]");
-        positive(&b, &format!("{field}.thickness"), s.thickness, "m")?;
-        let mat = b.material(&s.material, default_mat, &format!("{field}.material"))?;
+        positive(self, &format!("{field}.thickness"), s.thickness, "m")?;
+        let mat = self.material(&s.material, default_mat, &format!("{field}.material"))?;
         let kappa = s
             .shear_factor
             .unwrap_or(crate::structure::shell::DEFAULT_SHEAR_FACTOR);
         positive(
-            &b,
+            self,
             &format!("{field}.shear_factor"),
             kappa,
             "(5/6 is usual)",
@@ -465,110 +528,18 @@ pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> 
         let mut quads: Vec<[usize; 4]> = Vec::new();
         let mut tris: Vec<[usize; 3]> = Vec::new();
         if let Some(set) = &s.set {
-            let g = b.gmsh.as_ref();
-            let tri_ids = g
-                .and_then(|g| g.triangle_sets.get(set))
-                .cloned()
-                .unwrap_or_default();
-            let ids = g
-                .and_then(|g| g.element_sets.get(set))
-                .cloned()
-                .or_else(|| (!tri_ids.is_empty()).then(Vec::new))
-                .ok_or_else(|| {
-                    let mut known: Vec<String> = g
-                        .map(|g| {
-                            g.element_sets
-                                .keys()
-                                .chain(g.triangle_sets.keys())
-                                .cloned()
-                                .collect()
-                        })
-                        .unwrap_or_default();
-                    known.sort();
-                    known.dedup();
-                    b.err(
-                        &format!("{field}.set"),
-                        format!(
-                            "no physical surface '{set}' of quadrangles or triangles in the mesh; known: {}",
-                            if known.is_empty() {
-                                "(none)".to_string()
-                            } else {
-                                known.join(", ")
-                            }
-                        ),
-                    )
-                })?;
-            for q in ids {
-                if let Some(prev) = quad_section[q] {
-                    let tag = b.gmsh.as_ref().map(|g| g.quad_tags[q]).unwrap_or(0);
-                    return Err(b.err(
-                        &format!("{field}.set"),
-                        format!("quadrangle {tag} already has the section of shells[{prev}]; give each quadrangle one section"),
-                    ));
-                }
-                quad_section[q] = Some(si);
-                let gq = b.gmsh.as_ref().map(|g| g.quads[q]).unwrap_or([0; 4]);
-                quads.push(gq.map(|i| b.gnode(i)));
-            }
-            for t in tri_ids {
-                if let Some(prev) = tri_section[t] {
-                    let tag = b.gmsh.as_ref().map(|g| g.triangle_tags[t]).unwrap_or(0);
-                    return Err(b.err(
-                        &format!("{field}.set"),
-                        format!("triangle {tag} already has the section of shells[{prev}]; give each triangle one section"),
-                    ));
-                }
-                tri_section[t] = Some(si);
-                let gt = b.gmsh.as_ref().map(|g| g.triangles[t]).unwrap_or([0; 3]);
-                tris.push(gt.map(|i| b.gnode(i)));
-            }
+            self.shell_set_elements(si, &field, set, taken, &mut quads, &mut tris)?;
         }
         for (k, q) in s.quads.iter().enumerate() {
             let mut nodes = [0; 4];
             for (c, &i) in q.iter().enumerate() {
-                nodes[c] = b.inline_node(i, &format!("{field}.quads[{k}]"))?;
+                nodes[c] = self.inline_node(i, &format!("{field}.quads[{k}]"))?;
             }
             quads.push(nodes);
         }
-        let inline_tris = tris.len();
-        for (k, t) in s.triangles.iter().enumerate() {
-            let f = format!("{field}.triangles[{k}]");
-            let nodes = [
-                b.inline_node(t[0], &f)?,
-                b.inline_node(t[1], &f)?,
-                b.inline_node(t[2], &f)?,
-            ];
-            if nodes[0] == nodes[1] || nodes[1] == nodes[2] || nodes[0] == nodes[2] {
-                return Err(b.err(
-                    &f,
-                    format!("{t:?} is degenerate: a node is repeated; a triangle needs three distinct nodes"),
-                ));
-            }
-            crate::structure::tri3::tri_geometry(&nodes.map(|n| b.mesh.nodes[n]))
-                .map_err(|e| b.err(&f, format!("nodes {t:?}: {e}")))?;
-            tris.push(nodes);
-        }
-        {
-            let polys: Vec<&[usize]> = tris[inline_tris..].iter().map(|t| &t[..]).collect();
-            if let Some(fault) = crate::structure::tri3::check_orientation(&polys, &b.mesh.nodes) {
-                let (a, c) = (fault.elements[0], fault.elements[1]);
-                return Err(b.err(
-                    &format!("{field}.triangles[{c}]"),
-                    format!(
-                        "{:?} is inverted against triangles[{a}] {:?} ({}); order the nodes of one surface alike",
-                        s.triangles[c],
-                        s.triangles[a],
-                        if fault.same_direction {
-                            "both run their shared edge in the same direction"
-                        } else {
-                            "it folds back onto it"
-                        }
-                    ),
-                ));
-            }
-        }
+        self.inline_triangles(&field, s, &mut tris)?;
         if quads.is_empty() && tris.is_empty() {
-            return Err(b.err(
+            return Err(self.err(
                 &field,
                 "has no elements: give `set` (a Gmsh physical surface), `quads` or `triangles`",
             ));
@@ -578,120 +549,266 @@ pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> 
                 .iter()
                 .flatten()
                 .chain(tris.iter().flatten())
-                .map(|&n| b.mesh.nodes[n]),
+                .map(|&n| self.mesh.nodes[n]),
         );
         if let Some(msg) = thickness_fault(s.thickness, extent) {
-            return Err(b.err(&format!("{field}.thickness"), msg));
+            return Err(self.err(&format!("{field}.thickness"), msg));
         }
         for q in quads {
             let mut el = ShellElement::new(q, mat, s.thickness);
             el.shear_factor = kappa;
-            let e = b.mesh.add_shell(el);
-            b.in_part(&s.part, |p| p.shells.push(e));
+            let e = self.mesh.add_shell(el);
+            self.in_part(&s.part, |p| p.shells.push(e));
         }
         for t in tris {
-            let e = b
+            let e = self
                 .mesh
                 .add_triangle(TriShellElement::new(t, mat, s.thickness));
-            b.in_part(&s.part, |p| p.triangles.push(e));
+            self.in_part(&s.part, |p| p.triangles.push(e));
         }
-    }
-    if let Some(q) = quad_section.iter().position(|s| s.is_none()) {
-        let tag = b.gmsh.as_ref().map(|g| g.quad_tags[q]).unwrap_or(0);
-        return Err(b.err(
-            "shells",
-            format!("quadrangle {tag} of the mesh is in no `shells` set: give its physical surface a section"),
-        ));
-    }
-    if let Some(t) = tri_section.iter().position(|s| s.is_none()) {
-        let tag = b.gmsh.as_ref().map(|g| g.triangle_tags[t]).unwrap_or(0);
-        return Err(b.err(
-            "shells",
-            format!("triangle {tag} of the mesh is in no `shells` set: give its physical surface a section"),
-        ));
+        Ok(())
     }
 
-    // Frames.
-    let nl = b.gmsh.as_ref().map(|g| g.lines.len()).unwrap_or(0);
-    let mut line_section: Vec<Option<usize>> = vec![None; nl];
-    for (fi, f) in spec.frames.iter().enumerate() {
+    /// The quadrangles and triangles of the Gmsh physical surface `set` for `shells[si]`,
+    /// refusing an element another entry already gave a section.
+    fn shell_set_elements(
+        &mut self,
+        si: usize,
+        field: &str,
+        set: &str,
+        taken: &mut ShellSections,
+        quads: &mut Vec<[usize; 4]>,
+        tris: &mut Vec<[usize; 3]>,
+    ) -> Result<()> {
+        let g = self.gmsh.as_ref();
+        let tri_ids = g
+            .and_then(|g| g.triangle_sets.get(set))
+            .cloned()
+            .unwrap_or_default();
+        let ids = g
+            .and_then(|g| g.element_sets.get(set))
+            .cloned()
+            .or_else(|| (!tri_ids.is_empty()).then(Vec::new))
+            .ok_or_else(|| {
+                let mut known: Vec<String> = g
+                    .map(|g| {
+                        g.element_sets
+                            .keys()
+                            .chain(g.triangle_sets.keys())
+                            .cloned()
+                            .collect()
+                    })
+                    .unwrap_or_default();
+                known.sort();
+                known.dedup();
+                self.err(
+                    &format!("{field}.set"),
+                    format!(
+                        "no physical surface '{set}' of quadrangles or triangles in the mesh; known: {}",
+                        if known.is_empty() {
+                            "(none)".to_string()
+                        } else {
+                            known.join(", ")
+                        }
+                    ),
+                )
+            })?;
+        for q in ids {
+            if let Some(prev) = taken.quads[q] {
+                let tag = self.gmsh.as_ref().map(|g| g.quad_tags[q]).unwrap_or(0);
+                return Err(self.err(
+                    &format!("{field}.set"),
+                    format!("quadrangle {tag} already has the section of shells[{prev}]; give each quadrangle one section"),
+                ));
+            }
+            taken.quads[q] = Some(si);
+            let gq = self.gmsh.as_ref().map(|g| g.quads[q]).unwrap_or([0; 4]);
+            quads.push(gq.map(|i| self.gnode(i)));
+        }
+        for t in tri_ids {
+            if let Some(prev) = taken.triangles[t] {
+                let tag = self.gmsh.as_ref().map(|g| g.triangle_tags[t]).unwrap_or(0);
+                return Err(self.err(
+                    &format!("{field}.set"),
+                    format!("triangle {tag} already has the section of shells[{prev}]; give each triangle one section"),
+                ));
+            }
+            taken.triangles[t] = Some(si);
+            let gt = self.gmsh.as_ref().map(|g| g.triangles[t]).unwrap_or([0; 3]);
+            tris.push(gt.map(|i| self.gnode(i)));
+        }
+        Ok(())
+    }
+
+    /// The inline `triangles` of a shell entry, appended to `tris`: each must have three
+    /// distinct nodes and a proper geometry, and neighbours must be ordered alike (no inverted
+    /// triangle against one sharing its edge).
+    fn inline_triangles(
+        &mut self,
+        field: &str,
+        s: &ShellSpec,
+        tris: &mut Vec<[usize; 3]>,
+    ) -> Result<()> {
+        let inline_tris = tris.len();
+        for (k, t) in s.triangles.iter().enumerate() {
+            let f = format!("{field}.triangles[{k}]");
+            let nodes = [
+                self.inline_node(t[0], &f)?,
+                self.inline_node(t[1], &f)?,
+                self.inline_node(t[2], &f)?,
+            ];
+            if nodes[0] == nodes[1] || nodes[1] == nodes[2] || nodes[0] == nodes[2] {
+                return Err(self.err(
+                    &f,
+                    format!("{t:?} is degenerate: a node is repeated; a triangle needs three distinct nodes"),
+                ));
+            }
+            crate::structure::tri3::tri_geometry(&nodes.map(|n| self.mesh.nodes[n]))
+                .map_err(|e| self.err(&f, format!("nodes {t:?}: {e}")))?;
+            tris.push(nodes);
+        }
+        let polys: Vec<&[usize]> = tris[inline_tris..].iter().map(|t| &t[..]).collect();
+        if let Some(fault) = crate::structure::tri3::check_orientation(&polys, &self.mesh.nodes) {
+            let (a, c) = (fault.elements[0], fault.elements[1]);
+            return Err(self.err(
+                &format!("{field}.triangles[{c}]"),
+                format!(
+                    "{:?} is inverted against triangles[{a}] {:?} ({}); order the nodes of one surface alike",
+                    s.triangles[c],
+                    s.triangles[a],
+                    if fault.same_direction {
+                        "both run their shared edge in the same direction"
+                    } else {
+                        "it folds back onto it"
+                    }
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Adds every `frames` entry; a Gmsh line may take one frame section only.
+    fn add_frames(&mut self, spec: &GeneralSpec, default_mat: Material) -> Result<()> {
+        let nl = self.gmsh.as_ref().map(|g| g.lines.len()).unwrap_or(0);
+        let mut line_section: Vec<Option<usize>> = vec![None; nl];
+        for (fi, f) in spec.frames.iter().enumerate() {
+            self.add_frame(fi, f, default_mat, &mut line_section)?;
+        }
+        Ok(())
+    }
+
+    /// One `frames[fi]` entry: checks its section (A, I_y, I_z, J > 0), material and
+    /// orientation, divides it into 2-node elements, applies its end releases and adds the
+    /// elements to the mesh and its part.
+    fn add_frame(
+        &mut self,
+        fi: usize,
+        f: &FrameSpec,
+        default_mat: Material,
+        line_section: &mut [Option<usize>],
+    ) -> Result<()> {
         let field = format!("frames[{fi}]");
         for (k, v) in [("area", f.area), ("iy", f.iy), ("iz", f.iz), ("j", f.j)] {
             positive(
-                &b,
+                self,
                 &format!("{field}.{k}"),
                 v,
                 if k == "area" { "m²" } else { "m⁴" },
             )?;
         }
         let section =
-            Section::new(f.area, f.iy, f.iz, f.j).map_err(|e| b.err(&field, e.to_string()))?;
-        let mat = b.material(&f.material, default_mat, &format!("{field}.material"))?;
+            Section::new(f.area, f.iy, f.iz, f.j).map_err(|e| self.err(&field, e.to_string()))?;
+        let mat = self.material(&f.material, default_mat, &format!("{field}.material"))?;
         if let Some(o) = f.orientation {
             let n2 = o.iter().map(|x| x * x).sum::<f64>();
             if !(n2.is_finite() && n2 > 0.0) {
-                return Err(b.err(
+                return Err(self.err(
                     &format!("{field}.orientation"),
                     "must be a nonzero finite vector",
                 ));
             }
         }
+        let segs = self.frame_segments(fi, &field, f, line_section)?;
+        check_slenderness(self, &field, f, &segs)?;
+        let rel = self.frame_releases(&field, f, &segs)?;
+        for (k, s) in segs.into_iter().enumerate() {
+            let mut el = FrameElement::new(s, mat, section);
+            el.orientation = f.orientation;
+            el.releases = rel[k];
+            crate::structure::frame::check_releases(&el.releases)
+                .map_err(|e| self.err(&format!("{field}.releases"), e.to_string()))?;
+            let e = self.mesh.add_frame(el);
+            self.in_part(&f.part, |p| p.frames.push(e));
+        }
+        Ok(())
+    }
+
+    /// The 2-node elements of a frame entry: the lines of its Gmsh physical curve, or its
+    /// inline chain `nodes = [a, b, ...]` with each segment divided into `divisions` equal
+    /// elements (new nodes at `p_a + (k/n)(p_b − p_a)`).
+    fn frame_segments(
+        &mut self,
+        fi: usize,
+        field: &str,
+        f: &FrameSpec,
+        line_section: &mut [Option<usize>],
+    ) -> Result<Vec<[usize; 2]>> {
         let mut segs: Vec<[usize; 2]> = Vec::new();
         match (&f.set, &f.nodes) {
             (Some(set), None) => {
                 if f.divisions.is_some() {
-                    return Err(b.err(
+                    return Err(self.err(
                         &format!("{field}.divisions"),
                         "applies to `nodes = [a, b, ...]` only; a Gmsh curve is already divided",
                     ));
                 }
-                let ids = b
+                let ids = self
                     .gmsh
                     .as_ref()
                     .and_then(|g| g.line_sets.get(set))
                     .cloned()
                     .ok_or_else(|| {
-                        b.err(
+                        self.err(
                             &format!("{field}.set"),
                             format!("no physical curve '{set}' of 2-node lines in the mesh"),
                         )
                     })?;
                 for l in ids {
                     if line_section[l].replace(fi).is_some() {
-                        return Err(b.err(
+                        return Err(self.err(
                             &format!("{field}.set"),
                             "a line already has another frame section",
                         ));
                     }
-                    let gl = b.gmsh.as_ref().map(|g| g.lines[l]).unwrap_or([0; 2]);
-                    segs.push(gl.map(|i| b.gnode(i)));
+                    let gl = self.gmsh.as_ref().map(|g| g.lines[l]).unwrap_or([0; 2]);
+                    segs.push(gl.map(|i| self.gnode(i)));
                 }
             }
             (None, Some(chain)) => {
                 if chain.len() < 2 {
-                    return Err(b.err(
+                    return Err(self.err(
                         &format!("{field}.nodes"),
                         format!("needs at least two nodes [a, b, ...] (got {})", chain.len()),
                     ));
                 }
                 let nd = f.divisions.unwrap_or(1);
                 if nd == 0 || nd > 100_000 {
-                    return Err(b.err(
+                    return Err(self.err(
                         &format!("{field}.divisions"),
                         format!("must be in 1..=100000 (got {nd})"),
                     ));
                 }
                 for pair in chain.windows(2) {
-                    let a = b.inline_node(pair[0], &format!("{field}.nodes"))?;
-                    let c = b.inline_node(pair[1], &format!("{field}.nodes"))?;
-                    let (pa, pc) = (b.mesh.nodes[a], b.mesh.nodes[c]);
+                    let a = self.inline_node(pair[0], &format!("{field}.nodes"))?;
+                    let c = self.inline_node(pair[1], &format!("{field}.nodes"))?;
+                    let (pa, pc) = (self.mesh.nodes[a], self.mesh.nodes[c]);
                     let mut prev = a;
                     for k in 1..=nd {
                         let next = if k == nd {
                             c
                         } else {
                             let t = k as f64 / nd as f64;
-                            b.mesh
+                            self.mesh
                                 .add_node([0, 1, 2].map(|d| pa[d] + t * (pc[d] - pa[d])))
                         };
                         segs.push([prev, next]);
@@ -700,19 +817,30 @@ pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> 
                 }
             }
             _ => {
-                return Err(b.err(
-                    &field,
+                return Err(self.err(
+                    field,
                     "give either `set` (a Gmsh physical curve of 2-node lines) or `nodes = [a, b, ...]`",
                 ));
             }
         }
-        check_slenderness(&b, &field, f, &segs)?;
+        Ok(segs)
+    }
+
+    /// The end releases of a frame entry's elements (per element, per end, per local DOF
+    /// u_x, u_y, u_z, r_x, r_y, r_z): each `releases` entry frees its DOFs at every element end
+    /// at its node(s), which must be an end of some element of the member.
+    fn frame_releases(
+        &mut self,
+        field: &str,
+        f: &FrameSpec,
+        segs: &[[usize; 2]],
+    ) -> Result<Vec<[[bool; 6]; 2]>> {
         let mut rel: Vec<[[bool; 6]; 2]> = vec![[[false; 6]; 2]; segs.len()];
         for (ri, r) in f.releases.iter().enumerate() {
             let rfield = format!("{field}.releases[{ri}]");
             let mut mask = [false; 6];
             if r.dofs.is_empty() {
-                return Err(b.err(
+                return Err(self.err(
                     &format!("{rfield}.dofs"),
                     "is empty; give some of \"ux\" (axial), \"rx\" (torsion), \"ry\", \"rz\" (bending rotations, local axes)",
                 ));
@@ -721,14 +849,14 @@ pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> 
                 match ["ux", "rx", "ry", "rz"].iter().position(|n| n == name) {
                     Some(p) => mask[[0, 3, 4, 5][p]] = true,
                     None => {
-                        return Err(b.err(
+                        return Err(self.err(
                             &format!("{rfield}.dofs"),
                             format!("unknown or unsupported release '{name}'; valid: \"ux\" (axial), \"rx\" (torsion), \"ry\", \"rz\" (bending rotations about the local y, z axes)"),
                         ))
                     }
                 }
             }
-            let at = b.nodes_of(&r.node, &format!("{rfield}.node"))?;
+            let at = self.nodes_of(&r.node, &format!("{rfield}.node"))?;
             let mut hit = false;
             for (k, s) in segs.iter().enumerate() {
                 for end in 0..2 {
@@ -741,133 +869,133 @@ pub fn build_mesh(spec: &GeneralSpec, src: &Source) -> Result<(Mesh, [f64; 3])> 
                 }
             }
             if !hit {
-                return Err(b.err(
+                return Err(self.err(
                     &format!("{rfield}.node"),
                     "is not an end of any element of this member; give the member's end node (or a set holding it)",
                 ));
             }
         }
-        for (k, s) in segs.into_iter().enumerate() {
-            let mut el = FrameElement::new(s, mat, section);
-            el.orientation = f.orientation;
-            el.releases = rel[k];
-            crate::structure::frame::check_releases(&el.releases)
-                .map_err(|e| b.err(&format!("{field}.releases"), e.to_string()))?;
-            let e = b.mesh.add_frame(el);
-            b.in_part(&f.part, |p| p.frames.push(e));
-        }
+        Ok(rel)
     }
 
-    // Discrete elements.
-    for (i, s) in spec.springs.iter().enumerate() {
-        let field = format!("springs[{i}]");
-        nonnegative(
-            &b,
-            &format!("{field}.stiffness"),
-            &s.stiffness,
-            "N/m or N·m/rad",
-        )?;
-        let to = match &s.to {
-            Some(r) => Some(b.one_node(r, &format!("{field}.to"))?),
-            None => None,
-        };
-        for n in b.nodes_of(&s.node, &format!("{field}.node"))? {
-            b.mesh.add_spring(Spring {
-                node: n,
-                other: to,
-                stiffness: s.stiffness,
-            });
+    /// Adds the discrete elements: springs and dashpots (to ground or to a `to` node; K, C ≥ 0
+    /// per DOF) and point masses (m > 0, rotary inertia ≥ 0), at every node of their reference.
+    fn add_discrete(&mut self, spec: &GeneralSpec) -> Result<()> {
+        for (i, s) in spec.springs.iter().enumerate() {
+            let field = format!("springs[{i}]");
+            nonnegative(
+                self,
+                &format!("{field}.stiffness"),
+                &s.stiffness,
+                "N/m or N·m/rad",
+            )?;
+            let to = match &s.to {
+                Some(r) => Some(self.one_node(r, &format!("{field}.to"))?),
+                None => None,
+            };
+            for n in self.nodes_of(&s.node, &format!("{field}.node"))? {
+                self.mesh.add_spring(Spring {
+                    node: n,
+                    other: to,
+                    stiffness: s.stiffness,
+                });
+            }
         }
-    }
-    for (i, s) in spec.dashpots.iter().enumerate() {
-        let field = format!("dashpots[{i}]");
-        nonnegative(
-            &b,
-            &format!("{field}.damping"),
-            &s.damping,
-            "N·s/m or N·m·s/rad",
-        )?;
-        let to = match &s.to {
-            Some(r) => Some(b.one_node(r, &format!("{field}.to"))?),
-            None => None,
-        };
-        for n in b.nodes_of(&s.node, &format!("{field}.node"))? {
-            b.mesh.add_dashpot(Dashpot {
-                node: n,
-                other: to,
-                damping: s.damping,
-            });
+        for (i, s) in spec.dashpots.iter().enumerate() {
+            let field = format!("dashpots[{i}]");
+            nonnegative(
+                self,
+                &format!("{field}.damping"),
+                &s.damping,
+                "N·s/m or N·m·s/rad",
+            )?;
+            let to = match &s.to {
+                Some(r) => Some(self.one_node(r, &format!("{field}.to"))?),
+                None => None,
+            };
+            for n in self.nodes_of(&s.node, &format!("{field}.node"))? {
+                self.mesh.add_dashpot(Dashpot {
+                    node: n,
+                    other: to,
+                    damping: s.damping,
+                });
+            }
         }
-    }
-    for (i, m) in spec.masses.iter().enumerate() {
-        let field = format!("masses[{i}]");
-        positive(&b, &format!("{field}.mass"), m.mass, "kg")?;
-        let inertia = m.inertia.unwrap_or([0.0; 3]);
-        nonnegative(&b, &format!("{field}.inertia"), &inertia, "kg·m²")?;
-        for n in b.nodes_of(&m.node, &format!("{field}.node"))? {
-            let e = b.mesh.add_mass(PointMass {
-                node: n,
-                mass_kg: m.mass,
-                inertia_kg_m2: inertia,
-            });
-            b.in_part(&m.part, |p| p.masses.push(e));
+        for (i, m) in spec.masses.iter().enumerate() {
+            let field = format!("masses[{i}]");
+            positive(self, &format!("{field}.mass"), m.mass, "kg")?;
+            let inertia = m.inertia.unwrap_or([0.0; 3]);
+            nonnegative(self, &format!("{field}.inertia"), &inertia, "kg·m²")?;
+            for n in self.nodes_of(&m.node, &format!("{field}.node"))? {
+                let e = self.mesh.add_mass(PointMass {
+                    node: n,
+                    mass_kg: m.mass,
+                    inertia_kg_m2: inertia,
+                });
+                self.in_part(&m.part, |p| p.masses.push(e));
+            }
         }
+        Ok(())
     }
-    for (i, l) in spec.rigid_links.iter().enumerate() {
-        let field = format!("rigid_links[{i}]");
-        let master = b.one_node(&l.master, &format!("{field}.master"))?;
-        let slaves: Vec<usize> = b
-            .nodes_of(&l.slaves, &format!("{field}.slaves"))?
-            .into_iter()
-            .filter(|&s| s != master)
-            .collect();
-        if slaves.is_empty() {
-            return Err(b.err(
-                &format!("{field}.slaves"),
-                "holds no node other than the master",
-            ));
+
+    /// Adds the rigid links (a master and at least one other slave) and the constraints (zero
+    /// displacement of the named DOFs at every node of a set).
+    fn add_links_and_constraints(&mut self, spec: &GeneralSpec) -> Result<()> {
+        for (i, l) in spec.rigid_links.iter().enumerate() {
+            let field = format!("rigid_links[{i}]");
+            let master = self.one_node(&l.master, &format!("{field}.master"))?;
+            let slaves: Vec<usize> = self
+                .nodes_of(&l.slaves, &format!("{field}.slaves"))?
+                .into_iter()
+                .filter(|&s| s != master)
+                .collect();
+            if slaves.is_empty() {
+                return Err(self.err(
+                    &format!("{field}.slaves"),
+                    "holds no node other than the master",
+                ));
+            }
+            self.mesh.add_rigid_link(RigidLink { master, slaves });
         }
-        b.mesh.add_rigid_link(RigidLink { master, slaves });
-    }
-    for (i, c) in spec.constraints.iter().enumerate() {
-        let field = format!("constraints[{i}]");
-        let dofs = parse_dofs(&c.dofs, &format!("{BASE}.{field}.dofs"))
-            .map_err(|e| b.err(&format!("{field}.dofs"), e))?;
-        for n in b.nodes_of(&NodeRef::Set(c.set.clone()), &format!("{field}.set"))? {
-            b.mesh.fix(n, &dofs);
+        for (i, c) in spec.constraints.iter().enumerate() {
+            let field = format!("constraints[{i}]");
+            let dofs = parse_dofs(&c.dofs, &format!("{BASE}.{field}.dofs"))
+                .map_err(|e| self.err(&format!("{field}.dofs"), e))?;
+            for n in self.nodes_of(&NodeRef::Set(c.set.clone()), &format!("{field}.set"))? {
+                self.mesh.fix(n, &dofs);
+            }
         }
+        Ok(())
     }
-    // Points: every set by its name, plus the `points` aliases.
-    let gsets: Vec<String> = b
-        .gmsh
-        .as_ref()
-        .map(|g| g.node_sets.keys().cloned().collect())
-        .unwrap_or_default();
-    for name in gsets {
-        // Only groups whose nodes are in the model (used by an element or a reference).
-        let all_used = b
+
+    /// Names the mesh's points: every Gmsh node group whose nodes are all in the model, every
+    /// inline set, then the `points` aliases.
+    fn name_points(&mut self, spec: &GeneralSpec) -> Result<()> {
+        let gsets: Vec<String> = self
             .gmsh
             .as_ref()
-            .is_some_and(|g| g.node_sets[&name].iter().all(|&i| b.gmap[i].is_some()));
-        if all_used {
-            let v = b.nodes_of(&NodeRef::Set(name.clone()), "points")?;
-            b.mesh.name_point(name, v);
+            .map(|g| g.node_sets.keys().cloned().collect())
+            .unwrap_or_default();
+        for name in gsets {
+            // Only groups whose nodes are in the model (used by an element or a reference).
+            let all_used = self
+                .gmsh
+                .as_ref()
+                .is_some_and(|g| g.node_sets[&name].iter().all(|&i| self.gmap[i].is_some()));
+            if all_used {
+                let v = self.nodes_of(&NodeRef::Set(name.clone()), "points")?;
+                self.mesh.name_point(name, v);
+            }
         }
+        for (name, v) in self.sets.clone() {
+            self.mesh.name_point(name, v);
+        }
+        for (p, set) in &spec.points {
+            let v = self.nodes_of(&NodeRef::Set(set.clone()), &format!("points.{p}"))?;
+            self.mesh.name_point(p.clone(), v);
+        }
+        Ok(())
     }
-    for (name, v) in b.sets.clone() {
-        b.mesh.name_point(name, v);
-    }
-    for (p, set) in &spec.points {
-        let v = b.nodes_of(&NodeRef::Set(set.clone()), &format!("points.{p}"))?;
-        b.mesh.name_point(p.clone(), v);
-    }
-    let d = spec.impact_direction.unwrap_or([0.0, 0.0, -1.0]);
-    let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-    if !(norm.is_finite() && norm > 0.0) {
-        return Err(b.err("impact_direction", "must be a nonzero finite vector"));
-    }
-    check_coincident_nodes(&b, spec)?;
-    Ok((b.mesh, [d[0] / norm, d[1] / norm, d[2] / norm]))
 }
 
 /// Least slenderness `L/r` of a frame member (`r = sqrt(max(iy, iz)/area)` its radius of

@@ -57,6 +57,9 @@ use crate::io::{frd, uff};
 use crate::modal::ModalModel;
 use crate::{Error, Result};
 
+/// The section of the model file the imported modes come from (errors name its fields).
+const BASE: &str = "structure.modes";
+
 /// How far from 1 (relative) a modal mass the file gives may be while
 /// `mass_normalised = true` (UFF 55 writes 6 significant digits).
 pub const MASS_TOLERANCE: f64 = 1e-4;
@@ -115,7 +118,6 @@ pub fn modes_from_frd(f: &frd::FrdFile) -> Vec<FileMode> {
 
 /// The file's format: `format`, else the extension.
 fn format_of(spec: &ModesFileSpec, path: &Path, src: &Source) -> Result<&'static str> {
-    const BASE: &str = "structure.modes";
     let given = match &spec.format {
         Some(f) => f.to_ascii_lowercase(),
         None => path
@@ -226,7 +228,6 @@ fn unit_scale(
     file: &str,
     src: &Source,
 ) -> Result<UnitChoice> {
-    const BASE: &str = "structure.modes";
     let given = match spec.units.as_deref() {
         None => None,
         Some("m-kg-s") | Some("SI") => Some(uff::Units::si()),
@@ -324,11 +325,77 @@ pub fn build(
     file: &str,
     src: &Source,
 ) -> Result<ModalModel> {
-    const BASE: &str = "structure.modes";
     // Unit system (module docs): `units`, else the file's dataset 164, else SI.
     let units = unit_scale(modes, spec, file, src)?;
     let scale = units.scale;
-    // Direction.
+    let d = impact_direction(spec, src)?;
+    if spec.points.is_empty() {
+        return Err(src.error(
+            &format!("{BASE}.points"),
+            format!("{BASE}.points: map meid's points to node labels of the file, e.g. points = {{ O_b = 12, B = 7 }}"),
+        ));
+    }
+    let mut kept = kept_modes(modes, spec, file, src)?;
+    let mut notes = Vec::new();
+    if kept
+        .windows(2)
+        .any(|w| w[1].frequency_hz < w[0].frequency_hz)
+    {
+        kept.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+        notes.push(format!(
+            "{BASE}: the modes of {file} were not in ascending frequency; meid sorted them"
+        ));
+    }
+    let n = kept.len();
+    let divisor = mass_divisors(&kept, spec, file, src, &mut notes)?;
+    notes.extend(units.note);
+    let zeta = damping_ratios(&kept, spec, file, src, &mut notes)?;
+    let omega: Vec<f64> = kept
+        .iter()
+        .map(|m| 2.0 * std::f64::consts::PI * m.frequency_hz)
+        .collect();
+    let mut model = ModalModel::with_damping_ratios(omega, &zeta)?;
+    model.unstated_units = (!units.stated).then(|| file.to_string());
+    // Shapes at the points.
+    for (point, node) in &spec.points {
+        let shape = Shape {
+            scale,
+            direction: d,
+            divisor: &divisor,
+        };
+        let values = point_shape(&kept, point, *node, &shape, file, src)?;
+        model.points.insert(point.clone(), values);
+    }
+    model.labels = kept
+        .iter()
+        .map(|m| format!("mode {} ({:.4} Hz)", m.number, m.frequency_hz))
+        .collect();
+    model.mode_numbers = kept
+        .iter()
+        .map(|m| usize::try_from(m.number).unwrap_or(0))
+        .collect();
+    notes.insert(
+        0,
+        format!(
+            "{BASE}: {n} modes ({:.4} to {:.4} Hz) from {file}",
+            kept[0].frequency_hz,
+            kept[n - 1].frequency_hz
+        ),
+    );
+    model.notes = notes;
+    model.warnings.extend(repeated_warnings(modes, &kept, file));
+    model.validate().map_err(|e| match e {
+        Error::InvalidValue { field, message } => {
+            src.error(BASE, format!("{BASE}: {field}: {message}"))
+        }
+        other => other,
+    })?;
+    Ok(model)
+}
+
+/// The unit impact direction `d/|d|` (default `[0, 0, −1]`); a zero or non-finite vector is
+/// refused.
+fn impact_direction(spec: &ModesFileSpec, src: &Source) -> Result<[f64; 3]> {
     let d = spec.impact_direction.unwrap_or([0.0, 0.0, -1.0]);
     let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
     if !(norm.is_finite() && norm > 0.0) {
@@ -339,14 +406,17 @@ pub fn build(
             ),
         ));
     }
-    let d = [d[0] / norm, d[1] / norm, d[2] / norm];
-    if spec.points.is_empty() {
-        return Err(src.error(
-            &format!("{BASE}.points"),
-            format!("{BASE}.points: map meid's points to node labels of the file, e.g. points = {{ O_b = 12, B = 7 }}"),
-        ));
-    }
-    // Which modes: `select` (file mode numbers), then `max_hz`.
+    Ok([d[0] / norm, d[1] / norm, d[2] / norm])
+}
+
+/// The file's modes the model keeps: `select` (file mode numbers, in its order, none twice),
+/// then those up to `max_hz`; at least one, each with a finite frequency ≥ 0 Hz.
+fn kept_modes<'a>(
+    modes: &'a [FileMode],
+    spec: &ModesFileSpec,
+    file: &str,
+    src: &Source,
+) -> Result<Vec<&'a FileMode>> {
     let mut kept: Vec<&FileMode> = match &spec.select {
         None => modes.iter().collect(),
         Some(sel) => {
@@ -405,21 +475,22 @@ pub fn build(
             ));
         }
     }
-    let mut notes = Vec::new();
-    if kept
-        .windows(2)
-        .any(|w| w[1].frequency_hz < w[0].frequency_hz)
-    {
-        kept.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
-        notes.push(format!(
-            "{BASE}: the modes of {file} were not in ascending frequency; meid sorted them"
-        ));
-    }
-    let n = kept.len();
-    // Mass normalisation (module docs).
-    let mut divisor = Vec::with_capacity(n);
+    Ok(kept)
+}
+
+/// Mass normalisation (module docs): the divisor √(modal mass) of each kept mode's shape, 1
+/// for a mode without modal mass when `mass_normalised = true` states it; notes what was
+/// assumed and what was divided.
+fn mass_divisors(
+    kept: &[&FileMode],
+    spec: &ModesFileSpec,
+    file: &str,
+    src: &Source,
+    notes: &mut Vec<String>,
+) -> Result<Vec<f64>> {
+    let mut divisor = Vec::with_capacity(kept.len());
     let mut assumed = Vec::new();
-    for m in &kept {
+    for m in kept {
         match (m.modal_mass, spec.mass_normalised) {
             (Some(mm), Some(true)) if (mm - 1.0).abs() > MASS_TOLERANCE => {
                 return Err(src.error(
@@ -460,96 +531,103 @@ pub fn build(
             "{BASE}: shapes divided by √(modal mass) given in {file} (modal masses {lo:e} to {hi:e}) to make them mass-normalised"
         ));
     }
-    notes.extend(units.note);
-    // Damping.
-    let zeta = match &spec.damping_ratios {
-        Some(_) => super::lumped::ratios(
+    Ok(divisor)
+}
+
+/// The modal damping ratios ζ: `damping_ratios` as given, else the file's (UFF 55 record 8;
+/// 0 where it has none), each in [0, 1).
+fn damping_ratios(
+    kept: &[&FileMode],
+    spec: &ModesFileSpec,
+    file: &str,
+    src: &Source,
+    notes: &mut Vec<String>,
+) -> Result<Vec<f64>> {
+    if spec.damping_ratios.is_some() {
+        return super::lumped::ratios(
             &spec.damping_ratios,
-            n,
+            kept.len(),
             &format!("{BASE}.damping_ratios"),
             src,
-        )?,
-        None => {
-            let z: Vec<f64> = kept
-                .iter()
-                .map(|m| m.damping_ratio.unwrap_or(0.0))
-                .collect();
-            if let Some((m, z)) = kept
-                .iter()
-                .zip(&z)
-                .find(|(_, z)| !(z.is_finite() && **z >= 0.0 && **z < 1.0))
-            {
-                return Err(src.error(
-                    &format!("{BASE}.damping_ratios"),
-                    format!(
-                        "{file}: mode {} has the damping ratio {z}, outside [0, 1): give {BASE}.damping_ratios",
-                        m.number
-                    ),
-                ));
-            }
-            if z.iter().any(|z| *z > 0.0) {
-                notes.push(format!(
-                    "{BASE}: modal damping ratios from {file} (UFF 55 record 8)"
-                ));
-            }
-            z
-        }
-    };
-    let omega: Vec<f64> = kept
-        .iter()
-        .map(|m| 2.0 * std::f64::consts::PI * m.frequency_hz)
-        .collect();
-    let mut model = ModalModel::with_damping_ratios(omega, &zeta)?;
-    model.unstated_units = (!units.stated).then(|| file.to_string());
-    // Shapes at the points.
-    for (point, node) in &spec.points {
-        let mut values = Vec::with_capacity(n);
-        for (k, m) in kept.iter().enumerate() {
-            let Some((_, u)) = m.shapes.iter().find(|(label, _)| label == node) else {
-                return Err(src.error(
-                    &format!("{BASE}.points.{point}"),
-                    format!(
-                        "{BASE}.points.{point}: node {node} is not among the {} nodes of mode {} in {file}{}",
-                        m.shapes.len(),
-                        m.number,
-                        label_range(&m.shapes)
-                    ),
-                ));
-            };
-            let v = scale * (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]) / divisor[k];
-            if !v.is_finite() {
-                return Err(src.error(
-                    &format!("{BASE}.points.{point}"),
-                    format!(
-                        "{BASE}.points.{point}: the shape of mode {} at node {node} is not finite after normalisation",
-                        m.number
-                    ),
-                ));
-            }
-            values.push(v);
-        }
-        model.points.insert(point.clone(), values);
+        );
     }
-    model.labels = kept
+    let z: Vec<f64> = kept
         .iter()
-        .map(|m| format!("mode {} ({:.4} Hz)", m.number, m.frequency_hz))
+        .map(|m| m.damping_ratio.unwrap_or(0.0))
         .collect();
-    model.mode_numbers = kept
+    if let Some((m, z)) = kept
         .iter()
-        .map(|m| usize::try_from(m.number).unwrap_or(0))
-        .collect();
-    notes.insert(
-        0,
-        format!(
-            "{BASE}: {n} modes ({:.4} to {:.4} Hz) from {file}",
-            kept[0].frequency_hz,
-            kept[n - 1].frequency_hz
-        ),
-    );
-    model.notes = notes;
-    // A mode kept without a file mode of the same frequency (to the file's precision): one
-    // direction of a repeated eigenvalue, whose basis the FE program chose.
-    for m in &kept {
+        .zip(&z)
+        .find(|(_, z)| !(z.is_finite() && **z >= 0.0 && **z < 1.0))
+    {
+        return Err(src.error(
+            &format!("{BASE}.damping_ratios"),
+            format!(
+                "{file}: mode {} has the damping ratio {z}, outside [0, 1): give {BASE}.damping_ratios",
+                m.number
+            ),
+        ));
+    }
+    if z.iter().any(|z| *z > 0.0) {
+        notes.push(format!(
+            "{BASE}: modal damping ratios from {file} (UFF 55 record 8)"
+        ));
+    }
+    Ok(z)
+}
+
+/// How a file shape becomes a modal coordinate value: ψ_SI = `scale` · (d · u) / `divisor[k]`.
+struct Shape<'a> {
+    scale: f64,
+    direction: [f64; 3],
+    divisor: &'a [f64],
+}
+
+/// The mass-normalised shape of every kept mode at `point` (file node `node`) along the impact
+/// direction, in m/√kg.
+fn point_shape(
+    kept: &[&FileMode],
+    point: &str,
+    node: i64,
+    shape: &Shape,
+    file: &str,
+    src: &Source,
+) -> Result<Vec<f64>> {
+    let (scale, d) = (shape.scale, shape.direction);
+    let mut values = Vec::with_capacity(kept.len());
+    for (k, m) in kept.iter().enumerate() {
+        let Some((_, u)) = m.shapes.iter().find(|(label, _)| *label == node) else {
+            return Err(src.error(
+                &format!("{BASE}.points.{point}"),
+                format!(
+                    "{BASE}.points.{point}: node {node} is not among the {} nodes of mode {} in {file}{}",
+                    m.shapes.len(),
+                    m.number,
+                    label_range(&m.shapes)
+                ),
+            ));
+        };
+        let v = scale * (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]) / shape.divisor[k];
+        if !v.is_finite() {
+            return Err(src.error(
+                &format!("{BASE}.points.{point}"),
+                format!(
+                    "{BASE}.points.{point}: the shape of mode {} at node {node} is not finite after normalisation",
+                    m.number
+                ),
+            ));
+        }
+        values.push(v);
+    }
+    Ok(values)
+}
+
+/// A warning for each kept mode without a file mode of the same frequency (to
+/// [`REPEATED_TOLERANCE`]) left out: one direction of a repeated eigenvalue, whose basis the
+/// FE program chose.
+fn repeated_warnings(modes: &[FileMode], kept: &[&FileMode], file: &str) -> Vec<String> {
+    let mut warnings = Vec::new();
+    for m in kept {
         let partners: Vec<String> = modes
             .iter()
             .filter(|o| {
@@ -561,7 +639,7 @@ pub fn build(
             .map(|o| o.number.to_string())
             .collect();
         if !partners.is_empty() {
-            model.warnings.push(format!(
+            warnings.push(format!(
                 "{BASE}.select keeps mode {} of {file} but not mode(s) {} at the same frequency \
                  ({:.6} Hz, within {REPEATED_TOLERANCE:e}): a repeated eigenvalue, whose basis \
                  (which direction each mode takes) is the FE program's choice, not a property of \
@@ -572,13 +650,7 @@ pub fn build(
             ));
         }
     }
-    model.validate().map_err(|e| match e {
-        Error::InvalidValue { field, message } => {
-            src.error(BASE, format!("{BASE}: {field}: {message}"))
-        }
-        other => other,
-    })?;
-    Ok(model)
+    warnings
 }
 
 /// `" (labels 1 to 248)"` for messages.

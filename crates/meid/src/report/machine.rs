@@ -179,6 +179,105 @@ fn law_name(l: LawSpec) -> &'static str {
     }
 }
 
+/// Refuses report settings no study can use (a bad stroke rate, no blows, fewer than 3 map
+/// points per axis, a map span ≤ 1, a record length ≤ 0 s) and an energy map too large for the
+/// memory, before anything is run.
+fn check_options(options: &MachineOptions) -> Result<()> {
+    if let Some(r) = options.rate_bpm {
+        crate::analysis::blows::blow_interval_s(r)?;
+    }
+    if options.blows == 0 {
+        return Err(Error::invalid("blows", "needs at least one blow"));
+    }
+    if options.map_points < 3 {
+        return Err(Error::invalid(
+            "map_points",
+            format!(
+                "the energy map needs at least 3 points per axis (got {})",
+                options.map_points
+            ),
+        ));
+    }
+    if !(options.map_span.is_finite() && options.map_span > 1.0) {
+        return Err(Error::invalid(
+            "map_span",
+            format!(
+                "the map's span factor must be > 1 (got {})",
+                options.map_span
+            ),
+        ));
+    }
+    if !(options.record_s.is_finite() && options.record_s > 0.0) {
+        return Err(Error::invalid(
+            "record_s",
+            format!("the record length must be > 0 s (got {})", options.record_s),
+        ));
+    }
+    // The map's grid is estimated before anything is allocated (a sweep point ~2 KiB).
+    let n = (options.map_points | 1) as f64;
+    crate::limits::check_memory(
+        &format!("the energy map's {n} × {n} grid (2 KiB per point)"),
+        n * n * 2048.0,
+        "map_points",
+        "the map's points per axis (--map-points)",
+    )?;
+    Ok(())
+}
+
+/// One blow train of `blows_per_train` blows at `rate_bpm` for each case of the comparison,
+/// each blow starting from the state the previous one left.
+fn blow_trains(
+    model: &Model,
+    comparison: &ComparisonResult,
+    blows_per_train: usize,
+    rate_bpm: f64,
+) -> Result<Vec<(CaseName, BlowsRun)>> {
+    let mut blows = Vec::new();
+    let train = BlowOptions {
+        blows: blows_per_train,
+        rate_bpm,
+        ..BlowOptions::default()
+    };
+    for c in comparison.cases.iter().map(|c| c.case) {
+        let sys = model.impact_system(case_of(c))?;
+        blows.push((
+            c,
+            run_blows_with(&sys, &model.options(), &train, None, false)?,
+        ));
+    }
+    Ok(blows)
+}
+
+/// The optimiser over ω_d/ω_s for the energy left (E_p+/E_s−) and the peak floor force; a
+/// failed objective, or a model without a damper, leaves a note instead.
+fn optimize_studies(model: &Model, notes: &mut Vec<String>) -> Vec<OptimizeReport> {
+    let mut optimize = Vec::new();
+    if model.spec.damper.is_some() && model.spec.contact.bed_damper.is_some() {
+        for objective in [Objective::Energy, Objective::FloorForce] {
+            let study =
+                OptimizeStudy::new(model.clone(), vec![(Quantity::WdOverWs, None)], objective)
+                    .and_then(|s| s.run());
+            match study {
+                Ok(r) => optimize.push(r),
+                Err(e) => notes.push(format!("optimiser ({}): {e}", objective.metric())),
+            }
+        }
+    } else {
+        notes.push("optimiser: the model has no [damper] to tune".into());
+    }
+    optimize
+}
+
+/// The rows of the model table: quantity, symbol, value, unit.
+#[derive(Default)]
+struct ModelRows(Vec<Vec<String>>);
+
+impl ModelRows {
+    fn row(&mut self, q: &str, sym: &str, v: String, unit: &str) {
+        self.0.push(vec![q.into(), sym.into(), v, unit.into()]);
+    }
+}
+
 impl MachineReport {
     /// Loads `path` (with `--set` overrides) and runs every study; `progress` is called with
     /// each stage's name ([`STAGES`]) before it starts.
@@ -188,44 +287,7 @@ impl MachineReport {
         options: &MachineOptions,
         progress: &dyn Fn(&str),
     ) -> Result<Self> {
-        if let Some(r) = options.rate_bpm {
-            crate::analysis::blows::blow_interval_s(r)?;
-        }
-        if options.blows == 0 {
-            return Err(Error::invalid("blows", "needs at least one blow"));
-        }
-        if options.map_points < 3 {
-            return Err(Error::invalid(
-                "map_points",
-                format!(
-                    "the energy map needs at least 3 points per axis (got {})",
-                    options.map_points
-                ),
-            ));
-        }
-        if !(options.map_span.is_finite() && options.map_span > 1.0) {
-            return Err(Error::invalid(
-                "map_span",
-                format!(
-                    "the map's span factor must be > 1 (got {})",
-                    options.map_span
-                ),
-            ));
-        }
-        if !(options.record_s.is_finite() && options.record_s > 0.0) {
-            return Err(Error::invalid(
-                "record_s",
-                format!("the record length must be > 0 s (got {})", options.record_s),
-            ));
-        }
-        // The map's grid is estimated before anything is allocated (a sweep point ~2 KiB).
-        let n = (options.map_points | 1) as f64;
-        crate::limits::check_memory(
-            &format!("the energy map's {n} × {n} grid (2 KiB per point)"),
-            n * n * 2048.0,
-            "map_points",
-            "the map's points per axis (--map-points)",
-        )?;
+        check_options(options)?;
         progress(STAGES[0]);
         let (model, analysis) = fem::from_file_with_analysis(path, overrides, None)?;
         let modes = match &analysis {
@@ -287,19 +349,7 @@ impl MachineReport {
         .run()?;
 
         progress(STAGES[4]);
-        let mut blows = Vec::new();
-        let train = BlowOptions {
-            blows: options.blows,
-            rate_bpm,
-            ..BlowOptions::default()
-        };
-        for c in comparison.cases.iter().map(|c| c.case) {
-            let sys = model.impact_system(case_of(c))?;
-            blows.push((
-                c,
-                run_blows_with(&sys, &model.options(), &train, None, false)?,
-            ));
-        }
+        let blows = blow_trains(&model, &comparison, options.blows, rate_bpm)?;
 
         let production =
             match production::production(&model, rate_bpm, &SteadyOptions::default(), true) {
@@ -311,20 +361,7 @@ impl MachineReport {
             };
 
         progress(STAGES[5]);
-        let mut optimize = Vec::new();
-        if model.spec.damper.is_some() && model.spec.contact.bed_damper.is_some() {
-            for objective in [Objective::Energy, Objective::FloorForce] {
-                let study =
-                    OptimizeStudy::new(model.clone(), vec![(Quantity::WdOverWs, None)], objective)
-                        .and_then(|s| s.run());
-                match study {
-                    Ok(r) => optimize.push(r),
-                    Err(e) => notes.push(format!("optimiser ({}): {e}", objective.metric())),
-                }
-            }
-        } else {
-            notes.push("optimiser: the model has no [damper] to tune".into());
-        }
+        let optimize = optimize_studies(&model, &mut notes);
         Ok(MachineReport {
             rate_bpm,
             rate_origin,
@@ -556,12 +593,30 @@ impl MachineReport {
 
     /// The model summary table: machine, masses, contacts, damper, method.
     pub fn model_table(&self) -> Table {
+        let mut t = ModelRows::default();
+        self.machine_rows(&mut t);
+        let w_s = self.contact_rows(&mut t);
+        self.damper_rows(&mut t, w_s);
+        self.method_rows(&mut t);
+        let rows = t.0;
+        Table {
+            caption: "The model".into(),
+            header: vec![
+                "quantity".into(),
+                "symbol".into(),
+                "value".into(),
+                "unit".into(),
+            ],
+            rows,
+            ..Default::default()
+        }
+    }
+
+    /// The model table's machine rows: structure, retained modes, reference mode, bed and
+    /// slider masses, slider velocity and the blow energy E_s− = ½ m_s v_s².
+    fn machine_rows(&self, t: &mut ModelRows) {
         let s = &self.model.spec;
         let m = &self.model;
-        let mut rows: Vec<Vec<String>> = Vec::new();
-        let mut row = |q: &str, sym: &str, v: String, unit: &str| {
-            rows.push(vec![q.into(), sym.into(), v, unit.into()]);
-        };
         let structure = if let Some(l) = &s.structure.lumped {
             format!(
                 "lumped: {} masses, {} springs",
@@ -573,8 +628,8 @@ impl MachineReport {
         } else {
             "tabulated modes".into()
         };
-        row("structure", "", structure, "");
-        row(
+        t.row("structure", "", structure, "");
+        t.row(
             "retained modes",
             "",
             format!(
@@ -590,7 +645,7 @@ impl MachineReport {
             "",
         );
         if let Some(r) = m.reference_mode() {
-            row(
+            t.row(
                 "reference mode",
                 &self.reference_name(),
                 format!("{} rad/s; {}", sig(r.omega_rad_per_s, 5), r.describe()),
@@ -598,18 +653,25 @@ impl MachineReport {
             );
         }
         if let Some(mb) = m.bed_mass() {
-            row("bed mass", "m_b", sig(mb, 5), "kg");
+            t.row("bed mass", "m_b", sig(mb, 5), "kg");
         }
-        row("slider mass", "m_s", sig(s.slider.mass, 5), "kg");
-        row("slider velocity", "v_s", sig(s.slider.velocity, 5), "m/s");
-        row(
+        t.row("slider mass", "m_s", sig(s.slider.mass, 5), "kg");
+        t.row("slider velocity", "v_s", sig(s.slider.velocity, 5), "m/s");
+        t.row(
             "blow energy",
             "E_s− = ½ m_s v_s²",
             sig(0.5 * s.slider.mass * s.slider.velocity.powi(2), 5),
             "J",
         );
+    }
+
+    /// The model table's slider-bed contact rows (K_s, ω_s = √(K_s/m_s), C_s); returns ω_s
+    /// (rad/s).
+    fn contact_rows(&self, t: &mut ModelRows) -> f64 {
+        let s = &self.model.spec;
+        let m = &self.model;
         let cs = &s.contact.slider_bed;
-        row(
+        t.row(
             "slider-bed contact",
             "K_s",
             format!("{} ({} law)", sig(cs.stiffness, 5), law_name(cs.law)),
@@ -621,14 +683,14 @@ impl MachineReport {
         );
         let w_s = (cs.stiffness / s.slider.mass).sqrt();
         if cs.law == LawSpec::Linear {
-            row(
+            t.row(
                 "slider contact frequency",
                 "ω_s = √(K_s/m_s)",
                 sig(w_s, 5),
                 "rad/s",
             );
             if let Some(r) = m.reference_mode() {
-                row(
+                t.row(
                     "",
                     &format!("ω_s/{}", self.reference_name()),
                     format!(
@@ -647,7 +709,7 @@ impl MachineReport {
             _ => 0.0,
         };
         if c_s != 0.0 {
-            row(
+            t.row(
                 "slider-bed contact damping",
                 "C_s",
                 match cs.restitution {
@@ -657,14 +719,22 @@ impl MachineReport {
                 "N·s/m",
             );
         }
+        w_s
+    }
+
+    /// The model table's damper rows: m_d, m_d/m_b, k_d, c_d, K_d, ω_d = √(K_d/m_d) and ω_d/ω_s
+    /// (`w_s` in rad/s).
+    fn damper_rows(&self, t: &mut ModelRows, w_s: f64) {
+        let s = &self.model.spec;
+        let m = &self.model;
         match &s.damper {
             Some(d) => {
-                row("damper mass", "m_d", sig(d.mass, 5), "kg");
+                t.row("damper mass", "m_d", sig(d.mass, 5), "kg");
                 if let Some(mb) = m.bed_mass() {
-                    row("", "m_d/m_b", sig(d.mass / mb, 4), "1");
+                    t.row("", "m_d/m_b", sig(d.mass / mb, 4), "1");
                 }
-                row("damper spring", "k_d", sig(d.stiffness, 5), "N/m");
-                row(
+                t.row("damper spring", "k_d", sig(d.stiffness, 5), "N/m");
+                t.row(
                     "damper dashpot",
                     "c_d",
                     format!(
@@ -678,7 +748,7 @@ impl MachineReport {
                     "N·s/m",
                 );
                 if let Some(cd) = &s.contact.bed_damper {
-                    row(
+                    t.row(
                         "bed-damper contact",
                         "K_d",
                         format!("{} ({} law)", sig(cd.stiffness, 5), law_name(cd.law)),
@@ -690,20 +760,27 @@ impl MachineReport {
                     );
                     if cd.law == LawSpec::Linear {
                         let w_d = (cd.stiffness / d.mass).sqrt();
-                        row(
+                        t.row(
                             "damper contact frequency",
                             "ω_d = √(K_d/m_d)",
                             sig(w_d, 5),
                             "rad/s",
                         );
-                        row("", "ω_d/ω_s", sig(w_d / w_s, 4), "1");
+                        t.row("", "ω_d/ω_s", sig(w_d / w_s, 4), "1");
                     }
                 }
             }
-            None => row("damper", "", "none in the model".into(), ""),
+            None => t.row("damper", "", "none in the model".into(), ""),
         }
+    }
+
+    /// The model table's last rows: the added mass of the comparison, the method, the
+    /// simulated time and the output sample rate.
+    fn method_rows(&self, t: &mut ModelRows) {
+        let s = &self.model.spec;
+        let m = &self.model;
         if let Some((mass, point)) = m.added_mass() {
-            row(
+            t.row(
                 "added mass (comparison case)",
                 "m_a",
                 format!("{} at {point}", sig(mass, 5)),
@@ -711,7 +788,7 @@ impl MachineReport {
             );
         }
         let sim = &s.simulation;
-        row(
+        t.row(
             "method",
             "",
             match sim.method {
@@ -725,25 +802,13 @@ impl MachineReport {
             },
             "",
         );
-        row("simulated time of one run", "", sig(sim.duration, 4), "s");
-        row("output sample rate", "", sig(sim.sample_rate, 6), "Hz");
-        Table {
-            caption: "The model".into(),
-            header: vec![
-                "quantity".into(),
-                "symbol".into(),
-                "value".into(),
-                "unit".into(),
-            ],
-            rows,
-            ..Default::default()
-        }
+        t.row("simulated time of one run", "", sig(sim.duration, 4), "s");
+        t.row("output sample rate", "", sig(sim.sample_rate, 6), "Hz");
     }
 
     /// Writes the pictures and data into `dir` and returns the page. `generator` is the lead's
     /// note of what produced the page (e.g. `meid 0.1.0 (commit …)`).
     pub fn page(&self, dir: &Path, generator: &str) -> Result<Page> {
-        let mut sections = Vec::new();
         let name = self
             .model
             .spec
@@ -751,33 +816,52 @@ impl MachineReport {
             .clone()
             .unwrap_or_else(|| self.model_path.clone());
 
-        // 0. The verdict, in words, first.
-        sections.push(Section {
-            id: "verdict".into(),
-            heading: "Verdict".into(),
-            blocks: vec![Block::List(self.verdict())],
-        });
+        let sections = vec![
+            // The verdict, in words, first.
+            Section {
+                id: "verdict".into(),
+                heading: "Verdict".into(),
+                blocks: vec![Block::List(self.verdict())],
+            },
+            self.results_section(),
+            Section {
+                id: "model".into(),
+                heading: "Model".into(),
+                blocks: vec![Block::Table(self.model_table())],
+            },
+            self.modes_section(),
+            self.map_section(dir)?,
+            self.cases_section(dir)?,
+            super::measured::section(dir, self.measured.as_ref())?,
+            self.blows_section(dir)?,
+            self.optimiser_section(),
+            self.montecarlo_section(dir)?,
+            self.method_section(),
+        ];
+        Ok(Page {
+            title: format!("meid report: {name}"),
+            lead: format!("Model {} — {generator}.", self.model_path),
+            sections,
+        })
+    }
 
-        // 1. Key results.
+    /// The key results, and the studies left out with why.
+    fn results_section(&self) -> Section {
         let mut blocks = vec![Block::List(self.key_results())];
         if !self.notes.is_empty() {
             blocks.push(Block::Paragraph("Left out:".into()));
             blocks.push(Block::List(self.notes.clone()));
         }
-        sections.push(Section {
+        Section {
             id: "results".into(),
             heading: "Key results".into(),
             blocks,
-        });
+        }
+    }
 
-        // 2. The model.
-        sections.push(Section {
-            id: "model".into(),
-            heading: "Model".into(),
-            blocks: vec![Block::Table(self.model_table())],
-        });
-
-        // 3. Modes and truncation.
+    /// The mode table, the truncation table (what the retained modes keep), the modes' notes
+    /// and warnings.
+    fn modes_section(&self) -> Section {
         let mut blocks = vec![Block::Table(figures::mode_table(&self.modes))];
         if !self.modes.truncation.is_empty() {
             blocks.push(Block::Table(figures::truncation_table(
@@ -791,13 +875,16 @@ impl MachineReport {
             blocks.push(Block::Paragraph("Warnings:".into()));
             blocks.push(Block::List(self.modes.warnings.clone()));
         }
-        sections.push(Section {
+        Section {
             id: "modes".into(),
             heading: "Modes and truncation".into(),
             blocks,
-        });
+        }
+    }
 
-        // 4. Energy map.
+    /// The energy map E_p+/E_s− (paper Eq. 10) around the design, its picture written into
+    /// `dir`, with the design and the grid's smallest value.
+    fn map_section(&self, dir: &Path) -> Result<Section> {
         let mut blocks = Vec::new();
         match &self.map {
             Some(m) => {
@@ -866,13 +953,16 @@ impl MachineReport {
                 "No energy map: the model has no damper, or the map failed (see Key results, Left out).".into(),
             )),
         }
-        sections.push(Section {
+        Ok(Section {
             id: "energy-map".into(),
             heading: "Energy map around the design".into(),
             blocks,
-        });
+        })
+    }
 
-        // 5. None / damper / added mass.
+    /// None / damper / added mass: one blow in each case, its exact peaks, dB reductions by
+    /// measure and the comparison's pictures (written into `dir`).
+    fn cases_section(&self, dir: &Path) -> Result<Section> {
         let r = &self.comparison;
         let mut blocks = vec![
             Block::Paragraph(format!(
@@ -893,14 +983,16 @@ impl MachineReport {
         for f in figures::comparison_figures(dir, "cases", r)? {
             blocks.push(Block::Figure(f));
         }
-        sections.push(Section {
+        Ok(Section {
             id: "cases".into(),
             heading: "Without damper, with the damper, with an added mass".into(),
             blocks,
-        });
-        sections.push(super::measured::section(dir, self.measured.as_ref())?);
+        })
+    }
 
-        // 6. Blow trains.
+    /// The blow trains at the stroke rate: the last blow of each case's train (peaks, η,
+    /// whether it is steady, the damper's gap) and the trains' pictures (written into `dir`).
+    fn blows_section(&self, dir: &Path) -> Result<Section> {
         let runs: Vec<(CaseName, &BlowsRun)> = self.blows.iter().map(|(c, r)| (*c, r)).collect();
         let mut rows = Vec::new();
         for (c, run) in &runs {
@@ -955,13 +1047,15 @@ impl MachineReport {
         for f in figures::blow_train_figures(dir, "blows", &runs, self.rate_bpm)? {
             blocks.push(Block::Figure(f));
         }
-        sections.push(Section {
+        Ok(Section {
             id: "blows".into(),
             heading: "Repeated blows".into(),
             blocks,
-        });
+        })
+    }
 
-        // 7. Optimiser.
+    /// The optimiser's ω_d/ω_s for each objective against the paper's rule ω_d = ω_s.
+    fn optimiser_section(&self) -> Section {
         let mut blocks = Vec::new();
         if self.optimize.is_empty() {
             blocks.push(Block::Paragraph(
@@ -1016,13 +1110,16 @@ impl MachineReport {
                 ..Default::default()
             }));
         }
-        sections.push(Section {
+        Section {
             id: "optimiser".into(),
             heading: "Optimiser against the rule ω_d = ω_s".into(),
             blocks,
-        });
+        }
+    }
 
-        // 8. Monte Carlo.
+    /// The Monte Carlo study: its inputs' distributions, the sample statistics with 95 %
+    /// confidence intervals and the histograms (written into `dir`).
+    fn montecarlo_section(&self, dir: &Path) -> Result<Section> {
         let mut blocks = Vec::new();
         match &self.montecarlo {
             Some(mc) => {
@@ -1082,90 +1179,35 @@ impl MachineReport {
                     rows,
                     ..Default::default()
                 }));
-                for (k, (metric, stem, quantity, unit, scale)) in [
-                    (
-                        "energy_ratio",
-                        "mc-energy-ratio",
-                        "energy left in the machine",
-                        "E_p+/E_s− (%)",
-                        100.0,
-                    ),
-                    (
-                        "peak_floor_force_n",
-                        "mc-floor-force",
-                        "peak force to the floor",
-                        "peak |F_floor| (N)",
-                        1.0,
-                    ),
-                ]
-                .into_iter()
-                .enumerate()
-                {
-                    let values: Vec<f64> = mc
-                        .metric(metric)?
-                        .into_iter()
-                        .filter(|v| v.is_finite())
-                        .map(|v| v * scale)
-                        .collect();
-                    let Some(st) = mc.metric_stats.iter().find(|s| s.name == metric) else {
-                        continue;
-                    };
-                    if values.is_empty() {
-                        continue;
-                    }
-                    let mut st = st.clone();
-                    for v in [&mut st.mean, &mut st.std, &mut st.p5, &mut st.p50, &mut st.p95] {
-                        *v *= scale;
-                    }
-                    let _ = k;
-                    let fig = figures::histogram_figure(
-                        dir,
-                        stem,
-                        quantity,
-                        unit,
-                        &values,
-                        &st,
-                        format!(
-                            "Histogram of the {quantity}, {unit}, over {} samples, with the sample mean ({}) and 95th percentile ({}) marked (estimates).",
-                            values.len(),
-                            sig(st.mean, 4),
-                            sig(st.p95, 4)
-                        ),
-                    )?;
-                    blocks.push(Block::Figure(fig));
-                }
+                montecarlo_histograms(mc, dir, &mut blocks)?;
             }
             None => blocks.push(Block::Paragraph(
                 "No Monte Carlo study: the model gives no distribution. Give one with --vary PATH=DIST, e.g. meid report MODEL.toml --vary 'contact.slider_bed.stiffness=lognormal(K_s,0.2)' (K_s varies with the workpiece; distributions: normal(μ,σ), lognormal(mean,cov), uniform(a,b)).".into(),
             )),
         }
-        sections.push(Section {
+        Ok(Section {
             id: "montecarlo".into(),
             heading: "Monte Carlo over uncertain inputs".into(),
             blocks,
-        });
+        })
+    }
 
-        // 9. How the numbers were obtained.
+    /// How the numbers were obtained: exact peaks, exact spectra, named measures.
+    fn method_section(&self) -> Section {
         let mut method = String::new();
         let _ = write!(
             method,
             "Peaks are exact: located on the continuous piecewise solution between exactly located switches, not on the output samples. Spectra are the exact Fourier transforms of the response including its free decay; one-third-octave levels integrate them by adaptive Gauss-Kronrod. Reductions name their measure (time-peak 20 log10 of peaks; esd-peak, band-level, signal-energy and energy-ratio 10 log10 of energies). The energy map and the energy objective stop each run at the end of the collision; the floor-force objective runs the model's {} s.",
             sig(self.model.spec.simulation.duration, 4)
         );
-        sections.push(Section {
+        Section {
             id: "method".into(),
             heading: "How the numbers were obtained".into(),
             blocks: vec![
                 Block::Paragraph(method),
                 Block::Paragraph("Files: every picture as PNG and SVG, its data as CSV (linked under each caption), and report.json with the numbers of this page.".into()),
             ],
-        });
-
-        Ok(Page {
-            title: format!("meid report: {name}"),
-            lead: format!("Model {} — {generator}.", self.model_path),
-            sections,
-        })
+        }
     }
 
     /// The numbers of the page as JSON (`report.json`, `meid report --json`).
@@ -1243,6 +1285,70 @@ fn distribution_text(d: &crate::analysis::montecarlo::Distribution) -> String {
         }
         D::Uniform { low, high } => format!("uniform({}, {})", sig(low, 5), sig(high, 5)),
     }
+}
+
+/// The histograms of the energy left and the peak floor force over the Monte Carlo samples,
+/// with the sample mean and 95th percentile marked (pictures written into `dir`).
+fn montecarlo_histograms(mc: &MonteCarloResult, dir: &Path, blocks: &mut Vec<Block>) -> Result<()> {
+    for (k, (metric, stem, quantity, unit, scale)) in [
+        (
+            "energy_ratio",
+            "mc-energy-ratio",
+            "energy left in the machine",
+            "E_p+/E_s− (%)",
+            100.0,
+        ),
+        (
+            "peak_floor_force_n",
+            "mc-floor-force",
+            "peak force to the floor",
+            "peak |F_floor| (N)",
+            1.0,
+        ),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let values: Vec<f64> = mc
+            .metric(metric)?
+            .into_iter()
+            .filter(|v| v.is_finite())
+            .map(|v| v * scale)
+            .collect();
+        let Some(st) = mc.metric_stats.iter().find(|s| s.name == metric) else {
+            continue;
+        };
+        if values.is_empty() {
+            continue;
+        }
+        let mut st = st.clone();
+        for v in [
+            &mut st.mean,
+            &mut st.std,
+            &mut st.p5,
+            &mut st.p50,
+            &mut st.p95,
+        ] {
+            *v *= scale;
+        }
+        let _ = k;
+        let fig = figures::histogram_figure(
+                dir,
+                stem,
+                quantity,
+                unit,
+                &values,
+                &st,
+                format!(
+                    "Histogram of the {quantity}, {unit}, over {} samples, with the sample mean ({}) and 95th percentile ({}) marked (estimates).",
+                    values.len(),
+                    sig(st.mean, 4),
+                    sig(st.p95, 4)
+                ),
+            )?;
+        blocks.push(Block::Figure(fig));
+    }
+    Ok(())
 }
 
 fn objective_text(o: Objective) -> String {

@@ -353,6 +353,29 @@ impl MachineSpec {
     /// can be written out (`meid model expand`), edited and read back as a model file, and
     /// gives the same matrices.
     pub fn generate(&self) -> Result<GeneratedMachine> {
+        self.check_dimensions()?;
+        let cols = self.column_positions();
+        let mut g = GeneralSpec {
+            impact_direction: Some([0.0, 0.0, -1.0]),
+            ..GeneralSpec::default()
+        };
+        let bed = self.bed_plate(&mut g, &cols)?;
+        let base = self.base_plate(&mut g, &cols)?;
+        let columns = self.add_columns(&mut g, &cols, &bed, base.as_ref());
+        self.add_masses(&mut g, &bed, base.as_ref())?;
+        Ok(GeneratedMachine {
+            spec: g,
+            bed_grid: bed.grid,
+            base_grid: base.map(|b| b.grid),
+            columns,
+        })
+    }
+
+    /// Refuses a machine whose bed, column section or material is invalid, whose column length
+    /// is not > 0 m, whose mesh density is outside 2..=400 per plate side and 1..=1000 per
+    /// column, whose column inset or spider half-size does not fit the bed, or whose point B
+    /// lies outside the bed.
+    fn check_dimensions(&self) -> Result<()> {
         self.bed.validate("bed")?;
         self.column_section.validate("column section")?;
         self.column_material.validate("column")?;
@@ -398,18 +421,16 @@ impl MachineSpec {
                 ),
             ));
         }
-        inside("point B", self.b_offset_m, &self.bed)?;
-        let cols = self.column_positions();
-        let mut g = GeneralSpec {
-            impact_direction: Some([0.0, 0.0, -1.0]),
-            ..GeneralSpec::default()
-        };
-        let zb = self.column_length_m;
+        inside("point B", self.b_offset_m, &self.bed)
+    }
 
-        // Bed.
+    /// The bed plate at the columns' height: its grid lines through the centre, B, the column
+    /// axes, the bed's added masses and the column footprints' edges, its shells (part
+    /// `bed`), and the one-node sets `O_b` and `B`.
+    fn bed_plate(&self, g: &mut GeneralSpec, cols: &[[f64; 2]; 4]) -> Result<PlateMesh> {
         let mut bx = vec![0.0, self.b_offset_m[0]];
         let mut by = vec![0.0, self.b_offset_m[1]];
-        for c in &cols {
+        for c in cols {
             bx.push(c[0]);
             by.push(c[1]);
         }
@@ -432,109 +453,128 @@ impl MachineSpec {
         let h_bed = self.bed.length_x_m.max(self.bed.length_y_m) / self.elements_per_side as f64;
         let bxs = grid_1d(self.bed.length_x_m, &bx, h_bed);
         let bys = grid_1d(self.bed.length_y_m, &by, h_bed);
-        let bed_grid = plate_grid(&mut g, &bxs, &bys, zb, &self.bed, Some(BED_PART))?;
-        let bed_node = |p: [f64; 2]| (index_of(&bxs, p[0]), index_of(&bys, p[1]));
-        let (i, j) = bed_node([0.0, 0.0]);
-        g.sets.insert("O_b".into(), vec![bed_grid[i][j]]);
-        let (i, j) = bed_node(self.b_offset_m);
-        g.sets.insert("B".into(), vec![bed_grid[i][j]]);
+        let bed_grid = plate_grid(
+            g,
+            &bxs,
+            &bys,
+            self.column_length_m,
+            &self.bed,
+            Some(BED_PART),
+        )?;
+        let bed = PlateMesh {
+            grid: bed_grid,
+            xs: bxs,
+            ys: bys,
+            fx: bed_fx,
+            fy: bed_fy,
+        };
+        g.sets.insert("O_b".into(), vec![bed.node([0.0, 0.0])]);
+        g.sets.insert("B".into(), vec![bed.node(self.b_offset_m)]);
+        Ok(bed)
+    }
 
-        // Base.
-        let mut base_grid = None;
-        #[allow(clippy::type_complexity)]
-        let mut base_lookup: Option<(Vec<f64>, Vec<f64>, Vec<[f64; 2]>, Vec<[f64; 2]>)> = None;
-        if let Support::FloatingBase {
+    /// The floating base at z = 0, if the machine stands on one: its checks (plate, column feet
+    /// on it, spring inset, coefficients), its grid lines through the centre, the column axes,
+    /// the springs, its added masses and the footprints' edges, its shells, the set `O_f`, and
+    /// the coil springs and dashpots (translations only) at the four spring nodes.
+    fn base_plate(&self, g: &mut GeneralSpec, cols: &[[f64; 2]; 4]) -> Result<Option<PlateMesh>> {
+        let Support::FloatingBase {
             base,
             spring_stiffness_n_per_m,
             spring_damping_n_s_per_m,
             spring_inset_m,
         } = &self.support
-        {
-            base.validate("floating base")?;
-            for c in &cols {
-                inside("column foot on the floating base", *c, base)?;
-            }
-            let sx = 0.5 * base.length_x_m - spring_inset_m;
-            let sy = 0.5 * base.length_y_m - spring_inset_m;
-            if !(*spring_inset_m >= 0.0 && sx > 0.0 && sy > 0.0) {
-                return Err(Error::invalid(
-                    "spring inset",
-                    format!(
-                        "must lie in [0, {}) m (got {spring_inset_m})",
-                        0.5 * base.length_x_m.min(base.length_y_m)
-                    ),
-                ));
-            }
-            super::discrete::check_coefficients(
-                "spring stiffness",
-                "N/m",
-                spring_stiffness_n_per_m,
-            )?;
-            super::discrete::check_coefficients(
-                "spring damping",
-                "N s/m",
-                spring_damping_n_s_per_m,
-            )?;
-            let springs = [[sx, sy], [-sx, sy], [-sx, -sy], [sx, -sy]];
-            let mut xs = vec![0.0];
-            let mut ys = vec![0.0];
-            for p in cols.iter().chain(springs.iter()) {
-                xs.push(p[0]);
-                ys.push(p[1]);
-            }
-            for m in self.added_masses.iter().filter(|m| m.plate == Plate::Base) {
-                inside("added mass on the base", m.offset_m, base)?;
-                xs.push(m.offset_m[0]);
-                ys.push(m.offset_m[1]);
-            }
-            let (fx, fy) = if self.spiders {
-                (
-                    footprint_lines(&mut xs, &col_x, a, base.length_x_m),
-                    footprint_lines(&mut ys, &col_y, a, base.length_y_m),
-                )
-            } else {
-                (Vec::new(), Vec::new())
-            };
-            let h = base.length_x_m.max(base.length_y_m) / self.elements_per_side as f64;
-            let gx = grid_1d(base.length_x_m, &xs, h);
-            let gy = grid_1d(base.length_y_m, &ys, h);
-            let grid = plate_grid(&mut g, &gx, &gy, 0.0, base, None)?;
-            g.sets.insert(
-                "O_f".into(),
-                vec![grid[index_of(&gx, 0.0)][index_of(&gy, 0.0)]],
-            );
-            let at: Vec<usize> = springs
-                .iter()
-                .map(|p| grid[index_of(&gx, p[0])][index_of(&gy, p[1])])
-                .collect();
-            let k = spring_stiffness_n_per_m;
-            if k.iter().any(|&v| v > 0.0) {
-                g.springs.push(SpringSpec {
-                    node: NodeRef::List(at.clone()),
-                    to: None,
-                    stiffness: [k[0], k[1], k[2], 0.0, 0.0, 0.0],
-                });
-            }
-            let c = spring_damping_n_s_per_m;
-            if c.iter().any(|&v| v > 0.0) {
-                g.dashpots.push(DashpotSpec {
-                    node: NodeRef::List(at),
-                    to: None,
-                    damping: [c[0], c[1], c[2], 0.0, 0.0, 0.0],
-                });
-            }
-            base_grid = Some(grid);
-            base_lookup = Some((gx, gy, fx, fy));
+        else {
+            return Ok(None);
+        };
+        base.validate("floating base")?;
+        for c in cols {
+            inside("column foot on the floating base", *c, base)?;
         }
+        let sx = 0.5 * base.length_x_m - spring_inset_m;
+        let sy = 0.5 * base.length_y_m - spring_inset_m;
+        if !(*spring_inset_m >= 0.0 && sx > 0.0 && sy > 0.0) {
+            return Err(Error::invalid(
+                "spring inset",
+                format!(
+                    "must lie in [0, {}) m (got {spring_inset_m})",
+                    0.5 * base.length_x_m.min(base.length_y_m)
+                ),
+            ));
+        }
+        super::discrete::check_coefficients("spring stiffness", "N/m", spring_stiffness_n_per_m)?;
+        super::discrete::check_coefficients("spring damping", "N s/m", spring_damping_n_s_per_m)?;
+        let springs = [[sx, sy], [-sx, sy], [-sx, -sy], [sx, -sy]];
+        let mut xs = vec![0.0];
+        let mut ys = vec![0.0];
+        for p in cols.iter().chain(springs.iter()) {
+            xs.push(p[0]);
+            ys.push(p[1]);
+        }
+        for m in self.added_masses.iter().filter(|m| m.plate == Plate::Base) {
+            inside("added mass on the base", m.offset_m, base)?;
+            xs.push(m.offset_m[0]);
+            ys.push(m.offset_m[1]);
+        }
+        let a = self.spider_half_size_m;
+        let col_x: Vec<f64> = cols.iter().map(|c| c[0]).collect();
+        let col_y: Vec<f64> = cols.iter().map(|c| c[1]).collect();
+        let (fx, fy) = if self.spiders {
+            (
+                footprint_lines(&mut xs, &col_x, a, base.length_x_m),
+                footprint_lines(&mut ys, &col_y, a, base.length_y_m),
+            )
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        let h = base.length_x_m.max(base.length_y_m) / self.elements_per_side as f64;
+        let gx = grid_1d(base.length_x_m, &xs, h);
+        let gy = grid_1d(base.length_y_m, &ys, h);
+        let grid = plate_grid(g, &gx, &gy, 0.0, base, None)?;
+        let plate = PlateMesh {
+            grid,
+            xs: gx,
+            ys: gy,
+            fx,
+            fy,
+        };
+        g.sets.insert("O_f".into(), vec![plate.node([0.0, 0.0])]);
+        let at: Vec<usize> = springs.iter().map(|p| plate.node(*p)).collect();
+        let k = spring_stiffness_n_per_m;
+        if k.iter().any(|&v| v > 0.0) {
+            g.springs.push(SpringSpec {
+                node: NodeRef::List(at.clone()),
+                to: None,
+                stiffness: [k[0], k[1], k[2], 0.0, 0.0, 0.0],
+            });
+        }
+        let c = spring_damping_n_s_per_m;
+        if c.iter().any(|&v| v > 0.0) {
+            g.dashpots.push(DashpotSpec {
+                node: NodeRef::List(at),
+                to: None,
+                damping: [c[0], c[1], c[2], 0.0, 0.0, 0.0],
+            });
+        }
+        Ok(Some(plate))
+    }
 
-        // Columns and spiders. A plate node joins at most one spider (the first that reaches it)
-        // and never one whose master is another column end.
+    /// The columns: one frame chain per column from its bed node down to its foot (the base's
+    /// node on its axis, or a clamped foot node in the set [`FEET`]), with the spiders (rigid
+    /// links) of its footprints. A plate node joins at most one spider (the first that reaches
+    /// it) and never one whose master is another column end. Returns each column's nodes.
+    fn add_columns(
+        &self,
+        g: &mut GeneralSpec,
+        cols: &[[f64; 2]; 4],
+        bed: &PlateMesh,
+        base: Option<&PlateMesh>,
+    ) -> Vec<Vec<usize>> {
         let mut masters = std::collections::BTreeSet::new();
-        for c in &cols {
-            let (bi, bj) = bed_node(*c);
-            masters.insert(bed_grid[bi][bj]);
-            if let (Some(gr), Some((gx, gy, _, _))) = (&base_grid, &base_lookup) {
-                masters.insert(gr[index_of(gx, c[0])][index_of(gy, c[1])]);
+        for c in cols {
+            masters.insert(bed.node(*c));
+            if let Some(b) = base {
+                masters.insert(b.node(*c));
             }
         }
         let mut slaved = std::collections::BTreeSet::new();
@@ -552,27 +592,26 @@ impl MachineSpec {
         };
         let column_material = material_spec(self.column_material);
         let s = self.column_section;
+        let zb = self.column_length_m;
         let mut columns = Vec::new();
         let mut feet = Vec::new();
         for (k, c) in cols.iter().enumerate() {
-            let (bi, bj) = bed_node(*c);
-            let top = bed_grid[bi][bj];
+            let top = bed.node(*c);
             let mut nodes = vec![top];
             let ne = self.column_elements;
             for e in 1..ne {
                 let z = zb * (1.0 - e as f64 / ne as f64);
-                nodes.push(add_node(&mut g, [c[0], c[1], z]));
+                nodes.push(add_node(g, [c[0], c[1], z]));
             }
-            let foot = match (&base_grid, &base_lookup) {
-                (Some(gr), Some((gx, gy, fx, fy))) => {
-                    let (fi, fj) = (index_of(gx, c[0]), index_of(gy, c[1]));
+            let foot = match base {
+                Some(b) => {
                     if self.spiders {
-                        spider(&mut g, gr[fi][fj], footprint(gr, gx, gy, *c, fx[k], fy[k]));
+                        spider(g, b.node(*c), b.footprint(k, *c));
                     }
-                    gr[fi][fj]
+                    b.node(*c)
                 }
-                _ => {
-                    let f = add_node(&mut g, [c[0], c[1], 0.0]);
+                None => {
+                    let f = add_node(g, [c[0], c[1], 0.0]);
                     feet.push(f);
                     f
                 }
@@ -592,11 +631,7 @@ impl MachineSpec {
                 part: None,
             });
             if self.spiders {
-                spider(
-                    &mut g,
-                    top,
-                    footprint(&bed_grid, &bxs, &bys, *c, bed_fx[k], bed_fy[k]),
-                );
+                spider(g, top, bed.footprint(k, *c));
             }
             columns.push(nodes);
         }
@@ -607,18 +642,23 @@ impl MachineSpec {
                 dofs: vec!["all".into()],
             });
         }
+        columns
+    }
 
+    /// The added masses at their plate nodes (the bed's in the part `bed`); one on the base of
+    /// a machine without a floating base is refused.
+    fn add_masses(
+        &self,
+        g: &mut GeneralSpec,
+        bed: &PlateMesh,
+        base: Option<&PlateMesh>,
+    ) -> Result<()> {
         for m in &self.added_masses {
             let node = match m.plate {
-                Plate::Bed => {
-                    let (i, j) = bed_node(m.offset_m);
-                    bed_grid[i][j]
-                }
-                Plate::Base => match (&base_grid, &base_lookup) {
-                    (Some(gr), Some((gx, gy, _, _))) => {
-                        gr[index_of(gx, m.offset_m[0])][index_of(gy, m.offset_m[1])]
-                    }
-                    _ => return Err(Error::invalid(
+                Plate::Bed => bed.node(m.offset_m),
+                Plate::Base => match base {
+                    Some(b) => b.node(m.offset_m),
+                    None => return Err(Error::invalid(
                         "added mass",
                         "is on the floating base, but the machine has fixed columns and no base",
                     )),
@@ -631,12 +671,31 @@ impl MachineSpec {
                 part: (m.plate == Plate::Bed).then(|| BED_PART.to_string()),
             });
         }
-        Ok(GeneratedMachine {
-            spec: g,
-            bed_grid,
-            base_grid,
-            columns,
-        })
+        Ok(())
+    }
+}
+
+/// A generated plate: its nodes `grid[i][j]` at the grid lines `xs`, `ys` (m), and each
+/// column's footprint extent in x and y (`fx[k]`, `fy[k]`; empty without spiders).
+struct PlateMesh {
+    grid: Vec<Vec<usize>>,
+    xs: Vec<f64>,
+    ys: Vec<f64>,
+    fx: Vec<[f64; 2]>,
+    fy: Vec<[f64; 2]>,
+}
+
+impl PlateMesh {
+    /// The plate's node at the grid point (x, y) (m), which must be on the grid.
+    fn node(&self, p: [f64; 2]) -> usize {
+        self.grid[index_of(&self.xs, p[0])][index_of(&self.ys, p[1])]
+    }
+
+    /// The plate nodes in column `k`'s footprint around its axis `centre`, but the axis node.
+    fn footprint(&self, k: usize, centre: [f64; 2]) -> Vec<usize> {
+        footprint(
+            &self.grid, &self.xs, &self.ys, centre, self.fx[k], self.fy[k],
+        )
     }
 }
 

@@ -301,6 +301,37 @@ impl Mesh {
             }
         }
         let mut used = vec![false; self.nodes.len()];
+        self.check_frames(&mut used)?;
+        self.check_shells(&mut used)?;
+        self.check_triangles(&mut used)?;
+        self.check_discrete(&mut used)?;
+        let slave_of = self.check_rigid_links(&mut used)?;
+        for &dof in &self.fixed {
+            let node = dof / 6;
+            self.check_node(&format!("support on DOF {dof}"), node)?;
+            if let Some(j) = slave_of.get(&node) {
+                return Err(Error::invalid(
+                    format!("support on node {node}"),
+                    format!("the node is a slave of rigid link {j}; fix its master instead"),
+                ));
+            }
+        }
+        self.check_sets()?;
+        if let Some(n) = used.iter().position(|u| !u) {
+            return Err(Error::invalid(
+                format!("node {n}"),
+                format!(
+                    "at {:?} is used by no element, spring, dashpot, mass or rigid link; remove it or connect it",
+                    self.nodes[n]
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The frame elements: nodes, material, section, local axes (a nonzero length, an
+    /// orientation off the axis) and end releases; marks their nodes used.
+    fn check_frames(&self, used: &mut [bool]) -> Result<()> {
         for (i, f) in self.frames.iter().enumerate() {
             let what = format!("frame element {i} (nodes {}, {})", f.nodes[0], f.nodes[1]);
             for &n in &f.nodes {
@@ -317,6 +348,13 @@ impl Mesh {
             .map_err(|e| Error::invalid(what.clone(), e.to_string()))?;
             check_releases(&f.releases).map_err(|e| Error::invalid(what.clone(), e.to_string()))?;
         }
+        Ok(())
+    }
+
+    /// The quadrilateral shells: nodes, material, thickness, shear and drilling factors > 0,
+    /// four distinct nodes and a proper geometry (not degenerate, inverted or warped); marks
+    /// their nodes used.
+    fn check_shells(&self, used: &mut [bool]) -> Result<()> {
         for (i, s) in self.shells.iter().enumerate() {
             let what = format!(
                 "shell element {i} (nodes {}, {}, {}, {})",
@@ -360,6 +398,12 @@ impl Mesh {
             shell_geometry(&s.nodes.map(|n| self.nodes[n]))
                 .map_err(|e| Error::invalid(what.clone(), e.to_string()))?;
         }
+        Ok(())
+    }
+
+    /// The triangular shells: nodes, material, thickness and drilling factor > 0, three
+    /// distinct nodes and a proper geometry; marks their nodes used.
+    fn check_triangles(&self, used: &mut [bool]) -> Result<()> {
         for (i, s) in self.triangles.iter().enumerate() {
             let what = format!(
                 "triangle {i} (nodes {}, {}, {})",
@@ -394,6 +438,12 @@ impl Mesh {
             tri_geometry(&s.nodes.map(|n| self.nodes[n]))
                 .map_err(|e| Error::invalid(what.clone(), e.to_string()))?;
         }
+        Ok(())
+    }
+
+    /// The springs, dashpots (not joining a node to itself; coefficients finite and ≥ 0) and
+    /// point masses; marks their nodes used.
+    fn check_discrete(&self, used: &mut [bool]) -> Result<()> {
         for (i, s) in self.springs.iter().enumerate() {
             let what = format!("spring {i} (node {})", s.node);
             self.check_node(&what, s.node)?;
@@ -427,6 +477,13 @@ impl Mesh {
             check_coefficients(&format!("{what} mass"), "kg", &[m.mass_kg])?;
             check_coefficients(&format!("{what} inertia"), "kg m^2", &m.inertia_kg_m2)?;
         }
+        Ok(())
+    }
+
+    /// The rigid links: a node is the slave of one link only, never of its own link, and no
+    /// master is another link's slave (no chains); marks their nodes used. Returns each slave's
+    /// link.
+    fn check_rigid_links(&self, used: &mut [bool]) -> Result<BTreeMap<usize, usize>> {
         let mut slave_of: BTreeMap<usize, usize> = BTreeMap::new();
         for (i, l) in self.rigid_links.iter().enumerate() {
             let what = format!("rigid link {i} (master node {})", l.master);
@@ -454,16 +511,12 @@ impl Mesh {
                 ));
             }
         }
-        for &dof in &self.fixed {
-            let node = dof / 6;
-            self.check_node(&format!("support on DOF {dof}"), node)?;
-            if let Some(j) = slave_of.get(&node) {
-                return Err(Error::invalid(
-                    format!("support on node {node}"),
-                    format!("the node is a slave of rigid link {j}; fix its master instead"),
-                ));
-            }
-        }
+        Ok(slave_of)
+    }
+
+    /// The named points (at least one existing node each) and the element and triangle sets
+    /// (existing elements).
+    fn check_sets(&self) -> Result<()> {
         for (name, set) in &self.points {
             if set.is_empty() {
                 return Err(Error::invalid(format!("point {name}"), "names no node"));
@@ -495,15 +548,6 @@ impl Mesh {
                     ),
                 ));
             }
-        }
-        if let Some(n) = used.iter().position(|u| !u) {
-            return Err(Error::invalid(
-                format!("node {n}"),
-                format!(
-                    "at {:?} is used by no element, spring, dashpot, mass or rigid link; remove it or connect it",
-                    self.nodes[n]
-                ),
-            ));
         }
         Ok(())
     }

@@ -264,56 +264,9 @@ fn lowest_modes_scaled(
     let want = opts.count;
     let b = opts.block_size;
 
-    // Stiffness scale s = max K_ii / M_ii (and the necessary diagonal conditions).
-    let kd = diagonal(k);
-    let md = diagonal(m);
-    let mut s_max = 0.0_f64;
-    for i in 0..n {
-        if md[i] <= 0.0 {
-            return Err(Error::invalid(
-                "mass matrix",
-                format!("diagonal entry {i} is {:.3e}; a positive definite mass matrix needs every diagonal entry > 0 (a degree of freedom without mass?)", md[i]),
-            ));
-        }
-        if kd[i] < 0.0 {
-            return Err(Error::invalid(
-                "stiffness matrix",
-                format!("diagonal entry {i} is {:.3e}; a positive semi-definite stiffness matrix needs every diagonal entry ≥ 0", kd[i]),
-            ));
-        }
-        s_max = s_max.max(kd[i] / md[i]);
-    }
-    if s_max <= 0.0 || !s_max.is_finite() {
-        return Err(Error::invalid(
-            "stiffness matrix",
-            "has no positive diagonal entry (all modes would be rigid-body modes)",
-        ));
-    }
+    let (s_max, s_ref) = stiffness_scales(k, m, bulk_scale)?;
 
-    // The bulk stiffness scale: the mass-weighted median of K_ii/M_ii (module docs).
-    let s_ref = if bulk_scale {
-        weighted_median_ratio(&kd, &md).max(f64::MIN_POSITIVE)
-    } else {
-        s_max
-    };
-
-    let basis = {
-        let target = opts.basis_size.unwrap_or(2 * want + 2 * b).max(want + b);
-        let mut mm = target.div_ceil(b) * b;
-        if mm + b > n {
-            mm = n.saturating_sub(b) / b * b;
-        }
-        mm
-    };
-    if basis < want + b {
-        return Err(Error::invalid(
-            "eigen-solver size",
-            format!(
-                "{n} degrees of freedom are too few for {want} modes with block size {b} (need a basis of at least {} vectors plus one block); use modal::dense for small models",
-                want + b
-            ),
-        ));
-    }
+    let basis = basis_size(n, opts)?;
 
     // Sequential factorisations: faer's parallel supernodal kernels split their reductions by the
     // thread count (the results' last bits would change with it, see `modal::kernels`).
@@ -334,13 +287,8 @@ fn lowest_modes_scaled(
     let mut rng = SplitMix64::new(opts.seed);
     let mut st = Basis::new(n, basis, b);
     // Random start block.
-    {
-        let mut w = Mat::<f64>::zeros(n, b);
-        for c in 0..b {
-            w.col_mut(c).copy_from(fill_random(&mut rng, n));
-        }
-        st.append_block(w, m, &mut rng, &mut stats, false)?;
-    }
+    let w = random_block(&mut rng, n, b);
+    st.append_block(w, m, &mut rng, &mut stats, false)?;
 
     let mut tol_op = opts.tol;
     let mut best_converged = 0usize;
@@ -419,12 +367,7 @@ fn lowest_modes_scaled(
             stats.factorizations += 1;
             stats.reshifts += 1;
             // New start block: the Ritz vectors folded into b columns.
-            let x = mul_rows(st.v.get(.., ..basis), y.get(.., ..basis.min(want + b)));
-            let mut w = Mat::<f64>::zeros(n, b);
-            for i in 0..x.ncols() {
-                let mut col = w.col_mut(i % b);
-                col += x.col(i);
-            }
+            let w = folded_ritz_block(&st, &y, basis, basis.min(want + b), b);
             st.reset();
             st.append_block(w, m, &mut rng, &mut stats, false)?;
             continue;
@@ -433,6 +376,103 @@ fn lowest_modes_scaled(
         st.thick_restart(&theta, &y, &coupling, want)?;
         stats.ritz_s += clock.elapsed().as_secs_f64();
     }
+    Err(no_convergence(sigma, s_ref, opts, best_converged))
+}
+
+/// The stiffness scales of the pencil: `s_max = max K_ii/M_ii` and the reference scale of the
+/// shift, `s_max` or (`bulk_scale`) the mass-weighted median of `K_ii/M_ii` (module docs).
+/// Refuses a diagonal entry of M ≤ 0 or of K < 0, and a K without a positive diagonal entry.
+fn stiffness_scales(
+    k: SparseColMatRef<'_, usize, f64>,
+    m: SparseColMatRef<'_, usize, f64>,
+    bulk_scale: bool,
+) -> Result<(f64, f64)> {
+    let n = k.nrows();
+    // Stiffness scale s = max K_ii / M_ii (and the necessary diagonal conditions).
+    let kd = diagonal(k);
+    let md = diagonal(m);
+    let mut s_max = 0.0_f64;
+    for i in 0..n {
+        if md[i] <= 0.0 {
+            return Err(Error::invalid(
+                "mass matrix",
+                format!("diagonal entry {i} is {:.3e}; a positive definite mass matrix needs every diagonal entry > 0 (a degree of freedom without mass?)", md[i]),
+            ));
+        }
+        if kd[i] < 0.0 {
+            return Err(Error::invalid(
+                "stiffness matrix",
+                format!("diagonal entry {i} is {:.3e}; a positive semi-definite stiffness matrix needs every diagonal entry ≥ 0", kd[i]),
+            ));
+        }
+        s_max = s_max.max(kd[i] / md[i]);
+    }
+    if s_max <= 0.0 || !s_max.is_finite() {
+        return Err(Error::invalid(
+            "stiffness matrix",
+            "has no positive diagonal entry (all modes would be rigid-body modes)",
+        ));
+    }
+
+    // The bulk stiffness scale: the mass-weighted median of K_ii/M_ii (module docs).
+    let s_ref = if bulk_scale {
+        weighted_median_ratio(&kd, &md).max(f64::MIN_POSITIVE)
+    } else {
+        s_max
+    };
+    Ok((s_max, s_ref))
+}
+
+/// The Lanczos basis size: `opts.basis_size` (default `2 count + 2 b`, at least `count + b`)
+/// rounded up to whole blocks of `b`, and at most `n − b`; refuses fewer than `count + b`.
+fn basis_size(n: usize, opts: &LanczosOptions) -> Result<usize> {
+    let want = opts.count;
+    let b = opts.block_size;
+    let basis = {
+        let target = opts.basis_size.unwrap_or(2 * want + 2 * b).max(want + b);
+        let mut mm = target.div_ceil(b) * b;
+        if mm + b > n {
+            mm = n.saturating_sub(b) / b * b;
+        }
+        mm
+    };
+    if basis < want + b {
+        return Err(Error::invalid(
+            "eigen-solver size",
+            format!(
+                "{n} degrees of freedom are too few for {want} modes with block size {b} (need a basis of at least {} vectors plus one block); use modal::dense for small models",
+                want + b
+            ),
+        ));
+    }
+    Ok(basis)
+}
+
+/// A block of `b` random columns of length `n` (the Lanczos start block).
+fn random_block(rng: &mut SplitMix64, n: usize, b: usize) -> Mat<f64> {
+    let mut w = Mat::<f64>::zeros(n, b);
+    for c in 0..b {
+        w.col_mut(c).copy_from(fill_random(rng, n));
+    }
+    w
+}
+
+/// The first `count` Ritz vectors `V[:, ..basis] y` folded (summed column `i` into `i mod b`) into one
+/// start block of `b` columns, after a re-shift.
+fn folded_ritz_block(st: &Basis, y: &Mat<f64>, basis: usize, count: usize, b: usize) -> Mat<f64> {
+    let x = mul_rows(st.v.get(.., ..basis), y.get(.., ..count));
+    let mut w = Mat::<f64>::zeros(st.v.nrows(), b);
+    for i in 0..x.ncols() {
+        let mut col = w.col_mut(i % b);
+        col += x.col(i);
+    }
+    w
+}
+
+/// The error when the restart cycles run out: how many modes converged, and what to change
+/// (a shift too close to zero for the stiffness scale `s_ref`, else the iteration sizes).
+fn no_convergence(sigma: f64, s_ref: f64, opts: &LanczosOptions, best_converged: usize) -> Error {
+    let want = opts.count;
     let hint = if -sigma < RESHIFT_FLOOR * s_ref {
         format!(
             "; the shift σ = {sigma:.3e} is closer to zero than 1e-9 × the stiffness scale {s_ref:.3e}, so K - σM is nearly singular: use a more negative shift or the automatic one"
@@ -440,13 +480,13 @@ fn lowest_modes_scaled(
     } else {
         "; raise max_iter, block_size or basis_size".to_string()
     };
-    Err(Error::numerical(
+    Error::numerical(
         "sparse eigen-solver",
         format!(
             "no convergence after {} restart cycles ({} of {want} modes converged){hint}",
             opts.max_iter, best_converged
         ),
-    ))
+    )
 }
 
 fn validate(

@@ -277,6 +277,16 @@ pub fn db_tolerance(id: &str) -> f64 {
 /// Builds every row.
 pub fn rows(r: &Runs) -> Vec<Row> {
     let mut out = Vec::new();
+    frequency_rows(r, &mut out);
+    extremum_rows(r, &mut out);
+    db_rows(r, &mut out);
+    percent_rows(r, &mut out);
+    out.extend(qualitative_rows(r));
+    out
+}
+
+/// The natural frequencies of the retained modes (Hz) on the soft and stiff bases.
+fn frequency_rows(r: &Runs, out: &mut Vec<Row>) {
     let hz = |base: Base, i: usize| r.both(base, |m, _| Some(m.mode_hz(i)));
     let tuned = [
         "the model's support and column stiffnesses were tuned to the paper's frequencies (Table 1's k_f alone gives 5.46 Hz; docs/paper-machine.md), so agreement is by construction",
@@ -302,6 +312,11 @@ pub fn rows(r: &Runs) -> Vec<Row> {
             2,
         ));
     }
+}
+
+/// The extrema over the damper and slider contact frequencies: the argmin of E_p+/E_s− over
+/// ω_d/ω_s on each base, E_p+/E_s− at m_d/m_b = 1 and the resonance peaks over ω_s.
+fn extremum_rows(r: &Runs, out: &mut Vec<Row>) {
     // Minima over ω_d/ω_s.
     let min_reasons = [
         "the optimum lies within [0.8, 1.25] of ω_d = ω_s, as the paper says",
@@ -362,6 +377,11 @@ pub fn rows(r: &Runs) -> Vec<Row> {
         1,
     ));
     out.push(peak_none(r));
+}
+
+/// The dB reductions of Secs. 5-6, each by the primary measure of its quantity: reduction
+/// L(no damper) − L(case) (dB).
+fn db_rows(r: &Runs, out: &mut Vec<Row>) {
     // dB numbers.
     for id in [
         "T-acc",
@@ -411,6 +431,11 @@ pub fn rows(r: &Runs) -> Vec<Row> {
             2,
         ));
     }
+}
+
+/// The energy reductions 1 − η_case/η_none (%) of Sec. 6 and the paper's own arithmetic
+/// between them and its dB (power ratios: dB = −10 log10(1 − p/100)).
+fn percent_rows(r: &Runs, out: &mut Vec<Row>) {
     // Percentages of Sec. 6 and the paper's own arithmetic.
     for (p, case) in [
         (paper("pct-damper"), CaseName::Damper),
@@ -470,8 +495,6 @@ pub fn rows(r: &Runs) -> Vec<Row> {
             reason: "the paper's percentage and its dB do not match as power ratios (as amplitude ratios, 20 log10, they would give 4.6 and 2.6 dB)".into(),
         });
     }
-    out.extend(qualitative_rows(r));
-    out
 }
 
 /// The mass ratios Fig. 17 draws.
@@ -541,19 +564,36 @@ fn peak_none(r: &Runs) -> Row {
     }
 }
 
+/// The paper's qualitative statements, each checked on both models.
 fn qualitative_rows(r: &Runs) -> Vec<Row> {
     let mut out = Vec::new();
-    let pick = |base: Base, f: &dyn Fn(&Machine, &MachineStudy) -> (bool, String)| {
-        let l = r
-            .get(base, Kind::Lumped)
-            .map_or((false, "—".into()), |(m, s)| f(m, s));
-        let e = r
-            .get(base, Kind::Fe)
-            .map_or((false, "—".into()), |(m, s)| f(m, s));
-        (l, e)
-    };
+    energy_map_statements(r, &mut out);
+    history_statements(r, &mut out);
+    case_statements(r, &mut out);
+    base_statements(r, &mut out);
+    out
+}
+
+/// A statement checked on the lumped and the FE model of one base: `f` gives whether it holds
+/// and the numbers that show it; a missing study is "—", not holding.
+fn pick(
+    r: &Runs,
+    base: Base,
+    f: &dyn Fn(&Machine, &MachineStudy) -> (bool, String),
+) -> ((bool, String), (bool, String)) {
+    let l = r
+        .get(base, Kind::Lumped)
+        .map_or((false, "—".into()), |(m, s)| f(m, s));
+    let e = r
+        .get(base, Kind::Fe)
+        .map_or((false, "—".into()), |(m, s)| f(m, s));
+    (l, e)
+}
+
+/// Sec. 4.1's statements on the energy over ω_s/ω_6, ω_d/ω_s and m_d/m_b (Figs. 3-5).
+fn energy_map_statements(r: &Runs, out: &mut Vec<Row>) {
     // Energy decreases as ω_s/ω_6 grows past the resonance (Fig. 3, Sec. 4.1).
-    let (l, f) = pick(Base::Soft, &|_, s| {
+    let (l, f) = pick(r, Base::Soft, &|_, s| {
         let Some(fam) = &s.over_ws else {
             return (false, "—".into());
         };
@@ -584,7 +624,7 @@ fn qualitative_rows(r: &Runs) -> Vec<Row> {
         "",
     ));
     // Larger m_d lowers the energy (Fig. 4, Sec. 6).
-    let (l, f) = pick(Base::Soft, &|_, s| {
+    let (l, f) = pick(r, Base::Soft, &|_, s| {
         let v: Vec<f64> = s.minima.iter().map(|e| e.energy_ratio).collect();
         let ok = v.windows(2).all(|w| w[1] < w[0]);
         (
@@ -605,7 +645,7 @@ fn qualitative_rows(r: &Runs) -> Vec<Row> {
         f,
         "",
     ));
-    let (l, f) = pick(Base::Soft, &|_, s| {
+    let (l, f) = pick(r, Base::Soft, &|_, s| {
         let ok = !s.minima.is_empty() && s.minima.iter().all(|e| (0.8..=1.25).contains(&e.x));
         (
             ok,
@@ -626,7 +666,7 @@ fn qualitative_rows(r: &Runs) -> Vec<Row> {
         "",
     ));
     // Mass ratio matters above the resonance only (Fig. 5).
-    let (l, f) = pick(Base::Soft, &|_, s| {
+    let (l, f) = pick(r, Base::Soft, &|_, s| {
         let Some(fam) = &s.over_ws else {
             return (false, "—".into());
         };
@@ -657,8 +697,13 @@ fn qualitative_rows(r: &Runs) -> Vec<Row> {
         f,
         "",
     ));
+}
+
+/// Sec. 4.1's statements on the time histories at P, Q and R (Figs. 6-8): when PE_Kd peaks
+/// against the slider leaving, and where the damper keeps the most energy.
+fn history_statements(r: &Runs, out: &mut Vec<Row>) {
     // Figs. 6-8: timing of the PE_Kd peak against the slider leaving.
-    let (l, f) = pick(Base::Soft, &|_, s| {
+    let (l, f) = pick(r, Base::Soft, &|_, s| {
         let h = |p: &str| s.histories.iter().find(|h| h.point == p);
         let (Some(p), Some(q), Some(rr)) = (h("P"), h("Q"), h("R")) else {
             return (false, "—".into());
@@ -685,7 +730,7 @@ fn qualitative_rows(r: &Runs) -> Vec<Row> {
         f,
         "",
     ));
-    let (l, f) = pick(Base::Soft, &|_, s| {
+    let (l, f) = pick(r, Base::Soft, &|_, s| {
         let e = |p: &str| {
             s.histories
                 .iter()
@@ -712,8 +757,13 @@ fn qualitative_rows(r: &Runs) -> Vec<Row> {
         f,
         "",
     ));
+}
+
+/// Sec. 4.1's statements on the damper against no damper and the added mass (Figs. 9-11)
+/// and on the modes that dominate the response.
+fn case_statements(r: &Runs, out: &mut Vec<Row>) {
     // Fig. 9.
-    let (l, f) = pick(Base::Soft, &|_, s| {
+    let (l, f) = pick(r, Base::Soft, &|_, s| {
         let Some(fam) = &s.cases_over_ws else {
             return (false, "—".into());
         };
@@ -738,7 +788,7 @@ fn qualitative_rows(r: &Runs) -> Vec<Row> {
         "",
     ));
     // Figs. 10-11.
-    let (l, f) = pick(Base::Soft, &|_, s| {
+    let (l, f) = pick(r, Base::Soft, &|_, s| {
         use measures::time_peak;
         let c = &s.compare;
         let a = |k| time_peak(c, Quantity::Acceleration, k);
@@ -769,7 +819,7 @@ fn qualitative_rows(r: &Runs) -> Vec<Row> {
         f,
         "",
     ));
-    let (l, f) = pick(Base::Soft, &|m, s| {
+    let (l, f) = pick(r, Base::Soft, &|m, s| {
         let c = &s.compare;
         let fa = measures::dominant_peak_hz(c, Quantity::Acceleration, CaseName::NoDamper);
         let ff = measures::dominant_peak_hz(c, Quantity::Force, CaseName::NoDamper);
@@ -789,6 +839,11 @@ fn qualitative_rows(r: &Runs) -> Vec<Row> {
         f,
         "",
     ));
+}
+
+/// Secs. 4.2-4.3's statements on the base: the stiff base and no base against the soft
+/// one (Figs. 13-14, 18).
+fn base_statements(r: &Runs, out: &mut Vec<Row>) {
     // Sec. 4.2: T quieter than S.
     let stiff_vs_soft = |kind: Kind| -> (bool, String) {
         let (Some((_, s)), Some((_, t))) = (r.get(Base::Soft, kind), r.get(Base::Stiff, kind))
@@ -840,7 +895,7 @@ fn qualitative_rows(r: &Runs) -> Vec<Row> {
         none_vs_soft(Kind::Fe),
         "",
     ));
-    let (l, f) = pick(Base::None, &|m, s| {
+    let (l, f) = pick(r, Base::None, &|m, s| {
         let fa = measures::dominant_peak_hz(&s.compare, Quantity::Acceleration, CaseName::NoDamper);
         let bed = m.mode_hz(0);
         (
@@ -857,5 +912,4 @@ fn qualitative_rows(r: &Runs) -> Vec<Row> {
         f,
         "",
     ));
-    out
 }

@@ -246,143 +246,28 @@ pub fn study(machines: &[Machine], studies: &[MachineStudy], table: &[Row]) -> V
         .iter()
         .filter(|r| r.verdict != Verdict::Reproduced)
         .collect();
-    let get = |base: Base, kind: Kind| {
-        machines
-            .iter()
-            .zip(studies)
-            .find(|(m, _)| m.base == base && m.kind == kind)
-    };
-    // The compare variants of each configuration, run once and shared by its numbers.
-    let mut cache: Vec<(Base, Vec<VariantRuns>)> = Vec::new();
-    for base in [Base::Soft, Base::Stiff, Base::None] {
-        let needed = failing.iter().any(|r| {
-            spec(&r.id).is_some_and(|(b, _, _, _)| b == base)
-                || (base == Base::Stiff && r.id == "q-stiff-lower")
-                || (base == Base::None && r.id == "q-nobase-lower")
-        });
-        if !needed {
-            continue;
-        }
-        let runs: Vec<_> = variants(base)
-            .into_par_iter()
-            .map(|v| {
-                let l = get(base, Kind::Lumped).and_then(|(m, _)| run_variant(m, &v));
-                let f = get(base, Kind::Fe).and_then(|(m, _)| run_variant(m, &v));
-                (v, l, f)
-            })
-            .collect();
-        cache.push((base, runs));
-    }
+    let cache = variant_cache(machines, studies, &failing);
     for row in &failing {
         let id = row.id.as_str();
         if let Some((base, q, case, pct)) = spec(id) {
-            let p = paper(id);
-            // A percentage (Sec. 6) is read as the power change of the dB value.
-            let tol = if pct { 5.0 } else { db_tolerance(id) };
-            let conv = |v: Option<f64>| {
-                if pct {
-                    v.map(measures::db_to_percent)
-                } else {
-                    v
-                }
+            let number = Number {
+                id,
+                paper: paper(id),
+                base,
+                q,
+                case,
+                pct,
+                // A percentage (Sec. 6) is read as the power change of the dB value.
+                tol: if pct { 5.0 } else { db_tolerance(id) },
             };
-            // Candidate 1: the measure.
-            let all =
-                |k: Kind| get(base, k).map(|(_, s)| measures::all(s.compare_for(case), q, case));
-            let (la, fa) = (
-                all(Kind::Lumped).unwrap_or_default(),
-                all(Kind::Fe).unwrap_or_default(),
-            );
-            let names: Vec<String> =
-                la.iter()
-                    .chain(&fa)
-                    .map(|m| m.measure.clone())
-                    .fold(Vec::new(), |mut v, n| {
-                        if !v.contains(&n) {
-                            v.push(n);
-                        }
-                        v
-                    });
-            for name in names {
-                let find = |v: &[measures::Measured]| {
-                    v.iter().find(|m| m.measure == name).map(|m| m.reduction_db)
-                };
-                let (l, f) = (conv(find(&la)), conv(find(&fa)));
-                out.push(DeviationRow {
-                    number: id.into(),
-                    paper_value: p.value,
-                    unit: p.unit.into(),
-                    candidate: "measure".into(),
-                    setting: format!("{name} (exact)"),
-                    lumped: l,
-                    fe: f,
-                    reproduces: verdict(p.value, tol, l, f),
-                    evidence: Evidence::Search,
-                });
-            }
+            out.extend(number.measure_rows(machines, studies));
             if case == CaseName::AddedMass {
-                // Where the mass sits: the floating base of Figs. 10-11 instead of the bed.
-                let on_base = |k: Kind| {
-                    get(base, k).map(|(_, s)| measures::primary(&s.compare, q, case).reduction_db)
-                };
-                let (l, f) = (conv(on_base(Kind::Lumped)), conv(on_base(Kind::Fe)));
-                out.push(DeviationRow {
-                    number: id.into(),
-                    paper_value: p.value,
-                    unit: p.unit.into(),
-                    candidate: "added mass on the floating base instead of the bed".into(),
-                    setting: "added mass m_d at the base (as in Figs. 10-11); energy-ratio".into(),
-                    lumped: l,
-                    fe: f,
-                    reproduces: verdict(p.value, tol, l, f),
-                    evidence: Evidence::Reading,
-                });
+                out.push(number.mass_on_base_row(machines, studies));
                 continue;
             }
             // The variants of the configuration, read in the number's primary measure.
             if let Some((_, runs)) = cache.iter().find(|(b, _)| *b == base) {
-                for (v, l, f) in runs {
-                    // The energy ratio does not depend on how a spectrum is computed.
-                    if q == Quantity::EnergyRatio && v.options.spectrum == SpectrumMethod::Fft {
-                        continue;
-                    }
-                    let read = |r: &Option<Result<ComparisonResult>>| -> Option<f64> {
-                        match r {
-                            Some(Ok(c)) => Some(measures::primary(c, q, case).reduction_db),
-                            _ => None,
-                        }
-                    };
-                    let (lv, fv) = (conv(read(l)), conv(read(f)));
-                    let failed = [l, f]
-                        .iter()
-                        .filter_map(|r| match r {
-                            Some(Err(e)) => Some(e.to_string()),
-                            _ => None,
-                        })
-                        .collect::<Vec<_>>();
-                    let measure = match q {
-                        Quantity::EnergyRatio => "energy-ratio",
-                        _ if v.options.spectrum == SpectrumMethod::Fft => {
-                            "FFT ESD peak at the dominant mode"
-                        }
-                        _ => "ESD peak at the dominant mode",
-                    };
-                    let mut setting = format!("{}; {measure}", v.setting);
-                    if !failed.is_empty() {
-                        setting.push_str(&format!(" (failed: {})", failed.join("; ")));
-                    }
-                    out.push(DeviationRow {
-                        number: id.into(),
-                        paper_value: p.value,
-                        unit: p.unit.into(),
-                        candidate: v.candidate.into(),
-                        setting,
-                        lumped: lv,
-                        fe: fv,
-                        reproduces: verdict(p.value, tol, lv, fv),
-                        evidence: Evidence::Search,
-                    });
-                }
+                out.extend(number.variant_rows(runs));
             }
             continue;
         }
@@ -419,6 +304,190 @@ pub fn study(machines: &[Machine], studies: &[MachineStudy], table: &[Row]) -> V
         }
     }
     out
+}
+
+/// The machine of a configuration and model kind, with its study.
+fn machine_of<'a>(
+    machines: &'a [Machine],
+    studies: &'a [MachineStudy],
+    base: Base,
+    kind: Kind,
+) -> Option<(&'a Machine, &'a MachineStudy)> {
+    machines
+        .iter()
+        .zip(studies)
+        .find(|(m, _)| m.base == base && m.kind == kind)
+}
+
+/// The compare variants of each configuration a failing row needs, run once (in parallel)
+/// and shared by its numbers.
+fn variant_cache(
+    machines: &[Machine],
+    studies: &[MachineStudy],
+    failing: &[&Row],
+) -> Vec<(Base, Vec<VariantRuns>)> {
+    let get = |base: Base, kind: Kind| machine_of(machines, studies, base, kind);
+    let mut cache: Vec<(Base, Vec<VariantRuns>)> = Vec::new();
+    for base in [Base::Soft, Base::Stiff, Base::None] {
+        let needed = failing.iter().any(|r| {
+            spec(&r.id).is_some_and(|(b, _, _, _)| b == base)
+                || (base == Base::Stiff && r.id == "q-stiff-lower")
+                || (base == Base::None && r.id == "q-nobase-lower")
+        });
+        if !needed {
+            continue;
+        }
+        let runs: Vec<_> = variants(base)
+            .into_par_iter()
+            .map(|v| {
+                let l = get(base, Kind::Lumped).and_then(|(m, _)| run_variant(m, &v));
+                let f = get(base, Kind::Fe).and_then(|(m, _)| run_variant(m, &v));
+                (v, l, f)
+            })
+            .collect();
+        cache.push((base, runs));
+    }
+    cache
+}
+
+/// A failing dB number or percentage of the paper and how it is read ([`spec`]).
+struct Number<'a> {
+    id: &'a str,
+    paper: super::claims::PaperNumber,
+    base: Base,
+    q: Quantity,
+    case: CaseName,
+    /// A percentage of Sec. 6 (compared as `db_to_percent` of the dB value).
+    pct: bool,
+    tol: f64,
+}
+
+impl Number<'_> {
+    /// A reduction (dB) in the number's own unit.
+    fn conv(&self, v: Option<f64>) -> Option<f64> {
+        if self.pct {
+            v.map(measures::db_to_percent)
+        } else {
+            v
+        }
+    }
+
+    /// A candidate row of this number.
+    fn row(
+        &self,
+        candidate: String,
+        setting: String,
+        (lumped, fe): (Option<f64>, Option<f64>),
+        evidence: Evidence,
+    ) -> DeviationRow {
+        DeviationRow {
+            number: self.id.into(),
+            paper_value: self.paper.value,
+            unit: self.paper.unit.into(),
+            candidate,
+            setting,
+            lumped,
+            fe,
+            reproduces: verdict(self.paper.value, self.tol, lumped, fe),
+            evidence,
+        }
+    }
+
+    /// Candidate 1, the measure: the reduction by every measure either model reports.
+    fn measure_rows(&self, machines: &[Machine], studies: &[MachineStudy]) -> Vec<DeviationRow> {
+        let (base, q, case) = (self.base, self.q, self.case);
+        let all = |k: Kind| {
+            machine_of(machines, studies, base, k)
+                .map(|(_, s)| measures::all(s.compare_for(case), q, case))
+        };
+        let (la, fa) = (
+            all(Kind::Lumped).unwrap_or_default(),
+            all(Kind::Fe).unwrap_or_default(),
+        );
+        let names: Vec<String> =
+            la.iter()
+                .chain(&fa)
+                .map(|m| m.measure.clone())
+                .fold(Vec::new(), |mut v, n| {
+                    if !v.contains(&n) {
+                        v.push(n);
+                    }
+                    v
+                });
+        let mut out = Vec::new();
+        for name in names {
+            let find = |v: &[measures::Measured]| {
+                v.iter().find(|m| m.measure == name).map(|m| m.reduction_db)
+            };
+            let (l, f) = (self.conv(find(&la)), self.conv(find(&fa)));
+            out.push(self.row(
+                "measure".into(),
+                format!("{name} (exact)"),
+                (l, f),
+                Evidence::Search,
+            ));
+        }
+        out
+    }
+
+    /// Where the added mass sits: the floating base of Figs. 10-11 instead of the bed.
+    fn mass_on_base_row(&self, machines: &[Machine], studies: &[MachineStudy]) -> DeviationRow {
+        let (q, case) = (self.q, self.case);
+        let on_base = |k: Kind| {
+            machine_of(machines, studies, self.base, k)
+                .map(|(_, s)| measures::primary(&s.compare, q, case).reduction_db)
+        };
+        let (l, f) = (
+            self.conv(on_base(Kind::Lumped)),
+            self.conv(on_base(Kind::Fe)),
+        );
+        self.row(
+            "added mass on the floating base instead of the bed".into(),
+            "added mass m_d at the base (as in Figs. 10-11); energy-ratio".into(),
+            (l, f),
+            Evidence::Reading,
+        )
+    }
+
+    /// The variants of the configuration (`runs`), read in the number's primary measure; a
+    /// failed run is named in the setting.
+    fn variant_rows(&self, runs: &[VariantRuns]) -> Vec<DeviationRow> {
+        let (q, case) = (self.q, self.case);
+        let mut out = Vec::new();
+        for (v, l, f) in runs {
+            // The energy ratio does not depend on how a spectrum is computed.
+            if q == Quantity::EnergyRatio && v.options.spectrum == SpectrumMethod::Fft {
+                continue;
+            }
+            let read = |r: &Option<Result<ComparisonResult>>| -> Option<f64> {
+                match r {
+                    Some(Ok(c)) => Some(measures::primary(c, q, case).reduction_db),
+                    _ => None,
+                }
+            };
+            let (lv, fv) = (self.conv(read(l)), self.conv(read(f)));
+            let failed = [l, f]
+                .iter()
+                .filter_map(|r| match r {
+                    Some(Err(e)) => Some(e.to_string()),
+                    _ => None,
+                })
+                .collect::<Vec<_>>();
+            let measure = match q {
+                Quantity::EnergyRatio => "energy-ratio",
+                _ if v.options.spectrum == SpectrumMethod::Fft => {
+                    "FFT ESD peak at the dominant mode"
+                }
+                _ => "ESD peak at the dominant mode",
+            };
+            let mut setting = format!("{}; {measure}", v.setting);
+            if !failed.is_empty() {
+                setting.push_str(&format!(" (failed: {})", failed.join("; ")));
+            }
+            out.push(self.row(v.candidate.into(), setting, (lv, fv), Evidence::Search));
+        }
+        out
+    }
 }
 
 /// Candidates for the 2.2 % of Fig. 4: the minimum instead of ω_d = ω_s, ω_s = 6e3 rad/s

@@ -38,7 +38,7 @@ use deviation::DeviationRow;
 use figures::Figures;
 use machines::{Base, Kind, Machine, MASS_RATIO};
 pub use studies::Resolution;
-use studies::{MachineStudy, MapStudy};
+use studies::{Family, MachineStudy, MapStudy};
 
 /// An operating point as used.
 #[derive(Debug, Clone, Serialize)]
@@ -163,13 +163,64 @@ fn draw_all(
     studies: &[MachineStudy],
     res: &Resolution,
 ) -> Result<()> {
+    draw_mode_shapes(f, machines, studies)?;
+    // Energy maps (Figs. 3, 12, 16).
+    for (m, s) in machines.iter().zip(studies) {
+        for (k, map) in s.maps.iter().enumerate() {
+            let (number, sub) = match (m.base, k) {
+                (Base::Soft, 0) => (3, "(a)"),
+                (Base::Soft, _) => (3, "(b)"),
+                (Base::Stiff, _) => (12, ""),
+                (Base::None, _) => (16, ""),
+            };
+            draw_map(f, m, map, number, sub, res)?;
+        }
+    }
+    // Fig. 4, 5, 17 families; Fig. 9.
+    for (m, s) in machines.iter().zip(studies) {
+        if let Some(fam) = &s.over_wd {
+            draw_over_wd(f, m, s, fam, res)?;
+        }
+        if let Some(fam) = &s.over_ws {
+            draw_over_ws(f, m, s, fam, res)?;
+        }
+        if let Some(fam) = &s.cases_over_ws {
+            draw_cases_over_ws(f, m, fam, res)?;
+        }
+    }
+    // Figs. 6-8: energy histories.
+    for (m, s) in machines.iter().zip(studies) {
+        for h in &s.histories {
+            let number = match h.point {
+                "Q" => 6,
+                "P" => 7,
+                _ => 8,
+            };
+            draw_history(f, m, h, number, res)?;
+        }
+    }
+    // Comparisons.
+    for (m, s) in machines.iter().zip(studies) {
+        let (na, nf) = match m.base {
+            Base::Soft => (10, 11),
+            Base::Stiff => (13, 14),
+            Base::None => (18, 19),
+        };
+        draw_compare(f, m, &s.compare, na, nf)?;
+    }
+    Ok(())
+}
+
+/// Figs. 2 and 15: the mode shapes of the FE machines (soft base, no base) retained by the
+/// two-mode reduction.
+#[allow(clippy::needless_update)]
+fn draw_mode_shapes(f: &mut Figures, machines: &[Machine], studies: &[MachineStudy]) -> Result<()> {
     let get = |b: Base, k: Kind| {
         machines
             .iter()
             .zip(studies)
             .find(|(m, _)| m.base == b && m.kind == k)
     };
-    // Figs. 2 and 15: mode shapes of the FE machines.
     for (b, number) in [(Base::Soft, 2), (Base::None, 15)] {
         let Some((m, _)) = get(b, Kind::Fe) else {
             continue;
@@ -203,145 +254,136 @@ fn draw_all(
             )?;
         }
     }
-    // Energy maps (Figs. 3, 12, 16).
-    for (m, s) in machines.iter().zip(studies) {
-        for (k, map) in s.maps.iter().enumerate() {
-            let (number, sub) = match (m.base, k) {
-                (Base::Soft, 0) => (3, "(a)"),
-                (Base::Soft, _) => (3, "(b)"),
-                (Base::Stiff, _) => (12, ""),
-                (Base::None, _) => (16, ""),
-            };
-            draw_map(f, m, map, number, sub, res)?;
-        }
+    Ok(())
+}
+
+/// Fig. 4: E_p+/E_s− over ω_d/ω_s at ω_s/ω_6 = 150, one curve per mass ratio, with the
+/// minima.
+#[allow(clippy::needless_update)]
+fn draw_over_wd(
+    f: &mut Figures,
+    m: &Machine,
+    s: &MachineStudy,
+    fam: &Family,
+    res: &Resolution,
+) -> Result<()> {
+    let mut series: Vec<Series> = fam
+        .curves
+        .iter()
+        .map(|(l, y)| Series {
+            label: l.clone(),
+            x: fam.x.clone(),
+            y: y.clone(),
+            ..Default::default()
+        })
+        .collect();
+    for e in &s.minima {
+        series.push(Series {
+            label: format!(
+                "minimum, m_d/m_b = {}: {:.4} at ω_d/ω_s = {:.3}",
+                e.mass_ratio, e.energy_ratio, e.x
+            ),
+            x: vec![e.x],
+            y: vec![e.energy_ratio],
+            ..Default::default()
+        });
     }
-    // Fig. 4, 5, 17 families; Fig. 9.
-    for (m, s) in machines.iter().zip(studies) {
-        let r = m.base.reference();
-        if let Some(fam) = &s.over_wd {
-            let mut series: Vec<Series> = fam
-                .curves
-                .iter()
-                .map(|(l, y)| Series {
-                    label: l.clone(),
-                    x: fam.x.clone(),
-                    y: y.clone(),
-                    ..Default::default()
-                })
-                .collect();
-            for e in &s.minima {
-                series.push(Series {
-                    label: format!(
-                        "minimum, m_d/m_b = {}: {:.4} at ω_d/ω_s = {:.3}",
-                        e.mass_ratio, e.energy_ratio, e.x
-                    ),
-                    x: vec![e.x],
-                    y: vec![e.energy_ratio],
-                    ..Default::default()
-                });
-            }
-            let p = LinePlot {
-                title: format!("E_p+/E_s− over ω_d/ω_s, ω_s/ω_6 = 150 ({})", m.label()),
-                x_label: "ω_d/ω_s (1)".into(),
-                y_label: "E_p+/E_s− (1)".into(),
-                x_log: true,
-                series,
+    let p = LinePlot {
+        title: format!("E_p+/E_s− over ω_d/ω_s, ω_s/ω_6 = 150 ({})", m.label()),
+        x_label: "ω_d/ω_s (1)".into(),
+        y_label: "E_p+/E_s− (1)".into(),
+        x_log: true,
+        series,
+        ..Default::default()
+    };
+    f.line(4, &format!("fig04-{}", m.tag()), &p, format!(
+        "Reproduces paper Fig. 4 on the {} model: the share of the blow's energy left in the machine, E_p+/E_s− (Eq. 10 over Eq. 11), against ω_d/ω_s at ω_s/ω_6 = 150 (the paper's ω_s = 6e3 rad/s, ω_6 = 40 rad/s), one curve per mass ratio m_d/m_b; {} log-spaced points over 0.1-10, minima located by Brent's method (listed in the legend).",
+        m.label(), res.curve_points
+    ))?;
+    Ok(())
+}
+
+/// Figs. 5 and 17: E_p+/E_s− over ω_s/ω_ref with ω_d = ω_s, one curve per mass ratio, with
+/// the curve without damper when Fig. 9 has it on the same grid.
+#[allow(clippy::needless_update)]
+fn draw_over_ws(
+    f: &mut Figures,
+    m: &Machine,
+    s: &MachineStudy,
+    fam: &Family,
+    res: &Resolution,
+) -> Result<()> {
+    let r = m.base.reference();
+    let number = if m.base == Base::None { 17 } else { 5 };
+    let mut series: Vec<Series> = fam
+        .curves
+        .iter()
+        .map(|(l, y)| Series {
+            label: l.clone(),
+            x: fam.x.clone(),
+            y: y.clone(),
+            ..Default::default()
+        })
+        .collect();
+    // Without the damper (Fig. 9's curve on the same grid): no peak.
+    if let Some(none) = s.cases_over_ws.as_ref().filter(|c| c.x == fam.x) {
+        series.push(Series {
+            label: "without damper".into(),
+            x: none.x.clone(),
+            y: none.curves[0].1.clone(),
+            style: crate::plot::LineStyle::Dashed,
+            ..Default::default()
+        });
+    }
+    let p = LinePlot {
+        title: format!("E_p+/E_s− over ω_s/{r}, ω_d = ω_s ({})", m.label()),
+        x_label: format!("ω_s/{r} (1)"),
+        y_label: "E_p+/E_s− (1)".into(),
+        x_log: true,
+        series,
+        ..Default::default()
+    };
+    let peaks = s
+        .peaks
+        .iter()
+        .map(|e| format!("m_d/m_b = {}: {:.2}", e.mass_ratio, e.x))
+        .collect::<Vec<_>>()
+        .join(", ");
+    f.line(number, &format!("fig{number:02}-{}", m.tag()), &p, format!(
+        "Reproduces paper Fig. {number} on the {} model: E_p+/E_s− against ω_s/{r} with ω_d = ω_s and m_s fixed, one curve per mass ratio; {} log-spaced points. The maximum (Brent's method) lies at ω_s/{r} = {peaks}; the paper puts it near {}.{}",
+        m.label(), res.curve_points, if m.base == Base::None { "1" } else { "45" },
+        if s.cases_over_ws.is_some() { " Dashed: without the damper (no peak: the peak is the damper's)." } else { "" }
+    ))?;
+    Ok(())
+}
+
+/// Fig. 9: E_p+/E_s− without damper, with the damper and with the added mass over ω_s/ω_6.
+#[allow(clippy::needless_update)]
+fn draw_cases_over_ws(f: &mut Figures, m: &Machine, fam: &Family, res: &Resolution) -> Result<()> {
+    let p = LinePlot {
+        title: format!(
+            "damper vs added mass, m_d/m_b = m_add/m_b = 0.35 ({})",
+            m.label()
+        ),
+        x_label: "ω_s/ω_6 (1)".into(),
+        y_label: "E_p+/E_s− (1)".into(),
+        x_log: true,
+        series: fam
+            .curves
+            .iter()
+            .map(|(l, y)| Series {
+                label: l.clone(),
+                x: fam.x.clone(),
+                y: y.clone(),
                 ..Default::default()
-            };
-            f.line(4, &format!("fig04-{}", m.tag()), &p, format!(
-                "Reproduces paper Fig. 4 on the {} model: the share of the blow's energy left in the machine, E_p+/E_s− (Eq. 10 over Eq. 11), against ω_d/ω_s at ω_s/ω_6 = 150 (the paper's ω_s = 6e3 rad/s, ω_6 = 40 rad/s), one curve per mass ratio m_d/m_b; {} log-spaced points over 0.1-10, minima located by Brent's method (listed in the legend).",
-                m.label(), res.curve_points
-            ))?;
-        }
-        if let Some(fam) = &s.over_ws {
-            let number = if m.base == Base::None { 17 } else { 5 };
-            let mut series: Vec<Series> = fam
-                .curves
-                .iter()
-                .map(|(l, y)| Series {
-                    label: l.clone(),
-                    x: fam.x.clone(),
-                    y: y.clone(),
-                    ..Default::default()
-                })
-                .collect();
-            // Without the damper (Fig. 9's curve on the same grid): no peak.
-            if let Some(none) = s.cases_over_ws.as_ref().filter(|c| c.x == fam.x) {
-                series.push(Series {
-                    label: "without damper".into(),
-                    x: none.x.clone(),
-                    y: none.curves[0].1.clone(),
-                    style: crate::plot::LineStyle::Dashed,
-                    ..Default::default()
-                });
-            }
-            let p = LinePlot {
-                title: format!("E_p+/E_s− over ω_s/{r}, ω_d = ω_s ({})", m.label()),
-                x_label: format!("ω_s/{r} (1)"),
-                y_label: "E_p+/E_s− (1)".into(),
-                x_log: true,
-                series,
-                ..Default::default()
-            };
-            let peaks = s
-                .peaks
-                .iter()
-                .map(|e| format!("m_d/m_b = {}: {:.2}", e.mass_ratio, e.x))
-                .collect::<Vec<_>>()
-                .join(", ");
-            f.line(number, &format!("fig{number:02}-{}", m.tag()), &p, format!(
-                "Reproduces paper Fig. {number} on the {} model: E_p+/E_s− against ω_s/{r} with ω_d = ω_s and m_s fixed, one curve per mass ratio; {} log-spaced points. The maximum (Brent's method) lies at ω_s/{r} = {peaks}; the paper puts it near {}.{}",
-                m.label(), res.curve_points, if m.base == Base::None { "1" } else { "45" },
-                if s.cases_over_ws.is_some() { " Dashed: without the damper (no peak: the peak is the damper's)." } else { "" }
-            ))?;
-        }
-        if let Some(fam) = &s.cases_over_ws {
-            let p = LinePlot {
-                title: format!(
-                    "damper vs added mass, m_d/m_b = m_add/m_b = 0.35 ({})",
-                    m.label()
-                ),
-                x_label: "ω_s/ω_6 (1)".into(),
-                y_label: "E_p+/E_s− (1)".into(),
-                x_log: true,
-                series: fam
-                    .curves
-                    .iter()
-                    .map(|(l, y)| Series {
-                        label: l.clone(),
-                        x: fam.x.clone(),
-                        y: y.clone(),
-                        ..Default::default()
-                    })
-                    .collect(),
-                ..Default::default()
-            };
-            f.line(9, &format!("fig09-{}", m.tag()), &p, format!(
-                "Reproduces paper Fig. 9 on the {} model: E_p+/E_s− without damper, with the impact damper (m_d/m_b = 0.35, ω_d = ω_s) and with the same mass added rigidly on the floating base, against ω_s/ω_6; one `meid sweep --cases none,damper,added-mass` run, {} log-spaced points.",
-                m.label(), res.curve_points
-            ))?;
-        }
-    }
-    // Figs. 6-8: energy histories.
-    for (m, s) in machines.iter().zip(studies) {
-        for h in &s.histories {
-            let number = match h.point {
-                "Q" => 6,
-                "P" => 7,
-                _ => 8,
-            };
-            draw_history(f, m, h, number, res)?;
-        }
-    }
-    // Comparisons.
-    for (m, s) in machines.iter().zip(studies) {
-        let (na, nf) = match m.base {
-            Base::Soft => (10, 11),
-            Base::Stiff => (13, 14),
-            Base::None => (18, 19),
-        };
-        draw_compare(f, m, &s.compare, na, nf)?;
-    }
+            })
+            .collect(),
+        ..Default::default()
+    };
+    f.line(9, &format!("fig09-{}", m.tag()), &p, format!(
+        "Reproduces paper Fig. 9 on the {} model: E_p+/E_s− without damper, with the impact damper (m_d/m_b = 0.35, ω_d = ω_s) and with the same mass added rigidly on the floating base, against ω_s/ω_6; one `meid sweep --cases none,damper,added-mass` run, {} log-spaced points.",
+        m.label(), res.curve_points
+    ))?;
     Ok(())
 }
 

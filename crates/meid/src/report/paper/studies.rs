@@ -261,20 +261,78 @@ fn refine(x: &[f64], curve: &[f64], sign: f64, f: impl Fn(f64) -> f64) -> Result
 
 /// Runs every study of the paper on one machine.
 pub fn run(m: &Machine, res: &Resolution) -> Result<MachineStudy> {
+    let c = res.curve_points;
+    let maps = energy_maps(m, res)?;
+    let (over_wd, minima, at_equal) = if m.base == Base::Soft {
+        over_wd_study(m, c)?
+    } else {
+        (None, Vec::new(), Vec::new())
+    };
+    let (over_ws, peaks) = if m.base != Base::Stiff {
+        over_ws_study(m, c)?
+    } else {
+        (None, Vec::new())
+    };
+    let cases_over_ws = if m.base == Base::Soft {
+        Some(cases_over_ws_study(m, c)?)
+    } else {
+        None
+    };
+    // Figs. 6-8: energy histories at P, Q, R.
+    let histories = if m.base == Base::Soft {
+        WD_OVER_W6_PQR
+            .par_iter()
+            .map(|&(name, r)| history_at(m, name, r, res.history_rate_hz))
+            .collect::<Result<Vec<_>>>()?
+    } else {
+        Vec::new()
+    };
+    let point_minimum = Some(point_minimum_study(m, c)?);
+    // Figs. 10-11, 13-14, 18-19: the three cases at the operating point.
+    let compare = compare_at(m, res.spectrum_points, &CompareOptions::default())?;
+    let compare_bed = match added_mass_point(m) {
+        Some(_) if m.base == Base::Soft => Some(compare_model(
+            &with_added_mass_at(&m.model, None),
+            m.base,
+            res.spectrum_points,
+            &CompareOptions::default(),
+            None,
+        )?),
+        _ => None,
+    };
+    Ok(MachineStudy {
+        maps,
+        over_wd,
+        over_ws,
+        cases_over_ws,
+        minima,
+        at_equal,
+        peaks,
+        histories,
+        compare,
+        point_minimum,
+        compare_bed,
+    })
+}
+
+/// `v` as a comma-separated list for a `--vary` value.
+fn list(v: &[f64]) -> String {
+    v.iter()
+        .map(|r| format!("{r}"))
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+/// The energy maps E_p+/E_s− over ω_s/ω_ref × ω_d/ω_ref (Figs. 3, 12, 16), one per mass ratio
+/// (0.35, and 0.7 on the soft base), with the paper's marked points.
+fn energy_maps(m: &Machine, res: &Resolution) -> Result<Vec<MapStudy>> {
     let (lo, hi) = range(m.base);
     let n = res.map_points;
     let ratios: Vec<f64> = match m.base {
         Base::Soft => vec![MASS_RATIO, 0.7],
         _ => vec![MASS_RATIO],
     };
-    let list = |v: &[f64]| {
-        v.iter()
-            .map(|r| format!("{r}"))
-            .collect::<Vec<_>>()
-            .join(",")
-    };
-    // Energy maps (Figs. 3, 12, 16).
-    let maps = ratios
+    ratios
         .par_iter()
         .map(|&r| {
             let s = run_sweep(
@@ -304,177 +362,159 @@ pub fn run(m: &Machine, res: &Resolution) -> Result<MachineStudy> {
                 marked: marked_points(m, r),
             })
         })
-        .collect::<Result<Vec<_>>>()?;
-    let c = res.curve_points;
-    let family =
-        |r: &SweepResult, label: &dyn Fn(usize) -> String, ncurves: usize, k_case: bool| {
-            let x = r.spec.vary[0].values.clone();
-            let curves = (0..ncurves)
-                .map(|k| {
-                    let y = (0..x.len())
-                        .map(|i| {
-                            if k_case {
-                                r.points[i].case_metric(k, "energy_ratio")
-                            } else {
-                                r.points[i * ncurves + k].metric("energy_ratio")
-                            }
-                        })
-                        .collect();
-                    (label(k), y)
+        .collect::<Result<Vec<_>>>()
+}
+
+/// The curves E_p+/E_s− of a sweep over its first variable: `ncurves` curves, the last
+/// variable fastest (`k_case`: the sweep's cases instead), each labelled by `label(k)`.
+fn family(
+    r: &SweepResult,
+    label: &dyn Fn(usize) -> String,
+    ncurves: usize,
+    k_case: bool,
+) -> Family {
+    let x = r.spec.vary[0].values.clone();
+    let curves = (0..ncurves)
+        .map(|k| {
+            let y = (0..x.len())
+                .map(|i| {
+                    if k_case {
+                        r.points[i].case_metric(k, "energy_ratio")
+                    } else {
+                        r.points[i * ncurves + k].metric("energy_ratio")
+                    }
                 })
                 .collect();
-            Family { x, curves }
-        };
-    let ratio_label = |k: usize| format!("m_d/m_b = {}", FAMILY_RATIOS[k]);
-    let nf = FAMILY_RATIOS.len();
-    // Fig. 4 (soft base): over ω_d/ω_s at ω_s/ω_6 = 150.
-    let (over_wd, minima, at_equal) = if m.base == Base::Soft {
-        let r = run_sweep(
-            &m.model,
-            &[
-                format!("wd/ws={}", log_range(0.1, 10.0, c)),
-                format!("ws/w_ref={WS_OVER_W6_S}"),
-                format!("md/mb={}", list(&FAMILY_RATIOS)),
-            ],
-            m.m_b,
-            vec![],
-        )?;
-        // Sweep order: wd/ws slowest, then ws (one value), then md/mb fastest.
-        let fam = family(&r, &ratio_label, nf, false);
-        let qs = [Quantity::WdOverWs, Quantity::WsOverWref, Quantity::MdOverMb];
-        let minima = (0..nf)
-            .into_par_iter()
-            .map(|k| {
-                let rr = FAMILY_RATIOS[k];
-                let (x, e) = refine(&fam.x, &fam.curves[k].1, 1.0, |x| {
-                    energy_at(&m.model, m.m_b, &qs, &[x, WS_OVER_W6_S, rr])
-                })?;
-                Ok(Extremum {
-                    mass_ratio: rr,
-                    x,
-                    energy_ratio: e,
-                })
-            })
-            .collect::<Result<Vec<_>>>()?;
-        let at_equal = FAMILY_RATIOS
-            .iter()
-            .map(|&rr| Extremum {
-                mass_ratio: rr,
-                x: 1.0,
-                energy_ratio: energy_at(&m.model, m.m_b, &qs, &[1.0, WS_OVER_W6_S, rr]),
-            })
-            .collect();
-        (Some(fam), minima, at_equal)
-    } else {
-        (None, Vec::new(), Vec::new())
-    };
-    // Figs. 5 and 17: over ω_s/ω_ref at ω_d = ω_s.
-    let (over_ws, peaks) = if m.base != Base::Stiff {
-        let r = run_sweep(
-            &m.model,
-            &[
-                format!("ws/w_ref={}", log_range(lo, hi, c)),
-                "wd/ws=1".into(),
-                format!("md/mb={}", list(&FAMILY_RATIOS)),
-            ],
-            m.m_b,
-            vec![],
-        )?;
-        let fam = family(&r, &ratio_label, nf, false);
-        let qs = [Quantity::WsOverWref, Quantity::WdOverWs, Quantity::MdOverMb];
-        let peaks = (0..nf)
-            .into_par_iter()
-            .map(|k| {
-                let rr = FAMILY_RATIOS[k];
-                let (x, e) = refine(&fam.x, &fam.curves[k].1, -1.0, |x| {
-                    energy_at(&m.model, m.m_b, &qs, &[x, 1.0, rr])
-                })?;
-                Ok(Extremum {
-                    mass_ratio: rr,
-                    x,
-                    energy_ratio: e,
-                })
-            })
-            .collect::<Result<Vec<_>>>()?;
-        (Some(fam), peaks)
-    } else {
-        (None, Vec::new())
-    };
-    // Fig. 9: none / damper / added mass over ω_s/ω_ref.
-    let cases_over_ws = if m.base == Base::Soft {
-        let model = with_added_mass_at(&m.model, added_mass_point(m));
-        let r = run_sweep(
-            &model,
-            &[
-                format!("ws/w_ref={}", log_range(lo, hi, c)),
-                "wd/ws=1".into(),
-                format!("md/mb={MASS_RATIO}"),
-            ],
-            m.m_b,
-            vec![Case::NoDamper, Case::Damper, Case::AddedMass],
-        )?;
-        let labels = ["without damper", "impact damper", "added mass"];
-        Some(family(&r, &|k| labels[k].to_string(), 3, true))
-    } else {
-        None
-    };
-    // Figs. 6-8: energy histories at P, Q, R.
-    let histories = if m.base == Base::Soft {
-        WD_OVER_W6_PQR
-            .par_iter()
-            .map(|&(name, r)| history_at(m, name, r, res.history_rate_hz))
-            .collect::<Result<Vec<_>>>()?
-    } else {
-        Vec::new()
-    };
-    // The minimum over ω_d/ω_s at the operating point's ω_s (Figs. 3, 12, 16: near ω_d = ω_s).
-    let ws_point = m.w_s / m.w_ref;
-    let point_minimum = {
-        let r = run_sweep(
-            &m.model,
-            &[
-                format!("wd/ws={}", log_range(0.1, 10.0, c)),
-                format!("ws/w_ref={ws_point:e}"),
-                format!("md/mb={MASS_RATIO}"),
-            ],
-            m.m_b,
-            vec![],
-        )?;
-        let fam = family(&r, &|_| String::new(), 1, false);
-        let qs = [Quantity::WdOverWs, Quantity::WsOverWref, Quantity::MdOverMb];
-        let (x, e) = refine(&fam.x, &fam.curves[0].1, 1.0, |x| {
-            energy_at(&m.model, m.m_b, &qs, &[x, ws_point, MASS_RATIO])
-        })?;
-        Some(Extremum {
-            mass_ratio: MASS_RATIO,
-            x,
-            energy_ratio: e,
+            (label(k), y)
         })
-    };
-    // Figs. 10-11, 13-14, 18-19: the three cases at the operating point.
-    let compare = compare_at(m, res.spectrum_points, &CompareOptions::default())?;
-    let compare_bed = match added_mass_point(m) {
-        Some(_) if m.base == Base::Soft => Some(compare_model(
-            &with_added_mass_at(&m.model, None),
-            m.base,
-            res.spectrum_points,
-            &CompareOptions::default(),
-            None,
-        )?),
-        _ => None,
-    };
-    Ok(MachineStudy {
-        maps,
-        over_wd,
-        over_ws,
-        cases_over_ws,
-        minima,
-        at_equal,
-        peaks,
-        histories,
-        compare,
-        point_minimum,
-        compare_bed,
+        .collect();
+    Family { x, curves }
+}
+
+/// A curve's label `m_d/m_b = r` for the family's mass ratios.
+fn ratio_label(k: usize) -> String {
+    format!("m_d/m_b = {}", FAMILY_RATIOS[k])
+}
+
+/// Fig. 4 (soft base): E_p+/E_s− over ω_d/ω_s at ω_s/ω_6 = 150 for each mass ratio, the
+/// minimum of each curve (Brent in ln ω_d/ω_s) and the value at ω_d = ω_s.
+#[allow(clippy::type_complexity)]
+fn over_wd_study(m: &Machine, c: usize) -> Result<(Option<Family>, Vec<Extremum>, Vec<Extremum>)> {
+    let nf = FAMILY_RATIOS.len();
+    let r = run_sweep(
+        &m.model,
+        &[
+            format!("wd/ws={}", log_range(0.1, 10.0, c)),
+            format!("ws/w_ref={WS_OVER_W6_S}"),
+            format!("md/mb={}", list(&FAMILY_RATIOS)),
+        ],
+        m.m_b,
+        vec![],
+    )?;
+    // Sweep order: wd/ws slowest, then ws (one value), then md/mb fastest.
+    let fam = family(&r, &ratio_label, nf, false);
+    let qs = [Quantity::WdOverWs, Quantity::WsOverWref, Quantity::MdOverMb];
+    let minima = (0..nf)
+        .into_par_iter()
+        .map(|k| {
+            let rr = FAMILY_RATIOS[k];
+            let (x, e) = refine(&fam.x, &fam.curves[k].1, 1.0, |x| {
+                energy_at(&m.model, m.m_b, &qs, &[x, WS_OVER_W6_S, rr])
+            })?;
+            Ok(Extremum {
+                mass_ratio: rr,
+                x,
+                energy_ratio: e,
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let at_equal = FAMILY_RATIOS
+        .iter()
+        .map(|&rr| Extremum {
+            mass_ratio: rr,
+            x: 1.0,
+            energy_ratio: energy_at(&m.model, m.m_b, &qs, &[1.0, WS_OVER_W6_S, rr]),
+        })
+        .collect();
+    Ok((Some(fam), minima, at_equal))
+}
+
+/// Figs. 5 and 17: E_p+/E_s− over ω_s/ω_ref at ω_d = ω_s for each mass ratio, and the
+/// resonance peak of each curve (Brent in ln ω_s/ω_ref).
+fn over_ws_study(m: &Machine, c: usize) -> Result<(Option<Family>, Vec<Extremum>)> {
+    let (lo, hi) = range(m.base);
+    let nf = FAMILY_RATIOS.len();
+    let r = run_sweep(
+        &m.model,
+        &[
+            format!("ws/w_ref={}", log_range(lo, hi, c)),
+            "wd/ws=1".into(),
+            format!("md/mb={}", list(&FAMILY_RATIOS)),
+        ],
+        m.m_b,
+        vec![],
+    )?;
+    let fam = family(&r, &ratio_label, nf, false);
+    let qs = [Quantity::WsOverWref, Quantity::WdOverWs, Quantity::MdOverMb];
+    let peaks = (0..nf)
+        .into_par_iter()
+        .map(|k| {
+            let rr = FAMILY_RATIOS[k];
+            let (x, e) = refine(&fam.x, &fam.curves[k].1, -1.0, |x| {
+                energy_at(&m.model, m.m_b, &qs, &[x, 1.0, rr])
+            })?;
+            Ok(Extremum {
+                mass_ratio: rr,
+                x,
+                energy_ratio: e,
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok((Some(fam), peaks))
+}
+
+/// Fig. 9: E_p+/E_s− without damper, with the damper and with the added mass over
+/// ω_s/ω_ref (ω_d = ω_s, m_d/m_b = 0.35).
+fn cases_over_ws_study(m: &Machine, c: usize) -> Result<Family> {
+    let (lo, hi) = range(m.base);
+    let model = with_added_mass_at(&m.model, added_mass_point(m));
+    let r = run_sweep(
+        &model,
+        &[
+            format!("ws/w_ref={}", log_range(lo, hi, c)),
+            "wd/ws=1".into(),
+            format!("md/mb={MASS_RATIO}"),
+        ],
+        m.m_b,
+        vec![Case::NoDamper, Case::Damper, Case::AddedMass],
+    )?;
+    let labels = ["without damper", "impact damper", "added mass"];
+    Ok(family(&r, &|k| labels[k].to_string(), 3, true))
+}
+
+/// The minimum of E_p+/E_s− over ω_d/ω_s at the operating point's ω_s (Figs. 3, 12, 16: near
+/// ω_d = ω_s), m_d/m_b = 0.35.
+fn point_minimum_study(m: &Machine, c: usize) -> Result<Extremum> {
+    let ws_point = m.w_s / m.w_ref;
+    let r = run_sweep(
+        &m.model,
+        &[
+            format!("wd/ws={}", log_range(0.1, 10.0, c)),
+            format!("ws/w_ref={ws_point:e}"),
+            format!("md/mb={MASS_RATIO}"),
+        ],
+        m.m_b,
+        vec![],
+    )?;
+    let fam = family(&r, &|_| String::new(), 1, false);
+    let qs = [Quantity::WdOverWs, Quantity::WsOverWref, Quantity::MdOverMb];
+    let (x, e) = refine(&fam.x, &fam.curves[0].1, 1.0, |x| {
+        energy_at(&m.model, m.m_b, &qs, &[x, ws_point, MASS_RATIO])
+    })?;
+    Ok(Extremum {
+        mass_ratio: MASS_RATIO,
+        x,
+        energy_ratio: e,
     })
 }
 
