@@ -362,7 +362,7 @@ fn optimize_output_is_its_json_report() {
 // ---------------------------------------------------------------------------------------------
 // 4. Completions and manual pages.
 
-const SUBCOMMANDS: [&str; 16] = [
+const SUBCOMMANDS: [&str; 18] = [
     "simulate",
     "modes",
     "model",
@@ -375,6 +375,8 @@ const SUBCOMMANDS: [&str; 16] = [
     "merge",
     "paper",
     "measure",
+    "frf",
+    "identify",
     "validate",
     "calibrate",
     "completions",

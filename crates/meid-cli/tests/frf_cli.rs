@@ -149,7 +149,8 @@ fn frf_without_a_force_or_a_blow_is_refused_naming_the_channel() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
 
-/// Two blows whose response is noise unrelated to the force: the coherence is low, and both
+/// Two blows (records of 1.5 s) whose response is noise unrelated to the force: the coherence is
+/// low, and both
 /// `frf` and `identify` say on which channel and where; asking for more modes than points is
 /// named too.
 #[test]
@@ -170,7 +171,15 @@ fn low_coherence_and_too_few_points_are_named() {
     std::fs::write(&f, s).unwrap();
     let out = d.join("frf");
     let o = meid()
-        .args(["frf", f.to_str().unwrap(), "--pretrigger", "0.05", "-o"])
+        .args([
+            "frf",
+            f.to_str().unwrap(),
+            "--pretrigger",
+            "0.05",
+            "--record",
+            "1.5",
+        ])
+        .arg("-o")
         .arg(&out)
         .output()
         .unwrap();
