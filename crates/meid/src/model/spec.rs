@@ -34,10 +34,10 @@ pub struct ModelSpec {
     /// `[foundation]`: the block on the soil under a lumped structure
     /// ([`super::foundation`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub foundation: Option<super::foundation::FoundationSpec>,
+    pub foundation: Option<FoundationSpec>,
     /// `[[receiver]]`: where the ground vibration is checked ([`super::foundation`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub receiver: Vec<super::foundation::ReceiverSpec>,
+    pub receiver: Vec<ReceiverSpec>,
 }
 
 /// The structure: exactly one of the forms.
@@ -730,4 +730,146 @@ pub struct GroupSpringSpec {
     /// N·s/m per node.
     #[serde(default)]
     pub damping: Option<PerDirection>,
+}
+
+/// `[foundation]`: the block on the soil ([`super::foundation`], docs/foundation.md).
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct FoundationSpec {
+    /// The lumped mass that rests on the soil.
+    pub mass: String,
+    /// L (m), plan dimension along which the block rocks in [`Impedances::rocking`].
+    pub length: f64,
+    /// B (m).
+    pub width: f64,
+    /// h (m): needed for the block's volume (`block_density`), its rocking inertia and an
+    /// embedment.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height: Option<f64>,
+    /// D (m), 0 ≤ D ≤ h. Default 0 (a surface footing).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub embedment: Option<f64>,
+    /// kg, added to `mass`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub block_mass: Option<f64>,
+    /// kg/m³: the block's mass is `block_density · L B h`, added to `mass`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub block_density: Option<f64>,
+    pub soil: SoilSpec,
+    /// How ground vibration decays with distance (Bornitz).
+    #[serde(default)]
+    pub ground: GroundSpec,
+    /// `"long-term"` (default: a machine in production repeats its blow) or `"short-term"`
+    /// (an occasional blow): which DIN 4150-3 limits apply.
+    #[serde(default)]
+    pub excitation: Excitation,
+    /// The lumped mass that is the anvil (for the anvil-amplitude check).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anvil: Option<String>,
+    /// The elastic pad under the anvil (for the pad-stress check).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pad: Option<PadSpec>,
+    /// Allowable values of the foundation checks; a check without one is not applicable.
+    #[serde(default)]
+    pub allowable: AllowableSpec,
+}
+
+/// `[foundation.soil]` (module docs): exactly one of the three forms.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SoilSpec {
+    /// G (Pa).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear_modulus: Option<f64>,
+    /// V_s (m/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear_wave_velocity: Option<f64>,
+    /// ν.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub poisson: Option<f64>,
+    /// ρ (kg/m³).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<f64>,
+    /// D_m (fraction of critical), default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material_damping: Option<f64>,
+    /// Whether the half-space's radiation dashpot c_z acts (default true).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radiation_damping: Option<bool>,
+    /// C_u (N/m³), IS 2974.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uniform_compression: Option<f64>,
+    /// k_z (N/m) given directly.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness_z: Option<f64>,
+    /// c_z (N·s/m) given directly (with `stiffness_z` or `uniform_compression`), default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping_z: Option<f64>,
+}
+
+/// `[foundation.ground]`: the Bornitz attenuation `v(r) = v(r1) (r1/r)^n e^{−α (r − r1)}`.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct GroundSpec {
+    /// n: 0.5 for surface (Rayleigh) waves (default), 1 for body waves, 2 for body waves along
+    /// the surface.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geometric_exponent: Option<f64>,
+    /// α (1/m), default 0 (no material attenuation: the largest ground vibration).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub attenuation: Option<f64>,
+}
+
+/// DIN 4150-3's classes of excitation.
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Excitation {
+    #[default]
+    LongTerm,
+    ShortTerm,
+}
+
+/// `[foundation.pad]`: the spring of the lumped structure that is the elastic pad, and its area.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PadSpec {
+    /// The name of a `structure.lumped.springs` entry.
+    pub spring: String,
+    /// m².
+    pub area: f64,
+}
+
+/// `[foundation.allowable]`: the limits of the foundation checks (SI units).
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct AllowableSpec {
+    /// Peak displacement of the block (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub block_amplitude: Option<f64>,
+    /// Peak displacement of the anvil (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anvil_amplitude: Option<f64>,
+    /// Peak compressive stress in the pad (Pa).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pad_stress: Option<f64>,
+    /// Static + dynamic soil pressure under the block (Pa).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub soil_pressure: Option<f64>,
+}
+
+/// `[[receiver]]`: where the ground vibration is checked ([`super::foundation`]).
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ReceiverSpec {
+    pub name: String,
+    /// r (m) from the block's centre.
+    pub distance: f64,
+    /// `"industrial"`, `"residential"` or `"sensitive"` (DIN 4150-3 lines 1, 2, 3).
+    pub building: String,
+    /// What the people there do (a label, e.g. "residential, night").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kind: Option<String>,
+    /// The limit (m/s²) of the largest 1 s running r.m.s. of the W_m-weighted acceleration.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub people_limit: Option<f64>,
 }
