@@ -119,7 +119,7 @@ impl NetMode {
     /// Is switch `k` on?
     #[inline]
     pub fn on(self, k: usize) -> bool {
-        self.0 >> k & 1 == 1
+        (self.0 >> k) & 1 == 1
     }
     /// This mode with switch `k` set to `on`.
     #[inline]
@@ -179,7 +179,7 @@ impl Network {
             let f = |what: &str| format!("{}.{what}", b.name);
             if !(b.mass.is_finite() && b.mass > 0.0) {
                 return Err(Error::invalid(
-                    &f("mass"),
+                    f("mass"),
                     format!(
                         "must be a finite number > 0 kg (got {})",
                         crate::num(b.mass)
@@ -188,12 +188,12 @@ impl Network {
             }
             if !b.velocity.is_finite() {
                 return Err(Error::invalid(
-                    &f("velocity"),
+                    f("velocity"),
                     "must be a finite number (m/s)",
                 ));
             }
             if !b.force.is_finite() {
-                return Err(Error::invalid(&f("force"), "must be a finite number (N)"));
+                return Err(Error::invalid(f("force"), "must be a finite number (N)"));
             }
         }
         let point = |e: &End, field: &str| -> Result<()> {
@@ -212,7 +212,7 @@ impl Network {
             for (v, what) in [(s.stiffness, "stiffness"), (s.damping, "damping")] {
                 if !(v.is_finite() && v >= 0.0) {
                     return Err(Error::invalid(
-                        &format!("{}.{what}", s.name),
+                        format!("{}.{what}", s.name),
                         format!("must be a finite number ≥ 0 (got {})", crate::num(v)),
                     ));
                 }
@@ -220,7 +220,7 @@ impl Network {
             point(&s.anchor, &format!("{}.anchor", s.name))?;
             if s.anchor == End::Body(s.body) {
                 return Err(Error::invalid(
-                    &format!("{}.anchor", s.name),
+                    format!("{}.anchor", s.name),
                     "a damper cannot be anchored to itself",
                 ));
             }
@@ -231,13 +231,13 @@ impl Network {
             }
             if c.ends[0] == c.ends[1] {
                 return Err(Error::invalid(
-                    &format!("{}.between", c.name),
+                    format!("{}.between", c.name),
                     "a contact needs two different ends (it joins a body or point to itself)",
                 ));
             }
             if !c.gap.is_finite() {
                 return Err(Error::invalid(
-                    &format!("{}.gap", c.name),
+                    format!("{}.gap", c.name),
                     format!(
                         "must be a finite number of metres (> 0 open, < 0 preloaded; got {})",
                         crate::num(c.gap)
@@ -360,7 +360,7 @@ impl Network {
         match self.contacts[c].contact.law {
             ContactLaw::Linear { stiffness, damping } => Ok((stiffness, damping)),
             _ => Err(Error::invalid(
-                &format!("{}.law", self.contacts[c].name),
+                format!("{}.law", self.contacts[c].name),
                 "a general machine ([[contact]] arrays) takes linear contact laws (law = \"linear\", with damping or restitution); hertz and hunt-crossley need dopri5, which runs the paper's machine only for now",
             )),
         }

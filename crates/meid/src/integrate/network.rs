@@ -150,6 +150,9 @@ pub struct NetSolution {
     pub energy_ratio: Option<f64>,
 }
 
+/// A channel's affine functional `[ℓ; ℓ₀]` and that of its slope.
+type ChannelVectors = (Vec<f64>, Vec<f64>);
+
 /// The first-order data of one mode, and its closed form once built.
 struct ModeData {
     /// `A_σ` column-major (`n × n`, `n = 2·dofs`).
@@ -161,7 +164,7 @@ struct ModeData {
     f: Vec<f64>,
     prop: Option<Rc<Propagator>>,
     /// Per channel `(ℓ, ℓ_slope)` (both of length `n + 1`), `None` when identically zero.
-    chans: Option<Vec<Option<(Vec<f64>, Vec<f64>)>>>,
+    chans: Option<Vec<Option<ChannelVectors>>>,
 }
 
 impl ModeData {
@@ -379,7 +382,7 @@ struct Modes<'n> {
     data: HashMap<u64, ModeData>,
 }
 
-impl<'n> Modes<'n> {
+impl Modes<'_> {
     fn get(&mut self, mode: NetMode) -> Result<&mut ModeData> {
         if !self.data.contains_key(&mode.0) {
             let md = ModeData::new(self.net, mode)?;
@@ -513,7 +516,7 @@ pub fn initial_state(net: &Network) -> Result<Vec<f64>> {
         let (delta, _) = net.overlap(c, &x);
         let (kk, _) = net.linear_law(c)?;
         let force = kk * delta;
-        if link.gap < 0.0 && !(force > 1e-9 * kk * link.gap.abs()) {
+        if link.gap < 0.0 && (force.is_nan() || force <= 1e-9 * kk * link.gap.abs()) {
             return Err(Error::invalid(
                 format!("{}.gap", link.name),
                 format!(
@@ -827,7 +830,7 @@ fn check(net: &Network, sol: &NetSolution) -> Result<()> {
         ("end of the run", Some(sol.residual_run_end)),
     ] {
         if let Some(r) = r {
-            if !(r <= RESIDUAL_BOUND) {
+            if r.is_nan() || r > RESIDUAL_BOUND {
                 return Err(Error::numerical(
                     "simulation",
                     format!(
