@@ -19,6 +19,7 @@ mod measure_cli;
 mod model_cli;
 mod modes_cli;
 mod mutations;
+mod network_cli;
 mod outputs_cli;
 mod paper_cli;
 mod pictures_cli;

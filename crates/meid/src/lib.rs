@@ -7,8 +7,8 @@
 //! | input | [`model`] | TOML model files, `--set` overrides, validation with file/line/column errors |
 //! | structure | [`structure`] | finite elements (shell, frame, springs, masses), mesh, sparse assembly |
 //! | modes | [`modal`] | generalised symmetric eigen-solvers, the reduced [`modal::ModalModel`] (paper Eq. 9) |
-//! | impact | [`impact`] | slider, bed, damper, unilateral contacts: the piecewise-linear system (Eqs. 1-8) |
-//! | time | [`integrate`] | exact event-driven propagation; Dormand-Prince 5(4) with event location |
+//! | impact | [`impact`] | slider, bed, damper, unilateral contacts: the piecewise-linear system (Eqs. 1-8); any number of impactors, dampers and contacts ([`impact::network`]) |
+//! | time | [`integrate`] | exact event-driven propagation (the paper's system, and a general machine: [`integrate::network`]); Dormand-Prince 5(4) with event location |
 //! | studies | [`analysis`] | energies (Eqs. 10-24), spectra, sweeps, optimisation, comparisons |
 //! | surroundings | [`foundation`] | the block on the soil, ground vibration at receivers, DIN 4150 / ISO 2631 / IS 2974 checks |
 //! | measured data | [`record`], [`measure`] | records in SI; blows, spectra, FRFs, validation, calibration |

@@ -53,6 +53,8 @@ mod modal_never_lies;
 mod model_input;
 mod modes_import;
 mod modes_truncation;
+mod network_engine;
+mod network_model;
 mod optimize_checks;
 mod output_sets;
 mod plot_checks;

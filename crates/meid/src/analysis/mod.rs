@@ -5,6 +5,7 @@ pub mod compare;
 pub mod energy;
 pub mod esd;
 pub mod montecarlo;
+pub mod network;
 pub mod octave;
 pub mod optimize;
 pub mod production;

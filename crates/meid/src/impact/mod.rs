@@ -47,6 +47,7 @@
 //! [`crate::integrate`] propagates it exactly. Hertz and Hunt-Crossley laws need `dopri5`.
 
 mod channels;
+pub mod network;
 pub mod restitution;
 
 pub use channels::{Channel, ChannelMap, CHANNELS, N_CHANNELS};

@@ -489,13 +489,13 @@ const MAX_MICRO_STRETCHES: usize = 1000;
 /// noise is raised to `|v|` plus the function's own, so the search does not report the start
 /// as a crossing (a zero-length stretch, again and again), and reports a real return across
 /// zero. Otherwise the function is unchanged.
-struct Lifted<F> {
+pub(crate) struct Lifted<F> {
     f: F,
     noise: f64,
 }
 
 impl<F: Scalar> Lifted<F> {
-    fn new(f: F, value: f64, sign: f64) -> Self {
+    pub(crate) fn new(f: F, value: f64, sign: f64) -> Self {
         let own = f.noise();
         let noise = if value * sign < 0.0 {
             own + value.abs()
@@ -597,7 +597,11 @@ fn emit_samples(
 /// those identically zero left out). All are searched over common windows growing from one
 /// fastest period, so the search ends at the earliest crossing; only the earliest bracket is
 /// refined (and any other bracket starting before its root), in the order of their starts.
-fn first_switch<F: Scalar>(searches: &mut [Search<F>], period: f64, horizon: f64) -> Option<f64> {
+pub(crate) fn first_switch<F: Scalar>(
+    searches: &mut [Search<F>],
+    period: f64,
+    horizon: f64,
+) -> Option<f64> {
     let mut limit = if period.is_finite() {
         period.min(horizon)
     } else {
@@ -772,13 +776,13 @@ fn mode_channels<'c>(
 }
 
 /// 8-point Gauss-Legendre rule on [−1, 1]: the positive nodes and their weights.
-const GL_X: [f64; 4] = [
+pub(crate) const GL_X: [f64; 4] = [
     0.1834346424956498,
     0.525_532_409_916_329,
     0.7966664774136267,
     0.9602898564975363,
 ];
-const GL_W: [f64; 4] = [
+pub(crate) const GL_W: [f64; 4] = [
     0.362_683_783_378_362,
     0.3137066458778873,
     0.2223810344533745,
@@ -789,7 +793,7 @@ const GL_W: [f64; 4] = [
 /// (`ẋ = Re Σ β_k e^{λ_k s}`, so the integrand is a sum of exponentials), otherwise (the
 /// matrix-exponential fallback) by 8-point Gauss-Legendre quadrature on sub-intervals of a
 /// quarter of the fastest period. Taylor steps have [`taylor_dissipated`].
-fn dissipated(seg: &Segment<'_>, c: &Mat<f64>, nd: usize, len: f64) -> f64 {
+pub(crate) fn dissipated(seg: &Segment<'_>, c: &Mat<f64>, nd: usize, len: f64) -> f64 {
     if len <= 0.0 || c.norm_l2() == 0.0 {
         return 0.0;
     }
@@ -876,7 +880,7 @@ fn seg_period(seg: &Segment<'_>) -> f64 {
 }
 
 /// `∫₀^T e^{z s} ds`, stable for small `|z T|`.
-fn exp_integral(z: c64, t: f64) -> c64 {
+pub(crate) fn exp_integral(z: c64, t: f64) -> c64 {
     let zt = z * t;
     if zt.norm() < 1e-4 {
         t * (1.0 + zt / 2.0 + zt * zt / 6.0 + zt * zt * zt / 24.0)

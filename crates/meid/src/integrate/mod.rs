@@ -16,6 +16,7 @@
 pub mod dopri5;
 pub mod exact;
 pub mod expm;
+pub mod network;
 pub mod peaks;
 pub mod propagator;
 pub mod roots;

@@ -493,9 +493,10 @@ impl<'p> Segment<'p> {
                     // ℓᵀX_p(0) + ℓᵀ(X₀ − X_p(0)) and ℓᵀX₀ computed directly (the particular
                     // solution may be far larger than the value: a contact's overlap at rest
                     // is a small difference of two static deflections).
-                    let direct = self.start.as_ref().map_or(0.0, |x0| {
-                        dot(&l[..n], x0) + if l.len() > n { l[n] } else { 0.0 }
-                    });
+                    // (Without a forcing the segment's start is `grid[0]`.)
+                    let grid = self.grid.borrow();
+                    let x0: &[f64] = self.start.as_deref().unwrap_or(&grid[0]);
+                    let direct = dot(&l[..n], x0) + if l.len() > n { l[n] } else { 0.0 };
                     e.noise += 64.0 * f64::EPSILON * (scale + extra[0].abs())
                         + 4.0 * (e.value_slope(0.0).0 - direct).abs();
                 }

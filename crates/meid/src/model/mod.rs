@@ -35,6 +35,7 @@ pub mod general;
 pub mod imported;
 mod lumped;
 pub mod material;
+pub mod network;
 mod plausible;
 pub mod source;
 pub mod spec;
@@ -71,6 +72,14 @@ pub const MIN_MAGNITUDE: f64 = 1e-100;
 /// naming its field. NaN and infinities are left to each field's own check (which says what
 /// the field takes).
 fn check_magnitudes(spec: &ModelSpec, src: &Source) -> Result<()> {
+    let Ok(table) = toml::Table::try_from(spec) else {
+        return Ok(());
+    };
+    check_table_magnitudes(&table, src)
+}
+
+/// [`check_magnitudes`] of a model table.
+pub(crate) fn check_table_magnitudes(table: &toml::Table, src: &Source) -> Result<()> {
     fn walk(v: &toml::Value, path: &str, out: &mut Option<(String, f64)>) {
         if out.is_some() {
             return;
@@ -100,11 +109,8 @@ fn check_magnitudes(spec: &ModelSpec, src: &Source) -> Result<()> {
             _ => {}
         }
     }
-    let Ok(table) = toml::Table::try_from(spec) else {
-        return Ok(());
-    };
     let mut found = None;
-    walk(&toml::Value::Table(table), "", &mut found);
+    walk(&toml::Value::Table(table.clone()), "", &mut found);
     match found {
         Some((path, x)) => Err(src.error(
             &path,
@@ -235,6 +241,12 @@ impl Model {
         // 1. The file as written: syntax, unknown keys and types, with positions.
         let mut table: toml::Table =
             toml::from_str(&text).map_err(|e| source::toml_error(name, &text, &e))?;
+        if network::is_general(&table) {
+            return Err(Error::Input {
+                location: name.to_string(),
+                message: "this is a general machine ([[impactor]], [[damper]] or [[contact]] arrays): `meid simulate` runs it; the other commands take the paper's machine ([slider], [damper], [contact.slider_bed]) for now".into(),
+            });
+        }
         let from_file: ModelSpec = spec_from_text(name, &text)?;
         let mut src = Source {
             name: name.to_string(),
@@ -820,7 +832,18 @@ pub fn spec_from_table(table: toml::Table, src: &Source) -> Result<ModelSpec> {
 }
 
 fn build_structure(spec: &ModelSpec, src: &Source) -> Result<ModalModel> {
-    let st = &spec.structure;
+    let ctx = fem::ReductionContext::of(spec);
+    build_structure_of(&spec.structure, spec.foundation.as_ref(), src, &ctx)
+}
+
+/// The structure of a `[structure]` section (on the soil of `foundation`, when given), reduced
+/// in the context `ctx`.
+pub(crate) fn build_structure_of(
+    st: &StructureSpec,
+    foundation: Option<&spec::FoundationSpec>,
+    src: &Source,
+    ctx: &fem::ReductionContext,
+) -> Result<ModalModel> {
     let given = usize::from(st.lumped.is_some())
         + usize::from(st.modal.is_some())
         + usize::from(st.fem.is_some())
@@ -831,8 +854,7 @@ fn build_structure(spec: &ModelSpec, src: &Source) -> Result<ModalModel> {
             "give one of [structure.lumped], [structure.modal], [structure.fem] or [structure.modes], not several",
         ));
     }
-    let ctx = fem::ReductionContext::of(spec);
-    if let Some(f) = &spec.foundation {
+    if let Some(f) = foundation {
         let Some(l) = &st.lumped else {
             return Err(src.error(
                 "foundation",
@@ -840,16 +862,16 @@ fn build_structure(spec: &ModelSpec, src: &Source) -> Result<ModalModel> {
             ));
         };
         let found = foundation::Foundation::from_spec(f, l, src)?;
-        return lumped::modal_model(&found.augment(l), src, &ctx);
+        return lumped::modal_model(&found.augment(l), src, ctx);
     }
     if let Some(l) = &st.lumped {
-        return lumped::modal_model(l, src, &ctx);
+        return lumped::modal_model(l, src, ctx);
     }
     if let Some(m) = &st.modal {
         return lumped::from_modal_spec(m, src);
     }
     if let Some(f) = &st.fem {
-        return fem::modal_model(f, src, &ctx);
+        return fem::modal_model(f, src, ctx);
     }
     if let Some(m) = &st.modes {
         return imported::modal_model(m, src);

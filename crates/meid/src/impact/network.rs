@@ -1,0 +1,574 @@
+//! A general impact machine: a modal structure with any number of rigid impactors, impact
+//! dampers and unilateral contacts between them (the paper's system, [`super::ImpactSystem`],
+//! is one slider, one damper and two contacts of it).
+//!
+//! # Coordinates and sign convention
+//! One axis `z`, positive in the direction the blows strike (downwards on a press), as for the
+//! paper's system. Generalised coordinates, in this order:
+//!
+//! ```text
+//! x = [q_1 … q_n,  z_1 … z_m]      (modal coordinates, then the bodies in the model's order:
+//!                                   impactors first, then dampers)
+//! ```
+//!
+//! `u_P = Σ_i ψ_i(P) q_i` is the displacement of structure point `P`, `z_b` that of body `b`,
+//! and the ground does not move. `M = diag(1, …, 1, m_1 … m_m)` (mass-normalised modes).
+//!
+//! # Elements
+//! | element | relative displacement | force while acting | acts |
+//! |---|---|---|---|
+//! | contact `between = [A, B]`, gap `g` | overlap `δ = u_A − u_B − g = aᵀx − g` | `f = K δ + C δ̇` (closed only) | `−f` on A, `+f` on B |
+//! | damper suspension (k, c) | `δ_s = z_d − u_anchor` (`u_anchor = 0` for the ground) | `f_s = k δ_s + c δ̇_s` | `−f_s` on the damper, `+f_s` on the anchor |
+//!
+//! A contact's first end A is the one on the side the blow comes from: it closes by moving in
+//! `+z` towards B (the paper's slider-bed contact is `between = [slider, bed]`, its bed-damper
+//! contact `between = [bed, damper]`). A gap `g > 0` is a clearance at `x = 0`; `g < 0` a
+//! preload (the contact overlaps by `−g` at `x = 0`).
+//!
+//! With `σ` the mode (which contacts are closed, which one-way dashpots act), the equations are
+//! `M ẍ + C_σ ẋ + K_σ x = f_σ` with
+//!
+//! ```text
+//! K_σ = diag(ω²) ⊕ 0 + Σ_s k_s a_s a_sᵀ + Σ_{c closed} K_c a_c a_cᵀ
+//! C_σ = D ⊕ 0 + Σ_{s acting} c_s a_s a_sᵀ + Σ_{c closed} C_c a_c a_cᵀ
+//! f_σ = Σ_b F_b e_b + Σ_{c closed} K_c g_c a_c
+//! ```
+//!
+//! (`D` the structure's modal damping, `F_b` an impactor's constant force): affine, exact
+//! between switches ([`crate::integrate::network`]).
+//!
+//! # Switching rules
+//! As in the paper's system: a contact is closed while `δ > 0` and, with the force-release rule
+//! and a damped law, while `f > 0`; a one-way dashpot acts while `δ̇_s < 0` (the damper moving
+//! back towards its anchor side); a two-way dashpot always acts. A mode is a bit set of up to
+//! [`MAX_SWITCHES`] switches: the contacts in the model's order, then the one-way dashpots.
+
+use faer::Mat;
+
+use super::{Contact, ContactLaw, DashpotKind, Release};
+use crate::modal::ModalModel;
+use crate::{Error, Result};
+
+/// The most switches (contacts plus one-way dashpots) a network may have: a mode is a 64-bit set.
+pub const MAX_SWITCHES: usize = 64;
+
+/// What a contact end or a suspension anchor is.
+#[derive(Debug, Clone, PartialEq)]
+pub enum End {
+    /// A named point of the structure.
+    Point(String),
+    /// A body, by its index in [`Network::bodies`].
+    Body(usize),
+    /// The ground (does not move).
+    Ground,
+}
+
+/// A rigid body: an impactor (initial velocity, constant force) or a damper mass.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Body {
+    pub name: String,
+    /// m (kg).
+    pub mass: f64,
+    /// Velocity at t = 0 (m/s, positive along +z).
+    pub velocity: f64,
+    /// A constant force from t = 0 (N, positive along +z), e.g. its weight.
+    pub force: f64,
+}
+
+/// A damper's spring and dashpot between its mass and an anchor.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Suspension {
+    /// Name of the damper (for reports).
+    pub name: String,
+    /// Index of the damper's mass in [`Network::bodies`].
+    pub body: usize,
+    /// k (N/m).
+    pub stiffness: f64,
+    /// c (N·s/m).
+    pub damping: f64,
+    pub dashpot: DashpotKind,
+    /// A structure point or the ground.
+    pub anchor: End,
+}
+
+/// A unilateral contact between two ends.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Link {
+    pub name: String,
+    /// `[A, B]`: A strikes B moving along +z.
+    pub ends: [End; 2],
+    /// g (m): > 0 open at x = 0, < 0 preloaded.
+    pub gap: f64,
+    pub contact: Contact,
+}
+
+/// A switch of the network's piecewise system.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NetSwitch {
+    /// Contact `i` ([`Network::contacts`]) closed.
+    Contact(usize),
+    /// One-way dashpot of suspension `j` acting.
+    Dashpot(usize),
+}
+
+/// The discrete state: bit `k` set when switch `k` ([`Network::switches`]) is on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, PartialOrd, Ord)]
+pub struct NetMode(pub u64);
+
+impl NetMode {
+    /// Is switch `k` on?
+    #[inline]
+    pub fn on(self, k: usize) -> bool {
+        (self.0 >> k) & 1 == 1
+    }
+    /// This mode with switch `k` set to `on`.
+    #[inline]
+    pub fn with(self, k: usize, on: bool) -> Self {
+        if on {
+            NetMode(self.0 | 1 << k)
+        } else {
+            NetMode(self.0 & !(1 << k))
+        }
+    }
+}
+
+/// A scalar whose sign decides a switch: `g = ℓᵀX + ℓ₀` of the state `X = [x; ẋ]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NetIndicator {
+    pub kind: IndicatorKind,
+    /// `[ℓ; ℓ₀]`, length `2·dofs + 1`.
+    pub l: Vec<f64>,
+}
+
+/// What an indicator measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IndicatorKind {
+    /// The overlap `δ` of contact `i`.
+    Overlap(usize),
+    /// The force `K δ + C δ̇` of contact `i` (force-release rule, damped law).
+    Force(usize),
+    /// The relative velocity `δ̇_s` of suspension `j` (one-way dashpot).
+    DashpotVelocity(usize),
+}
+
+/// The general impact system. See the module documentation.
+#[derive(Debug, Clone)]
+pub struct Network {
+    pub structure: ModalModel,
+    pub bodies: Vec<Body>,
+    pub suspensions: Vec<Suspension>,
+    pub contacts: Vec<Link>,
+    /// `a_c` of each contact (`δ = a_cᵀx − g_c`).
+    rel: Vec<Vec<f64>>,
+    /// `a_s` of each suspension (`δ_s = a_sᵀx`).
+    spring_rel: Vec<Vec<f64>>,
+    switches: Vec<NetSwitch>,
+}
+
+impl Network {
+    /// Assembles and checks the network. Field names in errors: `impactor[i]`/`damper[i]`
+    /// (bodies named by the caller's `body_fields`), `contact[i]`.
+    pub fn new(
+        structure: &ModalModel,
+        bodies: Vec<Body>,
+        suspensions: Vec<Suspension>,
+        contacts: Vec<Link>,
+    ) -> Result<Self> {
+        structure.validate()?;
+        for b in &bodies {
+            let f = |what: &str| format!("{}.{what}", b.name);
+            if !(b.mass.is_finite() && b.mass > 0.0) {
+                return Err(Error::invalid(
+                    f("mass"),
+                    format!(
+                        "must be a finite number > 0 kg (got {})",
+                        crate::num(b.mass)
+                    ),
+                ));
+            }
+            if !b.velocity.is_finite() {
+                return Err(Error::invalid(
+                    f("velocity"),
+                    "must be a finite number (m/s)",
+                ));
+            }
+            if !b.force.is_finite() {
+                return Err(Error::invalid(f("force"), "must be a finite number (N)"));
+            }
+        }
+        let point = |e: &End, field: &str| -> Result<()> {
+            match e {
+                End::Point(p) => structure.point(p).map(|_| ()).map_err(|e| match e {
+                    Error::InvalidValue { message, .. } => Error::invalid(field, message),
+                    other => other,
+                }),
+                End::Body(i) if *i >= bodies.len() => {
+                    Err(Error::invalid(field, format!("no body {i}")))
+                }
+                _ => Ok(()),
+            }
+        };
+        for s in &suspensions {
+            for (v, what) in [(s.stiffness, "stiffness"), (s.damping, "damping")] {
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(Error::invalid(
+                        format!("{}.{what}", s.name),
+                        format!("must be a finite number ≥ 0 (got {})", crate::num(v)),
+                    ));
+                }
+            }
+            point(&s.anchor, &format!("{}.anchor", s.name))?;
+            if s.anchor == End::Body(s.body) {
+                return Err(Error::invalid(
+                    format!("{}.anchor", s.name),
+                    "a damper cannot be anchored to itself",
+                ));
+            }
+        }
+        for c in &contacts {
+            for e in &c.ends {
+                point(e, &format!("{}.between", c.name))?;
+            }
+            if c.ends[0] == c.ends[1] {
+                return Err(Error::invalid(
+                    format!("{}.between", c.name),
+                    "a contact needs two different ends (it joins a body or point to itself)",
+                ));
+            }
+            if !c.gap.is_finite() {
+                return Err(Error::invalid(
+                    format!("{}.gap", c.name),
+                    format!(
+                        "must be a finite number of metres (> 0 open, < 0 preloaded; got {})",
+                        crate::num(c.gap)
+                    ),
+                ));
+            }
+            super::check_contact(&c.name, &c.contact)?;
+        }
+        let one_way = suspensions
+            .iter()
+            .filter(|s| s.dashpot == DashpotKind::OneWay && s.damping > 0.0)
+            .count();
+        if contacts.len() + one_way > MAX_SWITCHES {
+            return Err(Error::invalid(
+                "contact",
+                format!(
+                    "{} contacts and {one_way} one-way dashpots make {} switches; meid handles at most {MAX_SWITCHES}",
+                    contacts.len(),
+                    contacts.len() + one_way
+                ),
+            ));
+        }
+        let mut net = Self {
+            structure: structure.clone(),
+            bodies,
+            suspensions,
+            contacts,
+            rel: Vec::new(),
+            spring_rel: Vec::new(),
+            switches: Vec::new(),
+        };
+        net.rel = net
+            .contacts
+            .iter()
+            .map(|c| net.difference(&c.ends[0], &c.ends[1]))
+            .collect();
+        net.spring_rel = net
+            .suspensions
+            .iter()
+            .map(|s| net.difference(&End::Body(s.body), &s.anchor))
+            .collect();
+        net.switches = (0..net.contacts.len()).map(NetSwitch::Contact).collect();
+        for (j, s) in net.suspensions.iter().enumerate() {
+            if s.dashpot == DashpotKind::OneWay && s.damping > 0.0 {
+                net.switches.push(NetSwitch::Dashpot(j));
+            }
+        }
+        Ok(net)
+    }
+
+    /// `a` with `aᵀx = u_A − u_B`.
+    fn difference(&self, a: &End, b: &End) -> Vec<f64> {
+        let mut v = vec![0.0; self.dofs()];
+        for (e, sign) in [(a, 1.0), (b, -1.0)] {
+            match e {
+                End::Point(p) => {
+                    if let Ok(psi) = self.structure.point(p) {
+                        for (vi, pi) in v.iter_mut().zip(psi) {
+                            *vi += sign * pi;
+                        }
+                    }
+                }
+                End::Body(i) => v[self.n_modes() + i] += sign,
+                End::Ground => {}
+            }
+        }
+        v
+    }
+
+    /// Number of structural modes n.
+    #[inline]
+    pub fn n_modes(&self) -> usize {
+        self.structure.len()
+    }
+    /// Number of second-order coordinates (modes and bodies).
+    #[inline]
+    pub fn dofs(&self) -> usize {
+        self.n_modes() + self.bodies.len()
+    }
+    /// The switches, in bit order.
+    pub fn switches(&self) -> &[NetSwitch] {
+        &self.switches
+    }
+    /// `a_c` of contact `c` (`δ = a_cᵀx − g_c`).
+    pub fn contact_vector(&self, c: usize) -> &[f64] {
+        &self.rel[c]
+    }
+    /// `a_s` of suspension `j` (`δ_s = a_sᵀx`).
+    pub fn suspension_vector(&self, j: usize) -> &[f64] {
+        &self.spring_rel[j]
+    }
+    /// Masses of the coordinates: `[1, …, 1, m_1 … m_m]`.
+    pub fn mass_diag(&self) -> Vec<f64> {
+        let mut m = vec![1.0; self.n_modes()];
+        m.extend(self.bodies.iter().map(|b| b.mass));
+        m
+    }
+
+    /// Is contact `c` closed in `mode`?
+    #[inline]
+    pub fn closed(&self, mode: NetMode, c: usize) -> bool {
+        mode.on(c)
+    }
+
+    /// Does the dashpot of suspension `j` act in `mode`?
+    pub fn dashpot_on(&self, mode: NetMode, j: usize) -> bool {
+        let s = &self.suspensions[j];
+        match s.dashpot {
+            DashpotKind::TwoWay => true,
+            DashpotKind::OneWay => self
+                .switches
+                .iter()
+                .position(|w| *w == NetSwitch::Dashpot(j))
+                .is_some_and(|k| mode.on(k)),
+        }
+    }
+
+    /// `(K, C)` of contact `c`'s linear law; an error for a non-linear law.
+    pub fn linear_law(&self, c: usize) -> Result<(f64, f64)> {
+        match self.contacts[c].contact.law {
+            ContactLaw::Linear { stiffness, damping } => Ok((stiffness, damping)),
+            _ => Err(Error::invalid(
+                format!("{}.law", self.contacts[c].name),
+                "a general machine ([[contact]] arrays) takes linear contact laws (law = \"linear\", with damping or restitution); hertz and hunt-crossley need dopri5, which runs the paper's machine only for now",
+            )),
+        }
+    }
+
+    /// `K_σ`, `C_σ` (`dofs × dofs`) and the forcing `f_σ` (length `dofs`) of a mode (module
+    /// documentation).
+    pub fn matrices(&self, mode: NetMode) -> Result<(Mat<f64>, Mat<f64>, Vec<f64>)> {
+        let nd = self.dofs();
+        let n = self.n_modes();
+        let mut k = Mat::<f64>::zeros(nd, nd);
+        let mut c = Mat::<f64>::zeros(nd, nd);
+        for i in 0..n {
+            k[(i, i)] = self.structure.omega_rad_per_s[i].powi(2);
+            for j in 0..n {
+                c[(i, j)] = self.structure.damping[i * n + j];
+            }
+        }
+        let mut add = |a: &[f64], kk: f64, cc: f64| {
+            for i in 0..nd {
+                if a[i] == 0.0 {
+                    continue;
+                }
+                for j in 0..nd {
+                    if a[j] != 0.0 {
+                        k[(i, j)] += kk * a[i] * a[j];
+                        c[(i, j)] += cc * a[i] * a[j];
+                    }
+                }
+            }
+        };
+        for (j, s) in self.suspensions.iter().enumerate() {
+            let cc = if self.dashpot_on(mode, j) {
+                s.damping
+            } else {
+                0.0
+            };
+            add(&self.spring_rel[j], s.stiffness, cc);
+        }
+        let mut f = vec![0.0; nd];
+        for (b, body) in self.bodies.iter().enumerate() {
+            f[n + b] = body.force;
+        }
+        for ci in 0..self.contacts.len() {
+            if self.closed(mode, ci) {
+                let (kk, cc) = self.linear_law(ci)?;
+                add(&self.rel[ci], kk, cc);
+                let g = self.contacts[ci].gap;
+                for (fi, ai) in f.iter_mut().zip(&self.rel[ci]) {
+                    *fi += kk * g * ai;
+                }
+            }
+        }
+        Ok((k, c, f))
+    }
+
+    /// The indicators whose signs decide the switches.
+    pub fn indicators(&self) -> Result<Vec<NetIndicator>> {
+        let nd = self.dofs();
+        let mut out = Vec::new();
+        for sw in &self.switches {
+            match *sw {
+                NetSwitch::Contact(ci) => {
+                    let a = &self.rel[ci];
+                    let g = self.contacts[ci].gap;
+                    let mut l = vec![0.0; 2 * nd + 1];
+                    l[..nd].copy_from_slice(a);
+                    l[2 * nd] = -g;
+                    out.push(NetIndicator {
+                        kind: IndicatorKind::Overlap(ci),
+                        l,
+                    });
+                    let (kk, cc) = self.linear_law(ci)?;
+                    if self.contacts[ci].contact.release == Release::Force && cc != 0.0 {
+                        let mut l = vec![0.0; 2 * nd + 1];
+                        for i in 0..nd {
+                            l[i] = kk * a[i];
+                            l[nd + i] = cc * a[i];
+                        }
+                        l[2 * nd] = -kk * g;
+                        out.push(NetIndicator {
+                            kind: IndicatorKind::Force(ci),
+                            l,
+                        });
+                    }
+                }
+                NetSwitch::Dashpot(j) => {
+                    let mut l = vec![0.0; 2 * nd + 1];
+                    l[nd..2 * nd].copy_from_slice(&self.spring_rel[j]);
+                    out.push(NetIndicator {
+                        kind: IndicatorKind::DashpotVelocity(j),
+                        l,
+                    });
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// The mode implied by the signs of [`Self::indicators`] (in their order): a contact is
+    /// closed when its overlap (and, if searched, its force) is positive; a one-way dashpot
+    /// acts when its relative velocity is negative. A sign 0 (identically zero) leaves a
+    /// contact open and a dashpot off.
+    pub fn implied(&self, inds: &[NetIndicator], signs: &[f64]) -> NetMode {
+        let mut closed = vec![true; self.contacts.len()];
+        let mut mode = NetMode(0);
+        for (ind, s) in inds.iter().zip(signs) {
+            match ind.kind {
+                IndicatorKind::Overlap(c) | IndicatorKind::Force(c) => closed[c] &= *s > 0.0,
+                IndicatorKind::DashpotVelocity(j) => {
+                    if let Some(k) = self
+                        .switches
+                        .iter()
+                        .position(|w| *w == NetSwitch::Dashpot(j))
+                    {
+                        mode = mode.with(k, *s < 0.0);
+                    }
+                }
+            }
+        }
+        for (c, on) in closed.into_iter().enumerate() {
+            mode = mode.with(c, on);
+        }
+        mode
+    }
+
+    /// Overlap `δ` and rate `δ̇` of contact `c` at the state `X = [x; ẋ]`.
+    pub fn overlap(&self, c: usize, x: &[f64]) -> (f64, f64) {
+        let nd = self.dofs();
+        let a = &self.rel[c];
+        (
+            dot(a, &x[..nd]) - self.contacts[c].gap,
+            dot(a, &x[nd..2 * nd]),
+        )
+    }
+
+    /// The force of contact `c` (N) in `mode` at `X`: `K δ + C δ̇` closed, 0 open.
+    pub fn contact_force(&self, mode: NetMode, c: usize, x: &[f64]) -> f64 {
+        if !self.closed(mode, c) {
+            return 0.0;
+        }
+        let (d, r) = self.overlap(c, x);
+        self.contacts[c].contact.law.force(d, r)
+    }
+
+    /// Kinetic and potential energy (J) at `X` in `mode`: `½ẋᵀMẋ` and
+    /// `½Σω_i²q_i² + Σ_s ½k_sδ_s² + Σ_{closed} ½K_cδ_c²`.
+    pub fn energies(&self, mode: NetMode, x: &[f64]) -> (f64, f64) {
+        let nd = self.dofs();
+        let n = self.n_modes();
+        let m = self.mass_diag();
+        let ke = 0.5 * (0..nd).map(|i| m[i] * x[nd + i] * x[nd + i]).sum::<f64>();
+        let mut pe = 0.5
+            * (0..n)
+                .map(|i| (self.structure.omega_rad_per_s[i] * x[i]).powi(2))
+                .sum::<f64>();
+        for (j, s) in self.suspensions.iter().enumerate() {
+            pe += 0.5 * s.stiffness * dot(&self.spring_rel[j], &x[..nd]).powi(2);
+        }
+        for c in 0..self.contacts.len() {
+            if self.closed(mode, c) {
+                pe += self.contacts[c]
+                    .contact
+                    .law
+                    .potential_energy(self.overlap(c, x).0);
+            }
+        }
+        (ke, pe)
+    }
+
+    /// The energy of the bodies at `X`: their kinetic energies and the suspensions' spring
+    /// energies (J), the paper's `E_s + E_d` (Eqs. 11-13).
+    pub fn body_energy(&self, x: &[f64]) -> f64 {
+        let nd = self.dofs();
+        let n = self.n_modes();
+        let mut e: f64 = self
+            .bodies
+            .iter()
+            .enumerate()
+            .map(|(b, body)| 0.5 * body.mass * x[nd + n + b].powi(2))
+            .sum();
+        for (j, s) in self.suspensions.iter().enumerate() {
+            e += 0.5 * s.stiffness * dot(&self.spring_rel[j], &x[..nd]).powi(2);
+        }
+        e
+    }
+
+    /// The work of the constant body forces between `x0` and `x` (J): `Σ_b F_b (z_b − z_b0)`.
+    pub fn force_work(&self, x0: &[f64], x: &[f64]) -> f64 {
+        let n = self.n_modes();
+        self.bodies
+            .iter()
+            .enumerate()
+            .map(|(b, body)| body.force * (x[n + b] - x0[n + b]))
+            .sum()
+    }
+
+    /// True when something carries force to the floor: the structure's ground reactions, a
+    /// suspension anchored to the ground or a contact with the ground.
+    pub fn has_floor_force(&self) -> bool {
+        self.structure.floor_force.is_some()
+            || self.suspensions.iter().any(|s| s.anchor == End::Ground)
+            || self.contacts.iter().any(|c| c.ends.contains(&End::Ground))
+    }
+}
+
+/// `Σ aᵢbᵢ`.
+#[inline]
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}

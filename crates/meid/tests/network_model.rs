@@ -1,0 +1,223 @@
+//! General machine files (`[[impactor]]`, `[[damper]]`, `[[contact]]`): parsing, bad input
+//! (errors naming the file, line and field), preloads, and the run of a file.
+
+use meid::model::network::NetworkModel;
+use meid::model::Model;
+
+/// A two-mass lumped structure, one impactor, one damper under "left".
+const BASE: &str = r#"name = "general"
+[structure.lumped]
+masses = [ { name = "left", mass = 10.0 }, { name = "right", mass = 10.0 } ]
+springs = [ { nodes = ["left", "right"], stiffness = 2.0e7 },
+            { nodes = ["left", "ground"], stiffness = 1.0e5 },
+            { nodes = ["right", "ground"], stiffness = 1.0e5 } ]
+damping_ratios = [0.01, 0.01]
+
+[[impactor]]
+name = "die"
+mass = 1.2
+velocity = 1.2
+
+[[damper]]
+name = "d_left"
+mass = 1.75
+stiffness = 900.0
+damping = 350.0
+point = "left"
+anchor = "ground"
+
+[[contact]]
+name = "die_left"
+between = ["die", "left"]
+stiffness = 4.3e7
+
+[[contact]]
+name = "left_damper"
+between = ["left", "d_left"]
+stiffness = 6.3e7
+restitution = 0.8
+
+[simulation]
+duration = 0.05
+"#;
+
+fn load(text: &str) -> meid::Result<NetworkModel> {
+    NetworkModel::from_text("m.toml", text.to_string(), &[])
+}
+
+/// The error of `text`, as a string; panics when it loads.
+fn error_of(text: &str) -> String {
+    match load(text) {
+        Ok(_) => panic!("loaded:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// The line (1-based) of the first occurrence of `needle` in `text`.
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines()
+        .position(|l| l.contains(needle))
+        .unwrap_or_else(|| panic!("{needle} not in the text"))
+        + 1
+}
+
+#[test]
+fn a_general_file_runs_and_restitution_sets_the_damping() {
+    let m = load(BASE).unwrap();
+    assert_eq!(m.network.contacts.len(), 2);
+    assert_eq!(m.notes.len(), 1, "{:?}", m.notes);
+    let sol = m.solve(&m.options().unwrap()).unwrap();
+    assert!(sol.energy_ratio.is_some());
+    assert!(sol.residual_run_end <= 1e-9);
+    assert!(!sol.impacts.is_empty());
+    // The paper machine's loader refuses it, saying which command runs it.
+    let e = Model::from_text("m.toml", BASE.to_string(), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("general machine") && e.contains("meid simulate"),
+        "{e}"
+    );
+}
+
+#[test]
+fn unknown_names_get_a_did_you_mean_with_file_and_line() {
+    let text = BASE.replace(
+        r#"between = ["die", "left"]"#,
+        r#"between = ["die", "lfet"]"#,
+    );
+    let e = error_of(&text);
+    let line = line_of(&text, "lfet");
+    assert!(e.contains(&format!("m.toml:{line}:")), "{e}");
+    assert!(
+        e.contains("contact[0].between") && e.contains("did you mean 'left'"),
+        "{e}"
+    );
+    let text = BASE.replace(r#"point = "left""#, r#"point = "rigth""#);
+    let e = error_of(&text);
+    assert!(
+        e.contains("damper[0].point") && e.contains("did you mean 'right'"),
+        "{e}"
+    );
+}
+
+#[test]
+fn unknown_keys_are_refused_with_a_did_you_mean() {
+    let text = BASE
+        .replace("gap_typo", "")
+        .replace("stiffness = 4.3e7", "stiffness = 4.3e7\ngpa = 1e-3");
+    let e = error_of(&text);
+    assert!(
+        e.contains(&format!("m.toml:{}", line_of(&text, "gpa"))),
+        "{e}"
+    );
+    assert!(e.contains("`gap`"), "{e}");
+}
+
+#[test]
+fn a_contact_with_itself_and_a_damper_anchored_to_itself_are_refused() {
+    let text = BASE.replace(
+        r#"between = ["die", "left"]"#,
+        r#"between = ["die", "die"]"#,
+    );
+    let e = error_of(&text);
+    assert!(
+        e.contains("contact[0].between") && e.contains("itself"),
+        "{e}"
+    );
+    assert!(
+        e.contains(&format!("m.toml:{}", line_of(&text, r#"["die", "die"]"#))),
+        "{e}"
+    );
+    let text = BASE.replace(r#"anchor = "ground""#, r#"anchor = "d_left""#);
+    let e = error_of(&text);
+    assert!(
+        e.contains("damper[0].anchor") && e.contains("itself"),
+        "{e}"
+    );
+    assert!(
+        e.contains(&format!(
+            "m.toml:{}",
+            line_of(&text, r#"anchor = "d_left""#)
+        )),
+        "{e}"
+    );
+}
+
+#[test]
+fn bad_numbers_are_refused_naming_the_field() {
+    for (from, to, field) in [
+        ("mass = 1.2", "mass = -1.2", "impactor[0].mass"),
+        ("mass = 1.75", "mass = -1.75", "damper[0].mass"),
+        (
+            "stiffness = 4.3e7",
+            "stiffness = 4.3e7\ngap = nan",
+            "contact[0].gap",
+        ),
+        (
+            "restitution = 0.8",
+            "restitution = 1.5",
+            "contact[1].restitution",
+        ),
+        (
+            "restitution = 0.8",
+            "restitution = 0.0",
+            "contact[1].restitution",
+        ),
+        (
+            "restitution = 0.8",
+            "restitution = 0.8\ndamping = 3.0",
+            "contact[1].restitution",
+        ),
+    ] {
+        let text = BASE.replacen(from, to, 1);
+        let e = error_of(&text);
+        assert!(e.contains(field), "{field}: {e}");
+        assert!(e.starts_with("m.toml:"), "{e}");
+    }
+}
+
+#[test]
+fn paper_sections_are_not_mixed_with_the_arrays() {
+    let e = error_of(&format!("{BASE}\n[slider]\nmass = 1.0\nvelocity = 1.0\n"));
+    assert!(e.contains("[slider]") && e.contains("[[impactor]]"), "{e}");
+}
+
+/// Two free impactors pressed together by a preload: nothing holds them against each other,
+/// so the preload carries no force at equilibrium: refused. A damper pressed onto the
+/// structure by a preload is held by its spring: in equilibrium, and the run starts from it.
+#[test]
+fn preloads_need_an_equilibrium() {
+    let text = format!(
+        "{BASE}\n[[impactor]]\nname = \"free\"\nmass = 1.0\n\n[[contact]]\nname = \"pressed\"\nbetween = [\"die\", \"free\"]\ngap = -1e-4\nstiffness = 1e6\n"
+    );
+    let e = error_of(&text);
+    assert!(
+        e.contains("contact[3].gap") || e.contains("contact[2].gap"),
+        "{e}"
+    );
+    assert!(e.contains("cannot be in equilibrium"), "{e}");
+    // A damper pressed onto its point by a preload: held by its spring, in equilibrium.
+    // (The die stands off by 1 mm: the preload lifts the bed towards it.)
+    let text = BASE
+        .replace(
+            "stiffness = 6.3e7\nrestitution = 0.8",
+            "stiffness = 6.3e7\nrestitution = 0.8\ngap = -1e-6",
+        )
+        .replace("stiffness = 4.3e7", "stiffness = 4.3e7\ngap = 1e-3");
+    let m = load(&text).unwrap();
+    let sol = m.solve(&m.options().unwrap()).unwrap();
+    // At equilibrium the contact force equals the damper spring's: k_d (z_d − 0) with the
+    // contact pushing the damper by K_d δ.
+    let x0 = &sol.x0;
+    let net = &m.network;
+    let (delta, _) = net.overlap(1, x0);
+    let zd = x0[net.n_modes() + 1];
+    let kd = 900.0;
+    assert!(delta > 0.0);
+    assert!(
+        ((6.3e7 * delta) - kd * zd).abs() < 1e-9 * kd * zd.abs(),
+        "{delta} {zd}"
+    );
+    assert!(sol.residual_run_end <= 1e-9);
+}
