@@ -31,6 +31,7 @@ mod fem_releases;
 mod fem_thread_determinism;
 mod fem_tri;
 mod forced_long_runs;
+mod function_length;
 mod fuzz_measure_readers;
 mod fuzz_parsers;
 mod held_contact;
