@@ -34,6 +34,7 @@ mod fem_tri;
 mod forced_long_runs;
 mod foundation_checks;
 mod frf_files;
+mod function_length;
 mod fuzz_measure_readers;
 mod fuzz_parsers;
 mod held_contact;
