@@ -56,16 +56,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
     if let Some(spec) = &a.rates {
         return crate::production::rate_map(&a.model, &model, spec, a.output.as_deref(), &a.print);
     }
-    let (rate_bpm, _) =
-        meid::analysis::production::stroke_rate(&model, a.rate_bpm).map_err(|_| {
-            meid::Error::invalid(
-                "--rate-bpm",
-                format!(
-                    "the stroke rate must be a finite number > 0 blows per minute (got {})",
-                    a.rate_bpm.unwrap_or(f64::NAN)
-                ),
-            )
-        })?;
+    let (rate_bpm, _) = crate::production::stroke_rate(&model, a.rate_bpm)?;
     if !a.vary.is_empty() {
         return crate::return_map::run(
             &a.model,

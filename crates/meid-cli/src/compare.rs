@@ -69,16 +69,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
             "--window and --tau shape the FFT of the record; add --spectrum fft (the exact spectrum needs no window)"
         );
     }
-    let (rate_bpm, origin) =
-        meid::analysis::production::stroke_rate(&model, a.rate_bpm).map_err(|_| {
-            meid::Error::invalid(
-                "--rate-bpm",
-                format!(
-                    "the stroke rate must be a finite number > 0 blows per minute (got {})",
-                    a.rate_bpm.unwrap_or(f64::NAN)
-                ),
-            )
-        })?;
+    let (rate_bpm, origin) = crate::production::stroke_rate(&model, a.rate_bpm)?;
     let record = if a.blows > 1 {
         a.blows as f64 * 60.0 / rate_bpm
     } else {

@@ -12,6 +12,21 @@ use meid::plot::{self, LinePlot, Marker, Series};
 
 use crate::args::PrintArgs;
 
+/// The stroke rate a command runs at: its `--rate-bpm` (`given`), else the model's
+/// `[production] rate_bpm`, else the assumed 60 /min, with where it came from
+/// ([`production::stroke_rate`]); a bad `--rate-bpm` is an input error naming the option.
+pub fn stroke_rate(model: &Model, given: Option<f64>) -> Result<(f64, production::RateOrigin)> {
+    Ok(production::stroke_rate(model, given).map_err(|_| {
+        meid::Error::invalid(
+            "--rate-bpm",
+            format!(
+                "the stroke rate must be a finite number > 0 blows per minute (got {})",
+                given.unwrap_or(f64::NAN)
+            ),
+        )
+    })?)
+}
+
 /// The production at one rate, and the steady state of the case asked for.
 pub struct Prod {
     pub production: Production,

@@ -1,6 +1,7 @@
 //! The integration tests of `meid-cli`, one test binary: every file in this directory is a
 //! module of it (`autotests = false` in Cargo.toml), so the tests link once instead of once
-//! per file. A new test file is declared below; `every_test_file_is_declared` fails otherwise.
+//! per file. A new test file is declared below; the library suite's `every_test_file_is_declared`
+//! checks this crate's files too.
 //! Run one file's tests with `cargo test --release -p meid-cli --test suite -- FILE::`.
 
 mod common;
@@ -31,28 +32,3 @@ mod shard_cli;
 mod study_audit_s12_cli;
 mod sweep_cli;
 mod trust3_cli;
-
-/// Every `tests/*.rs` file is a module of this binary: with `autotests = false`, an undeclared
-/// file would silently never run.
-#[test]
-fn every_test_file_is_declared() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests");
-    let suite = std::fs::read_to_string(dir.join("suite.rs")).expect("tests/suite.rs");
-    let mut missing = Vec::new();
-    for entry in std::fs::read_dir(&dir).expect("tests/") {
-        let path = entry.expect("entry").path();
-        let Some(stem) = path.file_stem().and_then(|s| s.to_str()) else {
-            continue;
-        };
-        if path.extension().is_some_and(|e| e == "rs")
-            && stem != "suite"
-            && !suite.lines().any(|l| l.trim() == format!("mod {stem};"))
-        {
-            missing.push(stem.to_string());
-        }
-    }
-    assert!(
-        missing.is_empty(),
-        "declare these in tests/suite.rs: {missing:?}"
-    );
-}

@@ -22,7 +22,7 @@ use meid::analysis::energy::simulate;
 use meid::measure::calibrate::{calibrate, parameters, Problem, Settings};
 use meid::measure::process::Processing;
 use meid::measure::validate::MeasuredCase;
-use meid::measure::{Abscissa, Quantity, Record};
+use meid::measure::{Quantity, Record};
 use meid::model::{Case, Model};
 use meid::rng::SplitMix64;
 
@@ -52,18 +52,7 @@ fn main() {
         }
         out.iter_mut()
             .for_each(|x| *x += 0.05 * rms * rng.next_normal());
-        Record {
-            name: name.into(),
-            quantity: q,
-            source_unit: q.si_unit().into(),
-            point: None,
-            abscissa: Abscissa::Even {
-                start_s: 0.0,
-                step_s: 1.0 / FS,
-            },
-            values: out,
-            origin: "synthetic".into(),
-        }
+        Record::sampled(name, q, 0.0, 1.0 / FS, out, "synthetic")
     };
     let records = vec![
         channel(

@@ -18,7 +18,7 @@ use std::time::Instant;
 
 use meid::io::uff;
 use meid::measure::process::{process_all, Processing};
-use meid::measure::{Abscissa, Quantity, Record};
+use meid::measure::{Quantity, Record};
 use meid::rng::SplitMix64;
 
 const FS: f64 = 51_200.0;
@@ -57,18 +57,7 @@ fn write(path: &Path) {
                 };
             }
         }
-        records.push(Record {
-            name,
-            quantity: q,
-            source_unit: q.si_unit().into(),
-            point: None,
-            abscissa: Abscissa::Even {
-                start_s: 0.0,
-                step_s: 1.0 / FS,
-            },
-            values: v,
-            origin: "bench".into(),
-        });
+        records.push(Record::sampled(name, q, 0.0, 1.0 / FS, v, "bench"));
     }
     let mut f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
     uff::write_records(&mut f, &records, true, path).unwrap();

@@ -5,7 +5,7 @@
 //! is matched to the brace that closes it. The functions still being split are listed in
 //! [`KNOWN_LONG`], each with its issue.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The longest a function may be (lines, `fn` line and closing brace included).
 const MAX_LINES: usize = 150;
@@ -27,16 +27,7 @@ const KNOWN_LONG: [(&str, &str); 11] = [
     ("meid/src/analysis/optimize.rs", "brent_search"),
 ];
 
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for e in std::fs::read_dir(dir).unwrap() {
-        let p = e.unwrap().path();
-        if p.is_dir() {
-            rust_files(&p, out);
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            out.push(p);
-        }
-    }
-}
+use crate::layering::rust_files;
 
 fn is_ident(c: char) -> bool {
     c.is_alphanumeric() || c == '_'

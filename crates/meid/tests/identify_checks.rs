@@ -155,7 +155,7 @@ fn lumped_example_blows_give_the_modal_model() {
     use meid::analysis::spectrum::TransientWindow;
     use meid::measure::frf::{estimate, FrfSettings};
     use meid::measure::process::Processing;
-    use meid::measure::{Abscissa, Quantity, Record};
+    use meid::measure::{Quantity, Record};
     use meid::model::{Case, Model};
 
     const FS: f64 = 20_000.0;
@@ -179,18 +179,7 @@ fn lumped_example_blows_give_the_modal_model() {
             seg.extend(v.iter().take(SEGMENT - LEAD));
             out.extend(seg.into_iter().map(|x| x + 0.002 * rms * rng.next_normal()));
         }
-        Record {
-            name: name.into(),
-            quantity: q,
-            source_unit: q.si_unit().into(),
-            point: None,
-            abscissa: Abscissa::Even {
-                start_s: 0.0,
-                step_s: 1.0 / FS,
-            },
-            values: out,
-            origin: "synthetic".into(),
-        }
+        Record::sampled(name, q, 0.0, 1.0 / FS, out, "synthetic")
     };
     let records = vec![
         channel(

@@ -14,7 +14,7 @@ use meid::measure::calibrate::{
 };
 use meid::measure::process::Processing;
 use meid::measure::validate::MeasuredCase;
-use meid::measure::{Abscissa, Quantity, Record};
+use meid::measure::{Quantity, Record};
 use meid::model::{Case, Model};
 use meid::rng::SplitMix64;
 
@@ -62,18 +62,7 @@ fn measured_case(m: &Model, case: Case, noise: f64, seed: u64, tag: &str) -> Mea
             assert_eq!(seg.len(), SEGMENT);
             out.extend(seg.into_iter().map(|x| x + noise * rms * rng.next_normal()));
         }
-        Record {
-            name: name.into(),
-            quantity: q,
-            source_unit: q.si_unit().into(),
-            point: None,
-            abscissa: Abscissa::Even {
-                start_s: 0.0,
-                step_s: 1.0 / FS,
-            },
-            values: out,
-            origin: "synthetic".into(),
-        }
+        Record::sampled(name, q, 0.0, 1.0 / FS, out, "synthetic")
     };
     let records = vec![
         channel(

@@ -352,18 +352,7 @@ fn blows_that_do_not_fit_name_the_valid_range() {
 
 /// A record of a group sampled at FS from t = 0.
 fn record(name: &str, q: Quantity, values: Vec<f64>) -> meid::measure::Record {
-    meid::measure::Record {
-        name: name.into(),
-        quantity: q,
-        source_unit: q.si_unit().into(),
-        point: None,
-        abscissa: meid::measure::Abscissa::Even {
-            start_s: 0.0,
-            step_s: 1.0 / FS,
-        },
-        values,
-        origin: "lab.csv".into(),
-    }
+    meid::measure::Record::sampled(name, q, 0.0, 1.0 / FS, values, "lab.csv")
 }
 
 /// The force window belongs to the blow's excitation only (session 12 audit: `--force-window`

@@ -10,7 +10,7 @@ use meid::analysis::energy::simulate;
 use meid::io::uff;
 use meid::measure::process::Processing;
 use meid::measure::validate::{validate, MeasuredCase};
-use meid::measure::{Abscissa, Quantity, Record};
+use meid::measure::{Quantity, Record};
 use meid::model::{Case, Model};
 
 const FS: f64 = 20_000.0;
@@ -35,17 +35,8 @@ fn measured(m: &Model, case: Case, acc_scale: f64, tag: &str) -> MeasuredCase {
         out.extend(v.iter().map(|x| x * s));
         out
     };
-    let rec = |name: &str, q: Quantity, v: Vec<f64>| Record {
-        name: name.into(),
-        quantity: q,
-        source_unit: q.si_unit().into(),
-        point: None,
-        abscissa: Abscissa::Even {
-            start_s: 0.0,
-            step_s: 1.0 / FS,
-        },
-        values: v,
-        origin: "synthetic".into(),
+    let rec = |name: &str, q: Quantity, v: Vec<f64>| {
+        Record::sampled(name, q, 0.0, 1.0 / FS, v, "synthetic")
     };
     let records = vec![
         rec(

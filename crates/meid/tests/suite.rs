@@ -76,27 +76,30 @@ mod testlab_checks;
 mod trust3_inputs;
 mod uff_interop;
 
-/// Every `tests/*.rs` file is a module of this binary: with `autotests = false`, an undeclared
-/// file would silently never run.
+/// Every `tests/*.rs` file of the library and of the CLI is a module of its crate's `suite.rs`
+/// binary: with `autotests = false`, an undeclared file would silently never run. (One test
+/// checks both crates.)
 #[test]
 fn every_test_file_is_declared() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests");
-    let suite = std::fs::read_to_string(dir.join("suite.rs")).expect("tests/suite.rs");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut missing = Vec::new();
-    for entry in std::fs::read_dir(&dir).expect("tests/") {
-        let path = entry.expect("entry").path();
-        let Some(stem) = path.file_stem().and_then(|s| s.to_str()) else {
-            continue;
-        };
-        if path.extension().is_some_and(|e| e == "rs")
-            && stem != "suite"
-            && !suite.lines().any(|l| l.trim() == format!("mod {stem};"))
-        {
-            missing.push(stem.to_string());
+    for dir in [root.join("tests"), root.join("../meid-cli/tests")] {
+        let suite = std::fs::read_to_string(dir.join("suite.rs")).expect("tests/suite.rs");
+        for entry in std::fs::read_dir(&dir).expect("tests/") {
+            let path = entry.expect("entry").path();
+            let Some(stem) = path.file_stem().and_then(|s| s.to_str()) else {
+                continue;
+            };
+            if path.extension().is_some_and(|e| e == "rs")
+                && stem != "suite"
+                && !suite.lines().any(|l| l.trim() == format!("mod {stem};"))
+            {
+                missing.push(dir.join(format!("{stem}.rs")).display().to_string());
+            }
         }
     }
     assert!(
         missing.is_empty(),
-        "declare these in tests/suite.rs: {missing:?}"
+        "declare these in their crate's tests/suite.rs: {missing:?}"
     );
 }

@@ -1673,17 +1673,23 @@ pub fn write_58<W: Write>(w: &mut W, ch: &Channel58, binary: bool) -> std::io::R
             w.write_all(&buf)?;
         }
     } else {
-        let mut line = String::with_capacity(82);
-        for c in ch.values.chunks(4) {
-            line.clear();
-            for v in c {
-                line.push_str(&format_e(*v, 12, 20));
-            }
-            line.push('\n');
-            w.write_all(line.as_bytes())?;
-        }
+        write_e20_lines(w, ch.values)?;
     }
     writeln!(w, "{:>6}", -1)
+}
+
+/// Values as ASCII `4E20.12` lines (four to a line), the layout of dataset 58's data.
+fn write_e20_lines(w: &mut impl Write, values: &[f64]) -> std::io::Result<()> {
+    let mut line = String::with_capacity(82);
+    for c in values.chunks(4) {
+        line.clear();
+        for v in c {
+            line.push_str(&format_e(*v, 12, 20));
+        }
+        line.push('\n');
+        w.write_all(line.as_bytes())?;
+    }
+    Ok(())
 }
 
 /// Writes a [`Function`] as one dataset 58 (ASCII): an FRF (type 4) as complex double
@@ -1778,20 +1784,12 @@ pub fn write_58_function<W: Write>(w: &mut W, f: &Function) -> std::io::Result<(
     axis(w, f.numerator, &name(f.numerator))?;
     axis(w, f.denominator, &name(f.denominator))?;
     axis(w, None, "NONE")?;
-    let mut line = String::with_capacity(82);
     let flat: Vec<f64> = if complex {
         f.values.iter().flat_map(|v| [v.re, v.im]).collect()
     } else {
         f.values.iter().map(|v| v.re).collect()
     };
-    for c in flat.chunks(4) {
-        line.clear();
-        for v in c {
-            line.push_str(&format_e(*v, 12, 20));
-        }
-        line.push('\n');
-        w.write_all(line.as_bytes())?;
-    }
+    write_e20_lines(w, &flat)?;
     writeln!(w, "{:>6}", -1)
 }
 

@@ -295,21 +295,10 @@ fn with_article(w: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::measure::{Abscissa, Quantity};
+    use crate::measure::Quantity;
 
     fn rec(name: &str, q: Quantity) -> Record {
-        Record {
-            name: name.into(),
-            quantity: q,
-            source_unit: q.si_unit().into(),
-            point: None,
-            abscissa: Abscissa::Even {
-                start_s: 0.0,
-                step_s: 1e-3,
-            },
-            values: vec![0.0; 4],
-            origin: "f.csv".into(),
-        }
+        Record::sampled(name, q, 0.0, 1e-3, vec![0.0; 4], "f.csv")
     }
 
     #[test]

@@ -51,21 +51,14 @@ impl Record {
             ));
         }
         let step = (h.time_s[n - 1] - h.time_s[0]) / (n - 1) as f64;
-        Ok(Record {
-            name: channel
-                .column()
-                .trim_end_matches(channel.suffix())
-                .to_string(),
+        Ok(Record::sampled(
+            channel.column().trim_end_matches(channel.suffix()),
             quantity,
-            source_unit: quantity.si_unit().to_string(),
-            point: None,
-            abscissa: Abscissa::Even {
-                start_s: h.time_s[0],
-                step_s: step,
-            },
-            values: values.clone(),
-            origin: "simulation".into(),
-        })
+            h.time_s[0],
+            step,
+            values.clone(),
+            "simulation",
+        ))
     }
 }
 

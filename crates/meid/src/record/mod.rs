@@ -71,6 +71,29 @@ pub struct Record {
     pub origin: String,
 }
 
+impl Record {
+    /// An evenly sampled record in SI units (`source_unit` = the quantity's SI unit, no point):
+    /// `t_n = start_s + n·step_s`, what simulated channels and synthetic test signals are.
+    pub fn sampled(
+        name: impl Into<String>,
+        quantity: Quantity,
+        start_s: f64,
+        step_s: f64,
+        values: Vec<f64>,
+        origin: impl Into<String>,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            quantity,
+            source_unit: quantity.si_unit().to_string(),
+            point: None,
+            abscissa: Abscissa::Even { start_s, step_s },
+            values,
+            origin: origin.into(),
+        }
+    }
+}
+
 /// Largest relative deviation of an uneven abscissa's steps from their mean for the record
 /// to count as evenly sampled (ASCII files print times to 6 significant digits).
 pub const EVEN_TOLERANCE: f64 = 1e-3;
