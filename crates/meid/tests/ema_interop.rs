@@ -2,7 +2,7 @@
 //! 3-DOF chain of `identify_checks` with 1 % noise), sdypy-EMA's stable poles closest to meid's
 //! modes lie within 0.1 % of meid's frequencies.
 //!
-//! Needs a Python with sdypy-EMA: `MEID_EMA_PYTHON`, else `target/ci-venv-ema/bin/python`
+//! Needs a Python with sdypy-EMA: `MEID_EMA_PYTHON`, else `target/ci-venv-py/bin/python`
 //! (which `.ci/run` creates). Without one the test prints why and passes, unless
 //! `MEID_EMA_REQUIRED=1` (set by `.ci/run`), when it fails.
 
@@ -20,7 +20,7 @@ fn root() -> PathBuf {
 fn python() -> Option<PathBuf> {
     let p = std::env::var_os("MEID_EMA_PYTHON")
         .map(PathBuf::from)
-        .unwrap_or_else(|| root().join("target/ci-venv-ema/bin/python"));
+        .unwrap_or_else(|| root().join("target/ci-venv-py/bin/python"));
     let ok = p.exists()
         && Command::new(&p)
             .args(["-c", "from sdypy import EMA"])
@@ -32,7 +32,7 @@ fn python() -> Option<PathBuf> {
         panic!("MEID_EMA_REQUIRED=1 but {} has no sdypy-EMA", p.display());
     } else {
         eprintln!(
-            "skipped: no Python with sdypy-EMA at {} (set MEID_EMA_PYTHON, or run .ci/run, which creates target/ci-venv-ema)",
+            "skipped: no Python with sdypy-EMA at {} (set MEID_EMA_PYTHON, or run .ci/run, which creates target/ci-venv-py)",
             p.display()
         );
         None

@@ -3,7 +3,7 @@
 //! relative in binary and to the printed precision in ASCII (pyuff `%20.11e`: 12 significant digits, meid `%20.12e`: 13;
 //! pyuff's abscissa fields `%13.5e`: 6).
 //!
-//! Needs a Python with pyuff: `MEID_PYUFF_PYTHON`, else `target/ci-venv/bin/python` (which
+//! Needs a Python with pyuff: `MEID_PYUFF_PYTHON`, else `target/ci-venv-py/bin/python` (which
 //! `.ci/run` creates). Without one the test prints why and passes, unless
 //! `MEID_PYUFF_REQUIRED=1` (set by `.ci/run`), when it fails.
 
@@ -21,7 +21,7 @@ fn root() -> PathBuf {
 fn python() -> Option<PathBuf> {
     let p = std::env::var_os("MEID_PYUFF_PYTHON")
         .map(PathBuf::from)
-        .unwrap_or_else(|| root().join("target/ci-venv/bin/python"));
+        .unwrap_or_else(|| root().join("target/ci-venv-py/bin/python"));
     let ok = p.exists()
         && Command::new(&p)
             .args(["-c", "import pyuff"])
@@ -33,7 +33,7 @@ fn python() -> Option<PathBuf> {
         panic!("MEID_PYUFF_REQUIRED=1 but {} has no pyuff", p.display());
     } else {
         eprintln!(
-            "skipped: no Python with pyuff at {} (set MEID_PYUFF_PYTHON, or run .ci/run, which creates target/ci-venv)",
+            "skipped: no Python with pyuff at {} (set MEID_PYUFF_PYTHON, or run .ci/run, which creates target/ci-venv-py)",
             p.display()
         );
         None
