@@ -185,6 +185,27 @@ struct Head58<'a> {
     unit_code: Option<i64>,
 }
 
+/// Records 1-11 of a dataset 58, as read.
+struct Records58 {
+    /// Records 1-5 (ID lines).
+    id: Vec<String>,
+    /// Record 6 and its line.
+    r6: String,
+    func_type: i64,
+    rsp_entity: String,
+    rsp_node: i64,
+    rsp_dir: i64,
+    /// Record 7's line, ordinate data type, number of points, even spacing, minimum, step.
+    r7_line: usize,
+    ord_type: i64,
+    npts: i64,
+    even: bool,
+    x0: f64,
+    dx: f64,
+    /// Records 8-11 with their lines.
+    axes: Vec<(String, usize)>,
+}
+
 /// Reads a UFF file (see the module docs).
 pub fn read_uff(path: &Path) -> Result<UffFile> {
     let (f, len) = crate::input::open(path)?;
@@ -477,6 +498,9 @@ impl<R: BufRead> Parser<'_, R> {
 
     /// Dataset 58 after its header line: a time response, a function [`Function`] (FRF,
     /// coherence, PSD), or `Skip(why)`: read past.
+    /// One dataset 58 (a function at one point): the binary header when `binary`, records
+    /// 1-11, the values of record 12, then a time response as a [`Record`] (function type 0
+    /// or 1), a [`Function`] (4, 6, 9: [`Self::function_58`]), or a reason to skip it.
     fn dataset_58(
         &mut self,
         ds: Ds,
@@ -484,57 +508,97 @@ impl<R: BufRead> Parser<'_, R> {
         binary: bool,
         unit_code: Option<i64>,
     ) -> Result<Read58> {
-        // Binary header: 58b, byte order, fp format, ASCII lines, bytes, 0 0 0 0.
-        let mut bin = None;
-        if binary {
-            let t: Vec<&str> = header.split_whitespace().collect();
-            let int = |k: usize, what: &str| -> Result<i64> {
-                t.get(k).and_then(|v| v.parse::<i64>().ok()).ok_or_else(|| {
-                    self.err(
-                        Some(ds),
-                        Some("binary header"),
-                        self.line_no,
-                        format!(
-                            "field {} ({what}): expected a whole number, got '{}'",
-                            k + 1,
-                            t.get(k).unwrap_or(&"")
-                        ),
-                    )
-                })
+        let bin = if binary {
+            Some(self.binary_header_58(ds, header)?)
+        } else {
+            None
+        };
+        let h = self.records_58(ds)?;
+        let (count, single) = self.value_count_58(ds, &h, bin.is_some())?;
+        let (values, printed) = self.values_58(ds, &h, bin, count, single)?;
+        if matches!(h.func_type, 4 | 6 | 9) {
+            let head = Head58 {
+                ds,
+                id: &h.id,
+                r6: &h.r6,
+                r7_line: h.r7_line,
+                axes: &h.axes,
+                even: h.even,
+                x0: h.x0,
+                dx: h.dx,
+                complex: matches!(h.ord_type, 5 | 6),
+                unit_code,
             };
-            let order = int(1, "byte order: 1 little-endian, 2 big-endian")?;
-            let fp = int(2, "floating-point format: 2 IEEE 754")?;
-            let ascii = int(3, "number of ASCII lines: 11")?;
-            let bytes = int(4, "number of bytes of binary data")?;
-            if !(order == 1 || order == 2) {
-                return Err(self.err(
-                    Some(ds),
-                    Some("binary header"),
-                    self.line_no,
-                    format!("byte order {order}: expected 1 (little-endian) or 2 (big-endian)"),
-                ));
-            }
-            if fp != 2 {
-                return Err(self.err(
-                    Some(ds),
-                    Some("binary header"),
-                    self.line_no,
-                    format!("floating-point format {fp}: only 2 (IEEE 754) is read"),
-                ));
-            }
-            if ascii != 11 {
-                return Err(self.err(
-                    Some(ds),
-                    Some("binary header"),
-                    self.line_no,
-                    format!("{ascii} ASCII lines: expected 11 (records 1-11)"),
-                ));
-            }
-            if bytes < 0 || bytes as u64 > self.left {
-                return Err(self.err(Some(ds), Some("binary header"), self.line_no, format!("{bytes} bytes of binary data announced, but only {} bytes are left in the file", self.left)));
-            }
-            bin = Some((order == 1, bytes as u64));
+            return self.function_58(&head, h.func_type, values);
         }
+        if !(h.func_type == 1 || h.func_type == 0) {
+            return Ok(Read58::Skip(format!(
+                "function type {} ({}), not a time response (1)",
+                h.func_type,
+                function_name(h.func_type)
+            )));
+        }
+        if matches!(h.ord_type, 5 | 6) {
+            return Ok(Read58::Skip("complex ordinate: not a time response".into()));
+        }
+        self.time_record_58(ds, h, values, &printed, unit_code)
+    }
+
+    /// A binary dataset 58's header line: `58b`, byte order, floating-point format, ASCII
+    /// lines, bytes, 0 0 0 0. Returns (little-endian, bytes of binary data).
+    fn binary_header_58(&self, ds: Ds, header: &str) -> Result<(bool, u64)> {
+        let t: Vec<&str> = header.split_whitespace().collect();
+        let int = |k: usize, what: &str| -> Result<i64> {
+            t.get(k).and_then(|v| v.parse::<i64>().ok()).ok_or_else(|| {
+                self.err(
+                    Some(ds),
+                    Some("binary header"),
+                    self.line_no,
+                    format!(
+                        "field {} ({what}): expected a whole number, got '{}'",
+                        k + 1,
+                        t.get(k).unwrap_or(&"")
+                    ),
+                )
+            })
+        };
+        let order = int(1, "byte order: 1 little-endian, 2 big-endian")?;
+        let fp = int(2, "floating-point format: 2 IEEE 754")?;
+        let ascii = int(3, "number of ASCII lines: 11")?;
+        let bytes = int(4, "number of bytes of binary data")?;
+        if !(order == 1 || order == 2) {
+            return Err(self.err(
+                Some(ds),
+                Some("binary header"),
+                self.line_no,
+                format!("byte order {order}: expected 1 (little-endian) or 2 (big-endian)"),
+            ));
+        }
+        if fp != 2 {
+            return Err(self.err(
+                Some(ds),
+                Some("binary header"),
+                self.line_no,
+                format!("floating-point format {fp}: only 2 (IEEE 754) is read"),
+            ));
+        }
+        if ascii != 11 {
+            return Err(self.err(
+                Some(ds),
+                Some("binary header"),
+                self.line_no,
+                format!("{ascii} ASCII lines: expected 11 (records 1-11)"),
+            ));
+        }
+        if bytes < 0 || bytes as u64 > self.left {
+            return Err(self.err(Some(ds), Some("binary header"), self.line_no, format!("{bytes} bytes of binary data announced, but only {} bytes are left in the file", self.left)));
+        }
+        Ok((order == 1, bytes as u64))
+    }
+
+    /// Records 1-11 of a dataset 58: the ID lines, record 6's function type and response
+    /// point, record 7's data layout, records 8-11 (the axes).
+    fn records_58(&mut self, ds: Ds) -> Result<Records58> {
         let mut id = Vec::with_capacity(5);
         for k in 1..=5 {
             id.push(self.need_line(ds, &format!("record {k} (ID line {k})"))?);
@@ -582,6 +646,28 @@ impl<R: BufRead> Parser<'_, R> {
             let l = self.need_line(ds, &format!("record {k}"))?;
             axes.push((l, self.line_no));
         }
+        Ok(Records58 {
+            id,
+            r6,
+            func_type,
+            rsp_entity,
+            rsp_node,
+            rsp_dir,
+            r7_line,
+            ord_type,
+            npts,
+            even,
+            x0,
+            dx,
+            axes,
+        })
+    }
+
+    /// The number of values record 12 holds (points × values per point) and whether they are
+    /// single precision; a count the rest of the file cannot hold is refused before anything
+    /// is allocated.
+    fn value_count_58(&self, ds: Ds, h: &Records58, binary: bool) -> Result<(u64, bool)> {
+        let (ord_type, even, npts, r7_line) = (h.ord_type, h.even, h.npts, h.r7_line);
         let per_point: u64 = match (ord_type, even) {
             (2 | 4, true) => 1,
             (2 | 4, false) => 2,
@@ -616,7 +702,7 @@ impl<R: BufRead> Parser<'_, R> {
         // Every value takes at least 2 bytes in ASCII (a digit and a separator) and 4 or 8
         // in binary: a count the file cannot hold is refused before anything is allocated.
         let width: u64 = if single { 4 } else { 8 };
-        let min_bytes = if bin.is_some() {
+        let min_bytes = if binary {
             count.saturating_mul(width)
         } else {
             count.saturating_mul(2)
@@ -629,6 +715,21 @@ impl<R: BufRead> Parser<'_, R> {
                 format!("{npts} points ({count} values) announced, but only {} bytes are left in the file", self.left),
             ));
         }
+        Ok((count, single))
+    }
+
+    /// Record 12's values (binary or ASCII) and, for ASCII, half a unit of each value's last
+    /// printed digit.
+    fn values_58(
+        &mut self,
+        ds: Ds,
+        h: &Records58,
+        bin: Option<(bool, u64)>,
+        count: u64,
+        single: bool,
+    ) -> Result<(Vec<f64>, Vec<f64>)> {
+        let (ord_type, even, npts) = (h.ord_type, h.even, h.npts);
+        let width: u64 = if single { 4 } else { 8 };
         let mut printed = Vec::new();
         let values = match bin {
             Some((little, bytes)) => {
@@ -666,30 +767,33 @@ impl<R: BufRead> Parser<'_, R> {
                 v
             }
         };
-        if matches!(func_type, 4 | 6 | 9) {
-            let head = Head58 {
-                ds,
-                id: &id,
-                r6: &r6,
-                r7_line,
-                axes: &axes,
-                even,
-                x0,
-                dx,
-                complex: matches!(ord_type, 5 | 6),
-                unit_code,
-            };
-            return self.function_58(&head, func_type, values);
-        }
-        if !(func_type == 1 || func_type == 0) {
-            return Ok(Read58::Skip(format!(
-                "function type {func_type} ({}), not a time response (1)",
-                function_name(func_type)
-            )));
-        }
-        if matches!(ord_type, 5 | 6) {
-            return Ok(Read58::Skip("complex ordinate: not a time response".into()));
-        }
+        Ok((values, printed))
+    }
+
+    /// A time response (function type 0 or 1, real ordinate) as a [`Record`] in SI units: the
+    /// axes' units, the abscissa (even, or uneven times that are an even grid as printed), the
+    /// values' checks and scaling, the channel's name.
+    fn time_record_58(
+        &self,
+        ds: Ds,
+        h: Records58,
+        values: Vec<f64>,
+        printed: &[f64],
+        unit_code: Option<i64>,
+    ) -> Result<Read58> {
+        let Records58 {
+            id,
+            rsp_entity,
+            rsp_node,
+            rsp_dir,
+            r7_line,
+            npts,
+            even,
+            x0,
+            dx,
+            axes,
+            ..
+        } = h;
         // Units: abscissa (record 8) and ordinate (record 9).
         let (xq, xf, xu) =
             self.axis_unit(ds, &axes[0].0, axes[0].1, "record 8 (abscissa)", unit_code)?;
