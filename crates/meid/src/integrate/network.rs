@@ -17,7 +17,25 @@
 //!    that fall on the same instant (two contacts closing at once) are resolved in one step.
 //!
 //! A force-release contact that opens with `δ > 0` takes its elastic energy `K δ²/2` with it
-//! (booked as dissipated, in the run's total and in the impact's row).
+//! (booked as dissipated, in the run's total and in the impact's row); one that closes again
+//! at `δ > 0` (its force `K δ + C δ̇` rising through zero before the overlap has returned to
+//! zero, as a body settling under a constant force does) gets `K δ²/2` back (booked as
+//! negative dissipation), as the paper's engines do.
+//!
+//! # Resting contact
+//! A contact rests when it stays closed with its force positive: a body at rest on a support
+//! under a constant force, a damper pressed on by a preload. Every contact is held that way by
+//! the rules above, with nothing added: its closed mode's closed form is exact over any span,
+//! and the search of step 1 finds no sign change of its indicators (overlap and force stay
+//! positive), so the run goes to its end in one stretch, without events or steps. Bounces that
+//! accumulate (a body falling onto a damped contact under a constant force) end after finitely
+//! many: a landing speed `v` is multiplied by about `e` per bounce, and below a landing speed of
+//! the order of `F/(m ω)` (`ω = √(K/m)`) the contact's force no longer returns to zero (force
+//! release), or its overlap no longer does (overlap release, `ζ > 0`): the body stays on,
+//! after about `ln(v₀ ω m/F)/ln(1/e)` bounces, at the accumulation time of the rigid limit,
+//! `√(2h/g)(1 + e)/(1 − e)` for a drop from rest at height `h` (`g = F/m`), within `O(1/ω)`
+//! per bounce. An undamped contact (`e = 1`) never comes to rest, as a rigid elastic one
+//! would not.
 //!
 //! # Initial state
 //! Velocities are the impactors' (dampers start at rest). Without a preloaded contact every
@@ -822,7 +840,8 @@ impl<'n, 'o> Run<'n, 'o> {
 
     /// The switch to `new_mode` at `t`: the contacts that open finish their impact rows (a
     /// force-release contact letting go at `δ > 0` dissipates `K δ²/2`), those that close
-    /// start one; the event is recorded, and more than `opts.max_events` is an error.
+    /// start one (one closing again at `δ > 0` gets `K δ²/2` back: negative dissipation); the
+    /// event is recorded, and more than `opts.max_events` is an error.
     fn switch_to(&mut self, new_mode: NetMode) -> Result<()> {
         let net = self.net;
         let t = self.t;
@@ -836,7 +855,14 @@ impl<'n, 'o> Run<'n, 'o> {
                     finish_impact(&mut self.impacts[o.row], &o.ext, t, rate, jump);
                 }
             } else if now && !was {
-                self.open[c] = Some(start_impact(net, c, &self.x, t, &mut self.impacts));
+                // A force-release contact may close again at δ > 0 (its force rising through
+                // zero before the overlap has): its elastic energy comes back with it.
+                let (delta, _) = net.overlap(c, &self.x);
+                let back = net.contacts[c].contact.law.potential_energy(delta);
+                self.dissipated_j -= back;
+                let o = start_impact(net, c, &self.x, t, &mut self.impacts);
+                self.impacts[o.row].dissipated_j -= back;
+                self.open[c] = Some(o);
                 self.touched |= !self.preloaded[c];
             }
         }
