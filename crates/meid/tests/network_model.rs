@@ -221,3 +221,97 @@ fn preloads_need_an_equilibrium() {
     );
     assert!(sol.residual_run_end <= 1e-9);
 }
+
+/// examples/press-off-centre-4-dampers.toml made mirror-symmetric about both bed axes (no
+/// off-centre strike point S, the accelerometer B at the centre, the slider striking O_b): the
+/// four identical dampers at (±0.16, ±0.08) m then see the same motion, so their contacts' impact
+/// rows are identical up to round-off. The mesh is the mirror image of itself to round-off (its
+/// grid lines are symmetric sets) and so are the modes, to the eigen-solver's accuracy
+/// (≈1e-12 of the mode shapes); switching times are located to 1e-13 of the fastest period.
+/// 1e-9 of each quantity's scale leaves room for that and is far below what any asymmetry does:
+/// B's grid lines at (0.08, 0.05) m alone make the rows differ by about 1e-3.
+#[test]
+fn four_dampers_at_symmetric_points_give_four_identical_impact_rows() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/press-off-centre-4-dampers.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let symmetric = text
+        .replacen("S = [0.15, 0.0], ", "", 1)
+        .replacen(
+            "spring_inset = 0.03\n",
+            "spring_inset = 0.03\nb_offset = [0.0, 0.0]\n",
+            1,
+        )
+        .replacen(
+            r#"between = ["slider", "S"]"#,
+            r#"between = ["slider", "O_b"]"#,
+            1,
+        )
+        .replacen("duration = 0.5", "duration = 0.05", 1);
+    assert!(!symmetric.contains("\"S\"") && symmetric.contains("b_offset"));
+    let m = NetworkModel::from_text("sym.toml", symmetric, &[]).unwrap();
+    let sol = m.solve(&m.options().unwrap()).unwrap();
+    let rows = |c: &str| -> Vec<_> { sol.impacts.iter().filter(|r| r.contact == c).collect() };
+    let first = rows("bed_damper1");
+    assert!(!first.is_empty());
+    let f_scale = first.iter().map(|r| r.peak_force_n).fold(0.0, f64::max);
+    let v_scale = first
+        .iter()
+        .map(|r| r.approach_velocity_m_per_s.abs())
+        .fold(0.0, f64::max);
+    let t_scale = sol.t_final;
+    let d_scale = first.iter().map(|r| r.duration_s).fold(0.0, f64::max);
+    let close = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-9 * scale;
+    for other in ["bed_damper2", "bed_damper3", "bed_damper4"] {
+        let rs = rows(other);
+        assert_eq!(rs.len(), first.len(), "{other}");
+        for (a, b) in first.iter().zip(&rs) {
+            let same = close(a.start_s, b.start_s, t_scale)
+                && close(a.duration_s, b.duration_s, t_scale)
+                && close(a.peak_time_s, b.peak_time_s, t_scale)
+                && close(a.peak_force_n, b.peak_force_n, f_scale)
+                && close(
+                    a.approach_velocity_m_per_s,
+                    b.approach_velocity_m_per_s,
+                    v_scale,
+                )
+                && close(a.impulse_n_s, b.impulse_n_s, f_scale * d_scale)
+                && close(
+                    a.exit_velocity_m_per_s.unwrap_or(0.0),
+                    b.exit_velocity_m_per_s.unwrap_or(0.0),
+                    v_scale,
+                );
+            assert!(same, "{other}:\n{a:?}\n{b:?}");
+        }
+    }
+}
+
+/// A bed point off the bed, or named as one of the machine's own points, is an error naming
+/// `structure.fem.machine.bed_points.NAME` in the file.
+#[test]
+fn bed_points_off_the_bed_or_with_the_machines_names_are_refused() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/press-off-centre-4-dampers.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    for (from, to, field, what) in [
+        (
+            "S = [0.15, 0.0]",
+            "S = [0.25, 0.0]",
+            "bed_points.S",
+            "outside",
+        ),
+        (
+            "D4 = [0.16, -0.08]",
+            "B = [0.16, -0.08]",
+            "bed_points.B",
+            "O_b, B, O_f",
+        ),
+    ] {
+        let e = error_of(&text.replacen(from, to, 1));
+        assert!(
+            e.contains(&format!("structure.fem.machine.{field}")) && e.contains(what),
+            "{e}"
+        );
+        assert!(e.starts_with("m.toml:"), "{e}");
+    }
+}

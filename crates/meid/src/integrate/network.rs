@@ -17,7 +17,25 @@
 //!    that fall on the same instant (two contacts closing at once) are resolved in one step.
 //!
 //! A force-release contact that opens with `δ > 0` takes its elastic energy `K δ²/2` with it
-//! (booked as dissipated, in the run's total and in the impact's row).
+//! (booked as dissipated, in the run's total and in the impact's row); one that closes again
+//! at `δ > 0` (its force `K δ + C δ̇` rising through zero before the overlap has returned to
+//! zero, as a body settling under a constant force does) gets `K δ²/2` back (booked as
+//! negative dissipation), as the paper's engines do.
+//!
+//! # Resting contact
+//! A contact rests when it stays closed with its force positive: a body at rest on a support
+//! under a constant force, a damper pressed on by a preload. Every contact is held that way by
+//! the rules above, with nothing added: its closed mode's closed form is exact over any span,
+//! and the search of step 1 finds no sign change of its indicators (overlap and force stay
+//! positive), so the run goes to its end in one stretch, without events or steps. Bounces that
+//! accumulate (a body falling onto a damped contact under a constant force) end after finitely
+//! many: a landing speed `v` is multiplied by about `e` per bounce, and below a landing speed of
+//! the order of `F/(m ω)` (`ω = √(K/m)`) the contact's force no longer returns to zero (force
+//! release), or its overlap no longer does (overlap release, `ζ > 0`): the body stays on,
+//! after about `ln(v₀ ω m/F)/ln(1/e)` bounces, at the accumulation time of the rigid limit,
+//! `√(2h/g)(1 + e)/(1 − e)` for a drop from rest at height `h` (`g = F/m`), within `O(1/ω)`
+//! per bounce. An undamped contact (`e = 1`) never comes to rest, as a rigid elastic one
+//! would not.
 //!
 //! # Initial state
 //! Velocities are the impactors' (dampers start at rest). Without a preloaded contact every
@@ -54,7 +72,7 @@ use faer::Mat;
 
 use super::exact::{dissipated, exp_integral, first_switch, Lifted, GL_W, GL_X};
 use super::peaks::{self, Extremes};
-use super::propagator::{Functional, Propagator};
+use super::propagator::{Functional, Propagator, Segment};
 use super::roots::{Scalar, Search, SearchOptions};
 use super::Options;
 use crate::impact::network::{dot, End, NetIndicator, NetMode, Network};
@@ -555,77 +573,162 @@ pub fn solve(net: &Network, opts: &Options) -> Result<NetSolution> {
             format!("must be > 0 s (got {})", opts.duration),
         ));
     }
-    let x0 = initial_state(net)?;
-    let nd = net.dofs();
-    let n = 2 * nd;
-    let nc = net.contacts.len();
-    let mut modes = Modes {
-        net,
-        inds: net.indicators()?,
-        kinds: channel_kinds(net),
-        masses: net.mass_diag(),
-        data: HashMap::new(),
-    };
-    let mut channels: Vec<NetChannel> = modes
-        .kinds
-        .iter()
-        .map(|k| NetChannel {
-            kind: k.clone(),
-            extremes: Extremes::default(),
-        })
-        .collect();
-    // ∫ C δ̇² of each damped contact: C a aᵀ.
-    let contact_c: Vec<Option<Mat<f64>>> = (0..nc)
-        .map(|c| {
-            let (_, cc) = net.linear_law(c).ok()?;
-            let a = net.contact_vector(c);
-            (cc != 0.0).then(|| Mat::from_fn(nd, nd, |i, j| cc * a[i] * a[j]))
-        })
-        .collect();
-    let mut signs = vec![0.0; modes.inds.len()];
-    let mut mode = modes.select(&x0, NetMode(0), &mut signs)?;
-    let mode0 = mode;
-    let (ke0, pe0) = net.energies(mode, &x0);
-    let e0 = ke0 + pe0;
-    let body_ke0: f64 = net
-        .bodies
-        .iter()
-        .map(|b| 0.5 * b.mass * b.velocity * b.velocity)
-        .sum();
-    let body_e0 = net.body_energy(&x0);
-    let preloaded: Vec<bool> = net.contacts.iter().map(|c| c.gap < 0.0).collect();
-    let mut touched = (0..nc).any(|c| !preloaded[c] && net.closed(mode, c));
-    let mut x = x0.clone();
-    let mut t = 0.0;
-    let mut events = Vec::new();
-    let mut impacts: Vec<ImpactRow> = Vec::new();
-    let mut open: Vec<Option<OpenImpact>> = (0..nc).map(|_| None).collect();
-    for c in 0..nc {
-        if net.closed(mode, c) {
-            open[c] = Some(start_impact(net, c, &x, t, &mut impacts));
+    let mut run = Run::new(net, opts)?;
+    loop {
+        let switched = run.stretch()?;
+        if !switched {
+            break;
+        }
+        let new_mode = run.next_mode()?;
+        if new_mode != run.mode {
+            run.switch_to(new_mode)?;
+        }
+        if run.collision_ended() && opts.stop_at_collision_end {
+            break;
+        }
+        if run.t >= opts.duration {
+            break;
         }
     }
-    let mut closed_time = vec![0.0; nc];
-    let mut dissipated_j = 0.0;
-    let mut collision_end = None;
-    let mut zero_length = 0usize;
-    let mut buf = vec![0.0; n];
-    loop {
-        let horizon = opts.duration - t;
-        let masses = modes.masses.clone();
-        let prop = modes.get(mode)?.propagator(&masses)?;
-        let seg = prop.segment(&x);
+    let sol = run.finish();
+    check(net, &sol)?;
+    Ok(sol)
+}
+
+/// The state of a run between stretches ([`solve`]).
+struct Run<'n, 'o> {
+    net: &'n Network,
+    opts: &'o Options,
+    modes: Modes<'n>,
+    channels: Vec<NetChannel>,
+    /// `C a aᵀ` of each damped contact (for `∫ C δ̇² dt`).
+    contact_c: Vec<Option<Mat<f64>>>,
+    /// The indicators' signs just after the last switch (0: not searched).
+    signs: Vec<f64>,
+    mode0: NetMode,
+    mode: NetMode,
+    x0: Vec<f64>,
+    x: Vec<f64>,
+    t: f64,
+    /// Initial total energy, the bodies' initial kinetic and total energies (J).
+    e0: f64,
+    body_ke0: f64,
+    body_e0: f64,
+    preloaded: Vec<bool>,
+    /// Has a contact that was not preloaded closed yet?
+    touched: bool,
+    events: Vec<(f64, NetMode, NetMode)>,
+    impacts: Vec<ImpactRow>,
+    open: Vec<Option<OpenImpact>>,
+    closed_time: Vec<f64>,
+    dissipated_j: f64,
+    collision_end: Option<NetCollisionEnd>,
+    /// Consecutive stretches of no length.
+    zero_length: usize,
+    /// Scratch state.
+    buf: Vec<f64>,
+}
+
+impl<'n, 'o> Run<'n, 'o> {
+    /// The initial state, its mode and energies, and the impacts of the contacts closed at t = 0.
+    fn new(net: &'n Network, opts: &'o Options) -> Result<Self> {
+        let x0 = initial_state(net)?;
+        let nd = net.dofs();
+        let nc = net.contacts.len();
+        let mut modes = Modes {
+            net,
+            inds: net.indicators()?,
+            kinds: channel_kinds(net),
+            masses: net.mass_diag(),
+            data: HashMap::new(),
+        };
+        let channels: Vec<NetChannel> = modes
+            .kinds
+            .iter()
+            .map(|k| NetChannel {
+                kind: k.clone(),
+                extremes: Extremes::default(),
+            })
+            .collect();
+        // ∫ C δ̇² of each damped contact: C a aᵀ.
+        let contact_c: Vec<Option<Mat<f64>>> = (0..nc)
+            .map(|c| {
+                let (_, cc) = net.linear_law(c).ok()?;
+                let a = net.contact_vector(c);
+                (cc != 0.0).then(|| Mat::from_fn(nd, nd, |i, j| cc * a[i] * a[j]))
+            })
+            .collect();
+        let mut signs = vec![0.0; modes.inds.len()];
+        let mode = modes.select(&x0, NetMode(0), &mut signs)?;
+        let (ke0, pe0) = net.energies(mode, &x0);
+        let body_ke0: f64 = net
+            .bodies
+            .iter()
+            .map(|b| 0.5 * b.mass * b.velocity * b.velocity)
+            .sum();
+        let body_e0 = net.body_energy(&x0);
+        let preloaded: Vec<bool> = net.contacts.iter().map(|c| c.gap < 0.0).collect();
+        let touched = (0..nc).any(|c| !preloaded[c] && net.closed(mode, c));
+        let mut impacts: Vec<ImpactRow> = Vec::new();
+        let mut open: Vec<Option<OpenImpact>> = (0..nc).map(|_| None).collect();
+        for (c, o) in open.iter_mut().enumerate() {
+            if net.closed(mode, c) {
+                *o = Some(start_impact(net, c, &x0, 0.0, &mut impacts));
+            }
+        }
+        Ok(Self {
+            net,
+            opts,
+            modes,
+            channels,
+            contact_c,
+            signs,
+            mode0: mode,
+            mode,
+            x: x0.clone(),
+            x0,
+            t: 0.0,
+            e0: ke0 + pe0,
+            body_ke0,
+            body_e0,
+            preloaded,
+            touched,
+            events: Vec::new(),
+            impacts,
+            open,
+            closed_time: vec![0.0; nc],
+            dissipated_j: 0.0,
+            collision_end: None,
+            zero_length: 0,
+            buf: vec![0.0; 2 * nd],
+        })
+    }
+
+    /// One stretch in the current mode, from `t` to the first switch or the end of the run:
+    /// its extremes, closed times, dissipation and impact bookkeeping, and the state at its
+    /// end. Returns whether it ended on a switch.
+    fn stretch(&mut self) -> Result<bool> {
+        let net = self.net;
+        let n = 2 * net.dofs();
+        let horizon = self.opts.duration - self.t;
+        let masses = self.modes.masses.clone();
+        let prop = self.modes.get(self.mode)?.propagator(&masses)?;
+        let seg = prop.segment(&self.x);
         let period = prop.period();
         let s_end = {
-            let funcs: Vec<Functional<'_>> =
-                modes.inds.iter().map(|i| seg.functional(&i.l)).collect();
+            let funcs: Vec<Functional<'_>> = self
+                .modes
+                .inds
+                .iter()
+                .map(|i| seg.functional(&i.l))
+                .collect();
             let mut searches: Vec<Search<Lifted<&Functional<'_>>>> = funcs
                 .iter()
-                .zip(&signs)
-                .zip(&modes.inds)
+                .zip(&self.signs)
+                .zip(&self.modes.inds)
                 .filter(|((_, s), _)| **s != 0.0)
                 .map(|((f, s), ind)| {
-                    let v = dot(&ind.l[..n], &x) + ind.l[n];
+                    let v = dot(&ind.l[..n], &self.x) + ind.l[n];
                     Search::new(Lifted::new(f, v, *s), *s, SearchOptions::default())
                 })
                 .collect();
@@ -635,180 +738,228 @@ pub fn solve(net: &Network, opts: &Options) -> Result<NetSolution> {
             Some(s) if s < horizon => (s.max(0.0), true),
             _ => (horizon, false),
         };
-        // Extremes, closed times, dissipation, impacts over the stretch.
-        let md = modes.channels(mode)?;
+        self.book_stretch(&seg, s_end)?;
+        seg.state(s_end, &mut self.buf);
+        self.x.copy_from_slice(&self.buf);
+        let t_before = self.t;
+        self.t += s_end;
+        if switched {
+            self.count_zero_length(s_end, period, t_before)?;
+        }
+        Ok(switched)
+    }
+
+    /// The extremes of every channel over a stretch of length `s_end` from `t`, the open
+    /// impacts' peaks, impulses and dissipation, the closed times and the dissipated energy.
+    fn book_stretch(&mut self, seg: &Segment<'_>, s_end: f64) -> Result<()> {
+        let net = self.net;
+        let nd = net.dofs();
+        let t = self.t;
+        let md = self.modes.channels(self.mode)?;
         let chans = md.chans.as_ref().map_or(&[][..], |v| &v[..]);
-        for (ch, lv) in channels.iter_mut().zip(chans) {
+        for (ch, lv) in self.channels.iter_mut().zip(chans) {
             let mut e = Extremes::default();
             match lv {
-                Some((l, la)) => peaks::on_segment(&seg, l, la, t, s_end, &mut e),
+                Some((l, la)) => peaks::on_segment(seg, l, la, t, s_end, &mut e),
                 None => e.offer(0.0, t),
             }
             merge(&mut ch.extremes, &e);
             if let (ChannelKind::ContactForce(c), Some((l, _))) = (&ch.kind, lv) {
-                if let Some(o) = open[*c].as_mut() {
+                if let Some(o) = self.open[*c].as_mut() {
                     merge(&mut o.ext, &e);
-                    impacts[o.row].impulse_n_s += integral(&seg.functional(l), s_end);
-                    if let Some(cm) = &contact_c[*c] {
-                        impacts[o.row].dissipated_j += dissipated(&seg, cm, nd, s_end);
+                    self.impacts[o.row].impulse_n_s += integral(&seg.functional(l), s_end);
+                    if let Some(cm) = &self.contact_c[*c] {
+                        self.impacts[o.row].dissipated_j += dissipated(seg, cm, nd, s_end);
                     }
                 }
             }
         }
-        for c in 0..nc {
-            if net.closed(mode, c) {
-                closed_time[c] += s_end;
+        for c in 0..net.contacts.len() {
+            if net.closed(self.mode, c) {
+                self.closed_time[c] += s_end;
             }
         }
-        dissipated_j += dissipated(&seg, &md.c, nd, s_end);
-        seg.state(s_end, &mut buf);
-        x.copy_from_slice(&buf);
-        let t_before = t;
-        t += s_end;
-        if !switched {
-            break;
-        }
-        if s_end <= 1e-14 * period.min(opts.duration) || t == t_before {
-            zero_length += 1;
-            if zero_length > 50 {
+        self.dissipated_j += dissipated(seg, &md.c, nd, s_end);
+        Ok(())
+    }
+
+    /// Counts consecutive stretches of no length ending on a switch: more than 50 is chatter,
+    /// an error.
+    fn count_zero_length(&mut self, s_end: f64, period: f64, t_before: f64) -> Result<()> {
+        if s_end <= 1e-14 * period.min(self.opts.duration) || self.t == t_before {
+            self.zero_length += 1;
+            if self.zero_length > 50 {
                 return Err(Error::numerical(
                     "network propagator",
                     format!(
-                        "switches chatter at t = {t:.9e} s without time advancing (mode {:#b})",
-                        mode.0
+                        "switches chatter at t = {:.9e} s without time advancing (mode {:#b})",
+                        self.t, self.mode.0
                     ),
                 ));
             }
         } else {
-            zero_length = 0;
+            self.zero_length = 0;
         }
-        let searched = signs.clone();
-        let mut new_mode = modes.select(&x, mode, &mut signs)?;
-        if new_mode == mode {
-            // The trajectory decides what the derivatives cannot: an indicator now on the other
-            // side of where it was searched from takes that side (and the mode follows); one at
-            // zero within round-off after a stretch of no length is not searched until the
-            // mode changes.
-            let mut moved = vec![false; signs.len()];
-            for (i, ind) in modes.inds.iter().enumerate() {
-                let v = dot(&ind.l[..n], &x) + ind.l[n];
-                if searched[i] != 0.0 && searched[i] * v < 0.0 && signs[i] == searched[i] {
-                    signs[i] = -searched[i];
-                    moved[i] = true;
-                } else if signs[i] * v <= 0.0 && zero_length > 0 {
-                    signs[i] = 0.0;
-                }
-            }
-            if moved.iter().any(|m| *m) {
-                new_mode = net.implied(&modes.inds, &signs);
-                let kept = signs.clone();
-                modes.signs(new_mode, &x, &mut signs)?;
-                for (i, m) in moved.iter().enumerate() {
-                    if *m {
-                        signs[i] = kept[i];
-                    }
-                }
+        Ok(())
+    }
+
+    /// The mode after the switch that ended the stretch ([`Modes::select`]), with the
+    /// trajectory deciding what the derivatives cannot: an indicator now on the other side of
+    /// where it was searched from takes that side (and the mode follows); one at zero within
+    /// round-off after a stretch of no length is not searched until the mode changes.
+    fn next_mode(&mut self) -> Result<NetMode> {
+        let n = 2 * self.net.dofs();
+        let searched = self.signs.clone();
+        let mut new_mode = self.modes.select(&self.x, self.mode, &mut self.signs)?;
+        if new_mode != self.mode {
+            return Ok(new_mode);
+        }
+        let signs = &mut self.signs;
+        let mut moved = vec![false; signs.len()];
+        for (i, ind) in self.modes.inds.iter().enumerate() {
+            let v = dot(&ind.l[..n], &self.x) + ind.l[n];
+            if searched[i] != 0.0 && searched[i] * v < 0.0 && signs[i] == searched[i] {
+                signs[i] = -searched[i];
+                moved[i] = true;
+            } else if signs[i] * v <= 0.0 && self.zero_length > 0 {
+                signs[i] = 0.0;
             }
         }
-        if new_mode != mode {
-            for c in 0..nc {
-                let (was, now) = (net.closed(mode, c), net.closed(new_mode, c));
-                if was && !now {
-                    let (delta, rate) = net.overlap(c, &x);
-                    let jump = net.contacts[c].contact.law.potential_energy(delta);
-                    dissipated_j += jump;
-                    if let Some(o) = open[c].take() {
-                        finish_impact(&mut impacts[o.row], &o.ext, t, rate, jump);
-                    }
-                } else if now && !was {
-                    open[c] = Some(start_impact(net, c, &x, t, &mut impacts));
-                    touched |= !preloaded[c];
+        if moved.iter().any(|m| *m) {
+            new_mode = self.net.implied(&self.modes.inds, signs);
+            let kept = signs.clone();
+            self.modes.signs(new_mode, &self.x, &mut self.signs)?;
+            for (i, m) in moved.iter().enumerate() {
+                if *m {
+                    self.signs[i] = kept[i];
                 }
             }
-            events.push((t, mode, new_mode));
-            if events.len() > opts.max_events {
-                return Err(Error::numerical(
-                    "network propagator",
-                    format!(
-                        "more than {} switching events by t = {t:.6e} s (simulation.max_events)",
-                        opts.max_events
-                    ),
-                ));
-            }
-            mode = new_mode;
         }
-        if collision_end.is_none()
-            && touched
-            && (0..nc).all(|c| preloaded[c] || !net.closed(mode, c))
-        {
-            collision_end = Some(NetCollisionEnd {
-                t,
-                x: x.clone(),
-                force_work_j: net.force_work(&x0, &x),
-                dissipated_j,
+        Ok(new_mode)
+    }
+
+    /// The switch to `new_mode` at `t`: the contacts that open finish their impact rows (a
+    /// force-release contact letting go at `δ > 0` dissipates `K δ²/2`), those that close
+    /// start one (one closing again at `δ > 0` gets `K δ²/2` back: negative dissipation); the
+    /// event is recorded, and more than `opts.max_events` is an error.
+    fn switch_to(&mut self, new_mode: NetMode) -> Result<()> {
+        let net = self.net;
+        let t = self.t;
+        for c in 0..net.contacts.len() {
+            let (was, now) = (net.closed(self.mode, c), net.closed(new_mode, c));
+            if was && !now {
+                let (delta, rate) = net.overlap(c, &self.x);
+                let jump = net.contacts[c].contact.law.potential_energy(delta);
+                self.dissipated_j += jump;
+                if let Some(o) = self.open[c].take() {
+                    finish_impact(&mut self.impacts[o.row], &o.ext, t, rate, jump);
+                }
+            } else if now && !was {
+                // A force-release contact may close again at δ > 0 (its force rising through
+                // zero before the overlap has): its elastic energy comes back with it.
+                let (delta, _) = net.overlap(c, &self.x);
+                let back = net.contacts[c].contact.law.potential_energy(delta);
+                self.dissipated_j -= back;
+                let o = start_impact(net, c, &self.x, t, &mut self.impacts);
+                self.impacts[o.row].dissipated_j -= back;
+                self.open[c] = Some(o);
+                self.touched |= !self.preloaded[c];
+            }
+        }
+        self.events.push((t, self.mode, new_mode));
+        if self.events.len() > self.opts.max_events {
+            return Err(Error::numerical(
+                "network propagator",
+                format!(
+                    "more than {} switching events by t = {t:.6e} s (simulation.max_events)",
+                    self.opts.max_events
+                ),
+            ));
+        }
+        self.mode = new_mode;
+        Ok(())
+    }
+
+    /// Records the end of the collision the first time every contact that was not preloaded
+    /// is open again after one of them closed; true once it has ended.
+    fn collision_ended(&mut self) -> bool {
+        if self.collision_end.is_some() {
+            return true;
+        }
+        let net = self.net;
+        let all_open =
+            (0..net.contacts.len()).all(|c| self.preloaded[c] || !net.closed(self.mode, c));
+        if self.touched && all_open {
+            self.collision_end = Some(NetCollisionEnd {
+                t: self.t,
+                x: self.x.clone(),
+                force_work_j: net.force_work(&self.x0, &self.x),
+                dissipated_j: self.dissipated_j,
             });
-            if opts.stop_at_collision_end {
-                break;
-            }
         }
-        if t >= opts.duration {
-            break;
-        }
+        self.collision_end.is_some()
     }
-    for c in 0..nc {
-        if let Some(o) = open[c].take() {
-            let row = &mut impacts[o.row];
-            row.duration_s = t - row.start_s;
-            let (v, tv) = o.ext.peak();
-            row.peak_force_n = v;
-            row.peak_time_s = tv;
-        }
-    }
-    let force_work_j = net.force_work(&x0, &x);
-    let residual = |xx: &[f64], w: f64, d: f64, m: NetMode| {
-        let (ke, pe) = net.energies(m, xx);
-        let denom = e0 + w.abs();
-        let disc = e0 + w - ke - pe - d;
+
+    /// The energy-balance residual `|E(0) + W − E − D| / (E(0) + |W|)` at `x` in mode `m`.
+    fn residual(&self, x: &[f64], w: f64, d: f64, m: NetMode) -> f64 {
+        let (ke, pe) = self.net.energies(m, x);
+        let denom = self.e0 + w.abs();
+        let disc = self.e0 + w - ke - pe - d;
         if disc == 0.0 {
             0.0
         } else {
             disc.abs() / denom.max(f64::MIN_POSITIVE)
         }
-    };
-    let residual_run_end = residual(&x, force_work_j, dissipated_j, mode);
-    let (residual_collision_end, energy_ratio) = match &collision_end {
-        Some(ce) => {
-            // The mode at the collision's end: every non-preloaded contact open, the preloaded
-            // ones as the state says.
-            let m = (0..nc).fold(NetMode(0), |m, c| {
-                m.with(c, preloaded[c] && net.overlap(c, &ce.x).0 > 0.0)
-            });
-            let r = residual(&ce.x, ce.force_work_j, ce.dissipated_j, m);
-            let e_in = body_ke0 + ce.force_work_j;
-            let kept = body_e0 + ce.force_work_j - net.body_energy(&ce.x);
-            (Some(r), (e_in > 0.0).then(|| kept / e_in))
+    }
+
+    /// The finished run: the impacts still open closed at the end of the run, the residuals
+    /// and the energy ratio (module documentation).
+    fn finish(mut self) -> NetSolution {
+        let net = self.net;
+        let t = self.t;
+        for o in self.open.iter_mut() {
+            if let Some(o) = o.take() {
+                let row = &mut self.impacts[o.row];
+                row.duration_s = t - row.start_s;
+                let (v, tv) = o.ext.peak();
+                row.peak_force_n = v;
+                row.peak_time_s = tv;
+            }
         }
-        None => (None, None),
-    };
-    let sol = NetSolution {
-        x0,
-        mode0,
-        t_final: t,
-        x_final: x,
-        mode_final: mode,
-        events,
-        collision_end,
-        channels,
-        closed_time_s: closed_time,
-        impacts,
-        dissipated_j,
-        force_work_j,
-        residual_collision_end,
-        residual_run_end,
-        energy_ratio,
-    };
-    check(net, &sol)?;
-    Ok(sol)
+        let force_work_j = net.force_work(&self.x0, &self.x);
+        let residual_run_end = self.residual(&self.x, force_work_j, self.dissipated_j, self.mode);
+        let (residual_collision_end, energy_ratio) = match &self.collision_end {
+            Some(ce) => {
+                // The mode at the collision's end: every non-preloaded contact open, the
+                // preloaded ones as the state says.
+                let m = (0..net.contacts.len()).fold(NetMode(0), |m, c| {
+                    m.with(c, self.preloaded[c] && net.overlap(c, &ce.x).0 > 0.0)
+                });
+                let r = self.residual(&ce.x, ce.force_work_j, ce.dissipated_j, m);
+                let e_in = self.body_ke0 + ce.force_work_j;
+                let kept = self.body_e0 + ce.force_work_j - net.body_energy(&ce.x);
+                (Some(r), (e_in > 0.0).then(|| kept / e_in))
+            }
+            None => (None, None),
+        };
+        NetSolution {
+            x0: self.x0,
+            mode0: self.mode0,
+            t_final: t,
+            x_final: self.x,
+            mode_final: self.mode,
+            events: self.events,
+            collision_end: self.collision_end,
+            channels: self.channels,
+            closed_time_s: self.closed_time,
+            impacts: self.impacts,
+            dissipated_j: self.dissipated_j,
+            force_work_j,
+            residual_collision_end,
+            residual_run_end,
+            energy_ratio,
+        }
+    }
 }
 
 /// A finished run's checks: finite state and extremes, and the energy balance within

@@ -315,6 +315,7 @@ pub fn machine_spec(m: &MachineFileSpec) -> Result<MachineSpec> {
     if let Some(v) = m.b_offset {
         spec.b_offset_m = v;
     }
+    spec.bed_points_m = m.bed_points.iter().map(|(k, v)| (k.clone(), *v)).collect();
     if let Some(v) = m.spiders {
         spec.spiders = v;
     }
@@ -682,7 +683,11 @@ fn machine_key(field: &str, m: Option<&MachineFileSpec>) -> Option<String> {
                 "elements_per_side"
             }
         }
-        f if f.starts_with("added_masses[") || f.starts_with("bed.") || f.starts_with("base.") => {
+        f if f.starts_with("added_masses[")
+            || f.starts_with("bed.")
+            || f.starts_with("base.")
+            || f.starts_with("bed_points.") =>
+        {
             return Some(f.to_string())
         }
         _ => return None,

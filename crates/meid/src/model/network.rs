@@ -299,13 +299,41 @@ fn locate(e: Error, spec: &NetworkSpec, src: &Source) -> Error {
 
 /// The checks that need no structure: names, numbers, ranges.
 fn check_fields(spec: &NetworkSpec, src: &Source) -> Result<()> {
-    let fail = |path: String, msg: String| Err(src.error(&path, format!("{path}: {msg}")));
     if spec.impactor.is_empty() {
-        return fail(
+        return Err(field_error(
+            src,
             "impactor".into(),
             "a general machine needs at least one [[impactor]] (name, mass, velocity)".into(),
-        );
+        ));
     }
+    check_bodies(spec, src)?;
+    let mut contact_names: Vec<&str> = Vec::new();
+    for (i, c) in spec.contact.iter().enumerate() {
+        check_contact_entry(&format!("contact[{i}]"), c)
+            .map_err(|(path, msg)| field_error(src, path, msg))?;
+    }
+    for (i, c) in spec.contact.iter().enumerate() {
+        if contact_names.contains(&c.name.as_str()) {
+            return Err(field_error(
+                src,
+                format!("contact[{i}].name"),
+                format!("'{}' names two contacts: names must be unique", c.name),
+            ));
+        }
+        contact_names.push(&c.name);
+    }
+    Ok(())
+}
+
+/// The error of model path `path`, located in the file: `path: msg`.
+fn field_error(src: &Source, path: String, msg: String) -> Error {
+    src.error(&path, format!("{path}: {msg}"))
+}
+
+/// The bodies' names (usable, unique), masses, the impactors' velocities and forces, the
+/// dampers' springs, dashpots and anchors.
+fn check_bodies(spec: &NetworkSpec, src: &Source) -> Result<()> {
+    let fail = |path: String, msg: String| Err(field_error(src, path, msg));
     let mut names: Vec<(&str, String)> = Vec::new();
     let entries = spec
         .impactor
@@ -371,82 +399,82 @@ fn check_fields(spec: &NetworkSpec, src: &Source) -> Result<()> {
             );
         }
     }
-    for (i, c) in spec.contact.iter().enumerate() {
-        let p = format!("contact[{i}]");
-        if c.between.len() != 2 {
-            return fail(
-                format!("{p}.between"),
-                format!(
-                    "needs two ends [A, B] (A strikes B moving along +z), got {}",
-                    c.between.len()
-                ),
-            );
-        }
-        if c.between[0] == c.between[1] {
-            return fail(
-                format!("{p}.between"),
-                format!(
-                    "'{}' cannot touch itself: a contact joins two different ends",
-                    c.between[0]
-                ),
-            );
-        }
-        if !c.gap.is_finite() {
-            return fail(format!("{p}.gap"), format!("must be a finite number of metres (> 0 open, < 0 preloaded, 0 touching; got {})", crate::num(c.gap)));
-        }
-        if !(c.stiffness.is_finite() && c.stiffness > 0.0) {
-            return fail(
-                format!("{p}.stiffness"),
-                format!(
-                    "must be a finite number > 0 N/m (got {})",
-                    crate::num(c.stiffness)
-                ),
-            );
-        }
-        if c.law != LawSpec::Linear {
-            return fail(format!("{p}.law"), "a general machine takes law = \"linear\" (with damping or restitution) for now: its exact engine needs piecewise-linear contacts, and dopri5 runs the paper's machine only".into());
-        }
-        if c.exponent.is_some() || c.alpha.is_some() {
-            return fail(format!("{p}.alpha"), "exponent and alpha belong to law = \"hunt-crossley\", which a general machine does not take yet".into());
-        }
-        if let Some(d) = c.damping {
-            if !(d.is_finite() && d >= 0.0) {
-                return fail(
-                    format!("{p}.damping"),
-                    format!("must be a finite number ≥ 0 N·s/m (got {})", crate::num(d)),
-                );
-            }
-        }
-        if let Some(e) = c.restitution {
-            if !(e > 0.0 && e <= 1.0) {
-                return fail(
-                    format!("{p}.restitution"),
-                    format!(
-                        "the coefficient of restitution must be in (0, 1] (1: elastic; got {})",
-                        crate::num(e)
-                    ),
-                );
-            }
-            if let Some(d) = c.damping {
-                return fail(
-                    format!("{p}.restitution"),
-                    format!(
-                        "given together with {p}.damping = {} N·s/m; give one of them",
-                        crate::num(d)
-                    ),
-                );
-            }
+    Ok(())
+}
+
+/// One `[[contact]]` entry at model path `p` (`contact[i]`): two different ends, a finite
+/// gap, a positive stiffness, the linear law, damping ≥ 0 or a restitution in (0, 1] (not
+/// both). The error is `(field path, message)`.
+fn check_contact_entry(p: &str, c: &ContactEntrySpec) -> std::result::Result<(), (String, String)> {
+    if c.between.len() != 2 {
+        return Err((
+            format!("{p}.between"),
+            format!(
+                "needs two ends [A, B] (A strikes B moving along +z), got {}",
+                c.between.len()
+            ),
+        ));
+    }
+    if c.between[0] == c.between[1] {
+        return Err((
+            format!("{p}.between"),
+            format!(
+                "'{}' cannot touch itself: a contact joins two different ends",
+                c.between[0]
+            ),
+        ));
+    }
+    if !c.gap.is_finite() {
+        return Err((
+            format!("{p}.gap"),
+            format!(
+                "must be a finite number of metres (> 0 open, < 0 preloaded, 0 touching; got {})",
+                crate::num(c.gap)
+            ),
+        ));
+    }
+    if !(c.stiffness.is_finite() && c.stiffness > 0.0) {
+        return Err((
+            format!("{p}.stiffness"),
+            format!(
+                "must be a finite number > 0 N/m (got {})",
+                crate::num(c.stiffness)
+            ),
+        ));
+    }
+    if c.law != LawSpec::Linear {
+        return Err((format!("{p}.law"), "a general machine takes law = \"linear\" (with damping or restitution) for now: its exact engine needs piecewise-linear contacts, and dopri5 runs the paper's machine only".into()));
+    }
+    if c.exponent.is_some() || c.alpha.is_some() {
+        return Err((format!("{p}.alpha"), "exponent and alpha belong to law = \"hunt-crossley\", which a general machine does not take yet".into()));
+    }
+    if let Some(d) = c.damping {
+        if !(d.is_finite() && d >= 0.0) {
+            return Err((
+                format!("{p}.damping"),
+                format!("must be a finite number ≥ 0 N·s/m (got {})", crate::num(d)),
+            ));
         }
     }
-    let mut contact_names: Vec<&str> = Vec::new();
-    for (i, c) in spec.contact.iter().enumerate() {
-        if contact_names.contains(&c.name.as_str()) {
-            return fail(
-                format!("contact[{i}].name"),
-                format!("'{}' names two contacts: names must be unique", c.name),
-            );
+    if let Some(e) = c.restitution {
+        if !(e > 0.0 && e <= 1.0) {
+            return Err((
+                format!("{p}.restitution"),
+                format!(
+                    "the coefficient of restitution must be in (0, 1] (1: elastic; got {})",
+                    crate::num(e)
+                ),
+            ));
         }
-        contact_names.push(&c.name);
+        if let Some(d) = c.damping {
+            return Err((
+                format!("{p}.restitution"),
+                format!(
+                    "given together with {p}.damping = {} N·s/m; give one of them",
+                    crate::num(d)
+                ),
+            ));
+        }
     }
     Ok(())
 }

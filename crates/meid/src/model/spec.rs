@@ -683,6 +683,10 @@ pub struct MachineFileSpec {
     /// Accelerometer B from the bed centre (m).
     #[serde(default)]
     pub b_offset: Option<[f64; 2]>,
+    /// Further named points on the bed, `name = [x, y]` from the bed centre (m): strike points
+    /// and damper points of a general machine ([[impactor]], [[damper]], [[contact]]).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub bed_points: BTreeMap<String, [f64; 2]>,
     #[serde(default)]
     pub added_masses: Vec<AddedMassFileSpec>,
     #[serde(default)]

@@ -135,6 +135,9 @@ pub struct MachineSpec {
     pub support: Support,
     /// Position of the accelerometer point B relative to the bed centre (m).
     pub b_offset_m: [f64; 2],
+    /// Further named points on the bed (strike points, damper points): name and position from
+    /// the bed centre (m). Each is a grid node and a one-node set.
+    pub bed_points_m: Vec<(String, [f64; 2])>,
     pub added_masses: Vec<AddedMass>,
     /// Tie column ends to their plates by rigid spiders over the column footprint.
     pub spiders: bool,
@@ -176,6 +179,7 @@ impl Default for MachineSpec {
                 spring_inset_m: 0.02,
             },
             b_offset_m: [0.08, 0.05],
+            bed_points_m: Vec::new(),
             added_masses: Vec::new(),
             spiders: true,
             spider_half_size_m: 0.02,
@@ -424,12 +428,23 @@ impl MachineSpec {
         inside("point B", self.b_offset_m, &self.bed)
     }
 
-    /// The bed plate at the columns' height: its grid lines through the centre, B, the column
-    /// axes, the bed's added masses and the column footprints' edges, its shells (part
-    /// `bed`), and the one-node sets `O_b` and `B`.
+    /// The bed plate at the columns' height: its grid lines through the centre, B, the further
+    /// bed points, the column axes, the bed's added masses and the column footprints' edges,
+    /// its shells (part `bed`), and the one-node sets `O_b`, `B` and one per bed point.
     fn bed_plate(&self, g: &mut GeneralSpec, cols: &[[f64; 2]; 4]) -> Result<PlateMesh> {
         let mut bx = vec![0.0, self.b_offset_m[0]];
         let mut by = vec![0.0, self.b_offset_m[1]];
+        for (name, p) in &self.bed_points_m {
+            if ["O_b", "B", "O_f", FEET].contains(&name.as_str()) || name.is_empty() {
+                return Err(Error::invalid(
+                    format!("bed_points.{name}"),
+                    format!("'{name}' is not a usable bed point name (empty, or one of O_b, B, O_f, {FEET}, which the machine names itself)"),
+                ));
+            }
+            inside(&format!("bed_points.{name}"), *p, &self.bed)?;
+            bx.push(p[0]);
+            by.push(p[1]);
+        }
         for c in cols {
             bx.push(c[0]);
             by.push(c[1]);
@@ -470,6 +485,9 @@ impl MachineSpec {
         };
         g.sets.insert("O_b".into(), vec![bed.node([0.0, 0.0])]);
         g.sets.insert("B".into(), vec![bed.node(self.b_offset_m)]);
+        for (name, p) in &self.bed_points_m {
+            g.sets.insert(name.clone(), vec![bed.node(*p)]);
+        }
         Ok(bed)
     }
 
