@@ -99,12 +99,28 @@ fn every_field_kind_matches_the_toml_route() {
     ] {
         check_typed(lumped, &[], path, value);
     }
-    // A contact law (stiffness then in N/m^1.5) and a restitution-set damping.
+    // A contact law (stiffness then in N/m^1.5; dopri5 integrates it) and a restitution-set
+    // damping.
     check_typed(
         lumped,
-        &["contact.slider_bed.stiffness=4.0e10".to_string()],
+        &[
+            "contact.slider_bed.stiffness=4.0e10".to_string(),
+            "simulation.method=dopri5".to_string(),
+        ],
         "contact.slider_bed.law",
         t("hertz"),
+    );
+    // Under a Hertz contact the contact frequency, and so the lumped structure's key, follows
+    // the approach velocity.
+    check_typed(
+        lumped,
+        &[
+            "contact.slider_bed.stiffness=4.0e10".to_string(),
+            "contact.slider_bed.law=hertz".to_string(),
+            "simulation.method=dopri5".to_string(),
+        ],
+        "slider.velocity",
+        FieldValue::Real(0.8),
     );
     check_typed(
         "hammer-on-soil.toml",

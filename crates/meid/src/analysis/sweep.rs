@@ -1594,15 +1594,17 @@ pub(crate) fn point_model_compiled(
     bed_mass_kg: Option<f64>,
     cache: Option<&StructureCache>,
 ) -> Result<PointModel> {
-    let mut model = base.clone();
     // 1. Field paths: typed setters, else the TOML route (which gives the model or the error).
     let has_fields = quantities.iter().any(|q| matches!(q, Quantity::Field(_)));
     let typed = has_fields
         .then(|| typed_fields_model(base, compiled, quantities, values, cache))
         .flatten();
+    let mut model;
     if let Some(m) = typed {
         model = m;
-    } else if has_fields {
+    } else if !has_fields {
+        model = base.clone();
+    } else {
         let mut table = spec_table(base)?;
         let mut fields: Vec<String> = Vec::new();
         for (q, v) in quantities.iter().zip(values) {
@@ -1632,8 +1634,14 @@ pub(crate) fn point_model_compiled(
     // Ratios set contact stiffnesses and the damper's mass, which enter the structure's key
     // only through the contact frequency.
     let ratios = quantities.iter().any(|q| !matches!(q, Quantity::Field(_)));
-    let key_before =
-        (ratios && uses_contact_omega(&model.spec.structure)).then(|| model.structure_key());
+    let base_key = || compiled.map_or_else(|| base.structure_key(), |c| c.base_key());
+    let key_before = (ratios && uses_contact_omega(&model.spec.structure)).then(|| {
+        if has_fields {
+            model.structure_key()
+        } else {
+            base_key()
+        }
+    });
     let w_ref = model.reference_omega();
     // Only md/mb needs m_b (derived from the point's model: building a general model's mesh).
     let m_b = if quantities.contains(&&Quantity::MdOverMb) {
@@ -1678,8 +1686,12 @@ pub(crate) fn point_model_compiled(
     }
     // A contact frequency changed by a ratio can change the structure's reduction (a lumped
     // model's rigid springs, an FE `select = "auto"` cutoff): then the point gets its own.
-    if key_before.is_some_and(|k| k != model.structure_key()) {
-        model.structure = base.structure_for(&model.spec, &model.source, cache)?;
+    if let Some(before) = key_before {
+        let key = model.structure_key();
+        if key != before {
+            model.structure =
+                base.structure_of_key(key, base_key(), &model.spec, &model.source, cache)?;
+        }
     }
     let derived = vec![
         model.spec.contact.slider_bed.stiffness,

@@ -8,12 +8,13 @@
 //!
 //! 1. clones the base spec and writes its values through the setters (a real field takes a
 //!    real, a whole-number field a whole number ≥ 0, an enumerated or text field its text);
-//! 2. checks the magnitude of each real number it set (0 or within
+//! 2. checks the magnitude of each real number it set (finite, and 0 or within
 //!    [`super::MIN_MAGNITUDE`]..=[`super::MAX_MAGNITUDE`], as [`super::check_magnitudes`]
 //!    checks the whole file; the other numbers are the base's, already checked);
 //! 3. takes the base's structure unless a setter can change the [`StructureKey`] (a field
 //!    under `structure`, `foundation` or `points`, or, when the reduction uses the contact
-//!    frequency ω_c, the slider's mass and velocity, the damper's mass and the contacts): then
+//!    frequency ω_c, the slider's mass, the damper's mass and the contacts, and the slider's
+//!    velocity when a contact law is not linear): then
 //!    the key of the point, a hash of typed values, finds the structure in the cache or builds
 //!    it;
 //! 4. runs every other check of a model file ([`Model::validate_values`]) on the point's model.
@@ -431,10 +432,12 @@ impl FieldSetter {
 
     /// Whether setting this field can change a model's [`StructureKey`]: a field under
     /// `structure`, `foundation` or `points`; with `omega` (the reduction uses the contact
-    /// frequency) also the slider's mass and velocity, the damper's mass and the contacts.
-    fn structural(&self, omega: bool) -> bool {
+    /// frequency ω_c) also the slider's mass, the damper's mass and the contacts, and with
+    /// `nonlinear` (a contact law of the model is not linear: its ω_c depends on the approach
+    /// velocity, [`super::fem::contact_omega`]) the slider's velocity.
+    fn structural(&self, omega: bool, nonlinear: bool) -> bool {
         match self.target {
-            Target::Slider(k) => omega && k < 2,
+            Target::Slider(k) => omega && (k == 0 || (k == 1 && nonlinear)),
             Target::Damper(k) => omega && k == 0,
             Target::Contact(..) => omega,
             Target::Sim(_) | Target::ProductionRate | Target::AddedMass(_) => false,
@@ -470,6 +473,11 @@ impl CompiledFields {
     pub fn paths(&self) -> &[String] {
         &self.paths
     }
+
+    /// The base model's [`StructureKey`].
+    pub fn base_key(&self) -> StructureKey {
+        self.base_key
+    }
 }
 
 impl Model {
@@ -484,7 +492,15 @@ impl Model {
             .map(|s| s.as_ref().and_then(|s| s.kind(&self.spec)))
             .collect();
         let omega = uses_contact_omega(&self.spec.structure);
-        let structural = setters.iter().flatten().any(|s| s.structural(omega));
+        let c = &self.spec.contact;
+        let nonlinear = std::iter::once(&c.slider_bed)
+            .chain(c.bed_damper.as_ref())
+            .any(|c| c.law != LawSpec::Linear);
+        // A varied contact law is structural itself (with omega), so the base's laws decide.
+        let structural = setters
+            .iter()
+            .flatten()
+            .any(|s| s.structural(omega, nonlinear));
         CompiledFields {
             paths: paths.iter().map(|p| p.trim().to_string()).collect(),
             setters,
@@ -513,8 +529,10 @@ impl Model {
             let setter = setter.as_ref()?;
             setter.set(&mut spec, v)?;
             if let FieldValue::Real(x) = v {
+                // A NaN or an infinity is left to the TOML route, which reads its literal
+                // (`NaN` is not a TOML number, `inf` is) and checks it there.
                 let a = x.abs();
-                if x.is_finite() && a != 0.0 && !(MIN_MAGNITUDE..=MAX_MAGNITUDE).contains(&a) {
+                if !x.is_finite() || (a != 0.0 && !(MIN_MAGNITUDE..=MAX_MAGNITUDE).contains(&a)) {
                     return None;
                 }
             }
