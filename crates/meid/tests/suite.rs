@@ -74,6 +74,7 @@ mod sweep_fields;
 mod sweep_optimize;
 mod testlab_checks;
 mod trust3_inputs;
+mod typed_fields;
 mod uff_interop;
 
 /// Every `tests/*.rs` file of the library and of the CLI is a module of its crate's `suite.rs`

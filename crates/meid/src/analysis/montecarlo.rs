@@ -13,7 +13,9 @@
 //! * `uniform(a, b)`: `x = a + (b − a) u`, `u ~ U[0, 1)`.
 //!
 //! Sample `i` is the model with the drawn values set as `--set` overrides would
-//! ([`Model::with_fields`]) and simulated ([`super::simulate`], case as specified, the model's
+//! ([`Model::with_fields`]), written through the inputs' typed setters compiled once per study
+//! ([`crate::model::setter`]: no TOML per sample; an input they do not cover takes the TOML
+//! route), and simulated ([`super::simulate`], case as specified, the model's
 //! `[simulation]`). The structure is solved once: a sample reuses the base model's modes
 //! unless its inputs change the structural part of the model
 //! ([`crate::model::StructureKey`]), so a Monte Carlo over contact stiffness on an FE model
@@ -41,7 +43,7 @@ use serde::Serialize;
 
 use super::energy::{simulate, Summary};
 use super::sweep::{field_kind, FieldKind};
-use crate::model::{Case, Model, StructureCache};
+use crate::model::{Case, CompiledFields, FieldValue, Model, StructureCache};
 use crate::{Error, Result};
 
 pub use crate::rng::{mix64, SplitMix64};
@@ -466,17 +468,24 @@ impl MonteCarlo {
             .collect()
     }
 
-    /// Simulates sample values `values`: the base model with the inputs set
-    /// ([`Model::with_fields`]; the structure is the base's, or `cache`'s, unless an input
-    /// changes the structural part of the model).
-    fn run_sample(&self, values: &[f64], cache: &StructureCache) -> Result<[f64; 5]> {
-        let fields: Vec<String> = self
-            .inputs
-            .iter()
-            .zip(values)
-            .map(|(u, v)| format!("{}={v:e}", u.path))
-            .collect();
-        let m = self.model.with_fields(&fields, Some(cache))?;
+    /// The inputs' paths compiled on the base model ([`crate::model::setter`]).
+    pub fn compile_inputs(&self) -> CompiledFields {
+        let paths: Vec<&str> = self.inputs.iter().map(|u| u.path.as_str()).collect();
+        self.model.compile_fields(&paths)
+    }
+
+    /// Simulates sample values `values`: the base model with the inputs set through the typed
+    /// setters `fields` ([`Model::with_values`]: the model `--set PATH=VALUE` with each value
+    /// written `{:e}` gives, [`Model::with_fields`]; the structure is the base's, or
+    /// `cache`'s, unless an input changes the structural part of the model).
+    fn run_sample(
+        &self,
+        values: &[f64],
+        fields: &CompiledFields,
+        cache: &StructureCache,
+    ) -> Result<[f64; 5]> {
+        let typed: Vec<FieldValue> = values.iter().map(|v| FieldValue::Real(*v)).collect();
+        let m = self.model.with_values(fields, &typed, Some(cache))?;
         let sys = m.impact_system(Case::AsSpecified)?;
         let run = simulate(&sys, &m.options(), false)?;
         Ok(metrics_of(&run.summary))
@@ -484,8 +493,13 @@ impl MonteCarlo {
 
     /// Sample `i`: its drawn inputs and its metrics or error.
     pub fn sample(&self, i: usize, cache: &StructureCache) -> Sample {
+        self.sample_with(i, &self.compile_inputs(), cache)
+    }
+
+    /// [`MonteCarlo::sample`] with the inputs compiled ([`MonteCarlo::compile_inputs`]).
+    pub fn sample_with(&self, i: usize, fields: &CompiledFields, cache: &StructureCache) -> Sample {
         let inputs = self.draw(i);
-        match self.run_sample(&inputs, cache) {
+        match self.run_sample(&inputs, fields, cache) {
             Ok(m) => Sample {
                 index: i,
                 inputs,
@@ -605,12 +619,13 @@ impl MonteCarlo {
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Vec<Sample> {
         let cache = StructureCache::new();
+        let fields = self.compile_inputs();
         let total = range.len();
         let done = std::sync::atomic::AtomicUsize::new(0);
         range
             .into_par_iter()
             .map(|i| {
-                let s = self.sample(i, &cache);
+                let s = self.sample_with(i, &fields, &cache);
                 let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 progress(d, total);
                 s
@@ -634,7 +649,13 @@ impl MonteCarlo {
         }
         let n = samples.len();
         if samples.iter().all(|s| s.error.is_some()) {
-            let first = self.run_sample(&self.draw(0), &StructureCache::new()).err();
+            let first = self
+                .run_sample(
+                    &self.draw(0),
+                    &self.compile_inputs(),
+                    &StructureCache::new(),
+                )
+                .err();
             let tag = format!("all {n} samples failed; this is sample 0's error");
             return Err(match first {
                 Some(Error::Input { location, message }) => Error::Input {

@@ -24,9 +24,13 @@
 //! 4. `md/mb = r`: `m_d = r m_b`;
 //! 5. if a ratio in 3 or 4 was given: `K_d = m_d w_d w_d` (so `md/mb` keeps `w_d`).
 //!
-//! Field values are written as TOML literals of the field's kind ([`field_kind`]): a
-//! whole-number field (`structure.fem.machine.elements_per_side`) gets an integer literal and
-//! refuses a non-integral value, naming the field. A varied `simulation.*` field sets that
+//! Field values are set as `--set PATH=LITERAL` would, with the literal of the field's kind
+//! ([`field_kind`]): a whole-number field (`structure.fem.machine.elements_per_side`) gets an
+//! integer and refuses a non-integral value, naming the field. The sweep compiles its field
+//! paths once into typed setters ([`crate::model::setter`]), which write a point's values into
+//! the typed model without TOML; a path they do not cover, or a point a check refuses, takes the
+//! TOML route (the model written as a table, the literals set, the table read back), which gives
+//! the same model or the error in its own words. A varied `simulation.*` field sets that
 //! point's integration options ([`point_options`]); a varied `simulation.duration` runs the
 //! point for its duration instead of stopping at the end of the collision.
 //!
@@ -84,7 +88,9 @@ use serde::Serialize;
 
 use crate::analysis::{simulate, Summary};
 use crate::integrate::{Method, Options};
-use crate::model::{Case, Model, StructureCache};
+use crate::model::{
+    uses_contact_omega, Case, CompiledFields, FieldValue, Model, SetterKind, StructureCache,
+};
 use crate::{Error, Result};
 
 /// A quantity a sweep can vary. In JSON it is written as its [`Quantity::name`]
@@ -532,6 +538,8 @@ pub struct Sweep {
     /// The structures the points built (when a varied field changes the structural part of
     /// the model, [`crate::model::StructureKey`]), shared by the points.
     pub cache: std::sync::Arc<StructureCache>,
+    /// The varied field paths compiled on the model ([`crate::model::setter`]).
+    fields: CompiledFields,
 }
 
 /// The name of a case in `--cases` and in the `METRIC:CASE` columns: `none`, `damper`,
@@ -601,6 +609,14 @@ impl Sweep {
         let mut options = model.options();
         options.stop_at_collision_end = true;
         let bed_mass_kg = check_bed_mass(bed_mass_kg)?;
+        let paths: Vec<&str> = vary
+            .iter()
+            .filter_map(|v| match &v.quantity {
+                Quantity::Field(p) => Some(p.as_str()),
+                _ => None,
+            })
+            .collect();
+        let fields = model.compile_fields(&paths);
         let s = Sweep {
             model,
             vary,
@@ -608,6 +624,7 @@ impl Sweep {
             bed_mass_kg,
             cases: Vec::new(),
             cache: Default::default(),
+            fields,
         };
         s.check()?;
         Ok(s)
@@ -768,8 +785,9 @@ impl Sweep {
 
     /// The model of grid point `index` (see the module docs for the order of resolution).
     pub fn point_model(&self, index: usize) -> Result<PointModel> {
-        point_model_cached(
+        point_model_compiled(
             &self.model,
+            Some(&self.fields),
             &self.quantities(),
             &self.values_at(index),
             self.bed_mass_kg,
@@ -787,15 +805,22 @@ impl Sweep {
     /// Simulates grid point `index`; failures become a [`PointResult`] with its error.
     pub fn run_point(&self, index: usize) -> PointResult {
         let values = self.values_at(index);
-        evaluate_cases(
+        let quantities = self.quantities();
+        let pm = point_model_compiled(
             &self.model,
-            &self.quantities(),
+            Some(&self.fields),
+            &quantities,
             &values,
             self.bed_mass_kg,
+            Some(&self.cache),
+        );
+        evaluate_model(
+            pm,
+            &quantities,
+            &values,
             &self.options,
             index,
             &self.point_cases(),
-            Some(&self.cache),
         )
     }
 
@@ -1501,10 +1526,85 @@ pub fn point_model_cached(
     bed_mass_kg: Option<f64>,
     cache: Option<&StructureCache>,
 ) -> Result<PointModel> {
-    let mut model = base.clone();
-    // 1. Field paths.
+    point_model_compiled(base, None, quantities, values, bed_mass_kg, cache)
+}
+
+/// The field paths among `quantities`, in order.
+fn field_paths<'a>(quantities: &[&'a Quantity]) -> Vec<&'a str> {
+    quantities
+        .iter()
+        .filter_map(|q| match q {
+            Quantity::Field(p) => Some(p.as_str()),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The model of `base` with the field quantities set by their typed setters (`compiled`, when
+/// it compiles the same paths, else compiled now; [`crate::model::setter`]); `None` when a
+/// field has no typed setter, a value does not fit its field or a check fails (the TOML route
+/// then gives the model or the error).
+fn typed_fields_model(
+    base: &Model,
+    compiled: Option<&CompiledFields>,
+    quantities: &[&Quantity],
+    values: &[f64],
+    cache: Option<&StructureCache>,
+) -> Option<Model> {
+    let paths = field_paths(quantities);
+    let own;
+    let fields = match compiled {
+        Some(c)
+            if c.paths()
+                .iter()
+                .map(String::as_str)
+                .eq(paths.iter().copied()) =>
+        {
+            c
+        }
+        _ => {
+            own = base.compile_fields(&paths);
+            &own
+        }
+    };
+    let mut typed = Vec::with_capacity(paths.len());
+    for (q, &v) in quantities.iter().zip(values) {
+        if !matches!(q, Quantity::Field(_)) {
+            continue;
+        }
+        typed.push(match fields.kind(typed.len())? {
+            SetterKind::Real => FieldValue::Real(v),
+            // As field_literal: every integer up to 2^53 is an exact f64.
+            SetterKind::Whole if v.fract() == 0.0 && v.abs() <= 9_007_199_254_740_992.0 => {
+                FieldValue::Integer(v as i64)
+            }
+            _ => return None,
+        });
+    }
+    base.with_values_typed(fields, &typed, cache)
+}
+
+/// [`point_model_cached`] with the field paths compiled once for the study (`compiled`;
+/// `None`: compiled for this point).
+pub(crate) fn point_model_compiled(
+    base: &Model,
+    compiled: Option<&CompiledFields>,
+    quantities: &[&Quantity],
+    values: &[f64],
+    bed_mass_kg: Option<f64>,
+    cache: Option<&StructureCache>,
+) -> Result<PointModel> {
+    // 1. Field paths: typed setters, else the TOML route (which gives the model or the error).
     let has_fields = quantities.iter().any(|q| matches!(q, Quantity::Field(_)));
-    if has_fields {
+    let typed = has_fields
+        .then(|| typed_fields_model(base, compiled, quantities, values, cache))
+        .flatten();
+    let mut model;
+    if let Some(m) = typed {
+        model = m;
+    } else if !has_fields {
+        model = base.clone();
+    } else {
         let mut table = spec_table(base)?;
         let mut fields: Vec<String> = Vec::new();
         for (q, v) in quantities.iter().zip(values) {
@@ -1531,8 +1631,17 @@ pub fn point_model_cached(
         model = base.with_spec(spec, source, cache)?;
     }
     let get = |q: Quantity| quantities.iter().position(|x| **x == q).map(|i| values[i]);
+    // Ratios set contact stiffnesses and the damper's mass, which enter the structure's key
+    // only through the contact frequency.
     let ratios = quantities.iter().any(|q| !matches!(q, Quantity::Field(_)));
-    let key_before = ratios.then(|| model.structure_key());
+    let base_key = || compiled.map_or_else(|| base.structure_key(), |c| c.base_key());
+    let key_before = (ratios && uses_contact_omega(&model.spec.structure)).then(|| {
+        if has_fields {
+            model.structure_key()
+        } else {
+            base_key()
+        }
+    });
     let w_ref = model.reference_omega();
     // Only md/mb needs m_b (derived from the point's model: building a general model's mesh).
     let m_b = if quantities.contains(&&Quantity::MdOverMb) {
@@ -1577,8 +1686,12 @@ pub fn point_model_cached(
     }
     // A contact frequency changed by a ratio can change the structure's reduction (a lumped
     // model's rigid springs, an FE `select = "auto"` cutoff): then the point gets its own.
-    if key_before.is_some_and(|k| k != model.structure_key()) {
-        model.structure = base.structure_for(&model.spec, &model.source, cache)?;
+    if let Some(before) = key_before {
+        let key = model.structure_key();
+        if key != before {
+            model.structure =
+                base.structure_of_key(key, base_key(), &model.spec, &model.source, cache)?;
+        }
     }
     let derived = vec![
         model.spec.contact.slider_bed.stiffness,
@@ -1644,8 +1757,21 @@ pub fn evaluate_cases(
     cases: &[Case],
     cache: Option<&StructureCache>,
 ) -> PointResult {
+    let pm = point_model_cached(base, quantities, values, bed_mass_kg, cache);
+    evaluate_model(pm, quantities, values, options, index, cases)
+}
+
+/// [`evaluate_cases`] of the point's model `pm` (or the error building it).
+fn evaluate_model(
+    pm: Result<PointModel>,
+    quantities: &[&Quantity],
+    values: &[f64],
+    options: &Options,
+    index: usize,
+    cases: &[Case],
+) -> PointResult {
     let nan_metrics = || vec![Some(f64::NAN); METRICS.len() * cases.len()];
-    let pm = match point_model_cached(base, quantities, values, bed_mass_kg, cache) {
+    let pm = match pm {
         Ok(pm) => pm,
         Err(e) => {
             return PointResult {

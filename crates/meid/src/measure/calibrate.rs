@@ -7,7 +7,8 @@
 //! address them (`structure.lumped.damping_ratios[1]`, `contact.slider_bed.stiffness` (K_s),
 //! `contact.bed_damper.stiffness` (K_d), a tabulated mode's frequency …), each within bounds
 //! `lo_i ≤ p_i ≤ hi_i`. Every evaluation builds the model with the values set
-//! ([`Model::with_fields`]); a [`StructureCache`] keeps the structures built, so the structure
+//! (the model [`Model::with_fields`] gives, written through typed setters compiled once,
+//! [`Model::with_values`]); a [`StructureCache`] keeps the structures built, so the structure
 //! is solved once when only contact or damping values vary (for a lumped model K_s, K_d enter
 //! the structural key through the contact frequency, and each new value builds its own
 //! two-mode structure: microseconds).
@@ -110,7 +111,7 @@ use super::mapping::MeasurementSpec;
 use super::process::{average_blows, blow_spectrum, Processing};
 use super::validate::{measured_blows, simulated_blow, MeasuredCase};
 use super::SimChannel;
-use crate::model::{Case, Model, StructureCache};
+use crate::model::{Case, CompiledFields, FieldValue, Model, StructureCache};
 use crate::{Error, Result};
 
 /// One fitted model value.
@@ -381,6 +382,8 @@ pub struct Problem<'a> {
     settings: Settings,
     cases: Vec<CaseTarget>,
     cache: StructureCache,
+    /// The fitted paths compiled on the model ([`crate::model::setter`]).
+    fields: CompiledFields,
 }
 
 /// Simulated blow averages of every case and channel (in the targets' order).
@@ -493,11 +496,14 @@ impl<'a> Problem<'a> {
                 channels,
             });
         }
+        let paths: Vec<&str> = params.iter().map(|q| q.path.as_str()).collect();
+        let fields = model.compile_fields(&paths);
         Ok(Problem {
             model,
             params,
             settings,
             cases,
+            fields,
             cache: StructureCache::new(),
         })
     }
@@ -512,15 +518,12 @@ impl<'a> Problem<'a> {
         self.cache.builds()
     }
 
-    /// The model with `values` set.
+    /// The model with `values` set: the model `--set PATH=VALUE` gives with each value written
+    /// `{:e}` ([`Model::with_fields`]), through the typed setters ([`Model::with_values`]).
     pub fn model_with(&self, values: &[f64]) -> Result<Model> {
-        let fields: Vec<String> = self
-            .params
-            .iter()
-            .zip(values)
-            .map(|(q, v)| format!("{}={v:e}", q.path))
-            .collect();
-        self.model.with_fields(&fields, Some(&self.cache))
+        let typed: Vec<FieldValue> = values.iter().map(|v| FieldValue::Real(*v)).collect();
+        self.model
+            .with_values(&self.fields, &typed, Some(&self.cache))
     }
 
     /// Simulated records (blow averages per case and channel) and the residual vector at

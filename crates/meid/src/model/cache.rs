@@ -7,8 +7,9 @@
 //! structure is a function of the **structural part** of the model only:
 //!
 //! ```text
-//! structure = build(spec.structure, role points (points.bed_contact, damper_anchor,
-//!                   measurement), ω_c if the reduction uses it, the file's name)
+//! structure = build(spec.structure, spec.foundation (the soil under a lumped structure),
+//!                   role points (points.bed_contact, damper_anchor, measurement),
+//!                   ω_c if the reduction uses it, the file's name)
 //! ```
 //!
 //! where ω_c is the highest contact frequency ([`super::fem::ReductionContext`]); the reduction
@@ -20,42 +21,62 @@
 //! `structure.fem.machine.elements_per_side` crossed with a contact stiffness solves each mesh
 //! once).
 //!
-//! Everything else is checked as a model file's values are ([`Model::validate_settings`]).
+//! [`StructureKey`] is a 128-bit hash of those typed values ([`super::keyhash`]), made without
+//! text. Everything else is checked as a model file's values are ([`Model::validate_settings`]).
+//! Studies set their fields through typed setters ([`super::setter`]) and take this module's
+//! TOML route ([`Model::with_fields`]) for the paths those do not cover.
 
 use std::collections::HashMap;
 use std::sync::Mutex;
 
 use super::fem::{ReductionContext, SelectSpec};
+use super::keyhash::KeyHasher;
 use super::{build_structure, check_magnitudes, spec_from_table, Model, ModelSpec};
 use crate::modal::ModalModel;
 use crate::{Error, Result};
 
-/// The structural part of a model (module docs), as text: equal keys, equal structures.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
-pub struct StructureKey(String);
+/// The structural part of a model (module docs) as a 128-bit hash of its typed values
+/// ([`super::keyhash`]: numbers by their bits, no text made): equal keys, equal structures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct StructureKey(u128);
 
 impl StructureKey {
     /// The key of `spec` read from the file named `source_name` (mesh files are found relative
     /// to it).
     pub fn of(spec: &ModelSpec, source_name: &str) -> Self {
-        let ctx = ReductionContext::of(spec);
         let st = &spec.structure;
-        let auto_cutoff = st.fem.as_ref().is_some_and(|f| {
-            f.auto_max_hz.is_none()
-                && match &f.select {
-                    None => true,
-                    Some(SelectSpec::Keyword(k)) => k == "auto",
-                    Some(_) => false,
-                }
-        });
-        let uses_omega = st.lumped.is_some() || auto_cutoff;
-        let omega = uses_omega.then(|| ctx.contact_omega_rad_per_s.to_bits());
-        let structure = serde_json::to_string(st).unwrap_or_else(|e| format!("unserialisable {e}"));
-        StructureKey(format!(
-            "{source_name}\u{1f}{structure}\u{1f}{:?}\u{1f}{omega:?}",
-            ctx.role_points
-        ))
+        let mut h = KeyHasher::new();
+        h.add_str(source_name);
+        h.add(st);
+        h.add(&spec.foundation);
+        // The role points (ReductionContext::role_points) are a function of these three.
+        let p = &spec.points;
+        h.add_str(&p.bed_contact);
+        h.add(&p.damper_anchor.as_deref().filter(|a| *a != "ground"));
+        h.add_str(&p.measurement);
+        if uses_contact_omega(st) {
+            let omega = ReductionContext::of(spec).contact_omega_rad_per_s;
+            h.add_u64(1);
+            h.add_u64(omega.to_bits());
+        } else {
+            h.add_u64(0);
+        }
+        StructureKey(h.finish())
     }
+}
+
+/// Whether the reduction of `st` depends on the contact frequency ω_c (module docs): a lumped
+/// structure (which springs are rigid) or an FE one selected by `"auto"` without `auto_max_hz`.
+pub(crate) fn uses_contact_omega(st: &super::StructureSpec) -> bool {
+    let auto_cutoff = st.fem.as_ref().is_some_and(|f| {
+        f.auto_max_hz.is_none()
+            && match &f.select {
+                None => true,
+                Some(SelectSpec::Keyword(k)) => k == "auto",
+                Some(_) => false,
+            }
+    });
+    st.lumped.is_some() || auto_cutoff
 }
 
 /// Structures built during a study, by [`StructureKey`] (at most [`StructureCache::CAPACITY`];
@@ -153,7 +174,19 @@ impl Model {
         cache: Option<&StructureCache>,
     ) -> Result<ModalModel> {
         let key = StructureKey::of(spec, &source.name);
-        if key == self.structure_key() {
+        self.structure_of_key(key, self.structure_key(), spec, source, cache)
+    }
+
+    /// [`Model::structure_for`] with the keys known: `key` of `spec`, `own` of this model.
+    pub(crate) fn structure_of_key(
+        &self,
+        key: StructureKey,
+        own: StructureKey,
+        spec: &ModelSpec,
+        source: &super::Source,
+        cache: Option<&StructureCache>,
+    ) -> Result<ModalModel> {
+        if key == own {
             return Ok(self.structure.clone());
         }
         if let Some(s) = cache.and_then(|c| c.get(&key)) {

@@ -33,19 +33,23 @@ pub mod fem;
 pub mod foundation;
 pub mod general;
 pub mod imported;
+mod keyhash;
 mod lumped;
 pub mod material;
 pub mod network;
 mod plausible;
+pub mod setter;
 pub mod source;
 pub mod spec;
 pub mod strict;
 
 use std::path::Path;
 
+pub(crate) use cache::uses_contact_omega;
 pub use cache::{StructureCache, StructureKey};
 pub use contacts::{ContactName, ContactSetting};
 pub use general::BED_PART;
+pub use setter::{CompiledFields, FieldSetter, FieldValue, SetterKind};
 pub use source::Source;
 pub use spec::*;
 
@@ -304,15 +308,38 @@ impl Model {
     }
 
     fn validate(&self) -> Result<()> {
-        self.validate_settings()?;
-        // Everything the impact system checks (masses, stiffnesses, ...), with positions.
-        self.impact_system(Case::AsSpecified).map(|_| ())
+        // The impact system (masses, stiffnesses, ...) is built by its last check.
+        self.validate_settings()
     }
 
-    /// The checks of [`Model::from_text`] that do not build the impact system: reference mode,
-    /// `[added_mass]`, named points and `[simulation]` (used again on the models of sweep
-    /// points, whose fields are set after the file was read).
+    /// The value checks of [`Model::from_text`] on top of reading the file, in order: the
+    /// tables' settings and the named points ([`Model::check_settings`],
+    /// [`Model::check_points`]), every real number's magnitude ([`check_magnitudes`]), the
+    /// blow's energy ([`Model::check_blow`]), `[simulation]` ([`Model::check_simulation`]) and
+    /// the impact system with the propagator's limits ([`Model::check_system`]). The first
+    /// failing check is the error.
     pub(crate) fn validate_settings(&self) -> Result<()> {
+        self.check_settings()?;
+        self.check_points()?;
+        check_magnitudes(&self.spec, &self.source)?;
+        self.check_blow()?;
+        self.check_simulation()?;
+        self.check_system()
+    }
+
+    /// The checks of [`Model::validate_settings`] but the magnitudes of the numbers: what a
+    /// model whose numbers were checked one by one ([`setter`]) still needs.
+    pub(crate) fn validate_values(&self) -> Result<()> {
+        self.check_settings()?;
+        self.check_points()?;
+        self.check_blow()?;
+        self.check_simulation()?;
+        self.check_system()
+    }
+
+    /// `structure.reference_mode` a retained mode, `[added_mass]` with a mass, `[production]`,
+    /// `[measurement]`, the receivers, a `[damper]` with its contact.
+    fn check_settings(&self) -> Result<()> {
         let s = &self.spec;
         let src = &self.source;
         if let Some(r) = s.structure.reference_mode {
@@ -357,6 +384,14 @@ impl Model {
                 "a [damper] needs its contact: add [contact.bed_damper]",
             ));
         }
+        Ok(())
+    }
+
+    /// The named points (`points.*`, `added_mass.point`) are points of the structure, and an
+    /// added mass sits at a point some retained mode moves.
+    fn check_points(&self) -> Result<()> {
+        let s = &self.spec;
+        let src = &self.source;
         for (role, name) in [
             ("points.bed_contact", Some(&s.points.bed_contact)),
             ("points.measurement", Some(&s.points.measurement)),
@@ -401,7 +436,13 @@ impl Model {
                 }
             }
         }
-        check_magnitudes(s, src)?;
+        Ok(())
+    }
+
+    /// The blow's energy `½ m_s v_s²` at most [`MAX_BLOW_ENERGY_J`].
+    fn check_blow(&self) -> Result<()> {
+        let s = &self.spec;
+        let src = &self.source;
         let (m_s, v_s) = (s.slider.mass, s.slider.velocity);
         let e_s = 0.5 * m_s * v_s * v_s;
         if m_s.is_finite()
@@ -418,7 +459,14 @@ impl Model {
                 ),
             ));
         }
-        let sim = &s.simulation;
+        Ok(())
+    }
+
+    /// `[simulation]`: duration and sample rate > 0, rtol in (0, 1), atol > 0, max_events in
+    /// 1..=1e8.
+    fn check_simulation(&self) -> Result<()> {
+        let src = &self.source;
+        let sim = &self.spec.simulation;
         for (field, v, unit) in [
             ("simulation.duration", sim.duration, "s"),
             ("simulation.sample_rate", sim.sample_rate, "Hz"),
@@ -458,7 +506,13 @@ impl Model {
                 ),
             ));
         }
-        // Everything the impact system checks (masses, stiffnesses, ...), with positions.
+        Ok(())
+    }
+
+    /// Everything the impact system checks (masses, stiffnesses, ...), with positions, and the
+    /// frequency spreads the closed-form propagator cannot carry (meaningless results).
+    fn check_system(&self) -> Result<()> {
+        let src = &self.source;
         self.impact_system(Case::AsSpecified)?;
         // Frequency spreads the closed-form propagator cannot carry (meaningless results).
         match self.propagator_findings().errors.into_iter().next() {
