@@ -197,7 +197,9 @@ fn bad_values_give_the_toml_routes_error() {
         );
         let typed = base.with_values(&fields, values, None).unwrap_err();
         let text = format!("{path}={}", value.literal());
-        let toml = base.with_fields(&[text.clone()], None).unwrap_err();
+        let toml = base
+            .with_fields(std::slice::from_ref(&text), None)
+            .unwrap_err();
         assert_eq!(typed.to_string(), toml.to_string(), "{text}");
     }
 }
