@@ -548,18 +548,14 @@ impl<R: BufRead> Parser<'_, R> {
     /// lines, bytes, 0 0 0 0. Returns (little-endian, bytes of binary data).
     fn binary_header_58(&self, ds: Ds, header: &str) -> Result<(bool, u64)> {
         let t: Vec<&str> = header.split_whitespace().collect();
+        let fail = |msg: String| self.err(Some(ds), Some("binary header"), self.line_no, msg);
         let int = |k: usize, what: &str| -> Result<i64> {
             t.get(k).and_then(|v| v.parse::<i64>().ok()).ok_or_else(|| {
-                self.err(
-                    Some(ds),
-                    Some("binary header"),
-                    self.line_no,
-                    format!(
-                        "field {} ({what}): expected a whole number, got '{}'",
-                        k + 1,
-                        t.get(k).unwrap_or(&"")
-                    ),
-                )
+                fail(format!(
+                    "field {} ({what}): expected a whole number, got '{}'",
+                    k + 1,
+                    t.get(k).unwrap_or(&"")
+                ))
             })
         };
         let order = int(1, "byte order: 1 little-endian, 2 big-endian")?;
@@ -567,31 +563,25 @@ impl<R: BufRead> Parser<'_, R> {
         let ascii = int(3, "number of ASCII lines: 11")?;
         let bytes = int(4, "number of bytes of binary data")?;
         if !(order == 1 || order == 2) {
-            return Err(self.err(
-                Some(ds),
-                Some("binary header"),
-                self.line_no,
-                format!("byte order {order}: expected 1 (little-endian) or 2 (big-endian)"),
-            ));
+            return Err(fail(format!(
+                "byte order {order}: expected 1 (little-endian) or 2 (big-endian)"
+            )));
         }
         if fp != 2 {
-            return Err(self.err(
-                Some(ds),
-                Some("binary header"),
-                self.line_no,
-                format!("floating-point format {fp}: only 2 (IEEE 754) is read"),
-            ));
+            return Err(fail(format!(
+                "floating-point format {fp}: only 2 (IEEE 754) is read"
+            )));
         }
         if ascii != 11 {
-            return Err(self.err(
-                Some(ds),
-                Some("binary header"),
-                self.line_no,
-                format!("{ascii} ASCII lines: expected 11 (records 1-11)"),
-            ));
+            return Err(fail(format!(
+                "{ascii} ASCII lines: expected 11 (records 1-11)"
+            )));
         }
         if bytes < 0 || bytes as u64 > self.left {
-            return Err(self.err(Some(ds), Some("binary header"), self.line_no, format!("{bytes} bytes of binary data announced, but only {} bytes are left in the file", self.left)));
+            return Err(fail(format!(
+                "{bytes} bytes of binary data announced, but only {} bytes are left in the file",
+                self.left
+            )));
         }
         Ok((order == 1, bytes as u64))
     }
