@@ -44,6 +44,8 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     // With -o, the history is streamed into the output set's history.csv (constant memory);
     // without, no sample is computed at all. Peaks come from the continuous solution either way.
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
+    // With -o, a bounded sketch of the history for the pictures.
+    let mut sketch = None;
     let (s, _solution) = match &set {
         Some(set) => {
             let rows = analysis::energy::sample_count(opts.duration, opts.sample_rate);
@@ -58,9 +60,11 @@ pub fn run(a: SimulateArgs) -> Result<()> {
                 .with_context(|| format!("cannot create {}", path.display()))?;
             let mut rec =
                 analysis::energy::StreamRecorder::new(&sys, std::io::BufWriter::new(file))
-                    .with_context(|| format!("cannot write {}", path.display()))?;
+                    .with_context(|| format!("cannot write {}", path.display()))?
+                    .with_sketch(rows);
             let r = analysis::energy::simulate_observed(&sys, &opts, Some(&mut rec))
                 .context("simulation failed")?;
+            sketch = rec.take_sketch();
             rec.finish()
                 .and_then(|mut w| std::io::Write::flush(&mut w))
                 .with_context(|| format!("cannot write {}", path.display()))?;
@@ -96,6 +100,10 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         }
         if let Some(f) = found.as_ref().filter(|f| !f.receivers.is_empty()) {
             meid::io::write_atomic(&set.path("receivers.csv"), receivers_csv(f).as_bytes())?;
+        }
+        if let Some(sk) = &sketch {
+            meid::report::histories::blow_pictures(set.dir(), sk, s)
+                .context("cannot draw the pictures")?;
         }
         meid::io::write_json(&set.path("summary.json"), &out)?;
         meid::io::write_atomic(

@@ -355,6 +355,16 @@ fn a_failed_run_leaves_the_previous_output_set() {
     assert_eq!(
         names,
         [
+            "bed_acceleration.png",
+            "bed_acceleration.svg",
+            "contact_forces.png",
+            "contact_forces.svg",
+            "displacements.png",
+            "displacements.svg",
+            "energies.png",
+            "energies.svg",
+            "floor_force.png",
+            "floor_force.svg",
             "history.csv",
             "manifest.json",
             "summary.json",

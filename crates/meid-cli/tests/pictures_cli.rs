@@ -169,17 +169,25 @@ fn compare_draws_each_case_in_its_panel_and_every_axis_has_a_unit() {
             .filter(|x| x.contains(" (") && x.ends_with(')'))
             .count();
         assert!(units >= 2, "{stem}: axis descriptions without units: {w:?}");
+        // A history names each case on its panel of the whole record and of the collision
+        // zoomed beside it; a spectrum once, in its legend.
+        let zoomed = stem.ends_with("-time");
         for case in ["without damper", "impact damper", "added mass"] {
             assert_eq!(
                 t.iter().filter(|x| *x == case).count(),
-                1,
-                "{stem}: case '{case}' named once (legend or panel caption)"
+                if zoomed { 2 } else { 1 },
+                "{stem}: case '{case}' named once per frame (legend or panel caption)"
             );
         }
+        assert_eq!(
+            t.iter().any(|x| x.starts_with("the collision: first")),
+            zoomed,
+            "{stem}: the collision zoomed beside the histories, only there"
+        );
     }
-    // The time histories: one "acceleration (m/s²)" axis per panel.
+    // The time histories: one "acceleration (m/s²)" axis per panel, whole and zoomed.
     let t = texts(&d.join("acceleration-time.svg"));
-    assert_eq!(t.iter().filter(|x| *x == "acceleration (m/s²)").count(), 3);
+    assert_eq!(t.iter().filter(|x| *x == "acceleration (m/s²)").count(), 6);
 }
 
 #[test]
@@ -214,4 +222,71 @@ fn montecarlo_histogram_marks_mean_and_p95_of_stats_json() {
     assert!(t.contains(&mean), "{mean} missing: {t:?}");
     assert!(t.contains(&p95), "{p95} missing: {t:?}");
     assert!(t.iter().any(|x| x == "energy ratio E_p+/E_s− (1)"));
+}
+
+/// `meid simulate -o`: the blow's pictures, each whole with the collision zoomed beside it,
+/// titled with the summary's exact peaks; without a damper, no damper curve.
+#[test]
+fn simulate_draws_the_blow_whole_and_its_collision() {
+    let d = common::tmpdir("pictures", "simulate");
+    ok(meid()
+        .arg("simulate")
+        .arg(example())
+        .args(["-q", "-o"])
+        .arg(&d)
+        .output()
+        .unwrap());
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("summary.json")).unwrap()).unwrap();
+    let a = summary["peak_bed_acceleration_m_per_s2"].as_f64().unwrap();
+    for stem in [
+        "bed_acceleration",
+        "floor_force",
+        "contact_forces",
+        "displacements",
+        "energies",
+    ] {
+        assert!(d.join(format!("{stem}.png")).is_file(), "{stem}.png");
+        let t = texts(&d.join(format!("{stem}.svg")));
+        assert_no_internal_names(&t, stem);
+        assert!(
+            t.iter().any(|x| x.starts_with("the collision: first")),
+            "{stem}: the collision beside the whole record: {t:?}"
+        );
+    }
+    let t = texts(&d.join("bed_acceleration.svg"));
+    let title = t
+        .iter()
+        .find(|x| x.starts_with("Bed acceleration a_B, exact peak "))
+        .expect("title");
+    let quoted: f64 = title["Bed acceleration a_B, exact peak ".len()..]
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((quoted - a).abs() <= 5e-4 * a.abs(), "{title} vs {a}");
+    let t = texts(&d.join("energies.svg"));
+    for label in [
+        "slider, kinetic",
+        "dissipated",
+        "damper, kinetic + spring + contact",
+    ] {
+        assert!(t.iter().any(|x| x == label), "energies: {label} in {t:?}");
+    }
+
+    let d = common::tmpdir("pictures", "simulate-none");
+    ok(meid()
+        .arg("simulate")
+        .arg(example())
+        .args(["--case", "none", "-q", "-o"])
+        .arg(&d)
+        .output()
+        .unwrap());
+    let t = texts(&d.join("contact_forces.svg"));
+    assert!(t.iter().any(|x| x == "slider-bed"), "{t:?}");
+    assert!(
+        !t.iter().any(|x| x == "bed-damper"),
+        "no damper curve: {t:?}"
+    );
 }

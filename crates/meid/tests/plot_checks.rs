@@ -424,3 +424,74 @@ fn bands_shade_ranges_with_one_legend_entry_per_label() {
         "{e}"
     );
 }
+
+/// A zoom frame beside the plot shows only its range, on a y scale fitted to the points inside
+/// it, under its own title, without a second legend; a bad range is refused by name.
+#[test]
+fn a_zoom_frame_shows_its_range_on_its_own_scale() {
+    let t = linspace(0.0, 1.0, 1001);
+    // A bump of height 1 in the first 0.1 s, a spike of 100 at 0.9 s.
+    let y: Vec<f64> = t
+        .iter()
+        .map(|&t| {
+            if t <= 0.1 {
+                (PI * t / 0.1).sin()
+            } else if (t - 0.9).abs() < 1e-9 {
+                100.0
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let plot = LinePlot {
+        title: "whole record".into(),
+        x_label: "time (s)".into(),
+        y_label: "value (m)".into(),
+        series: vec![Series {
+            label: "the bump".into(),
+            x: t.clone(),
+            y,
+            ..Default::default()
+        }],
+        zoom: Some((0.0, 0.1)),
+        zoom_title: "the first 0.1 s".into(),
+        ..Default::default()
+    };
+    let files = line_plot(out_dir("zoom").join("zoom"), &plot).unwrap();
+    assert_written(&files);
+    let png = std::fs::read(&files.png).unwrap();
+    let width = u32::from_be_bytes([png[16], png[17], png[18], png[19]]);
+    assert_eq!(width, 1600, "a zoom widens the picture");
+    let texts = meid::plot::svg_texts(&std::fs::read_to_string(&files.svg).unwrap());
+    let at = texts
+        .iter()
+        .position(|s| s == "the first 0.1 s")
+        .expect("zoom title");
+    let numbers =
+        |ts: &[String]| -> Vec<f64> { ts.iter().filter_map(|s| s.parse().ok()).collect() };
+    let (whole, zoom) = (numbers(&texts[..at]), numbers(&texts[at..]));
+    assert!(
+        whole.iter().any(|v| *v >= 80.0),
+        "the spike's scale on the left: {whole:?}"
+    );
+    assert!(
+        zoom.iter().all(|v| v.abs() <= 1.2),
+        "the zoom fits the bump, not the spike: {zoom:?}"
+    );
+    assert_eq!(
+        texts.iter().filter(|s| *s == "the bump").count(),
+        1,
+        "one legend"
+    );
+
+    for bad in [(0.1, 0.0), (f64::NAN, 0.1), (2.0, 3.0)] {
+        let p = LinePlot {
+            zoom: Some(bad),
+            ..plot.clone()
+        };
+        let e = line_plot(out_dir("zoom").join("bad"), &p)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("zoom"), "{e}");
+    }
+}

@@ -329,6 +329,7 @@ pub struct StreamRecorder<'a, W: std::io::Write> {
     sampler: Sampler<'a>,
     out: crate::io::HistoryWriter<W>,
     error: Option<std::io::Error>,
+    sketch: Option<super::sketch::HistorySketch>,
 }
 
 impl<'a, W: std::io::Write> StreamRecorder<'a, W> {
@@ -338,7 +339,20 @@ impl<'a, W: std::io::Write> StreamRecorder<'a, W> {
             sampler: Sampler::new(sys),
             out: crate::io::HistoryWriter::new(out)?,
             error: None,
+            sketch: None,
         })
+    }
+
+    /// Also keeps a bounded [`HistorySketch`](super::sketch::HistorySketch) of the rows
+    /// written, for pictures (`expected_samples`: the history's estimated length).
+    pub fn with_sketch(mut self, expected_samples: f64) -> Self {
+        self.sketch = Some(super::sketch::HistorySketch::new(expected_samples));
+        self
+    }
+
+    /// The sketch kept since [`Self::with_sketch`] (`None` without one, or once taken).
+    pub fn take_sketch(&mut self) -> Option<super::sketch::HistorySketch> {
+        self.sketch.take()
     }
 
     /// Rows written.
@@ -361,6 +375,9 @@ impl<W: std::io::Write> Observer for StreamRecorder<'_, W> {
             return;
         }
         let r = self.sampler.row(t, x, mode);
+        if let Some(sk) = &mut self.sketch {
+            sk.push(&r);
+        }
         if let Err(e) = self.out.row(&r) {
             self.error = Some(e);
         }

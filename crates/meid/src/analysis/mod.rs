@@ -11,6 +11,7 @@ pub mod optimize;
 pub mod production;
 pub mod quadrature;
 pub mod return_map;
+pub mod sketch;
 pub mod spectrum;
 pub mod steady;
 pub mod study;

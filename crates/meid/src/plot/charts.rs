@@ -501,6 +501,7 @@ pub fn line_plot(path_stem: impl AsRef<Path>, plot: &LinePlot) -> Result<PlotFil
     check_series("series", &plot.series)?;
     check_markers(&plot.markers)?;
     check_range("x_range", plot.x_range, plot.x_log)?;
+    check_range("zoom", plot.zoom, plot.x_log)?;
     if let Some(b) = plot
         .bands
         .iter()
@@ -525,12 +526,28 @@ pub fn line_plot(path_stem: impl AsRef<Path>, plot: &LinePlot) -> Result<PlotFil
             "no drawable point (finite, positive on a log axis, inside x_range)",
         ));
     }
+    let in_zoom = |s: &Series| {
+        s.x.iter()
+            .zip(&s.y)
+            .any(|(x, y)| inside(*x, plot.x_log, plot.zoom) && usable(*y, plot.y_log))
+    };
+    if plot.zoom.is_some() && !plot.series.iter().any(in_zoom) {
+        return Err(Error::invalid(
+            "zoom",
+            "no drawable point inside the zoom's range",
+        ));
+    }
     write_figure(path_stem.as_ref(), plot)
+}
+
+/// `x` is drawable on an axis (log or not) and inside `range` (`None`: everywhere).
+fn inside(x: f64, log: bool, range: Option<(f64, f64)>) -> bool {
+    usable(x, log) && range.is_none_or(|(a, b)| x >= a && x <= b)
 }
 
 impl LinePlot {
     fn in_x_range(&self, x: f64) -> bool {
-        usable(x, self.x_log) && self.x_range.is_none_or(|(a, b)| x >= a && x <= b)
+        inside(x, self.x_log, self.x_range)
     }
 
     fn panel_count(&self) -> usize {
@@ -551,15 +568,20 @@ struct LinesView<'a> {
     /// (palette position, series).
     series: Vec<(usize, &'a Series)>,
     marker_labels: bool,
+    /// The horizontal range drawn (`None`: all points).
+    x_range: Option<(f64, f64)>,
+    /// Draw the legend (the zoom frame beside a plot has none).
+    legend: bool,
 }
 
 impl Figure for LinePlot {
     fn size(&self) -> (u32, u32) {
         let n = self.panel_count() as u32;
+        let width = if self.zoom.is_some() { 1600 } else { 1000 };
         if n > 1 {
-            (1000, 90 + 250 * n)
+            (width, 90 + 250 * n)
         } else {
-            (1000, 680)
+            (width, 680)
         }
     }
 
@@ -567,12 +589,32 @@ impl Figure for LinePlot {
         &self,
         area: &DrawingArea<DB, Shift>,
     ) -> std::result::Result<(), String> {
+        let Some(zoom) = self.zoom else {
+            return self.draw_frames(area, &self.title, self.x_range, true);
+        };
+        let width = area.dim_in_pixel().0;
+        let (left, right) = area.split_horizontally(width * 3 / 5);
+        self.draw_frames(&left, &self.title, self.x_range, true)?;
+        self.draw_frames(&right, &self.zoom_title, Some(zoom), false)
+    }
+}
+
+impl LinePlot {
+    /// The plot's frame (or stacked panels) on `area`, showing `x_range` (`None`: the data's
+    /// extent, padded) with the y range fitted to the points inside it.
+    fn draw_frames<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        title: &str,
+        x_range: Option<(f64, f64)>,
+        legend: bool,
+    ) -> std::result::Result<(), String> {
         let pts = || {
             self.series
                 .iter()
                 .flat_map(|s| s.x.iter().copied().zip(s.y.iter().copied()))
         };
-        let xe = match self.x_range {
+        let xe = match x_range {
             Some(r) => r,
             None => extent(
                 pts().filter(|p| usable(p.1, self.y_log)).map(|p| p.0),
@@ -581,11 +623,13 @@ impl Figure for LinePlot {
             .ok_or("no drawable point")?,
         };
         let ye = extent(
-            pts().filter(|p| self.in_x_range(p.0)).map(|p| p.1),
+            pts()
+                .filter(|p| inside(p.0, self.x_log, x_range))
+                .map(|p| p.1),
             self.y_log,
         )
         .ok_or("no drawable point")?;
-        let xr = if self.x_range.is_some() {
+        let xr = if x_range.is_some() {
             xe.0..xe.1
         } else {
             padded(xe, self.x_log)
@@ -594,12 +638,14 @@ impl Figure for LinePlot {
         let n = self.panel_count();
         if n == 1 {
             let view = LinesView {
-                title: &self.title,
+                title,
                 caption_size: 26,
                 x_label: &self.x_label,
                 x_area: 58,
                 series: self.series.iter().enumerate().collect(),
-                marker_labels: true,
+                marker_labels: legend,
+                x_range,
+                legend,
             };
             return with_axes!(
                 self.x_log,
@@ -609,10 +655,10 @@ impl Figure for LinePlot {
                 draw_lines(area, self, &view)
             );
         }
-        let body = if self.title.is_empty() {
+        let body = if title.is_empty() {
             area.clone()
         } else {
-            area.titled(&self.title, (FONT, 26)).map_err(e2s)?
+            area.titled(title, (FONT, 26)).map_err(e2s)?
         };
         for (k, (panel, s)) in body
             .split_evenly((n, 1))
@@ -627,7 +673,9 @@ impl Figure for LinePlot {
                 x_label: if last { &self.x_label } else { "" },
                 x_area: if last { 58 } else { 30 },
                 series: vec![(k, s)],
-                marker_labels: k == 0,
+                marker_labels: k == 0 && legend,
+                x_range,
+                legend,
             };
             with_axes!(
                 self.x_log,
@@ -677,7 +725,7 @@ where
                 fill,
             )))
             .map_err(e2s)?;
-        if !b.label.is_empty() && !band_labels.contains(&b.label.as_str()) {
+        if view.legend && !b.label.is_empty() && !band_labels.contains(&b.label.as_str()) {
             band_labels.push(&b.label);
             any_label = true;
             entries += 1;
@@ -693,7 +741,7 @@ where
         // Split into runs of drawable points.
         let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
         for (&x, &y) in s.x.iter().zip(&s.y) {
-            if !p.in_x_range(x) {
+            if !inside(x, p.x_log, view.x_range) {
                 if runs.last().is_some_and(|r| !r.is_empty()) {
                     runs.push(Vec::new());
                 }
@@ -717,7 +765,7 @@ where
         let legend = chart
             .draw_series(LineSeries::new(Vec::<(f64, f64)>::new(), style))
             .map_err(e2s)?;
-        if !s.label.is_empty() && !p.panels {
+        if !s.label.is_empty() && !p.panels && view.legend {
             any_label = true;
             entries += 1;
             chars = chars.max(s.label.chars().count());
@@ -737,7 +785,7 @@ where
         }
     }
     draw_markers(&mut chart, &p.markers, view.marker_labels)?;
-    if !failed_x.is_empty() {
+    if !failed_x.is_empty() && view.legend {
         any_label = true;
         entries += 1;
         chars = chars.max(16);
@@ -764,6 +812,7 @@ pub fn spectrum_plot(path_stem: impl AsRef<Path>, plot: &SpectrumPlot) -> Result
         bands: Vec::new(),
         panels: false,
         x_range: plot.x_range,
+        ..Default::default()
     };
     line_plot(path_stem, &lines)
 }

@@ -130,6 +130,13 @@ pub struct LinePlot {
     /// Horizontal range shown, `(from, to)` in the x unit; `None` fits the data. Points
     /// outside it are not drawn (e.g. the first 0.3 s of a 2 s history).
     pub x_range: Option<(f64, f64)>,
+    /// A second frame beside the first (right, 40 % of a wider picture) showing only this
+    /// horizontal range, `(from, to)` in the x unit, with its own y range fitted to the points
+    /// inside it, e.g. the collision's first milliseconds beside the whole history. Titled
+    /// `zoom_title`; no legend of its own (the left frame's applies).
+    pub zoom: Option<(f64, f64)>,
+    /// Title of the [`zoom`](Self::zoom) frame.
+    pub zoom_title: String,
 }
 
 /// A field `z(x, y)` on a rectilinear grid, drawn as coloured cells (viridis) with a colour

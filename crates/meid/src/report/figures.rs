@@ -163,31 +163,28 @@ pub fn energy_map(dir: &Path, stem: &str, spec: &MapSpec) -> Result<Figure> {
     Ok(figure(stem, &spec.title, spec.caption.clone(), &[&csv]))
 }
 
-/// Seven contour levels evenly spaced between the smallest and largest finite values of
-/// `z`, `z_k = lo + (hi − lo) k/8` (none when `z` is constant or empty).
-pub fn even_contour_levels(z: &[f64]) -> Vec<f64> {
+/// Contour levels at round values (multiples of a 1-2-5 step, [`plot::nice_levels`]), at most
+/// seven, strictly between the smallest and largest finite values of `z`; none when `z` is
+/// constant or empty. The colour bar marks and labels each.
+pub fn round_contour_levels(z: &[f64]) -> Vec<f64> {
     let (lo, hi) = z
         .iter()
         .filter(|v| v.is_finite())
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         });
-    if lo < hi {
-        (1..8).map(|k| lo + (hi - lo) * k as f64 / 8.0).collect()
-    } else {
-        Vec::new()
-    }
+    plot::nice_levels(lo, hi, 7)
 }
 
 /// An energy map as the paper draws it (Figs. 3, 12, 16): `map` (grid, values, axes) with
-/// contour lines ([`even_contour_levels`] unless `map` gives its own), the line x = y over
+/// contour lines ([`round_contour_levels`] unless `map` gives its own), the line x = y over
 /// the range both axes share as a dashed overlay named `diagonal_label` in the legend (e.g.
 /// `ω_d = ω_s` on a ω_s/ω_6 × ω_d/ω_6 map; empty: no line), and `marks` as labelled points
 /// (the design, or the paper's P … U); marks at one place share a point labelled "Q = S".
 /// Marks outside the grid are left out (a point off the frame would be drawn over the axes).
 pub fn marked_heat_map(mut map: HeatMap, marks: &[Mark], diagonal_label: &str) -> HeatMap {
     if map.contour_levels.is_empty() {
-        map.contour_levels = even_contour_levels(&map.z);
+        map.contour_levels = round_contour_levels(&map.z);
     }
     let (Some(&x0), Some(&x1), Some(&y0), Some(&y1)) =
         (map.x.first(), map.x.last(), map.y.first(), map.y.last())
@@ -371,6 +368,20 @@ pub fn history_plot(r: &ComparisonResult, ch: Channel, label: CaseLabel) -> Line
         .unwrap_or(0.0);
     let shown = 1.25 * (t_last - t0) + t0;
     let zoom = shown.is_finite() && shown > t0 && shown < 0.8 * t_end;
+    // Beside it, the collision (the latest of the cases').
+    let t_c = r
+        .cases
+        .iter()
+        .filter_map(|c| {
+            let h = &c.history;
+            crate::analysis::sketch::collision_end(
+                &h.time_s,
+                &h.contact_force_slider_bed_n,
+                &h.contact_force_bed_damper_n,
+            )
+        })
+        .fold(f64::NAN, f64::max);
+    let collision = super::histories::collision_zoom(t0, t_c, if zoom { shown } else { t_end });
     LinePlot {
         title: if zoom {
             format!(
@@ -387,6 +398,10 @@ pub fn history_plot(r: &ComparisonResult, ch: Channel, label: CaseLabel) -> Line
         series,
         panels: true,
         x_range: zoom.then_some((t0, shown)),
+        zoom: collision,
+        zoom_title: collision
+            .map(super::histories::zoom_title)
+            .unwrap_or_default(),
         ..Default::default()
     }
 }
