@@ -13,9 +13,8 @@ const MAX_LINES: usize = 150;
 /// Functions longer than [`MAX_LINES`] today, whose split is under way elsewhere (issue 30,
 /// item 2; the integrators' with issue "[machines] Any impact machine"): `(file under
 /// crates/, function name)`.
-const KNOWN_LONG: [(&str, &str); 9] = [
+const KNOWN_LONG: [(&str, &str); 8] = [
     ("meid/src/integrate/dopri5.rs", "solve_from"),
-    ("meid/src/integrate/exact.rs", "solve_from"),
     ("meid/src/integrate/small/hqr.rs", "francis"),
     ("meid/src/integrate/peaks.rs", "exp_extremes"),
     ("meid/src/model/lumped.rs", "modal_model"),
