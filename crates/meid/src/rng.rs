@@ -2,7 +2,11 @@
 //! generators", OOPSLA 2014): 64-bit state, Weyl increment and Stafford's "Mix13" finaliser.
 //! One small, portable generator for every seeded draw in meid (Monte Carlo samples, optimiser
 //! restarts, Lanczos start vectors), so results depend on the seed only, not on a crate's
-//! version; written here because it is a dozen lines.
+//! version; written here because it is a dozen lines. Not the `rand` crates: their book
+//! ("Reproducibility") allows value-breaking changes in minor versions, and `StdRng` promises
+//! no reproducible output across versions or platforms, while a seeded study must draw the same
+//! samples for good; a named generator (`rand_pcg`, `rand_xoshiro`) would be a dependency for
+//! the same dozen lines.
 
 /// The generator's Weyl increment (2⁶⁴/φ).
 const GOLDEN_GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;

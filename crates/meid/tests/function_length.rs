@@ -11,19 +11,8 @@ use std::path::Path;
 const MAX_LINES: usize = 150;
 
 /// Functions longer than [`MAX_LINES`] today, whose split is under way elsewhere (issue 30,
-/// item 2; the integrators' with issue "[machines] Any impact machine"): `(file under
-/// crates/, function name)`.
-const KNOWN_LONG: [(&str, &str); 9] = [
-    ("meid/src/integrate/dopri5.rs", "solve_from"),
-    ("meid/src/integrate/exact.rs", "solve_from"),
-    ("meid/src/integrate/small/hqr.rs", "francis"),
-    ("meid/src/integrate/peaks.rs", "exp_extremes"),
-    ("meid/src/model/lumped.rs", "modal_model"),
-    ("meid/src/model/fem.rs", "analyse"),
-    ("meid/src/io/frd.rs", "results_block"),
-    ("meid/src/analysis/optimize.rs", "minimize_box_global"),
-    ("meid/src/analysis/optimize.rs", "brent_search"),
-];
+/// item 2): `(file under crates/, function name)`.
+const KNOWN_LONG: [(&str, &str); 1] = [("meid/src/model/fem.rs", "analyse")];
 
 use crate::layering::rust_files;
 

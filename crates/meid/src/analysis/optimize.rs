@@ -131,6 +131,7 @@ where
     brent_search(f, a, Some(start), b, options)
 }
 
+/// Brent's method on `[a, b]` ([`brent_minimize`]), from `start = (x, f(x))` when given.
 fn brent_search<F, R>(
     mut f: F,
     a: f64,
@@ -142,6 +143,87 @@ where
     F: FnMut(f64) -> R,
     R: ObjectiveValue,
 {
+    check_brent(a, b, options)?;
+    let BrentOptions {
+        x_tolerance,
+        relative_tolerance,
+        max_evaluations,
+    } = *options;
+    let mut history = Vec::new();
+    let mut failures = 0usize;
+    let mut eval = |x: f64, history: &mut Vec<(f64, f64)>, failures: &mut usize| -> f64 {
+        let v = f(x).into_value().unwrap_or_else(|| {
+            *failures += 1;
+            f64::INFINITY
+        });
+        history.push((x, v));
+        v
+    };
+
+    let golden = 0.5 * (3.0 - 5.0_f64.sqrt());
+    let (lo, hi) = (a, b);
+    let (x, fx) = match start {
+        Some((x, fx)) if x > a && x < b => {
+            let fx = fx.into_value().unwrap_or(f64::INFINITY);
+            history.push((x, fx));
+            (x, fx)
+        }
+        Some((x, _)) => {
+            return Err(Error::invalid(
+                "start",
+                format!("must lie inside ({a}, {b}), got {x}"),
+            ))
+        }
+        None => {
+            let x = lo + golden * (hi - lo);
+            (x, eval(x, &mut history, &mut failures))
+        }
+    };
+    let mut st = BrentState {
+        lo,
+        hi,
+        x,
+        fx,
+        w: x,
+        fw: fx,
+        v: x,
+        fv: fx,
+        d: 0.0,
+        e: 0.0,
+    };
+    let mut converged = false;
+    while history.len() < max_evaluations {
+        let m = 0.5 * (st.lo + st.hi);
+        let tol = relative_tolerance * st.x.abs() + x_tolerance;
+        let tol2 = 2.0 * tol;
+        if (st.x - m).abs() <= tol2 - 0.5 * (st.hi - st.lo) {
+            converged = true;
+            break;
+        }
+        let u = st.next_point(m, tol, golden);
+        let fu = eval(u, &mut history, &mut failures);
+        st.update(u, fu);
+    }
+    let (x, fx) = (st.x, st.fx);
+    if !fx.is_finite() {
+        return Err(Error::numerical(
+            "Brent minimisation",
+            format!("all {} evaluations on [{a}, {b}] failed", history.len()),
+        ));
+    }
+    Ok(Minimum1d {
+        x,
+        f: fx,
+        evaluations: history.len(),
+        failures,
+        converged,
+        history,
+    })
+}
+
+/// The interval and options of [`brent_search`] checked: finite `a < b`, a positive finite
+/// `x_tolerance`, a non-negative finite `relative_tolerance`, at least one evaluation.
+fn check_brent(a: f64, b: f64, options: &BrentOptions) -> Result<()> {
     if !(a.is_finite() && b.is_finite() && a < b) {
         return Err(Error::invalid(
             "interval",
@@ -168,48 +250,43 @@ where
     if max_evaluations < 1 {
         return Err(Error::invalid("max_evaluations", "must be at least 1"));
     }
-    let mut history = Vec::new();
-    let mut failures = 0usize;
-    let mut eval = |x: f64, history: &mut Vec<(f64, f64)>, failures: &mut usize| -> f64 {
-        let v = f(x).into_value().unwrap_or_else(|| {
-            *failures += 1;
-            f64::INFINITY
-        });
-        history.push((x, v));
-        v
-    };
+    Ok(())
+}
 
-    let golden = 0.5 * (3.0 - 5.0_f64.sqrt());
-    let (mut lo, mut hi) = (a, b);
-    let (mut x, mut fx) = match start {
-        Some((x, fx)) if x > a && x < b => {
-            let fx = fx.into_value().unwrap_or(f64::INFINITY);
-            history.push((x, fx));
-            (x, fx)
-        }
-        Some((x, _)) => {
-            return Err(Error::invalid(
-                "start",
-                format!("must lie inside ({a}, {b}), got {x}"),
-            ))
-        }
-        None => {
-            let x = lo + golden * (hi - lo);
-            (x, eval(x, &mut history, &mut failures))
-        }
-    };
-    let (mut w, mut v) = (x, x);
-    let (mut fw, mut fv) = (fx, fx);
-    let (mut d, mut e) = (0.0_f64, 0.0_f64);
-    let mut converged = false;
-    while history.len() < max_evaluations {
-        let m = 0.5 * (lo + hi);
-        let tol = relative_tolerance * x.abs() + x_tolerance;
+/// Brent's bracket `[lo, hi]` and its three best points: `x` the best so far, `w` the second
+/// best, `v` the previous `w` (values `fx`, `fw`, `fv`); `d` the last step, `e` the one before.
+struct BrentState {
+    lo: f64,
+    hi: f64,
+    x: f64,
+    fx: f64,
+    w: f64,
+    fw: f64,
+    v: f64,
+    fv: f64,
+    d: f64,
+    e: f64,
+}
+
+impl BrentState {
+    /// The next point `u`, at least `tol` from `x`: `x + p/q`, the minimum of the parabola
+    /// through `(v, fv)`, `(w, fw)`, `(x, fx)`, when that step falls inside the bracket and is
+    /// less than half the step before last; else the golden-section step `golden · e` into
+    /// the larger sub-interval (`m` the bracket's midpoint).
+    fn next_point(&mut self, m: f64, tol: f64, golden: f64) -> f64 {
+        let Self {
+            lo,
+            hi,
+            x,
+            fx,
+            w,
+            fw,
+            v,
+            fv,
+            ..
+        } = *self;
         let tol2 = 2.0 * tol;
-        if (x - m).abs() <= tol2 - 0.5 * (hi - lo) {
-            converged = true;
-            break;
-        }
+        let (mut d, mut e) = (self.d, self.e);
         let mut parabolic = false;
         if e.abs() > tol {
             // Parabola through (v, fv), (w, fw), (x, fx): step d = p / q from x.
@@ -238,51 +315,42 @@ where
             e = if x < m { hi - x } else { lo - x };
             d = golden * e;
         }
-        let u = if d.abs() >= tol {
+        (self.d, self.e) = (d, e);
+        if d.abs() >= tol {
             x + d
         } else if d > 0.0 {
             x + tol
         } else {
             x - tol
-        };
-        let fu = eval(u, &mut history, &mut failures);
-        if fu <= fx {
+        }
+    }
+
+    /// The bracket and the best points after the evaluation `f(u) = fu`.
+    fn update(&mut self, u: f64, fu: f64) {
+        let x = self.x;
+        if fu <= self.fx {
             if u < x {
-                hi = x;
+                self.hi = x;
             } else {
-                lo = x;
+                self.lo = x;
             }
-            (v, fv) = (w, fw);
-            (w, fw) = (x, fx);
-            (x, fx) = (u, fu);
+            (self.v, self.fv) = (self.w, self.fw);
+            (self.w, self.fw) = (self.x, self.fx);
+            (self.x, self.fx) = (u, fu);
         } else {
             if u < x {
-                lo = u;
+                self.lo = u;
             } else {
-                hi = u;
+                self.hi = u;
             }
-            if fu <= fw || w == x {
-                (v, fv) = (w, fw);
-                (w, fw) = (u, fu);
-            } else if fu <= fv || v == x || v == w {
-                (v, fv) = (u, fu);
+            if fu <= self.fw || self.w == x {
+                (self.v, self.fv) = (self.w, self.fw);
+                (self.w, self.fw) = (u, fu);
+            } else if fu <= self.fv || self.v == x || self.v == self.w {
+                (self.v, self.fv) = (u, fu);
             }
         }
     }
-    if !fx.is_finite() {
-        return Err(Error::numerical(
-            "Brent minimisation",
-            format!("all {} evaluations on [{a}, {b}] failed", history.len()),
-        ));
-    }
-    Ok(Minimum1d {
-        x,
-        f: fx,
-        evaluations: history.len(),
-        failures,
-        converged,
-        history,
-    })
 }
 
 /// Options of [`minimize_box`].
@@ -801,86 +869,15 @@ where
     R: ObjectiveValue,
 {
     let n = lower.len();
-    if n == 0 || upper.len() != n {
-        return Err(Error::invalid(
-            "bounds",
-            format!(
-                "needs as many lower as upper bounds, at least one; got {} and {}",
-                n,
-                upper.len()
-            ),
-        ));
-    }
-    check_box(lower, upper)?;
+    let total = check_global(lower, upper, options)?;
     let points = options.grid_points;
-    if points < 2 {
-        return Err(Error::invalid(
-            "grid_points",
-            format!("needs at least 2 points per variable (both bounds), got {points}"),
-        ));
-    }
-    if options.starts < 1 {
-        return Err(Error::invalid("starts", "needs at least one local search"));
-    }
-    let total = grid_size(points, n)
-        .filter(|&t| t.checked_add(n + 1).is_some_and(|m| m <= options.max_evaluations))
-        .ok_or_else(|| {
-            Error::invalid(
-                "max_evaluations",
-                format!(
-                    "{} evaluations cannot hold a grid of {points}^{n} points and one simplex ({} more)",
-                    options.max_evaluations,
-                    n + 1
-                ),
-            )
-        })?;
-    let width: Vec<f64> = lower.iter().zip(upper).map(|(l, u)| u - l).collect();
-    let to_x = |idx: &[usize]| -> Vec<f64> {
-        idx.iter()
-            .zip(lower)
-            .zip(upper)
-            .zip(&width)
-            .map(|(((&i, &lo), &hi), &w)| {
-                if i + 1 == points {
-                    hi
-                } else {
-                    lo + w * (i as f64 / (points - 1) as f64)
-                }
-            })
-            .collect()
-    };
+    let to_x = |idx: usize| grid_x(idx, lower, upper, points);
     let values: Vec<f64> = (0..total)
         .into_par_iter()
-        .map(|idx| {
-            f(&to_x(&grid_indices(idx, n, points)))
-                .into_value()
-                .unwrap_or(f64::INFINITY)
-        })
+        .map(|idx| f(&to_x(idx)).into_value().unwrap_or(f64::INFINITY))
         .collect();
     let grid_failures = values.iter().filter(|v| !v.is_finite()).count();
-    // Grid points lower than every grid neighbour, (value, index) ordered.
-    let below = |a: usize, b: usize| (values[a], a) < (values[b], b);
-    let stencil = grid_size(3, n).unwrap_or(0);
-    let mut minima: Vec<usize> = (0..total)
-        .filter(|&idx| values[idx].is_finite())
-        .filter(|&idx| {
-            let ind = grid_indices(idx, n, points);
-            (0..stencil).all(|s| {
-                let mut nb = 0usize;
-                let mut code = s;
-                for &i in &ind {
-                    let d = code % 3;
-                    code /= 3;
-                    let j = i + d;
-                    if j == 0 || j > points {
-                        return true; // outside the grid
-                    }
-                    nb = nb * points + (j - 1);
-                }
-                nb == idx || below(idx, nb)
-            })
-        })
-        .collect();
+    let mut minima = grid_minima(&values, n, points);
     if minima.is_empty() {
         return Err(Error::numerical(
             "global box search",
@@ -899,7 +896,7 @@ where
     let runs: Vec<(usize, Option<MinimumNd>)> = minima
         .par_iter()
         .map(|&idx| {
-            let x0 = to_x(&grid_indices(idx, n, points));
+            let x0 = to_x(idx);
             if share < n + 1 {
                 return (idx, None);
             }
@@ -909,16 +906,12 @@ where
             )
         })
         .collect();
-    let mut best: (Vec<f64>, f64, bool) = (
-        to_x(&grid_indices(minima[0], n, points)),
-        values[minima[0]],
-        false,
-    );
+    let mut best: (Vec<f64>, f64, bool) = (to_x(minima[0]), values[minima[0]], false);
     let mut evaluations = total;
     let mut failures = grid_failures;
     let mut searches = Vec::new();
     for (idx, run) in runs {
-        let start = to_x(&grid_indices(idx, n, points));
+        let start = to_x(idx);
         let Some(m) = run else { continue };
         evaluations += m.evaluations;
         failures += m.failures;
@@ -944,4 +937,89 @@ where
         converged: best.2,
         searches,
     })
+}
+
+/// The number of grid points of [`minimize_box_global`], the box and options checked: as
+/// many lower as upper bounds (at least one), each below its upper one, at least 2 grid points
+/// per variable and one local search, and a budget that holds the grid and one simplex.
+fn check_global(lower: &[f64], upper: &[f64], options: &GlobalOptions) -> Result<usize> {
+    let n = lower.len();
+    if n == 0 || upper.len() != n {
+        return Err(Error::invalid(
+            "bounds",
+            format!(
+                "needs as many lower as upper bounds, at least one; got {} and {}",
+                n,
+                upper.len()
+            ),
+        ));
+    }
+    check_box(lower, upper)?;
+    let points = options.grid_points;
+    if points < 2 {
+        return Err(Error::invalid(
+            "grid_points",
+            format!("needs at least 2 points per variable (both bounds), got {points}"),
+        ));
+    }
+    if options.starts < 1 {
+        return Err(Error::invalid("starts", "needs at least one local search"));
+    }
+    grid_size(points, n)
+        .filter(|&t| t.checked_add(n + 1).is_some_and(|m| m <= options.max_evaluations))
+        .ok_or_else(|| {
+            Error::invalid(
+                "max_evaluations",
+                format!(
+                    "{} evaluations cannot hold a grid of {points}^{n} points and one simplex ({} more)",
+                    options.max_evaluations,
+                    n + 1
+                ),
+            )
+        })
+}
+
+/// The point of grid index `idx` (last variable fastest) of `points` per variable, both
+/// bounds included (the last exactly the upper bound).
+fn grid_x(idx: usize, lower: &[f64], upper: &[f64], points: usize) -> Vec<f64> {
+    grid_indices(idx, lower.len(), points)
+        .iter()
+        .zip(lower)
+        .zip(upper)
+        .map(|((&i, &lo), &hi)| {
+            if i + 1 == points {
+                hi
+            } else {
+                lo + (hi - lo) * (i as f64 / (points - 1) as f64)
+            }
+        })
+        .collect()
+}
+
+/// The grid points lower than every grid neighbour (`values` by grid index, `(value, index)`
+/// ordered; failed points, `∞`, left out), in index order.
+fn grid_minima(values: &[f64], n: usize, points: usize) -> Vec<usize> {
+    let total = values.len();
+    let below = |a: usize, b: usize| (values[a], a) < (values[b], b);
+    let stencil = grid_size(3, n).unwrap_or(0);
+    (0..total)
+        .filter(|&idx| values[idx].is_finite())
+        .filter(|&idx| {
+            let ind = grid_indices(idx, n, points);
+            (0..stencil).all(|s| {
+                let mut nb = 0usize;
+                let mut code = s;
+                for &i in &ind {
+                    let d = code % 3;
+                    code /= 3;
+                    let j = i + d;
+                    if j == 0 || j > points {
+                        return true; // outside the grid
+                    }
+                    nb = nb * points + (j - 1);
+                }
+                nb == idx || below(idx, nb)
+            })
+        })
+        .collect()
 }

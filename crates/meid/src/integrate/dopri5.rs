@@ -1377,275 +1377,430 @@ pub fn solve_from(
             ),
         ));
     }
-    let rhs = Rhs::new(sys);
-    let nd = sys.dofs();
-    let nx = 2 * nd;
-    let ny = nx + 1;
-    let all_linear = rhs.linear_rows.is_some();
-    // The first-order matrices of linear modes (the right-hand side's rows).
-    let mut matrices = ModeSelector::new(sys);
-    let mut selector = Selector::new(sys, ny, opts.rtol);
-    let m = selector.inds.len();
-    let mut sides = Sides {
-        signs: vec![0.0; m],
-        provisional: vec![false; m],
-        noise: vec![0.0; m],
-        forced: vec![0.0; m],
-    };
-    let map = ChannelMap::new(sys);
-    let mut channels = Channels::new(sys);
-    let mut y = vec![0.0; ny];
-    y[..nx].copy_from_slice(x0);
-    let mut t = 0.0;
-    let t_end = opts.duration;
-    selector.observe(&y[..nx]);
-    let mut mode = selector.select(&rhs, &y[..nx], Mode(0), &mut sides);
-    let mut grid = Grid::new(opts);
-    let mut k: [Vec<f64>; 7] = std::array::from_fn(|_| vec![0.0; ny]);
-    let mut ytmp = vec![0.0; ny];
-    let mut ynew = vec![0.0; ny];
-    let mut dense = Dense {
-        r: std::array::from_fn(|_| vec![0.0; ny]),
-        h: 1.0,
-    };
-    let mut ybuf = vec![0.0; ny];
-    let mut ydot = vec![0.0; ny];
-    let (mut buf, mut bufd) = (vec![0.0; ny], vec![0.0; ny]);
-    let mut events = Vec::new();
-    let mut path = vec![PathPoint {
-        t: 0.0,
-        mode,
-        x: y[..nx].to_vec(),
-    }];
-    let mut totals = Totals::default();
-    totals
-        .peaks
-        .offer_all(&map.values(sys, mode, &y[..nx]), 0.0);
-    let mut collision_end = None;
-    let (mut steps, mut rejected) = (0usize, 0usize);
-    // Consecutive rejected steps and switches without progress (the guards).
-    let (mut stalled_rejects, mut stalled_switches) = (0usize, 0usize);
-    // Channel values and slopes at the start of the step.
-    let (mut cv0, mut cd0) = ([0.0; N_CHANNELS], [0.0; N_CHANNELS]);
-    let (mut cv1, mut cd1) = ([0.0; N_CHANNELS], [0.0; N_CHANNELS]);
-
-    let mut pace = Pace::new();
-    let mut holder = Holder::new(&rhs, selector.rel);
-    let sc = |a: f64, b: f64| opts.atol + opts.rtol * a.abs().max(b.abs());
-    let err_norm = |y0: &[f64], y1: &[f64], e: &[f64]| -> f64 {
-        let mut s = 0.0;
-        for i in 0..nx {
-            let r = e[i] / sc(y0[i], y1[i]);
-            s += r * r;
+    let mut run = Run::new(sys, x0, opts);
+    run.first_sample(obs);
+    loop {
+        if run.need_k1 {
+            run.restart();
         }
-        (s / nx as f64).sqrt()
-    };
-    let stalled = |what: &str, t: f64, mode: Mode| {
-        Error::numerical(
-            "dopri5",
-            format!(
-                "no progress at t = {t:.9e} s ({what}, mode: slider-bed {}, bed-damper {}, \
-                 dashpot {}). Likely cause: a contact stiffness too high for the tolerance \
-                 (rtol {:e}, atol {:e}) or contacts that chatter",
-                if mode.on(Switch::SliderBed) {
-                    "closed"
-                } else {
-                    "open"
-                },
-                if mode.on(Switch::BedDamper) {
-                    "closed"
-                } else {
-                    "open"
-                },
-                if mode.on(Switch::Dashpot) {
-                    "on"
-                } else {
-                    "off"
-                },
-                opts.rtol,
-                opts.atol
-            ),
-        )
-    };
-
-    // Emit t = 0.
-    // (With a phase φ > 0 the first sample, at φ, comes from the steps.)
-    if let Some(g) = grid.as_mut().filter(|g| g.phase == 0.0) {
-        obs.sample(0.0, &y[..nx], mode);
-        g.next = 1;
-    }
-    let mut h = 0.0;
-    let mut facold: f64 = 1e-4;
-    let mut need_k1 = true;
-    let mut last_reject = false;
-    'outer: loop {
-        if need_k1 {
-            if all_linear && !mode.any_held() {
-                // The mode's first-order matrix: its rows are the right-hand side.
-                rhs.set_lower_rows(mode, matrices.matrix(mode));
-            }
-            channels.prepare(sys, &map, mode);
-            rhs.eval(mode, &y, &mut k[0]);
-            channels.at(&rhs, mode, &y, &k[0], &mut cv0, &mut cd0);
-            if h == 0.0 {
-                let (k0, k1) = k.split_at_mut(1);
-                h = initial_step(
-                    &rhs,
-                    mode,
-                    &y,
-                    &k0[0],
-                    t_end - t,
-                    &mut ytmp,
-                    &mut k1[0],
-                    &sc,
-                );
-            }
-            need_k1 = false;
-        }
-        if t >= t_end * (1.0 - 1e-15) {
+        if run.t >= run.t_end * (1.0 - 1e-15) {
             break;
         }
-        h = h.min(t_end - t);
-        if h.is_nan() || h <= 16.0 * f64::EPSILON * t.abs() {
-            return Err(stalled("step size underflow", t, mode));
+        run.guard()?;
+        run.stages();
+        let err = run.err_norm();
+        let expo1 = 0.2 - 0.04 * 0.75;
+        let fac11 = err.powf(expo1);
+        if err > 1.0 || !err.is_finite() {
+            run.reject(err, fac11)?;
+            continue;
         }
-        if steps + rejected > MAX_STEPS {
+        run.stalled_rejects = 0;
+        if run.settle_provisional()? {
+            continue;
+        }
+        // Accepted: dense output, events, samples, extremes.
+        run.steps += 1;
+        run.dense_output();
+        let (s_end, switched) = run.indicator_crossing();
+        let (s_end, switched, release) = run.held_release(s_end, switched);
+        run.samples(s_end, obs);
+        run.book_step(s_end, switched);
+        if switched {
+            if run.switch_at(s_end, release)? && opts.stop_at_collision_end {
+                break;
+            }
+            // Keep the step size (the new mode may be as stiff).
+            continue;
+        }
+        run.advance();
+        run.control(err, fac11);
+        run.hold()?;
+    }
+    Ok(run.finish())
+}
+
+/// The error scale `atol + rtol · max(|a|, |b|)` of a component with values `a`, `b` at the
+/// step's ends.
+fn scale(opts: &Options, a: f64, b: f64) -> f64 {
+    opts.atol + opts.rtol * a.abs().max(b.abs())
+}
+
+/// The error of a run that makes no progress at `t` in `mode` (`what` says how).
+fn stalled(opts: &Options, what: &str, t: f64, mode: Mode) -> Error {
+    Error::numerical(
+        "dopri5",
+        format!(
+            "no progress at t = {t:.9e} s ({what}, mode: slider-bed {}, bed-damper {}, \
+             dashpot {}). Likely cause: a contact stiffness too high for the tolerance \
+             (rtol {:e}, atol {:e}) or contacts that chatter",
+            if mode.on(Switch::SliderBed) {
+                "closed"
+            } else {
+                "open"
+            },
+            if mode.on(Switch::BedDamper) {
+                "closed"
+            } else {
+                "open"
+            },
+            if mode.on(Switch::Dashpot) {
+                "on"
+            } else {
+                "off"
+            },
+            opts.rtol,
+            opts.atol
+        ),
+    )
+}
+
+/// The state of a run between steps ([`solve_from`]).
+struct Run<'s, 'o> {
+    sys: &'s ImpactSystem,
+    opts: &'o Options,
+    rhs: Rhs<'s>,
+    nd: usize,
+    nx: usize,
+    all_linear: bool,
+    /// The first-order matrices of linear modes (the right-hand side's rows).
+    matrices: ModeSelector<'s>,
+    selector: Selector<'s>,
+    sides: Sides,
+    map: ChannelMap,
+    channels: Channels,
+    /// The state `[x; ẋ; dissipated energy]` at `t`, and the mode.
+    y: Vec<f64>,
+    t: f64,
+    t_end: f64,
+    mode: Mode,
+    grid: Option<Grid>,
+    /// The stages (`k[0] = f(y)`, `k[6] = f(y_new)`), the stage state (then the error
+    /// estimate), the step's end state and its dense output.
+    k: [Vec<f64>; 7],
+    ytmp: Vec<f64>,
+    ynew: Vec<f64>,
+    dense: Dense,
+    /// The state and its derivative at the end of the step (cut at a switch); scratch.
+    ybuf: Vec<f64>,
+    ydot: Vec<f64>,
+    buf: Vec<f64>,
+    bufd: Vec<f64>,
+    events: Vec<Event>,
+    path: Vec<PathPoint>,
+    totals: Totals,
+    collision_end: Option<CollisionEnd>,
+    steps: usize,
+    rejected: usize,
+    /// Consecutive rejected steps and switches without progress (the guards).
+    stalled_rejects: usize,
+    stalled_switches: usize,
+    /// Channel values and slopes at the start and the end of the step.
+    cv0: [f64; N_CHANNELS],
+    cd0: [f64; N_CHANNELS],
+    cv1: [f64; N_CHANNELS],
+    cd1: [f64; N_CHANNELS],
+    pace: Pace,
+    holder: Holder,
+    /// The step size, the last accepted error (PI control), whether the next step needs
+    /// `f(y)` anew (after a switch), and whether the last step was rejected.
+    h: f64,
+    facold: f64,
+    need_k1: bool,
+    last_reject: bool,
+    /// The size of the last accepted step.
+    h_step: f64,
+}
+
+impl<'s, 'o> Run<'s, 'o> {
+    /// The initial state, its mode and the channels' values there, and the workspaces.
+    fn new(sys: &'s ImpactSystem, x0: &[f64], opts: &'o Options) -> Self {
+        let rhs = Rhs::new(sys);
+        let nd = sys.dofs();
+        let nx = 2 * nd;
+        let ny = nx + 1;
+        let all_linear = rhs.linear_rows.is_some();
+        let matrices = ModeSelector::new(sys);
+        let mut selector = Selector::new(sys, ny, opts.rtol);
+        let m = selector.inds.len();
+        let mut sides = Sides {
+            signs: vec![0.0; m],
+            provisional: vec![false; m],
+            noise: vec![0.0; m],
+            forced: vec![0.0; m],
+        };
+        let map = ChannelMap::new(sys);
+        let channels = Channels::new(sys);
+        let mut y = vec![0.0; ny];
+        y[..nx].copy_from_slice(x0);
+        selector.observe(&y[..nx]);
+        let mode = selector.select(&rhs, &y[..nx], Mode(0), &mut sides);
+        let grid = Grid::new(opts);
+        let path = vec![PathPoint {
+            t: 0.0,
+            mode,
+            x: y[..nx].to_vec(),
+        }];
+        let mut totals = Totals::default();
+        totals
+            .peaks
+            .offer_all(&map.values(sys, mode, &y[..nx]), 0.0);
+        let holder = Holder::new(&rhs, selector.rel);
+        Run {
+            sys,
+            opts,
+            rhs,
+            nd,
+            nx,
+            all_linear,
+            matrices,
+            selector,
+            sides,
+            map,
+            channels,
+            y,
+            t: 0.0,
+            t_end: opts.duration,
+            mode,
+            grid,
+            k: std::array::from_fn(|_| vec![0.0; ny]),
+            ytmp: vec![0.0; ny],
+            ynew: vec![0.0; ny],
+            dense: Dense {
+                r: std::array::from_fn(|_| vec![0.0; ny]),
+                h: 1.0,
+            },
+            ybuf: vec![0.0; ny],
+            ydot: vec![0.0; ny],
+            buf: vec![0.0; ny],
+            bufd: vec![0.0; ny],
+            events: Vec::new(),
+            path,
+            totals,
+            collision_end: None,
+            steps: 0,
+            rejected: 0,
+            stalled_rejects: 0,
+            stalled_switches: 0,
+            cv0: [0.0; N_CHANNELS],
+            cd0: [0.0; N_CHANNELS],
+            cv1: [0.0; N_CHANNELS],
+            cd1: [0.0; N_CHANNELS],
+            pace: Pace::new(),
+            holder,
+            h: 0.0,
+            facold: 1e-4,
+            need_k1: true,
+            last_reject: false,
+            h_step: 0.0,
+        }
+    }
+
+    /// The sample at t = 0 (with a phase φ > 0 the first sample, at φ, comes from the steps).
+    fn first_sample(&mut self, obs: &mut dyn Observer) {
+        if let Some(g) = self.grid.as_mut().filter(|g| g.phase == 0.0) {
+            obs.sample(0.0, &self.y[..self.nx], self.mode);
+            g.next = 1;
+        }
+    }
+
+    /// A (re)start in the current mode: its right-hand side's rows (linear laws), its channels,
+    /// `k[0] = f(y)` and the channels' values and slopes there, and the first step size.
+    fn restart(&mut self) {
+        let mode = self.mode;
+        if self.all_linear && !mode.any_held() {
+            // The mode's first-order matrix: its rows are the right-hand side.
+            self.rhs.set_lower_rows(mode, self.matrices.matrix(mode));
+        }
+        self.channels.prepare(self.sys, &self.map, mode);
+        self.rhs.eval(mode, &self.y, &mut self.k[0]);
+        let (cv0, cd0) = (&mut self.cv0, &mut self.cd0);
+        self.channels
+            .at(&self.rhs, mode, &self.y, &self.k[0], cv0, cd0);
+        if self.h == 0.0 {
+            let opts = self.opts;
+            let sc = |a: f64, b: f64| scale(opts, a, b);
+            let (k0, k1) = self.k.split_at_mut(1);
+            self.h = initial_step(
+                &self.rhs,
+                mode,
+                &self.y,
+                &k0[0],
+                self.t_end - self.t,
+                &mut self.ytmp,
+                &mut k1[0],
+                &sc,
+            );
+        }
+        self.need_k1 = false;
+    }
+
+    /// The step size cut to the end of the run, and the guards: a step below 16 ulps of `t`,
+    /// more than [`MAX_STEPS`] steps, or a pace beyond it ([`Pace`]) is an error.
+    fn guard(&mut self) -> Result<()> {
+        let (t, mode) = (self.t, self.mode);
+        self.h = self.h.min(self.t_end - t);
+        let h = self.h;
+        if h.is_nan() || h <= 16.0 * f64::EPSILON * t.abs() {
+            return Err(stalled(self.opts, "step size underflow", t, mode));
+        }
+        let n = self.steps + self.rejected;
+        if n > MAX_STEPS {
             return Err(stalled(
+                self.opts,
                 &format!("{MAX_STEPS} steps taken, the last of {h:.3e} s"),
                 t,
                 mode,
             ));
         }
-        if steps + rejected >= pace.next_check {
-            pace.check(steps + rejected, t, t_end, mode)?;
+        if n >= self.pace.next_check {
+            self.pace.check(n, t, self.t_end, mode)?;
         }
-        // Stages: `out = y + h Σ c_j k_j`, one contiguous pass per term.
-        let (k0, rest) = k.split_at_mut(1);
+        Ok(())
+    }
+
+    /// The stages of a step of size `h`: `ynew = y + h Σ a_7j k_j`, `k[6] = f(ynew)`, and the
+    /// error estimate `ytmp = h Σ e_j k_j`. Each stage state is `y + h Σ a_ij k_j`, one
+    /// contiguous pass per term.
+    fn stages(&mut self) {
+        let (h, mode, y, ytmp) = (self.h, self.mode, &self.y, &mut self.ytmp);
+        let rhs = &self.rhs;
+        let (k0, rest) = self.k.split_at_mut(1);
         let k0 = &k0[0];
-        {
-            combo(&mut ytmp, &y, h, &[(A21, k0)]);
-            let (k1, rest) = rest.split_at_mut(1);
-            let k1 = &mut k1[0];
-            rhs.eval(mode, &ytmp, k1);
-            combo(&mut ytmp, &y, h, &[(A31, k0), (A32, k1)]);
-            let (k2, rest) = rest.split_at_mut(1);
-            let k2 = &mut k2[0];
-            rhs.eval(mode, &ytmp, k2);
-            combo(&mut ytmp, &y, h, &[(A41, k0), (A42, k1), (A43, k2)]);
-            let (k3, rest) = rest.split_at_mut(1);
-            let k3 = &mut k3[0];
-            rhs.eval(mode, &ytmp, k3);
-            combo(
-                &mut ytmp,
-                &y,
-                h,
-                &[(A51, k0), (A52, k1), (A53, k2), (A54, k3)],
-            );
-            let (k4, rest) = rest.split_at_mut(1);
-            let k4 = &mut k4[0];
-            rhs.eval(mode, &ytmp, k4);
-            combo(
-                &mut ytmp,
-                &y,
-                h,
-                &[(A61, k0), (A62, k1), (A63, k2), (A64, k3), (A65, k4)],
-            );
-            let (k5, rest) = rest.split_at_mut(1);
-            let k5 = &mut k5[0];
-            rhs.eval(mode, &ytmp, k5);
-            combo(
-                &mut ynew,
-                &y,
-                h,
-                &[(A71, k0), (A73, k2), (A74, k3), (A75, k4), (A76, k5)],
-            );
-            let k6 = &mut rest[0];
-            rhs.eval(mode, &ynew, k6);
-            ytmp.iter_mut().for_each(|v| *v = 0.0);
-            for (c, kj) in [
-                (E1, k0),
-                (E3, &*k2),
-                (E4, &*k3),
-                (E5, &*k4),
-                (E6, &*k5),
-                (E7, &*k6),
-            ] {
-                let hc = h * c;
-                for (o, &v) in ytmp.iter_mut().zip(kj.iter()) {
-                    *o += hc * v;
-                }
+        combo(ytmp, y, h, &[(A21, k0)]);
+        let (k1, rest) = rest.split_at_mut(1);
+        let k1 = &mut k1[0];
+        rhs.eval(mode, ytmp, k1);
+        combo(ytmp, y, h, &[(A31, k0), (A32, k1)]);
+        let (k2, rest) = rest.split_at_mut(1);
+        let k2 = &mut k2[0];
+        rhs.eval(mode, ytmp, k2);
+        combo(ytmp, y, h, &[(A41, k0), (A42, k1), (A43, k2)]);
+        let (k3, rest) = rest.split_at_mut(1);
+        let k3 = &mut k3[0];
+        rhs.eval(mode, ytmp, k3);
+        combo(ytmp, y, h, &[(A51, k0), (A52, k1), (A53, k2), (A54, k3)]);
+        let (k4, rest) = rest.split_at_mut(1);
+        let k4 = &mut k4[0];
+        rhs.eval(mode, ytmp, k4);
+        combo(
+            ytmp,
+            y,
+            h,
+            &[(A61, k0), (A62, k1), (A63, k2), (A64, k3), (A65, k4)],
+        );
+        let (k5, rest) = rest.split_at_mut(1);
+        let k5 = &mut k5[0];
+        rhs.eval(mode, ytmp, k5);
+        combo(
+            &mut self.ynew,
+            y,
+            h,
+            &[(A71, k0), (A73, k2), (A74, k3), (A75, k4), (A76, k5)],
+        );
+        let k6 = &mut rest[0];
+        rhs.eval(mode, &self.ynew, k6);
+        ytmp.iter_mut().for_each(|v| *v = 0.0);
+        for (c, kj) in [
+            (E1, k0),
+            (E3, &*k2),
+            (E4, &*k3),
+            (E5, &*k4),
+            (E6, &*k5),
+            (E7, &*k6),
+        ] {
+            let hc = h * c;
+            for (o, &v) in ytmp.iter_mut().zip(kj.iter()) {
+                *o += hc * v;
             }
         }
-        let err = err_norm(&y, &ynew, &ytmp);
-        let expo1 = 0.2 - 0.04 * 0.75;
-        let fac11 = err.powf(expo1);
-        if err > 1.0 || !err.is_finite() {
-            rejected += 1;
-            stalled_rejects += 1;
-            if stalled_rejects > MAX_STALLED {
-                return Err(stalled(
-                    &format!("{MAX_STALLED} consecutive rejected steps, last h = {h:.3e} s"),
-                    t,
-                    mode,
-                ));
-            }
-            let f = if err.is_finite() {
-                (fac11 / 0.9).min(5.0)
-            } else {
-                10.0
-            };
-            h /= f.max(1.0);
-            last_reject = true;
-            continue;
+    }
+
+    /// The step's error, the RMS over the state (not the dissipated energy) of the estimate
+    /// `ytmp` in units of [`scale`].
+    fn err_norm(&self) -> f64 {
+        let (y0, y1, e) = (&self.y, &self.ynew, &self.ytmp);
+        let nx = self.nx;
+        let mut s = 0.0;
+        for i in 0..nx {
+            let r = e[i] / scale(self.opts, y0[i], y1[i]);
+            s += r * r;
         }
-        stalled_rejects = 0;
-        // Provisional indicators (zero to all orders at the restart): settled by where the
-        // step took them. One that left zero towards the other side of its mode did so at
-        // once: the mode it implies holds from the step's start, which is redone in it.
+        (s / nx as f64).sqrt()
+    }
+
+    /// A rejected step (error `err`, `fac11 = err^0.17`): the step size shrinks (by up to 5,
+    /// by 10 on a non-finite error); more than [`MAX_STALLED`] rejections in a row is an error.
+    fn reject(&mut self, err: f64, fac11: f64) -> Result<()> {
+        self.rejected += 1;
+        self.stalled_rejects += 1;
+        if self.stalled_rejects > MAX_STALLED {
+            return Err(stalled(
+                self.opts,
+                &format!(
+                    "{MAX_STALLED} consecutive rejected steps, last h = {:.3e} s",
+                    self.h
+                ),
+                self.t,
+                self.mode,
+            ));
+        }
+        let f = if err.is_finite() {
+            (fac11 / 0.9).min(5.0)
+        } else {
+            10.0
+        };
+        self.h /= f.max(1.0);
+        self.last_reject = true;
+        Ok(())
+    }
+
+    /// Provisional indicators (zero to all orders at the restart), settled by where the step
+    /// took them. One that left zero towards the other side of its mode did so at once: the
+    /// mode it implies holds from the step's start, which is redone in it (returns true).
+    fn settle_provisional(&mut self) -> Result<bool> {
+        let nx = self.nx;
         let mut redo = None;
-        for i in 0..m {
-            if !sides.provisional[i] {
+        for i in 0..self.selector.inds.len() {
+            if !self.sides.provisional[i] {
                 continue;
             }
-            let g = selector.inds[i].value(&ynew[..nx]);
-            if g.abs() <= selector.band(i, &ynew[..nx], norms(&ynew[..nx])) {
+            let ynew = &self.ynew[..nx];
+            let g = self.selector.inds[i].value(ynew);
+            if g.abs() <= self.selector.band(i, ynew, norms(ynew)) {
                 continue;
             }
-            sides.provisional[i] = false;
-            if g.signum() == sides.signs[i] {
+            self.sides.provisional[i] = false;
+            if g.signum() == self.sides.signs[i] {
                 continue;
             }
-            sides.forced[i] = g.signum();
+            self.sides.forced[i] = g.signum();
             redo = Some(());
         }
-        if redo.is_some() {
-            let start = mode;
-            let forced = sides.forced.clone();
-            let new_mode = selector.select(&rhs, &y[..nx], start, &mut sides);
-            sides.forced = forced;
-            if new_mode != mode {
-                rejected += 1;
-                y[nx] += switch_to(
-                    &map,
-                    sys,
-                    &mut totals,
-                    &mut events,
-                    &mut path,
-                    t,
-                    &y[..nx],
-                    mode,
-                    new_mode,
-                    opts.max_events,
-                )?;
-                mode = new_mode;
-                totals.dissipated = y[nx];
-                need_k1 = true;
-                continue;
-            }
+        if redo.is_none() {
+            return Ok(false);
         }
-        // Accepted: dense output.
-        steps += 1;
-        for i in 0..ny {
+        let start = self.mode;
+        let forced = self.sides.forced.clone();
+        let new_mode = self
+            .selector
+            .select(&self.rhs, &self.y[..nx], start, &mut self.sides);
+        self.sides.forced = forced;
+        if new_mode == self.mode {
+            return Ok(false);
+        }
+        self.rejected += 1;
+        self.record_switch(new_mode)?;
+        self.mode = new_mode;
+        self.totals.dissipated = self.y[nx];
+        self.need_k1 = true;
+        Ok(true)
+    }
+
+    /// The dense output of the accepted step (Hairer, Nørsett & Wanner's `contd5`).
+    fn dense_output(&mut self) {
+        let (h, y, ynew, k, dense) = (self.h, &self.y, &self.ynew, &self.k, &mut self.dense);
+        for i in 0..y.len() {
             let ydiff = ynew[i] - y[i];
             let bspl = h * k[0][i] - ydiff;
             dense.r[0][i] = y[i];
@@ -1661,19 +1816,25 @@ pub fn solve_from(
                     + D7 * k[6][i]);
         }
         dense.h = h;
-        // Events on the step.
+    }
+
+    /// The first crossing of an indicator on the step (not provisional, not of a held
+    /// contact): `(s_end, switched)`, `s_end = h` without one.
+    fn indicator_crossing(&self) -> (f64, bool) {
+        let (h, nx, mode) = (self.h, self.nx, self.mode);
+        let (y, ynew, k) = (&self.y, &self.ynew, &self.k);
         let mut s_end = h;
         let mut switched = false;
-        for (i, a) in selector.inds.iter().enumerate() {
-            if sides.provisional[i] || of_held(a.ind, mode) {
+        for (i, a) in self.selector.inds.iter().enumerate() {
+            if self.sides.provisional[i] || of_held(a.ind, mode) {
                 continue;
             }
             // Values and slopes at the step ends come from the state and the stages
             // (k₁ = f(y), k₇ = f(y_new)); the search on the dense output runs only where the
             // step may hold a crossing: a sign change at the end, or a dip of the cubic
             // Hermite interpolant in between (what its first interval would test).
-            let sg = sides.signs[i];
-            let lift = sides.noise[i];
+            let sg = self.sides.signs[i];
+            let lift = self.sides.noise[i];
             let ga = (sg * a.value(&y[..nx]) + lift).max(0.0);
             let da = sg * a.l.dot(&k[0][..nx]);
             let gb = sg * a.value(&ynew[..nx]) + lift;
@@ -1682,7 +1843,7 @@ pub fn solve_from(
                 continue;
             }
             let f = OnStep {
-                dense: &dense,
+                dense: &self.dense,
                 ind: a,
                 noise: lift,
             };
@@ -1693,203 +1854,258 @@ pub fn solve_from(
                 }
             }
         }
-        // Held contacts: the release, `λ_c` crossing below `−noise` ([`Holder`]).
+        (s_end, switched)
+    }
+
+    /// Held contacts: the release, `λ_c` crossing below `−noise` ([`Holder`]), if before (or
+    /// at) the step's end `s_end` so far: `(s_end, switched, release)`, `release` the held bits
+    /// of the contacts released there.
+    fn held_release(&self, mut s_end: f64, mut switched: bool) -> (f64, bool, u8) {
         let mut release = 0u8;
-        if mode.any_held() {
-            let (la, lda) = rhs.held_forces(mode, &y, &k[0]);
-            let (lb, ldb) = rhs.held_forces(mode, &ynew, &k[6]);
-            for (ci, sw) in CONTACTS.into_iter().enumerate() {
-                if !mode.held(sw) {
-                    continue;
-                }
-                let lift = holder.release_noise[ci];
-                let ga = (la[ci] + lift).max(0.0);
-                let gb = lb[ci] + lift;
-                if gb >= 0.0 && hermite_dip(ga, lda[ci], gb, ldb[ci], h).is_none() {
-                    continue;
-                }
-                let f = HeldForce {
-                    rhs: &rhs,
-                    mode,
-                    dense: &dense,
-                    ci,
-                    noise: lift,
-                };
-                let bit = Mode(0).holding(sw, true).0 & !Mode::bit(sw);
-                if let Some(s) = first_crossing(&f, s_end, 1.0, SearchOptions::default()) {
-                    if s < s_end || (s == s_end && !switched) {
-                        s_end = s;
-                        switched = true;
-                        release = bit;
-                    } else if s == s_end {
-                        release |= bit;
-                    }
+        let (h, mode) = (self.h, self.mode);
+        if !mode.any_held() {
+            return (s_end, switched, release);
+        }
+        let rhs = &self.rhs;
+        let (la, lda) = rhs.held_forces(mode, &self.y, &self.k[0]);
+        let (lb, ldb) = rhs.held_forces(mode, &self.ynew, &self.k[6]);
+        for (ci, sw) in CONTACTS.into_iter().enumerate() {
+            if !mode.held(sw) {
+                continue;
+            }
+            let lift = self.holder.release_noise[ci];
+            let ga = (la[ci] + lift).max(0.0);
+            let gb = lb[ci] + lift;
+            if gb >= 0.0 && hermite_dip(ga, lda[ci], gb, ldb[ci], h).is_none() {
+                continue;
+            }
+            let f = HeldForce {
+                rhs,
+                mode,
+                dense: &self.dense,
+                ci,
+                noise: lift,
+            };
+            let bit = Mode(0).holding(sw, true).0 & !Mode::bit(sw);
+            if let Some(s) = first_crossing(&f, s_end, 1.0, SearchOptions::default()) {
+                if s < s_end || (s == s_end && !switched) {
+                    s_end = s;
+                    switched = true;
+                    release = bit;
+                } else if s == s_end {
+                    release |= bit;
                 }
             }
         }
-        // Output samples inside (t, t + s_end].
-        if let Some(g) = grid.as_mut() {
+        (s_end, switched, release)
+    }
+
+    /// The output samples inside `(t, t + s_end]`, from the dense output.
+    fn samples(&mut self, s_end: f64, obs: &mut dyn Observer) {
+        let (t, nx) = (self.t, self.nx);
+        if let Some(g) = self.grid.as_mut() {
             loop {
                 let tj = g.time(g.next);
-                if tj > t + s_end || tj > t_end * (1.0 + 1e-12) {
+                if tj > t + s_end || tj > self.t_end * (1.0 + 1e-12) {
                     break;
                 }
-                dense.eval(tj - t, &mut ybuf);
-                obs.sample(tj, &ybuf[..nx], mode);
+                self.dense.eval(tj - t, &mut self.ybuf);
+                obs.sample(tj, &self.ybuf[..nx], self.mode);
                 g.next += 1;
             }
         }
-        // The state at the step's end (cut at a switch) and its derivative.
+    }
+
+    /// The state at the step's end (cut at a switch) and its derivative into `ybuf`, `ydot`;
+    /// the channels' extremes and the closed times on `[0, s_end]`.
+    fn book_step(&mut self, s_end: f64, switched: bool) {
+        let mode = self.mode;
         if switched {
-            dense.eval_with_slope(s_end, &mut ybuf, &mut ydot);
+            self.dense
+                .eval_with_slope(s_end, &mut self.ybuf, &mut self.ydot);
         } else {
-            ybuf.copy_from_slice(&ynew);
-            ydot.copy_from_slice(&k[6]);
+            self.ybuf.copy_from_slice(&self.ynew);
+            self.ydot.copy_from_slice(&self.k[6]);
         }
-        // Channel extremes and closed times on [0, s_end].
-        channels.at(&rhs, mode, &ybuf, &ydot, &mut cv1, &mut cd1);
+        let (cv1, cd1) = (&mut self.cv1, &mut self.cd1);
+        self.channels
+            .at(&self.rhs, mode, &self.ybuf, &self.ydot, cv1, cd1);
         step_extremes(
-            &channels,
-            &rhs,
+            &self.channels,
+            &self.rhs,
             mode,
-            &dense,
-            t,
+            &self.dense,
+            self.t,
             s_end,
-            (&cv0, &cd0, &cv1, &cd1),
-            &mut totals.peaks,
-            &mut buf,
-            &mut bufd,
+            (&self.cv0, &self.cd0, &self.cv1, &self.cd1),
+            &mut self.totals.peaks,
+            &mut self.buf,
+            &mut self.bufd,
         );
         for (ci, s) in [Switch::SliderBed, Switch::BedDamper]
             .into_iter()
             .enumerate()
         {
-            if mode.on(s) && (ci == 0 || sys.damper.is_some()) {
-                totals.closed_time[ci] += s_end;
+            if mode.on(s) && (ci == 0 || self.sys.damper.is_some()) {
+                self.totals.closed_time[ci] += s_end;
             }
-        }
-        if switched {
-            let t_old = t;
-            y.copy_from_slice(&ybuf);
-            selector.observe(&y[..nx]);
-            t += s_end;
-            if t - t_old <= 16.0 * f64::EPSILON * t.abs() {
-                stalled_switches += 1;
-                if stalled_switches > MAX_STALLED {
-                    return Err(stalled(
-                        &format!("{MAX_STALLED} consecutive switches without time advancing"),
-                        t,
-                        mode,
-                    ));
-                }
-            } else {
-                stalled_switches = 0;
-            }
-            sides.forced.iter_mut().for_each(|f| *f = 0.0);
-            holder.count = [0; 2];
-            // A released contact stays closed, compliant, from its frozen gap.
-            let start = Mode(mode.0 & !release);
-            let new_mode = selector.select(&rhs, &y[..nx], start, &mut sides);
-            if new_mode != mode {
-                y[nx] += switch_to(
-                    &map,
-                    sys,
-                    &mut totals,
-                    &mut events,
-                    &mut path,
-                    t,
-                    &y[..nx],
-                    mode,
-                    new_mode,
-                    opts.max_events,
-                )?;
-            } else if channels.nonlinear(mode) {
-                path.push(PathPoint {
-                    t,
-                    mode,
-                    x: y[..nx].to_vec(),
-                });
-            }
-            mode = new_mode;
-            totals.dissipated = y[nx];
-            need_k1 = true;
-            if collision_end.is_none() && !mode.on(Switch::SliderBed) && !mode.on(Switch::BedDamper)
-            {
-                collision_end = Some(CollisionEnd {
-                    t,
-                    x: y[..nx].to_vec(),
-                    totals,
-                });
-                if opts.stop_at_collision_end {
-                    break 'outer;
-                }
-            }
-            // Keep the step size (the new mode may be as stiff).
-            continue;
-        }
-        y.copy_from_slice(&ynew);
-        selector.observe(&y[..nx]);
-        k.swap(0, 6);
-        t += h;
-        (cv0, cd0) = (cv1, cd1);
-        totals.dissipated = y[nx];
-        if channels.nonlinear(mode) {
-            // A knot of the non-linear stretch (see `PathPoint`).
-            path.push(PathPoint {
-                t,
-                mode,
-                x: y[..nx].to_vec(),
-            });
-        }
-        // PI control.
-        let mut fac = fac11 / facold.powf(0.04);
-        fac = (fac / 0.9).clamp(0.1, 5.0);
-        let mut hnew = h / fac;
-        if last_reject {
-            hnew = hnew.min(h);
-        }
-        last_reject = false;
-        facold = err.max(1e-4);
-        let h_step = h;
-        h = hnew;
-        // A resting contact becomes held ([`Holder`]).
-        if let Some(held) = holder.entry(&rhs, mode, &y, &k[0], h_step) {
-            let ke0 = kinetic(&y[nd..nx], &rhs.masses);
-            sys.project_held(held, &mut y[nd..nx], &rhs.masses);
-            y[nx] += ke0 - kinetic(&y[nd..nx], &rhs.masses);
-            sides.forced.iter_mut().for_each(|f| *f = 0.0);
-            let new_mode = selector.select(&rhs, &y[..nx], held, &mut sides);
-            y[nx] += switch_to(
-                &map,
-                sys,
-                &mut totals,
-                &mut events,
-                &mut path,
-                t,
-                &y[..nx],
-                mode,
-                new_mode,
-                opts.max_events,
-            )?;
-            mode = new_mode;
-            totals.dissipated = y[nx];
-            need_k1 = true;
         }
     }
-    let mode_final = mode;
-    Ok(Solution {
-        events,
-        path,
-        collision_end,
-        t_final: t,
-        x_final: y[..nx].to_vec(),
-        mode_final,
-        totals,
-        steps,
-        taylor_steps: 0,
-        rejected,
-        fallback_modes: 0,
-    })
+
+    /// The switch at `t + s_end` (state in `ybuf`): the run restarts there in the mode
+    /// selected (a released contact stays closed, compliant, from its frozen gap); more than
+    /// [`MAX_STALLED`] switches in a row without time advancing is an error. Returns true if
+    /// the collision ended now (both contacts open for the first time).
+    fn switch_at(&mut self, s_end: f64, release: u8) -> Result<bool> {
+        let nx = self.nx;
+        let t_old = self.t;
+        self.y.copy_from_slice(&self.ybuf);
+        self.selector.observe(&self.y[..nx]);
+        self.t += s_end;
+        let t = self.t;
+        if t - t_old <= 16.0 * f64::EPSILON * t.abs() {
+            self.stalled_switches += 1;
+            if self.stalled_switches > MAX_STALLED {
+                return Err(stalled(
+                    self.opts,
+                    &format!("{MAX_STALLED} consecutive switches without time advancing"),
+                    t,
+                    self.mode,
+                ));
+            }
+        } else {
+            self.stalled_switches = 0;
+        }
+        self.sides.forced.iter_mut().for_each(|f| *f = 0.0);
+        self.holder.count = [0; 2];
+        let start = Mode(self.mode.0 & !release);
+        let new_mode = self
+            .selector
+            .select(&self.rhs, &self.y[..nx], start, &mut self.sides);
+        if new_mode != self.mode {
+            self.record_switch(new_mode)?;
+        } else if self.channels.nonlinear(self.mode) {
+            self.path.push(PathPoint {
+                t,
+                mode: self.mode,
+                x: self.y[..nx].to_vec(),
+            });
+        }
+        self.mode = new_mode;
+        self.totals.dissipated = self.y[nx];
+        self.need_k1 = true;
+        let mode = self.mode;
+        if self.collision_end.is_none()
+            && !mode.on(Switch::SliderBed)
+            && !mode.on(Switch::BedDamper)
+        {
+            self.collision_end = Some(CollisionEnd {
+                t,
+                x: self.y[..nx].to_vec(),
+                totals: self.totals,
+            });
+            return Ok(true);
+        }
+        Ok(false)
+    }
+
+    /// The accepted step taken whole: the state, `k[0] = f(y)` (FSAL), `t`, the channels'
+    /// values at the start of the next step, and a path knot while a contact is non-linear.
+    fn advance(&mut self) {
+        let nx = self.nx;
+        self.y.copy_from_slice(&self.ynew);
+        self.selector.observe(&self.y[..nx]);
+        self.k.swap(0, 6);
+        self.t += self.h;
+        (self.cv0, self.cd0) = (self.cv1, self.cd1);
+        self.totals.dissipated = self.y[nx];
+        if self.channels.nonlinear(self.mode) {
+            // A knot of the non-linear stretch (see `PathPoint`).
+            self.path.push(PathPoint {
+                t: self.t,
+                mode: self.mode,
+                x: self.y[..nx].to_vec(),
+            });
+        }
+    }
+
+    /// PI step-size control (β = 0.04) after an accepted step of error `err`
+    /// (`fac11 = err^0.17`): no growth right after a rejection.
+    fn control(&mut self, err: f64, fac11: f64) {
+        let h = self.h;
+        let mut fac = fac11 / self.facold.powf(0.04);
+        fac = (fac / 0.9).clamp(0.1, 5.0);
+        let mut hnew = h / fac;
+        if self.last_reject {
+            hnew = hnew.min(h);
+        }
+        self.last_reject = false;
+        self.facold = err.max(1e-4);
+        self.h_step = h;
+        self.h = hnew;
+    }
+
+    /// A resting contact becomes held ([`Holder`]) after the step of size `h_step`: the
+    /// velocities projected so that no held gap moves (the kinetic energy taken counted as
+    /// dissipated), and the run restarts in the held mode.
+    fn hold(&mut self) -> Result<()> {
+        let (nd, nx) = (self.nd, self.nx);
+        let Some(held) = self
+            .holder
+            .entry(&self.rhs, self.mode, &self.y, &self.k[0], self.h_step)
+        else {
+            return Ok(());
+        };
+        let masses = &self.rhs.masses;
+        let ke0 = kinetic(&self.y[nd..nx], masses);
+        self.sys.project_held(held, &mut self.y[nd..nx], masses);
+        self.y[nx] += ke0 - kinetic(&self.y[nd..nx], masses);
+        self.sides.forced.iter_mut().for_each(|f| *f = 0.0);
+        let new_mode = self
+            .selector
+            .select(&self.rhs, &self.y[..nx], held, &mut self.sides);
+        self.record_switch(new_mode)?;
+        self.mode = new_mode;
+        self.totals.dissipated = self.y[nx];
+        self.need_k1 = true;
+        Ok(())
+    }
+
+    /// The mode change to `new_mode` at `t` ([`switch_to`]), its energy jump added to the
+    /// dissipated energy.
+    fn record_switch(&mut self, new_mode: Mode) -> Result<()> {
+        let nx = self.nx;
+        self.y[nx] += switch_to(
+            &self.map,
+            self.sys,
+            &mut self.totals,
+            &mut self.events,
+            &mut self.path,
+            self.t,
+            &self.y[..nx],
+            self.mode,
+            new_mode,
+            self.opts.max_events,
+        )?;
+        Ok(())
+    }
+
+    /// The finished run.
+    fn finish(self) -> Solution {
+        Solution {
+            events: self.events,
+            path: self.path,
+            collision_end: self.collision_end,
+            t_final: self.t,
+            x_final: self.y[..self.nx].to_vec(),
+            mode_final: self.mode,
+            totals: self.totals,
+            steps: self.steps,
+            taylor_steps: 0,
+            rejected: self.rejected,
+            fallback_modes: 0,
+        }
+    }
 }
 
 /// A mode change at `t`: the channels on both sides of the switch, the event and the path point.

@@ -29,6 +29,8 @@
 //!    on a Taylor step);
 //! 5. the new mode at the switch (`switching::ModeSelector::select`).
 
+use std::rc::Rc;
+
 use faer::{c64, Mat};
 
 use super::peaks;
@@ -40,8 +42,9 @@ use super::{CollisionEnd, Event, Grid, Observer, Options, PathPoint, Solution, T
 use crate::impact::{Channel, ChannelMap, ImpactSystem, Mode, Switch, CHANNELS, N_CHANNELS};
 use crate::{Error, Result};
 
+/// A mode's closed form, built the first time a run needs it.
 struct ModeData {
-    prop: std::rc::Rc<Propagator>,
+    prop: Rc<Propagator>,
     /// The mode's damping matrix `C_σ` (dissipation).
     damping: Mat<f64>,
     /// Transition matrix for the output step.
@@ -80,263 +83,438 @@ pub fn solve_from(
             ));
         }
     }
-    let nd = sys.dofs();
-    let n = 2 * nd;
-    let masses = sys.mass_diag();
-    let mut selector = ModeSelector::new(sys);
-    let n_ind = selector.indicators().len();
-    // Closed forms of the modes that stay long, built on first use.
-    let mut cache: [Option<ModeData>; MODES] = Default::default();
-    let mut grid = Grid::new(opts);
-    let t_end = opts.duration;
-
-    let mut x = x0.to_vec();
-    let mut t = 0.0;
-    let mut signs = vec![0.0; n_ind];
-    let (mut mode, _) = selector.select(&x, Mode(0), &mut signs);
-    let mut events = Vec::new();
-    let mut totals = Totals::default();
-    let mut collision_end: Option<CollisionEnd> = None;
-    let mut segments = 0usize;
-    let mut zero_length = 0usize;
-    let mut micro_stretches = 0usize;
-    let mut searched_signs = vec![0.0; n_ind];
-    let mut moved = vec![false; n_ind];
-    let mut buf = vec![0.0; n];
-    let mut buf2 = vec![0.0; n];
-    let mut taylor_steps = [0usize; MODES];
-    // A constant slider force: `Ẋ = A_σ X + b` (`b` first-order, `f` second-order), and per
-    // mode the Taylor coefficients of the forced response from rest (built on first use).
-    let forcing = sys.forcing();
-    let force_2nd: Option<Vec<f64>> = forcing.as_ref().map(|b| b[nd..].to_vec());
-    let force_2nd: Option<Vec<f64>> = force_2nd.map(|mut f| {
-        f.iter_mut().zip(&masses).for_each(|(fi, mi)| *fi *= mi);
-        f
-    });
-    let mut forced_coef: [Option<Vec<f64>>; MODES] = Default::default();
-
-    // Taylor-step workspace: the first-order matrices prepared per mode, the coefficients
-    // c_0 … c_P of the current step, the polynomials of the indicators, and the searches' buffer (reused
-    // from step to step).
-    let mut tmats: [Option<TaylorMatrix>; MODES] = Default::default();
-    let mut coef = vec![0.0; (taylor::ORDER + 1) * n];
-    let mut ind_polys = vec![[0.0; taylor::ORDER + 1]; n_ind];
-    let mut searches: Vec<Search<Lifted<Poly>>> = Vec::with_capacity(n_ind);
-    let ind_proj: Vec<taylor::Projector> = selector
-        .vectors()
-        .iter()
-        .map(|l| taylor::Projector::new(l))
-        .collect();
-    let mut work = Vec::new();
-    // The response channels of each mode met (their vectors, projectors and slopes), built on
-    // first use: their exact extremes are tracked stretch by stretch (`super::peaks`).
-    let map = ChannelMap::new(sys);
-    let mut channels: [Option<ModeChannels>; MODES] = Default::default();
-    let mut chan_poly = [0.0; taylor::ORDER + 1];
-    let mut chan_buf = Vec::new();
-    let mut path = vec![PathPoint {
-        t: 0.0,
-        mode,
-        x: x.clone(),
-    }];
-
+    let mut run = Run::new(sys, x0, opts);
     loop {
-        let search = SearchOptions::default();
-        let horizon = t_end - t;
-        segments += 1;
-        // Until the run has built a mode's closed form (and for at most
-        // `opts.taylor_steps_per_mode` steps in that mode), the mode is propagated by Taylor steps
-        // from the current state: each is exact to round-off over its validity (a third of the
-        // fastest period) and needs no eigen-decomposition, so a short stretch, or a blow that
-        // is over in a few periods, never builds one. The choice depends only on the run's own
-        // history (never on the per-thread cache), so results do not depend on the thread
-        // count.
-        debug_assert!(usize::from(mode.0) < MODES, "three switch bits");
-        let mi = usize::from(mode.0) % MODES;
-        let use_taylor = cache[mi].is_none() && taylor_steps[mi] < opts.taylor_steps_per_mode;
-        let (s_end, switched, run_ends, period);
+        let st = run.stretch(obs)?;
+        // Advance.
+        let t_before = run.t;
+        run.t += st.s_end;
+        if st.run_ends {
+            break;
+        }
+        if !st.switched {
+            // End of a Taylor step: the same mode goes on, the indicators on the same sides.
+            continue;
+        }
+        let (no_progress, micro) = run.progress(st.s_end, st.period, t_before)?;
+        let new_mode = run.next_mode(no_progress, micro);
+        if new_mode != run.mode {
+            run.switch_to(new_mode)?;
+        }
+        run.mode = new_mode;
+        if run.collision_ends() && opts.stop_at_collision_end {
+            break;
+        }
+        if run.t >= run.t_end {
+            // A switch at the very end of the run: the sample at t_end, if still due.
+            run.last_sample(obs);
+            break;
+        }
+    }
+    Ok(run.finish())
+}
+
+/// A stretch's end: its length `s_end` (s), whether it ended on a switch, whether the run
+/// ends with it, and the mode's fastest period (s).
+struct Stretch {
+    s_end: f64,
+    switched: bool,
+    run_ends: bool,
+    period: f64,
+}
+
+/// The Taylor-step workspace, reused from step to step: the first-order matrices prepared per
+/// mode, per mode the Taylor coefficients of the forced response from rest (a constant slider
+/// force), the coefficients `c_0 … c_P` of the current step, the indicators' projectors and
+/// polynomials, and the searches' buffer.
+struct TaylorWork {
+    tmats: [Option<TaylorMatrix>; MODES],
+    forced_coef: [Option<Vec<f64>>; MODES],
+    coef: Vec<f64>,
+    ind_proj: Vec<taylor::Projector>,
+    ind_polys: Vec<[f64; taylor::ORDER + 1]>,
+    searches: Vec<Search<Lifted<Poly>>>,
+    /// Scratch space of [`TaylorMatrix::dissipated`].
+    work: Vec<f64>,
+}
+
+/// The state of a run between stretches ([`solve_from`]).
+struct Run<'s, 'o> {
+    sys: &'s ImpactSystem,
+    opts: &'o Options,
+    t_end: f64,
+    masses: Vec<f64>,
+    selector: ModeSelector<'s>,
+    /// Closed forms of the modes that stay long, built on first use.
+    cache: [Option<Rc<ModeData>>; MODES],
+    /// Taylor steps taken per mode.
+    taylor_steps: [usize; MODES],
+    tw: TaylorWork,
+    /// A constant slider force: `Ẋ = A_σ X + b` (`b` first-order, `force_2nd` second-order).
+    forcing: Option<Vec<f64>>,
+    force_2nd: Option<Vec<f64>>,
+    grid: Option<Grid>,
+    /// The response channels of each mode met (their vectors, projectors and slopes), built on
+    /// first use: their exact extremes are tracked stretch by stretch (`super::peaks`).
+    map: ChannelMap,
+    channels: [Option<ModeChannels>; MODES],
+    chan_poly: taylor::Coefficients,
+    chan_buf: Vec<f64>,
+    x: Vec<f64>,
+    t: f64,
+    mode: Mode,
+    /// The indicators' sides, and those the last stretch was searched from.
+    signs: Vec<f64>,
+    searched_signs: Vec<f64>,
+    moved: Vec<bool>,
+    events: Vec<Event>,
+    path: Vec<PathPoint>,
+    totals: Totals,
+    collision_end: Option<CollisionEnd>,
+    segments: usize,
+    /// Consecutive stretches of no length, and of micro-stretches ([`MICRO_STRETCH`]).
+    zero_length: usize,
+    micro_stretches: usize,
+    /// Scratch states.
+    buf: Vec<f64>,
+    buf2: Vec<f64>,
+}
+
+impl<'s, 'o> Run<'s, 'o> {
+    /// The initial state and mode, the forcing, and the empty caches and workspaces.
+    fn new(sys: &'s ImpactSystem, x0: &[f64], opts: &'o Options) -> Self {
+        let nd = sys.dofs();
+        let n = 2 * nd;
+        let masses = sys.mass_diag();
+        let mut selector = ModeSelector::new(sys);
+        let n_ind = selector.indicators().len();
+        let x = x0.to_vec();
+        let mut signs = vec![0.0; n_ind];
+        let (mode, _) = selector.select(&x, Mode(0), &mut signs);
+        let forcing = sys.forcing();
+        let force_2nd: Option<Vec<f64>> = forcing.as_ref().map(|b| b[nd..].to_vec());
+        let force_2nd: Option<Vec<f64>> = force_2nd.map(|mut f| {
+            f.iter_mut().zip(&masses).for_each(|(fi, mi)| *fi *= mi);
+            f
+        });
+        let ind_proj: Vec<taylor::Projector> = selector
+            .vectors()
+            .iter()
+            .map(|l| taylor::Projector::new(l))
+            .collect();
+        let tw = TaylorWork {
+            tmats: Default::default(),
+            forced_coef: Default::default(),
+            coef: vec![0.0; (taylor::ORDER + 1) * n],
+            ind_proj,
+            ind_polys: vec![[0.0; taylor::ORDER + 1]; n_ind],
+            searches: Vec::with_capacity(n_ind),
+            work: Vec::new(),
+        };
+        let path = vec![PathPoint {
+            t: 0.0,
+            mode,
+            x: x.clone(),
+        }];
+        Run {
+            sys,
+            opts,
+            t_end: opts.duration,
+            masses,
+            selector,
+            cache: Default::default(),
+            taylor_steps: [0; MODES],
+            tw,
+            forcing,
+            force_2nd,
+            grid: Grid::new(opts),
+            map: ChannelMap::new(sys),
+            channels: Default::default(),
+            chan_poly: [0.0; taylor::ORDER + 1],
+            chan_buf: Vec::new(),
+            x,
+            t: 0.0,
+            mode,
+            signs,
+            searched_signs: vec![0.0; n_ind],
+            moved: vec![false; n_ind],
+            events: Vec::new(),
+            path,
+            totals: Totals::default(),
+            collision_end: None,
+            segments: 0,
+            zero_length: 0,
+            micro_stretches: 0,
+            buf: vec![0.0; n],
+            buf2: vec![0.0; n],
+        }
+    }
+
+    /// One stretch in the current mode from `t`: by a Taylor step until the run has built the
+    /// mode's closed form (and for at most `opts.taylor_steps_per_mode` steps in that mode),
+    /// else in closed form. A Taylor step is exact to round-off over its validity (a third of
+    /// the fastest period) and needs no eigen-decomposition, so a short stretch, or a blow
+    /// that is over in a few periods, never builds one. The choice depends only on the run's
+    /// own history (never on the per-thread cache), so results do not depend on the thread
+    /// count.
+    fn stretch(&mut self, obs: &mut dyn Observer) -> Result<Stretch> {
+        self.segments += 1;
+        debug_assert!(usize::from(self.mode.0) < MODES, "three switch bits");
+        let mi = usize::from(self.mode.0) % MODES;
+        let use_taylor =
+            self.cache[mi].is_none() && self.taylor_steps[mi] < self.opts.taylor_steps_per_mode;
         if use_taylor {
-            taylor_steps[mi] += 1;
-            let tm = match &tmats[mi] {
-                Some(tm) => tm,
-                None => {
-                    let tm = TaylorMatrix::from_col_major(n, selector.matrix(mode)).ok_or_else(
-                        || Error::numerical("exact", format!("mode {mode:?}: non-finite matrix")),
-                    )?;
-                    tmats[mi].insert(tm)
-                }
-            };
-            tm.expand(&x, &mut coef);
-            if let Some(b) = &forcing {
-                let fc = forced_coef[mi].get_or_insert_with(|| {
-                    let mut fc = vec![0.0; (taylor::ORDER + 1) * n];
-                    tm.forced_coefficients(b, &mut fc);
-                    fc
-                });
-                for (c, f) in coef.iter_mut().zip(fc.iter()) {
-                    *c += f;
-                }
-            }
-            let tau = tm.validity();
-            period = tm.period();
-            // 1-2: the first switch, within the step's validity.
-            let reach = tau.min(horizon);
-            for (l, p) in ind_proj.iter().zip(ind_polys.iter_mut()) {
-                l.apply(&coef, p);
-            }
-            // (Indicators proved to keep their sign on the step, `Poly::keeps_sign`, are not
-            // searched.)
-            searches.clear();
-            for (p, &sign) in ind_polys.iter().zip(&signs) {
-                if sign != 0.0 && !taylor::keeps_sign(p, sign, reach) {
-                    let f = Lifted::new(Poly::new(p, tau, period), p[0], sign);
-                    searches.push(Search::new(f, sign, search));
-                }
-            }
-            let found = first_switch(&mut searches, period, reach);
-            (s_end, switched) = stretch_end(found, reach, reach >= horizon);
-            run_ends = !switched && s_end >= horizon;
-            // 3: output samples, from the polynomial.
-            if let Some(g) = grid.as_mut() {
-                let state = |s: f64, out: &mut [f64]| taylor::state(&coef, s, out);
-                let span = (t, s_end, run_ends, t_end);
-                emit_samples(g, span, mode, &state, None, obs, &mut buf, &mut buf2);
-            }
-            // 4: peaks, contact times, dissipation.
-            for ci in 0..2 {
-                if closed(sys, mode, ci) {
-                    totals.closed_time[ci] += s_end;
-                }
-            }
-            let mc = mode_channels(
-                &mut channels,
-                &map,
-                sys,
-                &mut selector,
-                mode,
-                false,
-                &mut chan_buf,
-            )?;
-            for &c in mc.zeros() {
-                totals.peaks.0[c].offer(0.0, t);
-            }
-            // The channel polynomials only to the degree the stretch needs (its remainder
-            // bound no larger than the full step's, `taylor::degree_for_reach`).
-            let deg = tm.degree(s_end);
-            for (r, &c) in mc.moving().iter().enumerate() {
-                mc.project(r, &coef, deg, &mut chan_poly);
-                peaks::on_poly(
-                    &chan_poly,
-                    deg,
-                    tau,
-                    period,
-                    t,
-                    s_end,
-                    &mut totals.peaks.0[c],
-                );
-            }
-            totals.dissipated += tm
-                .dissipated(&coef, &masses, s_end, &mut work)
-                .ok_or_else(|| Error::numerical("exact", "first-order matrix without [0, I]"))?;
-            taylor::state(&coef, s_end, &mut x);
+            self.taylor_stretch(mi, obs)
         } else {
-            if cache[mi].is_none() {
-                let (k, c) = sys.matrices(mode);
-                let am = selector.matrix(mode);
-                let a = Mat::from_fn(n, n, |i, j| am[j * n + i]);
-                let prop = Propagator::shared_forced(&k, &c, &masses, a, force_2nd.as_deref())?;
-                cache[mi] = Some(ModeData {
-                    prop,
-                    damping: c,
-                    step: None,
-                });
+            self.closed_stretch(mi, obs)
+        }
+    }
+
+    /// A Taylor step in mode `mi`: the first switch within the step's validity (steps 1-2 of
+    /// the module documentation), the output samples from the polynomial (3), and the peaks,
+    /// contact times and dissipation (4); `x` is left at the stretch's end.
+    fn taylor_stretch(&mut self, mi: usize, obs: &mut dyn Observer) -> Result<Stretch> {
+        let horizon = self.t_end - self.t;
+        self.taylor_steps[mi] += 1;
+        let (tau, period) = self.expand(mi)?;
+        // 1-2: the first switch, within the step's validity.
+        let reach = tau.min(horizon);
+        let tw = &mut self.tw;
+        for (l, p) in tw.ind_proj.iter().zip(tw.ind_polys.iter_mut()) {
+            l.apply(&tw.coef, p);
+        }
+        // (Indicators proved to keep their sign on the step, `Poly::keeps_sign`, are not
+        // searched.)
+        tw.searches.clear();
+        for (p, &sign) in tw.ind_polys.iter().zip(&self.signs) {
+            if sign != 0.0 && !taylor::keeps_sign(p, sign, reach) {
+                let f = Lifted::new(Poly::new(p, tau, period), p[0], sign);
+                tw.searches
+                    .push(Search::new(f, sign, SearchOptions::default()));
             }
-            let md = cache[mi]
-                .as_mut()
-                .ok_or_else(|| Error::numerical("exact", "mode cache"))?;
-            // (With a forcing the samples are evaluated one by one: the transition matrix
-            // propagates the deviation from the particular solution only.)
-            if let (Some(g), None, false) = (&grid, &md.step, md.prop.is_forced()) {
-                md.step = Some(md.prop.transition(g.dt));
+        }
+        let found = first_switch(&mut tw.searches, period, reach);
+        let (s_end, switched) = stretch_end(found, reach, reach >= horizon);
+        let run_ends = !switched && s_end >= horizon;
+        // 3: output samples, from the polynomial.
+        if let Some(g) = self.grid.as_mut() {
+            let coef = &self.tw.coef;
+            let state = |s: f64, out: &mut [f64]| taylor::state(coef, s, out);
+            let span = (self.t, s_end, run_ends, self.t_end);
+            let (buf, buf2) = (&mut self.buf, &mut self.buf2);
+            emit_samples(g, span, self.mode, &state, None, obs, buf, buf2);
+        }
+        self.book_taylor(mi, tau, period, s_end)?;
+        Ok(Stretch {
+            s_end,
+            switched,
+            run_ends,
+            period,
+        })
+    }
+
+    /// The Taylor coefficients of the step from `x` in mode `mi` (with the forced response
+    /// from rest added under a constant force), the mode's first-order matrix prepared on
+    /// first use; returns the step's validity `τ` and the fastest period (s).
+    fn expand(&mut self, mi: usize) -> Result<(f64, f64)> {
+        let n = self.x.len();
+        let mode = self.mode;
+        let tw = &mut self.tw;
+        let tm = match &tw.tmats[mi] {
+            Some(tm) => tm,
+            None => {
+                let tm = TaylorMatrix::from_col_major(n, self.selector.matrix(mode)).ok_or_else(
+                    || Error::numerical("exact", format!("mode {mode:?}: non-finite matrix")),
+                )?;
+                tw.tmats[mi].insert(tm)
             }
-            let md = &*md;
-            let prop = &*md.prop;
-            let seg = prop.segment(&x);
-            period = prop.period();
-            // 1-2: the first switch.
-            let funcs: Vec<Functional<'_>> = selector
+        };
+        tm.expand(&self.x, &mut tw.coef);
+        if let Some(b) = &self.forcing {
+            let fc = tw.forced_coef[mi].get_or_insert_with(|| {
+                let mut fc = vec![0.0; (taylor::ORDER + 1) * n];
+                tm.forced_coefficients(b, &mut fc);
+                fc
+            });
+            for (c, f) in tw.coef.iter_mut().zip(fc.iter()) {
+                *c += f;
+            }
+        }
+        Ok((tm.validity(), tm.period()))
+    }
+
+    /// Step 4 on a Taylor step of length `s_end`: the closed-contact times, the channels'
+    /// extremes (on their polynomials, only to the degree the stretch needs: the remainder
+    /// bound no larger than the full step's, `taylor::degree_for_reach`), the dissipated
+    /// energy, and the state at the end.
+    fn book_taylor(&mut self, mi: usize, tau: f64, period: f64, s_end: f64) -> Result<()> {
+        let (t, mode) = (self.t, self.mode);
+        self.closed_time(s_end);
+        let mc = mode_channels(
+            &mut self.channels,
+            &self.map,
+            self.sys,
+            &mut self.selector,
+            mode,
+            false,
+            &mut self.chan_buf,
+        )?;
+        for &c in mc.zeros() {
+            self.totals.peaks.0[c].offer(0.0, t);
+        }
+        let tw = &mut self.tw;
+        let tm = tw.tmats[mi]
+            .as_ref()
+            .ok_or_else(|| Error::numerical("exact", "Taylor matrix"))?;
+        let deg = tm.degree(s_end);
+        for (r, &c) in mc.moving().iter().enumerate() {
+            mc.project(r, &tw.coef, deg, &mut self.chan_poly);
+            peaks::on_poly(
+                &self.chan_poly,
+                deg,
+                tau,
+                period,
+                t,
+                s_end,
+                &mut self.totals.peaks.0[c],
+            );
+        }
+        self.totals.dissipated += tm
+            .dissipated(&tw.coef, &self.masses, s_end, &mut tw.work)
+            .ok_or_else(|| Error::numerical("exact", "first-order matrix without [0, I]"))?;
+        taylor::state(&tw.coef, s_end, &mut self.x);
+        Ok(())
+    }
+
+    /// The closed-contact times over a stretch of length `s_end` in the current mode.
+    fn closed_time(&mut self, s_end: f64) {
+        for ci in 0..2 {
+            if closed(self.sys, self.mode, ci) {
+                self.totals.closed_time[ci] += s_end;
+            }
+        }
+    }
+
+    /// The closed form of mode `mi`, built on first use (with the output step's transition
+    /// matrix when there is an output grid and no forcing: with a forcing the samples are
+    /// evaluated one by one, the transition matrix propagating the deviation from the
+    /// particular solution only).
+    fn closed_form(&mut self, mi: usize) -> Result<Rc<ModeData>> {
+        if self.cache[mi].is_none() {
+            let n = self.x.len();
+            let (k, c) = self.sys.matrices(self.mode);
+            let am = self.selector.matrix(self.mode);
+            let a = Mat::from_fn(n, n, |i, j| am[j * n + i]);
+            let force_2nd = self.force_2nd.as_deref();
+            let prop = Propagator::shared_forced(&k, &c, &self.masses, a, force_2nd)?;
+            let step = match &self.grid {
+                Some(g) if !prop.is_forced() => Some(prop.transition(g.dt)),
+                _ => None,
+            };
+            self.cache[mi] = Some(Rc::new(ModeData {
+                prop,
+                damping: c,
+                step,
+            }));
+        }
+        self.cache[mi]
+            .clone()
+            .ok_or_else(|| Error::numerical("exact", "mode cache"))
+    }
+
+    /// A stretch in closed form in mode `mi`: the first switch before the end of the run
+    /// (steps 1-2 of the module documentation), the output samples (3), and the peaks, contact
+    /// times and dissipation (4); `x` is left at the stretch's end.
+    fn closed_stretch(&mut self, mi: usize, obs: &mut dyn Observer) -> Result<Stretch> {
+        let horizon = self.t_end - self.t;
+        let md = self.closed_form(mi)?;
+        let prop = &*md.prop;
+        let seg = prop.segment(&self.x);
+        let period = prop.period();
+        // 1-2: the first switch.
+        let found = {
+            let funcs: Vec<Functional<'_>> = self
+                .selector
                 .vectors()
                 .iter()
                 .map(|l| seg.functional(l))
                 .collect();
             let mut closed_searches: Vec<Search<Lifted<&Functional<'_>>>> = funcs
                 .iter()
-                .zip(&signs)
-                .zip(selector.vectors())
+                .zip(&self.signs)
+                .zip(self.selector.vectors())
                 .filter(|((_, s), _)| **s != 0.0)
                 .map(|((f, s), l)| {
-                    let v = l.iter().zip(&x).map(|(a, b)| a * b).sum();
-                    Search::new(Lifted::new(f, v, *s), *s, search)
+                    let v = l.iter().zip(&self.x).map(|(a, b)| a * b).sum();
+                    Search::new(Lifted::new(f, v, *s), *s, SearchOptions::default())
                 })
                 .collect();
-            let found = first_switch(&mut closed_searches, period, horizon);
-            (s_end, switched) = stretch_end(found, horizon, true);
-            run_ends = !switched;
-            // 3: output samples.
-            if let Some(g) = grid.as_mut() {
-                let state = |s: f64, out: &mut [f64]| seg.state(s, out);
-                let span = (t, s_end, run_ends, t_end);
-                let step = md.step.as_ref();
-                emit_samples(g, span, mode, &state, step, obs, &mut buf, &mut buf2);
-            }
-            // 4: peaks, contact times, dissipation.
-            for ci in 0..2 {
-                if closed(sys, mode, ci) {
-                    totals.closed_time[ci] += s_end;
-                }
-            }
-            let mc = mode_channels(
-                &mut channels,
-                &map,
-                sys,
-                &mut selector,
-                mode,
-                true,
-                &mut chan_buf,
-            )?;
-            for &c in mc.zeros() {
-                totals.peaks.0[c].offer(0.0, t);
-            }
-            let slope_len = n + usize::from(forcing.is_some());
-            for ((&c, l), la) in mc
-                .moving()
-                .iter()
-                .zip(mc.dense.chunks_exact(n))
-                .zip(mc.slopes.chunks_exact(slope_len))
-            {
-                peaks::on_segment(&seg, l, la, t, s_end, &mut totals.peaks.0[c]);
-            }
-            totals.dissipated += dissipated(&seg, &md.damping, nd, s_end);
-            seg.state(s_end, &mut buf);
-            x.copy_from_slice(&buf);
+            first_switch(&mut closed_searches, period, horizon)
+        };
+        let (s_end, switched) = stretch_end(found, horizon, true);
+        let run_ends = !switched;
+        // 3: output samples.
+        if let Some(g) = self.grid.as_mut() {
+            let state = |s: f64, out: &mut [f64]| seg.state(s, out);
+            let span = (self.t, s_end, run_ends, self.t_end);
+            let step = md.step.as_ref();
+            let (buf, buf2) = (&mut self.buf, &mut self.buf2);
+            emit_samples(g, span, self.mode, &state, step, obs, buf, buf2);
         }
+        self.book_closed(&seg, &md.damping, s_end)?;
+        Ok(Stretch {
+            s_end,
+            switched,
+            run_ends,
+            period,
+        })
+    }
 
-        // Advance.
-        let t_before = t;
-        t += s_end;
-        if run_ends {
-            break;
+    /// Step 4 on a closed-form stretch of length `s_end`: the closed-contact times, the
+    /// channels' extremes (`peaks::on_segment`), the dissipated energy `∫ ẋᵀC_σẋ dt`
+    /// (`damping` = `C_σ`), and the state at the end.
+    fn book_closed(&mut self, seg: &Segment<'_>, damping: &Mat<f64>, s_end: f64) -> Result<()> {
+        let (t, mode) = (self.t, self.mode);
+        let n = self.x.len();
+        self.closed_time(s_end);
+        let mc = mode_channels(
+            &mut self.channels,
+            &self.map,
+            self.sys,
+            &mut self.selector,
+            mode,
+            true,
+            &mut self.chan_buf,
+        )?;
+        for &c in mc.zeros() {
+            self.totals.peaks.0[c].offer(0.0, t);
         }
-        if !switched {
-            // End of a Taylor step: the same mode goes on, the indicators on the same sides.
-            continue;
+        let slope_len = n + usize::from(self.forcing.is_some());
+        for ((&c, l), la) in mc
+            .moving()
+            .iter()
+            .zip(mc.dense.chunks_exact(n))
+            .zip(mc.slopes.chunks_exact(slope_len))
+        {
+            peaks::on_segment(seg, l, la, t, s_end, &mut self.totals.peaks.0[c]);
         }
-        // No progress: a stretch shorter than round-off of the time scale, or one that does not
-        // move `t` at all (2.5e-17 s at t = 3.7 s).
-        let no_progress = s_end <= 1e-14 * period.min(t_end) || t == t_before;
+        self.totals.dissipated += dissipated(seg, damping, n / 2, s_end);
+        seg.state(s_end, &mut self.buf);
+        self.x.copy_from_slice(&self.buf);
+        Ok(())
+    }
+
+    /// After a stretch of length `s_end` that ended on a switch (`t` advanced from
+    /// `t_before`): whether it made no progress (shorter than round-off of the time scale, or
+    /// not moving `t` at all: 2.5e-17 s at t = 3.7 s) and whether it was a micro-stretch
+    /// ([`MICRO_STRETCH`]). More than 50 stretches without progress in a row, or more than
+    /// [`MAX_MICRO_STRETCHES`] micro-stretches, are an error.
+    fn progress(&mut self, s_end: f64, period: f64, t_before: f64) -> Result<(bool, bool)> {
+        let (t, mode) = (self.t, self.mode);
+        let no_progress = s_end <= 1e-14 * period.min(self.t_end) || t == t_before;
         if no_progress {
-            zero_length += 1;
-            if zero_length > 50 {
+            self.zero_length += 1;
+            if self.zero_length > 50 {
                 return Err(Error::numerical(
                     "exact propagator",
                     format!(
@@ -346,15 +524,15 @@ pub fn solve_from(
                 ));
             }
         } else {
-            zero_length = 0;
+            self.zero_length = 0;
         }
         // A stretch far shorter than the time scale that ended without changing the mode: the
         // search saw an indicator leave its side, but the selection keeps the side (a
         // derivative within its round-off band taken as zero, a higher one of the other sign).
-        let micro = !no_progress && s_end <= MICRO_STRETCH * period.min(t_end);
+        let micro = !no_progress && s_end <= MICRO_STRETCH * period.min(self.t_end);
         if micro {
-            micro_stretches += 1;
-            if micro_stretches > MAX_MICRO_STRETCHES {
+            self.micro_stretches += 1;
+            if self.micro_stretches > MAX_MICRO_STRETCHES {
                 return Err(Error::numerical(
                     "exact propagator",
                     format!(
@@ -365,114 +543,147 @@ pub fn solve_from(
                 ));
             }
         } else {
-            micro_stretches = 0;
+            self.micro_stretches = 0;
         }
-        searched_signs.copy_from_slice(&signs);
-        // 5: the new mode, and the indicators' sides under its dynamics (those of the mode
-        // taken when no mode is consistent).
-        let (mut new_mode, _) = selector.select(&x, mode, &mut signs);
+        Ok((no_progress, micro))
+    }
+
+    /// Step 5: the new mode at the switch, and the indicators' sides under its dynamics (those
+    /// of the mode taken when no mode is consistent), with the trajectory deciding after a
+    /// micro-stretch ([`Run::settle_micro`]) and an indicator at rest at zero left unsearched.
+    fn next_mode(&mut self, no_progress: bool, micro: bool) -> Mode {
+        let mode = self.mode;
+        self.searched_signs.copy_from_slice(&self.signs);
+        let (mut new_mode, _) = self.selector.select(&self.x, mode, &mut self.signs);
         if micro && new_mode == mode {
-            // The trajectory decides what the derivatives cannot: an indicator that left the
-            // side it was searched from (its value now of the other sign, where the stretch's
-            // closed form took it) takes the side it went to, and the mode follows. Without
-            // this a dashpot velocity falling at 1.02e-6 m/s² (round-off band 1.05e-6 m/s²,
-            // second derivative +2.5e-5 m/s³) is re-found 3e-15 s later, millions of times.
-            moved.fill(false);
-            for (i, l) in selector.vectors().iter().enumerate() {
-                let was = searched_signs[i];
-                let v: f64 = l.iter().zip(&x).map(|(a, b)| a * b).sum();
-                if was != 0.0 && was * v < 0.0 && signs[i] == was {
-                    signs[i] = -was;
-                    moved[i] = true;
-                }
-            }
-            if moved.iter().any(|&m| m) {
-                new_mode = selector.implied(&signs);
-                // The other indicators' sides under the new mode's dynamics.
-                let kept = signs.clone();
-                selector.signs(new_mode, &x, &mut signs);
-                for (i, sg) in signs.iter_mut().enumerate() {
-                    if moved[i] {
-                        *sg = kept[i];
-                    }
-                }
-            }
+            new_mode = self.settle_micro(new_mode);
         }
-        if no_progress && new_mode == mode && forcing.is_some() {
+        if no_progress && new_mode == mode && self.forcing.is_some() {
             // Resting contact under a constant force: an indicator that "crossed" without time
             // advancing and without changing the mode is at zero within round-off (a dashpot's
             // relative velocity at rest against static forces of 1e5 N/m·mm). It is not
             // searched (sign 0) until the next switch that changes the mode, so the run
             // progresses instead of re-finding the same crossing.
-            for (sg, l) in signs.iter_mut().zip(selector.vectors()) {
-                let v: f64 = l.iter().zip(&x).map(|(a, b)| a * b).sum();
+            for (sg, l) in self.signs.iter_mut().zip(self.selector.vectors()) {
+                let v: f64 = l.iter().zip(&self.x).map(|(a, b)| a * b).sum();
                 if *sg * v <= 0.0 {
                     *sg = 0.0;
                 }
             }
         }
-        if new_mode != mode {
-            // A contact released by the force rule takes its elastic energy with it.
-            totals.dissipated += super::dopri5::contact_energy_jump(sys, mode, new_mode, &x);
-            path.push(PathPoint {
-                t,
-                mode: new_mode,
-                x: x.clone(),
-            });
-            events.push(Event {
-                t,
-                from: mode,
-                to: new_mode,
-            });
-            if events.len() > opts.max_events {
-                return Err(super::too_many_events(
-                    "exact propagator",
-                    &events,
-                    opts.max_events,
-                    t,
-                ));
+        new_mode
+    }
+
+    /// After a micro-stretch that kept the mode, the trajectory decides what the derivatives
+    /// cannot: an indicator that left the side it was searched from (its value now of the
+    /// other sign, where the stretch's closed form took it) takes the side it went to, and the
+    /// mode follows (returned; `new_mode` if none moved). Without this a dashpot velocity
+    /// falling at 1.02e-6 m/s² (round-off band 1.05e-6 m/s², second derivative +2.5e-5 m/s³)
+    /// is re-found 3e-15 s later, millions of times.
+    fn settle_micro(&mut self, new_mode: Mode) -> Mode {
+        let signs = &mut self.signs;
+        self.moved.fill(false);
+        for (i, l) in self.selector.vectors().iter().enumerate() {
+            let was = self.searched_signs[i];
+            let v: f64 = l.iter().zip(&self.x).map(|(a, b)| a * b).sum();
+            if was != 0.0 && was * v < 0.0 && signs[i] == was {
+                signs[i] = -was;
+                self.moved[i] = true;
             }
         }
-        mode = new_mode;
-        if collision_end.is_none() && !mode.on(Switch::SliderBed) && !mode.on(Switch::BedDamper) {
-            collision_end = Some(CollisionEnd {
-                t,
-                x: x.clone(),
-                totals,
-            });
-            if opts.stop_at_collision_end {
-                break;
+        if !self.moved.iter().any(|&m| m) {
+            return new_mode;
+        }
+        let new_mode = self.selector.implied(signs);
+        // The other indicators' sides under the new mode's dynamics.
+        let kept = signs.clone();
+        self.selector.signs(new_mode, &self.x, signs);
+        for (i, sg) in signs.iter_mut().enumerate() {
+            if self.moved[i] {
+                *sg = kept[i];
             }
         }
-        if t >= t_end {
-            // A switch at the very end of the run: the sample at t_end, if still due.
-            if let Some(g) = grid.as_mut() {
-                let xe = x.clone();
-                let state = |_: f64, out: &mut [f64]| out.copy_from_slice(&xe);
-                let span = (t, 0.0, true, t_end);
-                emit_samples(g, span, mode, &state, None, obs, &mut buf, &mut buf2);
-            }
-            break;
+        new_mode
+    }
+
+    /// The switch to `new_mode` at `t`: a contact released by the force rule takes its elastic
+    /// energy with it (counted as dissipated); the path point and the event are recorded, and
+    /// more than `opts.max_events` is an error.
+    fn switch_to(&mut self, new_mode: Mode) -> Result<()> {
+        let (t, mode) = (self.t, self.mode);
+        self.totals.dissipated +=
+            super::dopri5::contact_energy_jump(self.sys, mode, new_mode, &self.x);
+        self.path.push(PathPoint {
+            t,
+            mode: new_mode,
+            x: self.x.clone(),
+        });
+        self.events.push(Event {
+            t,
+            from: mode,
+            to: new_mode,
+        });
+        if self.events.len() > self.opts.max_events {
+            return Err(super::too_many_events(
+                "exact propagator",
+                &self.events,
+                self.opts.max_events,
+                t,
+            ));
+        }
+        Ok(())
+    }
+
+    /// Records the end of the collision (both contacts open) the first time it is reached;
+    /// true if it was reached now.
+    fn collision_ends(&mut self) -> bool {
+        let mode = self.mode;
+        if self.collision_end.is_some() || mode.on(Switch::SliderBed) || mode.on(Switch::BedDamper)
+        {
+            return false;
+        }
+        self.collision_end = Some(CollisionEnd {
+            t: self.t,
+            x: self.x.clone(),
+            totals: self.totals,
+        });
+        true
+    }
+
+    /// The sample at `t_end`, if still due, after a switch at the very end of the run.
+    fn last_sample(&mut self, obs: &mut dyn Observer) {
+        if let Some(g) = self.grid.as_mut() {
+            let xe = self.x.clone();
+            let state = |_: f64, out: &mut [f64]| out.copy_from_slice(&xe);
+            let span = (self.t, 0.0, true, self.t_end);
+            let (buf, buf2) = (&mut self.buf, &mut self.buf2);
+            emit_samples(g, span, self.mode, &state, None, obs, buf, buf2);
         }
     }
-    let fallback_modes = cache
-        .iter()
-        .flatten()
-        .filter(|m| !m.prop.is_spectral())
-        .count();
-    Ok(Solution {
-        events,
-        path,
-        collision_end,
-        t_final: t,
-        x_final: x,
-        mode_final: mode,
-        totals,
-        steps: segments,
-        taylor_steps: taylor_steps.iter().sum(),
-        rejected: 0,
-        fallback_modes,
-    })
+
+    /// The finished run: its events, path, totals and counts (the closed forms built by the
+    /// matrix-exponential fallback among them).
+    fn finish(self) -> Solution {
+        let fallback_modes = self
+            .cache
+            .iter()
+            .flatten()
+            .filter(|m| !m.prop.is_spectral())
+            .count();
+        Solution {
+            events: self.events,
+            path: self.path,
+            collision_end: self.collision_end,
+            t_final: self.t,
+            x_final: self.x,
+            mode_final: self.mode,
+            totals: self.totals,
+            steps: self.segments,
+            taylor_steps: self.taylor_steps.iter().sum(),
+            rejected: 0,
+            fallback_modes,
+        }
+    }
 }
 
 /// A stretch that ends at a switch after at most this fraction of the fastest period, without

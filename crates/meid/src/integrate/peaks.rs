@@ -420,175 +420,241 @@ fn exp_extremes(e: &ExpSum, dg: &Functional<'_>, t0: f64, len: f64, ext: &mut Ex
         });
         return;
     }
-    let n_win = ((len / (WINDOW_PERIODS * period)).round() as usize).max(1);
-    let w = len / n_win as f64;
-    let n_cell = ((w * CELLS_PER_PERIOD / period).ceil() as usize).max(1);
-    let hc = w / n_cell as f64;
-    let win_end = |i: usize| {
-        if i + 1 == n_win {
-            len
-        } else {
-            (i + 1) as f64 * w
-        }
-    };
-    let k = e.amp.len();
-    let mags: Vec<f64> = e.amp.iter().map(|a| a.norm()).collect();
-    let pad = BOUND_PAD
-        * (e.p0.abs()
-            + e.p1.abs() * len
-            + e.p2.abs() * len * len
-            + mags
-                .iter()
-                .zip(&e.lam)
-                .map(|(m, l)| m * (l.re * len).exp().max(1.0))
-                .sum::<f64>())
-        + e.noise();
-    let l4: Vec<f64> = e.lam.iter().map(|l| l.norm_sqr() * l.norm_sqr()).collect();
-    let w4 = w.powi(4) / 384.0;
-    let resolved: Vec<bool> = l4.iter().map(|l| l * w4 < 1.0).collect();
-
-    // 1. Window bounds, and the best boundaries as seeds. The resolved terms are advanced as
-    //    exponentials `z_k = A_k e^{λ_k a}`, the others only as envelopes `|A_k| e^{Re λ_k a}`;
-    //    a decaying envelope below 1e-3 of the round-off allowance leaves the loop, its bound
-    //    at that time kept as a constant (it only decreases afterwards).
-    let mut slow: Vec<(c64, c64, c64, f64, f64, c64, f64)> = Vec::with_capacity(k);
-    let mut fast: Vec<(f64, f64, f64, f64)> = Vec::with_capacity(k);
-    for j in 0..k {
-        let (amp, lam, mag) = (e.amp[j], e.lam[j], mags[j]);
-        let decay = (lam.re * w).exp();
-        if resolved[j] {
-            // (A, λ, e^{λw}, e^{Re λ w}, l4·max(1, e^{Re λ w}), z, env)
-            slow.push((
-                amp,
-                lam,
-                (lam * w).exp(),
-                decay,
-                l4[j] * decay.max(1.0),
-                amp,
-                mag,
-            ));
-        } else {
-            // (|A|, Re λ, e^{Re λ w}, env)
-            fast.push((mag, lam.re, decay, mag));
-        }
-    }
-    let mut dropped = 0.0;
-    let drop_below = 1e-3 * pad;
-    let (mut lo, mut hi) = (vec![0.0; n_win], vec![0.0; n_win]);
-    let sums = |slow: &[(c64, c64, c64, f64, f64, c64, f64)], s: f64| {
-        let (mut g, mut d) = (e.p0 + (e.p1 + e.p2 * s) * s, e.p1 + 2.0 * e.p2 * s);
-        for t in slow {
-            g += t.5.re;
-            d += (t.5 * t.1).re;
-        }
-        (g, d)
-    };
-    let (mut gs0, mut ds0) = sums(&slow, 0.0);
-    let (mut best_max, mut best_min) = ((f64::NEG_INFINITY, 0.0), (f64::INFINITY, 0.0));
-    for i in 0..n_win {
-        let b = win_end(i);
-        let reseed = (i + 1) % RESEED == 0 || i + 1 == n_win;
-        let mut m4 = 0.0;
-        for t in slow.iter_mut() {
-            m4 += t.6 * t.4;
-            if reseed {
-                t.5 = t.0 * (t.1 * b).exp();
-                t.6 = t.5.norm();
-            } else {
-                t.5 *= t.2;
-                t.6 *= t.3;
-            }
-        }
-        let mut far = dropped;
-        let mut j = 0;
-        while j < fast.len() {
-            let t = &mut fast[j];
-            let top = t.3 * t.2.max(1.0);
-            far += top;
-            t.3 = if reseed {
-                t.0 * (t.1 * b).exp()
-            } else {
-                t.3 * t.2
-            };
-            if t.2 < 1.0 && top < drop_below {
-                dropped += top;
-                fast.swap_remove(j);
-            } else {
-                j += 1;
-            }
-        }
-        let (gs1, ds1) = sums(&slow, b);
-        let h = b - i as f64 * w;
-        let (hlo, hhi) = hermite_range(gs0, ds0, gs1, ds1, h);
-        let rem = m4 * h.powi(4) / 384.0 + far + pad;
-        lo[i] = hlo - rem;
-        hi[i] = hhi + rem;
-        // Seeds: the boundaries where the resolved part is largest and smallest (the rest is
-        // within `far` of zero there).
-        if i + 1 < n_win {
-            if gs1 > best_max.0 {
-                best_max = (gs1, b);
-            }
-            if gs1 < best_min.0 {
-                best_min = (gs1, b);
-            }
-        }
-        (gs0, ds0) = (gs1, ds1);
-    }
-    for (g, s) in [best_max, best_min] {
+    let win = ExpWindows::new(e, len, period);
+    let (lo, hi, seeds) = win.bounds();
+    for (g, s) in seeds {
         if g.is_finite() {
             ext.offer(value(s), t0 + s);
         }
     }
-    let mut z = vec![c64::new(0.0, 0.0); k];
-    let mut env = vec![0.0; k];
+    win.refine(dg, t0, (&lo, &hi), ext);
+}
 
-    // 2. The windows that can beat the extremes, cell by cell.
-    let cell_step: Vec<c64> = e.lam.iter().map(|l| (l * hc).exp()).collect();
-    let cell_decay: Vec<f64> = e.lam.iter().map(|l| (l.re * hc).exp()).collect();
-    let cell_top: Vec<f64> = cell_decay
-        .iter()
-        .zip(&l4)
-        .map(|(d, l4)| d.max(1.0) * l4)
-        .collect();
-    let full = |z: &[c64], s: f64| {
-        let (mut g, mut d) = (e.p0 + (e.p1 + e.p2 * s) * s, e.p1 + 2.0 * e.p2 * s);
-        for (zk, l) in z.iter().zip(&e.lam) {
-            g += zk.re;
-            d += (zk * l).re;
+/// A resolved term of [`exp_extremes`]' window bounds: `(A, λ, e^{λw}, e^{Re λ w},
+/// |λ|⁴·max(1, e^{Re λ w}), z, env)`, `z = A e^{λa}` and `env = |A| e^{Re λ a}` at the window's
+/// start `a`.
+type Resolved = (c64, c64, c64, f64, f64, c64, f64);
+/// An unresolved term, bounded by its envelope only: `(|A|, Re λ, e^{Re λ w}, env)`.
+type Unresolved = (f64, f64, f64, f64);
+
+/// The windows and cells of [`exp_extremes`] on `[0, len]` of one exponential sum, with the
+/// terms' magnitudes `|A_k|`, `|λ_k|⁴` and the round-off allowance `pad` of the bounds.
+struct ExpWindows<'e> {
+    e: &'e ExpSum,
+    len: f64,
+    /// Windows: `n_win` of length `w`; cells: `n_cell` of length `hc` per window.
+    n_win: usize,
+    w: f64,
+    n_cell: usize,
+    hc: f64,
+    mags: Vec<f64>,
+    l4: Vec<f64>,
+    pad: f64,
+}
+
+impl<'e> ExpWindows<'e> {
+    /// Windows of about [`WINDOW_PERIODS`] fastest periods `period`, cells of at most
+    /// `1/`[`CELLS_PER_PERIOD`] of it; the allowance is [`BOUND_PAD`] of the sum's largest
+    /// possible size on `[0, len]` plus its noise.
+    fn new(e: &'e ExpSum, len: f64, period: f64) -> Self {
+        let n_win = ((len / (WINDOW_PERIODS * period)).round() as usize).max(1);
+        let w = len / n_win as f64;
+        let n_cell = ((w * CELLS_PER_PERIOD / period).ceil() as usize).max(1);
+        let hc = w / n_cell as f64;
+        let mags: Vec<f64> = e.amp.iter().map(|a| a.norm()).collect();
+        let pad = BOUND_PAD
+            * (e.p0.abs()
+                + e.p1.abs() * len
+                + e.p2.abs() * len * len
+                + mags
+                    .iter()
+                    .zip(&e.lam)
+                    .map(|(m, l)| m * (l.re * len).exp().max(1.0))
+                    .sum::<f64>())
+            + e.noise();
+        let l4: Vec<f64> = e.lam.iter().map(|l| l.norm_sqr() * l.norm_sqr()).collect();
+        ExpWindows {
+            e,
+            len,
+            n_win,
+            w,
+            n_cell,
+            hc,
+            mags,
+            l4,
+            pad,
         }
-        (g, d)
-    };
-    for i in 0..n_win {
-        if !ext.could_improve_range(lo[i], hi[i]) {
-            continue;
+    }
+
+    /// The end of window `i`.
+    fn end(&self, i: usize) -> f64 {
+        if i + 1 == self.n_win {
+            self.len
+        } else {
+            (i + 1) as f64 * self.w
         }
-        let a = i as f64 * w;
-        let b = win_end(i);
+    }
+
+    /// The terms split into those resolved on a window (`(|λ_k|w)⁴ < 384`), advanced as
+    /// exponentials, and the others, advanced as envelopes.
+    fn terms(&self) -> (Vec<Resolved>, Vec<Unresolved>) {
+        let (e, w) = (self.e, self.w);
+        let k = e.amp.len();
+        let w4 = w.powi(4) / 384.0;
+        let resolved: Vec<bool> = self.l4.iter().map(|l| l * w4 < 1.0).collect();
+        let mut slow: Vec<Resolved> = Vec::with_capacity(k);
+        let mut fast: Vec<Unresolved> = Vec::with_capacity(k);
         for j in 0..k {
-            z[j] = e.amp[j] * (e.lam[j] * a).exp();
-            env[j] = mags[j] * (e.lam[j].re * a).exp();
+            let (amp, lam, mag) = (e.amp[j], e.lam[j], self.mags[j]);
+            let decay = (lam.re * w).exp();
+            if resolved[j] {
+                // (A, λ, e^{λw}, e^{Re λ w}, l4·max(1, e^{Re λ w}), z, env)
+                slow.push((
+                    amp,
+                    lam,
+                    (lam * w).exp(),
+                    decay,
+                    self.l4[j] * decay.max(1.0),
+                    amp,
+                    mag,
+                ));
+            } else {
+                // (|A|, Re λ, e^{Re λ w}, env)
+                fast.push((mag, lam.re, decay, mag));
+            }
         }
-        let (mut g0, mut d0) = full(&z, a);
-        for c in 0..n_cell {
-            let ca = a + c as f64 * hc;
-            let cb = if c + 1 == n_cell { b } else { ca + hc };
+        (slow, fast)
+    }
+
+    /// Step 1: every window's range bound `(lo, hi)`, and the window boundaries where the
+    /// resolved part is largest and smallest (`(value, s)` each, as seeds). The resolved terms
+    /// are advanced as exponentials `z_k = A_k e^{λ_k a}`, the others only as envelopes
+    /// `|A_k| e^{Re λ_k a}`; a decaying envelope below 1e-3 of the round-off allowance leaves
+    /// the loop, its bound at that time kept as a constant (it only decreases afterwards).
+    fn bounds(&self) -> (Vec<f64>, Vec<f64>, [(f64, f64); 2]) {
+        let (e, w, n_win) = (self.e, self.w, self.n_win);
+        let (mut slow, mut fast) = self.terms();
+        let mut dropped = 0.0;
+        let drop_below = 1e-3 * self.pad;
+        let (mut lo, mut hi) = (vec![0.0; n_win], vec![0.0; n_win]);
+        let sums = |slow: &[Resolved], s: f64| {
+            let (mut g, mut d) = (e.p0 + (e.p1 + e.p2 * s) * s, e.p1 + 2.0 * e.p2 * s);
+            for t in slow {
+                g += t.5.re;
+                d += (t.5 * t.1).re;
+            }
+            (g, d)
+        };
+        let (mut gs0, mut ds0) = sums(&slow, 0.0);
+        let (mut best_max, mut best_min) = ((f64::NEG_INFINITY, 0.0), (f64::INFINITY, 0.0));
+        for i in 0..n_win {
+            let b = self.end(i);
+            let reseed = (i + 1) % RESEED == 0 || i + 1 == n_win;
             let mut m4 = 0.0;
+            for t in slow.iter_mut() {
+                m4 += t.6 * t.4;
+                if reseed {
+                    t.5 = t.0 * (t.1 * b).exp();
+                    t.6 = t.5.norm();
+                } else {
+                    t.5 *= t.2;
+                    t.6 *= t.3;
+                }
+            }
+            let mut far = dropped;
+            let mut j = 0;
+            while j < fast.len() {
+                let t = &mut fast[j];
+                let top = t.3 * t.2.max(1.0);
+                far += top;
+                t.3 = if reseed {
+                    t.0 * (t.1 * b).exp()
+                } else {
+                    t.3 * t.2
+                };
+                if t.2 < 1.0 && top < drop_below {
+                    dropped += top;
+                    fast.swap_remove(j);
+                } else {
+                    j += 1;
+                }
+            }
+            let (gs1, ds1) = sums(&slow, b);
+            let h = b - i as f64 * w;
+            let (hlo, hhi) = hermite_range(gs0, ds0, gs1, ds1, h);
+            let rem = m4 * h.powi(4) / 384.0 + far + self.pad;
+            lo[i] = hlo - rem;
+            hi[i] = hhi + rem;
+            // Seeds: the boundaries where the resolved part is largest and smallest (the rest is
+            // within `far` of zero there).
+            if i + 1 < n_win {
+                if gs1 > best_max.0 {
+                    best_max = (gs1, b);
+                }
+                if gs1 < best_min.0 {
+                    best_min = (gs1, b);
+                }
+            }
+            (gs0, ds0) = (gs1, ds1);
+        }
+        (lo, hi, [best_max, best_min])
+    }
+
+    /// Step 2: the windows, in time order, whose bound `(lo, hi)` can beat the extremes so
+    /// far, cut into cells with their own bounds; each cell that can beat them is searched
+    /// for the roots of the slope `dg`.
+    fn refine(&self, dg: &Functional<'_>, t0: f64, (lo, hi): (&[f64], &[f64]), ext: &mut Extremes) {
+        let (e, w, hc, n_cell, n_win) = (self.e, self.w, self.hc, self.n_cell, self.n_win);
+        let (k, mags, pad) = (e.amp.len(), &self.mags, self.pad);
+        let value = |s: f64| e.derivative(0, s);
+        let mut z = vec![c64::new(0.0, 0.0); k];
+        let mut env = vec![0.0; k];
+        let cell_step: Vec<c64> = e.lam.iter().map(|l| (l * hc).exp()).collect();
+        let cell_decay: Vec<f64> = e.lam.iter().map(|l| (l.re * hc).exp()).collect();
+        let cell_top: Vec<f64> = cell_decay
+            .iter()
+            .zip(&self.l4)
+            .map(|(d, l4)| d.max(1.0) * l4)
+            .collect();
+        let full = |z: &[c64], s: f64| {
+            let (mut g, mut d) = (e.p0 + (e.p1 + e.p2 * s) * s, e.p1 + 2.0 * e.p2 * s);
+            for (zk, l) in z.iter().zip(&e.lam) {
+                g += zk.re;
+                d += (zk * l).re;
+            }
+            (g, d)
+        };
+        for i in 0..n_win {
+            if !ext.could_improve_range(lo[i], hi[i]) {
+                continue;
+            }
+            let a = i as f64 * w;
+            let b = self.end(i);
             for j in 0..k {
-                m4 += env[j] * cell_top[j];
-                z[j] *= cell_step[j];
-                env[j] *= cell_decay[j];
+                z[j] = e.amp[j] * (e.lam[j] * a).exp();
+                env[j] = mags[j] * (e.lam[j].re * a).exp();
             }
-            let (g1, d1) = full(&z, cb);
-            let (hlo, hhi) = hermite_range(g0, d0, g1, d1, cb - ca);
-            let rem = m4 * (cb - ca).powi(4) / 384.0 + pad;
-            if ext.could_improve_range(hlo - rem, hhi + rem) {
-                ext.offer(value(ca), t0 + ca);
-                for_each_extremum(dg, ca, cb, EXTREMUM_SEARCH, |s, _| {
-                    ext.offer(value(s), t0 + s)
-                });
+            let (mut g0, mut d0) = full(&z, a);
+            for c in 0..n_cell {
+                let ca = a + c as f64 * hc;
+                let cb = if c + 1 == n_cell { b } else { ca + hc };
+                let mut m4 = 0.0;
+                for j in 0..k {
+                    m4 += env[j] * cell_top[j];
+                    z[j] *= cell_step[j];
+                    env[j] *= cell_decay[j];
+                }
+                let (g1, d1) = full(&z, cb);
+                let (hlo, hhi) = hermite_range(g0, d0, g1, d1, cb - ca);
+                let rem = m4 * (cb - ca).powi(4) / 384.0 + pad;
+                if ext.could_improve_range(hlo - rem, hhi + rem) {
+                    ext.offer(value(ca), t0 + ca);
+                    for_each_extremum(dg, ca, cb, EXTREMUM_SEARCH, |s, _| {
+                        ext.offer(value(s), t0 + s)
+                    });
+                }
+                (g0, d0) = (g1, d1);
             }
-            (g0, d0) = (g1, d1);
         }
     }
 }

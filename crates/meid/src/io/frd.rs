@@ -103,6 +103,19 @@ struct Block<'k> {
     line: usize,
 }
 
+/// The `100C` line of a results block.
+struct ResultsHead {
+    /// The value: a frequency step's frequency.
+    value: f64,
+    /// The number of nodes.
+    count: u64,
+    /// The analysis type (2: frequency) and the step number, when given.
+    ictype: Option<i64>,
+    numstep: Option<i64>,
+    /// 0 or 1 (ASCII; 1 when not given).
+    format: u8,
+}
+
 /// Step parameters (`1P…` lines) seen since the last results block.
 #[derive(Default)]
 struct StepParams {
@@ -381,54 +394,14 @@ impl<R: BufRead> Parser<'_, R> {
             kind: "100C (results)",
             line: self.line_no,
         };
-        // (1X,'  100','C',6A1,E12.5,I12,20A1,I2,I5,10A1,I2)
-        let value = parse_f(cols(head, 12, 24).trim());
-        let count = cols(head, 24, 36).trim().parse::<u64>().ok();
-        let ictype = cols(head, 56, 58).trim().parse::<i64>().ok();
-        let numstep = cols(head, 58, 63).trim().parse::<i64>().ok();
-        let format = cols(head, 73, 75).trim().parse::<u8>().ok().unwrap_or(1);
-        let (Some(value), Some(count)) = (value, count) else {
-            return Err(self.err(
-                Some(block),
-                block.line,
-                format!(
-                    "expected (1X,'  100','C',6A1,E12.5,I12,20A1,I2,I5,10A1,I2): set name, value, number of nodes, text, analysis type, step, analysis name, format; got '{}'",
-                    clip(head)
-                ),
-            ));
-        };
-        if format > 1 {
-            return Err(self.err(
-                Some(block),
-                block.line,
-                format!("format {format} (binary) is not read: meid reads ASCII .frd files (formats 0 and 1, CalculiX's default)"),
-            ));
-        }
-        // -4: the result's name and number of components.
-        let l4 = self.need_line(block)?;
-        if cols(&l4, 0, 3).trim() != "-4" {
-            return Err(self.err(
-                Some(block),
-                self.line_no,
-                format!(
-                    "expected ' -4  <name> <components> <type>' after the '  100C' line, got '{}'",
-                    clip(&l4)
-                ),
-            ));
-        }
-        let name = cols(&l4, 5, 13).trim().to_string();
-        // -5: one per component; those marked "exists = 1" are not in the data.
-        let mut in_data = 0usize;
-        let first_data = loop {
-            let l = self.need_line(block)?;
-            if cols(&l, 0, 3).trim() != "-5" {
-                break l;
-            }
-            let exists = cols(&l, 33, 38).trim().parse::<i64>().unwrap_or(0);
-            if exists != 1 {
-                in_data += 1;
-            }
-        };
+        let ResultsHead {
+            value,
+            count,
+            ictype,
+            numstep,
+            format,
+        } = self.results_head(head, block)?;
+        let (name, in_data, first_data) = self.components(block)?;
         let wanted = name == "DISP" && ictype == Some(2);
         if !wanted {
             out.skipped.push(format!(
@@ -448,61 +421,7 @@ impl<R: BufRead> Parser<'_, R> {
                 format!("DISP with {in_data} components in the data: expected D1, D2, D3"),
             ));
         }
-        let mut disp = Vec::new();
-        let mut l = first_data;
-        loop {
-            match cols(&l, 0, 3).trim() {
-                "-3" => break,
-                "-1" => {
-                    let (label, mut v) = self.data_line(&l, format, in_data, block, "DISP")?;
-                    // Continuation lines (` -2`) carry values 7, 8, ...
-                    while v.len() < in_data {
-                        let c = self.need_line(block)?;
-                        if cols(&c, 0, 3).trim() != "-2" {
-                            return Err(self.err(
-                                Some(block),
-                                self.line_no,
-                                format!(
-                                    "node {label}: {} of {in_data} values read; expected a continuation line ' -2', got '{}'",
-                                    v.len(),
-                                    clip(&c)
-                                ),
-                            ));
-                        }
-                        let w = if format == 0 { 5 } else { 10 };
-                        let more = fields12(&cols(&c, 3 + w, c.len()))
-                            .filter(|m| !m.is_empty() && m.iter().all(|x| x.is_finite()))
-                            .ok_or_else(|| {
-                                self.err(
-                                    Some(block),
-                                    self.line_no,
-                                    format!("node {label}: expected finite values (12 columns each), got '{}'", clip(&c)),
-                                )
-                            })?;
-                        v.extend(more);
-                    }
-                    if v.len() > in_data {
-                        return Err(self.err(
-                            Some(block),
-                            self.line_no,
-                            format!("node {label}: {} values; the ' -5' lines announce {in_data}", v.len()),
-                        ));
-                    }
-                    disp.push((label, [v[0], v[1], v[2]]));
-                }
-                _ => {
-                    return Err(self.err(
-                        Some(block),
-                        self.line_no,
-                        format!(
-                            "expected a DISP line ' -1  <node> <D1> <D2> <D3>' or the block end ' -3', got '{}'",
-                            clip(&l)
-                        ),
-                    ))
-                }
-            }
-            l = self.need_line(block)?;
-        }
+        let disp = self.disp_lines(first_data, format, in_data, block)?;
         if disp.len() as u64 != count {
             return Err(self.err(
                 Some(block),
@@ -526,6 +445,154 @@ impl<R: BufRead> Parser<'_, R> {
             generalised_mass: step.generalised_mass,
             displacements: disp,
         });
+        Ok(())
+    }
+
+    /// The `100C` line `head` of the results `block` (binary formats refused).
+    fn results_head(&self, head: &str, block: Block) -> Result<ResultsHead> {
+        // (1X,'  100','C',6A1,E12.5,I12,20A1,I2,I5,10A1,I2)
+        let value = parse_f(cols(head, 12, 24).trim());
+        let count = cols(head, 24, 36).trim().parse::<u64>().ok();
+        let ictype = cols(head, 56, 58).trim().parse::<i64>().ok();
+        let numstep = cols(head, 58, 63).trim().parse::<i64>().ok();
+        let format = cols(head, 73, 75).trim().parse::<u8>().ok().unwrap_or(1);
+        let (Some(value), Some(count)) = (value, count) else {
+            return Err(self.err(
+                Some(block),
+                block.line,
+                format!(
+                    "expected (1X,'  100','C',6A1,E12.5,I12,20A1,I2,I5,10A1,I2): set name, value, number of nodes, text, analysis type, step, analysis name, format; got '{}'",
+                    clip(head)
+                ),
+            ));
+        };
+        if format > 1 {
+            return Err(self.err(
+                Some(block),
+                block.line,
+                format!("format {format} (binary) is not read: meid reads ASCII .frd files (formats 0 and 1, CalculiX's default)"),
+            ));
+        }
+        Ok(ResultsHead {
+            value,
+            count,
+            ictype,
+            numstep,
+            format,
+        })
+    }
+
+    /// The `-4` line (the result's name) and the `-5` lines (one per component; those marked
+    /// "exists = 1" are not in the data) of the results `block`: the name, the number of
+    /// components in the data and the first line after the `-5` lines.
+    fn components(&mut self, block: Block) -> Result<(String, usize, String)> {
+        // -4: the result's name and number of components.
+        let l4 = self.need_line(block)?;
+        if cols(&l4, 0, 3).trim() != "-4" {
+            return Err(self.err(
+                Some(block),
+                self.line_no,
+                format!(
+                    "expected ' -4  <name> <components> <type>' after the '  100C' line, got '{}'",
+                    clip(&l4)
+                ),
+            ));
+        }
+        let name = cols(&l4, 5, 13).trim().to_string();
+        let mut in_data = 0usize;
+        let first_data = loop {
+            let l = self.need_line(block)?;
+            if cols(&l, 0, 3).trim() != "-5" {
+                break l;
+            }
+            let exists = cols(&l, 33, 38).trim().parse::<i64>().unwrap_or(0);
+            if exists != 1 {
+                in_data += 1;
+            }
+        };
+        Ok((name, in_data, first_data))
+    }
+
+    /// The `DISP` data lines of a results `block` from `first` to the block end ` -3`: per
+    /// node its label and `[D1, D2, D3]` (of `in_data` values, continuation lines included).
+    fn disp_lines(
+        &mut self,
+        first: String,
+        format: u8,
+        in_data: usize,
+        block: Block,
+    ) -> Result<Vec<(i64, [f64; 3])>> {
+        let mut disp = Vec::new();
+        let mut l = first;
+        loop {
+            match cols(&l, 0, 3).trim() {
+                "-3" => break,
+                "-1" => {
+                    let (label, mut v) = self.data_line(&l, format, in_data, block, "DISP")?;
+                    self.continuation(label, &mut v, format, in_data, block)?;
+                    if v.len() > in_data {
+                        return Err(self.err(
+                            Some(block),
+                            self.line_no,
+                            format!("node {label}: {} values; the ' -5' lines announce {in_data}", v.len()),
+                        ));
+                    }
+                    disp.push((label, [v[0], v[1], v[2]]));
+                }
+                _ => {
+                    return Err(self.err(
+                        Some(block),
+                        self.line_no,
+                        format!(
+                            "expected a DISP line ' -1  <node> <D1> <D2> <D3>' or the block end ' -3', got '{}'",
+                            clip(&l)
+                        ),
+                    ))
+                }
+            }
+            l = self.need_line(block)?;
+        }
+        Ok(disp)
+    }
+
+    /// The continuation lines (` -2`) of node `label`'s data line, which carry values 7, 8,
+    /// ..., appended to `v` until it holds `in_data` values.
+    fn continuation(
+        &mut self,
+        label: i64,
+        v: &mut Vec<f64>,
+        format: u8,
+        in_data: usize,
+        block: Block,
+    ) -> Result<()> {
+        while v.len() < in_data {
+            let c = self.need_line(block)?;
+            if cols(&c, 0, 3).trim() != "-2" {
+                return Err(self.err(
+                    Some(block),
+                    self.line_no,
+                    format!(
+                        "node {label}: {} of {in_data} values read; expected a continuation line ' -2', got '{}'",
+                        v.len(),
+                        clip(&c)
+                    ),
+                ));
+            }
+            let w = if format == 0 { 5 } else { 10 };
+            let more = fields12(&cols(&c, 3 + w, c.len()))
+                .filter(|m| !m.is_empty() && m.iter().all(|x| x.is_finite()))
+                .ok_or_else(|| {
+                    self.err(
+                        Some(block),
+                        self.line_no,
+                        format!(
+                            "node {label}: expected finite values (12 columns each), got '{}'",
+                            clip(&c)
+                        ),
+                    )
+                })?;
+            v.extend(more);
+        }
         Ok(())
     }
 }

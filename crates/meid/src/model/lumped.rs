@@ -196,7 +196,68 @@ fn spread(modes: &dense::DenseModes) -> (Option<f64>, f64) {
 /// floor through a spring made rigid to the ground is the force the other elements transmit
 /// to the fixed masses (their inertia is zero).
 pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Result<ModalModel> {
-    let base = "structure.lumped";
+    let base = BASE;
+    let index = mass_index(l, src)?;
+    let (springs, dashpots) = elements(l, src, &index)?;
+    let masses: Vec<f64> = l.masses.iter().map(|m| m.mass).collect();
+    let role_masses: Vec<usize> = ctx
+        .role_points
+        .iter()
+        .filter_map(|(p, _)| index.get(p).copied())
+        .collect();
+    let els = Elements {
+        masses: &masses,
+        springs: &springs,
+        dashpots: &dashpots,
+    };
+    let (part, mut notes) = rigid_limit(l, &els, &role_masses, ctx.contact_omega_rad_per_s)?;
+    let sys = System::build(&part, &masses, &springs, &dashpots);
+    let nd = sys.mass.len();
+    if nd == 0 {
+        return Err(src.error(
+            &format!("{base}.springs"),
+            format!("{base}: every mass is joined rigidly to the ground; nothing moves"),
+        ));
+    }
+    for d in &dashpots {
+        if part.node(d.a) == part.node(d.b) && !notes.is_empty() {
+            notes.push(format!(
+                "{} ('{}') joins masses made rigid together: it does nothing and is left out",
+                d.path, d.name
+            ));
+        }
+    }
+    let modes = merged_modes(&sys)?;
+    let mut model = modal_part(l, src, &sys, &modes, &mut notes)?;
+    model.floor_force = floor_force(l, src, &sys, &modes, &els)?;
+    model.labels = modes
+        .omega_rad_per_s
+        .iter()
+        .enumerate()
+        .map(|(j, w)| format!("mode {} ({:.4} Hz)", j + 1, w / TAU))
+        .collect();
+    flexibility_at_masses(l, &sys, &modes, &mut model);
+    if let Some(w) = spread_warning(&sys, &part, &springs, &modes) {
+        model.warnings.push(w);
+    }
+    model.notes = notes;
+    Ok(model)
+}
+
+/// The model's path in the input file.
+const BASE: &str = "structure.lumped";
+
+/// The masses, springs and dashpots of a lumped model.
+struct Elements<'a> {
+    masses: &'a [f64],
+    springs: &'a [Element],
+    dashpots: &'a [Element],
+}
+
+/// Each mass's index by name, the masses checked: at least one, each finite and > 0 kg, the
+/// names unique and not `ground`.
+fn mass_index(l: &LumpedSpec, src: &Source) -> Result<BTreeMap<String, usize>> {
+    let base = BASE;
     let n = l.masses.len();
     if n == 0 {
         return Err(src.error(
@@ -227,6 +288,17 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
             ));
         }
     }
+    Ok(index)
+}
+
+/// The springs (finite stiffness > 0 N/m) and dashpots (finite damping ≥ 0 N·s/m), each
+/// between two different nodes named in `index` or `ground`.
+fn elements(
+    l: &LumpedSpec,
+    src: &Source,
+    index: &BTreeMap<String, usize>,
+) -> Result<(Vec<Element>, Vec<Element>)> {
+    let base = BASE;
     let node = |name: &str, path: &str| -> Result<Option<usize>> {
         if name == GROUND {
             return Ok(None);
@@ -298,19 +370,29 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
             path,
         });
     }
-    let masses: Vec<f64> = l.masses.iter().map(|m| m.mass).collect();
-    let role_masses: Vec<usize> = ctx
-        .role_points
-        .iter()
-        .filter_map(|(p, _)| index.get(p).copied())
-        .collect();
+    Ok((springs, dashpots))
+}
 
-    // Rigid limit: merge the stiffest spring while the merged model is the more accurate one.
-    let wc2 = ctx.contact_omega_rad_per_s.powi(2);
+/// The rigid limit: the stiffest spring merged, one at a time, while the merged model is the
+/// more accurate one (`λ_r² ≥ λ_hi λ_lo / ε`, λ_hi at least the contact frequency `wc²`) and
+/// no mass with a role is fixed; the partition and a note per merge.
+fn rigid_limit(
+    l: &LumpedSpec,
+    els: &Elements<'_>,
+    role_masses: &[usize],
+    contact_omega_rad_per_s: f64,
+) -> Result<(Partition, Vec<String>)> {
+    let Elements {
+        masses,
+        springs,
+        dashpots,
+    } = *els;
+    let n = masses.len();
+    let wc2 = contact_omega_rad_per_s.powi(2);
     let mut part = Partition::new(n);
     let mut notes = Vec::new();
     loop {
-        let sys = System::build(&part, &masses, &springs, &dashpots);
+        let sys = System::build(&part, masses, springs, dashpots);
         let Some((r, lam_r)) = springs
             .iter()
             .enumerate()
@@ -326,7 +408,7 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
         if role_masses.iter().any(|&i| trial.find(i) == g) {
             break;
         }
-        let tsys = System::build(&trial, &masses, &springs, &dashpots);
+        let tsys = System::build(&trial, masses, springs, dashpots);
         if tsys.mass.is_empty() {
             break;
         }
@@ -362,26 +444,40 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
         ));
         part = trial;
     }
-    let sys = System::build(&part, &masses, &springs, &dashpots);
-    let nd = sys.mass.len();
-    if nd == 0 {
-        return Err(src.error(
-            &format!("{base}.springs"),
-            format!("{base}: every mass is joined rigidly to the ground; nothing moves"),
-        ));
-    }
-    for d in &dashpots {
-        if part.node(d.a) == part.node(d.b) && !notes.is_empty() {
-            notes.push(format!(
-                "{} ('{}') joins masses made rigid together: it does nothing and is left out",
-                d.path, d.name
-            ));
-        }
-    }
+    Ok((part, notes))
+}
+
+/// The merged system's modes, each oriented (largest entry positive) in the canonical basis
+/// of its eigenspace.
+fn merged_modes(sys: &System) -> Result<dense::DenseModes> {
     let mut modes = dense::solve(sys.k.as_ref(), sys.mass_matrix().as_ref())?;
     // The sign convention of every computed mode: largest entry positive.
     dense::orient_modes(&mut modes.shapes);
     crate::modal::eigenspace::canonical_basis(&mut modes.shapes, &modes.omega_rad_per_s, &[]);
+    Ok(modes)
+}
+
+/// The row of mode shapes at mass `i` (zeros for a mass fixed to the ground).
+fn shape_row(sys: &System, modes: &dense::DenseModes, i: usize) -> Vec<f64> {
+    let nd = sys.mass.len();
+    match sys.dof[i] {
+        Some(d) => (0..nd).map(|j| modes.shapes[(d, j)]).collect(),
+        None => vec![0.0; nd],
+    }
+}
+
+/// The modal model of the merged system: its frequencies and damping ratios (per-mode ratios
+/// given for the original modes keep their first entries, with a note), the dashpots' modal
+/// damping `Φᵀ C Φ`, the mode shapes at every mass and the effective masses `Γ_j²`.
+fn modal_part(
+    l: &LumpedSpec,
+    src: &Source,
+    sys: &System,
+    modes: &dense::DenseModes,
+    notes: &mut Vec<String>,
+) -> Result<ModalModel> {
+    let base = BASE;
+    let (n, nd) = (l.masses.len(), sys.mass.len());
     let zeta_path = format!("{base}.damping_ratios");
     let zeta = match &l.damping_ratios {
         Some(Ratios::PerMode(v)) if nd < n && v.len() == n => {
@@ -412,12 +508,7 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
             model.damping[a * nd + b] += s;
         }
     }
-    let row = |i: usize| -> Vec<f64> {
-        match sys.dof[i] {
-            Some(d) => (0..nd).map(|j| phi[(d, j)]).collect(),
-            None => vec![0.0; nd],
-        }
-    };
+    let row = |i: usize| shape_row(sys, modes, i);
     // Γ_j = Σ_i m_i ψ_j(i): every mass translates by 1 along the line of the blow (masses held
     // by a rigid spring to the ground have ψ = 0; merged masses share their DOF's row).
     let mut gamma = vec![0.0; nd];
@@ -429,8 +520,23 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
         model.points.insert(ms.name.clone(), r);
     }
     model.effective_mass_kg = Some(gamma.iter().map(|g| g * g).collect());
+    Ok(model)
+}
 
-    // Force to the floor.
+/// The force to the floor: the forces of the grounded springs and dashpots `floor` names
+/// (default: all of them), in modal coordinates; a mass fixed by a rigid spring passes on the
+/// forces of the elements joining it to moving masses. `None` when no element is selected.
+fn floor_force(
+    l: &LumpedSpec,
+    src: &Source,
+    sys: &System,
+    modes: &dense::DenseModes,
+    els: &Elements<'_>,
+) -> Result<Option<FloorForce>> {
+    let base = BASE;
+    let (springs, dashpots) = (els.springs, els.dashpots);
+    let nd = sys.mass.len();
+    let row = |i: usize| shape_row(sys, modes, i);
     let grounded: Vec<(&Element, bool)> = springs
         .iter()
         .map(|e| (e, true))
@@ -463,60 +569,66 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
             out
         }
     };
-    if !selected.is_empty() {
-        let mut f = FloorForce {
-            stiffness: vec![0.0; nd],
-            damping: vec![0.0; nd],
-        };
-        let mut add = |i: usize, v: f64, is_spring: bool| {
-            let r = row(i);
-            let t = if is_spring {
-                &mut f.stiffness
-            } else {
-                &mut f.damping
-            };
-            for j in 0..nd {
-                t[j] += v * r[j];
-            }
-        };
-        let mut reaction = false;
-        for (e, is_spring) in &selected {
-            let i = e.a.or(e.b).unwrap_or(0);
-            if sys.dof[i].is_some() {
-                add(i, e.value, *is_spring);
-            } else {
-                reaction = true;
-            }
-        }
-        if reaction {
-            // Masses fixed by a rigid spring to the ground pass on to the floor the forces of
-            // the elements joining them to moving masses: F = Σ k_e u_j + c_e u̇_j.
-            for (e, is_spring) in springs
-                .iter()
-                .map(|e| (e, true))
-                .chain(dashpots.iter().map(|e| (e, false)))
-            {
-                let (Some(a), Some(b)) = (e.a, e.b) else {
-                    continue;
-                };
-                match (sys.dof[a], sys.dof[b]) {
-                    (None, Some(_)) => add(b, e.value, is_spring),
-                    (Some(_), None) => add(a, e.value, is_spring),
-                    _ => {}
-                }
-            }
-        }
-        model.floor_force = Some(f);
+    if selected.is_empty() {
+        return Ok(None);
     }
-    model.labels = modes
-        .omega_rad_per_s
-        .iter()
-        .enumerate()
-        .map(|(j, w)| format!("mode {} ({:.4} Hz)", j + 1, w / TAU))
-        .collect();
+    let mut f = FloorForce {
+        stiffness: vec![0.0; nd],
+        damping: vec![0.0; nd],
+    };
+    let mut add = |i: usize, v: f64, is_spring: bool| {
+        let r = row(i);
+        let t = if is_spring {
+            &mut f.stiffness
+        } else {
+            &mut f.damping
+        };
+        for j in 0..nd {
+            t[j] += v * r[j];
+        }
+    };
+    let mut reaction = false;
+    for (e, is_spring) in &selected {
+        let i = e.a.or(e.b).unwrap_or(0);
+        if sys.dof[i].is_some() {
+            add(i, e.value, *is_spring);
+        } else {
+            reaction = true;
+        }
+    }
+    if reaction {
+        // Masses fixed by a rigid spring to the ground pass on to the floor the forces of
+        // the elements joining them to moving masses: F = Σ k_e u_j + c_e u̇_j.
+        for (e, is_spring) in springs
+            .iter()
+            .map(|e| (e, true))
+            .chain(dashpots.iter().map(|e| (e, false)))
+        {
+            let (Some(a), Some(b)) = (e.a, e.b) else {
+                continue;
+            };
+            match (sys.dof[a], sys.dof[b]) {
+                (None, Some(_)) => add(b, e.value, is_spring),
+                (Some(_), None) => add(a, e.value, is_spring),
+                _ => {}
+            }
+        }
+    }
+    Ok(Some(f))
+}
 
-    // Static flexibility of the (merged) structure at every mass, from its stiffness matrix.
-    let (lam_lo, lam_hi) = spread(&modes);
+/// The static flexibility of the (merged) structure at every mass, from its stiffness matrix
+/// (`truncation::static_flexibility`); a warning instead when it cannot be computed.
+fn flexibility_at_masses(
+    l: &LumpedSpec,
+    sys: &System,
+    modes: &dense::DenseModes,
+    model: &mut ModalModel,
+) {
+    let base = BASE;
+    let nd = sys.mass.len();
+    let phi = &modes.shapes;
+    let (lam_lo, _) = spread(modes);
     let rigid: Vec<Vec<f64>> = (0..nd)
         .filter(|&j| modes.omega_rad_per_s[j] == 0.0)
         .map(|j| (0..nd).map(|i| phi[(i, j)]).collect())
@@ -553,58 +665,63 @@ pub fn modal_model(l: &LumpedSpec, src: &Source, ctx: &ReductionContext) -> Resu
             "{base}: no static flexibility, so no truncation table: {e}"
         )),
     }
+}
 
-    // Spread the eigen-solver cannot resolve (what is left after the rigid-limit merges).
-    if let Some(lo) = lam_lo {
-        let s = lam_hi / lo;
-        if s > conditioning::MAX_RESOLVED_SPREAD {
-            let stiff = springs
+/// The warning for a spread of frequencies the eigen-solver cannot resolve (what is left
+/// after the rigid-limit merges), naming the stiffest spring between moving groups.
+fn spread_warning(
+    sys: &System,
+    part: &Partition,
+    springs: &[Element],
+    modes: &dense::DenseModes,
+) -> Option<String> {
+    let base = BASE;
+    let (lam_lo, lam_hi) = spread(modes);
+    let lo = lam_lo.filter(|lo| lam_hi / lo > conditioning::MAX_RESOLVED_SPREAD)?;
+    let s = lam_hi / lo;
+    let stiff = springs
+        .iter()
+        .filter_map(|e| sys.element_frequency2(part, e).map(|f| (e, f)))
+        .max_by(|x, y| x.1.total_cmp(&y.1));
+    let (field, advice) = match stiff {
+        Some((e, _)) => {
+            // The stiffest of the other springs between moving groups.
+            let rest = springs
                 .iter()
-                .filter_map(|e| sys.element_frequency2(&part, e).map(|f| (e, f)))
-                .max_by(|x, y| x.1.total_cmp(&y.1));
-            let (field, advice) = match stiff {
-                Some((e, _)) => {
-                    // The stiffest of the other springs between moving groups.
-                    let rest = springs
-                        .iter()
-                        .filter(|o| !std::ptr::eq(*o, e))
-                        .filter(|o| sys.element_frequency2(&part, o).is_some())
-                        .map(|o| o.value)
-                        .fold(0.0_f64, f64::max);
-                    let hint = if rest > 0.0 {
-                        format!(
-                            " or lower it to ~1e3 times the others (~{:.1e} N/m)",
-                            1e3 * rest
-                        )
-                    } else {
-                        String::new()
-                    };
-                    (
-                        format!("{}.stiffness", e.path),
-                        format!(
-                            "{}.stiffness = {:.3e} N/m ('{}') is the stiffest element: give it as \
-                             rigid (merge the masses it joins into one){hint}; a very light mass \
-                             on it has the same effect",
-                            e.path, e.value, e.name
-                        ),
-                    )
-                }
-                None => (
-                    base.to_string(),
-                    "a very light mass or a very stiff spring sets it".to_string(),
-                ),
+                .filter(|o| !std::ptr::eq(*o, e))
+                .filter(|o| sys.element_frequency2(part, o).is_some())
+                .map(|o| o.value)
+                .fold(0.0_f64, f64::max);
+            let hint = if rest > 0.0 {
+                format!(
+                    " or lower it to ~1e3 times the others (~{:.1e} N/m)",
+                    1e3 * rest
+                )
+            } else {
+                String::new()
             };
-            model.warnings.push(format!(
-                "{field}: the structure's frequencies span (ω_max/ω_min)² = {s:.2e}, beyond the \
-                 {:.1e} that double precision resolves to 1e-6: its lowest frequency carries a \
-                 relative error up to ε·{s:.1e} = {:.1e}. {advice}",
-                conditioning::MAX_RESOLVED_SPREAD,
-                f64::EPSILON * s
-            ));
+            (
+                format!("{}.stiffness", e.path),
+                format!(
+                    "{}.stiffness = {:.3e} N/m ('{}') is the stiffest element: give it as \
+                     rigid (merge the masses it joins into one){hint}; a very light mass \
+                     on it has the same effect",
+                    e.path, e.value, e.name
+                ),
+            )
         }
-    }
-    model.notes = notes;
-    Ok(model)
+        None => (
+            base.to_string(),
+            "a very light mass or a very stiff spring sets it".to_string(),
+        ),
+    };
+    Some(format!(
+        "{field}: the structure's frequencies span (ω_max/ω_min)² = {s:.2e}, beyond the \
+         {:.1e} that double precision resolves to 1e-6: its lowest frequency carries a \
+         relative error up to ε·{s:.1e} = {:.1e}. {advice}",
+        conditioning::MAX_RESOLVED_SPREAD,
+        f64::EPSILON * s
+    ))
 }
 
 /// Modes given as a table.

@@ -224,6 +224,10 @@ fn hessenberg(h: &mut [f64], z: &mut [f64], n: usize, tmp: &mut [f64]) {
 
 /// Francis double-shift QR to real Schur form, accumulating into `z`; eigenvalues in
 /// `wr + i wi`. Returns false when an eigenvalue needs more than `30 max(n, 10)` iterations.
+///
+/// Each iteration on the active block `l..=i` (`l` from [`negligible_subdiagonal`]): the
+/// shifts ([`shifts`]), the bulge's start ([`bulge_start`]) and the sweep ([`qr_sweep`]),
+/// until a 1×1 or 2×2 block deflates at the bottom.
 fn francis(h: &mut [f64], z: &mut [f64], n: usize, wr: &mut [f64], wi: &mut [f64]) -> bool {
     let smlnum = f64::MIN_POSITIVE * (n as f64 / ULP);
     let itmax = 30 * n.max(10);
@@ -232,37 +236,7 @@ fn francis(h: &mut [f64], z: &mut [f64], n: usize, wr: &mut [f64], wi: &mut [f64
         let i = hi - 1;
         let mut its = 0usize;
         let l = loop {
-            // Look for a negligible subdiagonal entry (Ahues–Tisseur, dlahqr).
-            let mut k = i;
-            while k > 0 {
-                let hkk1 = h[ix(k, k - 1, n)].abs();
-                if hkk1 <= smlnum {
-                    break;
-                }
-                let mut tst = h[ix(k - 1, k - 1, n)].abs() + h[ix(k, k, n)].abs();
-                if tst == 0.0 {
-                    if k >= 2 {
-                        tst += h[ix(k - 1, k - 2, n)].abs();
-                    }
-                    if k < i {
-                        tst += h[ix(k + 1, k, n)].abs();
-                    }
-                }
-                if hkk1 <= ULP * tst {
-                    let hk1k = h[ix(k - 1, k, n)].abs();
-                    let ab = hkk1.max(hk1k);
-                    let ba = hkk1.min(hk1k);
-                    let hkk = h[ix(k, k, n)].abs();
-                    let dif = (h[ix(k - 1, k - 1, n)] - h[ix(k, k, n)]).abs();
-                    let aa = hkk.max(dif);
-                    let bb = hkk.min(dif);
-                    let s = aa + ab;
-                    if ba * (ab / s) <= smlnum.max(ULP * (bb * (aa / s))) {
-                        break;
-                    }
-                }
-                k -= 1;
-            }
+            let k = negligible_subdiagonal(h, n, i, smlnum);
             if k > 0 {
                 h[ix(k, k - 1, n)] = 0.0;
             }
@@ -274,125 +248,9 @@ fn francis(h: &mut [f64], z: &mut [f64], n: usize, wr: &mut [f64], wi: &mut [f64
                 return false;
             }
             let l = k;
-            // Shifts: the eigenvalues of [[y, ·], [·, x]] with off-diagonal product w.
-            let (mut x, mut y, mut w);
-            if its.is_multiple_of(20) {
-                let s = h[ix(i, i - 1, n)].abs() + h[ix(i - 1, i - 2, n)].abs();
-                x = 0.75 * s + h[ix(i, i, n)];
-                y = x;
-                w = -0.4375 * s * s;
-            } else if its.is_multiple_of(10) {
-                let s = h[ix(l + 1, l, n)].abs() + h[ix(l + 2, l + 1, n)].abs();
-                x = 0.75 * s + h[ix(l, l, n)];
-                y = x;
-                w = -0.4375 * s * s;
-            } else {
-                x = h[ix(i, i, n)];
-                y = h[ix(i - 1, i - 1, n)];
-                w = h[ix(i, i - 1, n)] * h[ix(i - 1, i, n)];
-                let p = 0.5 * (y - x);
-                let q = p * p + w;
-                if q >= 0.0 {
-                    // Real shifts: use the one closer to h_ii twice.
-                    let sq = q.sqrt();
-                    let r1 = x + p + sq;
-                    let r2 = x + p - sq;
-                    let r = if (r1 - x).abs() <= (r2 - x).abs() {
-                        r1
-                    } else {
-                        r2
-                    };
-                    x = r;
-                    y = r;
-                    w = 0.0;
-                }
-            }
-            // Start of the bulge: two consecutive small subdiagonal entries.
-            let mut m = i - 2;
-            let mut v = [0.0f64; 3];
-            loop {
-                let zz = h[ix(m, m, n)];
-                let r = x - zz;
-                let s = y - zz;
-                let h21 = h[ix(m + 1, m, n)];
-                v[0] = r * s - w + h[ix(m, m + 1, n)] * h21;
-                v[1] = h21 * (h[ix(m + 1, m + 1, n)] - zz - r - s);
-                v[2] = h21 * h[ix(m + 2, m + 1, n)];
-                let sc = v[0].abs() + v[1].abs() + v[2].abs();
-                if sc > 0.0 {
-                    v.iter_mut().for_each(|t| *t /= sc);
-                }
-                if m == l {
-                    break;
-                }
-                let lhs = h[ix(m, m - 1, n)].abs() * (v[1].abs() + v[2].abs());
-                let rhs = ULP
-                    * v[0].abs()
-                    * (h[ix(m - 1, m - 1, n)].abs() + zz.abs() + h[ix(m + 1, m + 1, n)].abs());
-                if lhs <= rhs {
-                    break;
-                }
-                m -= 1;
-            }
-            // Double-shift QR sweep (bulge chase).
-            for k in m..i {
-                let nr = 3.min(i - k + 1);
-                if k > m {
-                    for (t, vt) in v.iter_mut().enumerate().take(nr) {
-                        *vt = h[ix(k + t, k - 1, n)];
-                    }
-                }
-                // Reflector I − τ u uᵀ, u = (1, v1, v2), mapping v to (β, 0, 0) (dlarfg).
-                let alpha = v[0];
-                let xnorm = if nr == 3 {
-                    (v[1] * v[1] + v[2] * v[2]).sqrt()
-                } else {
-                    v[1].abs()
-                };
-                if xnorm == 0.0 {
-                    continue;
-                }
-                // |v| ≤ 1 after the scaling above: no overflow in the squares.
-                let beta = -(alpha * alpha + xnorm * xnorm)
-                    .sqrt()
-                    .copysign(if alpha >= 0.0 { 1.0 } else { -1.0 });
-                let tau = (beta - alpha) / beta;
-                let sc = 1.0 / (alpha - beta);
-                let v1 = v[1] * sc;
-                let v2 = if nr == 3 { v[2] * sc } else { 0.0 };
-                if k > m {
-                    h[ix(k, k - 1, n)] = beta;
-                    h[ix(k + 1, k - 1, n)] = 0.0;
-                    if nr == 3 {
-                        h[ix(k + 2, k - 1, n)] = 0.0;
-                    }
-                } else if m > l {
-                    h[ix(k, k - 1, n)] *= 1.0 - tau;
-                }
-                let t1 = tau * v1;
-                let t2 = tau * v2;
-                if nr == 3 {
-                    for j in k..n {
-                        let c = &mut h[j * n + k..j * n + k + 3];
-                        let s = c[0] + v1 * c[1] + v2 * c[2];
-                        c[0] -= s * tau;
-                        c[1] -= s * t1;
-                        c[2] -= s * t2;
-                    }
-                    let rmax = (k + 3).min(i);
-                    apply_right3(h, n, k, rmax + 1, tau, t1, t2, v1, v2);
-                    apply_right3(z, n, k, n, tau, t1, t2, v1, v2);
-                } else {
-                    for j in k..n {
-                        let c = &mut h[j * n + k..j * n + k + 2];
-                        let s = c[0] + v1 * c[1];
-                        c[0] -= s * tau;
-                        c[1] -= s * t1;
-                    }
-                    apply_right2(h, n, k, i + 1, tau, t1, v1);
-                    apply_right2(z, n, k, n, tau, t1, v1);
-                }
-            }
+            let (x, y, w) = shifts(h, n, l, i, its);
+            let (m, v) = bulge_start(h, n, l, i, (x, y, w));
+            qr_sweep(h, z, n, (l, m, i), v);
         };
         if l == i {
             wr[i] = h[ix(i, i, n)];
@@ -404,6 +262,186 @@ fn francis(h: &mut [f64], z: &mut [f64], n: usize, wr: &mut [f64], wi: &mut [f64
         }
     }
     true
+}
+
+/// The row `k ≤ i` of the lowest negligible subdiagonal entry `h[k, k−1]` of the active
+/// block ending at row `i` (0 when there is none), by the Ahues–Tisseur criterion of LAPACK's
+/// `dlahqr`.
+fn negligible_subdiagonal(h: &[f64], n: usize, i: usize, smlnum: f64) -> usize {
+    let mut k = i;
+    while k > 0 {
+        let hkk1 = h[ix(k, k - 1, n)].abs();
+        if hkk1 <= smlnum {
+            break;
+        }
+        let mut tst = h[ix(k - 1, k - 1, n)].abs() + h[ix(k, k, n)].abs();
+        if tst == 0.0 {
+            if k >= 2 {
+                tst += h[ix(k - 1, k - 2, n)].abs();
+            }
+            if k < i {
+                tst += h[ix(k + 1, k, n)].abs();
+            }
+        }
+        if hkk1 <= ULP * tst {
+            let hk1k = h[ix(k - 1, k, n)].abs();
+            let ab = hkk1.max(hk1k);
+            let ba = hkk1.min(hk1k);
+            let hkk = h[ix(k, k, n)].abs();
+            let dif = (h[ix(k - 1, k - 1, n)] - h[ix(k, k, n)]).abs();
+            let aa = hkk.max(dif);
+            let bb = hkk.min(dif);
+            let s = aa + ab;
+            if ba * (ab / s) <= smlnum.max(ULP * (bb * (aa / s))) {
+                break;
+            }
+        }
+        k -= 1;
+    }
+    k
+}
+
+/// The shifts of iteration `its` on the block `l..=i`: the eigenvalues of `[[y, ·], [·, x]]`
+/// with off-diagonal product `w`, the trailing 2×2 block's (a real pair replaced by the one
+/// closer to `h[i, i]`, twice), or an exceptional shift every 10th iteration.
+fn shifts(h: &[f64], n: usize, l: usize, i: usize, its: usize) -> (f64, f64, f64) {
+    let (mut x, mut y, mut w);
+    if its.is_multiple_of(20) {
+        let s = h[ix(i, i - 1, n)].abs() + h[ix(i - 1, i - 2, n)].abs();
+        x = 0.75 * s + h[ix(i, i, n)];
+        y = x;
+        w = -0.4375 * s * s;
+    } else if its.is_multiple_of(10) {
+        let s = h[ix(l + 1, l, n)].abs() + h[ix(l + 2, l + 1, n)].abs();
+        x = 0.75 * s + h[ix(l, l, n)];
+        y = x;
+        w = -0.4375 * s * s;
+    } else {
+        x = h[ix(i, i, n)];
+        y = h[ix(i - 1, i - 1, n)];
+        w = h[ix(i, i - 1, n)] * h[ix(i - 1, i, n)];
+        let p = 0.5 * (y - x);
+        let q = p * p + w;
+        if q >= 0.0 {
+            // Real shifts: use the one closer to h_ii twice.
+            let sq = q.sqrt();
+            let r1 = x + p + sq;
+            let r2 = x + p - sq;
+            let r = if (r1 - x).abs() <= (r2 - x).abs() {
+                r1
+            } else {
+                r2
+            };
+            x = r;
+            y = r;
+            w = 0.0;
+        }
+    }
+    (x, y, w)
+}
+
+/// The bulge's start row `m ≥ l` (two consecutive small subdiagonal entries) and the first
+/// column `v` of the double-shift polynomial there, scaled to unit 1-norm.
+fn bulge_start(
+    h: &[f64],
+    n: usize,
+    l: usize,
+    i: usize,
+    shift: (f64, f64, f64),
+) -> (usize, [f64; 3]) {
+    let (x, y, w) = shift;
+    let mut m = i - 2;
+    let mut v = [0.0f64; 3];
+    loop {
+        let zz = h[ix(m, m, n)];
+        let r = x - zz;
+        let s = y - zz;
+        let h21 = h[ix(m + 1, m, n)];
+        v[0] = r * s - w + h[ix(m, m + 1, n)] * h21;
+        v[1] = h21 * (h[ix(m + 1, m + 1, n)] - zz - r - s);
+        v[2] = h21 * h[ix(m + 2, m + 1, n)];
+        let sc = v[0].abs() + v[1].abs() + v[2].abs();
+        if sc > 0.0 {
+            v.iter_mut().for_each(|t| *t /= sc);
+        }
+        if m == l {
+            break;
+        }
+        let lhs = h[ix(m, m - 1, n)].abs() * (v[1].abs() + v[2].abs());
+        let rhs = ULP
+            * v[0].abs()
+            * (h[ix(m - 1, m - 1, n)].abs() + zz.abs() + h[ix(m + 1, m + 1, n)].abs());
+        if lhs <= rhs {
+            break;
+        }
+        m -= 1;
+    }
+    (m, v)
+}
+
+/// The double-shift QR sweep (bulge chase) over rows `m..=i` of the block `l..=i`
+/// (`rows = (l, m, i)`) from the first column `v`: 3×3 (last: 2×2) reflectors applied to `h`
+/// and accumulated into `z`.
+fn qr_sweep(h: &mut [f64], z: &mut [f64], n: usize, rows: (usize, usize, usize), mut v: [f64; 3]) {
+    let (l, m, i) = rows;
+    for k in m..i {
+        let nr = 3.min(i - k + 1);
+        if k > m {
+            for (t, vt) in v.iter_mut().enumerate().take(nr) {
+                *vt = h[ix(k + t, k - 1, n)];
+            }
+        }
+        // Reflector I − τ u uᵀ, u = (1, v1, v2), mapping v to (β, 0, 0) (dlarfg).
+        let alpha = v[0];
+        let xnorm = if nr == 3 {
+            (v[1] * v[1] + v[2] * v[2]).sqrt()
+        } else {
+            v[1].abs()
+        };
+        if xnorm == 0.0 {
+            continue;
+        }
+        // |v| ≤ 1 after the scaling above: no overflow in the squares.
+        let beta = -(alpha * alpha + xnorm * xnorm)
+            .sqrt()
+            .copysign(if alpha >= 0.0 { 1.0 } else { -1.0 });
+        let tau = (beta - alpha) / beta;
+        let sc = 1.0 / (alpha - beta);
+        let v1 = v[1] * sc;
+        let v2 = if nr == 3 { v[2] * sc } else { 0.0 };
+        if k > m {
+            h[ix(k, k - 1, n)] = beta;
+            h[ix(k + 1, k - 1, n)] = 0.0;
+            if nr == 3 {
+                h[ix(k + 2, k - 1, n)] = 0.0;
+            }
+        } else if m > l {
+            h[ix(k, k - 1, n)] *= 1.0 - tau;
+        }
+        let t1 = tau * v1;
+        let t2 = tau * v2;
+        if nr == 3 {
+            for j in k..n {
+                let c = &mut h[j * n + k..j * n + k + 3];
+                let s = c[0] + v1 * c[1] + v2 * c[2];
+                c[0] -= s * tau;
+                c[1] -= s * t1;
+                c[2] -= s * t2;
+            }
+            let rmax = (k + 3).min(i);
+            apply_right3(h, n, k, rmax + 1, tau, t1, t2, v1, v2);
+            apply_right3(z, n, k, n, tau, t1, t2, v1, v2);
+        } else {
+            for j in k..n {
+                let c = &mut h[j * n + k..j * n + k + 2];
+                let s = c[0] + v1 * c[1];
+                c[0] -= s * tau;
+                c[1] -= s * t1;
+            }
+            apply_right2(h, n, k, i + 1, tau, t1, v1);
+            apply_right2(z, n, k, n, tau, t1, v1);
+        }
+    }
 }
 
 /// `M[0..rows, k..k+3] ← M (I − τ u uᵀ)`, `u = (1, v1, v2)`.
