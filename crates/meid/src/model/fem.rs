@@ -908,18 +908,86 @@ fn bed_part_mass(mesh: &crate::structure::Mesh, ctx: &ReductionContext) -> Optio
 /// gives the contact frequency (for the "auto" cutoff) and the model's named points.
 pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<FemAnalysis> {
     let base = "structure.fem";
-    if let Some(f) = spec.auto_max_hz {
-        if !(f.is_finite() && f > 0.0) {
-            return Err(src.error(
-                &format!("{base}.auto_max_hz"),
-                format!(
-                    "{base}.auto_max_hz must be a finite number > 0 Hz (got {})",
-                    crate::num(f)
-                ),
-            ));
+    check_auto_max_hz(spec, src)?;
+    let model = build_model(spec, src)?;
+    let (wanted, solved) = mode_counts(spec, src, model.n_dofs())?;
+    let (mut modes, solver) =
+        solve_modes(&model, spec.solver, solved.max(wanted)).map_err(|e| unsolvable(e, src))?;
+    let mut warnings = Vec::new();
+    let extent = super::general::bounding_diagonal(model.mesh.nodes.iter().copied());
+    warnings.extend(super::plausible::extent_slip(extent, base, src));
+    let score_points = score_points(spec, src, ctx, &model)?;
+    let functionals = point_functionals(&model, &score_points, ctx)?;
+    let cut_cluster = settle_modes(&mut modes, &functionals, wanted, solver)?;
+    let nm = modes.omega_rad_per_s.len();
+    let table = model.mode_table(&modes)?;
+    let psi = point_psi(&functionals, &modes);
+    let mut scores = vec![0.0; nm];
+    for p in &score_points {
+        for (s, v) in scores.iter_mut().zip(&psi[p]) {
+            *s += v * v;
         }
     }
-    let model = build_model(spec, src)?;
+    let static_flexibility = full_static_flexibility(&model, &modes, &functionals, &mut warnings);
+    let freq = &table.frequency_hz;
+    let input = AutoInput {
+        scores: &scores,
+        freq,
+        omega: &modes.omega_rad_per_s,
+        points: &score_points,
+        psi: &psi,
+        static_flexibility: &static_flexibility,
+        n_dofs: model.n_dofs(),
+    };
+    let (selected, selection) = select_modes(spec, src, ctx, &input, &mut warnings)?;
+    let cluster = eigenspace_clusters(&modes.omega_rad_per_s, cut_cluster);
+    warn_split_eigenspaces(&selected, &cluster, freq, &mut warnings);
+    let zeta = damping_ratios(spec, src, selected.len())?;
+    warn_split_damping(&selected, &zeta, &cluster, freq, &mut warnings);
+    let mut modal = reduced_model(spec, src, &model, &modes, &selected, &zeta)?;
+    let selected_residuals = sparse_residuals(&model, &modes, &selected);
+    warn_residuals(&selected, &selected_residuals, freq, &mut warnings);
+    modal.static_flexibility = static_flexibility;
+    modal.warnings = warnings;
+    modal.bed_mass_kg = bed_part_mass(&model.mesh, ctx);
+    if let Some(note) = model.constraint_like_note(CONSTRAINT_LIKE_RATIO) {
+        modal.notes.push(format!("{base}: {note}"));
+    }
+    Ok(FemAnalysis {
+        model,
+        modes,
+        table,
+        solver,
+        selected,
+        selection,
+        scores,
+        score_points,
+        selected_residuals,
+        modal,
+    })
+}
+
+/// `structure.fem.auto_max_hz`, when given, is a finite frequency > 0 Hz.
+fn check_auto_max_hz(spec: &FemSpec, src: &Source) -> Result<()> {
+    let base = "structure.fem";
+    match spec.auto_max_hz {
+        Some(f) if !(f.is_finite() && f > 0.0) => Err(src.error(
+            &format!("{base}.auto_max_hz"),
+            format!(
+                "{base}.auto_max_hz must be a finite number > 0 Hz (got {})",
+                crate::num(f)
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// The modes wanted (`structure.fem.count`, default 30, at most the model's `n_dofs`) and the
+/// modes to solve for: one more when the solver can compute it, so that a repeated eigenvalue
+/// cut by `count` (its partner the next mode) gets the canonical basis of its whole eigenspace
+/// too and the mode kept does not depend on the solver ([`settle_modes`] drops the extra one).
+fn mode_counts(spec: &FemSpec, src: &Source, n_dofs: usize) -> Result<(usize, usize)> {
+    let base = "structure.fem";
     let count = spec.count.unwrap_or(30);
     if count == 0 {
         return Err(src.error(
@@ -927,70 +995,67 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             format!("{base}.count must be >= 1"),
         ));
     }
-    let n_dofs = model.n_dofs();
     let lanczos = spec.solver.unwrap_or(if n_dofs < DENSE_LIMIT_DOFS {
         SolverSpec::Dense
     } else {
         SolverSpec::Lanczos
     }) == SolverSpec::Lanczos;
-    if lanczos {
-        let block = LanczosOptions::default().block_size;
-        let max = lanczos_max_modes(n_dofs, block);
-        if count.min(n_dofs) > max {
-            return Err(src.error(
-                &format!("{base}.count"),
-                format!(
-                    "{base}.count = {count}: the model has {n_dofs} degrees of freedom, of which the Lanczos solver computes at most {max} modes; lower {base}.count to {max} or less, or set {base}.solver = \"dense\" (all {n_dofs} modes; slow above ~{DENSE_LIMIT_DOFS} degrees of freedom)"
-                ),
-            ));
-        }
+    let max = lanczos_max_modes(n_dofs, LanczosOptions::default().block_size);
+    if lanczos && count.min(n_dofs) > max {
+        return Err(src.error(
+            &format!("{base}.count"),
+            format!(
+                "{base}.count = {count}: the model has {n_dofs} degrees of freedom, of which the Lanczos solver computes at most {max} modes; lower {base}.count to {max} or less, or set {base}.solver = \"dense\" (all {n_dofs} modes; slow above ~{DENSE_LIMIT_DOFS} degrees of freedom)"
+            ),
+        ));
     }
-    // One mode more than asked when the solver can compute it: a repeated eigenvalue cut by
-    // `count` (its partner the next mode) then gets the canonical basis of its whole eigenspace
-    // too, so that the mode kept does not depend on the solver; the extra mode is dropped below.
     let wanted = count.min(n_dofs);
     let mut solved = (count + 1).min(n_dofs);
     if lanczos {
-        solved = solved.min(lanczos_max_modes(
-            n_dofs,
-            LanczosOptions::default().block_size,
-        ));
+        solved = solved.min(max);
     }
-    let (mut modes, solver) =
-        solve_modes(&model, spec.solver, solved.max(wanted)).map_err(|e| unsolvable(e, src))?;
-    let mut warnings = Vec::new();
-    let extent = super::general::bounding_diagonal(model.mesh.nodes.iter().copied());
-    warnings.extend(super::plausible::extent_slip(extent, base, src));
+    Ok((wanted, solved))
+}
 
-    // The points that rank modes: `contact_points`, else the model's named points with a role.
-    let score_points: Vec<String> = match &spec.contact_points {
-        Some(v) => {
-            for (i, p) in v.iter().enumerate() {
-                if !model.mesh.points.contains_key(p) {
-                    let known: Vec<&str> = model.mesh.points.keys().map(|s| s.as_str()).collect();
-                    return Err(src.error(
-                        &format!("{base}.contact_points[{i}]"),
-                        format!(
-                            "{base}.contact_points: unknown point '{p}'; valid: {}",
-                            known.join(", ")
-                        ),
-                    ));
-                }
-            }
-            v.clone()
-        }
-        None => ctx
+/// The points that rank modes: `structure.fem.contact_points` (each a named point of the mesh),
+/// else the model's named points with a role that are in the mesh.
+fn score_points(
+    spec: &FemSpec,
+    src: &Source,
+    ctx: &ReductionContext,
+    model: &FeModel,
+) -> Result<Vec<String>> {
+    let base = "structure.fem";
+    let Some(v) = &spec.contact_points else {
+        return Ok(ctx
             .role_points
             .iter()
             .map(|(p, _)| p.clone())
             .filter(|p| model.mesh.points.contains_key(p))
-            .collect(),
+            .collect());
     };
-    // A repeated eigenvalue's modes: the basis of its eigenspace that does not depend on the
-    // solver (dense and Lanczos return different rotations of it), led by the direction that
-    // moves the first score point most (`modal::eigenspace`).
-    // The functionals of the score points, then of the role points (each once, in that order):
-    // the probes of the canonical basis, then the points' ψ.
+    for (i, p) in v.iter().enumerate() {
+        if !model.mesh.points.contains_key(p) {
+            let known: Vec<&str> = model.mesh.points.keys().map(|s| s.as_str()).collect();
+            return Err(src.error(
+                &format!("{base}.contact_points[{i}]"),
+                format!(
+                    "{base}.contact_points: unknown point '{p}'; valid: {}",
+                    known.join(", ")
+                ),
+            ));
+        }
+    }
+    Ok(v.clone())
+}
+
+/// The functionals (`ψ_i(P) = f_Pᵀ φ_i`) of the score points, then of the role points, each
+/// once and in that order: the probes of the canonical basis, then the points' ψ.
+fn point_functionals(
+    model: &FeModel,
+    score_points: &[String],
+    ctx: &ReductionContext,
+) -> Result<Vec<(String, Vec<f64>)>> {
     let mut functionals: Vec<(String, Vec<f64>)> = Vec::new();
     for p in score_points
         .iter()
@@ -1000,15 +1065,29 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             functionals.push((p.clone(), model.point_functional(p)?));
         }
     }
+    Ok(functionals)
+}
+
+/// Puts the solved modes in their reported form: a repeated eigenvalue's modes in the basis of
+/// its eigenspace that does not depend on the solver (dense and Lanczos return different
+/// rotations of it), led by the direction that moves the first probe point most
+/// (`modal::eigenspace`); every shape checked finite (ψ, effective masses and exported shapes
+/// are functions of the shapes: a non-finite entry is an error here, not a NaN in modes.csv);
+/// the modes cut to `wanted`. Returns the last wanted mode's eigenspace when it continues past
+/// `wanted`.
+fn settle_modes(
+    modes: &mut DenseModes,
+    functionals: &[(String, Vec<f64>)],
+    wanted: usize,
+    solver: &str,
+) -> Result<Option<std::ops::Range<usize>>> {
     let probes: Vec<&[f64]> = functionals.iter().map(|(_, f)| f.as_slice()).collect();
     crate::modal::eigenspace::canonical_basis(&mut modes.shapes, &modes.omega_rad_per_s, &probes);
-    // Every output (ψ, effective masses, exported shapes) is a function of the shapes: a
-    // non-finite entry is an error here, not a NaN in modes.csv.
     if let Some(j) =
         (0..modes.shapes.ncols()).find(|&j| modes.shapes.col(j).iter().any(|v| !v.is_finite()))
     {
         return Err(Error::numerical(
-            base,
+            "structure.fem",
             format!(
                 "mode {} ({:.6} Hz) has a non-finite mode-shape entry after the {solver} \
                  eigen-solution: its shape, ψ and effective masses cannot be reported",
@@ -1017,7 +1096,6 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             ),
         ));
     }
-    // The last wanted mode's eigenspace, when it continues past `count`.
     let cut_cluster = (modes.omega_rad_per_s.len() > wanted && wanted > 0)
         .then(|| crate::modal::eigenspace::degenerate_clusters(&modes.omega_rad_per_s))
         .map(|c| c[wanted - 1].clone())
@@ -1028,9 +1106,13 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
         modes.shapes = modes.shapes.subcols(0, wanted).to_owned();
         modes.rigid_body_modes = modes.omega_rad_per_s.iter().filter(|w| **w == 0.0).count();
     }
+    Ok(cut_cluster)
+}
+
+/// Each point's modal participation `ψ_i(P) = f_Pᵀ φ_i` over the modes.
+fn point_psi(functionals: &[(String, Vec<f64>)], modes: &DenseModes) -> BTreeMap<String, Vec<f64>> {
     let nm = modes.omega_rad_per_s.len();
-    let table = model.mode_table(&modes)?;
-    let psi: BTreeMap<String, Vec<f64>> = functionals
+    functionals
         .iter()
         .map(|(p, f)| {
             let v: Vec<f64> = (0..nm)
@@ -1038,16 +1120,13 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
                 .collect();
             (p.clone(), v)
         })
-        .collect();
-    let mut scores = vec![0.0; nm];
-    for p in &score_points {
-        for (s, v) in scores.iter_mut().zip(&psi[p]) {
-            *s += v * v;
-        }
-    }
+        .collect()
+}
 
-    // Static flexibility of the full model at those points (elastic part, module docs).
-    let rigid: Vec<Vec<f64>> = (0..nm)
+/// The rigid-body mode shapes (ω = 0) and the lowest elastic eigenvalue ω₁² (rad²/s²) of
+/// `modes`: what the inertia-relief static solution needs (`truncation::static_flexibility`).
+fn rigid_and_lowest(modes: &DenseModes) -> (Vec<Vec<f64>>, Option<f64>) {
+    let rigid = (0..modes.omega_rad_per_s.len())
         .filter(|&i| modes.omega_rad_per_s[i] == 0.0)
         .map(|i| modes.shapes.col(i).iter().copied().collect())
         .collect();
@@ -1056,8 +1135,20 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
         .iter()
         .find(|w| **w > 0.0)
         .map(|w| w * w);
+    (rigid, lowest_elastic)
+}
+
+/// The full model's static flexibility `G_PP` (m/N, elastic part, module docs) at each point
+/// of `functionals`; empty, with a warning, when the static solution fails.
+fn full_static_flexibility(
+    model: &FeModel,
+    modes: &DenseModes,
+    functionals: &[(String, Vec<f64>)],
+    warnings: &mut Vec<String>,
+) -> BTreeMap<String, f64> {
+    let (rigid, lowest_elastic) = rigid_and_lowest(modes);
     let fvecs: Vec<Vec<f64>> = functionals.iter().map(|(_, f)| f.clone()).collect();
-    let static_flexibility: BTreeMap<String, f64> = match truncation::static_flexibility(
+    match truncation::static_flexibility(
         model.stiffness.as_ref(),
         model.mass.as_ref(),
         &fvecs,
@@ -1067,36 +1158,30 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
         Ok(g) => functionals.iter().map(|(p, _)| p.clone()).zip(g).collect(),
         Err(e) => {
             warnings.push(format!(
-                "{base}: the static flexibility could not be computed, so modes are selected \
-                 without it and there is no truncation table: {e}"
+                "structure.fem: the static flexibility could not be computed, so modes are \
+                 selected without it and there is no truncation table: {e}"
             ));
             BTreeMap::new()
         }
-    };
+    }
+}
 
-    let freq = &table.frequency_hz;
-    let auto = |warnings: &mut Vec<String>| {
-        auto_select(
-            spec,
-            src,
-            ctx,
-            &AutoInput {
-                scores: &scores,
-                freq,
-                omega: &modes.omega_rad_per_s,
-                points: &score_points,
-                psi: &psi,
-                static_flexibility: &static_flexibility,
-                n_dofs: model.n_dofs(),
-            },
-            warnings,
-        )
-    };
+/// The selected modes (0-based, ascending, at least one) by `structure.fem.select`: "auto"
+/// (the default), "participation", a list of 1-based mode numbers or a band in Hz.
+fn select_modes(
+    spec: &FemSpec,
+    src: &Source,
+    ctx: &ReductionContext,
+    a: &AutoInput<'_>,
+    warnings: &mut Vec<String>,
+) -> Result<(Vec<usize>, Selection)> {
+    let base = "structure.fem";
+    let (nm, freq) = (a.scores.len(), a.freq);
     let (mut selected, selection) = match spec.select.clone() {
-        None => auto(&mut warnings)?,
-        Some(SelectSpec::Keyword(k)) if k == "auto" => auto(&mut warnings)?,
+        None => auto_select(spec, src, ctx, a, warnings)?,
+        Some(SelectSpec::Keyword(k)) if k == "auto" => auto_select(spec, src, ctx, a, warnings)?,
         Some(SelectSpec::Keyword(k)) if k == "participation" => {
-            participation_select(spec, src, &scores, freq, &modes.omega_rad_per_s, &score_points)?
+            participation_select(spec, src, a.scores, freq, a.omega, a.points)?
         }
         Some(SelectSpec::Keyword(k)) => {
             return Err(src.error(
@@ -1144,14 +1229,35 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             format!("{base}.select keeps no mode: select at least one of the {nm} modes computed (a list of mode numbers 1..={nm}, \"auto\", \"participation\" or {{ band_hz = [lo, hi] }})"),
         ));
     }
-    let ns = selected.len();
-    let mut cluster = crate::modal::eigenspace::degenerate_clusters(&modes.omega_rad_per_s);
-    if let Some(c) = &cut_cluster {
+    Ok((selected, selection))
+}
+
+/// Per computed mode, the modes sharing its eigenvalue (`modal::eigenspace`), with the last
+/// wanted mode's eigenspace `cut` extended past the computed modes when `count` cut it.
+fn eigenspace_clusters(
+    omega: &[f64],
+    cut: Option<std::ops::Range<usize>>,
+) -> Vec<std::ops::Range<usize>> {
+    let mut cluster = crate::modal::eigenspace::degenerate_clusters(omega);
+    if let Some(c) = &cut {
         // Its members beyond `count` were computed, and dropped: the pair is cut.
         for r in cluster.iter_mut().skip(c.start) {
             *r = c.clone();
         }
     }
+    cluster
+}
+
+/// Warns of a repeated eigenvalue of which the selection keeps some modes, not all: which
+/// direction within its eigenspace is kept is the canonical basis's choice.
+fn warn_split_eigenspaces(
+    selected: &[usize],
+    cluster: &[std::ops::Range<usize>],
+    freq: &[f64],
+    warnings: &mut Vec<String>,
+) {
+    let base = "structure.fem";
+    let nm = freq.len();
     for (i, c) in cluster.iter().enumerate() {
         if c.start != i || c.len() < 2 {
             continue;
@@ -1184,8 +1290,12 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             ));
         }
     }
+}
 
-    // Damping.
+/// The modal damping ratios of the `ns` selected modes: `damping_ratios` (one for all or one
+/// per mode, each in [0, 1)), or 0 (none, or Rayleigh damping, added by [`reduced_model`]).
+fn damping_ratios(spec: &FemSpec, src: &Source, ns: usize) -> Result<Vec<f64>> {
+    let base = "structure.fem";
     let zeta = match (&spec.damping_ratios, &spec.rayleigh) {
         (Some(_), Some(_)) => {
             return Err(src.error(
@@ -1217,20 +1327,31 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             ),
         ));
     }
-    // Per-mode ratios that differ within a repeated eigenvalue damp one direction of its
-    // eigenspace more than another: which one is the basis's choice, not the structure's.
+    Ok(zeta)
+}
+
+/// Warns of per-mode ratios that differ within a repeated eigenvalue: they damp one direction
+/// of its eigenspace more than another, and which one is the basis's choice, not the
+/// structure's.
+fn warn_split_damping(
+    selected: &[usize],
+    zeta: &[f64],
+    cluster: &[std::ops::Range<usize>],
+    freq: &[f64],
+    warnings: &mut Vec<String>,
+) {
     for (i, c) in cluster.iter().enumerate() {
         let z: Vec<(usize, f64)> = selected
             .iter()
-            .zip(&zeta)
+            .zip(zeta)
             .filter(|(j, _)| c.start == i && c.contains(j))
             .map(|(j, z)| (*j, *z))
             .collect();
         if z.len() > 1 && z.iter().any(|(_, v)| *v != z[0].1) {
             warnings.push(format!(
-                "{base}.damping_ratios: the modes {} share one eigenvalue ({:.6} Hz) but get \
-                 different ratios ({}): the damping then depends on meid's canonical basis of \
-                 their eigenspace (docs/fem.md, \"Repeated eigenvalues\"); give them one ratio",
+                "structure.fem.damping_ratios: the modes {} share one eigenvalue ({:.6} Hz) but \
+                 get different ratios ({}): the damping then depends on meid's canonical basis \
+                 of their eigenspace (docs/fem.md, \"Repeated eigenvalues\"); give them one ratio",
                 z.iter()
                     .map(|(j, _)| (j + 1).to_string())
                     .collect::<Vec<_>>()
@@ -1243,8 +1364,21 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             ));
         }
     }
+}
+
+/// The modal model of the selected modes ([`FeModel::modal_model`]) with Rayleigh damping
+/// `C = αM + βK` projected onto them: `D_ii += α + β ω_i²`.
+fn reduced_model(
+    spec: &FemSpec,
+    src: &Source,
+    model: &FeModel,
+    modes: &DenseModes,
+    selected: &[usize],
+    zeta: &[f64],
+) -> Result<ModalModel> {
+    let base = "structure.fem";
     let mut modal = model
-        .modal_model(&modes, &selected, &zeta)
+        .modal_model(modes, selected, zeta)
         .map_err(|e| match e {
             Error::InvalidValue { field, message } => src.error(
                 base,
@@ -1259,15 +1393,20 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
                 format!("{base}.rayleigh = [alpha, beta] must be finite and >= 0 (got [{a}, {b}])"),
             ));
         }
+        let n = modal.omega_rad_per_s.len();
         for (i, w) in modal.omega_rad_per_s.iter().enumerate() {
-            modal.damping[i * ns + i] += a + b * w * w;
+            modal.damping[i * n + i] += a + b * w * w;
         }
     }
-    let selected_residuals = sparse_residuals(&model, &modes, &selected);
-    for (&i, r) in selected.iter().zip(&selected_residuals) {
+    Ok(modal)
+}
+
+/// Warns of each selected mode whose relative residual exceeds [`RESIDUAL_WARNING`].
+fn warn_residuals(selected: &[usize], residuals: &[f64], freq: &[f64], warnings: &mut Vec<String>) {
+    for (&i, r) in selected.iter().zip(residuals) {
         if *r > RESIDUAL_WARNING {
             warnings.push(format!(
-                "{base}: mode {} ({:.4} Hz) has a relative residual {r:.1e} > {RESIDUAL_WARNING:.0e}: \
+                "structure.fem: mode {} ({:.4} Hz) has a relative residual {r:.1e} > {RESIDUAL_WARNING:.0e}: \
                  the eigen-solution is inaccurate, as when stiffnesses or masses span more than \
                  double precision carries (a very stiff spring: give a rigid link instead, or \
                  lower it to ~1e3 times the structure's stiffness)",
@@ -1276,24 +1415,6 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             ));
         }
     }
-    modal.static_flexibility = static_flexibility;
-    modal.warnings = warnings;
-    modal.bed_mass_kg = bed_part_mass(&model.mesh, ctx);
-    if let Some(note) = model.constraint_like_note(CONSTRAINT_LIKE_RATIO) {
-        modal.notes.push(format!("{base}: {note}"));
-    }
-    Ok(FemAnalysis {
-        model,
-        modes,
-        table,
-        solver,
-        selected,
-        selection,
-        scores,
-        score_points,
-        selected_residuals,
-        modal,
-    })
 }
 
 /// Relative residuals `‖K φ − λ M φ‖ / (‖K φ‖ + (|λ| + σ) ‖M φ‖)` of the modes `which`, with
