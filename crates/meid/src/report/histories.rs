@@ -81,7 +81,7 @@ pub fn blow_pictures(dir: &Path, sketch: &HistorySketch, s: &Summary) -> Result<
         (t, v.into_iter().map(|v| scale * v).collect::<Vec<f64>>())
     };
     let head_t: Vec<f64> = sketch.head().iter().map(|r| r[0]).collect();
-    let pictures: Vec<(&str, String, &str, Vec<(&str, (Vec<f64>, Vec<f64>))>)> = vec![
+    let pictures = [
         (
             "bed_acceleration",
             format!(
