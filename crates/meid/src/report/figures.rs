@@ -329,6 +329,19 @@ pub fn spectrum_words(r: &ComparisonResult) -> String {
     }
 }
 
+/// The zoom window `(t0, t0 + 1.5 (t_c − t0))` on a collision ending at `t_c`, for a picture
+/// showing `t0..t_shown`; `None` when the collision takes more than 40 % of what is shown (the
+/// whole picture is then the zoom) or did not start.
+pub fn collision_zoom(t0: f64, t_c: f64, t_shown: f64) -> Option<(f64, f64)> {
+    let end = t0 + 1.5 * (t_c - t0);
+    (t_c > t0 && end.is_finite() && end - t0 < 0.4 * (t_shown - t0)).then_some((t0, end))
+}
+
+/// The title of a zoom frame on `(t0, t1)`.
+pub fn zoom_title((t0, t1): (f64, f64)) -> String {
+    format!("the collision: first {} ms", sig(1e3 * (t1 - t0), 3))
+}
+
 /// The time histories of a channel, one panel per case on a common scale (overlaid, the
 /// last-drawn case hid the others), titled `channel.what()`. The window shown runs up to
 /// 1.25 × the last instant any case exceeds 2 % of the largest |value| (the rest of the
@@ -381,7 +394,7 @@ pub fn history_plot(r: &ComparisonResult, ch: Channel, label: CaseLabel) -> Line
             )
         })
         .fold(f64::NAN, f64::max);
-    let collision = super::histories::collision_zoom(t0, t_c, if zoom { shown } else { t_end });
+    let collision = collision_zoom(t0, t_c, if zoom { shown } else { t_end });
     LinePlot {
         title: if zoom {
             format!(
@@ -399,9 +412,7 @@ pub fn history_plot(r: &ComparisonResult, ch: Channel, label: CaseLabel) -> Line
         panels: true,
         x_range: zoom.then_some((t0, shown)),
         zoom: collision,
-        zoom_title: collision
-            .map(super::histories::zoom_title)
-            .unwrap_or_default(),
+        zoom_title: collision.map(zoom_title).unwrap_or_default(),
         ..Default::default()
     }
 }

@@ -15,20 +15,7 @@ use crate::io::HISTORY_COLUMNS;
 use crate::plot::{self, LinePlot, PlotFiles, Series};
 use crate::Result;
 
-use super::figures::sig;
-
-/// The zoom window `(t0, t0 + 1.5 (t_c − t0))` on a collision ending at `t_c`, for a picture
-/// showing `t0..t_shown`; `None` when the collision takes more than 40 % of what is shown (the
-/// whole picture is then the zoom) or did not start.
-pub fn collision_zoom(t0: f64, t_c: f64, t_shown: f64) -> Option<(f64, f64)> {
-    let end = t0 + 1.5 * (t_c - t0);
-    (t_c > t0 && end.is_finite() && end - t0 < 0.4 * (t_shown - t0)).then_some((t0, end))
-}
-
-/// The title of a zoom frame on `(t0, t1)`.
-pub fn zoom_title((t0, t1): (f64, f64)) -> String {
-    format!("the collision: first {} ms", sig(1e3 * (t1 - t0), 3))
-}
+use super::figures::{collision_zoom, sig, zoom_title};
 
 /// `value unit at t ms` for a title.
 fn at(value: f64, unit: &str, t: f64) -> String {
