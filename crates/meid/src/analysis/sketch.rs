@@ -87,14 +87,7 @@ impl HistorySketch {
             return;
         }
         for (col, b) in self.tail.iter_mut().zip(&mut self.bucket).skip(1) {
-            let (lo, hi) = ((b.0, b.1), (b.2, b.3));
-            if lo.0 == hi.0 {
-                col.push(lo);
-            } else if lo.0 < hi.0 {
-                col.extend([lo, hi]);
-            } else {
-                col.extend([hi, lo]);
-            }
+            col.extend(extremes(*b));
             *b = (0.0, f64::INFINITY, 0.0, f64::NEG_INFINITY);
         }
         self.in_bucket = 0;
@@ -107,13 +100,13 @@ impl HistorySketch {
             .iter()
             .position(|n| *n == name)
             .filter(|&c| c > 0)?;
-        let mut sketch = self.clone();
-        sketch.close_bucket();
-        let points = sketch
+        let open = (self.in_bucket > 0).then(|| extremes(self.bucket[c]));
+        let points = self
             .head
             .iter()
             .map(|r| (r[0], r[c]))
-            .chain(sketch.tail[c].iter().copied());
+            .chain(self.tail[c].iter().copied())
+            .chain(open.into_iter().flatten());
         Some(points.unzip())
     }
 
@@ -126,6 +119,17 @@ impl HistorySketch {
     pub fn span(&self) -> Option<(f64, f64)> {
         self.span
     }
+}
+
+/// A bucket's `(t_min, min, t_max, max)` as envelope points in time order: its minimum and its
+/// maximum, or one point when both are the same sample.
+fn extremes((t_lo, lo, t_hi, hi): (f64, f64, f64, f64)) -> impl Iterator<Item = (f64, f64)> {
+    let (a, b) = if t_hi < t_lo {
+        ((t_hi, hi), (t_lo, lo))
+    } else {
+        ((t_lo, lo), (t_hi, hi))
+    };
+    std::iter::once(a).chain((t_lo != t_hi).then_some(b))
 }
 
 /// The end of the blow's collision in sampled histories (times `t`, the slider-bed and the
