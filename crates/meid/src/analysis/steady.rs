@@ -22,7 +22,9 @@
 //! where `M_T` is the flow's state-transition (monodromy) matrix along the run's path,
 //! computed from the path itself ([`crate::integrate::PathPoint`]): between two switches the
 //! motion is `Ẋ = A_σ X + b` ([`ImpactSystem::first_order`]), so the stretch contributes
-//! `e^{A_σ Δt}` ([`crate::integrate::expm::expm`]); at a switch at `t_e` on the surface
+//! `e^{A_σ Δt}` (the engine's closed form of the mode, its transition matrix
+//! [`crate::integrate::propagator::Propagator::transition`], from the cache the run filled);
+//! at a switch at `t_e` on the surface
 //! `nᵀX = 0` the vector field may jump, and the variational equation takes the saltation matrix
 //! (Aizerman & Gantmacher; di Bernardo et al., *Piecewise-smooth Dynamical Systems*, 2008,
 //! §2.5)
@@ -66,13 +68,15 @@
 //! result says so (`smooth = false`) when the switching sequence of the last two Newton
 //! evaluations differs at convergence.
 
+use std::rc::Rc;
+
 use faer::linalg::solvers::Solve;
 use faer::Mat;
 use serde::Serialize;
 
 use super::blows::{blow_interval_s, next_strike, one_blow, BlowReport};
 use crate::impact::{ImpactSystem, Mode, Switch};
-use crate::integrate::{self, expm::expm, Method, Options, Solution};
+use crate::integrate::{self, propagator::Propagator, Method, Options, Solution};
 use crate::{Error, Result};
 
 /// Settings of the direct steady state.
@@ -319,14 +323,17 @@ impl<'a> Map<'a> {
         self.budget.saturating_sub(self.evaluations)
     }
 
-    /// One blow from `y` (blow number `k` for the report), with the Jacobian when `with_jac`.
-    fn eval(&mut self, y: &[f64], k: usize, with_jac: bool) -> Result<Evaluation> {
+    /// One blow from `y` (blow number `k` for the report), with the Jacobian when `with_jac`,
+    /// and the report's exact peaks only when `peaks` (an iterate of the search needs the
+    /// state at the next strike, not its levels: [`Options::peaks`]).
+    fn eval(&mut self, y: &[f64], k: usize, with_jac: bool, peaks: bool) -> Result<Evaluation> {
         self.spend()?;
         let x0 = self.embed(y);
         let t0 = k as f64 * self.opts.duration;
+        let o_blow = Options { peaks, ..self.opts };
         let done = one_blow(
             self.sys,
-            &self.opts,
+            &o_blow,
             &self.user,
             &x0,
             k,
@@ -378,8 +385,15 @@ impl<'a> Map<'a> {
             return None;
         }
         let sys = self.sys;
-        let nx = 2 * sys.dofs();
+        let nd = sys.dofs();
+        let nx = 2 * nd;
         let b = sys.forcing();
+        let masses = sys.mass_diag();
+        // The engine's closed forms (its per-thread cache: the same key, `K_σ`, `C_σ`, the
+        // masses and the second-order force, finds the propagators the run just used).
+        let force_2nd: Option<Vec<f64>> = b
+            .as_ref()
+            .map(|b| b[nd..].iter().zip(&masses).map(|(f, m)| f * m).collect());
         let field = |a: &Mat<f64>, x: &[f64]| -> Vec<f64> {
             (0..nx)
                 .map(|i| {
@@ -389,22 +403,31 @@ impl<'a> Map<'a> {
                 .collect()
         };
         let mut m = Mat::<f64>::identity(nx, nx);
-        let mut cache: Vec<(Mode, Mat<f64>)> = Vec::new();
-        let mut a_of = |mode: Mode| -> Mat<f64> {
-            if let Some((_, a)) = cache.iter().find(|(md, _)| *md == mode) {
-                return a.clone();
+        let mut cache: Vec<(Mode, Rc<Propagator>)> = Vec::new();
+        let mut prop_of = |mode: Mode| -> Option<Rc<Propagator>> {
+            if let Some((_, p)) = cache.iter().find(|(md, _)| *md == mode) {
+                return Some(p.clone());
             }
-            let a = sys.first_order(mode);
-            cache.push((mode, a.clone()));
-            a
+            let (k, c) = sys.matrices(mode);
+            let p = Propagator::shared_forced(
+                &k,
+                &c,
+                &masses,
+                sys.first_order(mode),
+                force_2nd.as_deref(),
+            )
+            .ok()?;
+            cache.push((mode, p.clone()));
+            Some(p)
         };
         for (i, pt) in sol.path.iter().enumerate() {
-            let a = a_of(pt.mode);
+            let prop = prop_of(pt.mode)?;
+            let a = &prop.a;
             if i > 0 {
                 let prev = &sol.path[i - 1];
-                let a_prev = a_of(prev.mode);
-                let f_minus = field(&a_prev, &pt.x);
-                let f_plus = field(&a, &pt.x);
+                let a_prev = &prop_of(prev.mode)?.a;
+                let f_minus = field(a_prev, &pt.x);
+                let f_plus = field(a, &pt.x);
                 let jump: Vec<f64> = f_plus.iter().zip(&f_minus).map(|(p, q)| p - q).collect();
                 let scale = f_minus
                     .iter()
@@ -433,7 +456,9 @@ impl<'a> Map<'a> {
             let t_end = sol.path.get(i + 1).map_or(sol.t_final, |q| q.t);
             let dt = t_end - pt.t;
             if dt > 0.0 {
-                m = expm(&a, dt) * &m;
+                // e^{A_σ Δt}: the closed form's transition matrix (of the homogeneous part,
+                // which is the variation of an affine flow).
+                m = prop.transition(dt) * &m;
             }
         }
         let finite = (0..nx).all(|c| (0..nx).all(|r| m[(r, c)].is_finite()));
@@ -524,19 +549,23 @@ struct Fixed {
 /// `P^k(y)`, its Jacobian, the k blows' reports and their switching sequences.
 type PeriodEval = (Vec<f64>, Mat<f64>, Vec<BlowReport>, Vec<Vec<Mode>>);
 
-/// `P^k(y)`, its Jacobian, the blows' reports and switching sequences.
-fn eval_k(map: &mut Map, y: &[f64], k: usize) -> Result<PeriodEval> {
+/// `P^k(y)`, its Jacobian (the identity when not `with_jac`: a start that is marched from is
+/// not differentiated), the blows' reports (with their exact peaks when `peaks`) and switching
+/// sequences.
+fn eval_k(map: &mut Map, y: &[f64], k: usize, peaks: bool, with_jac: bool) -> Result<PeriodEval> {
     let d = map.dim();
     let mut z = y.to_vec();
     let mut jac = Mat::<f64>::identity(d, d);
     let mut reports = Vec::with_capacity(k);
     let mut switches = Vec::with_capacity(k);
     for b in 0..k {
-        let e = map.eval(&z, b, true)?;
-        let jb = e
-            .jac
-            .ok_or_else(|| Error::numerical("steady state", "no Jacobian of the blow map"))?;
-        jac = jb * &jac;
+        let e = map.eval(&z, b, with_jac, peaks)?;
+        if with_jac {
+            let jb = e
+                .jac
+                .ok_or_else(|| Error::numerical("steady state", "no Jacobian of the blow map"))?;
+            jac = jb * &jac;
+        }
         z = e.p;
         reports.push(e.report);
         switches.push(e.switches);
@@ -552,6 +581,13 @@ fn eval_k(map: &mut Map, y: &[f64], k: usize) -> Result<PeriodEval> {
 /// With `march_first` the first step is a march step: from rest a damper touches the bed with
 /// zero overlap and zero relative velocity (a grazing start), where the map is not
 /// differentiable and a Newton step from there is wasted.
+///
+/// The iterates are evaluated without the blows' exact peaks (they need only the state at the
+/// next strike and the Jacobian), except the one Newton is expected to end on: after an accepted
+/// Newton step from residual `r₀` to `r₁`, quadratic convergence predicts `r₂ ≈ r₁³/r₀²`, and
+/// when that is within the tolerance the next evaluation tracks the peaks. The result's blows
+/// always carry them: a search that ends on an evaluation without them evaluates its last
+/// iterate once more (the same trajectory, bit for bit), with them.
 fn newton(
     map: &mut Map,
     y0: Vec<f64>,
@@ -561,12 +597,16 @@ fn newton(
     march_first: bool,
 ) -> Result<Fixed> {
     let mut y = y0;
-    let (mut z, mut jac, mut reports, mut switches) = eval_k(map, &y, k)?;
+    // From rest with a damper the first step is a march: the start is not differentiated.
+    let (mut z, mut jac, mut reports, mut switches) = eval_k(map, &y, k, false, !march_first)?;
+    let mut with_peaks = false;
     let diff = |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(p, q)| p - q).collect() };
     let mut residual = map.norm(&diff(&z, &y));
     map.record('s', residual);
     let mut smooth = true;
     let mut rejected = 0;
+    // The residual before the last accepted Newton step (`None` after a march step).
+    let mut before: Option<f64> = None;
     for _ in 1..iterations {
         if residual <= tol || map.left() < 2 * k {
             break;
@@ -580,12 +620,15 @@ fn newton(
         let tried = trial.is_some();
         let accepted = match trial {
             Some(yt) => {
-                let (zt, jt, rt, st) = eval_k(map, &yt, k)?;
+                let last = before.is_some_and(|r0| r0 > 0.0 && residual.powi(3) / (r0 * r0) <= tol);
+                let (zt, jt, rt, st) = eval_k(map, &yt, k, last, true)?;
                 let res_t = map.norm(&diff(&zt, &yt));
                 map.record(if res_t < residual { 'N' } else { 'x' }, res_t);
                 if res_t < residual {
                     smooth = st == switches;
+                    before = Some(residual);
                     (y, z, jac, reports, switches, residual) = (yt, zt, jt, rt, st, res_t);
+                    with_peaks = last;
                     true
                 } else {
                     false
@@ -600,12 +643,19 @@ fn newton(
                 break;
             }
             y = z.clone();
-            let (zt, jt, rt, st) = eval_k(map, &y, k)?;
+            let (zt, jt, rt, st) = eval_k(map, &y, k, false, true)?;
             smooth = st == switches;
             residual = map.norm(&diff(&zt, &y));
             map.record('m', residual);
             (z, jac, reports, switches) = (zt, jt, rt, st);
+            (with_peaks, before) = (false, None);
         }
+    }
+    if !with_peaks {
+        // The levels of the last iterate: the same blows again, with their exact peaks (and
+        // the Jacobian, which a start that converged at once was not given).
+        let (_, jt, rt, _) = eval_k(map, &y, k, true, true)?;
+        (jac, reports) = (jt, rt);
     }
     Ok(Fixed {
         converged: residual <= tol,
@@ -678,7 +728,7 @@ pub fn steady_state(sys: &ImpactSystem, opts: &Options, so: &SteadyOptions) -> R
         if map.left() == 0 {
             break;
         }
-        let e = map.eval(&y, j - 1, false)?;
+        let e = map.eval(&y, j - 1, false, true)?;
         y = e.p;
         reports.push(e.report);
         states.push(y.clone());
@@ -873,7 +923,7 @@ mod tests {
     use crate::model::{Case, Model};
 
     /// `e^{A t}` by scaling and squaring of a 30-term Taylor series: independent of the
-    /// engine's propagators and of [`expm`].
+    /// engine's propagators and of [`crate::integrate::expm::expm`].
     fn expm_taylor(a: &[[f64; 4]; 4], t: f64) -> [[f64; 4]; 4] {
         let norm = a
             .iter()
@@ -1133,6 +1183,37 @@ sample_rate = 20000.0
     /// switching many times). (From rest with the damper the map is not differentiable: the
     /// damper touches the bed at the strike with zero overlap and zero relative velocity, a
     /// grazing start.)
+    /// An iterate evaluated without the exact peaks (the Newton search's) follows the same
+    /// trajectory bit for bit as the evaluation with them, and its peaks stay empty; the
+    /// steady blows the result reports carry them.
+    #[test]
+    fn iterates_without_peaks_follow_the_same_trajectory() {
+        let model = example("paper-lumped");
+        let sys = model.impact_system(Case::Damper).unwrap();
+        let mut o = model.options();
+        o.sample_rate = None;
+        o.duration = 1.0;
+        let x0 = next_strike(&sys, &vec![0.0; 2 * sys.dofs()]);
+        let full = integrate::solve_from(&sys, &x0, &o, &mut integrate::NoOutput).unwrap();
+        let lean = integrate::solve_from(
+            &sys,
+            &x0,
+            &Options { peaks: false, ..o },
+            &mut integrate::NoOutput,
+        )
+        .unwrap();
+        assert_eq!(full.x_final, lean.x_final);
+        assert_eq!(full.totals.dissipated, lean.totals.dissipated);
+        assert_eq!(full.path.len(), lean.path.len());
+        let bed = crate::impact::Channel::BedAcceleration;
+        assert!(full.totals.peaks.get(bed).abs_peak() > 100.0);
+        assert_eq!(lean.totals.peaks.get(bed).abs_peak(), 0.0);
+        let s = steady_state(&sys, &model.options(), &SteadyOptions::default()).unwrap();
+        let b = &s.blows[0];
+        assert!(b.peak_bed_acceleration_m_per_s2 > 100.0, "{b:?}");
+        assert!(b.peak_floor_force_n > 0.0, "{b:?}");
+    }
+
     #[test]
     fn path_jacobian_matches_finite_differences() {
         let model = example("paper-lumped");
@@ -1145,9 +1226,9 @@ sample_rate = 20000.0
             let d = map.dim();
             let mut y = vec![0.0; d];
             for _ in 0..start {
-                y = map.eval(&y, 0, false).unwrap().p;
+                y = map.eval(&y, 0, false, false).unwrap().p;
             }
-            let e = map.eval(&y, 0, true).unwrap();
+            let e = map.eval(&y, 0, true, false).unwrap();
             let jac = e.jac.unwrap();
             let mut worst = 0.0_f64;
             let mut norm = 0.0_f64;
@@ -1158,8 +1239,8 @@ sample_rate = 20000.0
                 yp[j] += h;
                 let mut ym = y.clone();
                 ym[j] -= h;
-                let pp = map.eval(&yp, 0, false).unwrap().p;
-                let pm = map.eval(&ym, 0, false).unwrap().p;
+                let pp = map.eval(&yp, 0, false, false).unwrap().p;
+                let pm = map.eval(&ym, 0, false, false).unwrap().p;
                 for i in 0..d {
                     // in the energy norm's units: rows by √w_i, columns by 1/√w_j
                     let s = (map.weight[i] / map.weight[j]).sqrt();

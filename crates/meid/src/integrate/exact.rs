@@ -350,35 +350,41 @@ impl<'s, 'o> Run<'s, 'o> {
     fn book_taylor(&mut self, mi: usize, tau: f64, period: f64, s_end: f64) -> Result<()> {
         let (t, mode) = (self.t, self.mode);
         self.closed_time(s_end);
-        let mc = mode_channels(
-            &mut self.channels,
-            &self.map,
-            self.sys,
-            &mut self.selector,
-            mode,
-            false,
-            &mut self.chan_buf,
-        )?;
-        for &c in mc.zeros() {
-            self.totals.peaks.0[c].offer(0.0, t);
+        if self.opts.peaks {
+            let mc = mode_channels(
+                &mut self.channels,
+                &self.map,
+                self.sys,
+                &mut self.selector,
+                mode,
+                false,
+                &mut self.chan_buf,
+            )?;
+            for &c in mc.zeros() {
+                self.totals.peaks.0[c].offer(0.0, t);
+            }
+            let tw = &self.tw;
+            let tm = tw.tmats[mi]
+                .as_ref()
+                .ok_or_else(|| Error::numerical("exact", "Taylor matrix"))?;
+            let deg = tm.degree(s_end);
+            for (r, &c) in mc.moving().iter().enumerate() {
+                mc.project(r, &tw.coef, deg, &mut self.chan_poly);
+                peaks::on_poly(
+                    &self.chan_poly,
+                    deg,
+                    tau,
+                    period,
+                    t,
+                    s_end,
+                    &mut self.totals.peaks.0[c],
+                );
+            }
         }
         let tw = &mut self.tw;
         let tm = tw.tmats[mi]
             .as_ref()
             .ok_or_else(|| Error::numerical("exact", "Taylor matrix"))?;
-        let deg = tm.degree(s_end);
-        for (r, &c) in mc.moving().iter().enumerate() {
-            mc.project(r, &tw.coef, deg, &mut self.chan_poly);
-            peaks::on_poly(
-                &self.chan_poly,
-                deg,
-                tau,
-                period,
-                t,
-                s_end,
-                &mut self.totals.peaks.0[c],
-            );
-        }
         self.totals.dissipated += tm
             .dissipated(&tw.coef, &self.masses, s_end, &mut tw.work)
             .ok_or_else(|| Error::numerical("exact", "first-order matrix without [0, I]"))?;
@@ -477,26 +483,28 @@ impl<'s, 'o> Run<'s, 'o> {
         let (t, mode) = (self.t, self.mode);
         let n = self.x.len();
         self.closed_time(s_end);
-        let mc = mode_channels(
-            &mut self.channels,
-            &self.map,
-            self.sys,
-            &mut self.selector,
-            mode,
-            true,
-            &mut self.chan_buf,
-        )?;
-        for &c in mc.zeros() {
-            self.totals.peaks.0[c].offer(0.0, t);
-        }
-        let slope_len = n + usize::from(self.forcing.is_some());
-        for ((&c, l), la) in mc
-            .moving()
-            .iter()
-            .zip(mc.dense.chunks_exact(n))
-            .zip(mc.slopes.chunks_exact(slope_len))
-        {
-            peaks::on_segment(seg, l, la, t, s_end, &mut self.totals.peaks.0[c]);
+        if self.opts.peaks {
+            let mc = mode_channels(
+                &mut self.channels,
+                &self.map,
+                self.sys,
+                &mut self.selector,
+                mode,
+                true,
+                &mut self.chan_buf,
+            )?;
+            for &c in mc.zeros() {
+                self.totals.peaks.0[c].offer(0.0, t);
+            }
+            let slope_len = n + usize::from(self.forcing.is_some());
+            for ((&c, l), la) in mc
+                .moving()
+                .iter()
+                .zip(mc.dense.chunks_exact(n))
+                .zip(mc.slopes.chunks_exact(slope_len))
+            {
+                peaks::on_segment(seg, l, la, t, s_end, &mut self.totals.peaks.0[c]);
+            }
         }
         self.totals.dissipated += dissipated(seg, damping, n / 2, s_end);
         seg.state(s_end, &mut self.buf);
