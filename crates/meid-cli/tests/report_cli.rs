@@ -399,7 +399,11 @@ fn foundation_report_has_its_section_and_the_verdict_from_the_numbers() {
     assert_eq!(check_page(&out, &html), vec![], "check_page");
     let sec = section(&html, "foundation");
     assert!(sec.contains("<h2>Foundation and surroundings</h2>"));
-    assert_eq!(sec.matches("<figure").count(), 2, "PPV against distance, DIN chart");
+    assert_eq!(
+        sec.matches("<figure").count(),
+        2,
+        "PPV against distance, DIN chart"
+    );
     assert_eq!(
         sec.matches("<table").count(),
         5,
@@ -417,11 +421,16 @@ fn foundation_report_has_its_section_and_the_verdict_from_the_numbers() {
     let texts = meid::plot::svg_texts(&svg);
     for line in ["line 1", "line 2", "line 3"] {
         assert!(
-            texts.iter().any(|t| t.starts_with(line) && t.ends_with("long-term")),
+            texts
+                .iter()
+                .any(|t| t.starts_with(line) && t.ends_with("long-term")),
             "{texts:?}"
         );
     }
-    assert!(texts.iter().any(|t| t == "laboratory, impact damper"), "{texts:?}");
+    assert!(
+        texts.iter().any(|t| t == "laboratory, impact damper"),
+        "{texts:?}"
+    );
 
     let report = json(&out.join("report.json"));
     let cases = ["no-damper", "damper", "added-mass"];

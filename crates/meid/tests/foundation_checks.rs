@@ -362,7 +362,11 @@ fn din_chart_lines_hold_the_table_values_at_the_corners() {
                 .iter()
                 .position(|&x| x == corner)
                 .unwrap_or_else(|| panic!("line {line}: no point at {corner} Hz"));
-            assert!((v[k] - want).abs() < 1e-12, "line {line} at {corner} Hz: {}", v[k]);
+            assert!(
+                (v[k] - want).abs() < 1e-12,
+                "line {line} at {corner} Hz: {}",
+                v[k]
+            );
         }
         // Below 10 Hz the 10 Hz value, above 100 Hz the 100 Hz value; 30 Hz halfway.
         assert_eq!(f[0], 1.0);
@@ -371,7 +375,11 @@ fn din_chart_lines_hold_the_table_values_at_the_corners() {
         assert!((v.last().unwrap() - row[2]).abs() < 1e-12);
         let k30 = f.iter().position(|&x| x > 29.0 && x < 31.0).unwrap();
         let want30 = row[0] + (row[1] - row[0]) * (f[k30] - 10.0) / 40.0;
-        assert!((v[k30] - want30).abs() < 1e-9, "line {line} at {} Hz", f[k30]);
+        assert!(
+            (v[k30] - want30).abs() < 1e-9,
+            "line {line} at {} Hz",
+            f[k30]
+        );
     }
     // Table 3: 10, 5, 2.5 mm/s at all frequencies.
     for (line, _, v) in din_limit_lines(Excitation::LongTerm, 150.0) {
@@ -399,21 +407,41 @@ fn excitation_default_follows_the_stroke_rate() {
     let f = found(text.clone());
     assert_eq!(f.excitation, Excitation::LongTerm);
     let basis = f.excitation_basis.unwrap();
-    assert!(basis.contains("no [production] rate_bpm") && basis.contains("conservative"), "{basis}");
+    assert!(
+        basis.contains("no [production] rate_bpm") && basis.contains("conservative"),
+        "{basis}"
+    );
     // A stroke rate: long-term because the blow repeats.
     let with_rate = format!("{text}\n[production]\nrate_bpm = 40.0\n");
     let f = found(with_rate.clone());
     assert_eq!(f.excitation, Excitation::LongTerm);
     let basis = f.excitation_basis.unwrap();
-    assert!(basis.contains("rate_bpm = 40") && basis.contains("repeats"), "{basis}");
+    assert!(
+        basis.contains("rate_bpm = 40") && basis.contains("repeats"),
+        "{basis}"
+    );
     // The user's word wins, with or without a rate; then no default is explained.
-    let short = with_rate.replace("[foundation]\n", "[foundation]\nexcitation = \"short-term\"\n");
+    let short = with_rate.replace(
+        "[foundation]\n",
+        "[foundation]\nexcitation = \"short-term\"\n",
+    );
     let f = found(short);
     assert_eq!(f.excitation, Excitation::ShortTerm);
     assert_eq!(f.excitation_basis, None);
-    let long = text.replace("[foundation]\n", "[foundation]\nexcitation = \"long-term\"\n");
+    let long = text.replace(
+        "[foundation]\n",
+        "[foundation]\nexcitation = \"long-term\"\n",
+    );
     assert_eq!(found(long).excitation_basis, None);
     // --set reaches it too.
-    let m = Model::from_text("h.toml", with_rate, &["foundation.excitation=\"short-term\"".into()]).unwrap();
-    assert_eq!(m.foundation().unwrap().unwrap().excitation, Excitation::ShortTerm);
+    let m = Model::from_text(
+        "h.toml",
+        with_rate,
+        &["foundation.excitation=\"short-term\"".into()],
+    )
+    .unwrap();
+    assert_eq!(
+        m.foundation().unwrap().unwrap().excitation,
+        Excitation::ShortTerm
+    );
 }
