@@ -11,6 +11,10 @@
 //! * Records exported by `meid simulate --uff` and given back with `--measured` are the
 //!   simulation: the "Measured against simulated" section shows 0 % peak errors and measured
 //!   reductions equal to the simulated ones.
+//! * A model with a `[foundation]` and a damper (examples/paper-on-soil.toml) has the section
+//!   "Foundation and surroundings" with its two charts and tables for all three cases; each
+//!   receiver's verdict sentence gives |PPV/limit − 1| of `report.json`'s numbers, and a
+//!   receiver that fails in some case is in the page's verdict.
 //! * Bad input exits with code 2 and a message naming the option.
 
 use crate::common;
@@ -105,8 +109,11 @@ fn lumped_report_passes_the_page_check_and_reads_the_library_studies() {
         .arg(&out)
         .output()
         .unwrap());
-    check_report(&out, true);
+    let html = check_report(&out, true);
+    // No [foundation]: no "Foundation and surroundings" section and no foundation member.
+    assert!(!html.contains("<section id=\"foundation\">"));
     let report = json(&out.join("report.json"));
+    assert!(report.get("foundation").is_none() && report.get("receivers").is_none());
     // No stroke rate anywhere: the production line says its 60 /min is assumed, and does
     // not lead.
     assert_eq!(report["rate_origin"], "assumed");
@@ -366,4 +373,108 @@ fn bad_report_options_exit_2_naming_the_option() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("not a directory"), "{}", stderr(&o));
+}
+
+/// The sentence of receiver `name` in the HTML (escapes undone).
+fn receiver_sentence(html: &str, name: &str) -> String {
+    let start = html
+        .find(&format!("<li>The receiver &#39;{name}&#39;"))
+        .unwrap_or_else(|| panic!("no sentence for {name}"));
+    let rest = &html[start + 4..];
+    rest[..rest.find("</li>").unwrap()].replace("&#39;", "'")
+}
+
+#[test]
+fn foundation_report_has_its_section_and_the_verdict_from_the_numbers() {
+    let d = tmpdir("report", "foundation");
+    let out = d.join("page");
+    ok(meid()
+        .arg("report")
+        .arg(example_file("paper-on-soil.toml"))
+        .args(["-q", "--map-points", "5", "--blows", "2", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap());
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert_eq!(check_page(&out, &html), vec![], "check_page");
+    let sec = section(&html, "foundation");
+    assert!(sec.contains("<h2>Foundation and surroundings</h2>"));
+    assert_eq!(
+        sec.matches("<figure").count(),
+        2,
+        "PPV against distance, DIN chart"
+    );
+    assert_eq!(
+        sec.matches("<table").count(),
+        5,
+        "block, impedances, checks, DIN, people"
+    );
+    assert!(sec.contains("People in buildings"));
+    for stem in ["foundation-ppv", "foundation-din"] {
+        for ext in ["png", "svg", "csv"] {
+            assert!(out.join(format!("{stem}.{ext}")).is_file(), "{stem}.{ext}");
+        }
+    }
+    // The DIN chart's legend names the three lines, long-term (no excitation given: the
+    // default), and the receivers' points in each case.
+    let svg = std::fs::read_to_string(out.join("foundation-din.svg")).unwrap();
+    let texts = meid::plot::svg_texts(&svg);
+    for line in ["line 1", "line 2", "line 3"] {
+        assert!(
+            texts
+                .iter()
+                .any(|t| t.starts_with(line) && t.ends_with("long-term")),
+            "{texts:?}"
+        );
+    }
+    assert!(
+        texts.iter().any(|t| t == "laboratory, impact damper"),
+        "{texts:?}"
+    );
+
+    let report = json(&out.join("report.json"));
+    let cases = ["no-damper", "damper", "added-mass"];
+    let mut fails = Vec::new();
+    for (i, name) in ["workshop", "laboratory"].into_iter().enumerate() {
+        let sentence = receiver_sentence(sec, name);
+        // One "by N %" per case, in the comparison's order.
+        let pcts: Vec<f64> = sentence
+            .split(" by ")
+            .skip(1)
+            .map(|p| p.split(' ').next().unwrap().parse().unwrap())
+            .collect();
+        assert_eq!(pcts.len(), 3, "{sentence}");
+        let clauses: Vec<&str> = sentence.split("; ").collect();
+        for (k, case) in cases.into_iter().enumerate() {
+            let r = &report["receivers"][case][i];
+            assert_eq!(r["name"], name);
+            let ppv = r["ppv_m_per_s"].as_f64().unwrap();
+            let limit = r["checks"][0]["limit"].as_f64().unwrap();
+            let want = 100.0 * (ppv / limit - 1.0);
+            assert!(
+                (pcts[k] - want.abs()).abs() <= 0.5 + 1e-9,
+                "{name} {case}: {} vs {want} in {sentence}",
+                pcts[k]
+            );
+            assert_eq!(clauses[k].contains("exceeds"), want > 0.0, "{sentence}");
+            if want > 0.0 {
+                fails.push(name);
+            }
+        }
+    }
+    // The example shows the damper's verdict: the laboratory is over its long-term limit
+    // without damper and with the added mass, within it with the damper.
+    let lab = receiver_sentence(sec, "laboratory");
+    assert!(
+        lab.contains("exceeds the long-term limit (2.5 mm/s)")
+            && lab.contains("with the damper: within by"),
+        "{lab}"
+    );
+    assert_eq!(fails, ["laboratory", "laboratory"]);
+    // The page's verdict carries the failing receiver's sentence, not the passing one's.
+    let verdict = section(&html, "verdict").replace("&#39;", "'");
+    assert!(verdict.contains(&lab));
+    assert!(!verdict.contains("The receiver 'workshop'"));
+    let v = report["verdict"].as_array().unwrap();
+    assert!(v.iter().any(|s| s.as_str() == Some(lab.as_str())), "{v:?}");
 }

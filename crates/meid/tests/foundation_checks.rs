@@ -344,3 +344,104 @@ fn zero_crossing_and_wm_weighting() {
     let amp = tail.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     assert!((amp / standards::wm_gain(f) - 1.0).abs() < 1e-4, "{amp}");
 }
+
+/// The report's DIN 4150-3 chart: its limit lines pass through Table 1's values at the corner
+/// frequencies (and hold them below 10 Hz and above 100 Hz); long-term, Table 3's constants.
+#[test]
+fn din_chart_lines_hold_the_table_values_at_the_corners() {
+    use meid::model::foundation::Excitation;
+    use meid::report::foundation::din_limit_lines;
+    // DIN 4150-3 (1999-02) Table 1, foundation, mm/s at 10, 50, 100 Hz.
+    let table1 = [[20.0, 40.0, 50.0], [5.0, 15.0, 20.0], [3.0, 8.0, 10.0]];
+    let lines = din_limit_lines(Excitation::ShortTerm, 150.0);
+    assert_eq!(lines.len(), 3);
+    for (line, f, v) in &lines {
+        let row = table1[line - 1];
+        for (corner, want) in [10.0, 50.0, 100.0].into_iter().zip(row) {
+            let k = f
+                .iter()
+                .position(|&x| x == corner)
+                .unwrap_or_else(|| panic!("line {line}: no point at {corner} Hz"));
+            assert!(
+                (v[k] - want).abs() < 1e-12,
+                "line {line} at {corner} Hz: {}",
+                v[k]
+            );
+        }
+        // Below 10 Hz the 10 Hz value, above 100 Hz the 100 Hz value; 30 Hz halfway.
+        assert_eq!(f[0], 1.0);
+        assert!((v[0] - row[0]).abs() < 1e-12);
+        assert!(*f.last().unwrap() >= 200.0);
+        assert!((v.last().unwrap() - row[2]).abs() < 1e-12);
+        let k30 = f.iter().position(|&x| x > 29.0 && x < 31.0).unwrap();
+        let want30 = row[0] + (row[1] - row[0]) * (f[k30] - 10.0) / 40.0;
+        assert!(
+            (v[k30] - want30).abs() < 1e-9,
+            "line {line} at {} Hz",
+            f[k30]
+        );
+    }
+    // Table 3: 10, 5, 2.5 mm/s at all frequencies.
+    for (line, _, v) in din_limit_lines(Excitation::LongTerm, 150.0) {
+        let want = [10.0, 5.0, 2.5][line - 1];
+        assert!(v.iter().all(|&x| (x - want).abs() < 1e-12), "line {line}");
+    }
+}
+
+/// The excitation class: given, it wins; not given, long-term, with the reason in
+/// `excitation_basis` naming the stroke rate when the model has one, and the conservative
+/// choice when it has none.
+#[test]
+fn excitation_default_follows_the_stroke_rate() {
+    use meid::model::foundation::Excitation;
+    let path = example("hammer-foundation.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let found = |t: String| {
+        Model::from_text("h.toml", t, &[])
+            .unwrap()
+            .foundation()
+            .unwrap()
+            .unwrap()
+    };
+    // No excitation, no [production]: long-term, and why.
+    let f = found(text.clone());
+    assert_eq!(f.excitation, Excitation::LongTerm);
+    let basis = f.excitation_basis.unwrap();
+    assert!(
+        basis.contains("no [production] rate_bpm") && basis.contains("conservative"),
+        "{basis}"
+    );
+    // A stroke rate: long-term because the blow repeats.
+    let with_rate = format!("{text}\n[production]\nrate_bpm = 40.0\n");
+    let f = found(with_rate.clone());
+    assert_eq!(f.excitation, Excitation::LongTerm);
+    let basis = f.excitation_basis.unwrap();
+    assert!(
+        basis.contains("rate_bpm = 40") && basis.contains("repeats"),
+        "{basis}"
+    );
+    // The user's word wins, with or without a rate; then no default is explained.
+    let short = with_rate.replace(
+        "[foundation]\n",
+        "[foundation]\nexcitation = \"short-term\"\n",
+    );
+    let f = found(short);
+    assert_eq!(f.excitation, Excitation::ShortTerm);
+    assert_eq!(f.excitation_basis, None);
+    let long = text.replace(
+        "[foundation]\n",
+        "[foundation]\nexcitation = \"long-term\"\n",
+    );
+    assert_eq!(found(long).excitation_basis, None);
+    // --set reaches it too.
+    let m = Model::from_text(
+        "h.toml",
+        with_rate,
+        &["foundation.excitation=\"short-term\"".into()],
+    )
+    .unwrap();
+    assert_eq!(
+        m.foundation().unwrap().unwrap().excitation,
+        Excitation::ShortTerm
+    );
+}

@@ -94,12 +94,48 @@ pub struct Foundation {
     pub geometric_exponent: f64,
     pub attenuation_per_m: f64,
     pub excitation: Excitation,
+    /// Why `excitation` is what it is when `foundation.excitation` is not given (the default
+    /// and its reason); absent when the user gave it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub excitation_basis: Option<String>,
+}
+
+/// DIN 4150-3's class of excitation: the one given, else long-term with its reason. A
+/// `[production] rate_bpm` repeats the blow, and repeated vibration is long-term; without a
+/// stroke rate the model describes one blow of a machine that in production repeats it, and
+/// the long-term guideline values are the lower ones at every frequency (Table 3 against
+/// Table 1), so long-term is the conservative default.
+pub fn excitation_of(
+    given: Option<Excitation>,
+    rate_bpm: Option<f64>,
+) -> (Excitation, Option<String>) {
+    match (given, rate_bpm) {
+        (Some(e), _) => (e, None),
+        (None, Some(r)) => (
+            Excitation::LongTerm,
+            Some(format!(
+                "long-term by default: [production] rate_bpm = {} repeats the blow, and repeated vibration is long-term (DIN 4150-3); set foundation.excitation = \"short-term\" to say otherwise",
+                crate::num(r)
+            )),
+        ),
+        (None, None) => (
+            Excitation::LongTerm,
+            Some("long-term by default: the model gives no [production] rate_bpm, and a machine in production repeats its blow; the long-term limits are also the lower ones at every frequency, so the check is the conservative one. Set foundation.excitation = \"short-term\" for an occasional blow".into()),
+        ),
+    }
 }
 
 impl Foundation {
     /// Reads and checks `[foundation]` against the lumped structure `l`; errors name the field
     /// and the valid range.
-    pub fn from_spec(f: &FoundationSpec, l: &LumpedSpec, src: &Source) -> Result<Self> {
+    /// `rate_bpm` is the model's `[production] rate_bpm` (for the default excitation,
+    /// [`excitation_of`]).
+    pub fn from_spec(
+        f: &FoundationSpec,
+        l: &LumpedSpec,
+        rate_bpm: Option<f64>,
+        src: &Source,
+    ) -> Result<Self> {
         let err = |field: &str, msg: String| src.error(field, format!("{field}: {msg}"));
         let positive = |field: &str, v: f64, unit: &str| -> Result<f64> {
             if v.is_finite() && v > 0.0 {
@@ -225,6 +261,7 @@ impl Foundation {
                 ),
             ));
         }
+        let (excitation, excitation_basis) = excitation_of(f.excitation, rate_bpm);
         Ok(Foundation {
             mass_name: f.mass.clone(),
             length_m: length,
@@ -239,7 +276,8 @@ impl Foundation {
             equivalent_radius_m: r0,
             geometric_exponent: n,
             attenuation_per_m: alpha,
-            excitation: f.excitation,
+            excitation,
+            excitation_basis,
         })
     }
 

@@ -528,7 +528,8 @@ impl Model {
         let (Some(f), Some(l)) = (&s.foundation, &s.structure.lumped) else {
             return Ok(None);
         };
-        let found = foundation::Foundation::from_spec(f, l, &self.source)?;
+        let rate = s.production.as_ref().map(|p| p.rate_bpm);
+        let found = foundation::Foundation::from_spec(f, l, rate, &self.source)?;
         let src = &self.source;
         if let Some(a) = &f.anvil {
             if !l.masses.iter().any(|m| &m.name == a) {
@@ -915,7 +916,8 @@ pub(crate) fn build_structure_of(
                 "foundation: the block on the soil is built under a [structure.lumped] (the engine is one-axis and the soil joins a lumped mass to the ground); give the structure as masses and springs",
             ));
         };
-        let found = foundation::Foundation::from_spec(f, l, src)?;
+        // The excitation class does not enter the structure: no stroke rate needed here.
+        let found = foundation::Foundation::from_spec(f, l, None, src)?;
         return lumped::modal_model(&found.augment(l), src, ctx);
     }
     if let Some(l) = &st.lumped {

@@ -110,7 +110,7 @@ enum Slot<'a> {
     Method(&'a mut MethodSpec),
     Solver(&'a mut Option<SolverSpec>),
     Support(&'a mut Option<SupportSpec>),
-    Excitation(&'a mut Excitation),
+    Excitation(&'a mut Option<Excitation>),
 }
 
 fn name_of(names: &[&str], key: &str) -> Option<u8> {
@@ -394,7 +394,7 @@ impl Slot<'_> {
             (Slot::Method(x), V::Text(t)) => *x = variant(t)?,
             (Slot::Solver(x), V::Text(t)) => *x = Some(variant(t)?),
             (Slot::Support(x), V::Text(t)) => *x = Some(variant(t)?),
-            (Slot::Excitation(x), V::Text(t)) => *x = variant(t)?,
+            (Slot::Excitation(x), V::Text(t)) => *x = Some(variant(t)?),
             _ => return None,
         }
         Some(())

@@ -763,10 +763,11 @@ pub struct FoundationSpec {
     /// How ground vibration decays with distance (Bornitz).
     #[serde(default)]
     pub ground: GroundSpec,
-    /// `"long-term"` (default: a machine in production repeats its blow) or `"short-term"`
-    /// (an occasional blow): which DIN 4150-3 limits apply.
-    #[serde(default)]
-    pub excitation: Excitation,
+    /// `"long-term"` or `"short-term"` (an occasional blow): which DIN 4150-3 limits apply.
+    /// Not given: long-term, because of the model's `[production] rate_bpm` (repeated blows)
+    /// or, without one, as the conservative choice ([`super::foundation::excitation_of`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub excitation: Option<Excitation>,
     /// The lumped mass that is the anvil (for the anvil-amplitude check).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub anvil: Option<String>,

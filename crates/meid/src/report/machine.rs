@@ -135,6 +135,9 @@ pub struct MachineReport {
     pub measured: Option<Validation>,
     /// Why a study was left out (no damper, a failed study ...); shown on the page.
     pub notes: Vec<String>,
+    /// With a `[foundation]`: its checks and the receivers' for each case of the comparison
+    /// ([`crate::foundation::assess`]); empty without one.
+    pub foundation: Vec<(CaseName, crate::foundation::FoundationAssessment)>,
 }
 
 /// The stages of [`MachineReport::run`], in order, for progress reporting.
@@ -348,6 +351,14 @@ impl MachineReport {
         )
         .run()?;
 
+        // With a [foundation]: the block, the soil and the receivers in each case.
+        let mut foundation = Vec::new();
+        for c in comparison.cases.iter().map(|c| c.case) {
+            if let Some(a) = crate::foundation::assess(&model, case_of(c))? {
+                foundation.push((c, a));
+            }
+        }
+
         progress(STAGES[4]);
         let blows = blow_trains(&model, &comparison, options.blows, rate_bpm)?;
 
@@ -377,6 +388,7 @@ impl MachineReport {
             montecarlo,
             measured,
             notes,
+            foundation,
         })
     }
 
@@ -480,6 +492,9 @@ impl MachineReport {
                 20.0 * (d.peak_bed_acceleration_m_per_s2 / n.peak_bed_acceleration_m_per_s2).log10(),
             ));
         }
+        // A receiver over its DIN 4150-3 limit in any case (section "Foundation and
+        // surroundings").
+        out.extend(super::foundation::failing_sentences(&self.foundation));
         out
     }
 
@@ -816,7 +831,7 @@ impl MachineReport {
             .clone()
             .unwrap_or_else(|| self.model_path.clone());
 
-        let sections = vec![
+        let mut sections = vec![
             // The verdict, in words, first.
             Section {
                 id: "verdict".into(),
@@ -832,12 +847,15 @@ impl MachineReport {
             self.modes_section(),
             self.map_section(dir)?,
             self.cases_section(dir)?,
+        ];
+        sections.extend(super::foundation::section(dir, &self.foundation)?);
+        sections.extend([
             super::measured::section(dir, self.measured.as_ref())?,
             self.blows_section(dir)?,
             self.optimiser_section(),
             self.montecarlo_section(dir)?,
             self.method_section(),
-        ];
+        ]);
         Ok(Page {
             title: format!("meid report: {name}"),
             lead: format!("Model {} — {generator}.", self.model_path),
@@ -1243,7 +1261,7 @@ impl MachineReport {
                 "metric_stats": mc.metric_stats,
             })
         });
-        serde_json::json!({
+        let mut out = serde_json::json!({
             "model": self.model_path,
             "name": self.model.spec.name,
             "verdict": self.verdict(),
@@ -1260,7 +1278,25 @@ impl MachineReport {
             "measured": self.measured,
             "warnings": self.modes.warnings,
             "notes": self.notes,
-        })
+        });
+        // With a [foundation], as `meid compare --json` carries it: per case.
+        if let (false, Some(o)) = (self.foundation.is_empty(), out.as_object_mut()) {
+            let mut f = serde_json::Map::new();
+            let mut r = serde_json::Map::new();
+            for (c, a) in &self.foundation {
+                f.insert(
+                    c.name().into(),
+                    serde_json::to_value(&a.foundation).unwrap_or_default(),
+                );
+                r.insert(
+                    c.name().into(),
+                    serde_json::to_value(&a.receivers).unwrap_or_default(),
+                );
+            }
+            o.insert("foundation".into(), f.into());
+            o.insert("receivers".into(), r.into());
+        }
+        out
     }
 
     /// Writes the pictures, the data, `report.json` and `index.html` into `dir` (which must

@@ -11,6 +11,7 @@
 //! small structure, and escaping is the only subtle part.
 
 pub mod figures;
+pub mod foundation;
 pub mod histories;
 pub mod html;
 pub mod machine;
