@@ -249,10 +249,23 @@ fn truncated_selection_reports_a_small_share_and_a_warning() {
         );
         assert!(r.captured_share < 0.95, "{r:?}");
     }
+    // B is O_b's node: its static response to the blow is its own flexibility, so the share
+    // of the blow's response equals the captured share; O_b (the struck point) has none.
+    assert_eq!(d.truncation[0].blow_response_share, None);
+    let b = &d.truncation[1];
+    let share = b
+        .blow_response_share
+        .expect("B's share of the blow's response");
+    assert!((share - b.captured_share).abs() <= 1e-9, "{b:?}");
     assert_eq!(d.warnings.len(), 2, "{:?}", d.warnings);
     for w in &d.warnings {
         assert!(w.contains("static flexibility at point"), "{w}");
     }
+    assert!(
+        d.warnings[1].contains("of its static response to the blow"),
+        "{:?}",
+        d.warnings
+    );
 }
 
 /// A lumped model keeps all its modes: the share is 1 to 1e-12 at every point (the static

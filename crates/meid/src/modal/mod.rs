@@ -96,6 +96,10 @@ pub struct ModalModel {
     /// its elastic modes: `G_PP = Σ_{all elastic modes} ψ_i(P)²/ω_i²`, computed from the
     /// stiffness matrix (see [`truncation`]). Empty when unknown (tabulated modes).
     pub static_flexibility: BTreeMap<String, f64>,
+    /// The full structure's static cross flexibilities `G_PQ` (m/N, elastic part) between the
+    /// named points, P ≠ Q: `static_cross_flexibility[P][Q]` is the displacement of P under a
+    /// unit static force at Q ([`truncation::static_flexibility_matrix`]). Empty when unknown.
+    pub static_cross_flexibility: BTreeMap<String, BTreeMap<String, f64>>,
     /// What building the structure did that a user should know (e.g. a spring treated as rigid).
     pub notes: Vec<String>,
     /// What building the structure found doubtful (ill-conditioning, modes missing below the
@@ -136,6 +140,7 @@ impl ModalModel {
             mode_numbers: (1..=n).collect(),
             effective_mass_kg: None,
             static_flexibility: BTreeMap::new(),
+            static_cross_flexibility: BTreeMap::new(),
             notes: Vec::new(),
             warnings: Vec::new(),
             bed_mass_kg: None,
@@ -236,6 +241,11 @@ impl ModalModel {
             // (inertia-relief) flexibility depends on the mass distribution: unknown here.
             static_flexibility: if self.omega_rad_per_s.iter().all(|w| *w > 0.0) {
                 self.static_flexibility.clone()
+            } else {
+                BTreeMap::new()
+            },
+            static_cross_flexibility: if self.omega_rad_per_s.iter().all(|w| *w > 0.0) {
+                self.static_cross_flexibility.clone()
             } else {
                 BTreeMap::new()
             },

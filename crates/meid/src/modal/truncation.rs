@@ -72,6 +72,14 @@ pub struct TruncationRow {
     /// and its effective mass at P, `1/ψ_i(P)²` (kg).
     pub dominant_mode: Option<usize>,
     pub dominant_mode_effective_mass_kg: Option<f64>,
+    /// Of P's static response to a force at the struck point (the `bed_contact` point, O_b),
+    /// the share the retained modes carry: `Σ ψ_i(P) ψ_i(O_b)/ω_i² / G_{P,O_b}`. It says how
+    /// much of the quasi-static part of what is printed at P (its displacement under the blow,
+    /// the low-frequency part of its acceleration) the truncation loses, where
+    /// `captured_share` speaks of any load at P. `None` at O_b itself, where the full `G_{P,O_b}`
+    /// is unknown, or where P hardly moves under that force (`|G_{P,O_b}| < 1e-3 √(G_PP G_OO)`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blow_response_share: Option<f64>,
 }
 
 /// `(m_eff, dominant mode index, its 1/ψ²)` at a point with mode-shape values `psi` (module
@@ -107,6 +115,10 @@ impl ModalModel {
     /// structure (from [`ModalModel::static_flexibility`]), the retained modes' estimate and
     /// their ratio. Points without a known static flexibility (tabulated modes) are left out.
     pub fn truncation(&self, points: &[(String, Vec<String>)]) -> Vec<TruncationRow> {
+        let struck = points
+            .iter()
+            .find(|(_, roles)| roles.iter().any(|r| r == "bed_contact"))
+            .map(|(name, _)| name.as_str());
         let mut rows = Vec::new();
         for (name, roles) in points {
             let (Some(&g), Ok(psi)) = (self.static_flexibility.get(name), self.point(name)) else {
@@ -124,9 +136,31 @@ impl ModalModel {
                 effective_mass_kg: m_eff,
                 dominant_mode: dominant.map(|i| self.mode_numbers.get(i).copied().unwrap_or(i + 1)),
                 dominant_mode_effective_mass_kg: m_dominant,
+                blow_response_share: struck.and_then(|o| self.blow_response_share(name, o, g)),
             });
         }
         rows
+    }
+}
+
+impl ModalModel {
+    /// [`TruncationRow::blow_response_share`] of point `p` (static flexibility `g_pp`) under a
+    /// force at the struck point `o`.
+    fn blow_response_share(&self, p: &str, o: &str, g_pp: f64) -> Option<f64> {
+        if p == o {
+            return None;
+        }
+        let g_po = *self.static_cross_flexibility.get(p)?.get(o)?;
+        let g_oo = *self.static_flexibility.get(o)?;
+        if !(g_po.abs() >= 1e-3 * (g_pp * g_oo).abs().sqrt() && g_po.abs() > 0.0) {
+            return None;
+        }
+        let modal = modal_cross_flexibility(
+            &self.omega_rad_per_s,
+            self.point(p).ok()?,
+            self.point(o).ok()?,
+        );
+        Some(modal / g_po)
     }
 }
 
@@ -200,10 +234,25 @@ pub fn share_warning(row: &TruncationRow) -> Option<String> {
     } else {
         format!(" ({})", row.roles.join(", "))
     };
+    // What this means for the results printed at the point: its response to the blow.
+    let effect = match row.blow_response_share {
+        Some(b) => format!(
+            "; of its static response to the blow (a force at the struck point) they carry \
+             {:.2} %, so what is printed at '{}' (its displacement, the low-frequency part of \
+             its acceleration) is off by about {:.2} % in its quasi-static part (the missing \
+             modes' dynamic part is not estimated); results at the struck point are not \
+             affected by this",
+            100.0 * b,
+            row.point,
+            100.0 * (1.0 - b).abs()
+        ),
+        None => String::new(),
+    };
     Some(format!(
         "the retained modes carry {:.2} % of the static flexibility at point '{}'{roles} \
-         ({:.4e} of {:.4e} m/N): a mode that moves this point is missing; keep more modes \
-         (select = \"auto\", a larger `count`, or add the missing mode numbers to `select`)",
+         ({:.4e} of {:.4e} m/N): a mode that moves this point is missing{effect}; keep more \
+         modes (select = \"auto\", a larger `count`, or add the missing mode numbers to \
+         `select`)",
         100.0 * row.captured_share,
         row.point,
         row.modal_flexibility_m_per_n,
@@ -222,10 +271,77 @@ pub fn static_flexibility(
     rigid: &[Vec<f64>],
     lowest_elastic: Option<f64>,
 ) -> Result<Vec<f64>> {
+    let g = static_flexibility_matrix(k, m, functionals, rigid, lowest_elastic)?;
+    Ok(g.iter().enumerate().map(|(i, row)| row[i]).collect())
+}
+
+/// The static (cross) flexibilities `G_PQ = f_Pᵀ u_Q` (m/N, elastic part) between the points
+/// of `functionals`: the displacement of P under a unit static force at Q, a symmetric `p × p`
+/// matrix (rows of the result) whose diagonal is [`static_flexibility`]. The modal estimate of
+/// an entry is `Σ_{retained, ω_i > 0} ψ_i(P) ψ_i(Q)/ω_i²` ([`modal_cross_flexibility`]).
+pub fn static_flexibility_matrix(
+    k: SparseColMatRef<'_, usize, f64>,
+    m: SparseColMatRef<'_, usize, f64>,
+    functionals: &[Vec<f64>],
+    rigid: &[Vec<f64>],
+    lowest_elastic: Option<f64>,
+) -> Result<Vec<Vec<f64>>> {
+    let u = static_deflections(k, m, functionals, rigid, lowest_elastic)?;
+    let n = k.nrows();
+    Ok(functionals
+        .iter()
+        .map(|f| {
+            (0..u.ncols())
+                .map(|c| (0..n).map(|i| f[i] * u[(i, c)]).sum())
+                .collect()
+        })
+        .collect())
+}
+
+/// The off-diagonal entries of a [`static_flexibility_matrix`] by point names: `map[P][Q] =
+/// G_PQ` for P ≠ Q (the layout of [`ModalModel::static_cross_flexibility`]).
+pub fn cross_map<S: AsRef<str>>(
+    names: &[S],
+    g: &[Vec<f64>],
+) -> std::collections::BTreeMap<String, std::collections::BTreeMap<String, f64>> {
+    let mut map = std::collections::BTreeMap::new();
+    for (i, p) in names.iter().enumerate() {
+        let row: std::collections::BTreeMap<String, f64> = names
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != i)
+            .map(|(j, q)| (q.as_ref().to_string(), g[i][j]))
+            .collect();
+        map.insert(p.as_ref().to_string(), row);
+    }
+    map
+}
+
+/// `Σ_{ω_i > 0} ψ_i(P) ψ_i(Q)/ω_i²` (m/N) over the retained modes: the modal estimate of
+/// `G_PQ` ([`static_flexibility_matrix`]).
+pub fn modal_cross_flexibility(omega_rad_per_s: &[f64], psi_p: &[f64], psi_q: &[f64]) -> f64 {
+    omega_rad_per_s
+        .iter()
+        .zip(psi_p.iter().zip(psi_q))
+        .filter(|(w, _)| **w > 0.0)
+        .map(|(w, (a, b))| a * b / (w * w))
+        .fold(0.0, |acc, x| acc + x)
+}
+
+/// The elastic static deflections `u_Q` (columns) under unit loads at the points of
+/// `functionals` (module docs: Cholesky of K, or the inertia-relief iteration with rigid-body
+/// modes, converged on the diagonal `f_Qᵀ u_Q`).
+fn static_deflections(
+    k: SparseColMatRef<'_, usize, f64>,
+    m: SparseColMatRef<'_, usize, f64>,
+    functionals: &[Vec<f64>],
+    rigid: &[Vec<f64>],
+    lowest_elastic: Option<f64>,
+) -> Result<Mat<f64>> {
     let n = k.nrows();
     let p = functionals.len();
     if p == 0 {
-        return Ok(Vec::new());
+        return Ok(Mat::zeros(n, 0));
     }
     if functionals.iter().chain(rigid).any(|f| f.len() != n) {
         return Err(Error::invalid(
@@ -244,9 +360,7 @@ pub fn static_flexibility(
             )
         })?;
         llt.solve_in_place(rhs.as_mut())?;
-        return Ok((0..p)
-            .map(|j| (0..n).map(|i| functionals[j][i] * rhs[(i, j)]).sum())
-            .collect());
+        return Ok(rhs);
     }
     let lam1 = match lowest_elastic {
         Some(l) if l.is_finite() && l > 0.0 => l,
@@ -311,7 +425,7 @@ pub fn static_flexibility(
             .all(|(a, b)| (a - b).abs() <= 1e-15 * a.abs());
         g_old = g;
         if done {
-            return Ok(g_old);
+            return Ok(u);
         }
     }
     Err(Error::numerical(
@@ -347,6 +461,7 @@ mod tests {
             effective_mass_kg: Some(1.0),
             dominant_mode: Some(1),
             dominant_mode_effective_mass_kg: Some(1.0),
+            blow_response_share: None,
         };
         let text = to_text(&[row]);
         assert!(!text.contains("-0"), "{text}");
@@ -374,6 +489,60 @@ mod tests {
         let g = static_flexibility(kk.as_ref(), mm.as_ref(), &f, &[], None).unwrap();
         assert!((g[0] - 3.0 / k).abs() <= 1e-14 * 3.0 / k, "{g:?}");
         assert!((g[1] - 2.0 / k).abs() <= 1e-14 * 2.0 / k, "{g:?}");
+    }
+
+    /// Cross flexibilities against closed forms: on the grounded chain of three springs k a
+    /// force at the middle moves the tip as much as the middle (2/k); on the free pair joined
+    /// by k (inertia relief) `G_12 = φ(1)φ(2)/ω² = −m1 m2/((m1 + m2)² k)`, which the modal
+    /// estimate with the one elastic mode gives too (share 1).
+    #[test]
+    fn cross_flexibilities_match_the_closed_forms() {
+        let k = 2.0e5;
+        let kk = sparse(
+            3,
+            &[
+                (0, 0, 2.0 * k),
+                (0, 1, -k),
+                (1, 0, -k),
+                (1, 1, 2.0 * k),
+                (1, 2, -k),
+                (2, 1, -k),
+                (2, 2, k),
+            ],
+        );
+        let mm = sparse(3, &[(0, 0, 1.0), (1, 1, 2.0), (2, 2, 3.0)]);
+        let f = vec![vec![0.0, 0.0, 1.0], vec![0.0, 1.0, 0.0]];
+        let g = static_flexibility_matrix(kk.as_ref(), mm.as_ref(), &f, &[], None).unwrap();
+        for (got, want) in [(g[0][1], 2.0 / k), (g[1][0], 2.0 / k), (g[0][0], 3.0 / k)] {
+            assert!((got - want).abs() <= 1e-14 * want, "{g:?}");
+        }
+        let map = cross_map(&["tip", "middle"], &g);
+        assert_eq!(map["tip"]["middle"], g[0][1]);
+        assert!(!map["tip"].contains_key("tip"));
+
+        let (m1, m2, k) = (2.0, 6.0, 3.0e4);
+        let kk = sparse(2, &[(0, 0, k), (0, 1, -k), (1, 0, -k), (1, 1, k)]);
+        let mm = sparse(2, &[(0, 0, m1), (1, 1, m2)]);
+        let s = 1.0 / (m1 + m2).sqrt();
+        let lam = k * (1.0 / m1 + 1.0 / m2);
+        let f = vec![vec![1.0, 0.0], vec![0.0, 1.0]];
+        let g = static_flexibility_matrix(kk.as_ref(), mm.as_ref(), &f, &[vec![s, s]], Some(lam))
+            .unwrap();
+        let want = -m1 * m2 / ((m1 + m2).powi(2) * k);
+        assert!(
+            (g[0][1] - want).abs() <= 1e-13 * want.abs(),
+            "{g:?} vs {want}"
+        );
+        let (a, b) = (
+            (m2 / (m1 * (m1 + m2))).sqrt(),
+            -(m1 / (m2 * (m1 + m2))).sqrt(),
+        );
+        let modal = modal_cross_flexibility(&[0.0, lam.sqrt()], &[s, a], &[s, b]);
+        assert!(
+            (modal / g[0][1] - 1.0).abs() <= 1e-12,
+            "{modal} vs {}",
+            g[0][1]
+        );
     }
 
     /// Two free masses m1, m2 joined by k: one elastic mode, ω² = k (1/m1 + 1/m2), shape

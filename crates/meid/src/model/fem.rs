@@ -928,7 +928,8 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             *s += v * v;
         }
     }
-    let static_flexibility = full_static_flexibility(&model, &modes, &functionals, &mut warnings);
+    let (static_flexibility, static_cross) =
+        full_static_flexibility(&model, &modes, &functionals, &mut warnings);
     let freq = &table.frequency_hz;
     let input = AutoInput {
         scores: &scores,
@@ -948,6 +949,7 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
     let selected_residuals = sparse_residuals(&model, &modes, &selected);
     warn_residuals(&selected, &selected_residuals, freq, &mut warnings);
     modal.static_flexibility = static_flexibility;
+    modal.static_cross_flexibility = static_cross;
     modal.warnings = warnings;
     modal.bed_mass_kg = bed_part_mass(&model.mesh, ctx);
     if let Some(note) = model.constraint_like_note(CONSTRAINT_LIKE_RATIO) {
@@ -1139,32 +1141,41 @@ fn rigid_and_lowest(modes: &DenseModes) -> (Vec<Vec<f64>>, Option<f64>) {
 }
 
 /// The full model's static flexibility `G_PP` (m/N, elastic part, module docs) at each point
-/// of `functionals`; empty, with a warning, when the static solution fails.
+/// of `functionals`, and the cross flexibilities `G_PQ` (P ≠ Q); empty, with a warning, when the
+/// static solution fails.
 fn full_static_flexibility(
     model: &FeModel,
     modes: &DenseModes,
     functionals: &[(String, Vec<f64>)],
     warnings: &mut Vec<String>,
-) -> BTreeMap<String, f64> {
+) -> (BTreeMap<String, f64>, CrossFlexibility) {
     let (rigid, lowest_elastic) = rigid_and_lowest(modes);
     let fvecs: Vec<Vec<f64>> = functionals.iter().map(|(_, f)| f.clone()).collect();
-    match truncation::static_flexibility(
+    match truncation::static_flexibility_matrix(
         model.stiffness.as_ref(),
         model.mass.as_ref(),
         &fvecs,
         &rigid,
         lowest_elastic,
     ) {
-        Ok(g) => functionals.iter().map(|(p, _)| p.clone()).zip(g).collect(),
+        Ok(g) => {
+            let names: Vec<&String> = functionals.iter().map(|(p, _)| p).collect();
+            let diag = names.iter().zip(&g).enumerate();
+            let diag = diag.map(|(i, (p, row))| ((*p).clone(), row[i])).collect();
+            (diag, truncation::cross_map(&names, &g))
+        }
         Err(e) => {
             warnings.push(format!(
                 "structure.fem: the static flexibility could not be computed, so modes are \
                  selected without it and there is no truncation table: {e}"
             ));
-            BTreeMap::new()
+            (BTreeMap::new(), BTreeMap::new())
         }
     }
 }
+
+/// `G_PQ` by point names (P ≠ Q): [`crate::modal::ModalModel::static_cross_flexibility`].
+type CrossFlexibility = BTreeMap<String, BTreeMap<String, f64>>;
 
 /// The selected modes (0-based, ascending, at least one) by `structure.fem.select`: "auto"
 /// (the default), "participation", a list of 1-based mode numbers or a band in Hz.

@@ -645,9 +645,13 @@ fn flexibility_at_masses(
         .map(|d| (0..nd).map(|i| if i == d { 1.0 } else { 0.0 }).collect())
         .collect();
     let g = match (to_sparse(&sys.k), to_sparse(&sys.mass_matrix())) {
-        (Ok(k), Ok(m)) => {
-            truncation::static_flexibility(k.as_ref(), m.as_ref(), &functionals, &rigid, lam_lo)
-        }
+        (Ok(k), Ok(m)) => truncation::static_flexibility_matrix(
+            k.as_ref(),
+            m.as_ref(),
+            &functionals,
+            &rigid,
+            lam_lo,
+        ),
         _ => Err(crate::Error::numerical(
             "static flexibility",
             "sparse assembly failed",
@@ -655,11 +659,20 @@ fn flexibility_at_masses(
     };
     match g {
         Ok(g) => {
-            for (i, ms) in l.masses.iter().enumerate() {
+            // A mass fixed to the ground (no DOF) has no flexibility.
+            let at = |i: usize, j: usize| match (sys.dof[i], sys.dof[j]) {
+                (Some(a), Some(b)) => g[a][b],
+                _ => 0.0,
+            };
+            let n = l.masses.len();
+            let full: Vec<Vec<f64>> = (0..n).map(|i| (0..n).map(|j| at(i, j)).collect()).collect();
+            let names: Vec<&str> = l.masses.iter().map(|ms| ms.name.as_str()).collect();
+            for (i, name) in names.iter().enumerate() {
                 model
                     .static_flexibility
-                    .insert(ms.name.clone(), sys.dof[i].map_or(0.0, |d| g[d]));
+                    .insert(name.to_string(), full[i][i]);
             }
+            model.static_cross_flexibility = truncation::cross_map(&names, &full);
         }
         Err(e) => model.warnings.push(format!(
             "{base}: no static flexibility, so no truncation table: {e}"
