@@ -10,6 +10,7 @@ mod audit_s11_cli;
 mod calibrate_cli;
 mod cli;
 mod compare_cli;
+mod correlate_cli;
 mod conventions;
 mod fem_threads_cli;
 mod foundation_cli;

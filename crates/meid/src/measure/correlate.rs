@@ -796,7 +796,8 @@ fn blind_warnings(
 }
 
 impl Correlation {
-    /// The report as text: the mapping, the paired modes, the MAC and auto-MAC matrices.
+    /// The report as text: the mapping, the paired modes, the MAC and auto-MAC matrices, the
+    /// notes (the warnings are for the caller to show).
     pub fn to_text(&self) -> String {
         use std::fmt::Write as _;
         let mut s = String::new();
@@ -844,9 +845,6 @@ impl Correlation {
         };
         matrix(&mut s, "MAC (rows: identified, columns: model modes)", &self.mac);
         matrix(&mut s, "auto-MAC of the model modes at the measured points", &self.auto_mac);
-        for w in &self.warnings {
-            let _ = writeln!(s, "warning: {w}");
-        }
         for n in &self.notes {
             let _ = writeln!(s, "note: {n}");
         }

@@ -336,7 +336,8 @@ impl ModalCalibration {
         self.parameters.iter().map(|e| e.value).collect()
     }
 
-    /// The report as text: the values with their intervals, the before/after correlation table.
+    /// The report as text: the values with their intervals, the before/after correlation table
+    /// (the warnings are for the caller to show).
     pub fn to_text(&self) -> String {
         use std::fmt::Write as _;
         let mut s = String::new();
@@ -389,9 +390,6 @@ impl ModalCalibration {
                 p.error_after_percent,
                 p.mac_after
             );
-        }
-        for w in self.warnings.iter().chain(&self.after.warnings) {
-            let _ = writeln!(s, "warning: {w}");
         }
         s
     }
