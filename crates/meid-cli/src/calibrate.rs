@@ -21,7 +21,11 @@ pub struct CalibrateArgs {
     /// Measured file (UFF or CSV), optionally with the case it measured: none=FILE (the bare
     /// machine), damper=FILE, added-mass=FILE; a plain FILE is the model as specified
     /// (repeatable; the cases are fitted together).
-    #[arg(long = "measured", value_name = "[CASE=]FILE", required_unless_present = "modal")]
+    #[arg(
+        long = "measured",
+        value_name = "[CASE=]FILE",
+        required_unless_present = "modal"
+    )]
     measured: Vec<String>,
     /// Fit to identified modes instead of records: meid identify's JSON, modes.csv or UFF 55.
     /// Residuals: relative frequency errors of the paired modes and √W (1 − MAC), W the
@@ -30,7 +34,12 @@ pub struct CalibrateArgs {
     modal: Option<PathBuf>,
     /// Weight W of the shapes' (1 − MAC) beside the relative frequency errors (with --modal;
     /// 0: frequencies alone).
-    #[arg(long = "mac-weight", value_name = "W", default_value_t = 1.0, requires = "modal")]
+    #[arg(
+        long = "mac-weight",
+        value_name = "W",
+        default_value_t = 1.0,
+        requires = "modal"
+    )]
     mac_weight: f64,
     #[command(flatten)]
     mapping: crate::correlate::MappingArgs,

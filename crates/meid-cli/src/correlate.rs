@@ -104,7 +104,10 @@ pub fn point_coordinates(an: Option<&fem::FemAnalysis>) -> Option<BTreeMap<Strin
     let mesh = &an?.model.mesh;
     let mut out = BTreeMap::new();
     for (name, nodes) in &mesh.points {
-        let xyz: Vec<[f64; 3]> = nodes.iter().filter_map(|&k| mesh.nodes.get(k).copied()).collect();
+        let xyz: Vec<[f64; 3]> = nodes
+            .iter()
+            .filter_map(|&k| mesh.nodes.get(k).copied())
+            .collect();
         if xyz.is_empty() {
             continue;
         }
@@ -143,10 +146,16 @@ pub fn run(a: CorrelateArgs) -> Result<()> {
         meid::io::write_atomic(&dir.join("pairs.csv"), c.pairs_csv().as_bytes())?;
         let csv = meid::measure::correlate::Correlation::matrix_csv;
         meid::io::write_atomic(&dir.join("mac.csv"), csv(&c.mac, "identified").as_bytes())?;
-        meid::io::write_atomic(&dir.join("auto_mac.csv"), csv(&c.auto_mac, "model").as_bytes())?;
+        meid::io::write_atomic(
+            &dir.join("auto_mac.csv"),
+            csv(&c.auto_mac, "model").as_bytes(),
+        )?;
         let notes = c.plots(dir)?;
         c.notes.extend(notes);
-        meid::io::write_atomic(&dir.join("geometry.uff"), &geometry_uff(&model.structure, &mm)?)?;
+        meid::io::write_atomic(
+            &dir.join("geometry.uff"),
+            &geometry_uff(&model.structure, &mm)?,
+        )?;
         set.commit("correlate")?;
     }
     if !a.print.quiet {

@@ -148,24 +148,39 @@ fn correlate_bad_input_exits_2() {
         r#"{"points": ["anvil:1 +Z"], "modes": [{"frequency_hz": 280.0, "shape": [1.0]}]}"#,
         &[],
     );
-    assert!(e.contains("unmapped.json") && e.contains("anvil:1 +Z") && e.contains("base, bed") && e.contains("--map"), "{e}");
+    assert!(
+        e.contains("unmapped.json")
+            && e.contains("anvil:1 +Z")
+            && e.contains("base, bed")
+            && e.contains("--map"),
+        "{e}"
+    );
     let e = run(
         "noshape.json",
         r#"{"points": ["bed:1 +Z"], "modes": [{"frequency_hz": 280.0}]}"#,
         &[],
     );
-    assert!(e.contains("noshape.json") && e.contains("modes[0].shape"), "{e}");
+    assert!(
+        e.contains("noshape.json") && e.contains("modes[0].shape"),
+        "{e}"
+    );
     let e = run(
         "few.json",
         r#"{"points": ["bed:1 +Z"], "modes": [{"frequency_hz": 280.0, "shape": [1.0]}]}"#,
         &["--model-modes", "2"],
     );
-    assert!(e.contains("few.json") && e.contains("fewer than the 2 modes asked"), "{e}");
+    assert!(
+        e.contains("few.json") && e.contains("fewer than the 2 modes asked"),
+        "{e}"
+    );
     let e = run(
         "mapped.json",
         r#"{"points": ["x:1 +Z"], "modes": [{"frequency_hz": 280.0, "shape": [1.0]}]}"#,
         &["--map", "x=anvil"],
     );
-    assert!(e.contains("--map") && e.contains("anvil") && e.contains("base, bed"), "{e}");
+    assert!(
+        e.contains("--map") && e.contains("anvil") && e.contains("base, bed"),
+        "{e}"
+    );
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -29,8 +29,10 @@ fn tmp(name: &str) -> PathBuf {
 /// A model of three points a, b, c (display line x = 0, 1, 2) with the given shapes (per point,
 /// per mode) and frequencies.
 fn model(freqs: &[f64], shapes: &[(&str, Vec<f64>)]) -> ModelModes {
-    let points: BTreeMap<String, Vec<f64>> =
-        shapes.iter().map(|(n, v)| (n.to_string(), v.clone())).collect();
+    let points: BTreeMap<String, Vec<f64>> = shapes
+        .iter()
+        .map(|(n, v)| (n.to_string(), v.clone()))
+        .collect();
     let coordinates = shapes
         .iter()
         .enumerate()
@@ -66,7 +68,11 @@ fn identified(labels: &[&str], modes: &[(f64, Vec<f64>)]) -> IdentifiedModes {
 fn mac_closed_forms() {
     let m = mac_matrix(
         &[vec![1.0, 2.0, 3.0], vec![1.0, 0.0, 0.0]],
-        &[vec![-2.0, -4.0, -6.0], vec![3.0, 0.0, -1.0], vec![1.0, 1.0, 0.0]],
+        &[
+            vec![-2.0, -4.0, -6.0],
+            vec![3.0, 0.0, -1.0],
+            vec![1.0, 1.0, 0.0],
+        ],
     );
     assert!((m[0][0] - 1.0).abs() < 1e-15, "{m:?}");
     assert_eq!(m[0][1], 0.0);
@@ -81,7 +87,11 @@ fn mac_closed_forms() {
 fn pairing_on_a_permuted_set() {
     let perm = [2usize, 0, 1];
     let mac: Vec<Vec<f64>> = (0..3)
-        .map(|i| (0..3).map(|j| if j == perm[i] { 0.97 } else { 0.1 }).collect())
+        .map(|i| {
+            (0..3)
+                .map(|j| if j == perm[i] { 0.97 } else { 0.1 })
+                .collect()
+        })
         .collect();
     let pairs = pair_modes(&mac, 0.5, |_, _| 0.0);
     assert_eq!(pairs, vec![(0, 2), (1, 0), (2, 1)]);
@@ -97,23 +107,48 @@ fn pairing_on_a_permuted_set() {
 fn blind_points_are_warned_about() {
     let m = model(
         &[10.0, 20.0],
-        &[("a", vec![1.0, 1.0]), ("b", vec![1.0, 1.1]), ("c", vec![1.0, -1.0])],
+        &[
+            ("a", vec![1.0, 1.0]),
+            ("b", vec![1.0, 1.1]),
+            ("c", vec![1.0, -1.0]),
+        ],
     );
     let id = identified(&["a:1 +Z", "b:2 +Z"], &[(10.0, vec![1.0, 1.0])]);
     let c = correlate(&id, &m, &Mapping::default(), &Settings::default()).unwrap();
     assert!(c.auto_mac[0][1] > 0.9);
-    assert!(c.warnings.iter().any(|w| w.contains("auto-MAC of model modes 1 and 2")), "{:?}", c.warnings);
+    assert!(
+        c.warnings
+            .iter()
+            .any(|w| w.contains("auto-MAC of model modes 1 and 2")),
+        "{:?}",
+        c.warnings
+    );
     let id1 = identified(&["a:1 +Z"], &[(10.0, vec![1.0])]);
     let c1 = correlate(&id1, &m, &Mapping::default(), &Settings::default()).unwrap();
-    assert!(c1.warnings.iter().any(|w| w.contains("fewer points than modes")), "{:?}", c1.warnings);
-    let good = identified(&["a:1 +Z", "c:3 +Z"], &[(10.0, vec![1.0, 1.0]), (21.0, vec![1.0, -1.0])]);
+    assert!(
+        c1.warnings
+            .iter()
+            .any(|w| w.contains("fewer points than modes")),
+        "{:?}",
+        c1.warnings
+    );
+    let good = identified(
+        &["a:1 +Z", "c:3 +Z"],
+        &[(10.0, vec![1.0, 1.0]), (21.0, vec![1.0, -1.0])],
+    );
     let cg = correlate(&good, &m, &Mapping::default(), &Settings::default()).unwrap();
     assert!(cg.warnings.is_empty(), "{:?}", cg.warnings);
     assert_eq!(cg.pairs.len(), 2);
     assert!((cg.pairs[1].error_percent - 5.0).abs() < 1e-12);
     // Collinear points.
-    assert!(collinear(&[[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [2.0, 2.0, 0.0]], 1e-9));
-    assert!(!collinear(&[[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [2.0, 2.1, 0.0]], 1e-9));
+    assert!(collinear(
+        &[[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [2.0, 2.0, 0.0]],
+        1e-9
+    ));
+    assert!(!collinear(
+        &[[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [2.0, 2.1, 0.0]],
+        1e-9
+    ));
 }
 
 /// By name with a −Z point: its values are compared negated (sign −1), so an identified shape
@@ -132,8 +167,13 @@ fn mapping_by_name_flips_the_sign_of_minus_z() {
     assert!(c.mac[0][0].abs() < 1e-15);
     // An X direction is refused, naming the file, the point and the valid directions.
     let x = identified(&["a:1 +X"], &[(10.0, vec![1.0])]);
-    let e = correlate(&x, &m, &Mapping::default(), &Settings::default()).unwrap_err().to_string();
-    assert!(e.contains("test.json") && e.contains("a:1 +X") && e.contains("+Z and -Z"), "{e}");
+    let e = correlate(&x, &m, &Mapping::default(), &Settings::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("test.json") && e.contains("a:1 +X") && e.contains("+Z and -Z"),
+        "{e}"
+    );
 }
 
 /// By coordinates: nodes within the tolerance of the model's points map to them (the nearest);
@@ -141,7 +181,10 @@ fn mapping_by_name_flips_the_sign_of_minus_z() {
 /// points.
 #[test]
 fn mapping_by_coordinates_with_tolerance() {
-    let m = model(&[10.0, 30.0], &[("a", vec![1.0, 1.0]), ("b", vec![2.0, -1.0])]);
+    let m = model(
+        &[10.0, 30.0],
+        &[("a", vec![1.0, 1.0]), ("b", vec![2.0, -1.0])],
+    );
     let id = identified(&["7 +Z", "9 -Z"], &[(10.0, vec![1.0, -2.0])]);
     let nodes = BTreeMap::from([(7, [1.0005, 0.0, 0.0]), (9, [0.0, 0.0, 0.0002])]);
     let mapping = Mapping {
@@ -162,7 +205,10 @@ fn mapping_by_coordinates_with_tolerance() {
         ..Default::default()
     };
     let e = map_points(&id, &m, &far).unwrap_err().to_string();
-    assert!(e.contains("test.json") && e.contains("unmapped point(s) 7 +Z") && e.contains("a, b"), "{e}");
+    assert!(
+        e.contains("test.json") && e.contains("unmapped point(s) 7 +Z") && e.contains("a, b"),
+        "{e}"
+    );
 }
 
 /// The geometry meid writes for the lumped example reads back with meid's own reader: nodes
@@ -180,7 +226,10 @@ fn geometry_reads_back() {
     assert_eq!(u.traces.len(), 1);
     assert_eq!(u.traces[0].nodes, vec![1, 2]);
     assert_eq!(u.elements.len(), 1);
-    assert_eq!((u.elements[0].fe_descriptor, u.elements[0].nodes.clone()), (11, vec![1, 2]));
+    assert_eq!(
+        (u.elements[0].fe_descriptor, u.elements[0].nodes.clone()),
+        (11, vec![1, 2])
+    );
     assert_eq!(u.modes.len(), 2);
     assert!(u.skipped.is_empty(), "{:?}", u.skipped);
     for (i, md) in u.modes.iter().enumerate() {
@@ -213,11 +262,22 @@ fn geometry_reads_back() {
 fn bad_identified_files() {
     let dir = tmp("bad");
     let f = dir.join("noshape.json");
-    std::fs::write(&f, r#"{"points": ["bed:1 +Z"], "modes": [{"frequency_hz": 280.0, "damping_ratio": 0.01}]}"#).unwrap();
+    std::fs::write(
+        &f,
+        r#"{"points": ["bed:1 +Z"], "modes": [{"frequency_hz": 280.0, "damping_ratio": 0.01}]}"#,
+    )
+    .unwrap();
     let e = read_identified(&f).unwrap_err().to_string();
-    assert!(e.contains("noshape.json") && e.contains("modes[0].shape"), "{e}");
+    assert!(
+        e.contains("noshape.json") && e.contains("modes[0].shape"),
+        "{e}"
+    );
     let f = dir.join("nopoints.json");
-    std::fs::write(&f, r#"{"modes": [{"frequency_hz": 280.0, "shape": [1.0]}]}"#).unwrap();
+    std::fs::write(
+        &f,
+        r#"{"modes": [{"frequency_hz": 280.0, "shape": [1.0]}]}"#,
+    )
+    .unwrap();
     let e = read_identified(&f).unwrap_err().to_string();
     assert!(e.contains("nopoints.json") && e.contains("points"), "{e}");
     let f = dir.join("short.json");
@@ -226,11 +286,21 @@ fn bad_identified_files() {
     assert!(e.contains("1 values for 2 points"), "{e}");
     let mm = ModelModes::new(&lumped().structure, None);
     let id = identified(&["anvil:1 +Z"], &[(280.0, vec![1.0])]);
-    let e = correlate(&id, &mm, &Mapping::default(), &Settings::default()).unwrap_err().to_string();
-    assert!(e.contains("unmapped point(s) anvil:1 +Z") && e.contains("base, bed"), "{e}");
+    let e = correlate(&id, &mm, &Mapping::default(), &Settings::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("unmapped point(s) anvil:1 +Z") && e.contains("base, bed"),
+        "{e}"
+    );
     let id = identified(&["bed:1 +Z"], &[(280.0, vec![1.0])]);
-    let s = Settings { model_modes: Some(2), ..Settings::default() };
-    let e = correlate(&id, &mm, &Mapping::default(), &s).unwrap_err().to_string();
+    let s = Settings {
+        model_modes: Some(2),
+        ..Settings::default()
+    };
+    let e = correlate(&id, &mm, &Mapping::default(), &s)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("fewer than the 2 modes asked"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -247,14 +317,22 @@ fn modal_update_recovers_a_perturbed_stiffness() {
     let base = lumped();
     let k0 = 2.5415164e7;
     let k_true = 1.08 * k0;
-    let perturbed = base.with_fields(&[format!("{path}={k_true:e}")], None).unwrap();
+    let perturbed = base
+        .with_fields(&[format!("{path}={k_true:e}")], None)
+        .unwrap();
     let s = &perturbed.structure;
     let names = ["bed", "base"];
     let modes = (0..s.len())
         .map(|i| {
             let v: Vec<f64> = names.iter().map(|p| s.points[*p][i]).collect();
-            let top = v.iter().copied().fold(0.0_f64, |a, x| if x.abs() > a.abs() { x } else { a });
-            (s.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI), v.iter().map(|x| x / top).collect())
+            let top = v
+                .iter()
+                .copied()
+                .fold(0.0_f64, |a, x| if x.abs() > a.abs() { x } else { a });
+            (
+                s.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI),
+                v.iter().map(|x| x / top).collect(),
+            )
         })
         .collect::<Vec<_>>();
     let id = identified(&["bed:1 +Z", "base:2 +Z"], &modes);
@@ -275,8 +353,17 @@ fn modal_update_recovers_a_perturbed_stiffness() {
     assert!(c.converged, "{:?}", c.convergence);
     let k = c.parameters[0].value;
     assert!(((k - k_true) / k_true).abs() < 1e-2, "{k} vs {k_true}");
-    assert!(((k - k_true) / k_true).abs() < 1e-6, "noise-free: {k} vs {k_true}");
-    assert!(c.parameters[0].ci95_low <= k_true * (1.0 + 1e-6) && k_true * (1.0 - 1e-6) <= c.parameters[0].ci95_high);
-    assert!(c.pairs.iter().all(|p| p.error_after_percent.abs() < 1e-4 && p.mac_after > 0.999999));
+    assert!(
+        ((k - k_true) / k_true).abs() < 1e-6,
+        "noise-free: {k} vs {k_true}"
+    );
+    assert!(
+        c.parameters[0].ci95_low <= k_true * (1.0 + 1e-6)
+            && k_true * (1.0 - 1e-6) <= c.parameters[0].ci95_high
+    );
+    assert!(c
+        .pairs
+        .iter()
+        .all(|p| p.error_after_percent.abs() < 1e-4 && p.mac_after > 0.999999));
     assert!(c.pairs.iter().any(|p| p.error_before_percent.abs() > 0.5));
 }

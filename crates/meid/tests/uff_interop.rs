@@ -476,7 +476,11 @@ fn pyuff_reads_the_correlate_geometry() {
     let s = &m.structure;
     let mm = meid::measure::correlate::ModelModes::new(s, None);
     let path = dir.join("geometry.uff");
-    std::fs::write(&path, meid::measure::correlate::geometry_uff(s, &mm).unwrap()).unwrap();
+    std::fs::write(
+        &path,
+        meid::measure::correlate::geometry_uff(s, &mm).unwrap(),
+    )
+    .unwrap();
     let read: Value =
         serde_json::from_str(&script(&py, &["read", path.to_str().unwrap()])).unwrap();
     let sets = read.as_array().unwrap();
@@ -503,7 +507,12 @@ fn pyuff_reads_the_correlate_geometry() {
             .collect();
         for (k, p) in ["base", "bed"].iter().enumerate() {
             let psi = s.points[*p][i];
-            assert!(close(r3[k], psi, 5e-6), "mode {}: {p} {} vs {psi}", i + 1, r3[k]);
+            assert!(
+                close(r3[k], psi, 5e-6),
+                "mode {}: {p} {} vs {psi}",
+                i + 1,
+                r3[k]
+            );
         }
     }
     let _ = std::fs::remove_dir_all(&dir);

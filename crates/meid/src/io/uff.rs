@@ -1413,10 +1413,18 @@ impl<R: BufRead> Parser<'_, R> {
             let fields: Vec<String> = if ws.len() == 7 {
                 ws.iter().map(|t| t.to_string()).collect()
             } else {
-                [(0, 10), (10, 20), (20, 30), (30, 40), (40, 53), (53, 66), (66, 79)]
-                    .iter()
-                    .map(|&(a, b)| cols(&l, a, b).trim().to_string())
-                    .collect()
+                [
+                    (0, 10),
+                    (10, 20),
+                    (20, 30),
+                    (30, 40),
+                    (40, 53),
+                    (53, 66),
+                    (66, 79),
+                ]
+                .iter()
+                .map(|&(a, b)| cols(&l, a, b).trim().to_string())
+                .collect()
             };
             let label = fields[0].parse::<i64>().ok();
             let xyz: Vec<f64> = fields[4..].iter().filter_map(|t| parse_f(t)).collect();
@@ -1458,13 +1466,21 @@ impl<R: BufRead> Parser<'_, R> {
     /// Dataset 82: a trace line (module docs).
     fn dataset_82(&mut self, ds: Ds) -> Result<TraceLine> {
         let l1 = self.need_line(ds, "record 1")?;
-        let head = self.ints(ds, "record 1", &l1, "trace line number, number of nodes, colour")?;
+        let head = self.ints(
+            ds,
+            "record 1",
+            &l1,
+            "trace line number, number of nodes, colour",
+        )?;
         if head.len() < 2 {
             return Err(self.err(
                 Some(ds),
                 Some("record 1"),
                 self.line_no,
-                format!("expected 3I10 (trace line number, number of nodes, colour), got '{}'", clip(&l1)),
+                format!(
+                    "expected 3I10 (trace line number, number of nodes, colour), got '{}'",
+                    clip(&l1)
+                ),
             ));
         }
         let name = self.need_line(ds, "record 2")?.trim().to_string();
@@ -1492,7 +1508,12 @@ impl<R: BufRead> Parser<'_, R> {
             if l1.trim() == "-1" {
                 return Ok(out);
             }
-            let r1 = self.ints(ds, "record 1", &l1, "element label, FE descriptor, property tables, colour, number of nodes")?;
+            let r1 = self.ints(
+                ds,
+                "record 1",
+                &l1,
+                "element label, FE descriptor, property tables, colour, number of nodes",
+            )?;
             let &[label, fe_descriptor, _, _, color, count] = r1.as_slice() else {
                 return Err(self.err(
                     Some(ds),
@@ -1514,7 +1535,10 @@ impl<R: BufRead> Parser<'_, R> {
                     Some(ds),
                     Some("record 3"),
                     self.line_no,
-                    format!("element {label}: {} node labels, record 1 announces {count}", nodes.len()),
+                    format!(
+                        "element {label}: {} node labels, record 1 announces {count}",
+                        nodes.len()
+                    ),
                 ));
             }
             out.push(Element {
@@ -2167,8 +2191,17 @@ fn write_i10_lines<W: Write>(w: &mut W, labels: &[i64]) -> std::io::Result<()> {
 pub fn write_82<W: Write>(w: &mut W, t: &TraceLine) -> std::io::Result<()> {
     writeln!(w, "{:>6}\n{:>6}{:74}", -1, 82, "")?;
     writeln!(w, "{:>10}{:>10}{:>10}", t.number, t.nodes.len(), t.color)?;
-    let name: String = t.name.chars().filter(|c| !c.is_control()).take(80).collect();
-    writeln!(w, "{:<80}", if name.is_empty() { "NONE".into() } else { name })?;
+    let name: String = t
+        .name
+        .chars()
+        .filter(|c| !c.is_control())
+        .take(80)
+        .collect();
+    writeln!(
+        w,
+        "{:<80}",
+        if name.is_empty() { "NONE".into() } else { name }
+    )?;
     write_i10_lines(w, &t.nodes)?;
     writeln!(w, "{:>6}", -1)
 }

@@ -159,14 +159,21 @@ fn check_identified(m: &IdentifiedModes) -> Result<()> {
         return Err(bad(&m.file, "modes", format!("no mode: {VALID}")));
     }
     if m.points.is_empty() {
-        return Err(bad(&m.file, "points", format!("no measured point: {VALID}")));
+        return Err(bad(
+            &m.file,
+            "points",
+            format!("no measured point: {VALID}"),
+        ));
     }
     for (i, mode) in m.modes.iter().enumerate() {
         if mode.shape.is_empty() {
             return Err(bad(
                 &m.file,
                 &format!("modes[{i}].shape"),
-                format!("mode {} has no shape: correlation needs the shape at every point; {VALID}", i + 1),
+                format!(
+                    "mode {} has no shape: correlation needs the shape at every point; {VALID}",
+                    i + 1
+                ),
             ));
         }
         if mode.shape.len() != m.points.len() {
@@ -194,12 +201,18 @@ fn check_identified(m: &IdentifiedModes) -> Result<()> {
 }
 
 fn from_json(file: &str, text: &str) -> Result<IdentifiedModes> {
-    let v: serde_json::Value = serde_json::from_str(text)
-        .map_err(|e| bad(file, "JSON", format!("{e}: {VALID}")))?;
+    let v: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| bad(file, "JSON", format!("{e}: {VALID}")))?;
     let points = v
         .get("points")
         .and_then(|p| p.as_array())
-        .ok_or_else(|| bad(file, "points", format!("missing (a list of point labels): {VALID}")))?
+        .ok_or_else(|| {
+            bad(
+                file,
+                "points",
+                format!("missing (a list of point labels): {VALID}"),
+            )
+        })?
         .iter()
         .map(|p| p.as_str().map(parse_point_label))
         .collect::<Option<Vec<_>>>()
@@ -212,14 +225,24 @@ fn from_json(file: &str, text: &str) -> Result<IdentifiedModes> {
     for (i, m) in modes.iter().enumerate() {
         let num = |k: &str| m.get(k).and_then(|x| x.as_f64());
         let frequency_hz = num("frequency_hz").ok_or_else(|| {
-            bad(file, &format!("modes[{i}].frequency_hz"), "missing or not a number")
+            bad(
+                file,
+                &format!("modes[{i}].frequency_hz"),
+                "missing or not a number",
+            )
         })?;
         let shape = match m.get("shape") {
             None | Some(serde_json::Value::Null) => Vec::new(),
             Some(s) => s
                 .as_array()
                 .and_then(|a| a.iter().map(|x| x.as_f64()).collect::<Option<Vec<f64>>>())
-                .ok_or_else(|| bad(file, &format!("modes[{i}].shape"), "must be a list of numbers"))?,
+                .ok_or_else(|| {
+                    bad(
+                        file,
+                        &format!("modes[{i}].shape"),
+                        "must be a list of numbers",
+                    )
+                })?,
         };
         out.push(IdentifiedMode {
             frequency_hz,
@@ -272,7 +295,10 @@ fn from_csv(file: &str, text: &str) -> Result<IdentifiedModes> {
         modes.push(IdentifiedMode {
             frequency_hz: get(f_col)?,
             damping_ratio: z_col.map(get).transpose()?.unwrap_or(f64::NAN),
-            shape: shape_cols.iter().map(|(k, _)| get(*k)).collect::<Result<_>>()?,
+            shape: shape_cols
+                .iter()
+                .map(|(k, _)| get(*k))
+                .collect::<Result<_>>()?,
         });
     }
     Ok(IdentifiedModes {
@@ -480,7 +506,10 @@ fn map_one(
                 return Err(bad(
                     "--map",
                     key,
-                    format!("'{target}' is not a point of the model; its points are {}", model.names()),
+                    format!(
+                        "'{target}' is not a point of the model; its points are {}",
+                        model.names()
+                    ),
                 ));
             }
             return Ok(Some((target.clone(), "map", None, None)));
@@ -501,7 +530,9 @@ fn map_one(
             .coordinates
             .iter()
             .map(|(name, c)| {
-                let d = ((c[0] - xyz[0]).powi(2) + (c[1] - xyz[1]).powi(2) + (c[2] - xyz[2]).powi(2)).sqrt();
+                let d =
+                    ((c[0] - xyz[0]).powi(2) + (c[1] - xyz[1]).powi(2) + (c[2] - xyz[2]).powi(2))
+                        .sqrt();
                 (name, d)
             })
             .min_by(|a, b| a.1.total_cmp(&b.1));
@@ -629,7 +660,11 @@ pub fn collinear(points: &[[f64; 3]], tol: f64) -> bool {
     let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     let norm = |a: [f64; 3]| (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
     let p0 = points[0];
-    let Some(far) = points.iter().copied().max_by(|a, b| norm(sub(*a, p0)).total_cmp(&norm(sub(*b, p0)))) else {
+    let Some(far) = points
+        .iter()
+        .copied()
+        .max_by(|a, b| norm(sub(*a, p0)).total_cmp(&norm(sub(*b, p0))))
+    else {
         return false;
     };
     let d = sub(far, p0);
@@ -656,18 +691,36 @@ fn shapes(
 ) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
     let idx: Vec<usize> = mapped
         .iter()
-        .map(|m| ident.points.iter().position(|p| p.label == m.measured).unwrap_or(0))
+        .map(|m| {
+            ident
+                .points
+                .iter()
+                .position(|p| p.label == m.measured)
+                .unwrap_or(0)
+        })
         .collect();
     let a = ident
         .modes
         .iter()
-        .map(|m| idx.iter().map(|&k| m.shape.get(k).copied().unwrap_or(0.0)).collect())
+        .map(|m| {
+            idx.iter()
+                .map(|&k| m.shape.get(k).copied().unwrap_or(0.0))
+                .collect()
+        })
         .collect();
     let b = (0..model.frequencies_hz.len())
         .map(|j| {
             mapped
                 .iter()
-                .map(|m| m.sign * model.points.get(&m.model_point).and_then(|v| v.get(j)).copied().unwrap_or(0.0))
+                .map(|m| {
+                    m.sign
+                        * model
+                            .points
+                            .get(&m.model_point)
+                            .and_then(|v| v.get(j))
+                            .copied()
+                            .unwrap_or(0.0)
+                })
                 .collect()
         })
         .collect();
@@ -724,9 +777,22 @@ pub fn correlate(
             mac: mac[i][j],
         })
         .collect();
-    let mut warnings = blind_warnings(&auto_mac, settings.blind_mac, distinct.len(), &model, &mapped);
-    for b in b.iter().enumerate().filter(|(_, v)| v.iter().all(|x| *x == 0.0)) {
-        warnings.push(format!("model mode {} does not move any mapped point: its MAC is 0 with every shape", b.0 + 1));
+    let mut warnings = blind_warnings(
+        &auto_mac,
+        settings.blind_mac,
+        distinct.len(),
+        &model,
+        &mapped,
+    );
+    for b in b
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.iter().all(|x| *x == 0.0))
+    {
+        warnings.push(format!(
+            "model mode {} does not move any mapped point: its MAC is 0 with every shape",
+            b.0 + 1
+        ));
     }
     notes.push(format!(
         "pairing: the largest MAC among unpaired modes, repeatedly, while ≥ {}; each model mode once",
@@ -734,8 +800,12 @@ pub fn correlate(
     ));
     Ok(Correlation {
         file: ident.file.clone(),
-        unpaired_identified: (1..=fi.len()).filter(|i| !pairs.iter().any(|p| p.identified_mode == *i)).collect(),
-        unpaired_model: (1..=fm.len()).filter(|j| !pairs.iter().any(|p| p.model_mode == *j)).collect(),
+        unpaired_identified: (1..=fi.len())
+            .filter(|i| !pairs.iter().any(|p| p.identified_mode == *i))
+            .collect(),
+        unpaired_model: (1..=fm.len())
+            .filter(|j| !pairs.iter().any(|p| p.model_mode == *j))
+            .collect(),
         points: mapped,
         identified_frequencies_hz: fi,
         model_frequencies_hz: fm,
@@ -810,7 +880,8 @@ impl Correlation {
                 p.model_point,
                 p.sign,
                 p.rule,
-                p.distance_m.map_or(String::new(), |d| format!(", {d:.3e} m"))
+                p.distance_m
+                    .map_or(String::new(), |d| format!(", {d:.3e} m"))
             );
         }
         let _ = writeln!(
@@ -831,7 +902,11 @@ impl Correlation {
             );
         }
         if !self.unpaired_identified.is_empty() {
-            let _ = writeln!(s, "unpaired identified modes: {:?}", self.unpaired_identified);
+            let _ = writeln!(
+                s,
+                "unpaired identified modes: {:?}",
+                self.unpaired_identified
+            );
         }
         if !self.unpaired_model.is_empty() {
             let _ = writeln!(s, "unpaired model modes: {:?}", self.unpaired_model);
@@ -843,8 +918,16 @@ impl Correlation {
                 let _ = writeln!(s, "{:>4} {}", i + 1, cells.join(" "));
             }
         };
-        matrix(&mut s, "MAC (rows: identified, columns: model modes)", &self.mac);
-        matrix(&mut s, "auto-MAC of the model modes at the measured points", &self.auto_mac);
+        matrix(
+            &mut s,
+            "MAC (rows: identified, columns: model modes)",
+            &self.mac,
+        );
+        matrix(
+            &mut s,
+            "auto-MAC of the model modes at the measured points",
+            &self.auto_mac,
+        );
         for n in &self.notes {
             let _ = writeln!(s, "note: {n}");
         }
@@ -898,7 +981,9 @@ impl Correlation {
         ] {
             let (ny, nx) = (m.len(), m.first().map_or(0, Vec::len));
             if nx < 2 || ny < 2 {
-                notes.push(format!("{stem}.png: a {ny} × {nx} matrix is not drawn (needs 2 × 2 or more)"));
+                notes.push(format!(
+                    "{stem}.png: a {ny} × {nx} matrix is not drawn (needs 2 × 2 or more)"
+                ));
                 continue;
             }
             crate::plot::heat_map(
@@ -929,13 +1014,19 @@ impl Correlation {
 /// consecutive points) and one dataset 55 per mode (the mass-normalised shape along Z at each
 /// point, modal mass 1).
 pub fn geometry_uff(m: &ModalModel, model: &ModelModes) -> Result<Vec<u8>> {
-    use crate::io::uff::{write_15, write_164, write_2412, write_55, write_82, Element, Mode, Node, TraceLine, Units};
+    use crate::io::uff::{
+        write_15, write_164, write_2412, write_55, write_82, Element, Mode, Node, TraceLine, Units,
+    };
     let labels = crate::io::uff::point_node_labels(m);
     let nodes: Vec<Node> = labels
         .iter()
         .map(|(label, name)| Node {
             label: *label,
-            xyz: model.coordinates.get(name).copied().unwrap_or([(*label - 1) as f64, 0.0, 0.0]),
+            xyz: model
+                .coordinates
+                .get(name)
+                .copied()
+                .unwrap_or([(*label - 1) as f64, 0.0, 0.0]),
         })
         .collect();
     let io = |e: std::io::Error| Error::io("geometry.uff (in memory)", e);
@@ -975,14 +1066,32 @@ pub fn geometry_uff(m: &ModalModel, model: &ModelModes) -> Result<Vec<u8>> {
             frequency_hz: w / (2.0 * std::f64::consts::PI),
             modal_mass: 1.0,
             damping_ratio: if w > 0.0 { d / (2.0 * w) } else { 0.0 },
-            name: m.labels.get(i).cloned().unwrap_or_else(|| format!("mode {}", i + 1)),
+            name: m
+                .labels
+                .get(i)
+                .cloned()
+                .unwrap_or_else(|| format!("mode {}", i + 1)),
             id_lines: vec![
-                "meid: mass-normalised shape along Z (the impact direction) at the named points".into(),
+                "meid: mass-normalised shape along Z (the impact direction) at the named points"
+                    .into(),
                 "node k = the k-th named point in name order".into(),
             ],
             shapes: labels
                 .iter()
-                .map(|(label, p)| (*label, [0.0, 0.0, m.points.get(p).and_then(|v| v.get(i)).copied().unwrap_or(0.0)]))
+                .map(|(label, p)| {
+                    (
+                        *label,
+                        [
+                            0.0,
+                            0.0,
+                            m.points
+                                .get(p)
+                                .and_then(|v| v.get(i))
+                                .copied()
+                                .unwrap_or(0.0),
+                        ],
+                    )
+                })
                 .collect(),
             units: Some(si.clone()),
         };

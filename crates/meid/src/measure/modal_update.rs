@@ -374,7 +374,15 @@ impl ModalCalibration {
         let _ = writeln!(
             s,
             "\n{:>4} {:>5} {:>12} {:>12} {:>9} {:>7} {:>12} {:>9} {:>7}",
-            "test", "model", "f_test (Hz)", "before (Hz)", "err (%)", "MAC", "after (Hz)", "err (%)", "MAC"
+            "test",
+            "model",
+            "f_test (Hz)",
+            "before (Hz)",
+            "err (%)",
+            "MAC",
+            "after (Hz)",
+            "err (%)",
+            "MAC"
         );
         for p in &self.pairs {
             let _ = writeln!(
