@@ -424,30 +424,7 @@ impl<R: BufRead> Parser<'_, R> {
                     };
                     out.nodes.extend(self.dataset_2411(ds)?);
                 }
-                (15, false) => {
-                    let ds = Ds {
-                        ordinal,
-                        kind: "15",
-                        line: start,
-                    };
-                    out.nodes.extend(self.dataset_15(ds)?);
-                }
-                (82, false) => {
-                    let ds = Ds {
-                        ordinal,
-                        kind: "82",
-                        line: start,
-                    };
-                    out.traces.push(self.dataset_82(ds)?);
-                }
-                (2412, false) => {
-                    let ds = Ds {
-                        ordinal,
-                        kind: "2412",
-                        line: start,
-                    };
-                    out.elements.extend(self.dataset_2412(ds)?);
-                }
+                (15 | 82 | 2412, false) => self.geometry_dataset(num, ordinal, start, &mut out)?,
                 (55, false) => {
                     let ds = Ds {
                         ordinal,
@@ -1399,6 +1376,32 @@ impl<R: BufRead> Parser<'_, R> {
                 xyz: [xyz[0], xyz[1], xyz[2]],
             });
         }
+    }
+
+    /// Datasets 15 (nodes), 82 (a trace line) and 2412 (elements) into `out`.
+    fn geometry_dataset(
+        &mut self,
+        num: u32,
+        ordinal: usize,
+        start: usize,
+        out: &mut UffFile,
+    ) -> Result<()> {
+        let kind = match num {
+            15 => "15",
+            82 => "82",
+            _ => "2412",
+        };
+        let ds = Ds {
+            ordinal,
+            kind,
+            line: start,
+        };
+        match num {
+            15 => out.nodes.extend(self.dataset_15(ds)?),
+            82 => out.traces.push(self.dataset_82(ds)?),
+            _ => out.elements.extend(self.dataset_2412(ds)?),
+        }
+        Ok(())
     }
 
     /// Dataset 15: one node a line, `4I10,3E13.5` (whitespace-separated when it has 7 fields).
