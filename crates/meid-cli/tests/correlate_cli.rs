@@ -30,7 +30,7 @@ fn correlate_writes_its_set_and_pairs_its_own_modes() {
             .arg(&id)
             .arg("-o")
             .arg(&out)
-            .args(["--json", "-q"])
+            .arg("--json")
             .output()
             .unwrap(),
     );
@@ -70,7 +70,7 @@ fn correlate_writes_its_set_and_pairs_its_own_modes() {
             .arg(&geo)
             .arg("--geometry")
             .arg(&geo)
-            .args(["--json", "-q"])
+            .arg("--json")
             .output()
             .unwrap(),
     );
@@ -114,7 +114,7 @@ fn calibrate_modal_recovers_the_perturbed_stiffness() {
             .arg(&geo)
             .arg("--geometry")
             .arg(&geo)
-            .args(["--fit", KC, "--json", "-q", "-o"])
+            .args(["--fit", KC, "--json", "-o"])
             .arg(&upd)
             .output()
             .unwrap(),

@@ -247,7 +247,19 @@ fn geometry_reads_back() {
     let f = dir.join("modes.uff");
     std::fs::write(&f, &bytes).unwrap();
     let id = read_identified(&f).unwrap();
-    let c = correlate(&id, &mm, &Mapping::default(), &Settings::default()).unwrap();
+    // Its points are node numbers: by name they map to nothing (error), by the file's own
+    // coordinates to the points they were written for.
+    let e = correlate(&id, &mm, &Mapping::default(), &Settings::default()).unwrap_err();
+    assert!(
+        e.to_string().contains("unmapped point(s) 1 +Z, 2 +Z"),
+        "{e}"
+    );
+    let nodes = u.nodes.iter().map(|n| (n.label, n.xyz)).collect();
+    let by_xyz = Mapping {
+        geometry: Some(("geometry.uff".into(), nodes, 1e-9)),
+        ..Default::default()
+    };
+    let c = correlate(&id, &mm, &by_xyz, &Settings::default()).unwrap();
     assert_eq!(c.pairs.len(), 2);
     for p in &c.pairs {
         assert_eq!(p.identified_mode, p.model_mode);
