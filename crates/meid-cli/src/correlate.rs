@@ -121,7 +121,7 @@ pub fn point_coordinates(an: Option<&fem::FemAnalysis>) -> Option<BTreeMap<Strin
 /// Loads the model (with its FE analysis, for the points' coordinates).
 pub fn load(path: &Path, set: &[String]) -> Result<(meid::model::Model, ModelModes)> {
     let (model, analysis) = fem::from_file_with_analysis(path, set, None)?;
-    let mm = ModelModes::new(&model.structure, point_coordinates(analysis.as_ref()));
+    let mm = ModelModes::new(&model, point_coordinates(analysis.as_ref()));
     Ok((model, mm))
 }
 
@@ -152,10 +152,7 @@ pub fn run(a: CorrelateArgs) -> Result<()> {
         )?;
         let notes = c.plots(dir)?;
         c.notes.extend(notes);
-        meid::io::write_atomic(
-            &dir.join("geometry.uff"),
-            &geometry_uff(&model.structure, &mm)?,
-        )?;
+        meid::io::write_atomic(&dir.join("geometry.uff"), &geometry_uff(&model, &mm)?)?;
         set.commit("correlate")?;
     }
     if !a.print.quiet {

@@ -217,8 +217,8 @@ fn mapping_by_coordinates_with_tolerance() {
 fn geometry_reads_back() {
     let m = lumped();
     let s = &m.structure;
-    let mm = ModelModes::new(s, None);
-    let bytes = geometry_uff(s, &mm).unwrap();
+    let mm = ModelModes::new(&m, None);
+    let bytes = geometry_uff(&m, &mm).unwrap();
     let u = meid::io::uff::parse_uff(bytes.as_slice(), "geometry.uff", None).unwrap();
     assert_eq!(u.nodes.len(), 2);
     assert_eq!(u.nodes[1].label, 2);
@@ -296,7 +296,7 @@ fn bad_identified_files() {
     std::fs::write(&f, r#"{"points": ["bed:1 +Z", "base:2 +Z"], "modes": [{"frequency_hz": 280.0, "shape": [1.0]}]}"#).unwrap();
     let e = read_identified(&f).unwrap_err().to_string();
     assert!(e.contains("1 values for 2 points"), "{e}");
-    let mm = ModelModes::new(&lumped().structure, None);
+    let mm = ModelModes::new(&lumped(), None);
     let id = identified(&["anvil:1 +Z"], &[(280.0, vec![1.0])]);
     let e = correlate(&id, &mm, &Mapping::default(), &Settings::default())
         .unwrap_err()

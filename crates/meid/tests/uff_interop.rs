@@ -474,11 +474,11 @@ fn pyuff_reads_the_correlate_geometry() {
     let dir = tmp("geometry");
     let m = meid::model::Model::from_file(&root().join("examples/paper-lumped.toml"), &[]).unwrap();
     let s = &m.structure;
-    let mm = meid::measure::correlate::ModelModes::new(s, None);
+    let mm = meid::measure::correlate::ModelModes::new(&m, None);
     let path = dir.join("geometry.uff");
     std::fs::write(
         &path,
-        meid::measure::correlate::geometry_uff(s, &mm).unwrap(),
+        meid::measure::correlate::geometry_uff(&m, &mm).unwrap(),
     )
     .unwrap();
     let read: Value =

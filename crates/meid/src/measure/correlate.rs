@@ -57,7 +57,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::identify::mac_real;
-use crate::modal::ModalModel;
+use crate::model::Model;
 use crate::{Error, Result};
 
 /// A measured point of identified modes.
@@ -368,8 +368,8 @@ pub struct ModelModes {
 
 /// A lumped or tabulated model's display coordinates: point `k` (1-based, name order) at
 /// `x = k − 1` m (as [`crate::io::uff::modes_uff_points`] places them).
-pub fn geometry_coordinates(m: &ModalModel) -> BTreeMap<String, [f64; 3]> {
-    crate::io::uff::point_node_labels(m)
+pub fn geometry_coordinates(m: &Model) -> BTreeMap<String, [f64; 3]> {
+    crate::io::uff::point_node_labels(&m.structure)
         .into_iter()
         .map(|(label, name)| (name, [(label - 1) as f64, 0.0, 0.0]))
         .collect()
@@ -378,8 +378,9 @@ pub fn geometry_coordinates(m: &ModalModel) -> BTreeMap<String, [f64; 3]> {
 impl ModelModes {
     /// From the model's modes; `coordinates` of an FE model's points (the means of their
     /// nodes), or `None` for the display line ([`geometry_coordinates`]).
-    pub fn new(m: &ModalModel, coordinates: Option<BTreeMap<String, [f64; 3]>>) -> Self {
+    pub fn new(model: &Model, coordinates: Option<BTreeMap<String, [f64; 3]>>) -> Self {
         let geometric = coordinates.is_some();
+        let m = &model.structure;
         ModelModes {
             frequencies_hz: m
                 .omega_rad_per_s
@@ -388,7 +389,7 @@ impl ModelModes {
                 .collect(),
             labels: m.labels.clone(),
             points: m.points.clone(),
-            coordinates: coordinates.unwrap_or_else(|| geometry_coordinates(m)),
+            coordinates: coordinates.unwrap_or_else(|| geometry_coordinates(model)),
             geometric,
         }
     }
@@ -1013,7 +1014,8 @@ impl Correlation {
 /// 82 (one trace line through the points in that order), 2412 (rods, FE descriptor 11, between
 /// consecutive points) and one dataset 55 per mode (the mass-normalised shape along Z at each
 /// point, modal mass 1).
-pub fn geometry_uff(m: &ModalModel, model: &ModelModes) -> Result<Vec<u8>> {
+pub fn geometry_uff(whole: &Model, model: &ModelModes) -> Result<Vec<u8>> {
+    let m = &whole.structure;
     use crate::io::uff::{
         write_15, write_164, write_2412, write_55, write_82, Element, Mode, Node, TraceLine, Units,
     };

@@ -117,7 +117,7 @@ impl<'a> ModalProblem<'a> {
                 format!("{mac_weight}: give a finite weight ≥ 0 (0: frequencies alone)"),
             ));
         }
-        let mm = ModelModes::new(&model.structure, coordinates.clone());
+        let mm = ModelModes::new(model, coordinates.clone());
         let before = correlate(ident, &mm, &mapping, &correlate_settings)?;
         if before.pairs.is_empty() {
             return Err(Error::Input {
@@ -166,7 +166,7 @@ impl<'a> ModalProblem<'a> {
     /// Frequencies and MACs of the pairs, and the residuals, at `values`.
     fn evaluate(&self, values: &[f64]) -> Result<(Vec<(f64, f64)>, Vec<f64>)> {
         let m = self.model_with(values)?;
-        let mm = ModelModes::new(&m.structure, self.coordinates.clone());
+        let mm = ModelModes::new(&m, self.coordinates.clone());
         let points = &self.before.points;
         let mut per = Vec::new();
         let mut r = Vec::new();
@@ -280,7 +280,7 @@ pub fn calibrate_modal(problem: &ModalProblem<'_>) -> Result<ModalCalibration> {
     let fitted = problem.model_with(&values)?;
     let after_corr = correlate(
         problem.ident,
-        &ModelModes::new(&fitted.structure, problem.coordinates.clone()),
+        &ModelModes::new(&fitted, problem.coordinates.clone()),
         &problem.mapping,
         &problem.correlate_settings,
     )?;
