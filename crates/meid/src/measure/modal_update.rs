@@ -43,6 +43,9 @@ use crate::identify::mac_real;
 use crate::model::{CompiledFields, FieldValue, Model, StructureCache};
 use crate::{Error, Result};
 
+/// A paired model mode's frequency (Hz) and MAC with its identified mode.
+type FrequencyMac = (f64, f64);
+
 /// A model-updating problem (module docs).
 pub struct ModalProblem<'a> {
     model: &'a Model,
@@ -164,7 +167,7 @@ impl<'a> ModalProblem<'a> {
     }
 
     /// Frequencies and MACs of the pairs, and the residuals, at `values`.
-    fn evaluate(&self, values: &[f64]) -> Result<(Vec<(f64, f64)>, Vec<f64>)> {
+    fn evaluate(&self, values: &[f64]) -> Result<(Vec<FrequencyMac>, Vec<f64>)> {
         let m = self.model_with(values)?;
         let mm = ModelModes::new(&m, self.coordinates.clone());
         let points = &self.before.points;
