@@ -138,6 +138,13 @@ def read(path):
             out.append({"type": 164, "units_code": int(s["units_code"]), "length": float(s["length"]), "force": float(s["force"])})
         elif s["type"] == 2411:
             out.append({"type": 2411, "nodes": [[int(a), float(b), float(c), float(e)] for a, b, c, e in zip(s["node_nums"], s["x"], s["y"], s["z"])]})
+        elif s["type"] == 15:
+            out.append({"type": 15, "nodes": [[int(a), float(b), float(c), float(e)] for a, b, c, e in zip(s["node_nums"], s["x"], s["y"], s["z"])]})
+        elif s["type"] == 82:
+            out.append({"type": 82, "trace_num": int(s["trace_num"]), "id": s["id"].strip(), "nodes": [int(v) for v in s["nodes"]]})
+        elif s["type"] == 2412:
+            out.append({"type": 2412, "elements": [{"label": e["element_nums"], "fe_descriptor": e["fe_descriptor"], "nodes": e["nodes_nums"]}
+                                                   for k, v in s.items() if isinstance(k, int) for e in v]})
         elif s["type"] == 55:
             out.append({"type": 55, "freq": float(s["freq"]), "mode_n": int(s["mode_n"]), "damping": float(s["modal_damp_vis"]),
                         "node_nums": [int(v) for v in s["node_nums"]], "r3": [float(v) for v in s["r3"]],

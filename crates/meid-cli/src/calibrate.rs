@@ -21,8 +21,28 @@ pub struct CalibrateArgs {
     /// Measured file (UFF or CSV), optionally with the case it measured: none=FILE (the bare
     /// machine), damper=FILE, added-mass=FILE; a plain FILE is the model as specified
     /// (repeatable; the cases are fitted together).
-    #[arg(long = "measured", value_name = "[CASE=]FILE", required = true)]
+    #[arg(
+        long = "measured",
+        value_name = "[CASE=]FILE",
+        required_unless_present = "modal"
+    )]
     measured: Vec<String>,
+    /// Fit to identified modes instead of records: meid identify's JSON, modes.csv or UFF 55.
+    /// Residuals: relative frequency errors of the paired modes and √W (1 − MAC), W the
+    /// --mac-weight (docs/measure.md, "Correlation and model updating").
+    #[arg(long = "modal", value_name = "IDENTIFIED", conflicts_with_all = ["measured", "spectrum", "channel"])]
+    modal: Option<PathBuf>,
+    /// Weight W of the shapes' (1 − MAC) beside the relative frequency errors (with --modal;
+    /// 0: frequencies alone).
+    #[arg(
+        long = "mac-weight",
+        value_name = "W",
+        default_value_t = 1.0,
+        requires = "modal"
+    )]
+    mac_weight: f64,
+    #[command(flatten)]
+    mapping: crate::correlate::MappingArgs,
     /// Model paths to fit, as --set names them, comma-separated (repeatable), e.g.
     /// contact.slider_bed.stiffness,contact.bed_damper.stiffness,structure.lumped.damping_ratios[1].
     #[arg(long = "fit", value_name = "PATH[,PATH…]", required = true)]
@@ -70,6 +90,9 @@ fn parse_band(s: &str) -> Result<ResidualKind> {
 }
 
 pub fn run(a: CalibrateArgs) -> Result<()> {
+    if let Some(modal) = &a.modal {
+        return run_modal(&a, modal);
+    }
     let model = a.run.load(&a.model, None)?;
     crate::warn_model(&model, &a.print);
     let paths = parse_fit(&a.fit)?;
@@ -120,6 +143,79 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
                 dir.join("calibrated.toml").display()
             ),
             None => println!("give -o DIR to write the calibrated model file and the overlays"),
+        }
+    }
+    Ok(())
+}
+
+/// `meid calibrate --modal`: model values fitted to identified modes.
+fn run_modal(a: &CalibrateArgs, modal: &std::path::Path) -> Result<()> {
+    use meid::measure::correlate::{read_identified, Settings as CorrelateSettings};
+    use meid::measure::modal_update::{calibrate_modal, ModalProblem};
+    let model = a.run.load(&a.model, None)?;
+    crate::warn_model(&model, &a.print);
+    let paths = parse_fit(&a.fit)?;
+    let bounds = parse_bounds(&a.bounds)?;
+    let params = parameters(&model, &paths, &bounds)?;
+    if a.max_iterations == 0 {
+        bail!("--max-iterations must be at least 1");
+    }
+    let mapping = a.mapping.mapping()?;
+    // An FE model's point coordinates, for the mapping by coordinates.
+    let coordinates = if mapping.geometry.is_some() {
+        let (_, an) = meid::model::fem::from_file_with_analysis(&a.model, &a.run.set.set, None)?;
+        crate::correlate::point_coordinates(an.as_ref())
+    } else {
+        None
+    };
+    let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
+    let ident = read_identified(modal)?;
+    let settings = Settings {
+        max_iterations: a.max_iterations,
+        ..Settings::default()
+    };
+    let corr = CorrelateSettings {
+        min_mac: a.mapping.min_mac,
+        ..CorrelateSettings::default()
+    };
+    let problem = ModalProblem::new(
+        &model,
+        params,
+        &ident,
+        coordinates,
+        mapping,
+        corr,
+        a.mac_weight,
+        settings,
+    )?;
+    let c = calibrate_modal(&problem)?;
+    if let Some(set) = set {
+        meid::io::write_json(&set.path("calibration.json"), &crate::json::object(&c)?)?;
+        let text = calibrated_model_text(&model, problem.parameters(), &c.values())?;
+        meid::io::write_atomic(&set.path("calibrated.toml"), text.as_bytes())?;
+        set.commit("calibrate")?;
+    }
+    if !a.print.quiet {
+        for w in c.warnings.iter().chain(&c.after.warnings) {
+            crate::ui::warning(w);
+        }
+    }
+    if a.print.json {
+        crate::json::print(&c)?;
+    } else if a.print.human() {
+        println!(
+            "{} --modal — {}",
+            crate::ui::bold("meid calibrate"),
+            model.spec.name.as_deref().unwrap_or("model")
+        );
+        print!("{}", c.to_text());
+        match &a.output {
+            Some(dir) => println!(
+                "wrote {} (calibrated model: {})",
+                dir.display(),
+                dir.join("calibrated.toml").display()
+            ),
+            None => println!("give -o DIR to write the calibrated model file"),
         }
     }
     Ok(())

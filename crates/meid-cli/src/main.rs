@@ -32,6 +32,7 @@ mod args;
 mod blows;
 mod calibrate;
 mod compare;
+mod correlate;
 mod frf;
 mod json;
 mod measure;
@@ -104,10 +105,15 @@ pub(crate) enum Command {
     /// Modes from FRFs: LSCF poles with a stabilisation diagram, LSFD shapes, damping corrected
     /// for the exponential window.
     Identify(frf::IdentifyArgs),
+    /// Identified modes against the model's: point mapping (by name or coordinates, with
+    /// sign), MAC and auto-MAC, paired modes, frequency errors, blind-point warnings, and the
+    /// model's test geometry (UFF 15, 82, 2412, 55).
+    Correlate(correlate::CorrelateArgs),
     /// The simulation beside measured records: frequency, level and peak errors, reductions.
     Validate(validate::ValidateArgs),
-    /// Fit model values (damping ratios, contact stiffnesses, …) to measured records: estimates
-    /// with confidence intervals, residual, before/after overlays, the calibrated model file.
+    /// Fit model values (damping ratios, contact stiffnesses, …) to measured records, or to
+    /// identified modes (--modal): estimates with confidence intervals, residual, before/after
+    /// overlays or correlation table, the calibrated model file.
     Calibrate(calibrate::CalibrateArgs),
     /// Put the shards of a sweep or Monte Carlo (--shard K/N) together: the unsharded run's files.
     Merge(shard::MergeArgs),
@@ -153,6 +159,7 @@ fn main() -> ExitCode {
         Command::Measure(a) => measure::run(a),
         Command::Frf(a) => frf::run_frf(a),
         Command::Identify(a) => frf::run_identify(a),
+        Command::Correlate(a) => correlate::run(a),
         Command::Validate(a) => validate::run(a),
         Command::Calibrate(a) => calibrate::run(a),
         Command::Merge(a) => shard::merge(a, |name, command, shards| match (name, command) {

@@ -362,7 +362,7 @@ fn optimize_output_is_its_json_report() {
 // ---------------------------------------------------------------------------------------------
 // 4. Completions and manual pages.
 
-const SUBCOMMANDS: [&str; 18] = [
+const SUBCOMMANDS: [&str; 19] = [
     "simulate",
     "modes",
     "model",
@@ -377,6 +377,7 @@ const SUBCOMMANDS: [&str; 18] = [
     "measure",
     "frf",
     "identify",
+    "correlate",
     "validate",
     "calibrate",
     "completions",

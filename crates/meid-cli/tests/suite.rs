@@ -11,6 +11,7 @@ mod calibrate_cli;
 mod cli;
 mod compare_cli;
 mod conventions;
+mod correlate_cli;
 mod fem_threads_cli;
 mod foundation_cli;
 mod frf_cli;

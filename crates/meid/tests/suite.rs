@@ -10,6 +10,7 @@ mod accumulation;
 mod added_mass_point;
 mod compare_checks;
 mod compare_montecarlo;
+mod correlate_checks;
 mod dopri5_contact_laws;
 mod ema_interop;
 mod esd_checks;

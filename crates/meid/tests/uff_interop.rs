@@ -463,3 +463,57 @@ duration = 0.02
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The test geometry `meid correlate -o` writes (`geometry.uff`: datasets 164, 15, 82, 2412,
+/// 55) of the lumped example, read by pyuff: nodes 1 = base at x = 0 and 2 = bed at x = 1 m, one
+/// trace line 1 → 2, one rod (FE descriptor 11) 1-2, and each mode's z translations the model's
+/// ψ to the 6 digits of dataset 55.
+#[test]
+fn pyuff_reads_the_correlate_geometry() {
+    let Some(py) = python() else { return };
+    let dir = tmp("geometry");
+    let m = meid::model::Model::from_file(&root().join("examples/paper-lumped.toml"), &[]).unwrap();
+    let s = &m.structure;
+    let mm = meid::measure::correlate::ModelModes::new(&m, None);
+    let path = dir.join("geometry.uff");
+    std::fs::write(
+        &path,
+        meid::measure::correlate::geometry_uff(&m, &mm).unwrap(),
+    )
+    .unwrap();
+    let read: Value =
+        serde_json::from_str(&script(&py, &["read", path.to_str().unwrap()])).unwrap();
+    let sets = read.as_array().unwrap();
+    let types: Vec<i64> = sets.iter().map(|s| s["type"].as_i64().unwrap()).collect();
+    assert_eq!(types, [164, 15, 82, 2412, 55, 55]);
+    let nodes = sets[1]["nodes"].as_array().unwrap();
+    assert_eq!(nodes.len(), 2);
+    for (k, row) in nodes.iter().enumerate() {
+        assert_eq!(row[0].as_i64().unwrap(), k as i64 + 1);
+        assert_eq!(row[1].as_f64().unwrap(), k as f64);
+    }
+    assert_eq!(sets[2]["trace_num"], 1);
+    assert_eq!(sets[2]["nodes"], serde_json::json!([1, 2]));
+    let el = &sets[3]["elements"].as_array().unwrap();
+    assert_eq!(el.len(), 1);
+    assert_eq!(el[0]["fe_descriptor"], 11);
+    assert_eq!(el[0]["nodes"], serde_json::json!([1, 2]));
+    for (i, set) in sets[4..].iter().enumerate() {
+        let r3: Vec<f64> = set["r3"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        for (k, p) in ["base", "bed"].iter().enumerate() {
+            let psi = s.points[*p][i];
+            assert!(
+                close(r3[k], psi, 5e-6),
+                "mode {}: {p} {} vs {psi}",
+                i + 1,
+                r3[k]
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

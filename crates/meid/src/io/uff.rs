@@ -1,6 +1,18 @@
 //! Universal File Format (UFF/UNV) datasets: 58 (function at nodal DOF) in ASCII and binary
-//! (58b), 2411 (nodes, double precision), 55 (data at nodes: normal modes) and 164 (units),
-//! read and written.
+//! (58b), 2411 (nodes, double precision), 15 (nodes, single precision), 82 (trace lines), 2412
+//! (elements), 55 (data at nodes: normal modes) and 164 (units), read and written.
+//!
+//! Test geometry (datasets 15, 82, 2412; records as pyuff writes them):
+//!
+//! | dataset | record | format | fields |
+//! |---|---|---|---|
+//! | 15 | 1 per node | 4I10,3E13.5 | node label, definition and displacement coordinate systems, colour, x, y, z |
+//! | 82 | 1 | 3I10 | trace line number, number of nodes, colour |
+//! | 82 | 2 | 80A1 | identification |
+//! | 82 | 3 | 8I10 | the nodes (0: move to the next node without drawing) |
+//! | 2412 | 1 | 6I10 | element label, FE descriptor (11 rod, 91 thin-shell triangle, 94 thin-shell quadrilateral, …), physical and material property tables, colour, number of nodes |
+//! | 2412 | 2 (beams: 11, 21-24) | 3I10 | orientation node, fore- and aft-end cross sections |
+//! | 2412 | 3 | 8I10 | the nodes |
 //!
 //! # Layout read and written (I-DEAS/SDRC Universal File definitions)
 //!
@@ -66,6 +78,31 @@ pub struct Mode {
     /// before it, the UFF default, SI). The values above are as written, in those units.
     pub units: Option<Units>,
 }
+
+/// A trace line of dataset 82: the lines a viewer draws between nodes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TraceLine {
+    pub number: i64,
+    pub color: i64,
+    /// The identification line (trimmed).
+    pub name: String,
+    /// Node labels in drawing order; 0 moves to the next node without drawing.
+    pub nodes: Vec<i64>,
+}
+
+/// An element of dataset 2412.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Element {
+    pub label: i64,
+    /// FE descriptor id: 11 rod, 91 thin-shell linear triangle, 94 thin-shell linear
+    /// quadrilateral, 21 linear beam.
+    pub fe_descriptor: i64,
+    pub color: i64,
+    pub nodes: Vec<i64>,
+}
+
+/// FE descriptors of dataset 2412 whose elements carry the beam record (record 2).
+const BEAM_DESCRIPTORS: [i64; 5] = [11, 21, 22, 23, 24];
 
 /// Dataset 164: the unit system of the datasets that follow it.
 ///
@@ -133,6 +170,9 @@ pub struct UffFile {
     pub records: Vec<Record>,
     pub nodes: Vec<Node>,
     pub modes: Vec<Mode>,
+    /// Trace lines (dataset 82) and elements (2412); nodes of dataset 15 are in `nodes`.
+    pub traces: Vec<TraceLine>,
+    pub elements: Vec<Element>,
     /// Functions of dataset 58 / 58b in frequency: FRFs (type 4), coherences (6), PSDs (9).
     pub functions: Vec<Function>,
     /// Datasets passed over, one line each (type, where, why).
@@ -384,6 +424,7 @@ impl<R: BufRead> Parser<'_, R> {
                     };
                     out.nodes.extend(self.dataset_2411(ds)?);
                 }
+                (15 | 82 | 2412, false) => self.geometry_dataset(num, ordinal, start, &mut out)?,
                 (55, false) => {
                     let ds = Ds {
                         ordinal,
@@ -1337,6 +1378,181 @@ impl<R: BufRead> Parser<'_, R> {
         }
     }
 
+    /// Datasets 15 (nodes), 82 (a trace line) and 2412 (elements) into `out`.
+    fn geometry_dataset(
+        &mut self,
+        num: u32,
+        ordinal: usize,
+        start: usize,
+        out: &mut UffFile,
+    ) -> Result<()> {
+        let kind = match num {
+            15 => "15",
+            82 => "82",
+            _ => "2412",
+        };
+        let ds = Ds {
+            ordinal,
+            kind,
+            line: start,
+        };
+        match num {
+            15 => out.nodes.extend(self.dataset_15(ds)?),
+            82 => out.traces.push(self.dataset_82(ds)?),
+            _ => out.elements.extend(self.dataset_2412(ds)?),
+        }
+        Ok(())
+    }
+
+    /// Dataset 15: one node a line, `4I10,3E13.5` (whitespace-separated when it has 7 fields).
+    fn dataset_15(&mut self, ds: Ds) -> Result<Vec<Node>> {
+        let mut out = Vec::new();
+        loop {
+            let l = self.dataset_line(ds)?;
+            if l.trim() == "-1" {
+                return Ok(out);
+            }
+            let ws: Vec<&str> = l.split_whitespace().collect();
+            let fields: Vec<String> = if ws.len() == 7 {
+                ws.iter().map(|t| t.to_string()).collect()
+            } else {
+                [
+                    (0, 10),
+                    (10, 20),
+                    (20, 30),
+                    (30, 40),
+                    (40, 53),
+                    (53, 66),
+                    (66, 79),
+                ]
+                .iter()
+                .map(|&(a, b)| cols(&l, a, b).trim().to_string())
+                .collect()
+            };
+            let label = fields[0].parse::<i64>().ok();
+            let xyz: Vec<f64> = fields[4..].iter().filter_map(|t| parse_f(t)).collect();
+            match (label, xyz.len() == 3 && xyz.iter().all(|v| v.is_finite())) {
+                (Some(label), true) => out.push(Node {
+                    label,
+                    xyz: [xyz[0], xyz[1], xyz[2]],
+                }),
+                _ => {
+                    return Err(self.err(
+                        Some(ds),
+                        Some("record 1"),
+                        self.line_no,
+                        format!(
+                            "expected 4I10,3E13.5 (node label, coordinate systems, colour, x, y, z), got '{}'",
+                            clip(&l)
+                        ),
+                    ))
+                }
+            }
+        }
+    }
+
+    /// Whole numbers of a line (`what` names them in the error).
+    fn ints(&self, ds: Ds, record: &str, l: &str, what: &str) -> Result<Vec<i64>> {
+        l.split_whitespace()
+            .map(|t| t.parse::<i64>().ok())
+            .collect::<Option<Vec<i64>>>()
+            .ok_or_else(|| {
+                self.err(
+                    Some(ds),
+                    Some(record),
+                    self.line_no,
+                    format!("expected whole numbers ({what}), got '{}'", clip(l)),
+                )
+            })
+    }
+
+    /// Dataset 82: a trace line (module docs).
+    fn dataset_82(&mut self, ds: Ds) -> Result<TraceLine> {
+        let l1 = self.need_line(ds, "record 1")?;
+        let head = self.ints(
+            ds,
+            "record 1",
+            &l1,
+            "trace line number, number of nodes, colour",
+        )?;
+        if head.len() < 2 {
+            return Err(self.err(
+                Some(ds),
+                Some("record 1"),
+                self.line_no,
+                format!(
+                    "expected 3I10 (trace line number, number of nodes, colour), got '{}'",
+                    clip(&l1)
+                ),
+            ));
+        }
+        let name = self.need_line(ds, "record 2")?.trim().to_string();
+        let mut nodes = Vec::new();
+        loop {
+            let l = self.dataset_line(ds)?;
+            if l.trim() == "-1" {
+                break;
+            }
+            nodes.extend(self.ints(ds, "record 3", &l, "node labels")?);
+        }
+        Ok(TraceLine {
+            number: head[0],
+            color: head.get(2).copied().unwrap_or(0),
+            name,
+            nodes,
+        })
+    }
+
+    /// Dataset 2412: elements (module docs).
+    fn dataset_2412(&mut self, ds: Ds) -> Result<Vec<Element>> {
+        let mut out = Vec::new();
+        loop {
+            let l1 = self.dataset_line(ds)?;
+            if l1.trim() == "-1" {
+                return Ok(out);
+            }
+            let r1 = self.ints(
+                ds,
+                "record 1",
+                &l1,
+                "element label, FE descriptor, property tables, colour, number of nodes",
+            )?;
+            let &[label, fe_descriptor, _, _, color, count] = r1.as_slice() else {
+                return Err(self.err(
+                    Some(ds),
+                    Some("record 1"),
+                    self.line_no,
+                    format!("expected 6I10, got '{}'", clip(&l1)),
+                ));
+            };
+            if BEAM_DESCRIPTORS.contains(&fe_descriptor) {
+                self.need_line(ds, "record 2")?;
+            }
+            let mut nodes = Vec::new();
+            while (nodes.len() as i64) < count {
+                let l = self.need_line(ds, "record 3")?;
+                nodes.extend(self.ints(ds, "record 3", &l, "node labels")?);
+            }
+            if nodes.len() as i64 != count {
+                return Err(self.err(
+                    Some(ds),
+                    Some("record 3"),
+                    self.line_no,
+                    format!(
+                        "element {label}: {} node labels, record 1 announces {count}",
+                        nodes.len()
+                    ),
+                ));
+            }
+            out.push(Element {
+                label,
+                fe_descriptor,
+                color,
+                nodes,
+            });
+        }
+    }
+
     /// Dataset 164's records 1 and 2 ([`Units`]) from its lines.
     fn dataset_164(&self, ds: Ds, lines: &[String]) -> Result<Units> {
         let r1 = lines.first().map_or("", String::as_str);
@@ -1941,6 +2157,77 @@ pub fn write_2411<W: Write>(w: &mut W, nodes: &[Node]) -> std::io::Result<()> {
             format_e(n.xyz[1], 16, 25),
             format_e(n.xyz[2], 16, 25)
         )?;
+    }
+    writeln!(w, "{:>6}", -1)
+}
+
+/// Writes dataset 15 (nodes, single precision: `4I10,3E13.5`, as pyuff writes it; global
+/// coordinate systems 0).
+pub fn write_15<W: Write>(w: &mut W, nodes: &[Node]) -> std::io::Result<()> {
+    writeln!(w, "{:>6}\n{:>6}{:74}", -1, 15, "")?;
+    for n in nodes {
+        writeln!(
+            w,
+            "{:>10}{:>10}{:>10}{:>10}{}{}{}",
+            n.label,
+            0,
+            0,
+            11,
+            format_e(n.xyz[0], 5, 13),
+            format_e(n.xyz[1], 5, 13),
+            format_e(n.xyz[2], 5, 13)
+        )?;
+    }
+    writeln!(w, "{:>6}", -1)
+}
+
+/// Node labels `8I10` a line.
+fn write_i10_lines<W: Write>(w: &mut W, labels: &[i64]) -> std::io::Result<()> {
+    for chunk in labels.chunks(8) {
+        let line: String = chunk.iter().map(|n| format!("{n:>10}")).collect();
+        writeln!(w, "{line}")?;
+    }
+    Ok(())
+}
+
+/// Writes dataset 82 (one trace line; module docs).
+pub fn write_82<W: Write>(w: &mut W, t: &TraceLine) -> std::io::Result<()> {
+    writeln!(w, "{:>6}\n{:>6}{:74}", -1, 82, "")?;
+    writeln!(w, "{:>10}{:>10}{:>10}", t.number, t.nodes.len(), t.color)?;
+    let name: String = t
+        .name
+        .chars()
+        .filter(|c| !c.is_control())
+        .take(80)
+        .collect();
+    writeln!(
+        w,
+        "{:<80}",
+        if name.is_empty() { "NONE".into() } else { name }
+    )?;
+    write_i10_lines(w, &t.nodes)?;
+    writeln!(w, "{:>6}", -1)
+}
+
+/// Writes dataset 2412 (elements; module docs): property tables 1, beams with orientation
+/// node 0 and cross sections 0.
+pub fn write_2412<W: Write>(w: &mut W, elements: &[Element]) -> std::io::Result<()> {
+    writeln!(w, "{:>6}\n{:>6}{:74}", -1, 2412, "")?;
+    for e in elements {
+        writeln!(
+            w,
+            "{:>10}{:>10}{:>10}{:>10}{:>10}{:>10}",
+            e.label,
+            e.fe_descriptor,
+            1,
+            1,
+            e.color,
+            e.nodes.len()
+        )?;
+        if BEAM_DESCRIPTORS.contains(&e.fe_descriptor) {
+            writeln!(w, "{:>10}{:>10}{:>10}", 0, 0, 0)?;
+        }
+        write_i10_lines(w, &e.nodes)?;
     }
     writeln!(w, "{:>6}", -1)
 }

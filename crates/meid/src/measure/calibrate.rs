@@ -668,7 +668,7 @@ fn cholesky_solve(a: &[Vec<f64>], b: &[f64]) -> Option<Vec<f64>> {
 }
 
 /// The inverse of a small symmetric positive definite matrix (column by column).
-fn spd_inverse(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
+pub(super) fn spd_inverse(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
     let n = a.len();
     let mut inv = vec![vec![0.0; n]; n];
     for j in 0..n {
@@ -682,7 +682,7 @@ fn spd_inverse(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
     Some(inv)
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
@@ -1024,7 +1024,7 @@ pub struct Calibration {
     pub channels: Vec<ChannelFit>,
 }
 
-fn to_internal(p: &FitParameter, v: f64) -> f64 {
+pub(super) fn to_internal(p: &FitParameter, v: f64) -> f64 {
     if p.lower > 0.0 {
         v.ln()
     } else {
@@ -1032,7 +1032,7 @@ fn to_internal(p: &FitParameter, v: f64) -> f64 {
     }
 }
 
-fn from_internal(p: &FitParameter, x: f64) -> f64 {
+pub(super) fn from_internal(p: &FitParameter, x: f64) -> f64 {
     if p.lower > 0.0 {
         x.exp()
     } else {
@@ -1041,7 +1041,7 @@ fn from_internal(p: &FitParameter, x: f64) -> f64 {
 }
 
 /// `dp/dθ`.
-fn dp_dx(p: &FitParameter, v: f64) -> f64 {
+pub(super) fn dp_dx(p: &FitParameter, v: f64) -> f64 {
     if p.lower > 0.0 {
         v
     } else {
@@ -1223,7 +1223,7 @@ fn covariance(
 
 /// One parameter's estimate `v` with its 95 % interval `v ± (t se + step)` (`t` Student's
 /// 97.5 % quantile, `se` the standard error, `step` the Gauss-Newton step left).
-fn estimate(
+pub(super) fn estimate(
     p: &FitParameter,
     v: f64,
     se: f64,

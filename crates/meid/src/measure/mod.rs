@@ -16,11 +16,16 @@
 //!   reductions beside simulated ones).
 //! * [`calibrate`]: model values (damping ratios, contact stiffnesses, …) fitted to the
 //!   measurements by bounded least squares, with confidence intervals.
+//! * [`correlate`]: identified modes against the model's (point mapping, MAC, paired modes,
+//!   auto-MAC, test geometry); [`modal_update`]: model values fitted to identified modes
+//!   (`meid calibrate --modal`).
 
 pub mod calibrate;
+pub mod correlate;
 pub mod frf;
 pub mod identified;
 pub mod mapping;
+pub mod modal_update;
 pub mod process;
 pub mod report;
 pub mod validate;
