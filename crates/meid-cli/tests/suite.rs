@@ -14,6 +14,7 @@ mod conventions;
 mod fem_threads_cli;
 mod foundation_cli;
 mod frf_cli;
+mod impacts_cli;
 mod input_cli;
 mod json_shape;
 mod measure_cli;
