@@ -40,7 +40,10 @@ fn simulate_reports_the_impacts_of_the_paper_machine() {
             .filter(|r| r["contact"] == t["contact"])
             .collect();
         assert_eq!(t["impacts"].as_u64().unwrap() as usize, mine.len());
-        let sum: f64 = mine.iter().map(|r| r["impulse_n_s"].as_f64().unwrap()).sum();
+        let sum: f64 = mine
+            .iter()
+            .map(|r| r["impulse_n_s"].as_f64().unwrap())
+            .sum();
         assert!((t["impulse_n_s"].as_f64().unwrap() - sum).abs() <= 1e-12 * sum.abs());
     }
     let csv = std::fs::read_to_string(d.join("impacts.csv")).unwrap();

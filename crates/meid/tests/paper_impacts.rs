@@ -42,7 +42,10 @@ fn state_at<'s>(sol: &'s Solution, t: f64) -> &'s [f64] {
         .iter()
         .min_by(|a, b| (a.t - t).abs().total_cmp(&(b.t - t).abs()))
         .unwrap();
-    assert!((p.t - t).abs() <= 1e-15 * t.max(1e-3), "no path point at {t}");
+    assert!(
+        (p.t - t).abs() <= 1e-15 * t.max(1e-3),
+        "no path point at {t}"
+    );
     &p.x
 }
 
@@ -69,10 +72,10 @@ fn two_body(m1: f64, m2: f64, v0: f64, k: f64, c: f64, method: Method) -> Vec<Im
 
 #[test]
 fn a_two_body_linear_contact_gives_the_closed_form_row() {
-    let (m1, m2, v0, k) = (1.0, 3.0, 1.5, 1.0e6);
+    let (m1, m2, v0, k): (f64, f64, f64, f64) = (1.0, 3.0, 1.5, 1.0e6);
     let mu = m1 * m2 / (m1 + m2);
     for (zeta, method, tol) in [
-        (0.0, Method::Exact, 1e-9),
+        (0.0_f64, Method::Exact, 1e-9),
         (0.1, Method::Exact, 1e-9),
         (0.1, Method::Dopri5, 1e-6),
     ] {
@@ -129,7 +132,10 @@ fn the_slider_bed_impulse_is_the_slider_momentum_change() {
     // The collision's contact time and peak are the first closing's.
     let end_totals = sol.collision_end.as_ref().unwrap().totals;
     assert!(rel(r.duration_s, end_totals.closed_time[0]) < 1e-12);
-    assert!(rel(r.peak_force_n, end_totals.peak_force(0)) < 1e-9, "{r:?}");
+    assert!(
+        rel(r.peak_force_n, end_totals.peak_force(0)) < 1e-9,
+        "{r:?}"
+    );
 }
 
 #[test]
@@ -178,8 +184,14 @@ fn exact_and_dopri5_give_the_same_rows() {
         let close = |p: f64, q: f64, scale: f64| (p - q).abs() <= 1e-6 * scale;
         assert!(close(x.start_s, y.start_s, 1e-3), "{x:?}\n{y:?}");
         assert!(close(x.duration_s, y.duration_s, 1e-3), "{x:?}\n{y:?}");
-        assert!(close(x.impulse_n_s, y.impulse_n_s, x.impulse_n_s.abs()), "{x:?}\n{y:?}");
-        assert!(close(x.peak_force_n, y.peak_force_n, x.peak_force_n), "{x:?}\n{y:?}");
+        assert!(
+            close(x.impulse_n_s, y.impulse_n_s, x.impulse_n_s.abs()),
+            "{x:?}\n{y:?}"
+        );
+        assert!(
+            close(x.peak_force_n, y.peak_force_n, x.peak_force_n),
+            "{x:?}\n{y:?}"
+        );
         let e = |r: &ImpactRow| r.restitution.unwrap_or(0.0);
         assert!(close(e(x), e(y), 1.0), "{x:?}\n{y:?}");
     }

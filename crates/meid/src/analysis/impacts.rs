@@ -305,8 +305,8 @@ fn book_interpolated(
             let (th2, th3) = (th * th, th * th * th);
             let (h00, h10) = (2.0 * th3 - 3.0 * th2 + 1.0, th3 - 2.0 * th2 + th);
             let (h01, h11) = (-2.0 * th3 + 3.0 * th2, th3 - th2);
-            for k in 0..2 * nd {
-                x[k] = h00 * x0[k] + h10 * h * d0[k] + h01 * x1[k] + h11 * h * d1[k];
+            for (k, xk) in x.iter_mut().enumerate() {
+                *xk = h00 * x0[k] + h10 * h * d0[k] + h01 * x1[k] + h11 * h * d1[k];
             }
             let f = force(&x);
             let w = wi * h / 2.0;
