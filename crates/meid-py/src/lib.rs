@@ -460,7 +460,10 @@ impl Model {
         // The per-impact table and its totals per contact (`meid simulate --json`'s).
         if let serde_json::Value::Object(o) = &mut out {
             let je = |e: serde_json::Error| MeidError::new_err(e.to_string());
-            o.insert("impacts".into(), serde_json::to_value(&impacts).map_err(je)?);
+            o.insert(
+                "impacts".into(),
+                serde_json::to_value(&impacts).map_err(je)?,
+            );
             o.insert(
                 "impact_totals".into(),
                 serde_json::to_value(&totals).map_err(je)?,

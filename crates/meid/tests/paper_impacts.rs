@@ -52,13 +52,18 @@ fn state_at<'s>(sol: &'s Solution, t: f64) -> &'s [f64] {
 /// Slider `m1` at `v0` against a free body `m2` through a linear contact `(k, c)` released
 /// at zero overlap.
 fn two_body(m1: f64, m2: f64, v0: f64, k: f64, c: f64, method: Method) -> Vec<ImpactRow> {
+    let law = ContactLaw::Linear {
+        stiffness: k,
+        damping: c,
+    };
+    two_body_law(m1, m2, v0, law, method)
+}
+
+fn two_body_law(m1: f64, m2: f64, v0: f64, law: ContactLaw, method: Method) -> Vec<ImpactRow> {
     let mut s = ModalModel::with_damping_ratios(vec![0.0], &[0.0]).unwrap();
     s.points.insert("b".into(), vec![1.0 / m2.sqrt()]);
     let contact = Contact {
-        law: ContactLaw::Linear {
-            stiffness: k,
-            damping: c,
-        },
+        law,
         release: Release::Overlap,
     };
     let slider = Slider {
@@ -195,4 +200,27 @@ fn exact_and_dopri5_give_the_same_rows() {
         let e = |r: &ImpactRow| r.restitution.unwrap_or(0.0);
         assert!(close(e(x), e(y), 1.0), "{x:?}\n{y:?}");
     }
+}
+
+#[test]
+fn a_hertz_contact_row_comes_from_the_interpolated_path() {
+    // dopri5 on a Hertz contact (f = k δ^{3/2}): elastic, so the exit speed is v₀, the impulse
+    // 2 μ v₀ and the peak k δ_max^{3/2} with ½ μ v₀² = (2/5) k δ_max^{5/2}; the impulse and peak
+    // come from the interpolant between dopri5's steps (the peak at its quadrature nodes).
+    let (m1, m2, v0, k): (f64, f64, f64, f64) = (1.0, 3.0, 1.5, 1.0e9);
+    let mu = m1 * m2 / (m1 + m2);
+    let rows = two_body_law(
+        m1,
+        m2,
+        v0,
+        ContactLaw::Hertz { stiffness: k },
+        Method::Dopri5,
+    );
+    assert_eq!(rows.len(), 1, "{rows:?}");
+    let r = &rows[0];
+    let d_max = (5.0 * mu * v0 * v0 / (4.0 * k)).powf(0.4);
+    assert!(rel(r.exit_velocity_m_per_s.unwrap(), v0) < 1e-6, "{r:?}");
+    assert!(rel(r.impulse_n_s, 2.0 * mu * v0) < 1e-5, "{r:?}");
+    assert!(rel(r.peak_force_n, k * d_max.powf(1.5)) < 1e-3, "{r:?}");
+    assert!(r.dissipated_j.abs() < 1e-9, "{r:?}");
 }
