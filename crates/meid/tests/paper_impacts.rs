@@ -36,7 +36,7 @@ fn example(overrides: &[&str], case: Case) -> ImpactSystem {
 }
 
 /// The state of the run's path at time `t` (a switch, to round-off).
-fn state_at<'s>(sol: &'s Solution, t: f64) -> &'s [f64] {
+fn state_at(sol: &Solution, t: f64) -> &[f64] {
     let p = sol
         .path
         .iter()
