@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use meid::analysis::blows::{run_blows_progress, BlowOptions};
+use meid::analysis::blows::{run_blows_each, BlowOptions};
 use meid::plot::{self, LinePlot, Series};
 
 use crate::args::{CaseArg, PrintArgs, RunArgs};
@@ -85,6 +85,12 @@ pub fn run(a: BlowsArgs) -> Result<()> {
     let mut pictured: [Vec<f64>; 3] = Default::default();
     let bar = crate::progress::bar(a.print.quiet || a.print.json, a.blows, "blows");
     let progress = |done: usize, _total: usize| bar.set_position(done as u64);
+    // The per-impact table of every blow, from each blow's run as it ends.
+    let mut impacts: Vec<meid::analysis::impacts::BlowImpact> = Vec::new();
+    let mut on_blow = |k: usize, t0: f64, sol: &meid::integrate::Solution| -> meid::Result<()> {
+        impacts.extend(meid::analysis::impacts::blow_impacts(&sys, sol, k, t0)?);
+        Ok(())
+    };
     let r = match &set {
         Some(set) => {
             let interval = meid::analysis::blows::blow_interval_s(rate_bpm)?;
@@ -119,7 +125,15 @@ pub fn run(a: BlowsArgs) -> Result<()> {
                 pictured[2].extend_from_slice(&h.floor_force_n);
                 Ok(())
             };
-            let r = run_blows_progress(&sys, &opts, &b, Some(&mut sink), false, &progress);
+            let r = run_blows_each(
+                &sys,
+                &opts,
+                &b,
+                Some(&mut sink),
+                false,
+                &progress,
+                Some(&mut on_blow),
+            );
             bar.finish_and_clear();
             let r = r.context("blow train failed")?;
             w.into_inner()
@@ -127,7 +141,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
             r
         }
         None => {
-            let r = run_blows_progress(&sys, &opts, &b, None, false, &progress);
+            let r = run_blows_each(&sys, &opts, &b, None, false, &progress, Some(&mut on_blow));
             bar.finish_and_clear();
             r.context("blow train failed")?
         }
@@ -135,6 +149,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
     // The steady states after the march: the march's own refusals (a collision longer than
     // the interval, a run too long) come first, as they name the blow that failed.
     let prod = crate::production::cases(&model, case, rate_bpm, &a.print)?;
+    let impacts_csv = meid::analysis::impacts::blow_impacts_csv(&impacts);
     let out = serde_json::json!({
         "rate_bpm": rate_bpm,
         "interval_s": r.interval_s,
@@ -144,6 +159,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
         "blows": r.blows,
         "steady": r.steady,
         "damper_gap_at_next_strike_m": r.damper_gap_at_next_strike_m,
+        "impacts": impacts,
     });
     if let Some(set) = &set {
         write_march(
@@ -153,6 +169,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
             &r,
             &out,
             std::mem::take(&mut pictured),
+            &impacts_csv,
         )?;
     }
     if let Some(set) = set {
@@ -168,7 +185,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
     Ok(())
 }
 
-/// blows.csv, blows.json and the pictures of the march into the staging directory `dir`.
+/// blows.csv, blows.json, impacts.csv and the pictures of the march into the staging directory `dir`.
 fn write_march(
     dir: &std::path::Path,
     a: &BlowsArgs,
@@ -176,6 +193,7 @@ fn write_march(
     r: &meid::analysis::blows::BlowsRun,
     out: &serde_json::Value,
     pictured: [Vec<f64>; 3],
+    impacts_csv: &str,
 ) -> Result<()> {
     let mut w = String::from("blow,start_s,energy_ratio,machine_energy_at_strike_j,damper_energy_at_strike_j,peak_bed_acceleration_m_per_s2,peak_floor_force_n,peak_contact_force_slider_bed_n,damper_gap_at_strike_m,damper_contact_time_s\n");
     let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.9e}"));
@@ -195,6 +213,7 @@ fn write_march(
         ));
     }
     meid::io::write_atomic(&dir.join("blows.csv"), w.as_bytes())?;
+    meid::io::write_atomic(&dir.join("impacts.csv"), impacts_csv.as_bytes())?;
     meid::io::write_json(&dir.join("blows.json"), &crate::json::object(out)?)?;
     let [time_s, accel, floor] = pictured;
     for (stem, title, label, y) in [

@@ -46,7 +46,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     let set = a.output.as_deref().map(crate::outputs::begin).transpose()?;
     // With -o, a bounded sketch of the history for the pictures.
     let mut sketch = None;
-    let (s, _solution) = match &set {
+    let (s, solution) = match &set {
         Some(set) => {
             let rows = analysis::energy::sample_count(opts.duration, opts.sample_rate);
             crate::outputs::check_disk(
@@ -90,6 +90,13 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         o.insert("foundation".into(), serde_json::to_value(&f.foundation)?);
         o.insert("receivers".into(), serde_json::to_value(&f.receivers)?);
     }
+    // The per-impact table (the general machine's rows) and its totals per contact.
+    let impacts = analysis::impacts::impacts(&sys, &solution).context("per-impact table")?;
+    if let serde_json::Value::Object(o) = &mut out {
+        o.insert("impacts".into(), serde_json::to_value(&impacts)?);
+        let totals = analysis::impacts::totals(&sys, &impacts);
+        o.insert("impact_totals".into(), serde_json::to_value(&totals)?);
+    }
     if let Some(set) = set {
         if a.uff {
             // The same numbers as history.csv (read back from it), one dataset 58 per channel.
@@ -106,6 +113,10 @@ pub fn run(a: SimulateArgs) -> Result<()> {
                 .context("cannot draw the pictures")?;
         }
         meid::io::write_json(&set.path("summary.json"), &out)?;
+        meid::io::write_atomic(
+            &set.path("impacts.csv"),
+            analysis::network::impacts_csv(&impacts).as_bytes(),
+        )?;
         meid::io::write_atomic(
             &set.path("truncation.csv"),
             meid::modal::truncation::to_csv(&diag.truncation).as_bytes(),

@@ -205,6 +205,7 @@ fn blow_trains_stream_their_history() {
     for f in [
         "blows.csv",
         "blows.json",
+        "impacts.csv",
         "acceleration-time.png",
         "floor-force-time.svg",
         "blow-levels.png",
@@ -366,6 +367,7 @@ fn a_failed_run_leaves_the_previous_output_set() {
             "floor_force.png",
             "floor_force.svg",
             "history.csv",
+            "impacts.csv",
             "manifest.json",
             "summary.json",
             "truncation.csv"

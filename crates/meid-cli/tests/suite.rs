@@ -15,6 +15,7 @@ mod correlate_cli;
 mod fem_threads_cli;
 mod foundation_cli;
 mod frf_cli;
+mod impacts_cli;
 mod input_cli;
 mod json_shape;
 mod measure_cli;

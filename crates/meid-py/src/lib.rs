@@ -408,7 +408,7 @@ impl Model {
             fields.push(format!("simulation.sample_rate={}", toml_real(r)));
         }
         let case: Case = case.parse().map_err(err)?;
-        let (run_summary, columns, diag) = py
+        let (run_summary, columns, diag, (impacts, totals)) = py
             .detach(|| -> meid::Result<_> {
                 let m = if fields.is_empty() {
                     self.inner.clone()
@@ -443,7 +443,9 @@ impl Model {
                     }
                     cols
                 });
-                Ok((run.summary, columns, m.diagnostics()))
+                let impacts = meid::analysis::impacts::impacts(&sys, &run.solution)?;
+                let totals = meid::analysis::impacts::totals(&sys, &impacts);
+                Ok((run.summary, columns, m.diagnostics(), (impacts, totals)))
             })
             .map_err(err)?;
         // The summary's fields, then `truncation`, `notes` and `warnings`: `meid simulate
@@ -454,6 +456,18 @@ impl Model {
             (&mut out, serde_json::to_value(&diag))
         {
             o.extend(d);
+        }
+        // The per-impact table and its totals per contact (`meid simulate --json`'s).
+        if let serde_json::Value::Object(o) = &mut out {
+            let je = |e: serde_json::Error| MeidError::new_err(e.to_string());
+            o.insert(
+                "impacts".into(),
+                serde_json::to_value(&impacts).map_err(je)?,
+            );
+            o.insert(
+                "impact_totals".into(),
+                serde_json::to_value(&totals).map_err(je)?,
+            );
         }
         let summary = out.to_string();
         let warn = py.import("warnings")?;
@@ -1033,6 +1047,14 @@ fn blows_json(
             out["steady"] = serde_json::to_value(&r.steady)
                 .map_err(|e| meid::Error::numerical("blows", e.to_string()))?;
             out["damper_gap_at_next_strike_m"] = r.damper_gap_at_next_strike_m.into();
+            let mut impacts = Vec::new();
+            for (b, sol) in r.blows.iter().zip(&r.solutions) {
+                impacts.extend(meid::analysis::impacts::blow_impacts(
+                    &sys, sol, b.blow, b.start_s,
+                )?);
+            }
+            out["impacts"] = serde_json::to_value(&impacts)
+                .map_err(|e| meid::Error::numerical("blows", e.to_string()))?;
         }
         serde_json::to_string(&out).map_err(|e| meid::Error::numerical("blows", e.to_string()))
     })

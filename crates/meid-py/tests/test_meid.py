@@ -161,3 +161,17 @@ def test_blows_steady_state_is_the_cli_s():
     # At 60 /min the paper's damper does not return (docs/studies.md, "Production").
     assert s["damper_touches_bed"] is False
     assert py["verdict"] == ref["verdict"] and "does not return" in py["verdict"][0]
+
+
+def test_impact_tables_are_the_cli_s():
+    """Run.summary's `impacts` and `impact_totals`, and meid.blows(steady=False)'s `impacts`,
+    are `meid simulate --json`'s and `meid blows --json`'s."""
+    m = meid.Model.from_file(LUMPED)
+    s = m.simulate(duration=0.05, history=False).summary
+    ref = cli_json("simulate", LUMPED, "--duration", "0.05")
+    assert s["impacts"] == ref["impacts"] and s["impact_totals"] == ref["impact_totals"]
+    assert s["impacts"][0]["contact"] == "slider_bed"
+    py = meid.blows(m, 60.0, steady=False, blows=2)
+    ref = cli_json("blows", LUMPED, "--rate-bpm", "60", "--blows", "2")
+    assert py["impacts"] == ref["impacts"]
+    assert [r["blow"] for r in py["impacts"] if r["contact"] == "slider_bed"] == [1, 2]

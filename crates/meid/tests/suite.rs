@@ -59,6 +59,7 @@ mod network_engine;
 mod network_model;
 mod optimize_checks;
 mod output_sets;
+mod paper_impacts;
 mod plot_checks;
 mod plot_pictures;
 mod propagator_taylor;

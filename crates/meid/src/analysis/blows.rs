@@ -270,9 +270,26 @@ pub fn run_blows_progress(
     sys: &ImpactSystem,
     opts: &Options,
     blow: &BlowOptions,
+    on_history: Option<&mut HistorySink<'_>>,
+    keep_solutions: bool,
+    progress: &dyn Fn(usize, usize),
+) -> Result<BlowsRun> {
+    run_blows_each(sys, opts, blow, on_history, keep_solutions, progress, None)
+}
+
+/// Receives each blow's run: `(blow, 1-based; its strike time in the train, s; its run)`.
+pub type BlowSink<'a> = dyn FnMut(usize, f64, &Solution) -> Result<()> + 'a;
+
+/// [`run_blows_progress`] handing each blow's run to `on_blow` (when given) as it ends: the
+/// per-impact table of a train ([`super::impacts::blow_impacts`]) without keeping the runs.
+pub fn run_blows_each(
+    sys: &ImpactSystem,
+    opts: &Options,
+    blow: &BlowOptions,
     mut on_history: Option<&mut HistorySink<'_>>,
     keep_solutions: bool,
     progress: &dyn Fn(usize, usize),
+    mut on_blow: Option<&mut BlowSink<'_>>,
 ) -> Result<BlowsRun> {
     let record = on_history.is_some();
     if blow.blows == 0 {
@@ -376,6 +393,9 @@ pub fn run_blows_progress(
             sink(&h)?;
         }
         let sol = done.solution;
+        if let Some(f) = on_blow.as_mut() {
+            f(k + 1, t0, &sol)?;
+        }
         reports.push(done.report);
         dissipated_before += sol.totals.dissipated;
         // The next strike: same structure and damper state, a fresh slider touching the bed.

@@ -4,6 +4,7 @@ pub mod blows;
 pub mod compare;
 pub mod energy;
 pub mod esd;
+pub mod impacts;
 pub mod montecarlo;
 pub mod network;
 pub mod octave;

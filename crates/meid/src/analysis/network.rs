@@ -229,11 +229,22 @@ pub fn summary(model: &NetworkModel, sol: &NetSolution) -> NetSummary {
 
 /// The per-impact table as CSV (one row per closing; header with SI units).
 pub fn impacts_csv(rows: &[ImpactRow]) -> String {
-    let mut s = String::from(
-        "contact,start_s,approach_velocity_m_per_s,peak_force_n,peak_time_s,duration_s,impulse_n_s,dissipated_j,exit_velocity_m_per_s,restitution\n",
-    );
+    impact_rows_csv(false, rows.iter().map(|r| (None, r)))
+}
+
+/// The per-impact table as CSV; with `blow_column`, a leading `blow` column (a blow train's
+/// table) holding each row's blow.
+pub fn impact_rows_csv<'r>(
+    blow_column: bool,
+    rows: impl Iterator<Item = (Option<usize>, &'r ImpactRow)>,
+) -> String {
+    let mut s = String::from(if blow_column { "blow," } else { "" });
+    s += "contact,start_s,approach_velocity_m_per_s,peak_force_n,peak_time_s,duration_s,impulse_n_s,dissipated_j,exit_velocity_m_per_s,restitution\n";
     let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:e}"));
-    for r in rows {
+    for (b, r) in rows {
+        if blow_column {
+            s += &format!("{},", b.unwrap_or(0));
+        }
         s += &format!(
             "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{},{}\n",
             r.contact,

@@ -469,7 +469,7 @@ impl Modes<'_> {
 
 /// `∫₀^len ℓᵀX(s) ds` of a functional of a segment: in closed form for a sum of exponentials,
 /// by 8-point Gauss-Legendre on quarter periods for the matrix-exponential fallback.
-fn integral(f: &Functional<'_>, len: f64) -> f64 {
+pub(crate) fn integral(f: &Functional<'_>, len: f64) -> f64 {
     match f {
         Functional::Exp(e) => {
             let mut v = e.p0 * len + e.p1 * len * len / 2.0 + e.p2 * len.powi(3) / 3.0;
