@@ -1053,61 +1053,136 @@ fn scale(p: &FitParameter) -> f64 {
     p.start.abs().max(p.upper - p.lower)
 }
 
+/// What a bounded least-squares fit gives both calibrations (response and modal): the fitted
+/// values, the solver's outcome in its internal (bounded) variables, the residuals before and
+/// after, the Jacobian in the values (`J_p = J_θ · dθ/dp`), which values are identifiable and
+/// `J_pᵀJ_p` over those (`free`), and the residual variance `s² = rᵀr / (m − n)`.
+pub(super) struct BoundedFit<T> {
+    pub values: Vec<f64>,
+    pub out: LmOutcome,
+    /// The bounds in the internal variables: a value on one is at its bound.
+    pub lo: Vec<f64>,
+    pub hi: Vec<f64>,
+    pub before: T,
+    pub r0: Vec<f64>,
+    pub after: T,
+    pub r1: Vec<f64>,
+    pub jp: Vec<Vec<f64>>,
+    pub identifiability: Vec<Identifiability>,
+    pub free: Vec<usize>,
+    pub jtj: Vec<Vec<f64>>,
+    pub dof: usize,
+    pub s2: f64,
+    pub cost: f64,
+}
+
+impl<T> BoundedFit<T> {
+    /// Levenberg-Marquardt over `params` from their starts within their bounds:
+    /// `evaluate(values)` gives what the caller reports with the residuals, `residuals(values)`
+    /// the residuals alone.
+    pub fn run(
+        params: &[FitParameter],
+        settings: &Settings,
+        evaluate: impl Fn(&[f64]) -> Result<(T, Vec<f64>)>,
+        residuals: impl Fn(&[f64]) -> Result<Vec<f64>>,
+    ) -> Result<Self> {
+        let n = params.len();
+        let x0: Vec<f64> = params.iter().map(|p| to_internal(p, p.start)).collect();
+        let lo: Vec<f64> = params.iter().map(|p| to_internal(p, p.lower)).collect();
+        let hi: Vec<f64> = params.iter().map(|p| to_internal(p, p.upper)).collect();
+        let values_of = |x: &[f64]| -> Vec<f64> {
+            params
+                .iter()
+                .zip(x)
+                .map(|(p, &xi)| from_internal(p, xi).clamp(p.lower, p.upper))
+                .collect()
+        };
+        let starts: Vec<f64> = params.iter().map(|p| p.start).collect();
+        let (before, r0) = evaluate(&starts)?;
+        let out = levenberg_marquardt(|x| residuals(&values_of(x)), &x0, &lo, &hi, settings)?;
+        let values = values_of(&out.x);
+        let (after, r1) = evaluate(&values)?;
+        let cost = dot(&r1, &r1);
+        let dof = r1.len().saturating_sub(n);
+        let s2 = if dof > 0 { cost / dof as f64 } else { f64::NAN };
+        // J_p = J_θ · dθ/dp.
+        let jp: Vec<Vec<f64>> = (0..n)
+            .map(|i| {
+                let d = dp_dx(&params[i], values[i]);
+                out.jacobian[i].iter().map(|x| x / d).collect()
+            })
+            .collect();
+        let identifiability = identifiability(&out.jacobian);
+        // The covariance of the identifiable values (the others held: their columns are zero
+        // or dependent, and would make JᵀJ singular for every value).
+        let free: Vec<usize> = (0..n)
+            .filter(|&i| identifiability[i] == Identifiability::Identifiable)
+            .collect();
+        let jtj: Vec<Vec<f64>> = free
+            .iter()
+            .map(|&i| free.iter().map(|&j| dot(&jp[i], &jp[j])).collect())
+            .collect();
+        Ok(Self {
+            values,
+            out,
+            lo,
+            hi,
+            before,
+            r0,
+            after,
+            r1,
+            jp,
+            identifiability,
+            free,
+            jtj,
+            dof,
+            s2,
+            cost,
+        })
+    }
+
+    /// Whether value `i` ended on one of its bounds.
+    pub fn at_bound(&self, i: usize) -> bool {
+        self.out.x[i] <= self.lo[i] || self.out.x[i] >= self.hi[i]
+    }
+}
+
 /// Runs the calibration (module docs).
 pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
     let params = &problem.params;
     let n = params.len();
-    let x0: Vec<f64> = params.iter().map(|p| to_internal(p, p.start)).collect();
-    let lo: Vec<f64> = params.iter().map(|p| to_internal(p, p.lower)).collect();
-    let hi: Vec<f64> = params.iter().map(|p| to_internal(p, p.upper)).collect();
-    let values_of = |x: &[f64]| -> Vec<f64> {
-        params
-            .iter()
-            .zip(x)
-            .map(|(p, &xi)| from_internal(p, xi).clamp(p.lower, p.upper))
-            .collect()
-    };
-    let starts: Vec<f64> = params.iter().map(|p| p.start).collect();
-    let (before, r0) = problem.evaluate(&starts)?;
-    let out = levenberg_marquardt(
-        |x| problem.residuals(&values_of(x)),
-        &x0,
-        &lo,
-        &hi,
+    let fit = BoundedFit::run(
+        params,
         &problem.settings,
+        |v| problem.evaluate(v),
+        |v| problem.residuals(v),
     )?;
-    let values = values_of(&out.x);
-    let (after, r1) = problem.evaluate(&values)?;
+    let BoundedFit {
+        ref values,
+        ref out,
+        ref before,
+        ref r0,
+        ref after,
+        ref r1,
+        ref jp,
+        ref identifiability,
+        ref free,
+        jtj: ref a,
+        dof,
+        s2,
+        cost,
+        ..
+    } = fit;
     let m = r1.len();
-    let cost = dot(&r1, &r1);
-    let dof = m.saturating_sub(n);
-    let s2 = if dof > 0 { cost / dof as f64 } else { f64::NAN };
-    // J_p = J_θ · dθ/dp.
-    let jp: Vec<Vec<f64>> = (0..n)
-        .map(|i| {
-            let d = dp_dx(&params[i], values[i]);
-            out.jacobian[i].iter().map(|x| x / d).collect()
-        })
-        .collect();
-    let identifiability = identifiability(&out.jacobian);
-    // The covariance of the identifiable values (the others held: their columns are zero or
-    // dependent, and would make JᵀJ singular for every value).
-    let free: Vec<usize> = (0..n)
-        .filter(|&i| identifiability[i] == Identifiability::Identifiable)
-        .collect();
-    let a: Vec<Vec<f64>> = free
-        .iter()
-        .map(|&i| free.iter().map(|&j| dot(&jp[i], &jp[j])).collect())
-        .collect();
-    let baseline = baseline_term(problem, &free, &jp);
-    let c_inv = spd_inverse(&a);
-    let cov = covariance(c_inv.as_deref(), &baseline, &free, n, s2);
+    let baseline = baseline_term(problem, free, jp);
+    let c_inv = spd_inverse(a);
+    let cov = covariance(c_inv.as_deref(), &baseline, free, n, s2);
     // The Gauss-Newton step left at the estimate, δ = −C J_pᵀr over the free values: the
     // solver stops on a relative step or cost decrease (xtol, ftol), which on data with little
     // noise is far wider than the statistical interval.
     let mut solver_step = vec![f64::NAN; n];
     if let Some(c) = &c_inv {
-        let g: Vec<f64> = free.iter().map(|&i| dot(&jp[i], &r1)).collect();
+        let g: Vec<f64> = free.iter().map(|&i| dot(&jp[i], r1)).collect();
         for (k, &i) in free.iter().enumerate() {
             solver_step[i] = c[k].iter().zip(&g).map(|(c, g)| c * g).sum::<f64>().abs();
         }
@@ -1115,7 +1190,7 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
     let t = student_t_975(dof);
     let mut estimates = Vec::new();
     for (i, p) in params.iter().enumerate() {
-        let at_bound = out.x[i] <= lo[i] || out.x[i] >= hi[i];
+        let at_bound = fit.at_bound(i);
         let se = match &cov {
             Some(c) if !at_bound && c[i][i] >= 0.0 => c[i][i].sqrt(),
             _ => f64::NAN,
@@ -1149,7 +1224,7 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
         parameters: estimates,
         residual: problem.settings.residual,
         residuals: m,
-        rms_residual_before: (dot(&r0, &r0) / r0.len() as f64).sqrt(),
+        rms_residual_before: (dot(r0, r0) / r0.len() as f64).sqrt(),
         rms_residual_after: (cost / m as f64).sqrt(),
         sigma: s2.sqrt(),
         correlation,
@@ -1158,7 +1233,7 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
         convergence: out.reason,
         converged: out.reason.converged(),
         structures_built: problem.structures_built(),
-        channels: channel_fits(problem, &before, &after),
+        channels: channel_fits(problem, before, after),
     })
 }
 

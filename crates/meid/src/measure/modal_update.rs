@@ -33,8 +33,8 @@
 use serde::Serialize;
 
 use super::calibrate::{
-    dot, dp_dx, estimate, from_internal, identifiability, levenberg_marquardt, spd_inverse,
-    student_t_975, to_internal, Convergence, Estimate, FitParameter, Identifiability, Settings,
+    dot, estimate, spd_inverse, student_t_975, BoundedFit, Convergence, Estimate, FitParameter,
+    Settings,
 };
 use super::correlate::{
     correlate, IdentifiedModes, Mapping, ModelModes, Settings as CorrelateSettings,
@@ -225,51 +225,35 @@ impl<'a> ModalProblem<'a> {
 pub fn calibrate_modal(problem: &ModalProblem<'_>) -> Result<ModalCalibration> {
     let params = &problem.params;
     let n = params.len();
-    let x0: Vec<f64> = params.iter().map(|p| to_internal(p, p.start)).collect();
-    let lo: Vec<f64> = params.iter().map(|p| to_internal(p, p.lower)).collect();
-    let hi: Vec<f64> = params.iter().map(|p| to_internal(p, p.upper)).collect();
-    let values_of = |x: &[f64]| -> Vec<f64> {
-        params
-            .iter()
-            .zip(x)
-            .map(|(p, &xi)| from_internal(p, xi).clamp(p.lower, p.upper))
-            .collect()
-    };
-    let starts: Vec<f64> = params.iter().map(|p| p.start).collect();
-    let (before, r0) = problem.evaluate(&starts)?;
-    let out = levenberg_marquardt(
-        |x| problem.residuals(&values_of(x)),
-        &x0,
-        &lo,
-        &hi,
+    let fit = BoundedFit::run(
+        params,
         &problem.settings,
+        |v| problem.evaluate(v),
+        |v| problem.residuals(v),
     )?;
-    let values = values_of(&out.x);
-    let (after, r1) = problem.evaluate(&values)?;
+    let BoundedFit {
+        ref values,
+        ref out,
+        ref before,
+        ref r0,
+        ref after,
+        ref r1,
+        ref jp,
+        identifiability: ref ident,
+        ref free,
+        jtj: ref a,
+        dof,
+        s2,
+        cost,
+        ..
+    } = fit;
     let m = r1.len();
-    let cost = dot(&r1, &r1);
-    let dof = m.saturating_sub(n);
-    let s2 = if dof > 0 { cost / dof as f64 } else { f64::NAN };
-    let jp: Vec<Vec<f64>> = (0..n)
-        .map(|i| {
-            let d = dp_dx(&params[i], values[i]);
-            out.jacobian[i].iter().map(|x| x / d).collect()
-        })
-        .collect();
-    let ident = identifiability(&out.jacobian);
-    let free: Vec<usize> = (0..n)
-        .filter(|&i| ident[i] == Identifiability::Identifiable)
-        .collect();
-    let a: Vec<Vec<f64>> = free
-        .iter()
-        .map(|&i| free.iter().map(|&j| dot(&jp[i], &jp[j])).collect())
-        .collect();
-    let c = spd_inverse(&a);
+    let c = spd_inverse(a);
     let t = student_t_975(dof);
-    let g: Vec<f64> = free.iter().map(|&i| dot(&jp[i], &r1)).collect();
+    let g: Vec<f64> = free.iter().map(|&i| dot(&jp[i], r1)).collect();
     let mut estimates = Vec::new();
     for (i, p) in params.iter().enumerate() {
-        let at_bound = out.x[i] <= lo[i] || out.x[i] >= hi[i];
+        let at_bound = fit.at_bound(i);
         let k = free.iter().position(|&f| f == i);
         let (se, step) = match (&c, k) {
             (Some(c), Some(k)) if !at_bound => (
@@ -280,7 +264,7 @@ pub fn calibrate_modal(problem: &ModalProblem<'_>) -> Result<ModalCalibration> {
         };
         estimates.push(estimate(p, values[i], se, step, t, at_bound, ident[i]));
     }
-    let fitted = problem.model_with(&values)?;
+    let fitted = problem.model_with(values)?;
     let after_corr = correlate(
         problem.ident,
         &ModelModes::new(&fitted, problem.coordinates.clone()),
@@ -299,7 +283,7 @@ pub fn calibrate_modal(problem: &ModalProblem<'_>) -> Result<ModalCalibration> {
     let pairs = problem
         .pairs
         .iter()
-        .zip(before.iter().zip(&after))
+        .zip(before.iter().zip(after))
         .map(|(&(i, j), (b, a))| {
             let fi = problem.ident.modes[i].frequency_hz;
             PairUpdate {
@@ -319,7 +303,7 @@ pub fn calibrate_modal(problem: &ModalProblem<'_>) -> Result<ModalCalibration> {
         parameters: estimates,
         mac_weight: problem.mac_weight,
         residuals: m,
-        rms_residual_before: (dot(&r0, &r0) / r0.len() as f64).sqrt(),
+        rms_residual_before: (dot(r0, r0) / r0.len() as f64).sqrt(),
         rms_residual_after: (cost / m as f64).sqrt(),
         sigma: s2.sqrt(),
         iterations: out.iterations,

@@ -688,7 +688,7 @@ pub fn section(dir: &Path, cases: &CaseAssessments) -> Result<Option<Section>> {
         blocks.push(Block::List(sentences));
     }
     blocks.push(Block::Paragraph(format!(
-        "The lumped mass '{}' and the foundation block rest on the soil as one rigid body; the soil's vertical spring and dashpot are physical elements of the model, and every peak below is exact on the continuous solution of one blow in each case ({}).",
+        "The lumped mass '{}' and the foundation block rest on the soil as one rigid body; the soil's vertical spring and dashpot are physical elements of the model, and every peak below is exact on the continuous solution of one blow from rest in each case ({}). The long-term limits are meant for repeated blows: in production the next blow strikes a machine still moving, so where the production section shows a steady blow different from the first (a damper that does not return between blows), these checks describe the first blow only.",
         f.mass_name,
         cases.iter().map(|(c, _)| c.label()).collect::<Vec<_>>().join(", ")
     )));
