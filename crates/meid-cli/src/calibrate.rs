@@ -127,25 +127,7 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         c.plots(set.staging())?;
         set.commit("calibrate")?;
     }
-    if a.print.json {
-        crate::json::print(&c)?;
-    } else if a.print.human() {
-        println!(
-            "{} — {}",
-            crate::ui::bold("meid calibrate"),
-            model.spec.name.as_deref().unwrap_or("model")
-        );
-        print!("{}", c.to_text());
-        match &a.output {
-            Some(dir) => println!(
-                "wrote {} (calibrated model: {})",
-                dir.display(),
-                dir.join("calibrated.toml").display()
-            ),
-            None => println!("give -o DIR to write the calibrated model file and the overlays"),
-        }
-    }
-    Ok(())
+    print_result(&a, &c, c.to_text(), "", &model, " and the overlays")
 }
 
 /// `meid calibrate --modal`: model values fitted to identified modes.
@@ -200,22 +182,36 @@ fn run_modal(a: &CalibrateArgs, modal: &std::path::Path) -> Result<()> {
             crate::ui::warning(w);
         }
     }
+    print_result(a, &c, c.to_text(), " --modal", &model, "")
+}
+
+/// A calibration's result on stdout: its JSON, or its table with the title (`mode` after
+/// `meid calibrate`) and where the calibrated model was written (or how to get it: `-o DIR`
+/// writes the model file `and_more`).
+fn print_result(
+    a: &CalibrateArgs,
+    result: &impl serde::Serialize,
+    text: String,
+    mode: &str,
+    model: &meid::model::Model,
+    and_more: &str,
+) -> Result<()> {
     if a.print.json {
-        crate::json::print(&c)?;
+        crate::json::print(result)?;
     } else if a.print.human() {
         println!(
-            "{} --modal — {}",
+            "{}{mode} — {}",
             crate::ui::bold("meid calibrate"),
             model.spec.name.as_deref().unwrap_or("model")
         );
-        print!("{}", c.to_text());
+        print!("{text}");
         match &a.output {
             Some(dir) => println!(
                 "wrote {} (calibrated model: {})",
                 dir.display(),
                 dir.join("calibrated.toml").display()
             ),
-            None => println!("give -o DIR to write the calibrated model file"),
+            None => println!("give -o DIR to write the calibrated model file{and_more}"),
         }
     }
     Ok(())
