@@ -113,7 +113,17 @@ pub fn run(a: CompareArgs) -> Result<()> {
     let result = comparison.run_with_progress(&|done, _| bar.set_position(done as u64));
     bar.finish_and_clear();
     let result = result.context("comparison failed")?;
-    // With a [foundation]: its checks and the receivers' for every case.
+    // With a [foundation]: its checks and the receivers' for every case, on the steady blow
+    // when a stroke rate is given or in the model (as the production verdict), else one blow
+    // from rest.
+    let basis = if origin == RateOrigin::Assumed {
+        meid::foundation::Basis::FromRest
+    } else {
+        meid::foundation::Basis::Steady(meid::analysis::steady::SteadyOptions {
+            rate_bpm,
+            ..Default::default()
+        })
+    };
     let mut foundations = Vec::new();
     if let Some(m) = &model_for_foundation {
         for c in comparison.cases() {
@@ -122,8 +132,8 @@ pub fn run(a: CompareArgs) -> Result<()> {
                 CaseName::Damper => meid::model::Case::Damper,
                 CaseName::AddedMass => meid::model::Case::AddedMass,
             };
-            if let Some(f) =
-                meid::foundation::assess(m, case).context("foundation assessment failed")?
+            if let Some(f) = meid::foundation::assess_with(m, case, &basis)
+                .context("foundation assessment failed")?
             {
                 foundations.push((c, f));
             }

@@ -26,7 +26,7 @@
 //! |---|---|---|
 //! | 9 reports | [`report`] | everything below |
 //! | 8 measured data | [`measure`] | `analysis`, `model`, `io`, `record`, `plot`, `impact`, `identify` and the base |
-//! | 8 surroundings | [`foundation`] | `analysis`, `model`, `modal` and the base |
+//! | 8 surroundings | [`foundation`] | `analysis`, `model`, `integrate`, `modal` and the base |
 //! | 7 studies | [`analysis`] | `model`, `integrate`, `impact`, `io`, `modal`, `plot` and the base |
 //! | 6 model files | [`model`] | `integrate`, `impact`, `io` (its readers), `structure`, `modal` and the base |
 //! | 5 time | [`integrate`] | `impact`, `modal` and the base |

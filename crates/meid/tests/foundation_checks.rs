@@ -445,3 +445,81 @@ fn excitation_default_follows_the_stroke_rate() {
         Excitation::ShortTerm
     );
 }
+
+/// With a stroke rate the checks judge the periodic steady blow: found directly (Newton on the
+/// blow map) and replayed at the block, it equals the last blow of a train marched from rest
+/// for 40 blows (an independent route to the same periodic regime). At 20 /min the paper's
+/// damper returns to the bed before every strike (period-1).
+#[test]
+fn steady_basis_equals_the_marched_train_at_the_block() {
+    use meid::analysis::blows::{run_blows, BlowOptions};
+    use meid::analysis::steady::SteadyOptions;
+    let text = std::fs::read_to_string(example("paper-on-soil.toml")).unwrap();
+    // Measure the train at the base, which is the block on the soil.
+    let m = Model::from_text(
+        "paper-on-soil.toml",
+        text,
+        &["points.measurement=\"base\"".into()],
+    )
+    .unwrap();
+    let basis = foundation::Basis::Steady(SteadyOptions {
+        rate_bpm: 20.0,
+        ..SteadyOptions::default()
+    });
+    let a = foundation::assess_with(&m, Case::Damper, &basis)
+        .unwrap()
+        .unwrap();
+    let b = &a.foundation.blow_basis;
+    assert_eq!(b.blow, "steady blow of the train");
+    assert_eq!(b.regime.as_deref(), Some("period-1"));
+    assert_eq!(
+        (b.converged, b.damper_touches_bed),
+        (Some(true), Some(true))
+    );
+    let sys = m.impact_system(Case::Damper).unwrap();
+    let train = run_blows(
+        &sys,
+        &m.options(),
+        &BlowOptions {
+            blows: 40,
+            rate_bpm: 20.0,
+            ..BlowOptions::default()
+        },
+        false,
+    )
+    .unwrap();
+    let last = train.blows.last().unwrap();
+    let peak = |key: &str| {
+        a.foundation
+            .block_peaks
+            .iter()
+            .find(|p| p.channel == key)
+            .unwrap()
+            .peak
+    };
+    for (key, marched) in [
+        ("floor_force_n", last.peak_floor_force_n),
+        (
+            "bed_acceleration_m_per_s2",
+            last.peak_bed_acceleration_m_per_s2,
+        ),
+    ] {
+        let rel = (peak(key) / marched - 1.0).abs();
+        assert!(
+            rel < 1e-8,
+            "{key}: steady {} vs marched {marched}",
+            peak(key)
+        );
+    }
+    // The steady blow differs from the first blow from rest (the damper does not start at
+    // rest against the bed): the basis matters.
+    let rest = foundation::assess_with(&m, Case::Damper, &foundation::Basis::FromRest)
+        .unwrap()
+        .unwrap();
+    assert_eq!(rest.foundation.blow_basis.blow, "one blow from rest");
+    let (vs, vr) = (
+        a.foundation.peak_block_velocity_m_per_s,
+        rest.foundation.peak_block_velocity_m_per_s,
+    );
+    assert!((vs / vr - 1.0).abs() > 1e-3, "{vs} vs {vr}");
+}

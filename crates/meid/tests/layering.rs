@@ -37,7 +37,7 @@ fn allowed() -> BTreeMap<&'static str, Vec<&'static str>> {
                 "analysis", "model", "io", "record", "plot", "impact", "identify",
             ],
         ),
-        ("foundation", vec!["analysis", "model", "modal"]),
+        ("foundation", vec!["analysis", "model", "integrate", "modal"]),
     ])
 }
 

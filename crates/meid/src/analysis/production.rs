@@ -287,6 +287,17 @@ fn change(a: f64, b: f64) -> String {
     }
 }
 
+/// [`change`] followed by what it compares with: "3.6 dB higher than", "the same (within
+/// 0.05 dB) as".
+fn change_than(a: f64, b: f64) -> String {
+    let c = change(a, b);
+    if c.starts_with("the same") {
+        c + " as"
+    } else {
+        c + " than"
+    }
+}
+
 fn sig(v: f64, d: usize) -> String {
     if v == 0.0 || !v.is_finite() {
         return format!("{v}");
@@ -332,8 +343,8 @@ pub fn verdict(p: &Production) -> Vec<String> {
             )
         };
         out.push(format!(
-            "{head}the steady floor force is {} than without it ({} N against {} N) and the bed acceleration {} ({} against {} m/s²){}.",
-            change(d.peak_floor_force_n, n.peak_floor_force_n),
+            "{head}the steady floor force is {} without it ({} N against {} N) and the bed acceleration {} ({} against {} m/s²){}.",
+            change_than(d.peak_floor_force_n, n.peak_floor_force_n),
             sig(d.peak_floor_force_n, 4),
             sig(n.peak_floor_force_n, 4),
             change(d.peak_bed_acceleration_m_per_s2, n.peak_bed_acceleration_m_per_s2),
@@ -363,9 +374,9 @@ pub fn verdict(p: &Production) -> Vec<String> {
     }
     if let (Some(a), Some(n)) = (p.case(CaseName::AddedMass), none) {
         out.push(format!(
-            "The same mass added rigidly instead gives a steady floor force {} and a bed acceleration {} than the machine without it{}.",
+            "The same mass added rigidly instead gives a steady floor force {} and a bed acceleration {} the machine without it{}.",
             change(a.peak_floor_force_n, n.peak_floor_force_n),
-            change(a.peak_bed_acceleration_m_per_s2, n.peak_bed_acceleration_m_per_s2),
+            change_than(a.peak_bed_acceleration_m_per_s2, n.peak_bed_acceleration_m_per_s2),
             regime(a),
         ));
     }

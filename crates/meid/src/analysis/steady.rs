@@ -75,6 +75,7 @@ use faer::Mat;
 use serde::Serialize;
 
 use super::blows::{blow_interval_s, next_strike, one_blow, BlowReport};
+use super::energy::{History, Recorder};
 use crate::impact::{ImpactSystem, Mode, Switch};
 use crate::integrate::{self, propagator::Propagator, Method, Options, Solution};
 use crate::{Error, Result};
@@ -188,6 +189,11 @@ pub struct SteadyState {
     /// The search's residuals in order, each marked: `s` the start of a Newton search, `N` an
     /// accepted Newton step, `x` a rejected one, `m` a march step of the Newton search.
     pub residual_history: Vec<(char, f64)>,
+    /// The state `y` just before the first of [`Self::blows`] (the fixed point of `P^k`, or
+    /// for an irregular train the marched state before its last blows): [`replay`] runs the
+    /// steady blows again from it.
+    #[serde(skip)]
+    pub strike_state: Vec<f64>,
 }
 
 impl SteadyState {
@@ -749,6 +755,8 @@ pub fn steady_state(sys: &ImpactSystem, opts: &Options, so: &SteadyOptions) -> R
     }
     // 3. Irregular: the last blows' levels as an estimate.
     let tail: Vec<BlowReport> = reports.iter().rev().take(k_max).rev().cloned().collect();
+    // `states[j]` is the state before marched blow j + 1.
+    let strike_state = states[reports.len() - tail.len()].clone();
     let spread = |f: &dyn Fn(&BlowReport) -> f64| {
         let v: Vec<f64> = tail.iter().map(f).collect();
         let (lo, hi) = v
@@ -802,7 +810,58 @@ pub fn steady_state(sys: &ImpactSystem, opts: &Options, so: &SteadyOptions) -> R
         blows: tail,
         notes,
         residual_history: std::mem::take(&mut map.history),
+        strike_state,
     }))
+}
+
+/// One steady blow run again by [`replay`]: its solution (exact peaks in `totals.peaks`, blow
+/// time from its strike at 0) and its samples on the run options' output grid.
+pub struct Replayed {
+    pub solution: Solution,
+    pub history: History,
+}
+
+/// The steady blows of `s` (one per blow of its period; for an irregular train its last
+/// marched blows) run again on `sys` from [`SteadyState::strike_state`], each recorded on
+/// `opts.sample_rate` from its strike to the next (`s.interval_s`). `sys` must have the
+/// dynamics the steady state was found on; its output channels may differ (a probe point, a
+/// different floor-force functional), which is how the foundation's checks measure the steady
+/// blow at the block ([`crate::foundation`]).
+pub fn replay(sys: &ImpactSystem, opts: &Options, s: &SteadyState) -> Result<Vec<Replayed>> {
+    let so = SteadyOptions {
+        rate_bpm: s.rate_bpm,
+        ..SteadyOptions::default()
+    };
+    let map = Map::new(sys, opts, &so)?;
+    if s.strike_state.len() != map.dim() {
+        return Err(Error::numerical(
+            "steady state",
+            format!(
+                "the steady strike state has {} values, the system's blow map {}",
+                s.strike_state.len(),
+                map.dim()
+            ),
+        ));
+    }
+    let o_blow = Options {
+        sample_rate: opts.sample_rate,
+        peaks: true,
+        ..map.opts
+    };
+    let mut y = s.strike_state.clone();
+    let mut out = Vec::with_capacity(s.blows.len());
+    for b in 0..s.blows.len() {
+        let x0 = map.embed(&y);
+        let mut rec = Recorder::new(sys).starting_at(&x0);
+        let t0 = b as f64 * map.opts.duration;
+        let done = one_blow(sys, &o_blow, opts, &x0, b, t0, s.rate_bpm, &mut rec)?;
+        y = map.select(&done.solution.x_final);
+        out.push(Replayed {
+            solution: done.solution,
+            history: rec.history,
+        });
+    }
+    Ok(out)
 }
 
 fn jacobian_kind(map: &Map) -> Jacobian {
@@ -890,6 +949,7 @@ fn finish(
         blows,
         notes,
         residual_history: std::mem::take(&mut map.history),
+        strike_state: fixed.y,
     }))
 }
 

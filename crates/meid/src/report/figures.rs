@@ -573,7 +573,7 @@ pub fn comparison_figures(dir: &Path, prefix: &str, r: &ComparisonResult) -> Res
     Ok(out)
 }
 
-fn capitalise(s: &str) -> String {
+pub(crate) fn capitalise(s: &str) -> String {
     let mut c = s.chars();
     match c.next() {
         Some(f) => f.to_uppercase().collect::<String>() + c.as_str(),

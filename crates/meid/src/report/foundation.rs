@@ -674,6 +674,23 @@ pub fn people_table(cases: &CaseAssessments) -> Table {
     }
 }
 
+/// Which blow each case's checks judge, in sentences ("Without damper, the checks judge the
+/// steady blow of the train at 60 /min (period-1, …)."), one per case.
+fn basis_sentences(cases: &CaseAssessments) -> String {
+    cases
+        .iter()
+        .map(|(c, a)| {
+            let b = &a.foundation.blow_basis;
+            format!(
+                "{}: {}.",
+                super::figures::capitalise(c.label()),
+                b.statement
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 /// The section (`id="foundation"`); `None` when the model has no `[foundation]` (no case
 /// assessed). Pictures are written into `dir`.
 pub fn section(dir: &Path, cases: &CaseAssessments) -> Result<Option<Section>> {
@@ -688,9 +705,10 @@ pub fn section(dir: &Path, cases: &CaseAssessments) -> Result<Option<Section>> {
         blocks.push(Block::List(sentences));
     }
     blocks.push(Block::Paragraph(format!(
-        "The lumped mass '{}' and the foundation block rest on the soil as one rigid body; the soil's vertical spring and dashpot are physical elements of the model, and every peak below is exact on the continuous solution of one blow from rest in each case ({}). The long-term limits are meant for repeated blows: in production the next blow strikes a machine still moving, so where the production section shows a steady blow different from the first (a damper that does not return between blows), these checks describe the first blow only.",
+        "The lumped mass '{}' and the foundation block rest on the soil as one rigid body; the soil's vertical spring and dashpot are physical elements of the model, and every peak below is exact on the continuous solution ({}). {}",
         f.mass_name,
-        cases.iter().map(|(c, _)| c.label()).collect::<Vec<_>>().join(", ")
+        cases.iter().map(|(c, _)| c.label()).collect::<Vec<_>>().join(", "),
+        basis_sentences(cases)
     )));
     blocks.push(Block::Table(block_table(f, first)));
     blocks.push(Block::Table(impedance_table(first)));

@@ -354,7 +354,12 @@ impl MachineReport {
         // With a [foundation]: the block, the soil and the receivers in each case.
         let mut foundation = Vec::new();
         for c in comparison.cases.iter().map(|c| c.case) {
-            if let Some(a) = crate::foundation::assess(&model, case_of(c))? {
+            // Judged on the steady blow at the report's stroke rate, as the production section.
+            let basis = crate::foundation::Basis::Steady(SteadyOptions {
+                rate_bpm,
+                ..SteadyOptions::default()
+            });
+            if let Some(a) = crate::foundation::assess_with(&model, case_of(c), &basis)? {
                 foundation.push((c, a));
             }
         }
