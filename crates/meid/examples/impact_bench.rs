@@ -5,7 +5,10 @@
 //! ```
 //!
 //! (`--events` prints the collision's stretches and switches and each mode's Taylor step
-//! instead; `--callgrind*` run one case for `valgrind --tool=callgrind`.)
+//! instead; `--callgrind*` run one case for `valgrind --tool=callgrind`; `--spec PATH` writes
+//! case 1's system with meid's exact energy ratio and collision end for the peers in
+//! `bench/peer/`, and `--collisions N` runs N cold collisions of case 1 and nothing else, the
+//! meid side of their whole-process CPU-time comparison, `bench/peer/README.md`.)
 //!
 //! Method: every case is run once to warm up, then in `B` batches of `K` repetitions; the time
 //! per run of each batch is `elapsed / K` (std::time::Instant), and the median and minimum over
@@ -118,6 +121,41 @@ fn main() {
                 tm.period()
             );
         }
+        return;
+    }
+    // `--spec PATH`: the system and meid's exact values for the peers in `bench/peer/`.
+    if let Some(path) = flag_value(&args, "--spec") {
+        let sol = simulate(&sys, &oe, false).unwrap();
+        let mut spec = peer::spec_json(&sys).unwrap();
+        spec["meid_energy_ratio"] = sol.summary.energy_ratio.unwrap().into();
+        spec["meid_collision_end_s"] = sol.summary.collision_end_s.unwrap().into();
+        std::fs::write(&path, spec.to_string()).unwrap();
+        return;
+    }
+    // `--collisions N`: N cold collisions (as case 1) and nothing else, for whole-process CPU
+    // time against the peers (`bench/peer/README.md`); N = 0 measures the process's start.
+    if let Some(n) = flag_value(&args, "--collisions") {
+        let n: usize = n.parse().expect("--collisions N");
+        let t = Instant::now();
+        let mut end = None;
+        for _ in 0..n {
+            meid::integrate::propagator::clear_cache();
+            end = integrate::solve(&sys, &oe, &mut NoOutput)
+                .unwrap()
+                .collision_end
+                .map(|c| c.t);
+        }
+        let wall = t.elapsed().as_secs_f64();
+        let ratio = simulate(&sys, &oe, false)
+            .unwrap()
+            .summary
+            .energy_ratio
+            .unwrap();
+        println!(
+            "{{\"peer\": \"meid exact\", \"collisions\": {n}, \"energy_ratio\": {ratio:e}, \"collision_end_s\": {}, \"wall_per_collision_s\": {:e}}}",
+            end.map_or("null".to_string(), |e| format!("{e:e}")),
+            wall / n.max(1) as f64
+        );
         return;
     }
     if args.iter().any(|a| a == "--callgrind20") {
@@ -243,6 +281,12 @@ fn main() {
             );
         }
     }
+}
+
+/// The argument after `flag`, if `flag` is given.
+fn flag_value(args: &[String], flag: &str) -> Option<String> {
+    let i = args.iter().position(|a| a == flag)?;
+    Some(args.get(i + 1).expect("the flag needs a value").clone())
 }
 
 /// Case 3's options: 2 s, `exact`, 20 kHz output.
