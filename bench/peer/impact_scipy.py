@@ -54,6 +54,7 @@ from scipy.integrate import ode, solve_ivp
 from scipy.optimize import brentq
 
 SLIDER, DAMPER, DASHPOT = 1, 2, 4
+NOISE, TINY = 1e3 * np.finfo(float).eps, np.finfo(float).tiny
 
 
 class Blow:
@@ -65,6 +66,7 @@ class Blow:
         self.pf = np.array(spec["phi_f"])
         self.ms, self.vs, self.md = spec["m_s"], spec["v_s"], spec["m_d"]
         self.Ks, self.Kd, self.kd, self.cd = spec["K_s"], spec["K_d"], spec["k_d"], spec["c_d"]
+        self.abs_pb, self.abs_pf = np.abs(self.pb), np.abs(self.pf)
         self.rhs = [self.make_rhs(mode) for mode in range(8)]
         self.nfev = 0
 
@@ -86,25 +88,23 @@ class Blow:
 
         return rhs
 
-    def indicators(self, y):
-        """Slider overlap, damper overlap, dashpot relative velocity r."""
+    def indicator(self, y, k):
+        """Indicator k at y (slider overlap, damper overlap, dashpot relative velocity r) and
+        the size of its terms."""
         n = self.n
-        ub = self.pb @ y[:n]
-        return (y[n] - ub, ub - y[n + 1], y[2 * n + 3] - self.pf @ y[n + 2:2 * n + 2])
+        if k == 2:
+            qd = y[n + 2:2 * n + 2]
+            return y[2 * n + 3] - self.pf @ qd, abs(y[2 * n + 3]) + self.abs_pf @ np.abs(qd)
+        q = y[:n]
+        ub, size = self.pb @ q, abs(y[n + k]) + self.abs_pb @ np.abs(q)
+        return (y[n] - ub if k == 0 else ub - y[n + 1]), size
 
     def event_value(self, y, mode, k):
-        """Indicator k as an event function in `mode`: a value within round-off of zero (as at
-        the start, where every indicator is 0) counts as the side the state is on, so that it
-        is not a crossing."""
-        g = self.indicators(y)[k]
-        return g if abs(g) > self.noise(y)[k] else -self.wants(mode, k) * np.finfo(float).tiny
-
-    def noise(self, y):
-        """Round-off bound of each indicator at y: 1000 eps times the size of its terms."""
-        n, e = self.n, 1e3 * np.finfo(float).eps
-        ub = np.abs(self.pb) @ np.abs(y[:n])
-        return (e * (abs(y[n]) + ub), e * (ub + abs(y[n + 1])),
-                e * (abs(y[2 * n + 3]) + np.abs(self.pf) @ np.abs(y[n + 2:2 * n + 2])))
+        """Indicator k as an event function in `mode`: a value within round-off of zero (1000
+        eps of its terms' size; as at the start, where every indicator is 0) counts as the side
+        the state is on, so that it is not a crossing."""
+        g, size = self.indicator(y, k)
+        return g if abs(g) > NOISE * size else -self.wants(mode, k) * TINY
 
     @staticmethod
     def wants(mode, k):
@@ -119,10 +119,10 @@ class Blow:
         for mode in range(8):
             chain, signs = [y], [0, 0, 0]
             for _ in range(2 * self.n + 6):
-                g, tiny = self.indicators(chain[-1]), self.noise(chain[-1])
                 for k in range(3):
-                    if signs[k] == 0 and abs(g[k]) > tiny[k]:
-                        signs[k] = 1 if g[k] > 0 else -1
+                    g = self.event_value(chain[-1], mode, k)
+                    if signs[k] == 0 and abs(g) > TINY:
+                        signs[k] = 1 if g > 0 else -1
                 if all(signs):
                     break
                 chain.append(self.rhs[mode](0.0, chain[-1]))
@@ -229,7 +229,7 @@ def dopri5_stretcher(blow, rtol, atol, t_max):
             d, ga, gb = Blow.wants(mode, j), blow.event_value(ya, mode, j), blow.event_value(yb, mode, j)
             if (d > 0 and ga <= 0 < gb) or (d < 0 and ga >= 0 > gb):
                 def g(tt, j=j, ga=ga):
-                    return ga if tt == ta else blow.indicators(at(tt))[j]
+                    return ga if tt == ta else blow.indicator(at(tt), j)[0]
                 tj = brentq(g, ta, tb, xtol=1e-17, rtol=4 * np.finfo(float).eps)
                 if best is None or tj < best[0]:
                     best = (tj, j)
