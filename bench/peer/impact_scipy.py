@@ -115,21 +115,33 @@ class Blow:
         return 1 if on else -1  # the dashpot stops when r rises through 0, starts when it falls
 
     def start_mode(self, y):
-        """The state consistent with the lexicographic signs of the indicators at y."""
+        """The state consistent with the lexicographic signs of the indicators at y: from all
+        switches off, take the state the signs under the current one ask for, until they agree
+        (then every state in turn, if that does not settle)."""
+        mode = 0
+        for _ in range(8):
+            wanted = self.lex_state(y, mode)
+            if wanted == mode:
+                return mode
+            mode = wanted
         for mode in range(8):
-            chain, signs = [y], [0, 0, 0]
-            for _ in range(2 * self.n + 6):
-                for k in range(3):
-                    g = self.event_value(chain[-1], mode, k)
-                    if signs[k] == 0 and abs(g) > TINY:
-                        signs[k] = 1 if g > 0 else -1
-                if all(signs):
-                    break
-                chain.append(self.rhs[mode](0.0, chain[-1]))
-            on = (signs[0] > 0, signs[1] > 0, signs[2] < 0)
-            if all(bool(mode & (1 << k)) == on[k] for k in range(3)):
+            if self.lex_state(y, mode) == mode:
                 return mode
         raise RuntimeError("no consistent start state")
+
+    def lex_state(self, y, mode):
+        """The switch states the indicators' first non-zero derivatives at y ask for, the
+        derivatives taken in `mode`."""
+        chain, signs = y, [0, 0, 0]
+        for _ in range(2 * self.n + 6):
+            for k in range(3):
+                g = self.event_value(chain, mode, k)
+                if signs[k] == 0 and abs(g) > TINY:
+                    signs[k] = 1 if g > 0 else -1
+            if all(signs):
+                break
+            chain = self.rhs[mode](0.0, chain)
+        return (signs[0] > 0) * SLIDER | (signs[1] > 0) * DAMPER | (signs[2] < 0) * DASHPOT
 
     def y0(self):
         y = np.zeros(2 * self.n + 4)
