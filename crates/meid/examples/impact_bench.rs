@@ -5,7 +5,11 @@
 //! ```
 //!
 //! (`--events` prints the collision's stretches and switches and each mode's Taylor step
-//! instead; `--callgrind*` run one case for `valgrind --tool=callgrind`.)
+//! instead; `--callgrind*` run one case for `valgrind --tool=callgrind`; `--spec PATH` writes
+//! case 1's system with meid's exact energy ratio and collision end for the peers in
+//! `bench/peer/`, and `--collisions N` runs N cold collisions of case 1 and nothing else (and
+//! prints their CPU time per collision), the meid side of the CPU-time comparison in
+//! `bench/peer/README.md`.)
 //!
 //! Method: every case is run once to warm up, then in `B` batches of `K` repetitions; the time
 //! per run of each batch is `elapsed / K` (std::time::Instant), and the median and minimum over
@@ -25,7 +29,10 @@
 //!    single runs, 15-30 ms each; a meid batch of 400 runs takes a few ms); prints the time
 //!    ratios on medians and on minima (load only ever adds time; meid's minimum is over batch
 //!    means, SciPy's over single runs, which favours SciPy) and the energy-ratio difference. The
-//!    dopri5 ratio uses case 2's time, measured before, not interleaved.
+//!    dopri5 ratio uses case 2's time, measured before, not interleaved. These are **wall-time**
+//!    ratios against a peer without switch events (error 4.3e-7 at rtol 1e-8); the CPU-time
+//!    comparison with SciPy RK45, SciPy `ode('dopri5')` and Exudyn at matched accuracy is
+//!    `bench/peer/README.md` (`--spec`, `--collisions`).
 
 #[path = "common/peer.rs"]
 mod peer;
@@ -118,6 +125,46 @@ fn main() {
                 tm.period()
             );
         }
+        return;
+    }
+    // `--spec PATH`: the system and meid's exact values for the peers in `bench/peer/`.
+    if let Some(path) = flag_value(&args, "--spec") {
+        let sol = simulate(&sys, &oe, false).unwrap();
+        let mut spec = peer::spec_json(&sys).unwrap();
+        spec["meid_energy_ratio"] = sol.summary.energy_ratio.unwrap().into();
+        spec["meid_collision_end_s"] = sol.summary.collision_end_s.unwrap().into();
+        std::fs::write(&path, spec.to_string()).unwrap();
+        return;
+    }
+    // `--collisions N`: N cold collisions (as case 1) and nothing else, for whole-process CPU
+    // time against the peers (`bench/peer/README.md`); N = 0 measures the process's start.
+    if let Some(n) = flag_value(&args, "--collisions") {
+        let n: usize = n.parse().expect("--collisions N");
+        let (t, cpu0) = (Instant::now(), thread_cpu_ns());
+        let mut end = None;
+        for _ in 0..n {
+            meid::integrate::propagator::clear_cache();
+            end = integrate::solve(&sys, &oe, &mut NoOutput)
+                .unwrap()
+                .collision_end
+                .map(|c| c.t);
+        }
+        let wall = t.elapsed().as_secs_f64();
+        let cpu = thread_cpu_ns()
+            .zip(cpu0)
+            .map_or("null".to_string(), |(b, a)| {
+                format!("{:e}", (b - a) as f64 * 1e-9 / n.max(1) as f64)
+            });
+        let ratio = simulate(&sys, &oe, false)
+            .unwrap()
+            .summary
+            .energy_ratio
+            .unwrap();
+        println!(
+            "{{\"peer\": \"meid exact\", \"collisions\": {n}, \"energy_ratio\": {ratio:e}, \"collision_end_s\": {}, \"wall_per_collision_s\": {:e}, \"cpu_per_collision_s\": {cpu}}}",
+            end.map_or("null".to_string(), |e| format!("{e:e}")),
+            wall / n.max(1) as f64
+        );
         return;
     }
     if args.iter().any(|a| a == "--callgrind20") {
@@ -235,7 +282,7 @@ fn main() {
                 o_min * 1e6
             );
             println!(
-                "speed-up exact vs SciPy: {:.0}x on medians, {:.0}x on minima; dopri5 (timed above, not interleaved) vs SciPy: {:.0}x on medians; |energy ratio difference| {:.2e}",
+                "wall-time ratio SciPy / meid exact: {:.0}x on medians, {:.0}x on minima; SciPy / meid dopri5 (timed above, not interleaved): {:.0}x on medians; |energy ratio difference| {:.2e} (CPU-time ratios: bench/peer/README.md)",
                 t_med / o_med,
                 t_min / o_min,
                 t_med / med_d,
@@ -243,6 +290,23 @@ fn main() {
             );
         }
     }
+}
+
+/// This thread's CPU time so far (ns, user + system: the scheduler's run time,
+/// `/proc/thread-self/schedstat`), where Linux gives it.
+fn thread_cpu_ns() -> Option<u64> {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
+/// The argument after `flag`, if `flag` is given.
+fn flag_value(args: &[String], flag: &str) -> Option<String> {
+    let i = args.iter().position(|a| a == flag)?;
+    Some(args.get(i + 1).expect("the flag needs a value").clone())
 }
 
 /// Case 3's options: 2 s, `exact`, 20 kHz output.

@@ -9,8 +9,9 @@
 //! cost and the speed-up. The CSV of both runs is compared byte for byte.
 //!
 //! Then the SciPy peer (`bench/peer/impact_rk45.py`, RK45 rtol 1e-8) runs on five of the map's
-//! points (corners and centre, 3 runs each, median) and the per-point ratio is printed
-//! (`--no-peer` skips it).
+//! points (corners and centre, 3 runs each, median) and the per-point ratio of wall times is
+//! printed (`--no-peer` skips it): taken at different moments of a shared machine, it is
+//! indicative only; the CPU-time comparison with the peers is `bench/peer/README.md`.
 //!
 //! Run: `cargo run --release -p meid --example sweep_bench [MODEL.toml] [N]`.
 //! The machine has 2 cores shared with other builds: note the load average beside the figures.
@@ -128,7 +129,7 @@ fn main() -> meid::Result<()> {
             let scipy_min = total_min / count as f64;
             let meid_point = best[0] / sweep.len() as f64;
             println!(
-                "  SciPy {version} RK45 (rtol 1e-8), mean of {count} sampled points: {:.2} ms/point (of minima {:.2} ms) -> the map would take {:.1} min; meid 1 thread {:.1} us/point: {:.0}x per point ({:.0}x on SciPy's minima); max |energy ratio difference| {max_diff:.1e}",
+                "  SciPy {version} RK45 (rtol 1e-8), mean of {count} sampled points: {:.2} ms/point (of minima {:.2} ms) -> the map would take {:.1} min; meid 1 thread {:.1} us/point: wall-time ratio {:.0}x per point ({:.0}x on SciPy's minima; CPU time: bench/peer/README.md); max |energy ratio difference| {max_diff:.1e}",
                 scipy_point * 1e3,
                 scipy_min * 1e3,
                 scipy_point * sweep.len() as f64 / 60.0,

@@ -37,8 +37,9 @@ pub fn median_min(mut v: Vec<f64>) -> (f64, f64) {
     (median, v[0])
 }
 
-/// Writes `sys` as the peer's JSON spec and runs the script `runs` times on it.
-pub fn scipy_collision(sys: &ImpactSystem, root: &Path, runs: usize) -> Result<PeerRun, String> {
+/// `sys` as the peers' JSON spec (modal frequencies, damping matrix, mode-shape values at O_b
+/// and O_f, slider, damper and contact data): what `bench/peer/*.py` read.
+pub fn spec_json(sys: &ImpactSystem) -> Result<serde_json::Value, String> {
     let st = &sys.structure;
     let damper = sys
         .damper
@@ -53,6 +54,12 @@ pub fn scipy_collision(sys: &ImpactSystem, root: &Path, runs: usize) -> Result<P
         "m_d": damper.mass, "k_d": damper.stiffness, "c_d": damper.damping,
         "K_s": sys.slider_bed.law.stiffness(), "K_d": bed_damper.law.stiffness(),
     });
+    Ok(spec)
+}
+
+/// Writes `sys` as the peer's JSON spec and runs the script `runs` times on it.
+pub fn scipy_collision(sys: &ImpactSystem, root: &Path, runs: usize) -> Result<PeerRun, String> {
+    let spec = spec_json(sys)?;
     let path = std::env::temp_dir().join(format!("meid_impact_peer_{}.json", std::process::id()));
     std::fs::write(&path, spec.to_string()).map_err(|e| e.to_string())?;
     let out = Command::new("python3")
