@@ -161,6 +161,38 @@ fn lumped_report_passes_the_page_check_and_reads_the_library_studies() {
     assert_eq!(damper["blows"], blows["blows"]);
     assert_eq!(damper["steady"], blows["steady"]);
 
+    // The impacts table is `meid simulate`'s per-impact rows over the same record, per case,
+    // and its totals are theirs.
+    let cases = section(&html, "cases");
+    assert!(cases.contains("Impacts in the blow"));
+    for (case, contacts) in [
+        ("no-damper", &["slider_bed"][..]),
+        ("damper", &["slider_bed", "bed_damper"][..]),
+    ] {
+        let sim: serde_json::Value = serde_json::from_str(&ok(meid()
+            .arg("simulate")
+            .arg(paper_example())
+            .args(["--json", "--duration", "2", "--case", case])
+            .output()
+            .unwrap()))
+        .unwrap();
+        assert_eq!(report["impacts"][case], sim["impacts"], "{case}");
+        for c in contacts {
+            let total: f64 = sim["impacts"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|r| r["contact"] == *c)
+                .map(|r| r["impulse_n_s"].as_f64().unwrap())
+                .sum();
+            assert!(total > 0.0, "{case} {c}");
+            assert!(
+                cases.contains(&format!("<td>{c}</td>")),
+                "{case}: no row for {c}"
+            );
+        }
+    }
+
     // The map's centre is the design. Lumped structure (examples/paper-lumped.toml): the
     // two-mode closed form ω² = (b ∓ √(b² − 4c))/2 with b = k_c/m_b + (k_c + k_f)/m_f,
     // c = k_c k_f/(m_b m_f) gives ω_1, and ω_s = √(K_s/m_s).

@@ -37,7 +37,10 @@ fn allowed() -> BTreeMap<&'static str, Vec<&'static str>> {
                 "analysis", "model", "io", "record", "plot", "impact", "identify",
             ],
         ),
-        ("foundation", vec!["analysis", "model", "integrate", "modal"]),
+        (
+            "foundation",
+            vec!["analysis", "model", "integrate", "modal"],
+        ),
     ])
 }
 

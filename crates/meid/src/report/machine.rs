@@ -20,11 +20,14 @@ use super::figures::{self, sig, MapSpec, Mark};
 use super::html::{Block, Page, Section, Table};
 use crate::analysis::blows::{run_blows_with, BlowOptions, BlowsRun};
 use crate::analysis::compare::{CaseName, CompareOptions, Comparison, ComparisonResult};
+use crate::analysis::impacts;
 use crate::analysis::montecarlo::{MonteCarlo, MonteCarloResult, Uncertain};
 use crate::analysis::production::{self, Production};
 use crate::analysis::steady::SteadyOptions;
 use crate::analysis::study::{Objective, OptimizeReport, OptimizeStudy};
 use crate::analysis::sweep::{Quantity, Spacing, Sweep, SweepResult, Vary};
+use crate::integrate::network::ImpactRow;
+use crate::integrate::Options;
 use crate::measure::mapping::MeasurementSpec;
 use crate::measure::validate::Validation;
 use crate::model::fem::{self, ModeReport};
@@ -138,6 +141,9 @@ pub struct MachineReport {
     /// With a `[foundation]`: its checks and the receivers' for each case of the comparison
     /// ([`crate::foundation::assess`]); empty without one.
     pub foundation: Vec<(CaseName, crate::foundation::FoundationAssessment)>,
+    /// Every closing of each contact in each case's blow over the record
+    /// ([`crate::analysis::impacts`]).
+    pub impacts: Vec<(CaseName, Vec<ImpactRow>)>,
 }
 
 /// The stages of [`MachineReport::run`], in order, for progress reporting.
@@ -150,6 +156,30 @@ pub const STAGES: [&str; 7] = [
     "optimiser",
     "page",
 ];
+
+/// Every closing of each contact in each case of `comparison`, over the comparison's record of
+/// `record_s` seconds ([`impacts::impacts`] of the case's run; exact for linear laws).
+fn case_impacts(
+    model: &Model,
+    comparison: &ComparisonResult,
+    record_s: f64,
+) -> Result<Vec<(CaseName, Vec<ImpactRow>)>> {
+    comparison
+        .cases
+        .iter()
+        .map(|c| {
+            let sys = model.impact_system(case_of(c.case))?;
+            let opts = Options {
+                duration: record_s,
+                sample_rate: None,
+                stop_at_collision_end: false,
+                ..model.options()
+            };
+            let run = crate::analysis::energy::simulate(&sys, &opts, false)?;
+            Ok((c.case, impacts::impacts(&sys, &run.solution)?))
+        })
+        .collect()
+}
 
 fn case_of(c: CaseName) -> Case {
     match c {
@@ -364,6 +394,8 @@ impl MachineReport {
             }
         }
 
+        let impacts = case_impacts(&model, &comparison, options.record_s)?;
+
         progress(STAGES[4]);
         let blows = blow_trains(&model, &comparison, options.blows, rate_bpm)?;
 
@@ -394,6 +426,7 @@ impl MachineReport {
             measured,
             notes,
             foundation,
+            impacts,
         })
     }
 
@@ -1003,6 +1036,9 @@ impl MachineReport {
         if !r.reductions.is_empty() {
             blocks.push(Block::Table(figures::reductions_table(r)));
         }
+        if !self.impacts.is_empty() {
+            blocks.push(Block::Table(self.impacts_table()));
+        }
         for f in figures::comparison_figures(dir, "cases", r)? {
             blocks.push(Block::Figure(f));
         }
@@ -1011,6 +1047,69 @@ impl MachineReport {
             heading: "Without damper, with the damper, with an added mass".into(),
             blocks,
         })
+    }
+
+    /// Per case and contact: the number of closings over the record, the first closing (time,
+    /// approach velocity, restitution) and the totals (impulse, time closed, dissipated
+    /// energy), with the largest contact force and its time.
+    fn impacts_table(&self) -> Table {
+        let ms = |t: f64| sig(1e3 * t, 4);
+        let mut rows = Vec::new();
+        for (case, list) in &self.impacts {
+            let sys_contacts: Vec<&str> = {
+                let mut v: Vec<&str> = Vec::new();
+                for r in list {
+                    if !v.contains(&r.contact.as_str()) {
+                        v.push(&r.contact);
+                    }
+                }
+                v
+            };
+            for contact in sys_contacts {
+                let mine: Vec<&ImpactRow> = list.iter().filter(|r| r.contact == contact).collect();
+                let Some(first) = mine.first() else { continue };
+                let peak = mine
+                    .iter()
+                    .max_by(|a, b| a.peak_force_n.total_cmp(&b.peak_force_n))
+                    .unwrap_or(first);
+                rows.push(vec![
+                    case.label().to_string(),
+                    contact.to_string(),
+                    mine.len().to_string(),
+                    ms(first.start_s),
+                    sig(first.approach_velocity_m_per_s, 4),
+                    first.restitution.map_or("—".into(), |e| sig(e, 4)),
+                    format!(
+                        "{} at {} ms",
+                        sig(peak.peak_force_n, 4),
+                        ms(peak.peak_time_s)
+                    ),
+                    sig(mine.iter().map(|r| r.impulse_n_s).sum::<f64>(), 4),
+                    ms(mine.iter().map(|r| r.duration_s).sum::<f64>()),
+                    sig(mine.iter().map(|r| r.dissipated_j).sum::<f64>(), 4),
+                ]);
+            }
+        }
+        Table {
+            caption: format!(
+                "Impacts in the blow: every closing of each contact over the {} s record (a contact that never closes is not listed), the first closing's approach velocity and restitution (exit over approach velocity), the largest contact force and the totals; exact for linear contact laws (impulse and dissipation integrated in closed form on each stretch), report.json member impacts",
+                crate::num(self.options.record_s)
+            ),
+            header: vec![
+                "case".into(),
+                "contact".into(),
+                "closings".into(),
+                "first at (ms)".into(),
+                "approach velocity (m/s)".into(),
+                "restitution, first".into(),
+                "largest force (N)".into(),
+                "impulse, total (N·s)".into(),
+                "time closed, total (ms)".into(),
+                "dissipated, total (J)".into(),
+            ],
+            rows,
+            ..Default::default()
+        }
     }
 
     /// The blow trains at the stroke rate: the last blow of each case's train (peaks, η,
@@ -1284,6 +1383,17 @@ impl MachineReport {
             "warnings": self.modes.warnings,
             "notes": self.notes,
         });
+        // Every closing of each contact, per case.
+        if let Some(o) = out.as_object_mut() {
+            let mut m = serde_json::Map::new();
+            for (c, rows) in &self.impacts {
+                m.insert(
+                    c.name().into(),
+                    serde_json::to_value(rows).unwrap_or_default(),
+                );
+            }
+            o.insert("impacts".into(), m.into());
+        }
         // With a [foundation], as `meid compare --json` carries it: per case.
         if let (false, Some(o)) = (self.foundation.is_empty(), out.as_object_mut()) {
             let mut f = serde_json::Map::new();
