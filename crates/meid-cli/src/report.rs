@@ -135,7 +135,7 @@ pub fn run(a: ReportArgs) -> Result<()> {
         if let Some(meid::report::testlab::Outcome::Done(t)) = &report.test_against_model {
             let update = t.update.iter().flat_map(|u| &u.warnings);
             for w in t.warnings.iter().chain(update) {
-                crate::ui::warning(&format!("test against model: {w}"));
+                crate::ui::warning(format!("test against model: {w}"));
             }
         }
     }
