@@ -544,8 +544,8 @@ fn verdict(rows: &[ModeRow], hi_hz: f64, points: usize) -> String {
     let error = |r: &ModeRow| r.error_percent.unwrap_or(0.0).abs();
     if let Some(w) = found.iter().max_by(|a, b| error(a).total_cmp(&error(b))) {
         s.push_str(&format!(
-            "; worst frequency error {:+.1} % at model mode {}",
-            w.error_percent.unwrap_or(0.0),
+            "; worst frequency error {} % at model mode {}",
+            signed(w.error_percent.unwrap_or(0.0), 1),
             w.model_mode
         ));
         let least = found
@@ -621,6 +621,7 @@ fn done_blocks(dir: &Path, t: &TestAgainstModel) -> Result<Vec<Block>> {
         blocks.push(Block::Table(update_pairs_table(u)));
     }
     frf_plots(dir, &t.frf)?;
+    band_plots(dir, t)?;
     crate::measure::identified::stabilisation_plot(dir, &t.identification)?;
     let drawn = t.correlation.plots(dir)?;
     blocks.extend(figures(dir, t));
@@ -633,18 +634,92 @@ fn done_blocks(dir: &Path, t: &TestAgainstModel) -> Result<Vec<Block>> {
     Ok(blocks)
 }
 
+/// `test_frf_magnitude` and `test_frf_coherence`: the FRFs and their coherence in the band
+/// of the identification, the model's modes marked.
+fn band_plots(dir: &Path, t: &TestAgainstModel) -> Result<()> {
+    use crate::plot::{line_plot, LinePlot, Marker, Series};
+    let (lo, hi) = t.band_hz;
+    let series = |y: &dyn Fn(&crate::measure::frf::FrfChannel, usize) -> f64| -> Vec<Series> {
+        t.frf
+            .channels
+            .iter()
+            .map(|c| {
+                let k: Vec<usize> = (0..c.frequency_hz.len())
+                    .filter(|&k| c.frequency_hz[k] >= lo && c.frequency_hz[k] <= hi)
+                    .collect();
+                Series {
+                    label: c.response.clone(),
+                    x: k.iter().map(|&k| c.frequency_hz[k]).collect(),
+                    y: k.iter().map(|&k| y(c, k)).collect(),
+                    ..Default::default()
+                }
+            })
+            .collect()
+    };
+    let markers: Vec<Marker> = t
+        .modes
+        .iter()
+        .map(|r| Marker {
+            x: r.model_frequency_hz,
+            label: format!("model {}", r.model_mode),
+        })
+        .collect();
+    let what = format!(
+        "H1 {} against '{}' ({} blow(s))",
+        t.frf.kind.name(),
+        t.frf.force,
+        t.frf.blows_averaged
+    );
+    line_plot(
+        dir.join("test_frf_magnitude"),
+        &LinePlot {
+            title: format!("|H|: {what}"),
+            x_label: "frequency (Hz)".into(),
+            y_label: format!("|H| ({})", t.frf.unit),
+            y_log: true,
+            series: series(&|c, k| c.h[k].norm()),
+            markers: markers.clone(),
+            x_range: Some(t.band_hz),
+            ..Default::default()
+        },
+    )?;
+    line_plot(
+        dir.join("test_frf_coherence"),
+        &LinePlot {
+            title: format!("coherence γ²: {what}"),
+            x_label: "frequency (Hz)".into(),
+            y_label: "γ² (1)".into(),
+            series: series(&|c, k| c.coherence[k]),
+            markers,
+            x_range: Some(t.band_hz),
+            ..Default::default()
+        },
+    )?;
+    Ok(())
+}
+
+/// `v` with a sign and `decimals` decimals; a value that rounds to zero has none.
+fn signed(v: f64, decimals: usize) -> String {
+    let s = format!("{v:+.decimals$}");
+    if s[1..].chars().all(|c| c == '0' || c == '.') {
+        s[1..].to_string()
+    } else {
+        s
+    }
+}
+
 fn figures(dir: &Path, t: &TestAgainstModel) -> Vec<Block> {
     let what = format!("against the blow force '{}'", t.frf.force);
     [
         (
-            "frf_magnitude",
+            "test_frf_magnitude",
             format!(
-                "Measured FRF magnitudes |H| ({}) of the mapped responses {what}, case {}.",
+                "Measured FRF magnitudes |H| ({}) of the mapped responses {what}, case {}, in the band of the identification; the model's modes marked (all lines: frf_magnitude.png).",
                 t.frf.unit, t.case
             ),
         ),
         (
-            "frf_coherence",
+            "test_frf_coherence",
             format!(
                 "Coherence γ² of the FRFs over {} blow(s) (with one blow it is 1 by construction and says nothing of the noise).",
                 t.frf.blows_averaged
@@ -703,7 +778,7 @@ pub fn pairs_table(t: &TestAgainstModel) -> Table {
                     format!("{:.3}", r.model_frequency_hz),
                     r.test_mode.map_or_else(|| "—".into(), |m| m.to_string()),
                     opt(r.test_frequency_hz, |f| format!("{f:.3}")),
-                    opt(r.error_percent, |e| format!("{e:+.2}")),
+                    opt(r.error_percent, |e| signed(e, 2)),
                     opt(r.test_damping_ratio, |z| format!("{z:.4}")),
                     format!("{:.4}", r.model_damping_ratio),
                     opt(r.mac, |m| format!("{m:.3}")),
@@ -720,11 +795,11 @@ fn update_sentence(u: &ModalCalibration) -> String {
         .iter()
         .map(|e| {
             format!(
-                "{} {} → {} ({:+.2} %)",
+                "{} {} → {} ({} %)",
                 e.path,
                 sig(e.start, 5),
                 sig(e.value, 5),
-                100.0 * (e.value - e.start) / e.start
+                signed(100.0 * (e.value - e.start) / e.start, 2)
             )
         })
         .collect();
@@ -756,7 +831,7 @@ pub fn update_table(u: &ModalCalibration) -> Table {
                     e.path.clone(),
                     sig(e.start, 6),
                     sig(e.value, 6),
-                    format!("{:+.3}", 100.0 * (e.value - e.start) / e.start),
+                    signed(100.0 * (e.value - e.start) / e.start, 3),
                     if e.ci95_low.is_finite() {
                         format!("{} .. {}", sig(e.ci95_low, 6), sig(e.ci95_high, 6))
                     } else {
@@ -801,10 +876,10 @@ pub fn update_pairs_table(u: &ModalCalibration) -> Table {
                     p.model_mode.to_string(),
                     format!("{:.3}", p.identified_frequency_hz),
                     format!("{:.3}", p.model_frequency_before_hz),
-                    format!("{:+.2}", p.error_before_percent),
+                    signed(p.error_before_percent, 2),
                     format!("{:.3}", p.mac_before),
                     format!("{:.3}", p.model_frequency_after_hz),
-                    format!("{:+.2}", p.error_after_percent),
+                    signed(p.error_after_percent, 2),
                     format!("{:.3}", p.mac_after),
                 ]
             })
