@@ -138,6 +138,7 @@ pub fn run(a: CorrelateArgs) -> Result<()> {
         min_mac: a.mapping.min_mac,
         blind_mac: a.blind_mac,
         model_modes: a.model_modes,
+        by_frequency: false,
     };
     let mut c = correlate(&ident, &mm, &mapping, &settings)?;
     if let Some(set) = set {

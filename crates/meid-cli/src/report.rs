@@ -56,6 +56,23 @@ pub struct ReportArgs {
     /// model's [measurement] channels).
     #[arg(long = "channel", value_name = "NAME=TARGET")]
     channel: Vec<String>,
+    /// Update the model to the modes identified from the measured blows (section "Test
+    /// against model"): model paths to fit, as --set names them, comma-separated (repeatable),
+    /// e.g. structure.fem.machine.bed.thickness; as `meid calibrate --modal` (docs/report.md).
+    #[arg(long = "fit", value_name = "PATH[,PATH…]")]
+    fit: Vec<String>,
+    /// Bounds of fitted paths, PATH=LO..HI comma-separated (repeatable); default [p/10, 10 p].
+    #[arg(long = "bounds", value_name = "PATH=LO..HI[,…]", requires = "fit")]
+    bounds: Vec<String>,
+    /// Weight W of the shapes' (1 − MAC) beside the relative frequency errors of the update
+    /// (0: frequencies alone).
+    #[arg(
+        long = "mac-weight",
+        value_name = "W",
+        default_value_t = 1.0,
+        requires = "fit"
+    )]
+    mac_weight: f64,
     /// Processing of the measured records (over the model's [measurement] section).
     #[command(flatten)]
     processing: crate::measure::ProcessingArgs,
@@ -86,6 +103,11 @@ pub fn run(a: ReportArgs) -> Result<()> {
         measured: a.measured.clone(),
         channels: a.channel.clone(),
         processing: a.processing.as_section(),
+        update: meid::report::testlab::UpdateRequest {
+            fit: a.fit.clone(),
+            bounds: a.bounds.clone(),
+            mac_weight: a.mac_weight,
+        },
     };
     let dir = a.output.clone().unwrap_or_else(|| {
         let stem = a
@@ -109,6 +131,12 @@ pub fn run(a: ReportArgs) -> Result<()> {
     if !a.print.quiet {
         for w in &report.modes.warnings {
             crate::ui::warning(w);
+        }
+        if let Some(meid::report::testlab::Outcome::Done(t)) = &report.test_against_model {
+            let update = t.update.iter().flat_map(|u| &u.warnings);
+            for w in t.warnings.iter().chain(update) {
+                crate::ui::warning(format!("test against model: {w}"));
+            }
         }
     }
     let generator = format!(

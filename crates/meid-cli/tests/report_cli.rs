@@ -24,13 +24,14 @@ use std::path::Path;
 use common::{example_file, meid, ok, paper_example, stderr, tmpdir};
 use meid::report::html::check_page;
 
-const SECTIONS: [&str; 10] = [
+const SECTIONS: [&str; 11] = [
     "results",
     "model",
     "modes",
     "energy-map",
     "cases",
     "measured",
+    "test-against-model",
     "blows",
     "optimiser",
     "montecarlo",
@@ -344,6 +345,20 @@ fn simulated_uff_records_given_as_measurements_match_the_simulation() {
             assert!(e.abs() < 1e-6, "{ch}");
         }
     }
+    // The same records' test against the model: the blow on the bare machine's bed, both
+    // modes found (0.5 s: 2 Hz lines; the frequencies within 0.1 % of `meid modes`' 6.35 and
+    // 283 Hz), paired by frequency (one measured point).
+    let t = &j["test_against_model"];
+    assert_eq!(t["status"], "done", "{t}");
+    assert_eq!(t["case"], "none");
+    for (row, f) in t["modes"].as_array().unwrap().iter().zip([6.35, 283.0]) {
+        let got = row["test_frequency_hz"].as_f64().unwrap();
+        assert!(((got - f) / f).abs() < 1e-3, "{row}");
+    }
+    assert_eq!(t["correlation"]["settings"]["by_frequency"], true);
+    let s = section(&html, "test-against-model");
+    assert!(s.contains("2 of 2 model mode(s)"), "{s}");
+    assert!(s.contains("src=\"stabilisation.png\""), "{s}");
     let reductions = m["reductions"].as_array().unwrap();
     assert!(!reductions.is_empty());
     for r in reductions {
@@ -381,6 +396,11 @@ fn bad_report_options_exit_2_naming_the_option() {
             ],
             "unknown target 'roof'",
         ),
+        (
+            vec!["--fit", "structure.lumped.springs[0].stiffness"],
+            "--measured none=FILE",
+        ),
+        (vec!["--bounds", "damper.mass=1..2"], "--fit"),
     ] {
         let o = meid()
             .current_dir(&d)

@@ -52,6 +52,7 @@ mod measure_calibrate;
 mod measure_processing;
 mod measure_validate;
 mod modal_never_lies;
+mod modal_update_fe;
 mod model_input;
 mod modes_import;
 mod modes_truncation;

@@ -561,6 +561,10 @@ pub struct Settings {
     pub blind_mac: f64,
     /// The lowest model modes compared (`None`: all the model retains).
     pub model_modes: Option<usize>,
+    /// Pair by frequency instead: among the pairs with MAC ≥ `min_mac`, the smallest
+    /// frequency error first, repeatedly (for one measured point, where the MAC of any two
+    /// shapes is 1 and says nothing).
+    pub by_frequency: bool,
 }
 
 impl Default for Settings {
@@ -569,6 +573,7 @@ impl Default for Settings {
             min_mac: 0.5,
             blind_mac: 0.9,
             model_modes: None,
+            by_frequency: false,
         }
     }
 }
@@ -767,7 +772,20 @@ pub fn correlate(
     let fi: Vec<f64> = ident.modes.iter().map(|m| m.frequency_hz).collect();
     let fm = model.frequencies_hz.clone();
     let err = |i: usize, j: usize| 100.0 * (fi[i] - fm[j]) / fm[j];
-    let pairs: Vec<Pair> = pair_modes(&mac, settings.min_mac, err)
+    // By frequency: every admissible pair scores alike, so the tie-break (the smaller
+    // frequency error) decides.
+    let score: Vec<Vec<f64>> = if settings.by_frequency {
+        mac.iter()
+            .map(|r| {
+                r.iter()
+                    .map(|&m| if m >= settings.min_mac { 1.0 } else { 0.0 })
+                    .collect()
+            })
+            .collect()
+    } else {
+        mac.clone()
+    };
+    let pairs: Vec<Pair> = pair_modes(&score, settings.min_mac, err)
         .into_iter()
         .map(|(i, j)| Pair {
             identified_mode: i + 1,
@@ -795,10 +813,17 @@ pub fn correlate(
             b.0 + 1
         ));
     }
-    notes.push(format!(
-        "pairing: the largest MAC among unpaired modes, repeatedly, while ≥ {}; each model mode once",
-        settings.min_mac
-    ));
+    notes.push(if settings.by_frequency {
+        format!(
+            "pairing: by frequency, the smallest error among unpaired modes with MAC ≥ {}, repeatedly; each model mode once",
+            settings.min_mac
+        )
+    } else {
+        format!(
+            "pairing: the largest MAC among unpaired modes, repeatedly, while ≥ {}; each model mode once",
+            settings.min_mac
+        )
+    });
     Ok(Correlation {
         file: ident.file.clone(),
         unpaired_identified: (1..=fi.len())

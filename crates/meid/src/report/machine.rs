@@ -66,6 +66,8 @@ pub struct MachineOptions {
     /// Processing of the measurements (trigger, pre-trigger, record, window) over the
     /// model's `[measurement]` section ([`MeasurementSpec::over`]).
     pub processing: MeasurementSpec,
+    /// Model updating of the section "Test against model" (`--fit`; empty: none).
+    pub update: super::testlab::UpdateRequest,
 }
 
 impl Default for MachineOptions {
@@ -82,6 +84,7 @@ impl Default for MachineOptions {
             measured: Vec::new(),
             channels: Vec::new(),
             processing: MeasurementSpec::default(),
+            update: super::testlab::UpdateRequest::default(),
         }
     }
 }
@@ -136,6 +139,9 @@ pub struct MachineReport {
     pub montecarlo: Option<MonteCarloResult>,
     /// The simulation beside measured records, when some were given.
     pub measured: Option<Validation>,
+    /// The test against the model from the measured blows ([`super::testlab`]): `None`
+    /// without measured records.
+    pub test_against_model: Option<super::testlab::Outcome>,
     /// Why a study was left out (no damper, a failed study ...); shown on the page.
     pub notes: Vec<String>,
     /// With a `[foundation]`: its checks and the receivers' for each case of the comparison
@@ -335,13 +341,32 @@ impl MachineReport {
         options.map_points |= 1;
 
         // Measured records next: a bad file is an input error, found before the long studies.
-        let measured = super::measured::run(
+        let (measured, test_against_model) = match super::measured::run(
             path,
             &model,
             &options.measured,
             &options.channels,
             &options.processing,
-        )?;
+        )? {
+            Some((v, inputs)) => {
+                let t = super::testlab::run(
+                    &model,
+                    &inputs.cases,
+                    &inputs.processing,
+                    model.spec.measurement.as_ref(),
+                    &inputs.flags,
+                    &options.update,
+                )?;
+                (Some(v), t)
+            }
+            None if !options.update.fit.is_empty() => {
+                return Err(crate::Error::invalid(
+                    "--fit",
+                    "the model is updated to the modes of measured blows: give them with --measured none=FILE (or the model's [measurement] files)",
+                ))
+            }
+            None => (None, None),
+        };
 
         // Monte Carlo first: a bad --vary is an input error, found before the long studies.
         progress(STAGES[1]);
@@ -424,6 +449,7 @@ impl MachineReport {
             optimize,
             montecarlo,
             measured,
+            test_against_model,
             notes,
             foundation,
             impacts,
@@ -630,6 +656,9 @@ impl MachineReport {
         }
         if let Some(v) = &self.measured {
             out.push(super::measured::key_result(v));
+        }
+        if let Some(super::testlab::Outcome::Done(t)) = &self.test_against_model {
+            out.push(format!("Test against model: {}", t.verdict));
         }
         out
     }
@@ -889,6 +918,7 @@ impl MachineReport {
         sections.extend(super::foundation::section(dir, &self.foundation)?);
         sections.extend([
             super::measured::section(dir, self.measured.as_ref())?,
+            super::testlab::section(dir, self.test_against_model.as_ref())?,
             self.blows_section(dir)?,
             self.optimiser_section(),
             self.montecarlo_section(dir)?,
@@ -1380,6 +1410,7 @@ impl MachineReport {
             "optimize": self.optimize,
             "montecarlo": mc,
             "measured": self.measured,
+            "test_against_model": self.test_against_model,
             "warnings": self.modes.warnings,
             "notes": self.notes,
         });

@@ -8,30 +8,43 @@
 //! pre-trigger, record length, window); the numbers are those of `meid validate` on the same
 //! files.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::figures::sig;
 use super::html::{Block, Figure, Section, Table};
 use crate::measure::mapping::{parse_channel_flags, MeasurementSpec};
-use crate::measure::validate::{read_measured, validate, Validation};
+use crate::measure::process::Processing;
+use crate::measure::validate::{read_measured, validate, MeasuredCase, Validation};
+use crate::measure::SimChannel;
 use crate::model::Model;
 use crate::Result;
 
 /// The data file of the section, linked under each of its figures.
 pub const DATA_FILE: &str = "measured.json";
 
+/// The measured records and how to read them: the cases (`[CASE=]FILE`), the processing and
+/// the `--channel` mappings.
+pub struct MeasuredInputs {
+    pub cases: Vec<MeasuredCase>,
+    pub processing: Processing,
+    pub flags: BTreeMap<String, SimChannel>,
+}
+
 /// Runs the comparison when measured files are given: `measured` (`[CASE=]FILE`, as
 /// `meid validate --measured`, relative to the working directory) or else the model's
 /// `[measurement] files` (relative to the model file's directory); `channels` are
 /// `NAME=TARGET` mappings over the section's; `processing`'s settings win over the section's
-/// ([`MeasurementSpec::over`]). `None` when there is no measured file.
+/// ([`MeasurementSpec::over`]). `None` when there is no measured file; with one, the
+/// comparison and the records it read (for the section "Test against model",
+/// [`super::testlab`]).
 pub fn run(
     model_path: &Path,
     model: &Model,
     measured: &[String],
     channels: &[String],
     processing: &MeasurementSpec,
-) -> Result<Option<Validation>> {
+) -> Result<Option<(Validation, MeasuredInputs)>> {
     let section = model.spec.measurement.as_ref();
     let (files, base) = if !measured.is_empty() {
         (measured.to_vec(), None)
@@ -44,7 +57,15 @@ pub fn run(
     let p = processing.over(section).processing()?;
     let flags = parse_channel_flags(channels, &model.spec.points.measurement)?;
     let cases = read_measured(&files, base)?;
-    validate(model, &cases, &p, &flags).map(Some)
+    let v = validate(model, &cases, &p, &flags)?;
+    Ok(Some((
+        v,
+        MeasuredInputs {
+            cases,
+            processing: p,
+            flags,
+        },
+    )))
 }
 
 /// One line for the report's key results.

@@ -17,3 +17,4 @@ pub mod html;
 pub mod machine;
 pub mod measured;
 pub mod paper;
+pub mod testlab;
