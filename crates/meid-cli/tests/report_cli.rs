@@ -67,7 +67,7 @@ fn check_report(dir: &Path, with_mc: bool) -> String {
         6,
         "histories, spectra and 1/3-octave levels of a_B and F"
     );
-    assert_eq!(tables("cases"), 2, "peaks and reductions");
+    assert_eq!(tables("cases"), 3, "peaks, reductions and impacts");
     assert_eq!(figures("blows"), 2);
     assert_eq!(tables("model"), 1);
     assert!(tables("modes") >= 2, "modes and truncation");
@@ -166,14 +166,14 @@ fn lumped_report_passes_the_page_check_and_reads_the_library_studies() {
     // and its totals are theirs.
     let cases = section(&html, "cases");
     assert!(cases.contains("Impacts in the blow"));
-    for (case, contacts) in [
-        ("no-damper", &["slider_bed"][..]),
-        ("damper", &["slider_bed", "bed_damper"][..]),
+    for (case, flag, contacts) in [
+        ("no-damper", "none", &["slider_bed"][..]),
+        ("damper", "damper", &["slider_bed", "bed_damper"][..]),
     ] {
         let sim: serde_json::Value = serde_json::from_str(&ok(meid()
             .arg("simulate")
             .arg(paper_example())
-            .args(["--json", "--duration", "2", "--case", case])
+            .args(["--json", "--duration", "2", "--case", flag])
             .output()
             .unwrap()))
         .unwrap();
