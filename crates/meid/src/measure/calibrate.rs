@@ -1145,6 +1145,33 @@ impl<T> BoundedFit<T> {
     pub fn at_bound(&self, i: usize) -> bool {
         self.out.x[i] <= self.lo[i] || self.out.x[i] >= self.hi[i]
     }
+
+    /// The Gauss-Newton step left at the estimate, `|δ_i|` with `δ = −C J_pᵀr` over the free
+    /// values (`c_inv` = `(J_pᵀJ_p)⁻¹` over `free`), per value; NaN for a value that is not
+    /// free or without `c_inv`. The solver stops on a relative step or cost decrease (xtol,
+    /// ftol), which on data with little noise is far wider than the statistical interval.
+    pub fn solver_steps(&self, c_inv: Option<&[Vec<f64>]>) -> Vec<f64> {
+        let mut step = vec![f64::NAN; self.values.len()];
+        if let Some(c) = c_inv {
+            let g: Vec<f64> = self
+                .free
+                .iter()
+                .map(|&i| dot(&self.jp[i], &self.r1))
+                .collect();
+            for (k, &i) in self.free.iter().enumerate() {
+                step[i] = c[k].iter().zip(&g).map(|(c, g)| c * g).sum::<f64>().abs();
+            }
+        }
+        step
+    }
+
+    /// The r.m.s. residual at the starts and at the estimate.
+    pub fn rms_residuals(&self) -> (f64, f64) {
+        (
+            (dot(&self.r0, &self.r0) / self.r0.len() as f64).sqrt(),
+            (self.cost / self.r1.len() as f64).sqrt(),
+        )
+    }
 }
 
 /// Runs the calibration (module docs).
@@ -1161,7 +1188,6 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
         ref values,
         ref out,
         ref before,
-        ref r0,
         ref after,
         ref r1,
         ref jp,
@@ -1170,23 +1196,14 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
         jtj: ref a,
         dof,
         s2,
-        cost,
         ..
     } = fit;
     let m = r1.len();
     let baseline = baseline_term(problem, free, jp);
     let c_inv = spd_inverse(a);
     let cov = covariance(c_inv.as_deref(), &baseline, free, n, s2);
-    // The Gauss-Newton step left at the estimate, δ = −C J_pᵀr over the free values: the
-    // solver stops on a relative step or cost decrease (xtol, ftol), which on data with little
-    // noise is far wider than the statistical interval.
-    let mut solver_step = vec![f64::NAN; n];
-    if let Some(c) = &c_inv {
-        let g: Vec<f64> = free.iter().map(|&i| dot(&jp[i], r1)).collect();
-        for (k, &i) in free.iter().enumerate() {
-            solver_step[i] = c[k].iter().zip(&g).map(|(c, g)| c * g).sum::<f64>().abs();
-        }
-    }
+    let solver_step = fit.solver_steps(c_inv.as_deref());
+    let (rms_before, rms_after) = fit.rms_residuals();
     let t = student_t_975(dof);
     let mut estimates = Vec::new();
     for (i, p) in params.iter().enumerate() {
@@ -1224,8 +1241,8 @@ pub fn calibrate(problem: &Problem<'_>) -> Result<Calibration> {
         parameters: estimates,
         residual: problem.settings.residual,
         residuals: m,
-        rms_residual_before: (dot(r0, r0) / r0.len() as f64).sqrt(),
-        rms_residual_after: (cost / m as f64).sqrt(),
+        rms_residual_before: rms_before,
+        rms_residual_after: rms_after,
         sigma: s2.sqrt(),
         correlation,
         iterations: out.iterations,

@@ -33,8 +33,7 @@
 use serde::Serialize;
 
 use super::calibrate::{
-    dot, estimate, spd_inverse, student_t_975, BoundedFit, Convergence, Estimate, FitParameter,
-    Settings,
+    estimate, spd_inverse, student_t_975, BoundedFit, Convergence, Estimate, FitParameter, Settings,
 };
 use super::correlate::{
     correlate, IdentifiedModes, Mapping, ModelModes, Settings as CorrelateSettings,
@@ -235,31 +234,26 @@ pub fn calibrate_modal(problem: &ModalProblem<'_>) -> Result<ModalCalibration> {
         ref values,
         ref out,
         ref before,
-        ref r0,
         ref after,
         ref r1,
-        ref jp,
         identifiability: ref ident,
         ref free,
         jtj: ref a,
         dof,
         s2,
-        cost,
         ..
     } = fit;
     let m = r1.len();
     let c = spd_inverse(a);
     let t = student_t_975(dof);
-    let g: Vec<f64> = free.iter().map(|&i| dot(&jp[i], r1)).collect();
+    let steps = fit.solver_steps(c.as_deref());
+    let (rms_before, rms_after) = fit.rms_residuals();
     let mut estimates = Vec::new();
     for (i, p) in params.iter().enumerate() {
         let at_bound = fit.at_bound(i);
         let k = free.iter().position(|&f| f == i);
         let (se, step) = match (&c, k) {
-            (Some(c), Some(k)) if !at_bound => (
-                (s2 * c[k][k]).sqrt(),
-                c[k].iter().zip(&g).map(|(c, g)| c * g).sum::<f64>().abs(),
-            ),
+            (Some(c), Some(k)) if !at_bound => ((s2 * c[k][k]).sqrt(), steps[i]),
             _ => (f64::NAN, f64::NAN),
         };
         estimates.push(estimate(p, values[i], se, step, t, at_bound, ident[i]));
@@ -303,8 +297,8 @@ pub fn calibrate_modal(problem: &ModalProblem<'_>) -> Result<ModalCalibration> {
         parameters: estimates,
         mac_weight: problem.mac_weight,
         residuals: m,
-        rms_residual_before: (dot(r0, r0) / r0.len() as f64).sqrt(),
-        rms_residual_after: (cost / m as f64).sqrt(),
+        rms_residual_before: rms_before,
+        rms_residual_after: rms_after,
         sigma: s2.sqrt(),
         iterations: out.iterations,
         evaluations: out.evaluations + 2,

@@ -468,9 +468,17 @@ mod tests {
         assert!(text.contains(" 0.000 %"), "{text}");
     }
 
-    /// Fixed-free chain of three springs k: the tip flexibility is 3/k, the middle 2/k.
-    #[test]
-    fn grounded_chain_matches_series_springs() {
+    /// k, K, M and the unit loads of [`grounded_chain`].
+    type Chain = (
+        f64,
+        SparseColMat<usize, f64>,
+        SparseColMat<usize, f64>,
+        Vec<Vec<f64>>,
+    );
+
+    /// A fixed-free chain of three springs k = 2e5 N/m over masses 1, 2, 3 kg: k, K, M and the
+    /// unit loads at the tip and the middle.
+    fn grounded_chain() -> Chain {
         let k = 2.0e5;
         let kk = sparse(
             3,
@@ -486,6 +494,13 @@ mod tests {
         );
         let mm = sparse(3, &[(0, 0, 1.0), (1, 1, 2.0), (2, 2, 3.0)]);
         let f = vec![vec![0.0, 0.0, 1.0], vec![0.0, 1.0, 0.0]];
+        (k, kk, mm, f)
+    }
+
+    /// Fixed-free chain of three springs k: the tip flexibility is 3/k, the middle 2/k.
+    #[test]
+    fn grounded_chain_matches_series_springs() {
+        let (k, kk, mm, f) = grounded_chain();
         let g = static_flexibility(kk.as_ref(), mm.as_ref(), &f, &[], None).unwrap();
         assert!((g[0] - 3.0 / k).abs() <= 1e-14 * 3.0 / k, "{g:?}");
         assert!((g[1] - 2.0 / k).abs() <= 1e-14 * 2.0 / k, "{g:?}");
@@ -497,21 +512,7 @@ mod tests {
     /// estimate with the one elastic mode gives too (share 1).
     #[test]
     fn cross_flexibilities_match_the_closed_forms() {
-        let k = 2.0e5;
-        let kk = sparse(
-            3,
-            &[
-                (0, 0, 2.0 * k),
-                (0, 1, -k),
-                (1, 0, -k),
-                (1, 1, 2.0 * k),
-                (1, 2, -k),
-                (2, 1, -k),
-                (2, 2, k),
-            ],
-        );
-        let mm = sparse(3, &[(0, 0, 1.0), (1, 1, 2.0), (2, 2, 3.0)]);
-        let f = vec![vec![0.0, 0.0, 1.0], vec![0.0, 1.0, 0.0]];
+        let (k, kk, mm, f) = grounded_chain();
         let g = static_flexibility_matrix(kk.as_ref(), mm.as_ref(), &f, &[], None).unwrap();
         for (got, want) in [(g[0][1], 2.0 / k), (g[1][0], 2.0 / k), (g[0][0], 3.0 / k)] {
             assert!((got - want).abs() <= 1e-14 * want, "{g:?}");

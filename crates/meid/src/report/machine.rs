@@ -20,7 +20,7 @@ use super::figures::{self, sig, MapSpec, Mark};
 use super::html::{Block, Page, Section, Table};
 use crate::analysis::blows::{run_blows_with, BlowOptions, BlowsRun};
 use crate::analysis::compare::{CaseName, CompareOptions, Comparison, ComparisonResult};
-use crate::analysis::impacts;
+use crate::analysis::impacts::{self, ImpactTotals};
 use crate::analysis::montecarlo::{MonteCarlo, MonteCarloResult, Uncertain};
 use crate::analysis::production::{self, Production};
 use crate::analysis::steady::SteadyOptions;
@@ -149,7 +149,7 @@ pub struct MachineReport {
     pub foundation: Vec<(CaseName, crate::foundation::FoundationAssessment)>,
     /// Every closing of each contact in each case's blow over the record
     /// ([`crate::analysis::impacts`]).
-    pub impacts: Vec<(CaseName, Vec<ImpactRow>)>,
+    pub impacts: Vec<CaseImpacts>,
 }
 
 /// The stages of [`MachineReport::run`], in order, for progress reporting.
@@ -163,13 +163,16 @@ pub const STAGES: [&str; 7] = [
     "page",
 ];
 
+/// One case's closings of each contact and their totals per contact.
+pub type CaseImpacts = (CaseName, Vec<ImpactRow>, Vec<ImpactTotals>);
+
 /// Every closing of each contact in each case of `comparison`, over the comparison's record of
 /// `record_s` seconds ([`impacts::impacts`] of the case's run; exact for linear laws).
 fn case_impacts(
     model: &Model,
     comparison: &ComparisonResult,
     record_s: f64,
-) -> Result<Vec<(CaseName, Vec<ImpactRow>)>> {
+) -> Result<Vec<CaseImpacts>> {
     comparison
         .cases
         .iter()
@@ -182,7 +185,9 @@ fn case_impacts(
                 ..model.options()
             };
             let run = crate::analysis::energy::simulate(&sys, &opts, false)?;
-            Ok((c.case, impacts::impacts(&sys, &run.solution)?))
+            let rows = impacts::impacts(&sys, &run.solution)?;
+            let totals = impacts::totals(&sys, &rows);
+            Ok((c.case, rows, totals))
         })
         .collect()
 }
@@ -1080,43 +1085,27 @@ impl MachineReport {
     }
 
     /// Per case and contact: the number of closings over the record, the first closing (time,
-    /// approach velocity, restitution) and the totals (impulse, time closed, dissipated
-    /// energy), with the largest contact force and its time.
+    /// approach velocity, restitution) and the totals ([`impacts::totals`]: impulse, time
+    /// closed, dissipated energy, the largest contact force and its time).
     fn impacts_table(&self) -> Table {
         let ms = |t: f64| sig(1e3 * t, 4);
         let mut rows = Vec::new();
-        for (case, list) in &self.impacts {
-            let sys_contacts: Vec<&str> = {
-                let mut v: Vec<&str> = Vec::new();
-                for r in list {
-                    if !v.contains(&r.contact.as_str()) {
-                        v.push(&r.contact);
-                    }
-                }
-                v
-            };
-            for contact in sys_contacts {
-                let mine: Vec<&ImpactRow> = list.iter().filter(|r| r.contact == contact).collect();
-                let Some(first) = mine.first() else { continue };
-                let peak = mine
-                    .iter()
-                    .max_by(|a, b| a.peak_force_n.total_cmp(&b.peak_force_n))
-                    .unwrap_or(first);
+        for (case, list, totals) in &self.impacts {
+            for t in totals.iter().filter(|t| t.impacts > 0) {
+                let Some(first) = list.iter().find(|r| r.contact == t.contact) else {
+                    continue;
+                };
                 rows.push(vec![
                     case.label().to_string(),
-                    contact.to_string(),
-                    mine.len().to_string(),
+                    t.contact.clone(),
+                    t.impacts.to_string(),
                     ms(first.start_s),
                     sig(first.approach_velocity_m_per_s, 4),
                     first.restitution.map_or("—".into(), |e| sig(e, 4)),
-                    format!(
-                        "{} at {} ms",
-                        sig(peak.peak_force_n, 4),
-                        ms(peak.peak_time_s)
-                    ),
-                    sig(mine.iter().map(|r| r.impulse_n_s).sum::<f64>(), 4),
-                    ms(mine.iter().map(|r| r.duration_s).sum::<f64>()),
-                    sig(mine.iter().map(|r| r.dissipated_j).sum::<f64>(), 4),
+                    format!("{} at {} ms", sig(t.peak_force_n, 4), ms(t.peak_time_s)),
+                    sig(t.impulse_n_s, 4),
+                    ms(t.closed_time_s),
+                    sig(t.dissipated_j, 4),
                 ]);
             }
         }
@@ -1417,7 +1406,7 @@ impl MachineReport {
         // Every closing of each contact, per case.
         if let Some(o) = out.as_object_mut() {
             let mut m = serde_json::Map::new();
-            for (c, rows) in &self.impacts {
+            for (c, rows, _) in &self.impacts {
                 m.insert(
                     c.name().into(),
                     serde_json::to_value(rows).unwrap_or_default(),
