@@ -297,6 +297,23 @@ fn test_against_model_finds_the_modes_and_updates_the_model() {
     assert_eq!(m["status"], "done", "{m}");
     assert_eq!(m["modes"].as_array().unwrap().len(), 2);
     assert!(m["update"]["parameters"][0]["value"].as_f64().is_some());
+    // The updated model beside the page: the fitted value in place, read back.
+    assert_eq!(m["calibrated_model_file"], "calibrated.toml", "{m}");
+    let text = std::fs::read_to_string(out.join("calibrated.toml")).unwrap();
+    assert!(
+        text.starts_with("# Calibrated by `meid report --fit`"),
+        "{text}"
+    );
+    let updated = Model::from_text("calibrated.toml", text, &[]).unwrap();
+    let back = meid::measure::calibrate::parameters(
+        &updated,
+        &[path.to_string()],
+        &std::collections::BTreeMap::new(),
+    )
+    .unwrap()[0]
+        .start;
+    assert_eq!(back, k, "the file's value is the fitted one");
+    assert!(s.contains("calibrated.toml"), "the section names the file");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -1386,10 +1386,21 @@ pub fn calibrated_model_text(
     params: &[FitParameter],
     values: &[f64],
 ) -> Result<String> {
+    calibrated_model_text_by(model, params, values, "meid calibrate")
+}
+
+/// [`calibrated_model_text`] with the command that calibrated named in its header
+/// (`meid report --fit` writes the same file as `meid calibrate --modal`).
+pub fn calibrated_model_text_by(
+    model: &Model,
+    params: &[FitParameter],
+    values: &[f64],
+    command: &str,
+) -> Result<String> {
     let src = &model.source;
     let spans: Option<Vec<_>> = params.iter().map(|p| src.value_span(&p.path)).collect();
     let header = {
-        let mut h = String::from("# Calibrated by `meid calibrate`:\n");
+        let mut h = format!("# Calibrated by `{command}`:\n");
         for (p, v) in params.iter().zip(values) {
             h.push_str(&format!("#   {} = {v:e} (was {:e})\n", p.path, p.start));
         }

@@ -33,7 +33,9 @@ use serde::Serialize;
 use super::figures::sig;
 use super::html::{Block, Figure, Section, Table};
 use crate::identify::{identify, FrfData, Identification, Settings as IdentifySettings};
-use crate::measure::calibrate::{parameters, parse_bounds, parse_fit, Settings as FitSettings};
+use crate::measure::calibrate::{
+    calibrated_model_text_by, parameters, parse_bounds, parse_fit, Settings as FitSettings,
+};
 use crate::measure::correlate::{
     correlate, parse_point_label, Correlation, IdentifiedMode, IdentifiedModes, Mapping,
     ModelModes, Settings as CorrelateSettings,
@@ -49,6 +51,10 @@ use crate::{Error, Result};
 
 /// The data file of the section, linked under each of its figures.
 pub const DATA_FILE: &str = "test_against_model.json";
+
+/// The updated model's file (with `--fit`), written beside the page: the model's own text with
+/// the fitted values in place, as `meid calibrate --modal -o` writes it.
+pub const CALIBRATED_FILE: &str = "calibrated.toml";
 
 /// Model updating asked of the section (`meid report --fit`, `--bounds`, `--mac-weight`).
 #[derive(Debug, Clone, PartialEq)]
@@ -116,10 +122,15 @@ pub struct TestAgainstModel {
     pub modes: Vec<ModeRow>,
     pub correlation: Correlation,
     pub update: Option<ModalCalibration>,
+    /// The updated model's file name ([`CALIBRATED_FILE`]) when there is an update.
+    pub calibrated_model_file: Option<String>,
     pub warnings: Vec<String>,
     pub notes: Vec<String>,
     #[serde(skip)]
     pub identification: Identification,
+    /// The updated model's text (written as [`CALIBRATED_FILE`]).
+    #[serde(skip)]
+    pub calibrated_model: Option<String>,
 }
 
 /// The section's result: done, or why not.
@@ -249,7 +260,14 @@ pub fn run(
                 update.mac_weight,
                 FitSettings::default(),
             )?;
-            Some(calibrate_modal(&problem)?)
+            let c = calibrate_modal(&problem)?;
+            let text = calibrated_model_text_by(
+                model,
+                problem.parameters(),
+                &c.values(),
+                "meid report --fit",
+            )?;
+            Some((c, text))
         }
         Some(_) => {
             return skip(format!(
@@ -276,7 +294,9 @@ pub fn run(
         identified_modes: id.modes.clone(),
         modes,
         correlation,
-        update,
+        calibrated_model_file: update.as_ref().map(|_| CALIBRATED_FILE.to_string()),
+        calibrated_model: update.as_ref().map(|(_, text)| text.clone()),
+        update: update.map(|(c, _)| c),
         warnings,
         notes,
         frf: set,
@@ -619,6 +639,13 @@ fn done_blocks(dir: &Path, t: &TestAgainstModel) -> Result<Vec<Block>> {
     if let Some(u) = &t.update {
         blocks.push(Block::Table(update_table(u)));
         blocks.push(Block::Table(update_pairs_table(u)));
+    }
+    if let Some(text) = &t.calibrated_model {
+        crate::io::write_atomic(&dir.join(CALIBRATED_FILE), text.as_bytes())?;
+        blocks.push(Block::Paragraph(format!(
+            "The updated model is written beside this page as {CALIBRATED_FILE} (the model file \
+             with the fitted values in place; meid calibrate --modal -o writes the same file)."
+        )));
     }
     frf_plots(dir, &t.frf)?;
     band_plots(dir, t)?;
