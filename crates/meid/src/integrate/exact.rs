@@ -346,11 +346,11 @@ impl<'s, 'o> Run<'s, 'o> {
     /// Step 4 on a Taylor step of length `s_end`: the closed-contact times, the channels'
     /// extremes (on their polynomials, only to the degree the stretch needs: the remainder
     /// bound no larger than the full step's, `taylor::degree_for_reach`), the dissipated
-    /// energy, and the state at the end.
+    /// energy (both only with [`Options::levels`]), and the state at the end.
     fn book_taylor(&mut self, mi: usize, tau: f64, period: f64, s_end: f64) -> Result<()> {
         let (t, mode) = (self.t, self.mode);
         self.closed_time(s_end);
-        if self.opts.peaks {
+        if self.opts.levels {
             let mc = mode_channels(
                 &mut self.channels,
                 &self.map,
@@ -385,9 +385,11 @@ impl<'s, 'o> Run<'s, 'o> {
         let tm = tw.tmats[mi]
             .as_ref()
             .ok_or_else(|| Error::numerical("exact", "Taylor matrix"))?;
-        self.totals.dissipated += tm
-            .dissipated(&tw.coef, &self.masses, s_end, &mut tw.work)
-            .ok_or_else(|| Error::numerical("exact", "first-order matrix without [0, I]"))?;
+        if self.opts.levels {
+            self.totals.dissipated += tm
+                .dissipated(&tw.coef, &self.masses, s_end, &mut tw.work)
+                .ok_or_else(|| Error::numerical("exact", "first-order matrix without [0, I]"))?;
+        }
         taylor::state(&tw.coef, s_end, &mut self.x);
         Ok(())
     }
@@ -478,12 +480,12 @@ impl<'s, 'o> Run<'s, 'o> {
 
     /// Step 4 on a closed-form stretch of length `s_end`: the closed-contact times, the
     /// channels' extremes (`peaks::on_segment`), the dissipated energy `∫ ẋᵀC_σẋ dt`
-    /// (`damping` = `C_σ`), and the state at the end.
+    /// (`damping` = `C_σ`; both only with [`Options::levels`]), and the state at the end.
     fn book_closed(&mut self, seg: &Segment<'_>, damping: &Mat<f64>, s_end: f64) -> Result<()> {
         let (t, mode) = (self.t, self.mode);
         let n = self.x.len();
         self.closed_time(s_end);
-        if self.opts.peaks {
+        if self.opts.levels {
             let mc = mode_channels(
                 &mut self.channels,
                 &self.map,
@@ -506,7 +508,9 @@ impl<'s, 'o> Run<'s, 'o> {
                 peaks::on_segment(seg, l, la, t, s_end, &mut self.totals.peaks.0[c]);
             }
         }
-        self.totals.dissipated += dissipated(seg, damping, n / 2, s_end);
+        if self.opts.levels {
+            self.totals.dissipated += dissipated(seg, damping, n / 2, s_end);
+        }
         seg.state(s_end, &mut self.buf);
         self.x.copy_from_slice(&self.buf);
         Ok(())
@@ -619,8 +623,10 @@ impl<'s, 'o> Run<'s, 'o> {
     /// more than `opts.max_events` is an error.
     fn switch_to(&mut self, new_mode: Mode) -> Result<()> {
         let (t, mode) = (self.t, self.mode);
-        self.totals.dissipated +=
-            super::dopri5::contact_energy_jump(self.sys, mode, new_mode, &self.x);
+        if self.opts.levels {
+            self.totals.dissipated +=
+                super::dopri5::contact_energy_jump(self.sys, mode, new_mode, &self.x);
+        }
         self.path.push(PathPoint {
             t,
             mode: new_mode,

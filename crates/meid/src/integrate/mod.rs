@@ -75,11 +75,13 @@ pub struct Options {
     /// form (default [`exact::TAYLOR_STEPS_PER_MODE`]; 0 for closed forms only). Both are exact
     /// to round-off; the choice is a matter of speed.
     pub taylor_steps_per_mode: usize,
-    /// Track the response channels' exact extremes ([`Totals::peaks`]); default true. The
-    /// exact method skips them when false (the run's peaks then stay empty): a search that only
-    /// needs the final state of intermediate runs (the steady state's Newton iterates,
-    /// [`crate::analysis::steady`]) saves their cost. dopri5 always tracks them.
-    pub peaks: bool,
+    /// Track the run's levels: the response channels' exact extremes ([`Totals::peaks`]) and
+    /// the energy dissipated ([`Totals::dissipated`]); default true. The exact method skips
+    /// both when false (the run's peaks and dissipated energy then stay 0, so its energy
+    /// balance cannot be checked): a search that only needs the final state of intermediate runs (the steady
+    /// state's Newton iterates, [`crate::analysis::steady`]) saves their cost, and checks the
+    /// run whose levels it reports. dopri5 always tracks them.
+    pub levels: bool,
 }
 
 impl Default for Options {
@@ -94,7 +96,7 @@ impl Default for Options {
             atol: 1e-14,
             max_events: DEFAULT_MAX_EVENTS,
             taylor_steps_per_mode: exact::TAYLOR_STEPS_PER_MODE,
-            peaks: true,
+            levels: true,
         }
     }
 }
