@@ -1,0 +1,143 @@
+//! The documentation's paths resolve: every relative link of every markdown file of the
+//! repository (`[text](path)`, `[text](path#anchor)`) names a file or folder that exists, and
+//! every `docs/….md` path named anywhere in the repository's sources, tests, examples, scripts
+//! and pages (error messages and doc comments too) names a page that exists. Read from the
+//! files' text; build outputs (`target/`) and hidden folders other than `.ci` are left out.
+
+use std::path::{Path, PathBuf};
+
+/// The repository's root (this crate is `crates/meid`).
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// Every file under `dir`, skipping build outputs and hidden folders (except `.ci`).
+fn files_under(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if path.is_dir() {
+            let hidden = name.starts_with('.') && name != ".ci";
+            if !hidden && name != "target" && name != "node_modules" && name != "__pycache__" {
+                files_under(&path, out);
+            }
+        } else {
+            out.push(path);
+        }
+    }
+}
+
+/// The targets of the inline markdown links of `text` (`](target)`), without their
+/// `#anchor` and title, that are relative paths (not URLs, not `#anchor` alone). Links inside
+/// fenced code blocks and inline code spans are not links.
+fn relative_links(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut fenced = false;
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        if fenced {
+            continue;
+        }
+        // Drop inline code spans: `a](b)` in code is not a link.
+        let prose: String = line
+            .split('`')
+            .enumerate()
+            .filter(|(i, _)| i % 2 == 0)
+            .map(|(_, s)| s)
+            .collect::<Vec<_>>()
+            .join(" ");
+        let mut rest = prose.as_str();
+        while let Some(at) = rest.find("](") {
+            rest = &rest[at + 2..];
+            let Some(end) = rest.find(')') else { break };
+            let target = rest[..end].split_whitespace().next().unwrap_or("");
+            let path = target.split('#').next().unwrap_or("");
+            let external = target.contains("://") || target.starts_with("mailto:");
+            if !path.is_empty() && !external {
+                out.push(path.to_string());
+            }
+            rest = &rest[end..];
+        }
+    }
+    out
+}
+
+/// Every `docs/….md` path named in `text` (not the tail of a longer path such as
+/// `crates/x/docs/y.md`).
+fn docs_paths(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let bytes = text.as_bytes();
+    let path_char = |b: u8| b.is_ascii_alphanumeric() || matches!(b, b'/' | b'-' | b'_' | b'.');
+    let mut from = 0;
+    while let Some(at) = text[from..].find("docs/") {
+        let start = from + at;
+        from = start + 5;
+        if start > 0 && path_char(bytes[start - 1]) {
+            continue;
+        }
+        let mut end = start + 5;
+        while end < bytes.len() && path_char(bytes[end]) {
+            end += 1;
+        }
+        let candidate = text[start..end].trim_end_matches('.');
+        if let Some(stem) = candidate.strip_suffix(".md") {
+            out.push(format!("{stem}.md"));
+        }
+    }
+    out
+}
+
+#[test]
+fn the_link_readers_find_what_a_page_names() {
+    let page = "See [the model](reference/model-file.md#units), [web](https://x.org/a.md), \
+                [here](#top), `[code](not/a/link.md)` and [two](../b.md \"title\").\n\
+                ```\n[fenced](c.md)\n```\n";
+    assert_eq!(relative_links(page), ["reference/model-file.md", "../b.md"]);
+    let source = "// docs/explanations/fem.md, \"Repeated eigenvalues\"; crates/x/docs/y.md; \
+                  see docs/guide.md. and docs/reference/";
+    assert_eq!(docs_paths(source), ["docs/explanations/fem.md", "docs/guide.md"]);
+}
+
+#[test]
+fn every_relative_link_and_docs_path_resolves() {
+    let root = root();
+    let mut files = Vec::new();
+    for dir in ["crates", "docs", "examples", "bench", "fuzz", ".ci"] {
+        files_under(&root.join(dir), &mut files);
+    }
+    files.push(root.join("README.md"));
+    let mut broken = Vec::new();
+    let mut pages = 0;
+    for file in &files {
+        let Ok(text) = std::fs::read_to_string(file) else {
+            continue; // not text
+        };
+        let shown = file.strip_prefix(&root).unwrap_or(file).display().to_string();
+        if file.extension().is_some_and(|e| e == "md") {
+            pages += 1;
+            let dir = file.parent().unwrap_or(&root);
+            for link in relative_links(&text) {
+                if !dir.join(&link).exists() {
+                    broken.push(format!("{shown}: link ({link})"));
+                }
+            }
+        }
+        for path in docs_paths(&text) {
+            if !root.join(&path).is_file() {
+                broken.push(format!("{shown}: names {path}"));
+            }
+        }
+    }
+    assert!(pages >= 10, "only {pages} markdown files found under {}", root.display());
+    assert!(
+        broken.is_empty(),
+        "paths that do not exist:\n{}",
+        broken.join("\n")
+    );
+}
