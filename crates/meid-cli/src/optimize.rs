@@ -53,7 +53,7 @@ pub struct OptimizeArgs {
     bed_mass: Option<f64>,
     /// Optimise for production at this stroke rate (blows/min): the objective on the steady
     /// blow of the periodic blow train, and only designs whose damper returns to the bed
-    /// before every strike are feasible (docs/explanations/studies.md, "Production"). Default: the model's
+    /// before every strike are feasible (docs/explanations/blows.md, "Production"). Default: the model's
     /// [production] rate_bpm, if it has one.
     #[arg(long, value_name = "R")]
     rate_bpm: Option<f64>,

@@ -216,7 +216,7 @@ fn output(
         return Ok(());
     };
     result.write(set.staging())?;
-    // sweep.csv's rows with types and units (docs/explanations/studies.md, "Parquet").
+    // sweep.csv's rows with types and units (docs/reference/outputs.md, "Parquet").
     meid::io::parquet::write_parquet(&set.path("sweep.parquet"), &sweep.table(result))?;
     if let Some(e) = sweep.all_failed_error(result) {
         // The results (every row with its error) are written; the run is that error.
