@@ -108,7 +108,11 @@ fn every_command_and_option_is_in_the_reference() {
             names.extend(subs.into_iter().map(|s| format!("{name} {s}")));
         }
     }
-    assert!(names.len() >= 20, "only {} commands in `meid --help`", names.len());
+    assert!(
+        names.len() >= 20,
+        "only {} commands in `meid --help`",
+        names.len()
+    );
     let mut problems = Vec::new();
     for name in &names {
         let args: Vec<&str> = name.split(' ').chain(["--help"]).collect();
@@ -119,10 +123,14 @@ fn every_command_and_option_is_in_the_reference() {
             continue;
         };
         for missing in expected.difference(got) {
-            problems.push(format!("`meid {name}`: {missing} is not in the options table"));
+            problems.push(format!(
+                "`meid {name}`: {missing} is not in the options table"
+            ));
         }
         for invented in got.difference(&expected) {
-            problems.push(format!("`meid {name}`: {invented} is documented but not an option"));
+            problems.push(format!(
+                "`meid {name}`: {invented} is documented but not an option"
+            ));
         }
     }
     for name in documented.keys() {

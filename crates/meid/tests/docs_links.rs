@@ -101,7 +101,10 @@ fn the_link_readers_find_what_a_page_names() {
     assert_eq!(relative_links(page), ["reference/model-file.md", "../b.md"]);
     let source = "// docs/explanations/fem.md, \"Repeated eigenvalues\"; crates/x/docs/y.md; \
                   see docs/guide.md. and docs/reference/";
-    assert_eq!(docs_paths(source), ["docs/explanations/fem.md", "docs/guide.md"]);
+    assert_eq!(
+        docs_paths(source),
+        ["docs/explanations/fem.md", "docs/guide.md"]
+    );
 }
 
 #[test]
@@ -118,7 +121,11 @@ fn every_relative_link_and_docs_path_resolves() {
         let Ok(text) = std::fs::read_to_string(file) else {
             continue; // not text
         };
-        let shown = file.strip_prefix(&root).unwrap_or(file).display().to_string();
+        let shown = file
+            .strip_prefix(&root)
+            .unwrap_or(file)
+            .display()
+            .to_string();
         if file.extension().is_some_and(|e| e == "md") {
             pages += 1;
             let dir = file.parent().unwrap_or(&root);
@@ -134,7 +141,11 @@ fn every_relative_link_and_docs_path_resolves() {
             }
         }
     }
-    assert!(pages >= 10, "only {pages} markdown files found under {}", root.display());
+    assert!(
+        pages >= 10,
+        "only {pages} markdown files found under {}",
+        root.display()
+    );
     assert!(
         broken.is_empty(),
         "paths that do not exist:\n{}",
