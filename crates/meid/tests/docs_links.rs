@@ -2,7 +2,8 @@
 //! repository (`[text](path)`, `[text](path#anchor)`) names a file or folder that exists, and
 //! every `docs/….md` path named anywhere in the repository's sources, tests, examples, scripts
 //! and pages (error messages and doc comments too) names a page that exists. Read from the
-//! files' text; build outputs (`target/`) and hidden folders other than `.ci` are left out.
+//! files' text; build outputs (`target/`), fuzzing corpora and crash inputs (`corpus/`,
+//! `artifacts/`) and hidden folders other than `.ci` are left out.
 
 use std::path::{Path, PathBuf};
 
@@ -21,7 +22,15 @@ fn files_under(dir: &Path, out: &mut Vec<PathBuf>) {
         let name = entry.file_name().to_string_lossy().into_owned();
         if path.is_dir() {
             let hidden = name.starts_with('.') && name != ".ci";
-            if !hidden && name != "target" && name != "node_modules" && name != "__pycache__" {
+            // Fuzzing corpora and crash inputs are generated (mutated copies of the examples).
+            let generated = [
+                "target",
+                "node_modules",
+                "__pycache__",
+                "corpus",
+                "artifacts",
+            ];
+            if !hidden && !generated.contains(&name.as_str()) {
                 files_under(&path, out);
             }
         } else {
