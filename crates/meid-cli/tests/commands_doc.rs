@@ -69,7 +69,7 @@ fn doc_options(page: &str) -> BTreeMap<String, BTreeSet<String>> {
                     .chars()
                     .take_while(|c| c.is_ascii_alphanumeric() || *c == '-')
                     .collect();
-                if !opt.is_empty() {
+                if opt.starts_with(|c: char| c.is_ascii_alphabetic()) {
                     set.insert(format!("--{opt}"));
                 }
             }
@@ -109,7 +109,7 @@ fn every_command_and_option_is_in_the_reference() {
         }
     }
     assert!(
-        names.len() >= 20,
+        names.len() >= 19,
         "only {} commands in `meid --help`",
         names.len()
     );
