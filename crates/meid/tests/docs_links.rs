@@ -161,3 +161,99 @@ fn every_relative_link_and_docs_path_resolves() {
         broken.join("\n")
     );
 }
+
+/// The words inside the inline code spans (`` `…` ``) and fenced blocks of a page: the names
+/// it documents.
+fn code_words(page: &str) -> std::collections::BTreeSet<String> {
+    let mut words = std::collections::BTreeSet::new();
+    let mut fenced = false;
+    for line in page.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        let spans: Vec<&str> = if fenced {
+            vec![line]
+        } else {
+            line.split('`').skip(1).step_by(2).collect()
+        };
+        for span in spans {
+            let is_word = |c: char| c.is_ascii_alphanumeric() || c == '_';
+            words.extend(span.split(|c: char| !is_word(c)).map(str::to_string));
+        }
+    }
+    words
+}
+
+/// Every key of `value` (tables, and tables inside arrays), as dotted paths. The children of
+/// tables whose keys are the user's own names (`bed_points`, `sets`, `points`) are not keys.
+fn toml_keys(value: &toml::Value, path: &str, out: &mut Vec<String>) {
+    match value {
+        toml::Value::Table(t) => {
+            for (k, v) in t {
+                let p = if path.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{path}.{k}")
+                };
+                out.push(p.clone());
+                if !matches!(k.as_str(), "bed_points" | "sets" | "points") {
+                    toml_keys(v, &p, out);
+                }
+            }
+        }
+        toml::Value::Array(a) => a.iter().for_each(|v| toml_keys(v, path, out)),
+        _ => {}
+    }
+}
+
+#[test]
+fn the_key_readers_find_keys_and_documented_words() {
+    let v: toml::Value =
+        toml::from_str("a = 1\n[b]\nc = [{ d = 2 }]\n[b.sets]\nmine = [1]\n").expect("toml");
+    let mut keys = Vec::new();
+    toml_keys(&v, "", &mut keys);
+    assert_eq!(keys, ["a", "b", "b.c", "b.c.d", "b.sets"]);
+    let words = code_words("`length_x = 1` and `{ d, e }`, not f\n```toml\ng = 2\n```\n");
+    for w in ["length_x", "d", "e", "g"] {
+        assert!(words.contains(w), "{w}");
+    }
+    assert!(!words.contains("f"));
+}
+
+/// Every key the examples use is named in the model-file reference.
+#[test]
+fn every_key_of_the_examples_is_in_the_model_file_reference() {
+    let root = root();
+    let page = std::fs::read_to_string(root.join("docs/reference/model-file.md"))
+        .expect("docs/reference/model-file.md");
+    let words = code_words(&page);
+    let mut missing = Vec::new();
+    let mut examples = 0;
+    for entry in std::fs::read_dir(root.join("examples")).expect("examples/") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        examples += 1;
+        let text = std::fs::read_to_string(&path).expect("example");
+        let value: toml::Value = toml::from_str(&text).expect("example parses");
+        let mut keys = Vec::new();
+        toml_keys(&value, "", &mut keys);
+        for key in keys {
+            let last = key.rsplit('.').next().unwrap_or(&key);
+            if !words.contains(last) {
+                let name = path.file_name().unwrap_or_default().to_string_lossy();
+                missing.push(format!("examples/{name}: {key}"));
+            }
+        }
+    }
+    assert!(examples >= 5, "only {examples} examples");
+    missing.sort();
+    missing.dedup();
+    assert!(
+        missing.is_empty(),
+        "keys of the examples not named in docs/reference/model-file.md:\n{}",
+        missing.join("\n")
+    );
+}
