@@ -1,4 +1,4 @@
-"""Runs every code block of README.md and docs/*.md as a reader would paste it.
+"""Runs every code block of README.md and docs/**/*.md as a reader would paste it.
 
 - ```python blocks run as scripts with this interpreter (the CI venv, built by the README's
   own `pip install` line);
@@ -57,7 +57,7 @@ def run_block(lang, code, cwd, env):
 
 def main(argv):
     files = [pathlib.Path(a).resolve() for a in argv] or [ROOT / "README.md"] + sorted(
-        (ROOT / "docs").glob("*.md")
+        (ROOT / "docs").rglob("*.md")
     )
     meid = pathlib.Path(os.environ.get("MEID_BIN", ROOT / "target/release/meid")).resolve()
     if not meid.is_file():

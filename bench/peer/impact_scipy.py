@@ -9,7 +9,7 @@ SPEC.json is written by `target/release/examples/impact_bench --spec SPEC.json` 
 meid integrates: modal frequencies, modal damping matrix, mode-shape values at O_b and O_f,
 slider, damper and contact data, and meid's exact energy ratio and collision end).
 
-The model (docs/paper-machine.md, the impact damper of docs/model-format.md), modal
+The model (docs/explanations/paper-machine.md, the impact damper of docs/reference/model-file.md), modal
 coordinates q (mass-normalised), slider z_s, damper z_d:
 
     q'' = -w^2 q - D q' + phi_b (f_s - f_d) + phi_f f_a

@@ -24,7 +24,7 @@ pub struct BlowsArgs {
     #[arg(long, value_name = "FRACTION", default_value_t = 0.01)]
     tolerance: f64,
     /// Only the direct periodic steady state of each case (no march): the fixed point of the
-    /// blow-to-blow map, its regime and Floquet multipliers (docs/studies.md, "Production").
+    /// blow-to-blow map, its regime and Floquet multipliers (docs/explanations/blows.md, "Production").
     #[arg(long)]
     steady: bool,
     /// A stroke-rate map instead: the steady state of every case at each rate of
@@ -330,7 +330,7 @@ fn print_march(a: &BlowsArgs, rate_bpm: f64, r: &meid::analysis::blows::BlowsRun
 const RETURNED_GAP_M: f64 = 1e-5;
 
 /// One line on the damper's return: its gap to the bed at the next strike and, when it has
-/// not come back, the blows in which it never touched the bed (docs/studies.md explains why
+/// not come back, the blows in which it never touched the bed (docs/explanations/blows.md explains why
 /// a one-way dashpot holds it off).
 fn damper_hint(r: &meid::analysis::blows::BlowsRun) -> Option<String> {
     let gap = r.damper_gap_at_next_strike_m?;
@@ -356,7 +356,7 @@ fn damper_hint(r: &meid::analysis::blows::BlowsRun) -> Option<String> {
         )
     };
     Some(format!(
-        "damper gap at next blow: {:.4} mm (not returned{touch}; see docs/studies.md)",
+        "damper gap at next blow: {:.4} mm (not returned{touch}; see docs/explanations/blows.md)",
         gap * 1e3
     ))
 }

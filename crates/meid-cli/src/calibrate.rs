@@ -29,7 +29,7 @@ pub struct CalibrateArgs {
     measured: Vec<String>,
     /// Fit to identified modes instead of records: meid identify's JSON, modes.csv or UFF 55.
     /// Residuals: relative frequency errors of the paired modes and √W (1 − MAC), W the
-    /// --mac-weight (docs/measure.md, "Correlation and model updating").
+    /// --mac-weight (docs/explanations/measure.md, "Correlation and model updating").
     #[arg(long = "modal", value_name = "IDENTIFIED", conflicts_with_all = ["measured", "spectrum", "channel"])]
     modal: Option<PathBuf>,
     /// Weight W of the shapes' (1 − MAC) beside the relative frequency errors (with --modal;

@@ -1,6 +1,6 @@
 //! The shape every command's `--json` shares: one JSON object whose `warnings` and `notes`
 //! members carry the model's diagnostics (the same warnings the terminal shows on stderr) and
-//! the command's own notes (docs/json.md).
+//! the command's own notes (docs/reference/json.md).
 //!
 //! A command loads at most one model, so the diagnostics are recorded once per run
 //! ([`record`], called where the model's warnings are shown) and added when the object is

@@ -26,7 +26,7 @@ pub struct ModesArgs {
     export_matrices: bool,
     /// Also write DIR/modes.uff: units (UFF dataset 164, SI), nodes (2411) and one dataset 55 per mode
     /// (mass-normalised shapes), for test-lab tools (needs -o). Lumped/tabulated models: node k
-    /// is the k-th named point by name, as the psi columns of modes.csv (docs/measure.md).
+    /// is the k-th named point by name, as the psi columns of modes.csv (docs/explanations/measure.md).
     #[arg(long, requires = "output")]
     uff: bool,
     /// Override a model field, e.g. --set structure.fem.machine.elements_per_side=12 (repeatable).

@@ -48,12 +48,12 @@ pub struct OptimizeArgs {
     grid: Option<usize>,
     /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, the
     /// FE machine's bed plate, or a general FE model's elements labelled part = "bed"; see
-    /// docs/studies.md).
+    /// docs/explanations/studies.md).
     #[arg(long, value_name = "KG")]
     bed_mass: Option<f64>,
     /// Optimise for production at this stroke rate (blows/min): the objective on the steady
     /// blow of the periodic blow train, and only designs whose damper returns to the bed
-    /// before every strike are feasible (docs/studies.md, "Production"). Default: the model's
+    /// before every strike are feasible (docs/explanations/blows.md, "Production"). Default: the model's
     /// [production] rate_bpm, if it has one.
     #[arg(long, value_name = "R")]
     rate_bpm: Option<f64>,

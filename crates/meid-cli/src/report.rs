@@ -58,7 +58,7 @@ pub struct ReportArgs {
     channel: Vec<String>,
     /// Update the model to the modes identified from the measured blows (section "Test
     /// against model"): model paths to fit, as --set names them, comma-separated (repeatable),
-    /// e.g. structure.fem.machine.bed.thickness; as `meid calibrate --modal` (docs/report.md).
+    /// e.g. structure.fem.machine.bed.thickness; as `meid calibrate --modal` (docs/reference/report.md).
     #[arg(long = "fit", value_name = "PATH[,PATH…]")]
     fit: Vec<String>,
     /// Bounds of fitted paths, PATH=LO..HI comma-separated (repeatable); default [p/10, 10 p].

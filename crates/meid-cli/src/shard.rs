@@ -1,5 +1,5 @@
 //! `--shard K/N` (sweep, montecarlo) and `meid merge`: a study split into N independent runs
-//! that can go to N machines (e.g. a Slurm job array, docs/studies.md), then put together into
+//! that can go to N machines (e.g. a Slurm job array, docs/explanations/studies.md), then put together into
 //! the files the unsharded run writes, byte for byte.
 //!
 //! Shard K of N (1 ≤ K ≤ N) of a study of T points or samples computes the indices

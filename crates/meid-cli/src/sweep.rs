@@ -56,7 +56,7 @@ pub struct SweepArgs {
     shard: Option<crate::shard::Shard>,
     /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, the
     /// FE machine's bed plate, or a general FE model's elements labelled part = "bed"; see
-    /// docs/studies.md).
+    /// docs/explanations/studies.md).
     #[arg(long, value_name = "KG")]
     bed_mass: Option<f64>,
     // --json prints the result (sweep.json's content); -q: no progress bar or summary either.
@@ -216,7 +216,7 @@ fn output(
         return Ok(());
     };
     result.write(set.staging())?;
-    // sweep.csv's rows with types and units (docs/studies.md, "Parquet").
+    // sweep.csv's rows with types and units (docs/reference/outputs.md, "Parquet").
     meid::io::parquet::write_parquet(&set.path("sweep.parquet"), &sweep.table(result))?;
     if let Some(e) = sweep.all_failed_error(result) {
         // The results (every row with its error) are written; the run is that error.

@@ -221,7 +221,7 @@ fn blows_json_reports_steady_state() {
 
 /// The human report ends with the damper's gap at the next blow: at 60 /min the one-way
 /// dashpot's slow return (c_d/k_d = 0.39 s) leaves it about a millimetre off the bed and it
-/// never touches the bed again; at 6 /min it is back (docs/studies.md).
+/// never touches the bed again; at 6 /min it is back (docs/explanations/blows.md).
 #[test]
 fn blows_hint_reports_the_damper_gap() {
     let run = |rate: &str, n: &str| {

@@ -1,4 +1,4 @@
-//! One JSON shape for every command (docs/json.md): `--json` prints one object, with
+//! One JSON shape for every command (docs/reference/json.md): `--json` prints one object, with
 //! `warnings` and `notes` members carrying the model's diagnostics (the same warnings stderr
 //! shows), and quantities whose key names their unit.
 

@@ -270,7 +270,7 @@ fn lumped_modes_csv_psi_is_signed_and_rebuilds_the_model() {
         (r1 / r0 - 1.0).abs() < 1e-9,
         "energy ratio from modes.csv {r1} vs the lumped model {r0}"
     );
-    // docs/studies.md: 14.64 % for this model at 0.5 s.
+    // docs/explanations/studies.md: 14.64 % for this model at 0.5 s.
     assert!((r0 - 0.1464).abs() < 5e-5, "{r0}");
 }
 
@@ -278,7 +278,7 @@ fn lumped_modes_csv_psi_is_signed_and_rebuilds_the_model() {
 /// (base = 1, bed = 2) at made-up coordinates without saying so anywhere; mapping node 1 to the
 /// first mass of the model file (bed) gave 8.25 % instead of 14.64 %. Now the rule is in the
 /// file (ID lines 2-5 of every dataset 55: "node k = k-th point by name as in modes.csv" and
-/// the `label = name` pairs) and in docs/measure.md. Reference: modes.csv — reading modes.uff
+/// the `label = name` pairs) and in docs/explanations/measure.md. Reference: modes.csv — reading modes.uff
 /// back with meid's reader and mapping node k to the k-th ψ column gives the same signed ψ
 /// (to the 6 significant digits of dataset 55), the nodes sit at x = k − 1 m, and importing the
 /// file as `[structure.modes]` with that mapping gives the model's energy ratio (to 1e-4).

@@ -6,7 +6,7 @@
 //! the data were streamed, not held. Output directories are replaced as a set (manifest.json
 //! last); a failed run leaves the previous set as it was. References: the estimates are
 //! closed forms of the inputs (samples × bytes per sample, DOFs × 6 KiB), stated in the
-//! messages; the measured figures are in docs/studies.md ("Cost limits").
+//! messages; the measured figures are in README.md ("Outputs and cost limits").
 
 use crate::common;
 

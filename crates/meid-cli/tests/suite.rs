@@ -9,6 +9,7 @@ mod common;
 mod audit_s11_cli;
 mod calibrate_cli;
 mod cli;
+mod commands_doc;
 mod compare_cli;
 mod conventions;
 mod correlate_cli;

@@ -158,7 +158,7 @@ def test_blows_steady_state_is_the_cli_s():
                 "damper_gap_at_strike_m", "damper_touches_bed", "multipliers_abs"]:
         assert s[key] == ref["steady_state"][key], key
     assert s["converged"] and s["regime"] == "period-1"
-    # At 60 /min the paper's damper does not return (docs/studies.md, "Production").
+    # At 60 /min the paper's damper does not return (docs/explanations/blows.md, "Production").
     assert s["damper_touches_bed"] is False
     assert py["verdict"] == ref["verdict"] and "does not return" in py["verdict"][0]
 

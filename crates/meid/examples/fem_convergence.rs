@@ -1,7 +1,7 @@
 //! NAFEMS free-vibration benchmarks as meid model files: mesh generator and convergence table.
 //!
 //! ```text
-//! cargo run --release -p meid --example fem_convergence                 # the table (docs/fem.md)
+//! cargo run --release -p meid --example fem_convergence                 # the table (docs/explanations/fem.md)
 //! cargo run --release -p meid --example fem_convergence -- --write-data crates/meid/tests/data
 //! ```
 //!

@@ -1,7 +1,7 @@
 //! Three-node shells (CST + DKT) from model files: mesh generator and convergence table.
 //!
 //! ```text
-//! cargo run --release -p meid --example tri_convergence                 # the table (docs/fem.md)
+//! cargo run --release -p meid --example tri_convergence                 # the table (docs/explanations/fem.md)
 //! cargo run --release -p meid --example tri_convergence -- --write-data crates/meid/tests/data
 //! ```
 //!

@@ -71,7 +71,7 @@ fn within_one_percent(label: &str, f: &[f64], first: usize, reference: &[f64], s
 // Vibration" (which cites NAFEMS Test No. 32); FV12 also in the CATIA V5 Analysis verification
 // "Free Thin Square Plate". The model files and meshes are written by
 // `cargo run --release -p meid --example fem_convergence -- --write-data crates/meid/tests/data`;
-// the mesh-convergence table is in docs/fem.md.
+// the mesh-convergence table is in docs/explanations/fem.md.
 
 /// NAFEMS FV2, pin-ended double cross (fv2.toml): eight frame arms of 5 m, 16 elements each,
 /// pinned (ux = uy = 0) at the arm ends, in-plane by per-DOF constraints (uz = rx = ry = 0 on

@@ -3,7 +3,7 @@
 //! Reference: paper section 4 — soft base (k_f = 1.5e4 N/m): vertical rigid-body mode 6.35 Hz and
 //! the bed's elastic mode 283 Hz; stiff base (k_f = 1.0e7 N/m): 141 Hz and 292 Hz. Tolerance 3 %
 //! (the brief's). The support stiffness of the examples is the tuned effective value, see
-//! docs/paper-machine.md.
+//! docs/explanations/paper-machine.md.
 
 use std::path::PathBuf;
 
@@ -155,7 +155,7 @@ fn bed_mode_hz(spec: &MachineSpec) -> f64 {
 /// Mesh convergence of the bed mode with the column footprint of fixed physical size: the
 /// frequencies at 8, 16 and 32 elements per side fall monotonically and the change halves at
 /// least (reference: a convergent sequence; with the old one-element-ring spiders the change
-/// did not shrink, 298 → 286 → 272 Hz, docs/paper-machine.md).
+/// did not shrink, 298 → 286 → 272 Hz, docs/explanations/paper-machine.md).
 #[test]
 fn bed_mode_converges_with_the_mesh() {
     let f: Vec<f64> = [8, 16, 32]

@@ -109,7 +109,7 @@ fn lanczos_modes_of_the_paper_machine_are_thread_count_independent() {
     assert!(r0.max_residual < 1e-6, "residual {}", r0.max_residual);
     let orth = orthonormality(model0, &r0.shapes);
     assert!(orth < 1e-10, "orthonormality {orth}");
-    // The paper's vertical rigid-body mode (6.35 Hz) is among them (docs/paper-machine.md).
+    // The paper's vertical rigid-body mode (6.35 Hz) is among them (docs/explanations/paper-machine.md).
     assert!(
         r0.frequency_hz.iter().any(|f| (f - 6.35).abs() < 0.2),
         "{:?}",

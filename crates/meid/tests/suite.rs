@@ -11,6 +11,7 @@ mod added_mass_point;
 mod compare_checks;
 mod compare_montecarlo;
 mod correlate_checks;
+mod docs_links;
 mod dopri5_contact_laws;
 mod ema_interop;
 mod esd_checks;

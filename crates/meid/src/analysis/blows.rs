@@ -32,7 +32,7 @@
 //! returns with the slow root of an overdamped oscillator (time constant ≈ c_d/k_d, 0.39 s on
 //! the paper example) and the dashpot rectifies the base's residual vibration
 //! (`k_d ⟨z_d − u_f⟩ = c_d ⟨max(−(ż_d − u̇_f), 0)⟩`), so at stroke rates faster than its
-//! return the damper no longer touches the bed after the first blow. docs/studies.md gives the
+//! return the damper no longer touches the bed after the first blow. docs/explanations/blows.md gives the
 //! figures, and the comb filter of the rigid-body mode that makes a single stroke rate a poor
 //! basis for comparing cases.
 //!

@@ -1,6 +1,6 @@
 //! From the floor to the neighbours: the foundation's impedances, its checks (block and anvil
 //! amplitude, pad stress, soil pressure) and the ground vibration at the model's receivers with
-//! DIN 4150-3's and the people-in-buildings checks (docs/foundation.md).
+//! DIN 4150-3's and the people-in-buildings checks (docs/explanations/foundation.md).
 //!
 //! Every number comes from meid's exact solution of one blow ([`crate::analysis::energy`]): the
 //! block's displacement, velocity and acceleration, the pad's compression and the soil's force

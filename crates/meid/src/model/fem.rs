@@ -1288,7 +1288,7 @@ fn warn_split_eigenspaces(
             warnings.push(format!(
                 "{base}.select keeps mode(s) {} of the modes {} that share one eigenvalue ({:.6} Hz): \
                  which direction within their eigenspace is kept is meid's canonical basis \
-                 (docs/fem.md, \"Repeated eigenvalues\"), not a property of the structure; select \
+                 (docs/explanations/fem.md, \"Repeated eigenvalues\"), not a property of the structure; select \
                  all of them{}",
                 one(&kept),
                 one(&all),
@@ -1362,7 +1362,7 @@ fn warn_split_damping(
             warnings.push(format!(
                 "structure.fem.damping_ratios: the modes {} share one eigenvalue ({:.6} Hz) but \
                  get different ratios ({}): the damping then depends on meid's canonical basis \
-                 of their eigenspace (docs/fem.md, \"Repeated eigenvalues\"); give them one ratio",
+                 of their eigenspace (docs/explanations/fem.md, \"Repeated eigenvalues\"); give them one ratio",
                 z.iter()
                     .map(|(j, _)| (j + 1).to_string())
                     .collect::<Vec<_>>()

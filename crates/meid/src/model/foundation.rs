@@ -1,5 +1,5 @@
 //! `[foundation]` and `[[receiver]]`: a rigid block on soil, its impedances, and the named
-//! receivers around it (docs/foundation.md).
+//! receivers around it (docs/explanations/foundation.md).
 //!
 //! # The block on the soil
 //! `[foundation]` names the lumped mass that rests on the soil (`mass`, e.g. the floating base
@@ -510,7 +510,7 @@ pub struct Impedance {
     pub source: &'static str,
 }
 
-/// Every impedance meid computes for the foundation (docs/foundation.md): the half-space's
+/// Every impedance meid computes for the foundation (docs/explanations/foundation.md): the half-space's
 /// analogs (Lysmer; Hall; Richart, Hall & Woods) and Gazetas' rectangle, or IS 2974's
 /// coefficients of elastic compression; a spring given directly has only its vertical.
 pub fn impedances(f: &Foundation) -> Vec<Impedance> {

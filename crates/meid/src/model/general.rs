@@ -1,6 +1,6 @@
 //! The general finite-element model section, `[structure.fem.model]`: any structure of nodes,
 //! shells, frames, springs, dashpots, point masses, rigid links and constraints, inline or from a
-//! Gmsh mesh (see `docs/model-format.md`).
+//! Gmsh mesh (see `docs/reference/model-file.md`).
 //!
 //! ```toml
 //! [structure.fem.model]
@@ -115,7 +115,7 @@ pub struct ShellSpec {
     /// Transverse shear correction factor κ (default 5/6; π²/12 matches Mindlin's plate).
     #[serde(default)]
     pub shear_factor: Option<f64>,
-    /// Part label (docs/model-format.md): `part = "bed"` marks the bed, whose mass is the
+    /// Part label (docs/reference/model-file.md): `part = "bed"` marks the bed, whose mass is the
     /// bed mass m_b of `md/mb` studies.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub part: Option<String>,
@@ -152,7 +152,7 @@ pub struct FrameSpec {
     /// [`crate::structure::frame`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub releases: Vec<ReleaseSpec>,
-    /// Part label (docs/model-format.md): `part = "bed"` marks the bed, whose mass is the
+    /// Part label (docs/reference/model-file.md): `part = "bed"` marks the bed, whose mass is the
     /// bed mass m_b of `md/mb` studies.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub part: Option<String>,
@@ -197,7 +197,7 @@ pub struct MassSpec {
     /// `[Ixx, Iyy, Izz]` about global axes through the node (kg·m²).
     #[serde(default)]
     pub inertia: Option<[f64; 3]>,
-    /// Part label (docs/model-format.md): `part = "bed"` marks the bed, whose mass is the
+    /// Part label (docs/reference/model-file.md): `part = "bed"` marks the bed, whose mass is the
     /// bed mass m_b of `md/mb` studies.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub part: Option<String>,

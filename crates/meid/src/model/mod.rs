@@ -3,7 +3,7 @@
 //! A model names a structure, the slider, an impact damper and/or an added mass at a named
 //! point (or neither), the two contacts and the simulation settings; under a lumped structure,
 //! optionally a `[foundation]` on soil and `[[receiver]]`s around it ([`foundation`]). See
-//! `docs/model-format.md` for the full reference and `examples/paper-lumped.toml` for a complete
+//! `docs/reference/model-file.md` for the full reference and `examples/paper-lumped.toml` for a complete
 //! file.
 //!
 //! # Units (SI throughout; field names carry no suffix except `frequencies_hz`)

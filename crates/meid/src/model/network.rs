@@ -8,7 +8,7 @@
 //! machine and are not mixed with the arrays: a file is one form or the other
 //! ([`is_general`]). The paper's form runs on the paper's engine, unchanged.
 //!
-//! Fields (SI units; `docs/model-format.md`, "General machines"):
+//! Fields (SI units; `docs/reference/model-file.md`, "General machines"):
 //!
 //! | section | fields |
 //! |---|---|

@@ -736,7 +736,7 @@ pub struct GroupSpringSpec {
     pub damping: Option<PerDirection>,
 }
 
-/// `[foundation]`: the block on the soil ([`super::foundation`], docs/foundation.md).
+/// `[foundation]`: the block on the soil ([`super::foundation`], docs/explanations/foundation.md).
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct FoundationSpec {

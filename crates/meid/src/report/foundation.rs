@@ -1,4 +1,4 @@
-//! The "Foundation and surroundings" section of a machine's page (docs/report.md): the block's
+//! The "Foundation and surroundings" section of a machine's page (docs/reference/report.md): the block's
 //! and the pad's numbers with their checks, the ground vibration against distance, DIN 4150-3's
 //! chart with each receiver's (frequency, PPV) point, the people-in-buildings table, and one
 //! verdict sentence per receiver on top, over the cases of the report's comparison.
@@ -391,7 +391,7 @@ fn block_table(f: &Foundation, first: &FoundationAssessment) -> Table {
             "equivalent radius r1 = √(L B/π)".into(),
             sig(f.equivalent_radius_m, 4),
             "m".into(),
-            "docs/foundation.md".into(),
+            "docs/explanations/foundation.md".into(),
         ],
         vec![
             "vertical spring k_z".into(),

@@ -101,7 +101,7 @@ pub fn section(dir: &Path, v: Option<&Validation>) -> Result<Section> {
     let mut blocks = Vec::new();
     match v {
         None => blocks.push(Block::Paragraph(
-            "No measurement compared: give measured records with meid report MODEL.toml --measured [CASE=]FILE … (UFF 58/58b or CSV; CASE: none, damper, added-mass) and, when the channel names do not say it, --channel NAME=B|floor|blow; or list them in the model's [measurement] files (docs/measure.md). The comparison is that of meid validate.".into(),
+            "No measurement compared: give measured records with meid report MODEL.toml --measured [CASE=]FILE … (UFF 58/58b or CSV; CASE: none, damper, added-mass) and, when the channel names do not say it, --channel NAME=B|floor|blow; or list them in the model's [measurement] files (docs/explanations/measure.md). The comparison is that of meid validate.".into(),
         )),
         Some(v) => {
             crate::io::write_json(&dir.join(DATA_FILE), v)?;

@@ -589,7 +589,7 @@ fn verdict(rows: &[ModeRow], hi_hz: f64, points: usize) -> String {
 pub fn section(dir: &Path, outcome: Option<&Outcome>) -> Result<Section> {
     let blocks = match outcome {
         None => vec![Block::Paragraph(
-            "No test against the model: give measured blows with meid report MODEL.toml --measured none=FILE, the blow force and responses at the model's points sampled together (UFF 58/58b, CSV), and the page shows their FRFs, the identified modes, the modes paired with the model's by the MAC and, with --fit PATH, the model updated to them (docs/report.md).".into(),
+            "No test against the model: give measured blows with meid report MODEL.toml --measured none=FILE, the blow force and responses at the model's points sampled together (UFF 58/58b, CSV), and the page shows their FRFs, the identified modes, the modes paired with the model's by the MAC and, with --fit PATH, the model updated to them (docs/reference/report.md).".into(),
         )],
         Some(Outcome::Skipped { reason }) => vec![Block::Paragraph(format!(
             "No test against the model: {reason}."

@@ -22,7 +22,7 @@
 //! through the footprint's edges, so the rigid patch is the same physical square on every mesh and
 //! refining the mesh converges to one answer (a plate with rigid square inclusions). A spider over
 //! "the ring of elements around the node" instead shrinks with the mesh and the bed mode then keeps
-//! falling (311 → 272 Hz from 4 to 20 elements per side; docs/paper-machine.md). Where two
+//! falling (311 → 272 Hz from 4 to 20 elements per side; docs/explanations/paper-machine.md). Where two
 //! footprints overlap, a node joins the first spider only, and a master is never a slave.
 //!
 //! Named points: `O_b` (bed centre, the slider contact point), `O_f` (base centre, where the

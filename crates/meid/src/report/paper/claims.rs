@@ -289,9 +289,9 @@ pub fn rows(r: &Runs) -> Vec<Row> {
 fn frequency_rows(r: &Runs, out: &mut Vec<Row>) {
     let hz = |base: Base, i: usize| r.both(base, |m, _| Some(m.mode_hz(i)));
     let tuned = [
-        "the model's support and column stiffnesses were tuned to the paper's frequencies (Table 1's k_f alone gives 5.46 Hz; docs/paper-machine.md), so agreement is by construction",
+        "the model's support and column stiffnesses were tuned to the paper's frequencies (Table 1's k_f alone gives 5.46 Hz; docs/explanations/paper-machine.md), so agreement is by construction",
         "",
-        "the tuned model misses the frequency: see docs/paper-machine.md",
+        "the tuned model misses the frequency: see docs/explanations/paper-machine.md",
     ];
     for (id, base, i) in [
         ("f6-soft", Base::Soft, 0),

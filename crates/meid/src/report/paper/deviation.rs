@@ -160,7 +160,7 @@ fn variants(base: Base) -> Vec<Variant> {
     );
     // The retained modes are then every mode in order: the reference mode (the paper's ω_6, the
     // vertical rigid-body mode; ω_4, the bed, without a base) is the FE machine's 5th (soft),
-    // 6th (stiff) or 4th (no base) mode (docs/paper-machine.md).
+    // 6th (stiff) or 4th (no base) mode (docs/explanations/paper-machine.md).
     x.rebuild = vec![
         "structure.fem.select=\"auto\"".into(),
         format!("structure.reference_mode={}", auto_reference(base)),

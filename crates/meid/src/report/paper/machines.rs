@@ -1,6 +1,6 @@
 //! The six machines of the paper study: the three configurations of section 4 (soft floating
 //! base, stiff floating base, no floating base), each as a two-mode lumped model and as the
-//! finite-element machine of `docs/paper-machine.md`, and the operating points S, T, U.
+//! finite-element machine of `docs/explanations/paper-machine.md`, and the operating points S, T, U.
 //!
 //! The model files are the repository's examples, compiled in (`include_str!`), so that
 //! `meid paper` runs from any directory.
@@ -203,7 +203,7 @@ fn lumped_overrides(base: Base) -> Result<Vec<String>> {
 
 /// Builds the six machines at their operating points: S (soft base) at ω_s = ω_d = 150 ω_6,
 /// T (stiff base) and U (no base) with the same K_s as S (section 4.2: "K_s at point T is the
-/// same as K_s at point S"; for U see `docs/paper.md`) and ω_d = ω_s. `w_s` of T and U is S's
+/// same as K_s at point S"; for U see `docs/explanations/paper.md`) and ω_d = ω_s. `w_s` of T and U is S's
 /// of the same kind (lumped or FE).
 pub fn build() -> Result<Vec<Machine>> {
     let mut out = Vec::new();

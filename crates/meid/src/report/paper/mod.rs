@@ -8,7 +8,7 @@
 //! data `figNN-*.csv`, and `paper.json` (operating points, table, deviation study, the
 //! resolutions used). Nothing is printed; [`PaperReport::table_text`] formats the table.
 //!
-//! The operating points (`docs/paper.md`): S on the soft base at ω_s/ω_6 = 150 with ω_d = ω_s
+//! The operating points (`docs/explanations/paper.md`): S on the soft base at ω_s/ω_6 = 150 with ω_d = ω_s
 //! (the point of Figs. 4 and 6 and the top of Table 1's K_s range); T on the stiff base with
 //! the K_s of S (section 4.2 says so) and ω_d = ω_s; U without a base with the same K_s and
 //! ω_d = ω_s (the paper gives no other value; the deviation study varies it).
@@ -637,7 +637,7 @@ fn page(r: &PaperReport, figs: &Figures, res: &Resolution) -> Page {
         id: "about".into(),
         heading: "What this page is".into(),
         blocks: vec![
-            Block::Paragraph("Every simulation study behind Figs. 2-19 of \"Application of Momentum Exchange Impact Dampers to Forging Machine\", run by meid on a two-mode lumped model and on the finite-element machine (docs/paper-machine.md) for the three configurations of the paper's section 4: soft floating base (k_f tuned to 6.35 Hz), stiff floating base (141 Hz) and no floating base. Each figure says which paper figure it reproduces; its data (CSV) and vector picture (SVG) are linked under it. The table compares every number the paper states with meid's, and the deviation study tests candidate explanations of the numbers meid does not reproduce.".into()),
+            Block::Paragraph("Every simulation study behind Figs. 2-19 of \"Application of Momentum Exchange Impact Dampers to Forging Machine\", run by meid on a two-mode lumped model and on the finite-element machine (docs/explanations/paper-machine.md) for the three configurations of the paper's section 4: soft floating base (k_f tuned to 6.35 Hz), stiff floating base (141 Hz) and no floating base. Each figure says which paper figure it reproduces; its data (CSV) and vector picture (SVG) are linked under it. The table compares every number the paper states with meid's, and the deviation study tests candidate explanations of the numbers meid does not reproduce.".into()),
             Block::Paragraph(format!(
                 "Resolution: energy maps {} × {} points, family curves {} points (extrema refined by Brent's method), spectra drawn at {} frequencies (mode peaks located exactly), energy histories sampled at {} MHz. Every number in the tables is computed by this run; none is typed in except the paper's.",
                 res.map_points, res.map_points, res.curve_points, res.spectrum_points, res.history_rate_hz / 1e6
