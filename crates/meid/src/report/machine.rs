@@ -1165,10 +1165,11 @@ impl MachineReport {
         let interval = runs.first().map_or(f64::NAN, |(_, r)| r.interval_s);
         let mut blocks = vec![
             Block::Paragraph(format!(
-                "{} blows at {} blows/min (interval {} s = 60/rate exactly); each blow starts from the state the previous one left, with a fresh slider at v_s. The model file has no stroke rate: it is the report's setting (meid report --rate-bpm). A single rate reads the rigid-body mode's comb filter as much as the damper (docs/explanations/blows.md, \"Repeated blows\"): check the neighbouring rates before concluding.",
+                "{} blows at {} blows/min (interval {} s = 60/rate exactly); each blow starts from the state the previous one left, with a fresh slider at v_s. The rate: {} (meid report --rate-bpm sets another). A single rate reads the rigid-body mode's comb filter as much as the damper (docs/explanations/blows.md, \"Repeated blows\"): check the neighbouring rates before concluding.",
                 self.options.blows,
                 figures::plain(self.rate_bpm),
-                figures::plain(interval)
+                figures::plain(interval),
+                self.rate_origin.describe()
             )),
             Block::Table(Table {
                 caption: "The last blow of each train".into(),
