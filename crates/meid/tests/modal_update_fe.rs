@@ -136,3 +136,73 @@ fn modal_update_recovers_thickness_and_spring_together() {
         assert!(err.abs() < 1e-5, "noise-free: {g} vs {t} ({err:e})");
     }
 }
+
+/// Issue 32 item 6d from modes *identified* from blows, as a test lab has them: the machine
+/// with its plate truly 3 % thinner and its springs truly 8 % stiffer struck three times,
+/// velocities at O_b, O_f and B with 0.2 % noise, modes identified on 2..400 Hz
+/// (`identify_checks::modes_from_blows`, the same chain as item 6b); the example is fitted to
+/// them. Both values come back within the issue's 1 %. (The identified modes carry the
+/// identification's own errors, about 3e-4 in the 6.35 Hz bounce mode's frequency on 2 s
+/// records, so the fit is not exact as with the model's own modes above.)
+#[test]
+fn modal_update_from_identified_modes_recovers_thickness_and_spring() {
+    const POINTS: [&str; 3] = ["O_b", "O_f", "B"];
+    let truth = [0.97 * 0.01095, 1.08 * 2.111e4];
+    let set: Vec<String> = [THICKNESS, SPRING]
+        .iter()
+        .zip(truth)
+        .map(|(p, v)| format!("{p}={v:e}"))
+        .collect();
+    let truth_model = machine(&set);
+    let n_band = truth_model
+        .structure
+        .omega_rad_per_s
+        .iter()
+        .filter(|w| **w / (2.0 * std::f64::consts::PI) < 400.0)
+        .count();
+    let ident =
+        crate::identify_checks::modes_from_blows(&truth_model, &POINTS, (2.0, 400.0), n_band);
+    assert_eq!(ident.modes.len(), n_band, "{:#?}", ident.modes);
+    let id = IdentifiedModes {
+        file: "identified from blows".into(),
+        points: POINTS
+            .iter()
+            .enumerate()
+            .map(|(k, n)| parse_point_label(&format!("{n}:{} +Z", k + 1)))
+            .collect(),
+        modes: ident
+            .modes
+            .iter()
+            .map(|m| IdentifiedMode {
+                frequency_hz: m.frequency_hz,
+                damping_ratio: m.damping_ratio,
+                shape: m.shape.clone(),
+            })
+            .collect(),
+    };
+    let base = machine(&[]);
+    let paths: Vec<String> = [THICKNESS, SPRING].iter().map(|p| p.to_string()).collect();
+    let params = parameters(&base, &paths, &BTreeMap::new()).unwrap();
+    let problem = ModalProblem::new(
+        &base,
+        params,
+        &id,
+        None,
+        Mapping::default(),
+        Settings::default(),
+        1.0,
+        FitSettings::default(),
+    )
+    .unwrap();
+    let c = calibrate_modal(&problem).unwrap();
+    assert!(c.converged, "{:?}", c.convergence);
+    assert_eq!(c.pairs.len(), id.modes.len());
+    for (g, t) in c.values().iter().zip(truth) {
+        let err = (g - t) / t;
+        eprintln!("from identified modes: {g:e} vs {t:e} ({err:.2e})");
+        assert!(err.abs() < 1e-2, "{g} vs {t} ({err:e})");
+    }
+    for p in &c.pairs {
+        assert!(p.error_after_percent.abs() < 0.1, "{p:?}");
+    }
+}
