@@ -155,7 +155,7 @@ fn lumped_example_blows_give_the_modal_model() {
     use meid::analysis::spectrum::TransientWindow;
     use meid::measure::frf::{estimate, FrfSettings};
     use meid::measure::process::Processing;
-    use meid::measure::{Quantity, Record};
+    use meid::measure::Quantity;
     use meid::model::{Case, Model};
 
     const FS: f64 = 20_000.0;
@@ -172,14 +172,7 @@ fn lumped_example_blows_give_the_modal_model() {
     let h = simulate(&sys, &o, true).unwrap().history.unwrap();
     let mut rng = SplitMix64::new(3);
     let mut channel = |name: &str, q: Quantity, v: &[f64]| {
-        let rms = (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
-        let mut out = Vec::new();
-        for _ in 0..3 {
-            let mut seg = vec![0.0; LEAD];
-            seg.extend(v.iter().take(SEGMENT - LEAD));
-            out.extend(seg.into_iter().map(|x| x + 0.002 * rms * rng.next_normal()));
-        }
-        Record::sampled(name, q, 0.0, 1.0 / FS, out, "synthetic")
+        three_noisy_blows(name, q, v, FS, LEAD, SEGMENT, &mut rng)
     };
     let records = vec![
         channel(
@@ -234,6 +227,27 @@ fn lumped_example_blows_give_the_modal_model() {
             got.damping_ratio_windowed
         );
     }
+}
+
+/// A record of three blows of `v` one after the other, each `segment` samples at `fs` Hz led
+/// by `lead` zeros, with white noise of 0.2 % of `v`'s r.m.s. added.
+fn three_noisy_blows(
+    name: &str,
+    q: meid::measure::Quantity,
+    v: &[f64],
+    fs: f64,
+    lead: usize,
+    segment: usize,
+    rng: &mut SplitMix64,
+) -> meid::measure::Record {
+    let rms = (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
+    let mut out = Vec::new();
+    for _ in 0..3 {
+        let mut seg = vec![0.0; lead];
+        seg.extend(v.iter().take(segment - lead));
+        out.extend(seg.into_iter().map(|x| x + 0.002 * rms * rng.next_normal()));
+    }
+    meid::measure::Record::sampled(name, q, 0.0, 1.0 / fs, out, "synthetic")
 }
 
 /// Identifies the modes of `m`'s machine from its own blows (no damper: the structure is linear
@@ -298,14 +312,7 @@ pub(crate) fn modes_from_blows(
 
     let mut rng = SplitMix64::new(11);
     let mut channel = |name: &str, q: Quantity, v: &[f64]| {
-        let rms = (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
-        let mut out = Vec::new();
-        for _ in 0..3 {
-            let mut seg = vec![0.0; LEAD];
-            seg.extend(v.iter().take(SEGMENT - LEAD));
-            out.extend(seg.into_iter().map(|x| x + 0.002 * rms * rng.next_normal()));
-        }
-        Record::sampled(name, q, 0.0, 1.0 / FS, out, "synthetic")
+        three_noisy_blows(name, q, v, FS, LEAD, SEGMENT, &mut rng)
     };
     let mut records: Vec<Record> = points
         .iter()

@@ -60,6 +60,29 @@ fn own_modes(m: &Model) -> IdentifiedModes {
     }
 }
 
+/// Fits `paths` of the example (from its values) to the modes `id`, checking that the fit
+/// converged and paired every mode.
+fn fit(paths: &[&str], id: &IdentifiedModes) -> meid::measure::modal_update::ModalCalibration {
+    let base = machine(&[]);
+    let paths: Vec<String> = paths.iter().map(|p| p.to_string()).collect();
+    let params = parameters(&base, &paths, &BTreeMap::new()).unwrap();
+    let problem = ModalProblem::new(
+        &base,
+        params,
+        id,
+        None,
+        Mapping::default(),
+        Settings::default(),
+        1.0,
+        FitSettings::default(),
+    )
+    .unwrap();
+    let c = calibrate_modal(&problem).unwrap();
+    assert!(c.converged, "{:?}", c.convergence);
+    assert_eq!(c.pairs.len(), id.modes.len());
+    c
+}
+
 /// Fits `paths` of the example to the modes of the example with `truth` set; returns the
 /// fitted values after checking the fit converged, every pair agrees after it and the
 /// intervals hold the true values.
@@ -72,23 +95,7 @@ fn recover(paths: &[&str], truth: &[f64]) -> Vec<f64> {
     let truth_model = machine(&set);
     let id = own_modes(&truth_model);
     assert!(id.modes.len() >= 2, "{} modes", id.modes.len());
-    let base = machine(&[]);
-    let paths: Vec<String> = paths.iter().map(|p| p.to_string()).collect();
-    let params = parameters(&base, &paths, &BTreeMap::new()).unwrap();
-    let problem = ModalProblem::new(
-        &base,
-        params,
-        &id,
-        None,
-        Mapping::default(),
-        Settings::default(),
-        1.0,
-        FitSettings::default(),
-    )
-    .unwrap();
-    let c = calibrate_modal(&problem).unwrap();
-    assert!(c.converged, "{:?}", c.convergence);
-    assert_eq!(c.pairs.len(), id.modes.len());
+    let c = fit(paths, &id);
     assert!(c.pairs.iter().any(|p| p.error_before_percent.abs() > 0.5));
     for p in &c.pairs {
         assert!(
@@ -170,33 +177,9 @@ fn modal_update_from_identified_modes_recovers_thickness_and_spring() {
             .enumerate()
             .map(|(k, n)| parse_point_label(&format!("{n}:{} +Z", k + 1)))
             .collect(),
-        modes: ident
-            .modes
-            .iter()
-            .map(|m| IdentifiedMode {
-                frequency_hz: m.frequency_hz,
-                damping_ratio: m.damping_ratio,
-                shape: m.shape.clone(),
-            })
-            .collect(),
+        modes: ident.modes.iter().map(IdentifiedMode::from).collect(),
     };
-    let base = machine(&[]);
-    let paths: Vec<String> = [THICKNESS, SPRING].iter().map(|p| p.to_string()).collect();
-    let params = parameters(&base, &paths, &BTreeMap::new()).unwrap();
-    let problem = ModalProblem::new(
-        &base,
-        params,
-        &id,
-        None,
-        Mapping::default(),
-        Settings::default(),
-        1.0,
-        FitSettings::default(),
-    )
-    .unwrap();
-    let c = calibrate_modal(&problem).unwrap();
-    assert!(c.converged, "{:?}", c.convergence);
-    assert_eq!(c.pairs.len(), id.modes.len());
+    let c = fit(&[THICKNESS, SPRING], &id);
     for (g, t) in c.values().iter().zip(truth) {
         let err = (g - t) / t;
         eprintln!("from identified modes: {g:e} vs {t:e} ({err:.2e})");

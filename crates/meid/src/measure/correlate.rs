@@ -80,6 +80,18 @@ pub struct IdentifiedMode {
     pub shape: Vec<f64>,
 }
 
+impl From<&crate::identify::Mode> for IdentifiedMode {
+    /// What correlation needs of a mode `meid identify` found: its frequency, damping ratio
+    /// (the window's decay removed) and real-normalised shape.
+    fn from(m: &crate::identify::Mode) -> Self {
+        Self {
+            frequency_hz: m.frequency_hz,
+            damping_ratio: m.damping_ratio,
+            shape: m.shape.clone(),
+        }
+    }
+}
+
 /// Identified modes read from a file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct IdentifiedModes {

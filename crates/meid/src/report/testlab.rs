@@ -498,15 +498,7 @@ fn identified(
                 p
             })
             .collect(),
-        modes: id
-            .modes
-            .iter()
-            .map(|m| IdentifiedMode {
-                frequency_hz: m.frequency_hz,
-                damping_ratio: m.damping_ratio,
-                shape: m.shape.clone(),
-            })
-            .collect(),
+        modes: id.modes.iter().map(IdentifiedMode::from).collect(),
     }
 }
 
