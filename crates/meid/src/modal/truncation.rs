@@ -36,7 +36,8 @@
 //! m_eff(P) = 1 / Σ_{retained} ψ_i(P)²        (kg),     per mode  m_i(P) = 1 / ψ_i(P)²,
 //! ```
 //!
-//! (the driving-point apparent mass at the instant of impact; with all modes of a lumped model
+//! (the driving-point apparent mass at the instant of impact, over the structure's retained
+//! modes: static-correction pseudo-modes are left out; with all modes of a lumped model
 //! retained, `Σ ψ_i(P)² = (M⁻¹)_PP` and `m_eff` is the mass lumped at P). This, not the bed's
 //! mass, is what a damper's mass should be compared with: the momentum exchange is between the
 //! damper and `m_eff`, and it is largest when `m_d / m_eff` is near 1.
@@ -65,8 +66,9 @@ pub struct TruncationRow {
     pub modal_flexibility_m_per_n: f64,
     /// `modal / static` (1 when the point does not move under a static load, `G_PP = 0`).
     pub captured_share: f64,
-    /// `m_eff(P) = 1/Σ ψ_i(P)²` over the retained modes (kg; module docs); `None` when no
-    /// retained mode moves P.
+    /// `m_eff(P) = 1/Σ ψ_i(P)²` over the retained modes of the structure (kg; module docs;
+    /// static-correction pseudo-modes left out: Ritz vectors whose ψ depend on the points
+    /// corrected, not a property of the structure); `None` when no retained mode moves P.
     pub effective_mass_kg: Option<f64>,
     /// The retained mode that moves P most (largest `ψ_i(P)²`; the structure's mode number)
     /// and its effective mass at P, `1/ψ_i(P)²` (kg).
@@ -144,9 +146,8 @@ impl ModalModel {
             };
             let modal = modal_flexibility(&self.omega_rad_per_s, psi);
             let share = if g > 0.0 { modal / g } else { 1.0 };
-            let (m_eff, _, _) = effective_mass(psi);
             let psi_modes = structural(psi);
-            let (_, dominant, m_dominant) = effective_mass(&psi_modes);
+            let (m_eff, dominant, m_dominant) = effective_mass(&psi_modes);
             let modes_share = corrected.then(|| {
                 let m = modal_flexibility(&self.omega_rad_per_s, &psi_modes);
                 if g > 0.0 {
@@ -233,7 +234,7 @@ pub fn to_text(rows: &[TruncationRow]) -> String {
     }
     s.push_str("  (m_eff = 1/sum psi^2 over the retained modes: the mass the structure opposes to a blow at the point)\n");
     if corrected {
-        s.push_str("  (with static correction: modal and share include the pseudo-modes, which restore the full static flexibility at the named points; the dominant mode is a structural one)\n");
+        s.push_str("  (with static correction: modal and share include the pseudo-modes, which restore the full static flexibility at the named points; m_eff and the dominant mode are over the structural modes)\n");
     }
     s
 }

@@ -7,6 +7,7 @@
 //! [structure.fem]
 //! select = "auto"            # or "participation", [6, 10] (1-based mode numbers), { band_hz = [1, 400] }
 //! damping_ratios = 0.01      # one value, or one per selected mode; or rayleigh = [alpha, beta]
+//! static_correction = true   # pseudo-modes restoring the static flexibility (default true)
 //! solver = "dense"           # or "lanczos" (default: dense below 1000 DOF)
 //! count = 30                 # modes computed (table length; Lanczos k)
 //!
@@ -51,7 +52,17 @@
 //! ([`crate::modal::eigenspace`]; one mode more than `count` is solved for it) and are kept
 //! together by "auto" and "participation".
 //!
-//! //! **Rayleigh damping** `C = αM + βK` gives the modal damping `D_ii = α + β ω_i²`.
+//! **Static correction** (`static_correction = true`, the default): after the selection, the
+//! selected modes are augmented by pseudo-modes, Ritz vectors built from the full model's static
+//! responses `K⁻¹ f_P` at the named points minus what the selected modes carry of them
+//! ([`crate::modal::static_correction`]): the reduced model then has the full model's static
+//! flexibility `G_PQ` at those points (up to the pseudo-modes left out beyond the resolved
+//! spread, with a note). Pseudo-modes are appended after the selected modes, labelled "static
+//! correction j", mode number 0, flagged in [`ModalModel::pseudo_modes`]; their damping is
+//! `α + β ω̃²` with Rayleigh damping (the exact projection) and, with modal ratios, the ratio of
+//! the highest selected mode.
+//!
+//! **Rayleigh damping** `C = αM + βK` gives the modal damping `D_ii = α + β ω_i²`.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
