@@ -509,7 +509,10 @@ fn every_study_prints_the_models_warnings() {
             .collect();
         args.splice(
             1..1,
-            ["--set".to_string(), "structure.fem.static_correction=false".to_string()],
+            [
+                "--set".to_string(),
+                "structure.fem.static_correction=false".to_string(),
+            ],
         );
         let out = in_dir(&d, &args).output().unwrap();
         assert!(out.status.success(), "{name}: {}", stderr(&out));

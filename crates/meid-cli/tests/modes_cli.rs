@@ -541,7 +541,13 @@ fn truncation_table_and_warnings_reach_the_output() {
     );
 
     let out = meid()
-        .args(["simulate", "--set", NO_CORRECTION, "--set", "structure.fem.select=\"auto\""])
+        .args([
+            "simulate",
+            "--set",
+            NO_CORRECTION,
+            "--set",
+            "structure.fem.select=\"auto\"",
+        ])
         .arg(&model)
         .output()
         .unwrap();
@@ -580,8 +586,18 @@ fn static_correction_brings_the_share_to_one() {
     assert!(alone > 0.5 && alone < 0.95, "{alone}");
     assert!(v["warnings"].as_array().unwrap().is_empty(), "{v}");
     let csv = std::fs::read_to_string(d.join("truncation.csv")).unwrap();
-    assert!(csv.lines().next().unwrap().ends_with(",static_correction,modes_share"), "{csv}");
-    let out = meid().args(["modes", "--json"]).arg(&model).output().unwrap();
+    assert!(
+        csv.lines()
+            .next()
+            .unwrap()
+            .ends_with(",static_correction,modes_share"),
+        "{csv}"
+    );
+    let out = meid()
+        .args(["modes", "--json"])
+        .arg(&model)
+        .output()
+        .unwrap();
     let v = common::ok_json(out);
     let pseudo = v["static_correction"].as_array().unwrap();
     assert!(!pseudo.is_empty(), "{v}");

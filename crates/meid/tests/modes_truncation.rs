@@ -643,6 +643,10 @@ fn static_correction_restores_the_share_and_silences_the_warning() {
     for i in 1..st.len() {
         assert!(st.is_pseudo(i), "{:?}", st.labels);
         assert_eq!(st.mode_numbers[i], 0);
-        assert!(st.labels[i].starts_with("static correction"), "{}", st.labels[i]);
+        assert!(
+            st.labels[i].starts_with("static correction"),
+            "{}",
+            st.labels[i]
+        );
     }
 }
