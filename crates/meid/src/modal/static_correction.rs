@@ -162,7 +162,7 @@ fn residual_basis(
         let before = dot(&r, &sparse_mul(m, &r)).max(0.0).sqrt();
         m_orthogonalise(m, &basis, &mut r, 2);
         let after = dot(&r, &sparse_mul(m, &r)).max(0.0).sqrt();
-        if !(after > DEPENDENT_NORM * before) {
+        if after.is_nan() || after <= DEPENDENT_NORM * before {
             notes.push(format!(
                 "static correction: point '{name}' adds no vector: its static response lies in \
                  the span of the modes and of the correction at {} (the same nodes, or a \
