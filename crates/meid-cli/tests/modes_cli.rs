@@ -491,13 +491,14 @@ fn gmsh_mesh_model_runs_through_simulate() {
 /// modes selected by index carry 84 % of the centre's static flexibility (< 95 %): a
 /// `warning:` line on stderr, a `warnings` list and a `truncation` table in the JSON of
 /// `meid simulate` and `meid modes`, and truncation.csv under -o. `select = "auto"` brings the
-/// share above 95 % and the warning goes.
+/// share above 95 % and the warning goes. (Without the static correction, which would bring
+/// the share to 1: `static_correction_brings_the_share_to_one`.)
 #[test]
 fn truncation_table_and_warnings_reach_the_output() {
     let model = data("clamped_plate.toml");
     let d = tmpdir("trunc");
     let out = meid()
-        .args(["simulate", "--json", "-o"])
+        .args(["simulate", "--set", NO_CORRECTION, "--json", "-o"])
         .arg(&d)
         .arg(&model)
         .output()
@@ -529,7 +530,7 @@ fn truncation_table_and_warnings_reach_the_output() {
     assert_eq!(csv.lines().count(), 3);
 
     let out = meid()
-        .args(["modes", "--json"])
+        .args(["modes", "--set", NO_CORRECTION, "--json"])
         .arg(&model)
         .output()
         .unwrap();
@@ -540,7 +541,13 @@ fn truncation_table_and_warnings_reach_the_output() {
     );
 
     let out = meid()
-        .args(["simulate", "--set", "structure.fem.select=\"auto\""])
+        .args([
+            "simulate",
+            "--set",
+            NO_CORRECTION,
+            "--set",
+            "structure.fem.select=\"auto\"",
+        ])
         .arg(&model)
         .output()
         .unwrap();
@@ -551,6 +558,53 @@ fn truncation_table_and_warnings_reach_the_output() {
     );
     let text = common::ok(out);
     assert!(text.contains("static flexibility captured"), "{text}");
+}
+
+/// The static correction off (`--set`), for the tests of the uncorrected truncation table.
+const NO_CORRECTION: &str = "structure.fem.static_correction=false";
+
+/// The clamped plate's three modes by index with the static correction (the default): the
+/// JSON rows say `static_correction: true`, the share at the centre is 1 up to round-off with
+/// the modes' own share (84 %) beside it, no warning; `meid modes` lists the pseudo-modes as
+/// "static correction", apart from the structure's modes; truncation.csv carries both.
+#[test]
+fn static_correction_brings_the_share_to_one() {
+    let model = data("clamped_plate.toml");
+    let d = tmpdir("corrected");
+    let out = meid()
+        .args(["simulate", "--json", "-o"])
+        .arg(&d)
+        .arg(&model)
+        .output()
+        .unwrap();
+    let v = common::ok_json(out);
+    let t = v["truncation"].as_array().unwrap();
+    assert_eq!(t[0]["static_correction"], true);
+    let share = t[0]["captured_share"].as_f64().unwrap();
+    assert!((share - 1.0).abs() <= 1e-9, "{share}");
+    let alone = t[0]["modes_share"].as_f64().unwrap();
+    assert!(alone > 0.5 && alone < 0.95, "{alone}");
+    assert!(v["warnings"].as_array().unwrap().is_empty(), "{v}");
+    let csv = std::fs::read_to_string(d.join("truncation.csv")).unwrap();
+    assert!(
+        csv.lines()
+            .next()
+            .unwrap()
+            .ends_with(",static_correction,modes_share"),
+        "{csv}"
+    );
+    let out = meid()
+        .args(["modes", "--json"])
+        .arg(&model)
+        .output()
+        .unwrap();
+    let v = common::ok_json(out);
+    let pseudo = v["static_correction"].as_array().unwrap();
+    assert!(!pseudo.is_empty(), "{v}");
+    assert_eq!(v["selected"].as_array().unwrap().len(), 3);
+    let out = meid().args(["modes"]).arg(&model).output().unwrap();
+    let text = common::ok(out);
+    assert!(text.contains("static correction 1"), "{text}");
 }
 
 /// A "rigid" 1e16 N/m column in the lumped example is merged: the human output carries a

@@ -22,11 +22,12 @@ fn load(name: &str) -> Model {
 }
 
 /// Selected frequencies (Hz) of an example with `[structure.fem]`.
+/// The selected modes of the structure (Hz), without the static correction's pseudo-modes.
 fn selected_hz(m: &Model) -> Vec<f64> {
-    m.structure
-        .omega_rad_per_s
-        .iter()
-        .map(|w| w / (2.0 * std::f64::consts::PI))
+    let s = &m.structure;
+    (0..s.len())
+        .filter(|&i| !s.is_pseudo(i))
+        .map(|i| s.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI))
         .collect()
 }
 

@@ -140,7 +140,12 @@ fn load(tag: &str, fem_extra: &str) -> Model {
 /// default keeps it, captures ≥ 95 % at O_b, and the old selection reports its loss.
 #[test]
 fn auto_keeps_the_bounce_mode_the_old_rule_dropped() {
-    let old = load("old", "select = \"participation\"\nauto_count = 2");
+    // Without the static correction, which would restore the share (see
+    // `static_correction_restores_the_share_and_silences_the_warning`).
+    let old = load(
+        "old",
+        "select = \"participation\"\nauto_count = 2\nstatic_correction = false",
+    );
     let f0 = old.structure.omega_rad_per_s[0] / (2.0 * std::f64::consts::PI);
     assert!(
         f0 > 100.0,
@@ -159,11 +164,10 @@ fn auto_keeps_the_bounce_mode_the_old_rule_dropped() {
     );
 
     let new = load("new", "");
-    let f: Vec<f64> = new
-        .structure
-        .omega_rad_per_s
-        .iter()
-        .map(|w| w / (2.0 * std::f64::consts::PI))
+    let st = &new.structure;
+    let f: Vec<f64> = (0..st.len())
+        .filter(|&i| !st.is_pseudo(i))
+        .map(|i| st.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI))
         .collect();
     // The bounce: a rigid plate on 4 kz: sqrt(4 kz / m)/2π = 14 Hz (the plate's bending lowers
     // it a little).
@@ -234,7 +238,7 @@ fn auto_keeps_every_participating_mode_below_the_cutoff() {
 /// is warned about, in the diagnostics and on the CLI's stderr.
 #[test]
 fn truncated_selection_reports_a_small_share_and_a_warning() {
-    let m = load("trunc", "select = [7]");
+    let m = load("trunc", "select = [7]\nstatic_correction = false");
     let d = m.diagnostics();
     // O_b and B name the same node: two rows, two warnings.
     assert_eq!(d.truncation.len(), 2);
@@ -610,5 +614,39 @@ fn a_repeated_eigenvalue_gives_the_same_modes_whatever_the_solver() {
         let total: f64 = an.table.total_mass.iter().sum();
         assert!(an.table.effective_mass[19][1] <= 1e-9 * total);
         assert!(psi20(an) > 1.13, "{}", psi20(an));
+    }
+}
+
+/// The selection of `truncated_selection_reports_a_small_share_and_a_warning` (one plate mode
+/// of the sprung plate, < 95 % at O_b) with the static correction on (the default): the
+/// pseudo-modes restore the full static flexibility, so the share at O_b and B is 1 up to
+/// round-off, the rows say `static_correction` with the modes' own share below 95 %, and no
+/// truncation warning is left; the pseudo-modes are labelled "static correction", numbered 0.
+#[test]
+fn static_correction_restores_the_share_and_silences_the_warning() {
+    let m = load("corrected", "select = [7]");
+    let d = m.diagnostics();
+    assert_eq!(d.truncation.len(), 2);
+    for r in &d.truncation {
+        assert!(r.static_correction, "{r:?}");
+        assert!((r.captured_share - 1.0).abs() <= 1e-9, "{r:?}");
+        assert!(r.modes_share.is_some_and(|s| s < 0.95), "{r:?}");
+        assert_eq!(r.dominant_mode, Some(7), "{r:?}");
+    }
+    assert!(
+        !d.warnings.iter().any(|w| w.contains("static flexibility")),
+        "{:?}",
+        d.warnings
+    );
+    let st = &m.structure;
+    assert!(st.len() > 1 && !st.is_pseudo(0));
+    for i in 1..st.len() {
+        assert!(st.is_pseudo(i), "{:?}", st.labels);
+        assert_eq!(st.mode_numbers[i], 0);
+        assert!(
+            st.labels[i].starts_with("static correction"),
+            "{}",
+            st.labels[i]
+        );
     }
 }

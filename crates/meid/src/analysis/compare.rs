@@ -552,17 +552,19 @@ impl Comparison {
             .reference_mode()
             .map(|r| (r.index, r.number))
             .or_else(|| {
-                (0..n).find(|&i| st.omega_rad_per_s[i] > 0.0).map(|i| {
-                    (
-                        i,
-                        self.model
-                            .structure
-                            .mode_numbers
-                            .get(i)
-                            .copied()
-                            .unwrap_or(i + 1),
-                    )
-                })
+                (0..n)
+                    .find(|&i| st.omega_rad_per_s[i] > 0.0 && !st.is_pseudo(i))
+                    .map(|i| {
+                        (
+                            i,
+                            self.model
+                                .structure
+                                .mode_numbers
+                                .get(i)
+                                .copied()
+                                .unwrap_or(i + 1),
+                        )
+                    })
             });
         let mut out = Vec::new();
         if let Some((r, number)) = reference {
@@ -574,7 +576,8 @@ impl Comparison {
         let pm = &bare.points.measurement;
         let mut best: Option<(usize, f64)> = None;
         for i in 0..n {
-            if Some(i) == reference.map(|r| r.0) || st.omega_rad_per_s[i] <= 0.0 {
+            if Some(i) == reference.map(|r| r.0) || st.omega_rad_per_s[i] <= 0.0 || st.is_pseudo(i)
+            {
                 continue;
             }
             let w = pb[i].abs() * pm[i].abs();

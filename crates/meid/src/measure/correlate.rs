@@ -388,19 +388,27 @@ pub fn geometry_coordinates(m: &Model) -> BTreeMap<String, [f64; 3]> {
 }
 
 impl ModelModes {
-    /// From the model's modes; `coordinates` of an FE model's points (the means of their
-    /// nodes), or `None` for the display line ([`geometry_coordinates`]).
+    /// From the model's modes (the structure's: static-correction pseudo-modes are not modes
+    /// a test can measure, and are left out); `coordinates` of an FE model's points (the means
+    /// of their nodes), or `None` for the display line ([`geometry_coordinates`]).
     pub fn new(model: &Model, coordinates: Option<BTreeMap<String, [f64; 3]>>) -> Self {
         let geometric = coordinates.is_some();
         let m = &model.structure;
+        let keep: Vec<usize> = (0..m.len()).filter(|&i| !m.is_pseudo(i)).collect();
         ModelModes {
-            frequencies_hz: m
-                .omega_rad_per_s
+            frequencies_hz: keep
                 .iter()
-                .map(|w| w / (2.0 * std::f64::consts::PI))
+                .map(|&i| m.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI))
                 .collect(),
-            labels: m.labels.clone(),
-            points: m.points.clone(),
+            labels: keep
+                .iter()
+                .map(|&i| m.labels.get(i).cloned().unwrap_or_default())
+                .collect(),
+            points: m
+                .points
+                .iter()
+                .map(|(k, v)| (k.clone(), keep.iter().map(|&i| v[i]).collect()))
+                .collect(),
             coordinates: coordinates.unwrap_or_else(|| geometry_coordinates(model)),
             geometric,
         }

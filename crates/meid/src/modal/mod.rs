@@ -15,7 +15,8 @@
 //! Submodules: [`check`] (every computed set of modes checked against stated bounds; rigid-body
 //! modes from the problem itself), [`dense`] (dense generalised symmetric eigen-solver), [`eigenspace`] (repeated eigenvalues: a
 //! basis of their eigenspace that does not depend on the solver), [`lanczos`]
-//! (sparse shift-invert block Lanczos for large models), [`truncation`] (the static flexibility
+//! (sparse shift-invert block Lanczos for large models), [`static_correction`] (pseudo-modes that
+//! restore the static flexibility a truncation loses at the named points), [`truncation`] (the static flexibility
 //! a set of retained modes captures at the named points), [`conditioning`] (spreads double
 //! precision cannot carry).
 //!
@@ -29,6 +30,7 @@ pub mod dense;
 pub mod eigenspace;
 pub(crate) mod kernels;
 pub mod lanczos;
+pub mod static_correction;
 pub mod truncation;
 
 use std::collections::BTreeMap;
@@ -109,6 +111,13 @@ pub struct ModalModel {
     /// every node of the bed contact point is on them (`Mesh::mass_of`, computed from the
     /// mesh the modes came from); `None` otherwise.
     pub bed_mass_kg: Option<f64>,
+    /// Per retained mode, for a static-correction pseudo-mode ([`static_correction`]: a Ritz
+    /// vector that restores the static flexibility of the modes left out, not a mode of the
+    /// structure; its `mode_numbers` entry is 0 and its label "static correction j") the named
+    /// point whose flexibility it carries most; `None` for a mode of the structure. Empty when
+    /// the model has none (lumped, tabulated and imported structures, `static_correction =
+    /// false`).
+    pub pseudo_modes: Vec<Option<String>>,
     /// The file of imported modes (`[structure.modes]`) when neither it (UFF dataset 164) nor
     /// the model (`structure.modes.units`) states their units: read as SI, and checked
     /// against the slider by [`crate::model::Model::diagnostics`]. `None` for every other
@@ -144,6 +153,7 @@ impl ModalModel {
             notes: Vec::new(),
             warnings: Vec::new(),
             bed_mass_kg: None,
+            pseudo_modes: Vec::new(),
             unstated_units: None,
         })
     }
@@ -156,6 +166,12 @@ impl ModalModel {
     /// True when no mode is retained.
     pub fn is_empty(&self) -> bool {
         self.omega_rad_per_s.is_empty()
+    }
+
+    /// Whether retained mode `i` (0-based) is a static-correction pseudo-mode
+    /// ([`ModalModel::pseudo_modes`]).
+    pub fn is_pseudo(&self, i: usize) -> bool {
+        self.pseudo_modes.get(i).is_some_and(Option::is_some)
     }
 
     /// Mode-shape values at a named point.
@@ -253,6 +269,8 @@ impl ModalModel {
             warnings: self.warnings.clone(),
             // The bare structure's bed, as the mass ratio md/mb means it.
             bed_mass_kg: self.bed_mass_kg,
+            // The Ritz re-diagonalisation mixes pseudo-modes with structural ones.
+            pseudo_modes: Vec::new(),
             unstated_units: self.unstated_units.clone(),
         })
     }
@@ -276,6 +294,15 @@ impl ModalModel {
                     format!("must be finite and >= 0 rad/s (got {w})"),
                 ));
             }
+        }
+        if !(self.pseudo_modes.is_empty() || self.pseudo_modes.len() == n) {
+            return Err(Error::invalid(
+                "modes",
+                format!(
+                    "{} static-correction flags for {n} modes: give one per mode or none",
+                    self.pseudo_modes.len()
+                ),
+            ));
         }
         if self.damping.iter().any(|d| !d.is_finite()) {
             return Err(Error::invalid(

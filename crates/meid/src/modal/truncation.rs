@@ -36,7 +36,8 @@
 //! m_eff(P) = 1 / Σ_{retained} ψ_i(P)²        (kg),     per mode  m_i(P) = 1 / ψ_i(P)²,
 //! ```
 //!
-//! (the driving-point apparent mass at the instant of impact; with all modes of a lumped model
+//! (the driving-point apparent mass at the instant of impact, over the structure's retained
+//! modes: static-correction pseudo-modes are left out; with all modes of a lumped model
 //! retained, `Σ ψ_i(P)² = (M⁻¹)_PP` and `m_eff` is the mass lumped at P). This, not the bed's
 //! mass, is what a damper's mass should be compared with: the momentum exchange is between the
 //! damper and `m_eff`, and it is largest when `m_d / m_eff` is near 1.
@@ -65,8 +66,9 @@ pub struct TruncationRow {
     pub modal_flexibility_m_per_n: f64,
     /// `modal / static` (1 when the point does not move under a static load, `G_PP = 0`).
     pub captured_share: f64,
-    /// `m_eff(P) = 1/Σ ψ_i(P)²` over the retained modes (kg; module docs); `None` when no
-    /// retained mode moves P.
+    /// `m_eff(P) = 1/Σ ψ_i(P)²` over the retained modes of the structure (kg; module docs;
+    /// static-correction pseudo-modes left out: Ritz vectors whose ψ depend on the points
+    /// corrected, not a property of the structure); `None` when no retained mode moves P.
     pub effective_mass_kg: Option<f64>,
     /// The retained mode that moves P most (largest `ψ_i(P)²`; the structure's mode number)
     /// and its effective mass at P, `1/ψ_i(P)²` (kg).
@@ -80,6 +82,15 @@ pub struct TruncationRow {
     /// is unknown, or where P hardly moves under that force (`|G_{P,O_b}| < 1e-3 √(G_PP G_OO)`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub blow_response_share: Option<f64>,
+    /// Whether the retained set includes static-correction pseudo-modes
+    /// ([`super::static_correction`]): then `modal_flexibility_m_per_n` and `captured_share`
+    /// are those of the corrected basis (1 up to round-off at a corrected point) and
+    /// `modes_share` is what the structural modes alone carry.
+    pub static_correction: bool,
+    /// With the static correction, the share `Σ_{structural} ψ²/ω² / G_PP` the retained
+    /// structural modes carry alone (what the table showed without correction).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub modes_share: Option<f64>,
 }
 
 /// `(m_eff, dominant mode index, its 1/ψ²)` at a point with mode-shape values `psi` (module
@@ -120,13 +131,31 @@ impl ModalModel {
             .find(|(_, roles)| roles.iter().any(|r| r == "bed_contact"))
             .map(|(name, _)| name.as_str());
         let mut rows = Vec::new();
+        let corrected = (0..self.len()).any(|i| self.is_pseudo(i));
+        // The structural modes alone: pseudo-modes count for nothing in the dominant mode and
+        // the modes-only share.
+        let structural = |v: &[f64]| -> Vec<f64> {
+            v.iter()
+                .enumerate()
+                .map(|(i, x)| if self.is_pseudo(i) { 0.0 } else { *x })
+                .collect()
+        };
         for (name, roles) in points {
             let (Some(&g), Ok(psi)) = (self.static_flexibility.get(name), self.point(name)) else {
                 continue;
             };
             let modal = modal_flexibility(&self.omega_rad_per_s, psi);
             let share = if g > 0.0 { modal / g } else { 1.0 };
-            let (m_eff, dominant, m_dominant) = effective_mass(psi);
+            let psi_modes = structural(psi);
+            let (m_eff, dominant, m_dominant) = effective_mass(&psi_modes);
+            let modes_share = corrected.then(|| {
+                let m = modal_flexibility(&self.omega_rad_per_s, &psi_modes);
+                if g > 0.0 {
+                    m / g
+                } else {
+                    1.0
+                }
+            });
             rows.push(TruncationRow {
                 point: name.clone(),
                 roles: roles.clone(),
@@ -137,6 +166,8 @@ impl ModalModel {
                 dominant_mode: dominant.map(|i| self.mode_numbers.get(i).copied().unwrap_or(i + 1)),
                 dominant_mode_effective_mass_kg: m_dominant,
                 blow_response_share: struck.and_then(|o| self.blow_response_share(name, o, g)),
+                static_correction: corrected,
+                modes_share,
             });
         }
         rows
@@ -179,14 +210,19 @@ pub fn to_text(rows: &[TruncationRow]) -> String {
         "point", "G_PP m/N", "modal m/N", "share", "m_eff kg", "mode: 1/psi^2 kg"
     );
     let kg = |v: Option<f64>| v.map_or("—".to_string(), |m| format!("{m:.4}"));
+    let corrected = rows.iter().any(|r| r.static_correction);
     for r in rows {
         let dominant = match (r.dominant_mode, r.dominant_mode_effective_mass_kg) {
             (Some(n), Some(m)) => format!("{n}: {m:.4}"),
             _ => "—".to_string(),
         };
+        let alone = match r.modes_share {
+            Some(m) => format!("  (modes alone {:.3} %)", 100.0 * m),
+            None => String::new(),
+        };
         let _ = writeln!(
             s,
-            "  {:<w$} {:>14.6e} {:>14.6e} {:>9.3} % {:>12} {:>20}  {}",
+            "  {:<w$} {:>14.6e} {:>14.6e} {:>9.3} % {:>12} {:>20}  {}{alone}",
             r.point,
             r.static_flexibility_m_per_n,
             r.modal_flexibility_m_per_n,
@@ -197,20 +233,24 @@ pub fn to_text(rows: &[TruncationRow]) -> String {
         );
     }
     s.push_str("  (m_eff = 1/sum psi^2 over the retained modes: the mass the structure opposes to a blow at the point)\n");
+    if corrected {
+        s.push_str("  (with static correction: modal and share include the pseudo-modes, which restore the full static flexibility at the named points; m_eff and the dominant mode are over the structural modes)\n");
+    }
     s
 }
 
 /// CSV: `point,roles,static_flexibility_m_per_n,modal_flexibility_m_per_n,captured_share,
-/// effective_mass_kg,dominant_mode,dominant_mode_effective_mass_kg` (roles separated by `;`;
-/// an empty field where no retained mode moves the point).
+/// effective_mass_kg,dominant_mode,dominant_mode_effective_mass_kg,static_correction,
+/// modes_share` (roles separated by `;`; an empty field where no retained mode moves the point
+/// or, for `modes_share`, without static correction).
 pub fn to_csv(rows: &[TruncationRow]) -> String {
     let mut s = String::from(
-        "point,roles,static_flexibility_m_per_n,modal_flexibility_m_per_n,captured_share,effective_mass_kg,dominant_mode,dominant_mode_effective_mass_kg\n",
+        "point,roles,static_flexibility_m_per_n,modal_flexibility_m_per_n,captured_share,effective_mass_kg,dominant_mode,dominant_mode_effective_mass_kg,static_correction,modes_share\n",
     );
     let opt = |v: Option<f64>| v.map_or(String::new(), |m| format!("{m:e}"));
     for r in rows {
         s.push_str(&format!(
-            "{},{},{:e},{:e},{:e},{},{},{}\n",
+            "{},{},{:e},{:e},{:e},{},{},{},{},{}\n",
             r.point,
             r.roles.join(";"),
             r.static_flexibility_m_per_n,
@@ -218,7 +258,9 @@ pub fn to_csv(rows: &[TruncationRow]) -> String {
             r.captured_share,
             opt(r.effective_mass_kg),
             r.dominant_mode.map_or(String::new(), |n| n.to_string()),
-            opt(r.dominant_mode_effective_mass_kg)
+            opt(r.dominant_mode_effective_mass_kg),
+            r.static_correction,
+            opt(r.modes_share)
         ));
     }
     s
@@ -248,8 +290,13 @@ pub fn share_warning(row: &TruncationRow) -> Option<String> {
         ),
         None => String::new(),
     };
+    let carriers = if row.static_correction {
+        "retained modes with their static correction (a pseudo-mode was left out: see the notes)"
+    } else {
+        "retained modes"
+    };
     Some(format!(
-        "the retained modes carry {:.2} % of the static flexibility at point '{}'{roles} \
+        "the {carriers} carry {:.2} % of the static flexibility at point '{}'{roles} \
          ({:.4e} of {:.4e} m/N): a mode that moves this point is missing{effect}; keep more \
          modes (select = \"auto\", a larger `count`, or add the missing mode numbers to \
          `select`)",
@@ -287,15 +334,24 @@ pub fn static_flexibility_matrix(
     lowest_elastic: Option<f64>,
 ) -> Result<Vec<Vec<f64>>> {
     let u = static_deflections(k, m, functionals, rigid, lowest_elastic)?;
-    let n = k.nrows();
-    Ok(functionals
+    Ok(flexibility_of_deflections(functionals, u.as_ref()))
+}
+
+/// `G_PQ = f_Pᵀ u_Q` (rows P, columns Q) from the static deflections `u` of
+/// [`static_deflections`] (one column per point of `functionals`).
+pub fn flexibility_of_deflections(
+    functionals: &[Vec<f64>],
+    u: faer::MatRef<'_, f64>,
+) -> Vec<Vec<f64>> {
+    let n = u.nrows();
+    functionals
         .iter()
         .map(|f| {
             (0..u.ncols())
                 .map(|c| (0..n).map(|i| f[i] * u[(i, c)]).sum())
                 .collect()
         })
-        .collect())
+        .collect()
 }
 
 /// The off-diagonal entries of a [`static_flexibility_matrix`] by point names: `map[P][Q] =
@@ -330,8 +386,9 @@ pub fn modal_cross_flexibility(omega_rad_per_s: &[f64], psi_p: &[f64], psi_q: &[
 
 /// The elastic static deflections `u_Q` (columns) under unit loads at the points of
 /// `functionals` (module docs: Cholesky of K, or the inertia-relief iteration with rigid-body
-/// modes, converged on the diagonal `f_Qᵀ u_Q`).
-fn static_deflections(
+/// modes, converged on the diagonal `f_Qᵀ u_Q`). One factorisation serves every point: the
+/// truncation table and the static correction ([`super::static_correction`]) share them.
+pub fn static_deflections(
     k: SparseColMatRef<'_, usize, f64>,
     m: SparseColMatRef<'_, usize, f64>,
     functionals: &[Vec<f64>],
@@ -462,6 +519,8 @@ mod tests {
             dominant_mode: Some(1),
             dominant_mode_effective_mass_kg: Some(1.0),
             blow_response_share: None,
+            static_correction: false,
+            modes_share: None,
         };
         let text = to_text(&[row]);
         assert!(!text.contains("-0"), "{text}");

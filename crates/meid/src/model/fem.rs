@@ -7,6 +7,7 @@
 //! [structure.fem]
 //! select = "auto"            # or "participation", [6, 10] (1-based mode numbers), { band_hz = [1, 400] }
 //! damping_ratios = 0.01      # one value, or one per selected mode; or rayleigh = [alpha, beta]
+//! static_correction = true   # pseudo-modes restoring the static flexibility (default true)
 //! solver = "dense"           # or "lanczos" (default: dense below 1000 DOF)
 //! count = 30                 # modes computed (table length; Lanczos k)
 //!
@@ -51,7 +52,17 @@
 //! ([`crate::modal::eigenspace`]; one mode more than `count` is solved for it) and are kept
 //! together by "auto" and "participation".
 //!
-//! //! **Rayleigh damping** `C = αM + βK` gives the modal damping `D_ii = α + β ω_i²`.
+//! **Static correction** (`static_correction = true`, the default): after the selection, the
+//! selected modes are augmented by pseudo-modes, Ritz vectors built from the full model's static
+//! responses `K⁻¹ f_P` at the named points minus what the selected modes carry of them
+//! ([`crate::modal::static_correction`]): the reduced model then has the full model's static
+//! flexibility `G_PQ` at those points (up to the pseudo-modes left out beyond the resolved
+//! spread, with a note). Pseudo-modes are appended after the selected modes, labelled "static
+//! correction j", mode number 0, flagged in [`ModalModel::pseudo_modes`]; their damping is
+//! `α + β ω̃²` with Rayleigh damping (the exact projection) and, with modal ratios, the ratio of
+//! the highest selected mode.
+//!
+//! **Rayleigh damping** `C = αM + βK` gives the modal damping `D_ii = α + β ω_i²`.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -71,7 +82,7 @@ use super::spec::{ContactSpec, LawSpec, ModelSpec, Ratios};
 use super::{Model, Source};
 use crate::modal::dense::{DenseModes, DEFAULT_RELATIVE_SHIFT};
 use crate::modal::lanczos::{self, LanczosOptions};
-use crate::modal::{truncation, ModalModel};
+use crate::modal::{static_correction, truncation, ModalModel};
 use crate::structure::machine::{AddedMass, Plate, PlateSpec};
 use crate::structure::{FeModel, MachineSpec, Material, Mesh, ModeTable, Section, Support};
 use crate::{Error, Result};
@@ -928,8 +939,8 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             *s += v * v;
         }
     }
-    let (static_flexibility, static_cross) =
-        full_static_flexibility(&model, &modes, &functionals, &mut warnings);
+    let statics = full_static_flexibility(&model, &modes, &functionals, &mut warnings);
+    let (static_flexibility, static_cross) = (statics.diagonal.clone(), statics.cross.clone());
     let freq = &table.frequency_hz;
     let input = AutoInput {
         scores: &scores,
@@ -945,7 +956,16 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
     warn_split_eigenspaces(&selected, &cluster, freq, &mut warnings);
     let zeta = damping_ratios(spec, src, selected.len())?;
     warn_split_damping(&selected, &zeta, &cluster, freq, &mut warnings);
-    let mut modal = reduced_model(spec, src, &model, &modes, &selected, &zeta)?;
+    let corrected = correct_statically(spec, &model, &modes, &selected, &functionals, &statics)?;
+    let mut modal = match &corrected {
+        Some(c) => corrected_model(spec, src, &model, &modes, &selected, &zeta, c)?,
+        None => reduced_model(spec, src, &model, &modes, &selected, &zeta)?,
+    };
+    if let Some(c) = &corrected {
+        modal
+            .notes
+            .extend(c.notes.iter().map(|n| format!("{base}: {n}")));
+    }
     let selected_residuals = sparse_residuals(&model, &modes, &selected);
     warn_residuals(&selected, &selected_residuals, freq, &mut warnings);
     modal.static_flexibility = static_flexibility;
@@ -1140,38 +1160,147 @@ fn rigid_and_lowest(modes: &DenseModes) -> (Vec<Vec<f64>>, Option<f64>) {
     (rigid, lowest_elastic)
 }
 
+/// The full model's static solution at the named points ([`full_static_flexibility`]).
+#[derive(Default)]
+struct Statics {
+    /// `G_PP` by point name (m/N, elastic part).
+    diagonal: BTreeMap<String, f64>,
+    /// `G_PQ` (P ≠ Q) by point names.
+    cross: CrossFlexibility,
+    /// The deflections `u_P` (columns, in the order of the functionals) and `G_PP` in that
+    /// order; `None` when the static solution failed.
+    deflections: Option<(faer::Mat<f64>, Vec<f64>)>,
+}
+
 /// The full model's static flexibility `G_PP` (m/N, elastic part, module docs) at each point
-/// of `functionals`, and the cross flexibilities `G_PQ` (P ≠ Q); empty, with a warning, when the
-/// static solution fails.
+/// of `functionals`, the cross flexibilities `G_PQ` (P ≠ Q) and the deflections (one
+/// factorisation for the truncation table and the static correction); empty, with a warning,
+/// when the static solution fails.
 fn full_static_flexibility(
     model: &FeModel,
     modes: &DenseModes,
     functionals: &[(String, Vec<f64>)],
     warnings: &mut Vec<String>,
-) -> (BTreeMap<String, f64>, CrossFlexibility) {
+) -> Statics {
     let (rigid, lowest_elastic) = rigid_and_lowest(modes);
     let fvecs: Vec<Vec<f64>> = functionals.iter().map(|(_, f)| f.clone()).collect();
-    match truncation::static_flexibility_matrix(
+    match truncation::static_deflections(
         model.stiffness.as_ref(),
         model.mass.as_ref(),
         &fvecs,
         &rigid,
         lowest_elastic,
     ) {
-        Ok(g) => {
+        Ok(u) => {
+            let g = truncation::flexibility_of_deflections(&fvecs, u.as_ref());
             let names: Vec<&String> = functionals.iter().map(|(p, _)| p).collect();
             let diag = names.iter().zip(&g).enumerate();
             let diag = diag.map(|(i, (p, row))| ((*p).clone(), row[i])).collect();
-            (diag, truncation::cross_map(&names, &g))
+            let gpp = (0..g.len()).map(|i| g[i][i]).collect();
+            Statics {
+                diagonal: diag,
+                cross: truncation::cross_map(&names, &g),
+                deflections: Some((u, gpp)),
+            }
         }
         Err(e) => {
             warnings.push(format!(
                 "structure.fem: the static flexibility could not be computed, so modes are \
-                 selected without it and there is no truncation table: {e}"
+                 selected without it and there is no truncation table nor static correction: {e}"
             ));
-            (BTreeMap::new(), BTreeMap::new())
+            Statics::default()
         }
     }
+}
+
+/// The static correction of the selected modes at the named points
+/// ([`crate::modal::static_correction`]), unless `structure.fem.static_correction = false` or
+/// the static solution failed.
+fn correct_statically(
+    spec: &FemSpec,
+    model: &FeModel,
+    modes: &DenseModes,
+    selected: &[usize],
+    functionals: &[(String, Vec<f64>)],
+    statics: &Statics,
+) -> Result<Option<static_correction::StaticCorrection>> {
+    let Some((u, g)) = &statics.deflections else {
+        return Ok(None);
+    };
+    if !spec.static_correction.unwrap_or(true) {
+        return Ok(None);
+    }
+    let n = model.n_dofs();
+    let retained =
+        faer::Mat::<f64>::from_fn(n, selected.len(), |i, c| modes.shapes[(i, selected[c])]);
+    let omega: Vec<f64> = selected.iter().map(|&s| modes.omega_rad_per_s[s]).collect();
+    let loads = static_correction::PointLoads {
+        functionals,
+        deflections: u.as_ref(),
+        flexibility: g,
+    };
+    static_correction::static_correction(
+        model.stiffness.as_ref(),
+        model.mass.as_ref(),
+        retained.as_ref(),
+        &omega,
+        &loads,
+    )
+    .map(Some)
+}
+
+/// The modal model of the selected modes augmented by the pseudo-modes of `c` (appended after
+/// them, labelled "static correction j", mode number 0, [`ModalModel::pseudo_modes`]).
+/// Damping: Rayleigh `α + β ω̃²` (the exact projection: the augmented basis diagonalises K and
+/// M); modal ratios: each pseudo-mode takes the ratio of the highest selected mode (with one
+/// ratio for all, that ratio), documented in docs/explanations/fem.md.
+fn corrected_model(
+    spec: &FemSpec,
+    src: &Source,
+    model: &FeModel,
+    modes: &DenseModes,
+    selected: &[usize],
+    zeta: &[f64],
+    c: &static_correction::StaticCorrection,
+) -> Result<ModalModel> {
+    let (n, nm, q) = (
+        model.n_dofs(),
+        modes.omega_rad_per_s.len(),
+        c.eigenvalues.len(),
+    );
+    let mut aug = modes.clone();
+    aug.shapes = faer::Mat::<f64>::from_fn(n, nm + q, |i, j| {
+        if j < nm {
+            modes.shapes[(i, j)]
+        } else {
+            c.shapes[(i, j - nm)]
+        }
+    });
+    aug.eigenvalues.extend(&c.eigenvalues);
+    aug.omega_rad_per_s
+        .extend(c.eigenvalues.iter().map(|l| l.sqrt()));
+    let sel: Vec<usize> = selected.iter().copied().chain(nm..nm + q).collect();
+    let last = zeta.last().copied().unwrap_or(0.0);
+    let z: Vec<f64> = zeta
+        .iter()
+        .copied()
+        .chain(std::iter::repeat_n(last, q))
+        .collect();
+    let mut modal = reduced_model(spec, src, model, &aug, &sel, &z)?;
+    let ns = selected.len();
+    modal.pseudo_modes = (0..ns + q)
+        .map(|i| i.checked_sub(ns).map(|j| c.points[j].clone()))
+        .collect();
+    for j in 0..q {
+        modal.mode_numbers[ns + j] = 0;
+        modal.labels[ns + j] = format!(
+            "static correction {} ({:.4} Hz, point '{}')",
+            j + 1,
+            c.eigenvalues[j].sqrt() / (2.0 * std::f64::consts::PI),
+            c.points[j]
+        );
+    }
+    Ok(modal)
 }
 
 /// `G_PQ` by point names (P ≠ Q): [`crate::modal::ModalModel::static_cross_flexibility`].
@@ -1769,6 +1898,37 @@ pub struct ModeRow {
     pub selected: bool,
 }
 
+/// One static-correction pseudo-mode in `meid modes`: a Ritz vector of the reduced model, not a
+/// mode of the structure.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct PseudoModeRow {
+    /// 1-based among the pseudo-modes.
+    pub index: usize,
+    /// Its Ritz frequency `ω̃/2π` (Hz).
+    pub frequency_hz: f64,
+    /// The point whose static flexibility it carries most.
+    pub point: String,
+    /// Effective modal mass along the impact direction `(φ̃ᵀ M r)²` (kg).
+    pub effective_mass_z_kg: Option<f64>,
+    /// ψ̃(P) along the impact direction at each named point (1/√kg).
+    pub psi_per_sqrt_kg: BTreeMap<String, f64>,
+}
+
+/// The pseudo-mode rows of a reduced model ([`ModalModel::pseudo_modes`]).
+pub fn pseudo_mode_rows(m: &ModalModel) -> Vec<PseudoModeRow> {
+    (0..m.len())
+        .filter(|&i| m.is_pseudo(i))
+        .enumerate()
+        .map(|(j, i)| PseudoModeRow {
+            index: j + 1,
+            frequency_hz: m.omega_rad_per_s[i] / (2.0 * std::f64::consts::PI),
+            point: m.pseudo_modes[i].clone().unwrap_or_default(),
+            effective_mass_z_kg: m.effective_mass_kg.as_ref().and_then(|e| e.get(i).copied()),
+            psi_per_sqrt_kg: m.points.iter().map(|(k, v)| (k.clone(), v[i])).collect(),
+        })
+        .collect()
+}
+
 /// What `meid modes` reports.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct ModeReport {
@@ -1786,6 +1946,9 @@ pub struct ModeReport {
     pub total_mass: Option<EffectiveMass>,
     /// Relative residual of each selected mode.
     pub selected_residuals: Vec<f64>,
+    /// The static-correction pseudo-modes of the reduced model (Ritz vectors, not modes of the
+    /// structure; [`crate::modal::static_correction`]); empty without correction.
+    pub static_correction: Vec<PseudoModeRow>,
     /// max |Φᵀ M Φ − I| over the computed modes.
     pub orthonormality_error: Option<f64>,
     /// Captured share of the static flexibility at the named points with a role.
@@ -1860,6 +2023,7 @@ impl FemAnalysis {
             dofs: self.model.n_dofs(),
             total_mass: Some(eff(self.table.total_mass)),
             selected_residuals: self.selected_residuals.clone(),
+            static_correction: pseudo_mode_rows(&self.modal),
             orthonormality_error: Some(self.modes.orthonormality_error),
             truncation: Vec::new(),
             notes: Vec::new(),
@@ -1889,6 +2053,7 @@ pub fn report_from_modal(m: &ModalModel) -> ModeReport {
         dofs: 0,
         total_mass: None,
         selected_residuals: Vec::new(),
+        static_correction: Vec::new(),
         orthonormality_error: None,
         truncation: Vec::new(),
         notes: Vec::new(),
@@ -1961,6 +2126,24 @@ impl ModeReport {
                     .map(|r| format!("{r:.1e}"))
                     .collect::<Vec<_>>()
             );
+        }
+        if !self.static_correction.is_empty() {
+            let _ = writeln!(
+                s,
+                "static correction (Ritz vectors restoring the static flexibility of the modes left out; not modes of the structure):"
+            );
+            for r in &self.static_correction {
+                let _ = write!(
+                    s,
+                    "  static correction {} {:>12.4} Hz  point '{}'",
+                    r.index, r.frequency_hz, r.point
+                );
+                for p in &points {
+                    let v = r.psi_per_sqrt_kg.get(p).copied().unwrap_or(0.0);
+                    let _ = write!(s, "  psi({p}) {v:.4e}");
+                }
+                s.push('\n');
+            }
         }
         s.push_str(&truncation::to_text(&self.truncation));
         for n in &self.notes {

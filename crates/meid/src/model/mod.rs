@@ -343,7 +343,8 @@ impl Model {
         let s = &self.spec;
         let src = &self.source;
         if let Some(r) = s.structure.reference_mode {
-            if !self.structure.mode_numbers.contains(&r) {
+            let st = &self.structure;
+            if !(0..st.len()).any(|i| st.mode_numbers[i] == r && !st.is_pseudo(i)) {
                 return Err(src.error(
                     "structure.reference_mode",
                     format!(
@@ -726,11 +727,17 @@ impl Model {
     pub fn reference_mode(&self) -> Option<ReferenceMode> {
         let st = &self.structure;
         let (index, given) = match self.spec.structure.reference_mode {
-            Some(r) => (st.mode_numbers.iter().position(|&k| k == r)?, true),
+            Some(r) => (
+                (0..st.len()).find(|&i| st.mode_numbers[i] == r && !st.is_pseudo(i))?,
+                true,
+            ),
             None => {
                 let m = st.effective_mass_kg.as_ref()?;
+                // Static-correction pseudo-modes are not modes of the structure.
                 let best = (0..st.len())
-                    .filter(|&i| st.omega_rad_per_s[i] > 0.0 && m[i].is_finite())
+                    .filter(|&i| {
+                        st.omega_rad_per_s[i] > 0.0 && m[i].is_finite() && !st.is_pseudo(i)
+                    })
                     .max_by(|&a, &b| m[a].total_cmp(&m[b]))?;
                 (best, false)
             }
@@ -759,7 +766,9 @@ impl Model {
         st.mode_numbers
             .iter()
             .zip(&st.omega_rad_per_s)
-            .map(|(k, w)| format!("{k} ({:.4} Hz)", w / (2.0 * std::f64::consts::PI)))
+            .enumerate()
+            .filter(|(i, _)| !st.is_pseudo(*i))
+            .map(|(_, (k, w))| format!("{k} ({:.4} Hz)", w / (2.0 * std::f64::consts::PI)))
             .collect::<Vec<_>>()
             .join(", ")
     }
@@ -774,7 +783,7 @@ impl Model {
             .iter()
             .map(|p| 1.0 / (p * p))
             .enumerate()
-            .filter(|(_, m)| m.is_finite())
+            .filter(|(i, m)| m.is_finite() && !self.structure.is_pseudo(*i))
             .min_by(|a, b| a.1.total_cmp(&b.1))?;
         let ratio = r.strike_point_mass_kg / lightest;
         if ratio.is_finite() && ratio <= REFERENCE_MASS_SPREAD {

@@ -473,6 +473,10 @@ pub struct FemSpec {
     /// Number of lowest modes computed (default 30; all for dense if fewer DOFs).
     #[serde(default)]
     pub count: Option<usize>,
+    /// Static correction (default true): the selected modes plus pseudo-modes that restore the
+    /// full static flexibility at the named points ([`crate::modal::static_correction`]).
+    #[serde(default)]
+    pub static_correction: Option<bool>,
 }
 
 /// Mode selection.
