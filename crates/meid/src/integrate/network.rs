@@ -37,9 +37,53 @@
 //! per bounce. An undamped contact (`e = 1`) never comes to rest, as a rigid elastic one
 //! would not.
 //!
+//! # Rigid contacts
+//! A contact with the rigid law ([`crate::impact::ContactLaw::Rigid`], restitution `e`) has no
+//! force law: it is open, or held as a constraint.
+//!
+//! - **Impact.** When its overlap `aᵀx − g` reaches 0 (found by the search of step 1 and moved
+//!   onto the exact zero by two Newton steps on its closed form, so that no lateness
+//!   accumulates over a train of bounces) while closing at `v_in = aᵀẋ > 0`, the velocities jump
+//!   by the impulse `J` along `a` that gives `aᵀẋ⁺ = −e v_in`:
+//!   `ẋ⁺ = ẋ − (1 + e) v_in M⁻¹a/(aᵀM⁻¹a)`, removing `½(1 − e²) v_in²/(aᵀM⁻¹a)` (Newton's law of
+//!   restitution), booked as the contact's dissipated energy (run total and impact row). The row
+//!   has `impulse_n_s = J`, `duration_s = 0` and `peak_force_n = None`: an impulse has no finite
+//!   peak. Springs and dashpots transmit no impulse; every other rigid contact at zero overlap
+//!   or held at that instant does: the impulses `P ≥ 0` of all of them solve the complementarity
+//!   problem `w = G P − b ≥ 0`, `Pᵀw = 0` (`G = AᵀM⁻¹A`, `b_c = (1 + e_c) v_c` for a closing
+//!   contact, `v_c` otherwise; [`crate::impact::network::impulses_lcp`]), and each books
+//!   `P_c (v_c⁻ + v_c⁺)/2`, the kinetic energy its impulse removes (these sum exactly to the
+//!   loss).
+//! - **Rest.** Under a constant force the bounces of `e < 1` accumulate (infinitely many in a
+//!   finite time). After an impact with rebound `u = e v_in` and a normal acceleration
+//!   `aₙ = d(aᵀẋ)/dt > 0` pushing the contact closed, the next flight rises `u²/(2aₙ)`: when
+//!   that is inside the band within which [`lex_signs`] calls an overlap zero (`1e-9` of the
+//!   overlap's terms), or when the rest of the bounces, `2u/(aₙ(1 − e))`, is shorter than the
+//!   clock's resolution `ε t`, the next impacts come within round-off. The impact is then
+//!   plastic (`e = 0`: the remaining bounces' energy `½ e² v_in²/(aᵀM⁻¹a)` is dissipated with
+//!   it) and the contact is **held**: the constraint `aᵀx = g` of the constrained mode
+//!   ([`Network::constrained`], exact, the α-terms vanishing on the manifold), with the
+//!   constraint force `λ = G⁻¹AᵀM⁻¹(f − Cẋ − Kx)` (affine in the state) as the contact's force
+//!   channel. Its resting row starts at the instant the collapsed bounces end, the impact plus
+//!   their geometric sum `2u/(aₙ(1 − e))` (exact for a constant `aₙ`; the accumulation time
+//!   `√(2h/g)(1 + e)/(1 − e)` of a ball dropped from `h` to round-off: about 1e-16 relative
+//!   measured, 1e-9 asked by the tests). The
+//!   number of impacts stays finite: about `ln(v₀²/(2aₙ·1e-9·s))/(2 ln(1/e))` for a first landing
+//!   at `v₀` and an overlap scale `s`.
+//! - **Release.** A held contact lets go when `λ` crosses zero (searched as an indicator);
+//!   with several held, the most negative goes first and the others' forces are those of the
+//!   smaller set.
+//!
+//! The dopri5 method runs the paper's machine only, so a rigid contact with a Hertz or
+//! Hunt-Crossley contact in one machine (which would need it) is not possible yet; the paper's
+//! form (`[contact.slider_bed]`) refuses the rigid law with a message that says how to write
+//! the machine as a general one: its engine has no impulses, and the general machine's exact
+//! engine already runs the same machine (`examples/hammer-rigid.toml`).
+//!
 //! # Initial state
 //! Velocities are the impactors' (dampers start at rest). Without a preloaded contact every
-//! displacement starts at 0 (the impactors touch, or stand off by their gaps). With preloaded
+//! displacement starts at 0 (the impactors touch, or stand off by their gaps). A rigid contact
+//! closing at t = 0 strikes then; one touching with its bodies pushed together rests. With preloaded
 //! contacts (`g < 0`) the displacements are the static equilibrium
 //! `K_p x = f_p` of the mode `p` in which exactly the preloaded contacts are closed (forcing:
 //! the preloads `K_c g_c a_c` and the constant forces); a direction `K_p` does not hold (a free

@@ -14,12 +14,17 @@
 //! |---|---|
 //! | `[[impactor]]` | `name`, `mass` (kg), `velocity` (m/s at t = 0, +z towards what it strikes; default 0), `force` (N, constant from t = 0, +z; default 0) |
 //! | `[[damper]]` | `name`, `mass` (kg), `stiffness` (N/m), `damping` (N·s/m, default 0), `dashpot` (`one-way`/`two-way`), `point` (the structure point it touches), `anchor` (a structure point or `ground`, default `ground`) |
-//! | `[[contact]]` | `name`, `between = [A, B]` (structure points, impactors, dampers or `ground`; A strikes B moving along +z), `gap` (m; > 0 open, < 0 preloaded; default 0), `law` (`linear`), `stiffness`, `damping` or `restitution`, `release` (`force`/`overlap`) |
+//! | `[[contact]]` | `name`, `between = [A, B]` (structure points, impactors, dampers or `ground`; A strikes B moving along +z), `gap` (m; > 0 open, < 0 preloaded; default 0), `law` (`linear`: `stiffness`, `damping` or `restitution`, `release` (`force`/`overlap`); `rigid`: `restitution` in [0, 1] only, no preload) |
 //!
 //! `restitution = e` on a linear contact sets `C = 2ζ(e)√(K m*)` with `ζ(e)` of its release
 //! rule ([`crate::impact::restitution::zeta_of_e`]) and the reduced mass of the two ends,
 //! `1/m* = aᵀM⁻¹a` (`a` the contact's relative vector: `1/m_body` for a body,
 //! `Σ_i ψ_i(P)²` for a structure point, summed over both ends; the ground adds nothing).
+//!
+//! `law = "rigid"` is the instantaneous impact with Newton's restitution `e` ∈ [0, 1]
+//! ([`crate::impact::ContactLaw::Rigid`], [`crate::integrate::network`], "Rigid contacts"): it
+//! takes `restitution` (required) and no `stiffness`, `damping`, `exponent` or `alpha` (a rigid
+//! contact has none), and no preload (`gap` < 0 would overlap it); `release` does not apply.
 //!
 //! Every damper must touch its `point` through a contact `between = [point, damper]` (in
 //! either order). Names are unique across impactors, dampers and structure points.
