@@ -103,7 +103,10 @@ fn a_two_body_linear_contact_gives_the_closed_form_row() {
         let lost = 0.5 * mu * v0 * v0 * (1.0 - e * e);
         if zeta == 0.0 {
             // Undamped: peak √(kμ) v₀ at a quarter of the contact, nothing dissipated.
-            assert!(rel(r.peak_force_n.unwrap(), (k * mu).sqrt() * v0) < tol, "{r:?}");
+            assert!(
+                rel(r.peak_force_n.unwrap(), (k * mu).sqrt() * v0) < tol,
+                "{r:?}"
+            );
             assert!(rel(r.peak_time_s, PI / (2.0 * wn)) < 1e-9, "{r:?}");
             assert!(r.dissipated_j.abs() < 1e-12 * lost.max(1.0), "{r:?}");
         } else {
@@ -225,6 +228,9 @@ fn a_hertz_contact_row_comes_from_the_interpolated_path() {
     let d_max = (5.0 * mu * v0 * v0 / (4.0 * k)).powf(0.4);
     assert!(rel(r.exit_velocity_m_per_s.unwrap(), v0) < 1e-6, "{r:?}");
     assert!(rel(r.impulse_n_s, 2.0 * mu * v0) < 1e-5, "{r:?}");
-    assert!(rel(r.peak_force_n.unwrap(), k * d_max.powf(1.5)) < 1e-3, "{r:?}");
+    assert!(
+        rel(r.peak_force_n.unwrap(), k * d_max.powf(1.5)) < 1e-3,
+        "{r:?}"
+    );
     assert!(r.dissipated_j.abs() < 1e-9, "{r:?}");
 }

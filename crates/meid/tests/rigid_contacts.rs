@@ -110,7 +110,11 @@ fn rigid_two_body_newton() {
             assert!((r.restitution.unwrap() - e).abs() <= 1e-12, "{r:?}");
             // The collision ends at the impact: the energy ratio is the share lost.
             let ratio = sol.energy_ratio.unwrap();
-            assert!((ratio - lost / ke).abs() <= 1e-12, "{ratio} vs {}", lost / ke);
+            assert!(
+                (ratio - lost / ke).abs() <= 1e-12,
+                "{ratio} vs {}",
+                lost / ke
+            );
         }
     }
 }
@@ -149,7 +153,10 @@ fn rigid_strike_on_modal_structure() {
         let j = (1.0 + e) * v / (1.0 / m + s2);
         let nd = net.dofs();
         for (i, p) in psi.iter().enumerate() {
-            assert!((ce.x[nd + i] - j * p).abs() <= 1e-12 * v, "mode {i}, e = {e}");
+            assert!(
+                (ce.x[nd + i] - j * p).abs() <= 1e-12 * v,
+                "mode {i}, e = {e}"
+            );
         }
         assert!((body_velocity(&net, &ce.x, 0) - (v - j / m)).abs() <= 1e-12 * v);
         let lost = 0.5 * (1.0 - e * e) * v * v / (1.0 / m + s2);
@@ -263,7 +270,13 @@ fn rigid_stiff_limit_of_linear_contacts() {
             &s,
             vec![body("hammer", m, v, 0.0)],
             vec![],
-            vec![link("blow", End::Body(0), End::Point("P".into()), 0.0, contact)],
+            vec![link(
+                "blow",
+                End::Body(0),
+                End::Point("P".into()),
+                0.0,
+                contact,
+            )],
         )
         .unwrap();
         let mut o = opts(1.0);
@@ -346,7 +359,11 @@ fn rigid_model_file_runs() {
 #[test]
 fn rigid_bad_input_names_file_line_and_field() {
     for (to, field, says) in [
-        ("law = \"rigid\"", "contact[0].restitution", "needs restitution"),
+        (
+            "law = \"rigid\"",
+            "contact[0].restitution",
+            "needs restitution",
+        ),
         (
             "law = \"rigid\"\nrestitution = 1.5",
             "contact[0].restitution",
@@ -384,8 +401,7 @@ fn rigid_bad_input_names_file_line_and_field() {
         ),
     ] {
         let text = RIGID.replacen("law = \"rigid\"\nrestitution = 0.5", to, 1);
-        let e = match meid::model::network::NetworkModel::from_text("m.toml", text.clone(), &[])
-        {
+        let e = match meid::model::network::NetworkModel::from_text("m.toml", text.clone(), &[]) {
             Ok(_) => panic!("loaded:\n{text}"),
             Err(e) => e.to_string(),
         };

@@ -133,13 +133,11 @@ pub fn totals(sys: &ImpactSystem, rows: &[ImpactRow]) -> Vec<ImpactTotals> {
         .iter()
         .map(|name| {
             let mine: Vec<&ImpactRow> = rows.iter().filter(|r| r.contact == *name).collect();
-            let peak = mine
-                .iter()
-                .max_by(|a, b| {
-                    a.peak_force_n
-                        .unwrap_or(0.0)
-                        .total_cmp(&b.peak_force_n.unwrap_or(0.0))
-                });
+            let peak = mine.iter().max_by(|a, b| {
+                a.peak_force_n
+                    .unwrap_or(0.0)
+                    .total_cmp(&b.peak_force_n.unwrap_or(0.0))
+            });
             ImpactTotals {
                 contact: (*name).to_string(),
                 impacts: mine.len(),

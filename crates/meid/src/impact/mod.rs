@@ -1241,10 +1241,7 @@ fn check_contact(field: &str, c: &Contact) -> Result<()> {
 /// write the machine as a general one.
 fn refuse_rigid(field: &str, c: &Contact) -> Result<()> {
     if let ContactLaw::Rigid { .. } = c.law {
-        return Err(Error::invalid(
-            format!("{field}.law"),
-            RIGID_PAPER_FORM,
-        ));
+        return Err(Error::invalid(format!("{field}.law"), RIGID_PAPER_FORM));
     }
     Ok(())
 }

@@ -841,7 +841,8 @@ pub(crate) fn invert(g: &[f64], r: usize) -> Option<Vec<f64>> {
         inv[i * r + i] = 1.0;
     }
     for col in 0..r {
-        let piv = (col..r).max_by(|&x, &y| m[x * r + col].abs().total_cmp(&m[y * r + col].abs()))?;
+        let piv =
+            (col..r).max_by(|&x, &y| m[x * r + col].abs().total_cmp(&m[y * r + col].abs()))?;
         if !(m[piv * r + col].abs() > 1e-12 * scale) {
             return None;
         }

@@ -119,7 +119,9 @@ use super::peaks::{self, Extremes};
 use super::propagator::{Functional, Propagator, Segment};
 use super::roots::{Scalar, Search, SearchOptions};
 use super::Options;
-use crate::impact::network::{dot, impulses_lcp, End, IndicatorKind, NetIndicator, NetMode, Network};
+use crate::impact::network::{
+    dot, impulses_lcp, End, IndicatorKind, NetIndicator, NetMode, Network,
+};
 use crate::{Error, Result};
 
 /// The band, relative to the size of its terms, within which [`lex_signs`] calls a value zero.
@@ -1187,7 +1189,12 @@ impl<'n, 'o> Run<'n, 'o> {
     /// For each contact of `set` that closes, struck by the impulses `p`: `Some(τ)` when its
     /// rebound ends within round-off (see [`Run::rigid_impacts`]), `τ = 2u/(aₙ(1 − e))` the
     /// time the remaining bounces take (0 for `e = 1`: a rebound within round-off).
-    fn rests(&mut self, set: &[(usize, f64, bool)], g: &[f64], p: &[f64]) -> Result<Vec<Option<f64>>> {
+    fn rests(
+        &mut self,
+        set: &[(usize, f64, bool)],
+        g: &[f64],
+        p: &[f64],
+    ) -> Result<Vec<Option<f64>>> {
         let net = self.net;
         let nd = net.dofs();
         let n = 2 * nd;
@@ -1224,7 +1231,11 @@ impl<'n, 'o> Run<'n, 'o> {
                 .map(|(ai, xi)| (ai * xi).abs())
                 .sum::<f64>()
                 + net.contacts[*c].gap.abs();
-            let tau = if e < 1.0 { 2.0 * u / (an * (1.0 - e)) } else { 0.0 };
+            let tau = if e < 1.0 {
+                2.0 * u / (an * (1.0 - e))
+            } else {
+                0.0
+            };
             let apex = u * u / (2.0 * an);
             if apex <= VALUE_TOL * scale || (e < 1.0 && tau <= f64::EPSILON * self.t) {
                 out[k] = Some(tau);

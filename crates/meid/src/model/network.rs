@@ -769,8 +769,7 @@ fn assemble(
             ends: [a, b],
             gap: c.gap,
             contact: Contact {
-                law: ContactLaw::Linear { stiffness, damping,
-                },
+                law: ContactLaw::Linear { stiffness, damping },
                 release,
             },
         });
