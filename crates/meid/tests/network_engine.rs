@@ -37,7 +37,7 @@ fn body(name: &str, mass: f64, velocity: f64) -> Body {
     }
 }
 
-fn link(name: &str, a: End, b: End, gap: f64, contact: Contact) -> Link {
+pub(crate) fn link(name: &str, a: End, b: End, gap: f64, contact: Contact) -> Link {
     Link {
         name: name.into(),
         ends: [a, b],
@@ -46,7 +46,7 @@ fn link(name: &str, a: End, b: End, gap: f64, contact: Contact) -> Link {
     }
 }
 
-fn opts(duration: f64) -> Options {
+pub(crate) fn opts(duration: f64) -> Options {
     Options {
         duration,
         sample_rate: None,
@@ -54,7 +54,7 @@ fn opts(duration: f64) -> Options {
     }
 }
 
-fn rel(a: f64, b: f64) -> f64 {
+pub(crate) fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs().max(f64::MIN_POSITIVE)
 }
 

@@ -54,7 +54,7 @@ fn error_of(text: &str) -> String {
 }
 
 /// The line (1-based) of the first occurrence of `needle` in `text`.
-fn line_of(text: &str, needle: &str) -> usize {
+pub(crate) fn line_of(text: &str, needle: &str) -> usize {
     text.lines()
         .position(|l| l.contains(needle))
         .unwrap_or_else(|| panic!("{needle} not in the text"))

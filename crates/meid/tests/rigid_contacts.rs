@@ -6,10 +6,12 @@
 
 use std::f64::consts::PI;
 
-use meid::impact::network::{Body, End, Link, Network};
+use meid::impact::network::{Body, End, Network};
+
+use super::network_engine::{link, opts, rel};
+use super::network_model::line_of;
 use meid::impact::{restitution, Contact, ContactLaw, Release};
 use meid::integrate::network::{self as engine, ChannelKind, NetSolution};
-use meid::integrate::Options;
 use meid::modal::ModalModel;
 
 /// A structure that takes no part: one mode at 1 Hz with a point "s" nothing touches.
@@ -35,27 +37,6 @@ fn body(name: &str, mass: f64, velocity: f64, force: f64) -> Body {
     }
 }
 
-fn link(name: &str, a: End, b: End, gap: f64, contact: Contact) -> Link {
-    Link {
-        name: name.into(),
-        ends: [a, b],
-        gap,
-        contact,
-    }
-}
-
-fn opts(duration: f64) -> Options {
-    Options {
-        duration,
-        sample_rate: None,
-        ..Options::default()
-    }
-}
-
-fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs().max(f64::MIN_POSITIVE)
-}
-
 fn body_velocity(net: &Network, x: &[f64], b: usize) -> f64 {
     x[net.dofs() + net.n_modes() + b]
 }
@@ -66,6 +47,29 @@ fn balanced(sol: &NetSolution) {
     if let Some(r) = sol.residual_collision_end {
         assert!(r <= 1e-9, "{r}");
     }
+}
+
+/// A hammer (m, v) striking point "P" of `s` through `contact`, run to the end of the
+/// collision: the network and its solution (energy balance checked).
+fn strike(s: &ModalModel, m: f64, v: f64, contact: Contact) -> (Network, NetSolution) {
+    let net = Network::new(
+        s,
+        vec![body("hammer", m, v, 0.0)],
+        vec![],
+        vec![link(
+            "blow",
+            End::Body(0),
+            End::Point("P".into()),
+            0.0,
+            contact,
+        )],
+    )
+    .unwrap();
+    let mut o = opts(1.0);
+    o.stop_at_collision_end = true;
+    let sol = engine::solve(&net, &o).unwrap();
+    balanced(&sol);
+    (net, sol)
 }
 
 const ES: [f64; 7] = [0.0, 0.1, 0.3, 0.5, 0.7, 0.9, 1.0];
@@ -130,23 +134,7 @@ fn rigid_strike_on_modal_structure() {
     s.points.insert("P".into(), psi.clone());
     let (m, v) = (3.0, 1.7);
     for e in [0.0, 0.5, 1.0] {
-        let net = Network::new(
-            &s,
-            vec![body("hammer", m, v, 0.0)],
-            vec![],
-            vec![link(
-                "blow",
-                End::Body(0),
-                End::Point("P".into()),
-                0.0,
-                rigid(e),
-            )],
-        )
-        .unwrap();
-        let mut o = opts(1.0);
-        o.stop_at_collision_end = true;
-        let sol = engine::solve(&net, &o).unwrap();
-        balanced(&sol);
+        let (net, sol) = strike(&s, m, v, rigid(e));
         let ce = sol.collision_end.as_ref().unwrap();
         assert_eq!(ce.t, 0.0);
         let s2: f64 = psi.iter().map(|p| p * p).sum();
@@ -266,23 +254,7 @@ fn rigid_stiff_limit_of_linear_contacts() {
     let mut s = ModalModel::with_damping_ratios(vec![2.0 * PI * 50.0], &[0.0]).unwrap();
     s.points.insert("P".into(), vec![psi]);
     let run = |contact: Contact| {
-        let net = Network::new(
-            &s,
-            vec![body("hammer", m, v, 0.0)],
-            vec![],
-            vec![link(
-                "blow",
-                End::Body(0),
-                End::Point("P".into()),
-                0.0,
-                contact,
-            )],
-        )
-        .unwrap();
-        let mut o = opts(1.0);
-        o.stop_at_collision_end = true;
-        let sol = engine::solve(&net, &o).unwrap();
-        balanced(&sol);
+        let (net, sol) = strike(&s, m, v, contact);
         let ce = sol.collision_end.as_ref().unwrap();
         (body_velocity(&net, &ce.x, 0), sol.energy_ratio.unwrap())
     };
@@ -332,14 +304,6 @@ restitution = 0.5
 [simulation]
 duration = 0.05
 "#;
-
-/// The line (1-based) of the first occurrence of `needle` in `text`.
-fn line_of(text: &str, needle: &str) -> usize {
-    text.lines()
-        .position(|l| l.contains(needle))
-        .unwrap_or_else(|| panic!("{needle} not in the text"))
-        + 1
-}
 
 /// The file runs: one impact, Newton's anvil velocity, and the energy balance closes.
 #[test]
