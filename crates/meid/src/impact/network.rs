@@ -843,7 +843,8 @@ pub(crate) fn invert(g: &[f64], r: usize) -> Option<Vec<f64>> {
     for col in 0..r {
         let piv =
             (col..r).max_by(|&x, &y| m[x * r + col].abs().total_cmp(&m[y * r + col].abs()))?;
-        if !(m[piv * r + col].abs() > 1e-12 * scale) {
+        let pivot = m[piv * r + col].abs();
+        if pivot.is_nan() || pivot <= 1e-12 * scale {
             return None;
         }
         for j in 0..r {

@@ -650,7 +650,17 @@ pub fn solve(net: &Network, opts: &Options) -> Result<NetSolution> {
     let mut run = Run::new(net, opts)?;
     run.rigid_events()?;
     let ended_at_start = run.collision_ended() && opts.stop_at_collision_end;
-    while !ended_at_start {
+    if !ended_at_start {
+        run_stretches(&mut run, opts)?;
+    }
+    let sol = run.finish();
+    check(net, &sol)?;
+    Ok(sol)
+}
+
+/// The run's stretches and switches to its end (or the collision's, when asked).
+fn run_stretches(run: &mut Run<'_, '_>, opts: &Options) -> Result<()> {
+    loop {
         let switched = run.stretch()?;
         if !switched {
             break;
@@ -677,9 +687,7 @@ pub fn solve(net: &Network, opts: &Options) -> Result<NetSolution> {
             break;
         }
     }
-    let sol = run.finish();
-    check(net, &sol)?;
-    Ok(sol)
+    Ok(())
 }
 
 /// The state of a run between stretches ([`solve`]).
@@ -1222,7 +1230,7 @@ impl<'n, 'o> Run<'n, 'o> {
                     / m[i];
             }
             let an = dot(&slope[..n], &x) + slope[n];
-            if !(an > 0.0) {
+            if an.is_nan() || an <= 0.0 {
                 continue;
             }
             let scale: f64 = a
