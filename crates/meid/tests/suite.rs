@@ -68,6 +68,7 @@ mod propagator_taylor;
 mod reference_mode;
 mod report_measured;
 mod restitution_contacts;
+mod rigid_contacts;
 mod small_eig;
 mod spectrum_checks;
 mod stiff_inputs;

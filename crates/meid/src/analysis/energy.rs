@@ -478,6 +478,7 @@ fn likely_causes(sys: &ImpactSystem) -> String {
             exponent,
             alpha,
         } => format!("hunt-crossley, K = {stiffness:e} N/m^{exponent}, alpha = {alpha:e} s/m"),
+        ContactLaw::Rigid { restitution } => format!("rigid, e = {restitution}"),
     };
     let mut out = format!("contact.slider_bed ({})", law(&sys.slider_bed));
     if let (Some(c), Some(d)) = (&sys.bed_damper, &sys.damper) {

@@ -118,7 +118,7 @@ pub fn impacts(sys: &ImpactSystem, sol: &Solution) -> Result<Vec<ImpactRow>> {
         let mut row = o.row;
         row.duration_s = sol.t_final - row.start_s;
         let (v, tv) = o.ext.peak();
-        row.peak_force_n = v.max(0.0);
+        row.peak_force_n = Some(v.max(0.0));
         row.peak_time_s = tv;
         rows.push(row);
     }
@@ -133,16 +133,18 @@ pub fn totals(sys: &ImpactSystem, rows: &[ImpactRow]) -> Vec<ImpactTotals> {
         .iter()
         .map(|name| {
             let mine: Vec<&ImpactRow> = rows.iter().filter(|r| r.contact == *name).collect();
-            let peak = mine
-                .iter()
-                .max_by(|a, b| a.peak_force_n.total_cmp(&b.peak_force_n));
+            let peak = mine.iter().max_by(|a, b| {
+                a.peak_force_n
+                    .unwrap_or(0.0)
+                    .total_cmp(&b.peak_force_n.unwrap_or(0.0))
+            });
             ImpactTotals {
                 contact: (*name).to_string(),
                 impacts: mine.len(),
                 closed_time_s: mine.iter().map(|r| r.duration_s).sum(),
                 impulse_n_s: mine.iter().map(|r| r.impulse_n_s).sum(),
                 dissipated_j: mine.iter().map(|r| r.dissipated_j).sum(),
-                peak_force_n: peak.map_or(0.0, |r| r.peak_force_n),
+                peak_force_n: peak.and_then(|r| r.peak_force_n).unwrap_or(0.0),
                 peak_time_s: peak.map_or(f64::NAN, |r| r.peak_time_s),
             }
         })
@@ -174,7 +176,7 @@ fn start(sys: &ImpactSystem, s: Switch, ci: usize, t: f64, x: &[f64]) -> Open {
             contact: CONTACT_NAMES[ci].to_string(),
             start_s: t,
             approach_velocity_m_per_s: rate,
-            peak_force_n: 0.0,
+            peak_force_n: Some(0.0),
             peak_time_s: t,
             duration_s: 0.0,
             impulse_n_s: 0.0,
@@ -192,7 +194,7 @@ fn finish(sys: &ImpactSystem, s: Switch, o: Open, t: f64, x: &[f64]) -> ImpactRo
     let mut row = o.row;
     row.duration_s = t - row.start_s;
     let (v, tv) = o.ext.peak();
-    row.peak_force_n = v.max(0.0);
+    row.peak_force_n = Some(v.max(0.0));
     row.peak_time_s = tv;
     // The energy still stored when the contact lets go at δ > 0 goes with it.
     row.dissipated_j += sys.contact(s).law.potential_energy(delta);

@@ -246,11 +246,11 @@ pub fn impact_rows_csv<'r>(
             s += &format!("{},", b.unwrap_or(0));
         }
         s += &format!(
-            "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{},{}\n",
+            "{},{:e},{:e},{},{:e},{:e},{:e},{:e},{},{}\n",
             r.contact,
             r.start_s,
             r.approach_velocity_m_per_s,
-            r.peak_force_n,
+            opt(r.peak_force_n),
             r.peak_time_s,
             r.duration_s,
             r.impulse_n_s,

@@ -72,6 +72,14 @@ pub enum ContactLaw {
         exponent: f64,
         alpha: f64,
     },
+    /// Rigid (instantaneous) contact with Newton's restitution `e ∈ [0, 1]`: on closing at an
+    /// approach velocity `v_in = aᵀẋ > 0` the impulse `J = (1 + e) v_in / (aᵀM⁻¹a)` along `a`
+    /// gives `aᵀẋ⁺ = −e v_in` and removes `½(1 − e²) v_in² / (aᵀM⁻¹a)` (Newton's law of
+    /// restitution, e.g. Pfeiffer & Glocker, *Multibody Dynamics with Unilateral Contacts*,
+    /// 1996, ch. 6); while resting it is the constraint `aᵀx = g` with a force `λ ≥ 0`. The
+    /// stiff limit `K → ∞` of a linear contact with the same restitution. General machines
+    /// only ([`crate::integrate::network`]); the paper's engine refuses it.
+    Rigid { restitution: f64 },
 }
 
 impl ContactLaw {
@@ -91,6 +99,8 @@ impl ContactLaw {
                 exponent,
                 alpha,
             } => stiffness * delta.max(0.0).powf(exponent) * (1.0 + 1.5 * alpha * rate),
+            // Impulsive: no finite force law (the engine books impulses and constraint forces).
+            ContactLaw::Rigid { .. } => 0.0,
         }
     }
 
@@ -113,6 +123,7 @@ impl ContactLaw {
                     stiffness * dn * 1.5 * alpha,
                 )
             }
+            ContactLaw::Rigid { .. } => (0.0, 0.0),
         }
     }
 
@@ -124,15 +135,17 @@ impl ContactLaw {
             ContactLaw::Linear { stiffness, damping } => stiffness * delta + damping * rate,
             ContactLaw::Hertz { .. } => delta,
             ContactLaw::HuntCrossley { alpha, .. } => 1.0 + 1.5 * alpha * rate,
+            ContactLaw::Rigid { .. } => delta,
         }
     }
 
-    /// Stiffness coefficient K of the law.
+    /// Stiffness coefficient K of the law (infinite for the rigid law).
     pub fn stiffness(&self) -> f64 {
         match *self {
             ContactLaw::Linear { stiffness, .. }
             | ContactLaw::Hertz { stiffness }
             | ContactLaw::HuntCrossley { stiffness, .. } => stiffness,
+            ContactLaw::Rigid { .. } => f64::INFINITY,
         }
     }
 
@@ -142,6 +155,7 @@ impl ContactLaw {
             ContactLaw::Linear { damping, .. } => damping != 0.0,
             ContactLaw::Hertz { .. } => false,
             ContactLaw::HuntCrossley { alpha, .. } => alpha != 0.0,
+            ContactLaw::Rigid { restitution } => restitution != 1.0,
         }
     }
 
@@ -158,6 +172,8 @@ impl ContactLaw {
                 exponent,
                 ..
             } => stiffness * delta.powf(exponent + 1.0) / (exponent + 1.0),
+            // A rigid contact never overlaps: it stores nothing.
+            ContactLaw::Rigid { .. } => 0.0,
         }
     }
 }
@@ -388,6 +404,7 @@ impl ImpactSystem {
                 format!("must be > 0 m/s towards the bed (got {})", slider.velocity),
             ));
         }
+        refuse_rigid("contact.slider_bed", &slider_bed)?;
         check_contact("contact.slider_bed", &slider_bed)?;
         let (structure, damper, bed_damper, added_mass) = match absorber {
             Absorber::None => (structure.clone(), None, None, 0.0),
@@ -395,6 +412,7 @@ impl ImpactSystem {
                 check_positive("damper.mass", d.mass, "kg")?;
                 check_non_negative("damper.stiffness", d.stiffness, "N/m")?;
                 check_non_negative("damper.damping", d.damping, "N·s/m")?;
+                refuse_rigid("contact.bed_damper", &c)?;
                 check_contact("contact.bed_damper", &c)?;
                 (structure.clone(), Some(d), Some(c), 0.0)
             }
@@ -819,7 +837,10 @@ impl ImpactSystem {
                             l[nd + i] = damping * a[i];
                         }
                     }
-                    ContactLaw::Hertz { .. } => l[..nd].copy_from_slice(a),
+                    // (The paper's system refuses the rigid law: `refuse_rigid`.)
+                    ContactLaw::Hertz { .. } | ContactLaw::Rigid { .. } => {
+                        l[..nd].copy_from_slice(a)
+                    }
                     ContactLaw::HuntCrossley { alpha, .. } => {
                         for i in 0..nd {
                             l[nd + i] = 1.5 * alpha * a[i];
@@ -1203,8 +1224,30 @@ fn check_contact(field: &str, c: &Contact) -> Result<()> {
             check_positive(&format!("{field}.exponent"), exponent, "")?;
             check_non_negative(&format!("{field}.alpha"), alpha, "s/m")
         }
+        ContactLaw::Rigid { restitution } => {
+            if (0.0..=1.0).contains(&restitution) {
+                Ok(())
+            } else {
+                Err(Error::invalid(
+                    format!("{field}.restitution"),
+                    format!("the rigid law's coefficient of restitution must be in [0, 1] (0: plastic, 1: elastic; got {})", crate::num(restitution)),
+                ))
+            }
+        }
     }
 }
+
+/// The paper's engine takes compliant laws only: a rigid law there is refused, saying how to
+/// write the machine as a general one.
+fn refuse_rigid(field: &str, c: &Contact) -> Result<()> {
+    if let ContactLaw::Rigid { .. } = c.law {
+        return Err(Error::invalid(format!("{field}.law"), RIGID_PAPER_FORM));
+    }
+    Ok(())
+}
+
+/// Why the paper's machine refuses the rigid law, and what to write instead.
+pub const RIGID_PAPER_FORM: &str = "the rigid law (instantaneous impacts) runs on general machines only: the paper's engine integrates compliant contacts. Write the same machine as a general one: an [[impactor]] for the slider (mass, velocity, force), a [[damper]] per damper (point, anchor), and a [[contact]] per contact with between = [A, B] (\"slider\" → the struck point for slider_bed), law = \"rigid\" and restitution = e (docs/reference/model-file.md, \"General machines\"; examples/hammer-rigid.toml)";
 
 #[cfg(test)]
 mod tests {

@@ -245,6 +245,15 @@ impl Network {
                 ));
             }
             super::check_contact(&c.name, &c.contact)?;
+            if matches!(c.contact.law, ContactLaw::Rigid { .. }) && c.gap < 0.0 {
+                return Err(Error::invalid(
+                    format!("{}.gap", c.name),
+                    format!(
+                        "a rigid contact cannot be preloaded (gap = {} m would overlap it): give a gap ≥ 0",
+                        crate::num(c.gap)
+                    ),
+                ));
+            }
         }
         let one_way = suspensions
             .iter()
@@ -355,10 +364,37 @@ impl Network {
         }
     }
 
-    /// `(K, C)` of contact `c`'s linear law; an error for a non-linear law.
+    /// The restitution of contact `c` when its law is rigid ([`ContactLaw::Rigid`]).
+    pub fn rigid(&self, c: usize) -> Option<f64> {
+        match self.contacts[c].contact.law {
+            ContactLaw::Rigid { restitution } => Some(restitution),
+            _ => None,
+        }
+    }
+
+    /// The rigid contacts held (closed, as constraints `a_cᵀx = g_c`) in `mode`.
+    pub fn held(&self, mode: NetMode) -> Vec<usize> {
+        (0..self.contacts.len())
+            .filter(|&c| self.closed(mode, c) && self.rigid(c).is_some())
+            .collect()
+    }
+
+    /// The bits of `mode`'s held rigid contacts.
+    pub fn held_bits(&self, mode: NetMode) -> NetMode {
+        self.held(mode)
+            .into_iter()
+            .fold(NetMode(0), |m, c| m.with(c, true))
+    }
+
+    /// `(K, C)` of contact `c`'s linear law; an error for a non-linear law (a rigid law has
+    /// none: see [`Self::rigid`]).
     pub fn linear_law(&self, c: usize) -> Result<(f64, f64)> {
         match self.contacts[c].contact.law {
             ContactLaw::Linear { stiffness, damping } => Ok((stiffness, damping)),
+            ContactLaw::Rigid { .. } => Err(Error::invalid(
+                format!("{}.law", self.contacts[c].name),
+                "a rigid contact has no stiffness or damping (internal: asked for its linear law)",
+            )),
             _ => Err(Error::invalid(
                 format!("{}.law", self.contacts[c].name),
                 "a general machine ([[contact]] arrays) takes linear contact laws (law = \"linear\", with damping or restitution); hertz and hunt-crossley need dopri5, which runs the paper's machine only for now",
@@ -367,8 +403,20 @@ impl Network {
     }
 
     /// `K_σ`, `C_σ` (`dofs × dofs`) and the forcing `f_σ` (length `dofs`) of a mode (module
-    /// documentation).
+    /// documentation); with held rigid contacts, those of the constrained mode
+    /// ([`Self::constrained`]).
     pub fn matrices(&self, mode: NetMode) -> Result<(Mat<f64>, Mat<f64>, Vec<f64>)> {
+        let (k, c, f) = self.free_matrices(mode)?;
+        let held = self.held(mode);
+        if held.is_empty() {
+            return Ok((k, c, f));
+        }
+        self.constrained(&held, k, c, f)
+    }
+
+    /// `K_σ`, `C_σ`, `f_σ` of the elements of a mode, without the held rigid contacts'
+    /// constraints (a rigid contact adds no stiffness, damping or forcing).
+    fn free_matrices(&self, mode: NetMode) -> Result<(Mat<f64>, Mat<f64>, Vec<f64>)> {
         let nd = self.dofs();
         let n = self.n_modes();
         let mut k = Mat::<f64>::zeros(nd, nd);
@@ -405,7 +453,7 @@ impl Network {
             f[n + b] = body.force;
         }
         for ci in 0..self.contacts.len() {
-            if self.closed(mode, ci) {
+            if self.closed(mode, ci) && self.rigid(ci).is_none() {
                 let (kk, cc) = self.linear_law(ci)?;
                 add(&self.rel[ci], kk, cc);
                 let g = self.contacts[ci].gap;
@@ -433,6 +481,9 @@ impl Network {
                         kind: IndicatorKind::Overlap(ci),
                         l,
                     });
+                    if self.rigid(ci).is_some() {
+                        continue;
+                    }
                     let (kk, cc) = self.linear_law(ci)?;
                     if self.contacts[ci].contact.release == Release::Force && cc != 0.0 {
                         let mut l = vec![0.0; 2 * nd + 1];
@@ -463,9 +514,12 @@ impl Network {
     /// The mode implied by the signs of [`Self::indicators`] (in their order): a contact is
     /// closed when its overlap (and, if searched, its force) is positive; a one-way dashpot
     /// acts when its relative velocity is negative. A sign 0 (identically zero) leaves a
-    /// contact open and a dashpot off.
+    /// contact open and a dashpot off. A rigid contact is left open: whether it is held is
+    /// decided by its impacts and constraint force ([`crate::integrate::network`]).
     pub fn implied(&self, inds: &[NetIndicator], signs: &[f64]) -> NetMode {
-        let mut closed = vec![true; self.contacts.len()];
+        let mut closed: Vec<bool> = (0..self.contacts.len())
+            .map(|c| self.rigid(c).is_none())
+            .collect();
         let mut mode = NetMode(0);
         for (ind, s) in inds.iter().zip(signs) {
             match ind.kind {
@@ -565,6 +619,256 @@ impl Network {
             || self.suspensions.iter().any(|s| s.anchor == End::Ground)
             || self.contacts.iter().any(|c| c.ends.contains(&End::Ground))
     }
+}
+
+/// Rigid contacts held as constraints.
+///
+/// With the held contacts' vectors as the columns of `A` (`nd × r`), their gaps `g`,
+/// `G = AᵀM⁻¹A` and the M-orthogonal projector `P = I − M⁻¹A G⁻¹Aᵀ` (onto the motions that
+/// keep `Aᵀx` fixed), the constrained motion `M ẍ = f − Cẋ − Kx − Aλ`, `Aᵀx = g` is, exactly,
+///
+/// ```text
+/// M ẍ + C' ẋ + K' x = f',   K' = PᵀKP + α₁α₂ A G⁻¹Aᵀ,   C' = PᵀCP + (α₁+α₂) A G⁻¹Aᵀ,
+///                           f' = Pᵀ(f − K x_g) + α₁α₂ A G⁻¹ g,   x_g = M⁻¹A G⁻¹ g:
+/// ```
+///
+/// `AᵀM⁻¹` of it gives `z̈ + (α₁+α₂)ż + α₁α₂(z − g) = 0` for `z = Aᵀx` (PᵀA = 0), so a state
+/// on the manifold (`Aᵀx = g`, `Aᵀẋ = 0`) stays on it and the α-terms vanish there, and the
+/// rest is the constrained dynamics `M P ẍ = Pᵀ(f − C P ẋ − K P x − K x_g)` (with `x = Px + x_g`,
+/// `ẋ = Pẋ` on the manifold). `K'`, `C'` are symmetric, so the mode has the same closed form
+/// as any other ([`crate::integrate::propagator`]); the two distinct rates
+/// `α₁ = ω_r`, `α₂ = 2ω_r` (`ω_r` the Gershgorin bound of the mode's fastest rate, from
+/// `M^{-½}KM^{-½}` and `M^{-½}CM^{-½}`; 1 rad/s when it has neither) make the constraint block
+/// diagonalisable (a projection alone would leave a defective double zero eigenvalue). The
+/// constraint forces (compressive positive) are `λ = G⁻¹AᵀM⁻¹(f − Cẋ − Kx)` of the free `K`,
+/// `C`, `f` ([`Network::constraint_forces`]), affine in the state.
+impl Network {
+    /// `A` (column per held contact, column-major `nd × r`), `G⁻¹` (`r × r`) and `M⁻¹`.
+    fn held_system(&self, held: &[usize]) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>)> {
+        let nd = self.dofs();
+        let r = held.len();
+        let minv: Vec<f64> = self.mass_diag().iter().map(|m| 1.0 / m).collect();
+        let a: Vec<f64> = held
+            .iter()
+            .flat_map(|&c| self.rel[c].iter().copied())
+            .collect();
+        let mut g = vec![0.0; r * r];
+        for i in 0..r {
+            for j in 0..r {
+                g[i * r + j] = (0..nd)
+                    .map(|k| a[i * nd + k] * minv[k] * a[j * nd + k])
+                    .sum();
+            }
+        }
+        let ginv = invert(&g, r).ok_or_else(|| {
+            let names: Vec<&str> = held
+                .iter()
+                .map(|&c| self.contacts[c].name.as_str())
+                .collect();
+            Error::invalid(
+                format!("{}.between", names[0]),
+                format!(
+                    "the rigid contacts {} resting at once hold the same motion twice (their vectors aᵀ are dependent): the impulses between them are not determined; make one of them linear",
+                    names.join(", ")
+                ),
+            )
+        })?;
+        Ok((a, ginv, minv))
+    }
+
+    /// `K'`, `C'`, `f'` of the mode with the rigid contacts `held` held (see above).
+    pub(crate) fn constrained(
+        &self,
+        held: &[usize],
+        k: Mat<f64>,
+        c: Mat<f64>,
+        f: Vec<f64>,
+    ) -> Result<(Mat<f64>, Mat<f64>, Vec<f64>)> {
+        let nd = self.dofs();
+        let r = held.len();
+        let (a, ginv, minv) = self.held_system(held)?;
+        // B = M⁻¹ A G⁻¹ (nd × r), H = A G⁻¹ Aᵀ (nd × nd), P = I − B Aᵀ.
+        let b = |i: usize, j: usize| -> f64 {
+            (0..r)
+                .map(|l| minv[i] * a[l * nd + i] * ginv[l * r + j])
+                .sum()
+        };
+        let bm = Mat::from_fn(nd, r, b);
+        let am = Mat::from_fn(nd, r, |i, j| a[j * nd + i]);
+        let p = Mat::<f64>::identity(nd, nd) - &bm * am.transpose();
+        let h = Mat::<f64>::from_fn(nd, nd, |i, j| {
+            (0..r)
+                .map(|l| {
+                    a[l * nd + i] * (0..r).map(|m| ginv[l * r + m] * a[m * nd + j]).sum::<f64>()
+                })
+                .sum::<f64>()
+        });
+        let gaps: Vec<f64> = held.iter().map(|&c| self.contacts[c].gap).collect();
+        let xg: Vec<f64> = (0..nd)
+            .map(|i| (0..r).map(|j| bm[(i, j)] * gaps[j]).sum())
+            .collect();
+        let rate = |m: &Mat<f64>| -> f64 {
+            (0..nd)
+                .map(|i| {
+                    (0..nd)
+                        .map(|j| m[(i, j)].abs() * (minv[i] * minv[j]).sqrt())
+                        .sum::<f64>()
+                })
+                .fold(0.0, f64::max)
+        };
+        let mut w = rate(&k).sqrt().max(rate(&c));
+        if !(w.is_finite() && w > 0.0) {
+            w = 1.0;
+        }
+        let (a1, a2) = (w, 2.0 * w);
+        let mut kp = p.transpose() * &k * &p;
+        let mut cp = p.transpose() * &c * &p;
+        for i in 0..nd {
+            for j in 0..nd {
+                // Exactly symmetric (the products above are up to round-off).
+                let (ks, cs) = (
+                    0.5 * (kp[(i, j)] + kp[(j, i)]),
+                    0.5 * (cp[(i, j)] + cp[(j, i)]),
+                );
+                kp[(i, j)] = ks + a1 * a2 * h[(i, j)];
+                cp[(i, j)] = cs + (a1 + a2) * h[(i, j)];
+            }
+        }
+        let kxg: Vec<f64> = (0..nd)
+            .map(|i| f[i] - (0..nd).map(|j| k[(i, j)] * xg[j]).sum::<f64>())
+            .collect();
+        let mut fp: Vec<f64> = (0..nd)
+            .map(|i| (0..nd).map(|j| p[(j, i)] * kxg[j]).sum())
+            .collect();
+        for (i, fi) in fp.iter_mut().enumerate() {
+            let ag: f64 = (0..r)
+                .map(|l| a[l * nd + i] * (0..r).map(|m| ginv[l * r + m] * gaps[m]).sum::<f64>())
+                .sum();
+            *fi += a1 * a2 * ag;
+        }
+        Ok((kp, cp, fp))
+    }
+
+    /// The constraint forces of the rigid contacts held in `mode`, as affine functionals
+    /// `[ℓ; ℓ₀]` (length `2·dofs + 1`) of the state: `λ = G⁻¹AᵀM⁻¹(f − Cẋ − Kx)` with the
+    /// mode's free `K`, `C`, `f` (N, compressive positive), in the order of [`Self::held`].
+    pub fn constraint_forces(&self, mode: NetMode) -> Result<Vec<(usize, Vec<f64>)>> {
+        let held = self.held(mode);
+        if held.is_empty() {
+            return Ok(Vec::new());
+        }
+        let nd = self.dofs();
+        let r = held.len();
+        let (k, c, f) = self.free_matrices(mode)?;
+        let (a, ginv, minv) = self.held_system(&held)?;
+        Ok(held
+            .iter()
+            .enumerate()
+            .map(|(row, &ci)| {
+                // w = M⁻¹ A G⁻¹ e_row.
+                let w: Vec<f64> = (0..nd)
+                    .map(|i| {
+                        (0..r)
+                            .map(|l| minv[i] * a[l * nd + i] * ginv[l * r + row])
+                            .sum()
+                    })
+                    .collect();
+                let mut l = vec![0.0; 2 * nd + 1];
+                for j in 0..nd {
+                    l[j] = -(0..nd).map(|i| w[i] * k[(i, j)]).sum::<f64>();
+                    l[nd + j] = -(0..nd).map(|i| w[i] * c[(i, j)]).sum::<f64>();
+                }
+                l[2 * nd] = dot(&w, &f);
+                (ci, l)
+            })
+            .collect())
+    }
+}
+
+/// The impulses `P ≥ 0` of simultaneous rigid impacts: the linear complementarity problem
+/// `w = G P − b ≥ 0`, `P ≥ 0`, `Pᵀw = 0` (`G = AᵀM⁻¹A` row-major `r × r`, `b_c` the velocity
+/// change each contact needs: `(1 + e_c) v_c` closing, `v_c` otherwise; `w_c` is then how much
+/// faster than `e_c v_c` contact `c` separates), solved by enumerating the active sets in
+/// order of size (exact for the few contacts meeting at one instant; `G` positive definite
+/// has exactly one solution). `None` without a solution within round-off, or for more than
+/// 16 contacts at once.
+pub(crate) fn impulses_lcp(g: &[f64], b: &[f64]) -> Option<Vec<f64>> {
+    let r = b.len();
+    if r > 16 {
+        return None;
+    }
+    let tol = 1e-12
+        * b.iter().fold(0.0_f64, |m, v| m.max(v.abs()))
+        * (1.0 + (0..r).map(|i| g[i * r + i]).fold(0.0_f64, f64::max));
+    let mut sets: Vec<u32> = (0..(1u32 << r)).collect();
+    sets.sort_by_key(|s| (s.count_ones(), *s));
+    for set in sets {
+        let idx: Vec<usize> = (0..r).filter(|i| set >> i & 1 == 1).collect();
+        let k = idx.len();
+        let mut p = vec![0.0; r];
+        if k > 0 {
+            let sub: Vec<f64> = idx
+                .iter()
+                .flat_map(|&i| idx.iter().map(move |&j| g[i * r + j]))
+                .collect();
+            let Some(inv) = invert(&sub, k) else {
+                continue;
+            };
+            for (a, &i) in idx.iter().enumerate() {
+                p[i] = (0..k).map(|c| inv[a * k + c] * b[idx[c]]).sum();
+            }
+        }
+        if p.iter().any(|v| *v < -tol) {
+            continue;
+        }
+        let ok = (0..r).all(|i| {
+            set >> i & 1 == 1 || (0..r).map(|j| g[i * r + j] * p[j]).sum::<f64>() - b[i] >= -tol
+        });
+        if ok {
+            return Some(p.into_iter().map(|v| v.max(0.0)).collect());
+        }
+    }
+    None
+}
+
+/// The inverse of the `r × r` row-major matrix `g` by Gauss-Jordan elimination with partial
+/// pivoting; `None` when a pivot falls below `1e-12` of the largest diagonal entry (singular).
+pub(crate) fn invert(g: &[f64], r: usize) -> Option<Vec<f64>> {
+    let scale = (0..r).map(|i| g[i * r + i].abs()).fold(0.0, f64::max);
+    let mut m = g.to_vec();
+    let mut inv = vec![0.0; r * r];
+    for i in 0..r {
+        inv[i * r + i] = 1.0;
+    }
+    for col in 0..r {
+        let piv =
+            (col..r).max_by(|&x, &y| m[x * r + col].abs().total_cmp(&m[y * r + col].abs()))?;
+        let pivot = m[piv * r + col].abs();
+        if pivot.is_nan() || pivot <= 1e-12 * scale {
+            return None;
+        }
+        for j in 0..r {
+            m.swap(col * r + j, piv * r + j);
+            inv.swap(col * r + j, piv * r + j);
+        }
+        let d = m[col * r + col];
+        for j in 0..r {
+            m[col * r + j] /= d;
+            inv[col * r + j] /= d;
+        }
+        for i in 0..r {
+            if i != col {
+                let fct = m[i * r + col];
+                if fct != 0.0 {
+                    for j in 0..r {
+                        m[i * r + j] -= fct * m[col * r + j];
+                        inv[i * r + j] -= fct * inv[col * r + j];
+                    }
+                }
+            }
+        }
+    }
+    Some(inv)
 }
 
 /// `Σ aᵢbᵢ`.

@@ -37,9 +37,53 @@
 //! per bounce. An undamped contact (`e = 1`) never comes to rest, as a rigid elastic one
 //! would not.
 //!
+//! # Rigid contacts
+//! A contact with the rigid law ([`crate::impact::ContactLaw::Rigid`], restitution `e`) has no
+//! force law: it is open, or held as a constraint.
+//!
+//! - **Impact.** When its overlap `aᵀx − g` reaches 0 (found by the search of step 1 and moved
+//!   onto the exact zero by two Newton steps on its closed form, so that no lateness
+//!   accumulates over a train of bounces) while closing at `v_in = aᵀẋ > 0`, the velocities jump
+//!   by the impulse `J` along `a` that gives `aᵀẋ⁺ = −e v_in`:
+//!   `ẋ⁺ = ẋ − (1 + e) v_in M⁻¹a/(aᵀM⁻¹a)`, removing `½(1 − e²) v_in²/(aᵀM⁻¹a)` (Newton's law of
+//!   restitution), booked as the contact's dissipated energy (run total and impact row). The row
+//!   has `impulse_n_s = J`, `duration_s = 0` and `peak_force_n = None`: an impulse has no finite
+//!   peak. Springs and dashpots transmit no impulse; every other rigid contact at zero overlap
+//!   or held at that instant does: the impulses `P ≥ 0` of all of them solve the complementarity
+//!   problem `w = G P − b ≥ 0`, `Pᵀw = 0` (`G = AᵀM⁻¹A`, `b_c = (1 + e_c) v_c` for a closing
+//!   contact, `v_c` otherwise; [`crate::impact::network::impulses_lcp`]), and each books
+//!   `P_c (v_c⁻ + v_c⁺)/2`, the kinetic energy its impulse removes (these sum exactly to the
+//!   loss).
+//! - **Rest.** Under a constant force the bounces of `e < 1` accumulate (infinitely many in a
+//!   finite time). After an impact with rebound `u = e v_in` and a normal acceleration
+//!   `aₙ = d(aᵀẋ)/dt > 0` pushing the contact closed, the next flight rises `u²/(2aₙ)`: when
+//!   that is inside the band within which [`lex_signs`] calls an overlap zero (`1e-9` of the
+//!   overlap's terms), or when the rest of the bounces, `2u/(aₙ(1 − e))`, is shorter than the
+//!   clock's resolution `ε t`, the next impacts come within round-off. The impact is then
+//!   plastic (`e = 0`: the remaining bounces' energy `½ e² v_in²/(aᵀM⁻¹a)` is dissipated with
+//!   it) and the contact is **held**: the constraint `aᵀx = g` of the constrained mode
+//!   ([`Network::constrained`], exact, the α-terms vanishing on the manifold), with the
+//!   constraint force `λ = G⁻¹AᵀM⁻¹(f − Cẋ − Kx)` (affine in the state) as the contact's force
+//!   channel. Its resting row starts at the instant the collapsed bounces end, the impact plus
+//!   their geometric sum `2u/(aₙ(1 − e))` (exact for a constant `aₙ`; the accumulation time
+//!   `√(2h/g)(1 + e)/(1 − e)` of a ball dropped from `h` to round-off: about 1e-16 relative
+//!   measured, 1e-9 asked by the tests). The
+//!   number of impacts stays finite: about `ln(v₀²/(2aₙ·1e-9·s))/(2 ln(1/e))` for a first landing
+//!   at `v₀` and an overlap scale `s`.
+//! - **Release.** A held contact lets go when `λ` crosses zero (searched as an indicator);
+//!   with several held, the most negative goes first and the others' forces are those of the
+//!   smaller set.
+//!
+//! The dopri5 method runs the paper's machine only, so a rigid contact with a Hertz or
+//! Hunt-Crossley contact in one machine (which would need it) is not possible yet; the paper's
+//! form (`[contact.slider_bed]`) refuses the rigid law with a message that says how to write
+//! the machine as a general one: its engine has no impulses, and the general machine's exact
+//! engine already runs the same machine (`examples/hammer-rigid.toml`).
+//!
 //! # Initial state
 //! Velocities are the impactors' (dampers start at rest). Without a preloaded contact every
-//! displacement starts at 0 (the impactors touch, or stand off by their gaps). With preloaded
+//! displacement starts at 0 (the impactors touch, or stand off by their gaps). A rigid contact
+//! closing at t = 0 strikes then; one touching with its bodies pushed together rests. With preloaded
 //! contacts (`g < 0`) the displacements are the static equilibrium
 //! `K_p x = f_p` of the mode `p` in which exactly the preloaded contacts are closed (forcing:
 //! the preloads `K_c g_c a_c` and the constant forces); a direction `K_p` does not hold (a free
@@ -75,9 +119,13 @@ use super::peaks::{self, Extremes};
 use super::propagator::{Functional, Propagator, Segment};
 use super::roots::{Scalar, Search, SearchOptions};
 use super::Options;
-use crate::impact::network::{dot, End, NetIndicator, NetMode, Network};
+use crate::impact::network::{
+    dot, impulses_lcp, End, IndicatorKind, NetIndicator, NetMode, Network,
+};
 use crate::{Error, Result};
 
+/// The band, relative to the size of its terms, within which [`lex_signs`] calls a value zero.
+const VALUE_TOL: f64 = 1e-9;
 /// Highest derivative order consulted when deciding an indicator's side.
 const K_MAX: usize = 8;
 /// The energy-balance residual an exact run must stay within (relative).
@@ -119,7 +167,9 @@ pub struct ImpactRow {
     pub start_s: f64,
     /// Closing speed `δ̇` when the contact closed (m/s).
     pub approach_velocity_m_per_s: f64,
-    pub peak_force_n: f64,
+    /// Largest force while closed (N); `None` for a rigid contact's impact, an impulse with no
+    /// finite peak (its row carries the impulse, duration 0).
+    pub peak_force_n: Option<f64>,
     pub peak_time_s: f64,
     /// Time closed (s); up to the end of the run for a contact still closed then.
     pub duration_s: f64,
@@ -181,6 +231,9 @@ struct ModeData {
     c: Mat<f64>,
     f: Vec<f64>,
     prop: Option<Rc<Propagator>>,
+    /// The held rigid contacts' constraint forces `(contact, [ℓ; ℓ₀])`
+    /// ([`Network::constraint_forces`]).
+    lambda: Vec<(usize, Vec<f64>)>,
     /// Per channel `(ℓ, ℓ_slope)` (both of length `n + 1`), `None` when identically zero.
     chans: Option<Vec<Option<ChannelVectors>>>,
 }
@@ -210,6 +263,7 @@ impl ModeData {
             c,
             f,
             prop: None,
+            lambda: net.constraint_forces(mode)?,
             chans: None,
         })
     }
@@ -271,7 +325,12 @@ fn channel_vector(net: &Network, md: &ModeData, mode: NetMode, kind: &ChannelKin
     let nm = net.n_modes();
     let mut l = vec![0.0; n + 1];
     let contact = |l: &mut Vec<f64>, c: usize, sign: f64| {
-        if let (true, Ok((k, cc))) = (net.closed(mode, c), net.linear_law(c)) {
+        if let Some((_, lam)) = md.lambda.iter().find(|(ci, _)| *ci == c) {
+            // A held rigid contact: its constraint force.
+            for (li, v) in l.iter_mut().zip(lam) {
+                *li += sign * v;
+            }
+        } else if let (true, Ok((k, cc))) = (net.closed(mode, c), net.linear_law(c)) {
             let a = net.contact_vector(c);
             for i in 0..nd {
                 l[i] += sign * k * a[i];
@@ -355,7 +414,7 @@ fn lex_signs(inds: &[NetIndicator], md: &ModeData, x: &[f64], out: &mut [f64]) {
     let mut terms: Vec<f64> = x.iter().map(|v| v.abs()).collect();
     let mut open = inds.len();
     for k in 0..=K_MAX {
-        let tol = if k == 0 { 1e-9 } else { 1e-11 };
+        let tol = if k == 0 { VALUE_TOL } else { 1e-11 };
         for (ind, o) in inds.iter().zip(out.iter_mut()) {
             if *o != 0.0 {
                 continue;
@@ -425,11 +484,13 @@ impl Modes<'_> {
     /// A consistent mode at `x`, iterated from `start` (module documentation), and the
     /// indicators' signs under it. Without a fixed point, the last candidate.
     fn select(&mut self, x: &[f64], start: NetMode, signs: &mut [f64]) -> Result<NetMode> {
+        // Held rigid contacts stay held: their impacts and constraint forces decide.
+        let held = self.net.held_bits(start).0;
         let mut cand = start;
         let mut seen = vec![start];
         for _ in 0..(2 * self.inds.len() + 8) {
             self.signs(cand, x, signs)?;
-            let next = self.net.implied(&self.inds, signs);
+            let next = NetMode(self.net.implied(&self.inds, signs).0 | held);
             if next == cand {
                 return Ok(cand);
             }
@@ -532,6 +593,19 @@ pub fn initial_state(net: &Network) -> Result<Vec<f64>> {
     for c in 0..net.contacts.len() {
         let link = &net.contacts[c];
         let (delta, _) = net.overlap(c, &x);
+        if net.rigid(c).is_some() {
+            // Never preloaded (refused); an overlap here is the open-contact error below.
+            if delta > 1e-9 * link.gap.abs().max(1e-12) {
+                return Err(Error::invalid(
+                    format!("{}.gap", link.name),
+                    format!(
+                        "at the static state under the preloads the rigid contact overlaps by {delta:.3e} m although its gap is {} m: give a larger gap",
+                        crate::num(link.gap)
+                    ),
+                ));
+            }
+            continue;
+        }
         let (kk, _) = net.linear_law(c)?;
         let force = kk * delta;
         if link.gap < 0.0 && (force.is_nan() || force <= 1e-9 * kk * link.gap.abs()) {
@@ -574,14 +648,37 @@ pub fn solve(net: &Network, opts: &Options) -> Result<NetSolution> {
         ));
     }
     let mut run = Run::new(net, opts)?;
+    run.rigid_events()?;
+    let ended_at_start = run.collision_ended() && opts.stop_at_collision_end;
+    if !ended_at_start {
+        run_stretches(&mut run, opts)?;
+    }
+    let sol = run.finish();
+    check(net, &sol)?;
+    Ok(sol)
+}
+
+/// The run's stretches and switches to its end (or the collision's, when asked).
+fn run_stretches(run: &mut Run<'_, '_>, opts: &Options) -> Result<()> {
     loop {
         let switched = run.stretch()?;
         if !switched {
             break;
         }
+        run.rigid_events()?;
         let new_mode = run.next_mode()?;
         if new_mode != run.mode {
             run.switch_to(new_mode)?;
+            run.rigid_events()?;
+        }
+        if run.impacts.len() > opts.max_events {
+            return Err(Error::numerical(
+                "network propagator",
+                format!(
+                    "more than {} impacts by t = {:.6e} s (simulation.max_events)",
+                    opts.max_events, run.t
+                ),
+            ));
         }
         if run.collision_ended() && opts.stop_at_collision_end {
             break;
@@ -590,9 +687,7 @@ pub fn solve(net: &Network, opts: &Options) -> Result<NetSolution> {
             break;
         }
     }
-    let sol = run.finish();
-    check(net, &sol)?;
-    Ok(sol)
+    Ok(())
 }
 
 /// The state of a run between stretches ([`solve`]).
@@ -712,9 +807,12 @@ impl<'n, 'o> Run<'n, 'o> {
         let n = 2 * net.dofs();
         let horizon = self.opts.duration - self.t;
         let masses = self.modes.masses.clone();
-        let prop = self.modes.get(self.mode)?.propagator(&masses)?;
+        let md = self.modes.get(self.mode)?;
+        let lam: Vec<Vec<f64>> = md.lambda.iter().map(|(_, l)| l.clone()).collect();
+        let prop = md.propagator(&masses)?;
         let seg = prop.segment(&self.x);
         let period = prop.period();
+        let held = net.held_bits(self.mode);
         let s_end = {
             let funcs: Vec<Functional<'_>> = self
                 .modes
@@ -722,17 +820,28 @@ impl<'n, 'o> Run<'n, 'o> {
                 .iter()
                 .map(|i| seg.functional(&i.l))
                 .collect();
+            let lam_funcs: Vec<Functional<'_>> = lam.iter().map(|l| seg.functional(l)).collect();
             let mut searches: Vec<Search<Lifted<&Functional<'_>>>> = funcs
                 .iter()
                 .zip(&self.signs)
                 .zip(&self.modes.inds)
-                .filter(|((_, s), _)| **s != 0.0)
+                .filter(|((_, s), ind)| **s != 0.0 && !held_overlap(held, ind))
                 .map(|((f, s), ind)| {
                     let v = dot(&ind.l[..n], &self.x) + ind.l[n];
                     Search::new(Lifted::new(f, v, *s), *s, SearchOptions::default())
                 })
                 .collect();
-            first_switch(&mut searches, period, horizon)
+            // A held rigid contact lets go when its constraint force λ (> 0 now) reaches 0.
+            for (f, l) in lam_funcs.iter().zip(&lam) {
+                let v = dot(&l[..n], &self.x) + l[n];
+                searches.push(Search::new(
+                    Lifted::new(f, v, 1.0),
+                    1.0,
+                    SearchOptions::default(),
+                ));
+            }
+            let found = first_switch(&mut searches, period, horizon);
+            found.map(|s| self.rigid_root(s, &funcs))
         };
         let (s_end, switched) = match s_end {
             Some(s) if s < horizon => (s.max(0.0), true),
@@ -747,6 +856,35 @@ impl<'n, 'o> Run<'n, 'o> {
             self.count_zero_length(s_end, period, t_before)?;
         }
         Ok(switched)
+    }
+
+    /// The switch at `s` moved back onto the exact zero of a rigid contact's overlap when
+    /// that is what ended the stretch: the search stops where the overlap is past zero by its
+    /// round-off band, and an impact there would strike a little late and fast; over a train
+    /// of bounces of shrinking speed `u` (a late time of band/u each) that bias accumulates.
+    /// Two Newton steps on the overlap's closed form `δ(s)` give the zero to round-off.
+    fn rigid_root(&self, s: f64, funcs: &[Functional<'_>]) -> f64 {
+        let mut best = s;
+        for ((f, ind), sign) in funcs.iter().zip(&self.modes.inds).zip(&self.signs) {
+            if *sign >= 0.0 || !rigid_overlap(self.net, ind) {
+                continue;
+            }
+            let (v, d) = f.value_slope(s);
+            if !(v >= 0.0 && d > 0.0) {
+                continue;
+            }
+            let mut r = s - v / d;
+            for _ in 0..2 {
+                let (v, d) = f.value_slope(r);
+                if d > 0.0 {
+                    r -= v / d;
+                }
+            }
+            if r.is_finite() && r >= 0.0 && r < best {
+                best = r;
+            }
+        }
+        best
     }
 
     /// The extremes of every channel over a stretch of length `s_end` from `t`, the open
@@ -817,6 +955,9 @@ impl<'n, 'o> Run<'n, 'o> {
         let signs = &mut self.signs;
         let mut moved = vec![false; signs.len()];
         for (i, ind) in self.modes.inds.iter().enumerate() {
+            if rigid_overlap(self.net, ind) {
+                continue;
+            }
             let v = dot(&ind.l[..n], &self.x) + ind.l[n];
             if searched[i] != 0.0 && searched[i] * v < 0.0 && signs[i] == searched[i] {
                 signs[i] = -searched[i];
@@ -880,6 +1021,280 @@ impl<'n, 'o> Run<'n, 'o> {
         Ok(())
     }
 
+    /// The rigid contacts at an instant (t = 0 or a switch): held ones whose constraint force
+    /// turns negative let go ([`Run::release_held`]), then the impacts of those closing
+    /// ([`Run::rigid_impacts`]); the indicators' signs are then those of the new state.
+    fn rigid_events(&mut self) -> Result<()> {
+        if !(0..self.net.contacts.len()).any(|c| self.net.rigid(c).is_some()) {
+            return Ok(());
+        }
+        let changed = self.release_held()? | self.rigid_impacts()?;
+        if changed {
+            self.mode = self.modes.select(&self.x, self.mode, &mut self.signs)?;
+        }
+        Ok(())
+    }
+
+    /// Lets go, one at a time, the held rigid contact whose constraint force `λ` is the most
+    /// negative of those turning negative just after now (the sign of its first non-vanishing
+    /// derivative, [`lex_signs`]); the others' forces are then those of the smaller set.
+    fn release_held(&mut self) -> Result<bool> {
+        let mut changed = false;
+        loop {
+            let md = self.modes.get(self.mode)?;
+            if md.lambda.is_empty() {
+                return Ok(changed);
+            }
+            let inds: Vec<NetIndicator> = md
+                .lambda
+                .iter()
+                .map(|(c, l)| NetIndicator {
+                    kind: IndicatorKind::Force(*c),
+                    l: l.clone(),
+                })
+                .collect();
+            let mut signs = vec![0.0; inds.len()];
+            lex_signs(&inds, md, &self.x, &mut signs);
+            let n = self.x.len();
+            let worst = inds
+                .iter()
+                .zip(&signs)
+                .filter(|(_, s)| **s < 0.0)
+                .map(|(ind, _)| (ind, dot(&ind.l[..n], &self.x) + ind.l[n]))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            let Some((ind, _)) = worst else {
+                return Ok(changed);
+            };
+            let IndicatorKind::Force(c) = ind.kind else {
+                return Ok(changed);
+            };
+            self.switch_to(self.mode.with(c, false))?;
+            changed = true;
+        }
+    }
+
+    /// The rigid contacts at zero overlap (within the band [`lex_signs`] calls zero) and the
+    /// ones held; `(contact, closing speed v = aᵀẋ, does it close?)`, where an open one closes
+    /// when its overlap turns positive just after now.
+    fn rigid_at_contact(&mut self) -> Result<Vec<(usize, f64, bool)>> {
+        let net = self.net;
+        let nd = net.dofs();
+        let mut signs = vec![0.0; self.modes.inds.len()];
+        self.modes.signs(self.mode, &self.x, &mut signs)?;
+        let mut out = Vec::new();
+        for (ind, sg) in self.modes.inds.iter().zip(&signs) {
+            let IndicatorKind::Overlap(c) = ind.kind else {
+                continue;
+            };
+            if net.rigid(c).is_none() {
+                continue;
+            }
+            let (d, v) = net.overlap(c, &self.x);
+            let a = net.contact_vector(c);
+            let scale: f64 = a
+                .iter()
+                .zip(&self.x[..nd])
+                .map(|(ai, xi)| (ai * xi).abs())
+                .sum::<f64>()
+                + net.contacts[c].gap.abs();
+            if net.closed(self.mode, c) {
+                out.push((c, v, false));
+            } else if d.abs() <= VALUE_TOL * scale || (d > 0.0 && *sg > 0.0) {
+                out.push((c, v, *sg > 0.0));
+            }
+        }
+        Ok(out)
+    }
+
+    /// Newton impacts of the rigid contacts closing now (module documentation, "Rigid
+    /// contacts"): the impulses of every rigid contact at zero overlap or held, from the
+    /// complementarity problem of [`impulses_lcp`]; a contact whose rebound would end within
+    /// round-off (the next apex `u²/(2aₙ)` inside the band [`lex_signs`] calls zero, or the
+    /// rest of the bounces, `2u/(aₙ(1 − e))`, shorter than the clock's resolution `ε t`) is
+    /// struck plastically instead and held from now on. Returns whether anything changed.
+    fn rigid_impacts(&mut self) -> Result<bool> {
+        let net = self.net;
+        let nd = net.dofs();
+        let set = self.rigid_at_contact()?;
+        if !set.iter().any(|(_, _, closes)| *closes) {
+            return Ok(false);
+        }
+        // The search stops just past the overlap's zero (within its round-off): put the
+        // contacts that close exactly on it, along M⁻¹a (a shift within round-off, so no
+        // overshoot accumulates over a train of bounces).
+        let m = net.mass_diag();
+        for (c, _, closes) in &set {
+            if *closes {
+                let (d, _) = net.overlap(*c, &self.x);
+                let a = net.contact_vector(*c);
+                let g: f64 = (0..nd).map(|k| a[k] * a[k] / m[k]).sum();
+                for k in 0..nd {
+                    self.x[k] -= a[k] / m[k] * d / g;
+                }
+            }
+        }
+        let r = set.len();
+        let mut g = vec![0.0; r * r];
+        for (i, (ci, _, _)) in set.iter().enumerate() {
+            for (j, (cj, _, _)) in set.iter().enumerate() {
+                let (ai, aj) = (net.contact_vector(*ci), net.contact_vector(*cj));
+                g[i * r + j] = (0..nd).map(|k| ai[k] * aj[k] / m[k]).sum();
+            }
+        }
+        let mode0 = self.mode;
+        let t0 = self.t;
+        let e_of = |c: usize, v: f64, plastic: bool| -> f64 {
+            match net.rigid(c) {
+                Some(e) if v > 0.0 && !plastic && !net.closed(mode0, c) => e,
+                _ => 0.0,
+            }
+        };
+        let solve = |plastic: &[bool]| -> Result<Vec<f64>> {
+            let b: Vec<f64> = set
+                .iter()
+                .zip(plastic)
+                .map(|((c, v, _), p)| (1.0 + e_of(*c, *v, *p)) * v)
+                .collect();
+            impulses_lcp(&g, &b).ok_or_else(|| {
+                Error::numerical(
+                    "network propagator",
+                    format!(
+                        "the impulses of {r} rigid contacts meeting at t = {t0:.9e} s have no solution (more than 16 at once, or dependent contacts)"
+                    ),
+                )
+            })
+        };
+        let mut plastic = vec![false; r];
+        let p = solve(&plastic)?;
+        let rest = self.rests(&set, &g, &p)?;
+        for (k, rt) in rest.iter().enumerate() {
+            plastic[k] = rt.is_some();
+        }
+        let p = if plastic.iter().any(|x| *x) {
+            solve(&plastic)?
+        } else {
+            p
+        };
+        self.apply_impulses(&set, &p);
+        let mut mode = self.mode;
+        for (k, rt) in rest.iter().enumerate() {
+            if rt.is_some() {
+                mode = mode.with(set[k].0, true);
+            }
+        }
+        if mode != self.mode {
+            self.switch_to(mode)?;
+            for (k, rt) in rest.iter().enumerate() {
+                if let (Some(tau), Some(o)) = (rt, &self.open[set[k].0]) {
+                    // The collapsed bounces end (the contact comes to rest) τ later.
+                    self.impacts[o.row].start_s = self.t + tau;
+                }
+            }
+        }
+        Ok(true)
+    }
+
+    /// For each contact of `set` that closes, struck by the impulses `p`: `Some(τ)` when its
+    /// rebound ends within round-off (see [`Run::rigid_impacts`]), `τ = 2u/(aₙ(1 − e))` the
+    /// time the remaining bounces take (0 for `e = 1`: a rebound within round-off).
+    fn rests(
+        &mut self,
+        set: &[(usize, f64, bool)],
+        g: &[f64],
+        p: &[f64],
+    ) -> Result<Vec<Option<f64>>> {
+        let net = self.net;
+        let nd = net.dofs();
+        let n = 2 * nd;
+        let r = set.len();
+        let md = self.modes.get(self.mode)?;
+        let mut out = vec![None; r];
+        for (k, (c, v, closes)) in set.iter().enumerate() {
+            let Some(e) = net.rigid(*c) else { continue };
+            if !closes || net.closed(self.mode, *c) {
+                continue;
+            }
+            let dv: f64 = (0..r).map(|j| g[k * r + j] * p[j]).sum();
+            let u = (dv - v).max(0.0);
+            // aₙ = d(aᵀẋ)/dt just after, under the mode with the contact open.
+            let mut lv = vec![0.0; n + 1];
+            lv[nd..n].copy_from_slice(net.contact_vector(*c));
+            let slope = md.slope(&lv);
+            let mut x = self.x.clone();
+            let a = net.contact_vector(*c);
+            let m = net.mass_diag();
+            for i in 0..nd {
+                x[nd + i] -= (0..r)
+                    .map(|j| net.contact_vector(set[j].0)[i] * p[j])
+                    .sum::<f64>()
+                    / m[i];
+            }
+            let an = dot(&slope[..n], &x) + slope[n];
+            if an.is_nan() || an <= 0.0 {
+                continue;
+            }
+            let scale: f64 = a
+                .iter()
+                .zip(&x[..nd])
+                .map(|(ai, xi)| (ai * xi).abs())
+                .sum::<f64>()
+                + net.contacts[*c].gap.abs();
+            let tau = if e < 1.0 {
+                2.0 * u / (an * (1.0 - e))
+            } else {
+                0.0
+            };
+            let apex = u * u / (2.0 * an);
+            if apex <= VALUE_TOL * scale || (e < 1.0 && tau <= f64::EPSILON * self.t) {
+                out[k] = Some(tau);
+            }
+        }
+        Ok(out)
+    }
+
+    /// Applies the impulses `p` of the contacts `set` (`ẋ⁺ = ẋ − M⁻¹Σ a_c P_c`), books each
+    /// one's dissipation `P_c (v_c⁻ + v_c⁺)/2` (the exact kinetic energy it removes) and its
+    /// row: a new impact row (duration 0, no peak force) for an open contact, added to the
+    /// resting row of a held one.
+    fn apply_impulses(&mut self, set: &[(usize, f64, bool)], p: &[f64]) {
+        let net = self.net;
+        let nd = net.dofs();
+        let m = net.mass_diag();
+        for ((c, _, _), pc) in set.iter().zip(p) {
+            let a = net.contact_vector(*c);
+            for i in 0..nd {
+                self.x[nd + i] -= a[i] * pc / m[i];
+            }
+        }
+        for ((c, v, _), pc) in set.iter().zip(p) {
+            if *pc <= 0.0 {
+                continue;
+            }
+            let (_, after) = net.overlap(*c, &self.x);
+            let lost = pc * (v + after) / 2.0;
+            self.dissipated_j += lost;
+            self.touched = true;
+            if let Some(o) = &self.open[*c] {
+                let row = &mut self.impacts[o.row];
+                row.impulse_n_s += pc;
+                row.dissipated_j += lost;
+                continue;
+            }
+            self.impacts.push(ImpactRow {
+                contact: net.contacts[*c].name.clone(),
+                start_s: self.t,
+                approach_velocity_m_per_s: *v,
+                peak_force_n: None,
+                peak_time_s: self.t,
+                duration_s: 0.0,
+                impulse_n_s: *pc,
+                dissipated_j: lost,
+                exit_velocity_m_per_s: Some(-after),
+                restitution: (*v > 0.0).then(|| -after / v),
+            });
+        }
+    }
+
     /// Records the end of the collision the first time every contact that was not preloaded
     /// is open again after one of them closed; true once it has ended.
     fn collision_ended(&mut self) -> bool {
@@ -922,7 +1337,7 @@ impl<'n, 'o> Run<'n, 'o> {
                 let row = &mut self.impacts[o.row];
                 row.duration_s = t - row.start_s;
                 let (v, tv) = o.ext.peak();
-                row.peak_force_n = v;
+                row.peak_force_n = Some(v);
                 row.peak_time_s = tv;
             }
         }
@@ -1015,7 +1430,7 @@ fn start_impact(
         contact: net.contacts[c].name.clone(),
         start_s: t,
         approach_velocity_m_per_s: rate,
-        peak_force_n: 0.0,
+        peak_force_n: Some(0.0),
         peak_time_s: t,
         duration_s: 0.0,
         impulse_n_s: 0.0,
@@ -1032,10 +1447,20 @@ fn start_impact(
 fn finish_impact(row: &mut ImpactRow, ext: &Extremes, t: f64, rate: f64, jump: f64) {
     row.duration_s = t - row.start_s;
     let (v, tv) = ext.peak();
-    row.peak_force_n = v;
+    row.peak_force_n = Some(v);
     row.peak_time_s = tv;
     row.dissipated_j += jump;
     row.exit_velocity_m_per_s = Some(-rate);
     row.restitution =
         (row.approach_velocity_m_per_s > 0.0).then(|| -rate / row.approach_velocity_m_per_s);
+}
+
+/// Is `ind` the overlap of a rigid contact held in `held`?
+fn held_overlap(held: NetMode, ind: &NetIndicator) -> bool {
+    matches!(ind.kind, IndicatorKind::Overlap(c) if held.on(c))
+}
+
+/// Is `ind` the overlap of a rigid contact?
+fn rigid_overlap(net: &Network, ind: &NetIndicator) -> bool {
+    matches!(ind.kind, IndicatorKind::Overlap(c) if net.rigid(c).is_some())
 }

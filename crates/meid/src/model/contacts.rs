@@ -97,6 +97,12 @@ impl Model {
     ) -> Result<ContactSetting> {
         let s = &self.spec;
         let path = which.path();
+        if spec.law == LawSpec::Rigid {
+            return Err(self.source.error(
+                &format!("{path}.law"),
+                format!("{path}.law: {}", crate::impact::RIGID_PAPER_FORM),
+            ));
+        }
         if spec.law != LawSpec::Linear && spec.damping.is_some_and(|c| c != 0.0) {
             return Err(self.source.error(
                 &format!("{path}.damping"),
@@ -189,7 +195,7 @@ impl Model {
         let given = match spec.law {
             LawSpec::Linear => spec.damping.map(|v| ("damping", v, "N·s/m")),
             LawSpec::HuntCrossley => spec.alpha.map(|v| ("alpha", v, "s/m")),
-            LawSpec::Hertz => {
+            LawSpec::Hertz | LawSpec::Rigid => {
                 return fail(
                     "the hertz law (f = K δ^1.5) has no damping for a restitution to set; use law = \"hunt-crossley\" (f = K δ^n (1 + 3/2 α δ̇), whose α restitution sets) or leave restitution out".into(),
                 )
@@ -247,6 +253,10 @@ fn law(spec: &ContactSpec, c: f64, alpha: f64) -> ContactLaw {
         },
         LawSpec::Hertz => ContactLaw::Hertz {
             stiffness: spec.stiffness,
+        },
+        // Refused before (`setting`): the paper's engine has no rigid law.
+        LawSpec::Rigid => ContactLaw::Rigid {
+            restitution: spec.restitution.unwrap_or(1.0),
         },
         LawSpec::HuntCrossley => ContactLaw::HuntCrossley {
             stiffness: spec.stiffness,

@@ -169,6 +169,8 @@ pub fn contact_omega(c: &ContactSpec, m: f64, v: f64) -> Option<f64> {
         LawSpec::Linear => return Some((k / m).sqrt()),
         LawSpec::Hertz => 1.5,
         LawSpec::HuntCrossley => c.exponent.unwrap_or(1.5),
+        // No contact frequency: the impacts are instantaneous.
+        LawSpec::Rigid => return None,
     };
     if !(n.is_finite() && n > 0.0 && v.is_finite() && v > 0.0) {
         return None;

@@ -251,6 +251,7 @@ impl Model {
                 message: "this is a general machine ([[impactor]], [[damper]] or [[contact]] arrays): `meid simulate` runs it; the other commands take the paper's machine ([slider], [damper], [contact.slider_bed]) for now".into(),
             });
         }
+        refuse_rigid_paper_form(name, &text, &table)?;
         let from_file: ModelSpec = spec_from_text(name, &text)?;
         let mut src = Source {
             name: name.to_string(),
@@ -1132,4 +1133,33 @@ fn round4(v: f64) -> f64 {
     }
     let scale = 10f64.powi(3 - v.abs().log10().floor() as i32);
     (v * scale).round() / scale
+}
+
+/// A paper-form contact with `law = "rigid"` (which also leaves out the stiffness the paper's
+/// form requires) is refused before the sections are read, saying how to write the machine as
+/// a general one ([`crate::impact::RIGID_PAPER_FORM`]).
+fn refuse_rigid_paper_form(name: &str, text: &str, table: &toml::Table) -> Result<()> {
+    let Some(toml::Value::Table(contacts)) = table.get("contact") else {
+        return Ok(());
+    };
+    for which in ["slider_bed", "bed_damper"] {
+        let rigid = contacts
+            .get(which)
+            .and_then(|c| c.get("law"))
+            .and_then(|l| l.as_str())
+            == Some("rigid");
+        if rigid {
+            let src = Source {
+                name: name.to_string(),
+                text: text.to_string(),
+                overrides: Vec::new(),
+            };
+            let path = format!("contact.{which}.law");
+            return Err(src.error(
+                &path,
+                format!("{path}: {}", crate::impact::RIGID_PAPER_FORM),
+            ));
+        }
+    }
+    Ok(())
 }

@@ -14,12 +14,17 @@
 //! |---|---|
 //! | `[[impactor]]` | `name`, `mass` (kg), `velocity` (m/s at t = 0, +z towards what it strikes; default 0), `force` (N, constant from t = 0, +z; default 0) |
 //! | `[[damper]]` | `name`, `mass` (kg), `stiffness` (N/m), `damping` (N·s/m, default 0), `dashpot` (`one-way`/`two-way`), `point` (the structure point it touches), `anchor` (a structure point or `ground`, default `ground`) |
-//! | `[[contact]]` | `name`, `between = [A, B]` (structure points, impactors, dampers or `ground`; A strikes B moving along +z), `gap` (m; > 0 open, < 0 preloaded; default 0), `law` (`linear`), `stiffness`, `damping` or `restitution`, `release` (`force`/`overlap`) |
+//! | `[[contact]]` | `name`, `between = [A, B]` (structure points, impactors, dampers or `ground`; A strikes B moving along +z), `gap` (m; > 0 open, < 0 preloaded; default 0), `law` (`linear`: `stiffness`, `damping` or `restitution`, `release` (`force`/`overlap`); `rigid`: `restitution` in [0, 1] only, no preload) |
 //!
 //! `restitution = e` on a linear contact sets `C = 2ζ(e)√(K m*)` with `ζ(e)` of its release
 //! rule ([`crate::impact::restitution::zeta_of_e`]) and the reduced mass of the two ends,
 //! `1/m* = aᵀM⁻¹a` (`a` the contact's relative vector: `1/m_body` for a body,
 //! `Σ_i ψ_i(P)²` for a structure point, summed over both ends; the ground adds nothing).
+//!
+//! `law = "rigid"` is the instantaneous impact with Newton's restitution `e` ∈ [0, 1]
+//! ([`crate::impact::ContactLaw::Rigid`], [`crate::integrate::network`], "Rigid contacts"): it
+//! takes `restitution` (required) and no `stiffness`, `damping`, `exponent` or `alpha` (a rigid
+//! contact has none), and no preload (`gap` < 0 would overlap it); `release` does not apply.
 //!
 //! Every damper must touch its `point` through a contact `between = [point, damper]` (in
 //! either order). Names are unique across impactors, dampers and structure points.
@@ -106,7 +111,9 @@ pub struct ContactEntrySpec {
     pub gap: f64,
     #[serde(default)]
     pub law: LawSpec,
-    pub stiffness: f64,
+    /// N/m; required by the linear law, refused by the rigid one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness: Option<f64>,
     #[serde(default)]
     pub damping: Option<f64>,
     #[serde(default)]
@@ -433,17 +440,26 @@ fn check_contact_entry(p: &str, c: &ContactEntrySpec) -> std::result::Result<(),
             ),
         ));
     }
-    if !(c.stiffness.is_finite() && c.stiffness > 0.0) {
+    if c.law == LawSpec::Rigid {
+        return check_rigid_entry(p, c);
+    }
+    let stiffness = c.stiffness.ok_or_else(|| {
+        (
+            format!("{p}.stiffness"),
+            "missing: the linear law needs a contact stiffness K (N/m); or write law = \"rigid\" with a restitution for instantaneous impacts".to_string(),
+        )
+    })?;
+    if !(stiffness.is_finite() && stiffness > 0.0) {
         return Err((
             format!("{p}.stiffness"),
             format!(
                 "must be a finite number > 0 N/m (got {})",
-                crate::num(c.stiffness)
+                crate::num(stiffness)
             ),
         ));
     }
     if c.law != LawSpec::Linear {
-        return Err((format!("{p}.law"), "a general machine takes law = \"linear\" (with damping or restitution) for now: its exact engine needs piecewise-linear contacts, and dopri5 runs the paper's machine only".into()));
+        return Err((format!("{p}.law"), "a general machine takes law = \"linear\" (with damping or restitution) or law = \"rigid\" (with restitution) for now: its exact engine needs piecewise-linear contacts, and dopri5 runs the paper's machine only".into()));
     }
     if c.exponent.is_some() || c.alpha.is_some() {
         return Err((format!("{p}.alpha"), "exponent and alpha belong to law = \"hunt-crossley\", which a general machine does not take yet".into()));
@@ -479,6 +495,52 @@ fn check_contact_entry(p: &str, c: &ContactEntrySpec) -> std::result::Result<(),
     Ok(())
 }
 
+/// A `law = "rigid"` entry at model path `p`: a restitution in [0, 1], no stiffness, damping,
+/// exponent or alpha, no preload.
+fn check_rigid_entry(p: &str, c: &ContactEntrySpec) -> std::result::Result<(), (String, String)> {
+    for (what, v) in [
+        ("stiffness", c.stiffness),
+        ("damping", c.damping),
+        ("exponent", c.exponent),
+        ("alpha", c.alpha),
+    ] {
+        if let Some(v) = v {
+            return Err((
+                format!("{p}.{what}"),
+                format!(
+                    "{what} = {} is given with law = \"rigid\": a rigid contact has no stiffness or damping (its impacts are instantaneous, their loss set by restitution = e alone); remove {what}, or use law = \"linear\" for a compliant contact",
+                    crate::num(v)
+                ),
+            ));
+        }
+    }
+    let Some(e) = c.restitution else {
+        return Err((
+            format!("{p}.restitution"),
+            "missing: law = \"rigid\" needs restitution = e, the coefficient of restitution in [0, 1] (0: plastic, 1: elastic; IS 2974-2 uses 0.5 for a hammer's tup on its anvil)".into(),
+        ));
+    };
+    if !(0.0..=1.0).contains(&e) {
+        return Err((
+            format!("{p}.restitution"),
+            format!(
+                "the rigid law's coefficient of restitution must be in [0, 1] (0: plastic, 1: elastic; got {})",
+                crate::num(e)
+            ),
+        ));
+    }
+    if c.gap < 0.0 {
+        return Err((
+            format!("{p}.gap"),
+            format!(
+                "a rigid contact cannot be preloaded (gap = {} m would overlap it): give a gap ≥ 0, or use law = \"linear\" for a preload",
+                crate::num(c.gap)
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// The reduction context of the structure: the named points the machine uses, and the fastest
 /// contact frequency `√(K/m)` against a body.
 fn context(spec: &NetworkSpec) -> ReductionContext {
@@ -510,7 +572,7 @@ fn context(spec: &NetworkSpec) -> ReductionContext {
             if let Some((_, m)) = masses.iter().find(|(n, _)| n == e) {
                 let cs = ContactSpec {
                     law: c.law,
-                    stiffness: c.stiffness,
+                    stiffness: c.stiffness.unwrap_or(0.0),
                     damping: c.damping,
                     exponent: c.exponent,
                     alpha: c.alpha,
@@ -665,6 +727,21 @@ fn assemble(
             ReleaseSpec::Force => Release::Force,
             ReleaseSpec::Overlap => Release::Overlap,
         };
+        if c.law == LawSpec::Rigid {
+            links.push(Link {
+                name: c.name.clone(),
+                ends: [a, b],
+                gap: c.gap,
+                contact: Contact {
+                    law: ContactLaw::Rigid {
+                        restitution: c.restitution.unwrap_or(1.0),
+                    },
+                    release,
+                },
+            });
+            continue;
+        }
+        let stiffness = c.stiffness.unwrap_or(0.0);
         let damping = match c.restitution {
             None => c.damping.unwrap_or(0.0),
             Some(e) => {
@@ -678,7 +755,7 @@ fn assemble(
                     .sum();
                 let zeta = restitution::zeta_of_e(e, release).map_err(|e| locate(e, spec, src))?;
                 let m_red = 1.0 / inv_m;
-                let damping = 2.0 * zeta * (c.stiffness * m_red).sqrt();
+                let damping = 2.0 * zeta * (stiffness * m_red).sqrt();
                 notes.push(format!(
                     "{path} ({}): restitution e = {} → damping C = {damping:.5e} N·s/m (ζ = {zeta:.5}, m* = {m_red:.5e} kg, 1/m* = aᵀM⁻¹a over its two ends)",
                     c.name,
@@ -692,10 +769,7 @@ fn assemble(
             ends: [a, b],
             gap: c.gap,
             contact: Contact {
-                law: ContactLaw::Linear {
-                    stiffness: c.stiffness,
-                    damping,
-                },
+                law: ContactLaw::Linear { stiffness, damping },
                 release,
             },
         });

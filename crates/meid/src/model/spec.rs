@@ -328,6 +328,8 @@ pub enum LawSpec {
     Linear,
     Hertz,
     HuntCrossley,
+    /// Instantaneous impacts with Newton's restitution (general machines only).
+    Rigid,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq, Default)]

@@ -220,6 +220,7 @@ fn law_name(l: LawSpec) -> &'static str {
         LawSpec::Linear => "linear",
         LawSpec::Hertz => "hertz",
         LawSpec::HuntCrossley => "hunt-crossley",
+        LawSpec::Rigid => "rigid",
     }
 }
 
