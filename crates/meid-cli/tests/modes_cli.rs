@@ -91,8 +91,15 @@ fn fem_model_table_json_and_files() {
         "modes.pvd",
         "K.mtx",
         "M.mtx",
+        "model_sketch.png",
+        "model_sketch.svg",
     ] {
         assert!(d.join(f).is_file(), "{f} not written");
+    }
+    // The sketch beside the mode shapes names the model's points by role.
+    let sketch = std::fs::read_to_string(d.join("model_sketch.svg")).unwrap();
+    for label in ["strike O_b (slider)", "anchor O_f", "measurement B"] {
+        assert!(sketch.contains(label), "no '{label}' in model_sketch.svg");
     }
     let csv = std::fs::read_to_string(d.join("modes.csv")).unwrap();
     assert_eq!(csv.lines().count(), 13);
