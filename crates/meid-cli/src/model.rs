@@ -61,7 +61,7 @@ pub fn run(a: ModelArgs) -> Result<()> {
                 anyhow::anyhow!("cannot create the directory {}: {e}", k.output.display())
             })?;
             let stem = k.output.join("model_sketch");
-            match meid::plot::sketch::write_model_sketch(&k.model, &k.set.set, &stem)? {
+            match meid::report::sketch::write_model_sketch(&k.model, &k.set.set, &stem)? {
                 Some((files, _)) => {
                     println!("wrote {} and {}", files.png.display(), files.svg.display())
                 }

@@ -77,12 +77,12 @@ pub fn run(a: ModesArgs) -> Result<()> {
             io::write_atomic(&dir.join("modes.vtu"), vtu.as_bytes())?;
             io::write_atomic(&dir.join("modes.pvd"), io::vtk::pvd("modes.vtu").as_bytes())?;
             // The model's points on its mesh, then the selected modes (paper Figs. 2 and 15).
-            let (points, notes) = meid::plot::sketch::paper_points(&model.spec);
+            let (points, notes) = meid::report::sketch::paper_points(&model.spec);
             let title = match model.spec.name.as_deref() {
                 Some(n) => format!("model sketch: {n}"),
                 None => "model sketch".into(),
             };
-            let sketch = meid::plot::sketch::sketch_of_fe(&an.model, &title, &points, notes)?;
+            let sketch = meid::report::sketch::sketch_of_fe(&an.model, &title, &points, notes)?;
             meid::plot::mesh::sketch_plot(dir.join("model_sketch"), &sketch)?;
             let edges = io::vtk::mesh_edges(&an.model);
             for &i in &an.selected {

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use meid::plot::mesh::SketchRole;
-use meid::plot::sketch::{model_sketch, write_model_sketch};
+use meid::report::sketch::{model_sketch, write_model_sketch};
 
 fn example(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -90,8 +90,8 @@ fn sketch_markers_sit_at_the_projection_of_the_named_nodes() {
         let nodes = &fe.mesh.points[name];
         let mut p = [0.0; 3];
         for &n in nodes {
-            for d in 0..3 {
-                p[d] += fe.mesh.nodes[n][d] / nodes.len() as f64;
+            for (pd, x) in p.iter_mut().zip(fe.mesh.nodes[n]) {
+                *pd += x / nodes.len() as f64;
             }
         }
         let k = sketch.marks.iter().position(|m| m.role == role).unwrap();

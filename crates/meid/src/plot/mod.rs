@@ -23,7 +23,6 @@ pub mod axis;
 mod charts;
 pub mod contour;
 pub mod mesh;
-pub mod sketch;
 
 pub use axis::{nice_levels, nice_ticks};
 pub use charts::{area_plot, heat_map, line_plot, spectrum_plot};

@@ -933,17 +933,17 @@ impl MachineReport {
     }
 
     /// The model: its sketch first (the FE mesh with the strike, damper, anchor, measurement
-    /// and floor points; [`crate::plot::sketch`]), then the table of its values. A lumped or
+    /// and floor points; [`crate::report::sketch`]), then the table of its values. A lumped or
     /// tabulated structure has no mesh: a note says so instead of the picture.
     fn model_section(&self, dir: &Path) -> Result<Section> {
         let mut blocks = Vec::new();
-        match crate::plot::sketch::model_sketch(&self.model)? {
+        match crate::report::sketch::model_sketch(&self.model)? {
             Some(sketch) => {
                 crate::plot::mesh::sketch_plot(dir.join("model_sketch"), &sketch)?;
                 blocks.push(Block::Figure(super::html::Figure {
                     src: "model_sketch.png".into(),
                     alt: "the model's FE mesh with its strike, damper, anchor, measurement and floor points".into(),
-                    caption: crate::plot::sketch::caption(&sketch),
+                    caption: crate::report::sketch::caption(&sketch),
                     data: vec!["model_sketch.svg".into()],
                 }));
             }

@@ -1,16 +1,16 @@
 //! The model sketch (issue 34 item 8): the user's own FE mesh, undeformed, with the model's
 //! points marked by role — the strike (an arrow along the blow), the dampers (joined to their
 //! anchors), the measurement points and the floor (supports and springs/dashpots to ground).
-//! Drawn by [`super::mesh::sketch_plot`] in the mesh pictures' projection
-//! ([`super::mesh::project`]). Lumped and tabulated structures have no mesh: no sketch.
+//! Drawn by [`crate::plot::mesh::sketch_plot`] in the mesh pictures' projection
+//! ([`crate::plot::mesh::project`]). Lumped and tabulated structures have no mesh: no sketch.
 
 use std::path::Path;
 
-use super::mesh::{SketchMark, SketchPlot, SketchRole};
-use super::PlotFiles;
 use crate::model::fem;
 use crate::model::network::{NetworkModel, NetworkSpec};
 use crate::model::{Model, ModelSpec, StructureSpec};
+use crate::plot::mesh::{SketchMark, SketchPlot, SketchRole};
+use crate::plot::PlotFiles;
 use crate::structure::FeModel;
 use crate::{Error, Result};
 
@@ -267,7 +267,7 @@ pub fn write_model_sketch(
         model_sketch(&Model::from_file(path, overrides)?)?
     };
     match sketch {
-        Some(s) => Ok(Some((super::mesh::sketch_plot(stem, &s)?, s))),
+        Some(s) => Ok(Some((crate::plot::mesh::sketch_plot(stem, &s)?, s))),
         None => Ok(None),
     }
 }
