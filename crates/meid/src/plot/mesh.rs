@@ -77,6 +77,22 @@ fn view_ranges(
     )
 }
 
+/// The largest side (m) of the nodes' bounding box (at least 1e-9).
+fn largest_extent_m(nodes: &[[f64; 3]]) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in nodes {
+        for d in 0..3 {
+            lo[d] = lo[d].min(p[d]);
+            hi[d] = hi[d].max(p[d]);
+        }
+    }
+    (0..3)
+        .map(|d| hi[d] - lo[d])
+        .fold(0.0_f64, f64::max)
+        .max(1e-9)
+}
+
 /// Draws `<stem>.png` and `<stem>.svg`.
 pub fn mesh_plot(path_stem: impl AsRef<Path>, plot: &MeshPlot) -> Result<PlotFiles> {
     let n = plot.nodes.len();
@@ -119,18 +135,7 @@ impl Figure for MeshPlot {
         &self,
         area: &DrawingArea<DB, Shift>,
     ) -> std::result::Result<(), String> {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in &self.nodes {
-            for d in 0..3 {
-                lo[d] = lo[d].min(p[d]);
-                hi[d] = hi[d].max(p[d]);
-            }
-        }
-        let size = (0..3)
-            .map(|d| hi[d] - lo[d])
-            .fold(0.0_f64, f64::max)
-            .max(1e-9);
+        let size = largest_extent_m(&self.nodes);
         let umax = self
             .displacement
             .iter()
@@ -311,18 +316,7 @@ impl SketchPlot {
 
     /// The extent (m) of the mesh: its largest bounding-box side.
     fn extent_m(&self) -> f64 {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in &self.nodes {
-            for d in 0..3 {
-                lo[d] = lo[d].min(p[d]);
-                hi[d] = hi[d].max(p[d]);
-            }
-        }
-        (0..3)
-            .map(|d| hi[d] - lo[d])
-            .fold(0.0_f64, f64::max)
-            .max(1e-9)
+        largest_extent_m(&self.nodes)
     }
 
     /// The screen positions ([`project`]) of every mark's positions, in mark order.
