@@ -14,8 +14,9 @@ use crate::args::PrintArgs;
 pub struct ModesArgs {
     /// Model file (TOML).
     model: PathBuf,
-    /// Write modes.csv, modes.json, truncation.csv, modes.vtu + modes.pvd and mode_<n>.png/.svg
-    /// of the selected modes (FE models) into DIR.
+    /// Write modes.csv, modes.json, truncation.csv, modes.vtu + modes.pvd, model_sketch.png/.svg
+    /// (the mesh with the model's points) and mode_<n>.png/.svg of the selected modes (FE models)
+    /// into DIR.
     #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
     /// Number of lowest modes to compute and show (FE models).
@@ -75,7 +76,14 @@ pub fn run(a: ModesArgs) -> Result<()> {
             let vtu = io::vtk::modes_vtu(&an.model, &an.modes, &which)?;
             io::write_atomic(&dir.join("modes.vtu"), vtu.as_bytes())?;
             io::write_atomic(&dir.join("modes.pvd"), io::vtk::pvd("modes.vtu").as_bytes())?;
-            // Pictures of the selected modes (paper Figs. 2 and 15).
+            // The model's points on its mesh, then the selected modes (paper Figs. 2 and 15).
+            let (points, notes) = meid::report::sketch::paper_points(&model.spec);
+            let title = match model.spec.name.as_deref() {
+                Some(n) => format!("model sketch: {n}"),
+                None => "model sketch".into(),
+            };
+            let sketch = meid::report::sketch::sketch_of_fe(&an.model, &title, &points, notes)?;
+            meid::plot::mesh::sketch_plot(dir.join("model_sketch"), &sketch)?;
             let edges = io::vtk::mesh_edges(&an.model);
             for &i in &an.selected {
                 let plot = meid::plot::mesh::MeshPlot {

@@ -91,8 +91,15 @@ fn fem_model_table_json_and_files() {
         "modes.pvd",
         "K.mtx",
         "M.mtx",
+        "model_sketch.png",
+        "model_sketch.svg",
     ] {
         assert!(d.join(f).is_file(), "{f} not written");
+    }
+    // The sketch beside the mode shapes names the model's points by role.
+    let sketch = std::fs::read_to_string(d.join("model_sketch.svg")).unwrap();
+    for label in ["strike O_b (slider)", "anchor O_f", "measurement B"] {
+        assert!(sketch.contains(label), "no '{label}' in model_sketch.svg");
     }
     let csv = std::fs::read_to_string(d.join("modes.csv")).unwrap();
     assert_eq!(csv.lines().count(), 13);
@@ -765,4 +772,34 @@ sample_rate = 20000.0
     assert_eq!(out.status.code(), Some(2));
     let err = common::stderr(&out);
     assert!(err.contains("cut.msh (byte "), "{err}");
+}
+
+/// `meid model sketch`: a general machine's four dampers and off-centre strike on its mesh; a
+/// lumped model fails (exit 2) saying it has no mesh.
+#[test]
+fn model_sketch_draws_a_general_machine_and_refuses_a_lumped_one() {
+    let d = tmpdir("sketch");
+    let out = meid()
+        .args(["model", "sketch", "-o"])
+        .arg(&d)
+        .arg(example("press-off-centre-4-dampers.toml"))
+        .output()
+        .unwrap();
+    common::ok(out);
+    let svg = std::fs::read_to_string(d.join("model_sketch.svg")).unwrap();
+    for k in 1..=4 {
+        let label = format!("damper damper{k} at D{k}");
+        assert!(svg.contains(&label), "no '{label}'");
+    }
+    assert!(svg.contains("strike S (slider)"));
+    assert!(d.join("model_sketch.png").is_file());
+    let out = meid()
+        .args(["model", "sketch", "-o"])
+        .arg(tmpdir("sketch-lumped"))
+        .arg(example("paper-lumped.toml"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no FE mesh to sketch"), "{err}");
 }

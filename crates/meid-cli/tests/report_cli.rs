@@ -286,6 +286,29 @@ fn fe_report_passes_the_page_check() {
         section(&html, "montecarlo").contains("--vary"),
         "says how to give one"
     );
+    // The Model section opens with the sketch of the mesh (check_page above found its files),
+    // its caption naming each marked point by role.
+    let model = section(&html, "model");
+    let fig = model
+        .find("<figure")
+        .expect("a figure in the Model section");
+    assert!(
+        fig < model.find("<table").unwrap(),
+        "sketch before the table"
+    );
+    assert!(model.contains("src=\"model_sketch.png\""), "{model}");
+    for label in [
+        "strike O_b (slider)",
+        "damper at O_b",
+        "anchor O_f",
+        "measurement B",
+        "floor: 4 springs to ground",
+    ] {
+        assert!(model.contains(label), "no '{label}' in: {model}");
+    }
+    for f in ["model_sketch.png", "model_sketch.svg"] {
+        assert!(std::fs::metadata(out.join(f)).unwrap().len() > 1000, "{f}");
+    }
 }
 
 #[test]

@@ -55,6 +55,7 @@ mod measure_validate;
 mod modal_never_lies;
 mod modal_update_fe;
 mod model_input;
+mod model_sketch;
 mod modes_import;
 mod modes_truncation;
 mod network_engine;

@@ -912,11 +912,7 @@ impl MachineReport {
                 blocks: vec![Block::List(self.verdict())],
             },
             self.results_section(),
-            Section {
-                id: "model".into(),
-                heading: "Model".into(),
-                blocks: vec![Block::Table(self.model_table())],
-            },
+            self.model_section(dir)?,
             self.modes_section(),
             self.map_section(dir)?,
             self.cases_section(dir)?,
@@ -934,6 +930,33 @@ impl MachineReport {
             title: format!("meid report: {name}"),
             lead: format!("Model {} — {generator}.", self.model_path),
             sections,
+        })
+    }
+
+    /// The model: its sketch first (the FE mesh with the strike, damper, anchor, measurement
+    /// and floor points; [`crate::report::sketch`]), then the table of its values. A lumped or
+    /// tabulated structure has no mesh: a note says so instead of the picture.
+    fn model_section(&self, dir: &Path) -> Result<Section> {
+        let mut blocks = Vec::new();
+        match crate::report::sketch::model_sketch(&self.model)? {
+            Some(sketch) => {
+                crate::plot::mesh::sketch_plot(dir.join("model_sketch"), &sketch)?;
+                blocks.push(Block::Figure(super::html::Figure {
+                    src: "model_sketch.png".into(),
+                    alt: "the model's FE mesh with its strike, damper, anchor, measurement and floor points".into(),
+                    caption: crate::report::sketch::caption(&sketch),
+                    data: vec!["model_sketch.svg".into()],
+                }));
+            }
+            None => blocks.push(Block::Paragraph(
+                "No sketch of the model: its structure is lumped or tabulated (no FE mesh to draw).".into(),
+            )),
+        }
+        blocks.push(Block::Table(self.model_table()));
+        Ok(Section {
+            id: "model".into(),
+            heading: "Model".into(),
+            blocks,
         })
     }
 

@@ -17,4 +17,5 @@ pub mod html;
 pub mod machine;
 pub mod measured;
 pub mod paper;
+pub mod sketch;
 pub mod testlab;
