@@ -247,7 +247,10 @@ fn four_dampers_at_symmetric_points_give_four_identical_impact_rows() {
             r#"between = ["slider", "O_b"]"#,
             1,
         )
-        .replacen("duration = 0.5", "duration = 0.05", 1);
+        // The damper impacts of the blow fall within its first 4 ms; 5 ms of the symmetric
+        // machine (whose four identical one-way dashpots switch at the same instants) keep the
+        // test's cost in bounds.
+        .replacen("duration = 0.5", "duration = 0.005", 1);
     assert!(!symmetric.contains("\"S\"") && symmetric.contains("b_offset"));
     let m = NetworkModel::from_text("sym.toml", symmetric, &[]).unwrap();
     let sol = m.solve(&m.options().unwrap()).unwrap();

@@ -249,26 +249,14 @@ pub fn run(
     };
     let correlation = correlate(&ident, &mm, &mapping, &corr_settings)?;
     let update = match fit {
-        Some(params) if !correlation.pairs.is_empty() => {
-            let problem = ModalProblem::new(
-                model,
-                params,
-                &ident,
-                None,
-                mapping,
-                corr_settings,
-                update.mac_weight,
-                FitSettings::default(),
-            )?;
-            let c = calibrate_modal(&problem)?;
-            let text = calibrated_model_text_by(
-                model,
-                problem.parameters(),
-                &c.values(),
-                "meid report --fit",
-            )?;
-            Some((c, text))
-        }
+        Some(params) if !correlation.pairs.is_empty() => Some(updated_model(
+            model,
+            params,
+            &ident,
+            mapping,
+            corr_settings,
+            update.mac_weight,
+        )?),
         Some(_) => {
             return skip(format!(
                 "no identified mode pairs with a model mode at MAC ≥ {}",
@@ -302,6 +290,36 @@ pub fn run(
         frf: set,
         identification: id,
     }))))
+}
+
+/// The model updated to the identified modes (`meid calibrate --modal`'s fit) and its file's
+/// text ([`CALIBRATED_FILE`]).
+fn updated_model(
+    model: &Model,
+    params: Vec<crate::measure::calibrate::FitParameter>,
+    ident: &IdentifiedModes,
+    mapping: Mapping,
+    corr_settings: CorrelateSettings,
+    mac_weight: f64,
+) -> Result<(ModalCalibration, String)> {
+    let problem = ModalProblem::new(
+        model,
+        params,
+        ident,
+        None,
+        mapping,
+        corr_settings,
+        mac_weight,
+        FitSettings::default(),
+    )?;
+    let c = calibrate_modal(&problem)?;
+    let text = calibrated_model_text_by(
+        model,
+        problem.parameters(),
+        &c.values(),
+        "meid report --fit",
+    )?;
+    Ok((c, text))
 }
 
 /// The records sampled with the force, the force's name, the mapped responses and the notes
