@@ -354,7 +354,7 @@ pub(crate) fn modes_from_blows(
 /// frequency within 0.5 %, damping ratio within 10 % of the modal ζ once the window's decay is
 /// removed, and MAC ≥ 0.99 between the identified shape at the three points and the model's
 /// `ψ(P)` (the model's two shapes there have a MAC of 0.54 with each other, so a wrong pairing
-/// fails). Modes above the band, and any static-correction vectors, are not compared.
+/// fails). Modes above the band and the static-correction pseudo-modes are not compared.
 #[test]
 fn fe_example_blows_give_the_modal_model() {
     const BAND_HZ: (f64, f64) = (2.0, 400.0);
@@ -364,11 +364,13 @@ fn fe_example_blows_give_the_modal_model() {
     let m = meid::model::Model::from_file(&path, &[]).unwrap();
     let s = &m.structure;
     let n = s.omega_rad_per_s.len();
-    // The structural modes the model keeps in the band.
+    // The structural modes the model keeps in the band (not the static-correction pseudo-mode
+    // at 5.45 Hz for B's missing rocking flexibility, which the centred blow does not excite:
+    // ψ(O_b) ≈ 3e-10).
     let in_band: Vec<usize> = (0..n)
         .filter(|&r| {
             let f = s.omega_rad_per_s[r] / (2.0 * std::f64::consts::PI);
-            f > BAND_HZ.0 && f < BAND_HZ.1
+            !s.is_pseudo(r) && f > BAND_HZ.0 && f < BAND_HZ.1
         })
         .collect();
     assert_eq!(in_band.len(), 2, "6.35 and 285.8 Hz");
