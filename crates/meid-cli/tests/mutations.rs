@@ -334,10 +334,17 @@ fn every_mutation_of_the_examples_gives_finite_output_or_an_error_naming_the_fie
                             // Without a damper its summary entries are null by design.
                             let no_damper = matches!(m.change, Change::Delete)
                                 && (m.path == "damper" || m.path == "contact.bed_damper");
+                            // An impact's restitution is null by design when it closes
+                            // with no approach velocity (a contact touching at the strike);
+                            // the impact rows' order follows the machine.
+                            let undefined_restitution = |p: &str| {
+                                p.starts_with(".impacts[") && p.ends_with("].restitution")
+                            };
                             let new: Vec<&String> = n
                                 .iter()
                                 .filter(|p| !base.contains(p))
                                 .filter(|p| !(no_damper && p.contains("damper")))
+                                .filter(|p| !undefined_restitution(p))
                                 .collect();
                             if new.is_empty() {
                                 counts.lock().unwrap()[0] += 1;

@@ -158,11 +158,14 @@ fn modal_update_recovers_thickness_and_spring_together() {
 fn modal_update_from_identified_modes_recovers_thickness_and_spring() {
     const POINTS: [&str; 3] = ["O_b", "O_f", "B"];
     let truth = [0.97 * 0.01095, 1.08 * 2.111e4];
-    let set: Vec<String> = [THICKNESS, SPRING]
+    let mut set: Vec<String> = [THICKNESS, SPRING]
         .iter()
         .zip(truth)
         .map(|(p, v)| format!("{p}={v:e}"))
         .collect();
+    // The blows of the structure as its kept modes give them (as in 6b, without the static
+    // correction: with it the 6.35 Hz mode is not identified from 2 s records).
+    set.push("structure.fem.static_correction=false".into());
     let truth_model = machine(&set);
     let s = &truth_model.structure;
     let n_band = (0..s.len())

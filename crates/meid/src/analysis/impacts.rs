@@ -199,8 +199,10 @@ fn finish(sys: &ImpactSystem, s: Switch, o: Open, t: f64, x: &[f64]) -> ImpactRo
     // The energy still stored when the contact lets go at δ > 0 goes with it.
     row.dissipated_j += sys.contact(s).law.potential_energy(delta);
     row.exit_velocity_m_per_s = Some(-rate);
-    row.restitution =
-        (row.approach_velocity_m_per_s > 0.0).then(|| -rate / row.approach_velocity_m_per_s);
+    // Undefined (None) without an approach, or one so slow that the ratio overflows.
+    row.restitution = (row.approach_velocity_m_per_s > 0.0)
+        .then(|| -rate / row.approach_velocity_m_per_s)
+        .filter(|e| e.is_finite());
     row
 }
 

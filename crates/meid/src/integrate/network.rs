@@ -1290,7 +1290,7 @@ impl<'n, 'o> Run<'n, 'o> {
                 impulse_n_s: *pc,
                 dissipated_j: lost,
                 exit_velocity_m_per_s: Some(-after),
-                restitution: (*v > 0.0).then(|| -after / v),
+                restitution: (*v > 0.0).then(|| -after / v).filter(|e| e.is_finite()),
             });
         }
     }
