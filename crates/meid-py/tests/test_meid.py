@@ -77,13 +77,20 @@ def test_errors_carry_file_line_column():
 
 
 def test_modes_of_the_fe_model():
-    m = meid.Model.from_file(SOFT, [COARSE])
+    # The two kept modes of the structure (without the static correction's pseudo-modes).
+    m = meid.Model.from_file(SOFT, [COARSE, "structure.fem.static_correction=false"])
     md = m.modes()
     f = md["frequencies_hz"]
     assert f.shape == (2,) and f[0] < f[1]
     assert md["shapes"].shape == (len(md["points"]), 2)
     assert "O_b" in md["points"]
     assert m.modes(1)["frequencies_hz"].shape == (1,)
+    # With the correction (the default) the pseudo-modes follow them, labelled as such.
+    mc = meid.Model.from_file(SOFT, [COARSE]).modes()
+    n = mc["frequencies_hz"].shape[0]
+    assert n > 2 and mc["frequencies_hz"][:2] == pytest.approx(f, rel=1e-9)
+    assert all(lab.startswith("static correction") for lab in mc["labels"][2:])
+    assert not any(lab.startswith("static correction") for lab in mc["labels"][:2])
 
 
 def test_sweep_equals_the_cli_sweep():
