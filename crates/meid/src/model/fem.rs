@@ -1270,17 +1270,29 @@ fn corrected_model(
         modes.omega_rad_per_s.len(),
         c.eigenvalues.len(),
     );
-    let mut aug = modes.clone();
-    aug.shapes = faer::Mat::<f64>::from_fn(n, nm + q, |i, j| {
-        if j < nm {
-            modes.shapes[(i, j)]
-        } else {
-            c.shapes[(i, j - nm)]
-        }
-    });
-    aug.eigenvalues.extend(&c.eigenvalues);
-    aug.omega_rad_per_s
-        .extend(c.eigenvalues.iter().map(|l| l.sqrt()));
+    // The solved modes with the pseudo-modes after them (the shapes copied once, not cloned
+    // and then rebuilt: at 1M DOF each copy is n × modes doubles).
+    let aug = DenseModes {
+        shapes: faer::Mat::<f64>::from_fn(n, nm + q, |i, j| {
+            if j < nm {
+                modes.shapes[(i, j)]
+            } else {
+                c.shapes[(i, j - nm)]
+            }
+        }),
+        eigenvalues: modes
+            .eigenvalues
+            .iter()
+            .chain(&c.eigenvalues)
+            .copied()
+            .collect(),
+        omega_rad_per_s: (modes.omega_rad_per_s.iter().copied())
+            .chain(c.eigenvalues.iter().map(|l| l.sqrt()))
+            .collect(),
+        orthonormality_error: modes.orthonormality_error,
+        max_residual: modes.max_residual,
+        rigid_body_modes: modes.rigid_body_modes,
+    };
     let sel: Vec<usize> = selected.iter().copied().chain(nm..nm + q).collect();
     let last = zeta.last().copied().unwrap_or(0.0);
     let z: Vec<f64> = zeta
