@@ -198,7 +198,7 @@ fn output(
         let dir = set.staging();
         meid::io::write_atomic(&dir.join("samples.csv"), &r.samples_csv()?)?;
         // samples.csv's rows with types, units and exact values (docs/reference/outputs.md, "Parquet").
-        meid::io::parquet::write_parquet(&dir.join("samples.parquet"), &study.table(r))?;
+        crate::outputs::write_parquet_table(&dir.join("samples.parquet"), &study.table(r))?;
         meid::io::write_json(&dir.join("stats.json"), &crate::json::object(&stats)?)?;
         let values = r.metric(&a.metric)?;
         let bins = ((values.len() as f64).sqrt().ceil() as usize).clamp(5, 50);

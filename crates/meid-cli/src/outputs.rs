@@ -106,3 +106,23 @@ pub fn check_disk(dir: &Path, what: &str, bytes: f64, reduce: &str) -> Result<()
     }
     Ok(())
 }
+
+/// Writes `table` as the Parquet file `path` beside its CSV (docs/reference/outputs.md,
+/// "Parquet"). A meid built without the `parquet` feature (the README's first command leaves it
+/// out to build faster) writes no Parquet file and says so on standard error.
+pub fn write_parquet_table(path: &Path, table: &meid::io::table::Table) -> Result<()> {
+    #[cfg(feature = "parquet")]
+    meid::io::parquet::write_parquet(path, table)?;
+    #[cfg(not(feature = "parquet"))]
+    {
+        let _ = table;
+        crate::ui::warning(format_args!(
+            "{} not written: this meid was built without the `parquet` feature \
+             (`cargo install --locked --path crates/meid-cli` has it)",
+            path.file_name()
+                .map(|n| n.to_string_lossy())
+                .unwrap_or_default()
+        ));
+    }
+    Ok(())
+}

@@ -217,7 +217,7 @@ fn output(
     };
     result.write(set.staging())?;
     // sweep.csv's rows with types and units (docs/reference/outputs.md, "Parquet").
-    meid::io::parquet::write_parquet(&set.path("sweep.parquet"), &sweep.table(result))?;
+    crate::outputs::write_parquet_table(&set.path("sweep.parquet"), &sweep.table(result))?;
     if let Some(e) = sweep.all_failed_error(result) {
         // The results (every row with its error) are written; the run is that error.
         set.commit("sweep")?;

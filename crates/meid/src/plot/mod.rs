@@ -259,8 +259,7 @@ pub(crate) trait Figure {
     ) -> std::result::Result<(), String>;
 }
 
-/// A unique temporary name next to `final_path`, keeping its extension (the PNG encoder
-/// chooses the format from it).
+/// A unique temporary name next to `final_path`, keeping its extension.
 fn temporary_path(dir: &Path, name: &str, ext: &str) -> PathBuf {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
@@ -292,17 +291,21 @@ pub(crate) fn write_figure<F: Figure>(stem: &Path, figure: &F) -> Result<PlotFil
     let size = figure.size();
     let draw_error = |path: &Path, msg: String| Error::io(path, std::io::Error::other(msg));
 
-    // PNG.
-    let tmp_png = temporary_path(&dir, &name, "png");
+    // PNG: drawn into an RGB buffer, encoded by `png`.
+    let mut rgb = vec![0u8; 3 * size.0 as usize * size.1 as usize];
     let rendered = (|| {
-        let root = BitMapBackend::new(&tmp_png, size).into_drawing_area();
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
         figure.draw(&root)?;
         root.present().map_err(|e| e.to_string())
     })();
     if let Err(msg) = rendered {
-        let _ = std::fs::remove_file(&tmp_png);
         return Err(draw_error(&png, msg));
+    }
+    let tmp_png = temporary_path(&dir, &name, "png");
+    if let Err(e) = write_png(&tmp_png, size, &rgb) {
+        let _ = std::fs::remove_file(&tmp_png);
+        return Err(Error::io(&png, e));
     }
     rename(&tmp_png, &png)?;
 
@@ -324,6 +327,17 @@ pub(crate) fn write_figure<F: Figure>(stem: &Path, figure: &F) -> Result<PlotFil
     }
     rename(&tmp_svg, &svg)?;
     Ok(PlotFiles { png, svg })
+}
+
+/// Encodes an 8-bit RGB buffer of `size` (width, height) pixels as a PNG file.
+fn write_png(path: &Path, size: (u32, u32), rgb: &[u8]) -> std::io::Result<()> {
+    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut enc = png::Encoder::new(file, size.0, size.1);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut w = enc.write_header().map_err(std::io::Error::other)?;
+    w.write_image_data(rgb).map_err(std::io::Error::other)?;
+    w.finish().map_err(std::io::Error::other)
 }
 
 fn rename(from: &Path, to: &Path) -> Result<()> {
