@@ -91,9 +91,9 @@
 //! only). FRFs of another type than the one stated by an odd power of `iω` (an accelerance read
 //! as a mobility, a mobility as a receptance or an accelerance) are fitted with residues
 //! `≈ R_r (iω_r)^{±1}`: turned by 90°, onto the real axis; the fit is then wrong for every mode,
-//! and the missing or extra `iω` turns the upper residual into a term the model cannot hold
-//! (a mobility read as mobility has `iω UR`; an accelerance read as one has `(iω)³ UR`), so a
-//! real upper residual spoils the residues of the outputs that carry it. **Rule**: per mode,
+//! and the upper residual has no term in it (the data hold `(iω)^d UR` with their own `d`, the
+//! model `(iω)^{d'} UR` with the stated one), so a real upper residual spoils the residues of
+//! the outputs that carry it. **Rule**: per mode,
 //! the angle `θ_R` of the principal line of its residue column (as for MPD, module docs above;
 //! `θ_R ∈ (−90°, 90°]`); a mode with `MPC ≥` [`NEAR_REAL_MPC`] is *turned* when
 //! `|θ_R| < 45°` (nearer the real axis than the imaginary one). When more than half of the
