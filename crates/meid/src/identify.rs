@@ -82,6 +82,25 @@
 //! The stabilisation works on the poles as identified; the modes are reported with
 //! `λ = λ_w + σ_w`, so `ω = |λ|`, `ζ = −Re λ/|λ|` exactly (not the first-order `ζ_w − 1/(ωτ)`).
 //!
+//! # Check of the FRF type
+//!
+//! For a normal (real) mode of a proportionally damped structure the receptance residues are
+//! `R_r = φ_r φ_rᵀ/(2iω_d,r)`, mass-normalised `φ_r` (D. J. Ewins, *Modal Testing: Theory,
+//! Practice and Application*, 2nd ed., 2000, ch. 2): imaginary, whatever `ζ_r`, and an
+//! exponential window does not turn them (it multiplies `h(t)` by `e^{−σ_w t}` and moves the poles
+//! only). FRFs of another type than the one stated by an odd power of `iω` (an accelerance read
+//! as a mobility, a mobility as a receptance or an accelerance) are fitted with residues
+//! `≈ R_r (iω_r)^{±1}`: turned by 90°, onto the real axis; the fit is then wrong for every mode,
+//! and the upper residual has no term in it (the data hold `(iω)^d UR` with their own `d`, the
+//! model `(iω)^{d'} UR` with the stated one), so a real upper residual spoils the residues of
+//! the outputs that carry it. **Rule**: per mode,
+//! the angle `θ_R` of the principal line of its residue column (as for MPD, module docs above;
+//! `θ_R ∈ (−90°, 90°]`); a mode with `MPC ≥` [`NEAR_REAL_MPC`] is *turned* when
+//! `|θ_R| < 45°` (nearer the real axis than the imaginary one). When more than half of the
+//! near-real modes are turned, a warning says the FRFs' stated type is likely wrong by one power
+//! of `iω`. A type wrong by two powers (an accelerance read as a receptance) only flips the
+//! residues' sign, which the check cannot see without knowing the driving point.
+//!
 //! The module imports only the base: data in, numbers out.
 
 use faer::linalg::solvers::{Solve, SolveLstsq};
@@ -90,6 +109,10 @@ use num_complex::Complex64 as C;
 use serde::Serialize;
 
 use crate::{num, Error, Result};
+
+/// Least MPC of a mode whose residues' phase enters the check of the FRF type (module docs,
+/// "Check of the FRF type"): a near-real mode, whose residues lie on one line.
+pub const NEAR_REAL_MPC: f64 = 0.9;
 
 /// What an FRF's response is per unit force: displacement, velocity or acceleration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -883,6 +906,7 @@ fn finish(
     let fit = lsfd(d, b, &lambda)?;
     let cols = shape_columns(d, &fit, lambda.len());
     let mut modes = Vec::with_capacity(lambda.len());
+    let mut angles = Vec::with_capacity(lambda.len());
     for ((l, fs, zs, n), (reference, col)) in picked.iter().zip(cols) {
         let lc = l + d.window_decay_per_s;
         let w = lc.norm();
@@ -897,6 +921,7 @@ fn finish(
             ));
         }
         let (complex, real, mpc, mpd) = shape_measures(&col);
+        angles.push(principal_line_deg(&col));
         modes.push(Mode {
             frequency_hz: w / (2.0 * std::f64::consts::PI),
             damping_ratio: zeta,
@@ -912,6 +937,9 @@ fn finish(
             residues: col.iter().map(|v| [v.re, v.im]).collect(),
         });
     }
+    if let Some(w) = type_check(d.kind, &modes, &angles) {
+        warnings.push(w);
+    }
     let fits = (0..d.h.len())
         .map(|j| PairFit {
             output: j / d.inputs,
@@ -922,4 +950,45 @@ fn finish(
         })
         .collect();
     Ok((modes, fits))
+}
+
+/// The angle (degrees, in (−90°, 90°]) of the principal line of the complex numbers `v`:
+/// `θ = ½ atan2(2 Σ xy, Σ x² − Σ y²)`, `x + iy = v` (as for MPD, module docs).
+pub fn principal_line_deg(v: &[C]) -> f64 {
+    let (sxx, syy, sxy) = v.iter().fold((0.0, 0.0, 0.0), |(a, b, c), x| {
+        (a + x.re * x.re, b + x.im * x.im, c + x.re * x.im)
+    });
+    let deg = (0.5 * (2.0 * sxy).atan2(sxx - syy)).to_degrees();
+    if deg <= -90.0 {
+        deg + 180.0
+    } else {
+        deg
+    }
+}
+
+/// The check of the FRF type (module docs): a warning when more than half of the near-real modes
+/// (MPC ≥ [`NEAR_REAL_MPC`]) have residues whose principal line (`angles`, degrees) lies within
+/// 45° of the real axis.
+fn type_check(kind: FrfKind, modes: &[Mode], angles: &[f64]) -> Option<String> {
+    let near_real: Vec<(&Mode, f64)> = modes
+        .iter()
+        .zip(angles)
+        .filter(|(m, _)| m.mpc >= NEAR_REAL_MPC)
+        .map(|(m, a)| (m, *a))
+        .collect();
+    let turned: Vec<String> = near_real
+        .iter()
+        .filter(|(_, a)| a.abs() < 45.0)
+        .map(|(m, a)| format!("{:.2} Hz at {:.0}°", m.frequency_hz, a))
+        .collect();
+    if turned.is_empty() || 2 * turned.len() <= near_real.len() {
+        return None;
+    }
+    Some(format!(
+        "the residues of {} of the {} near-real mode(s) lie nearer the real axis than the imaginary one ({}), where a normal mode's receptance residues φφᵀ/(2iω_d) are imaginary: the FRFs, stated as {}, are likely off by one power of iω (an accelerance read as a mobility, a mobility as a receptance or an accelerance); check the FRF type",
+        turned.len(),
+        near_real.len(),
+        turned.join(", "),
+        kind.name()
+    ))
 }
