@@ -7,6 +7,8 @@ pub mod esd;
 pub mod impacts;
 pub mod montecarlo;
 pub mod network;
+pub mod network_study;
+pub mod placement;
 pub mod octave;
 pub mod optimize;
 pub mod production;
