@@ -5,7 +5,7 @@ use meid::model::network::NetworkModel;
 use meid::model::Model;
 
 /// A two-mass lumped structure, one impactor, one damper under "left".
-const BASE: &str = r#"name = "general"
+pub(crate) const BASE: &str = r#"name = "general"
 [structure.lumped]
 masses = [ { name = "left", mass = 10.0 }, { name = "right", mass = 10.0 } ]
 springs = [ { nodes = ["left", "right"], stiffness = 2.0e7 },
