@@ -76,7 +76,15 @@ pub fn run(a: OptimizeArgs) -> Result<()> {
         if !general {
             bail!("--place: a placement study takes a general machine ([[impactor]], [[damper]], [[contact]]); {} is the paper's machine", a.model.display());
         }
-        return crate::placement::run(&a.model, &a.set.set, &a.objective, &a.place, a.rate_bpm, a.output.as_deref(), a.print);
+        return crate::placement::run(
+            &a.model,
+            &a.set.set,
+            &a.objective,
+            &a.place,
+            a.rate_bpm,
+            a.output.as_deref(),
+            a.print,
+        );
     }
     Objective::parse(&a.objective)?;
     let model = load(&a.model, &a.set.set, None, None, None)?;

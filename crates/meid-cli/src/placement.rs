@@ -23,7 +23,12 @@ pub struct PlaceArgs {
     pub dampers: Option<String>,
     /// With --place: the total damper mass (kg), M/n to each of n dampers (default: the
     /// file's dampers' total).
-    #[arg(long, value_name = "KG", requires = "place", conflicts_with = "mass_bounds")]
+    #[arg(
+        long,
+        value_name = "KG",
+        requires = "place",
+        conflicts_with = "mass_bounds"
+    )]
     pub total_mass: Option<f64>,
     /// With --place: every damper's mass free in LO..HI kg, chosen per placement by the
     /// bounded Nelder-Mead search.
@@ -49,9 +54,13 @@ pub struct PlaceArgs {
 
 /// `N` or `LO..HI`, counts of dampers.
 fn parse_counts(s: &str) -> Result<(usize, usize)> {
-    let bad = || anyhow::anyhow!("--dampers `{s}`: give N or LO..HI (whole numbers ≥ 1), e.g. 1..4");
+    let bad =
+        || anyhow::anyhow!("--dampers `{s}`: give N or LO..HI (whole numbers ≥ 1), e.g. 1..4");
     let (lo, hi) = match s.split_once("..") {
-        Some((a, b)) => (a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?),
+        Some((a, b)) => (
+            a.trim().parse().map_err(|_| bad())?,
+            b.trim().parse().map_err(|_| bad())?,
+        ),
         None => {
             let n = s.trim().parse().map_err(|_| bad())?;
             (n, n)
@@ -64,9 +73,13 @@ fn parse_counts(s: &str) -> Result<(usize, usize)> {
 fn study(model: NetworkModel, objective: &str, p: &PlaceArgs) -> Result<PlacementStudy> {
     let masses = match (&p.mass_bounds, p.total_mass) {
         (Some(b), _) => {
-            let (lo, hi) = meid::analysis::study::parse_range(b)
-                .map_err(|_| anyhow::anyhow!("--mass-bounds `{b}`: give LO..HI in kg, e.g. 0.5..2"))?;
-            MassRule::Free { lower: lo, upper: hi }
+            let (lo, hi) = meid::analysis::study::parse_range(b).map_err(|_| {
+                anyhow::anyhow!("--mass-bounds `{b}`: give LO..HI in kg, e.g. 0.5..2")
+            })?;
+            MassRule::Free {
+                lower: lo,
+                upper: hi,
+            }
         }
         (None, Some(t)) => MassRule::Total(t),
         (None, None) => MassRule::Total(model.spec.damper.iter().map(|d| d.mass).sum()),
@@ -75,7 +88,9 @@ fn study(model: NetworkModel, objective: &str, p: &PlaceArgs) -> Result<Placemen
         Some(t) => t.clone(),
         None => match model.spec.damper.first() {
             Some(d) => d.name.clone(),
-            None => bail!("--place: the file has no [[damper]] to copy to the places (--template names one)"),
+            None => bail!(
+                "--place: the file has no [[damper]] to copy to the places (--template names one)"
+            ),
         },
     };
     let study = PlacementStudy {
@@ -129,7 +144,8 @@ fn line(r: &PlacedResult) -> String {
         r.dampers,
         r.points.join(", "),
         masses.join(", "),
-        r.objective.map_or("failed".to_string(), |f| format!("{f:.6e}"))
+        r.objective
+            .map_or("failed".to_string(), |f| format!("{f:.6e}"))
     )
 }
 

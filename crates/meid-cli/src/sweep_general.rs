@@ -13,10 +13,26 @@ use crate::sweep::SweepArgs;
 /// The options of the paper machine's sweep that a general machine's does not take.
 fn refuse_paper_options(a: &SweepArgs) -> Result<()> {
     for (given, flag, why) in [
-        (!a.cases.is_empty(), "--cases", "a general machine runs as its file says (its [[damper]] entries are the dampers)"),
-        (a.bed_mass.is_some(), "--bed-mass", "md/mb belongs to the paper's machine; vary damper.NAME.mass"),
-        (a.shard.is_some(), "--shard", "a general machine's sweep runs whole"),
-        (a.resume || a.force, "--resume/--force", "a general machine's sweep keeps no journal"),
+        (
+            !a.cases.is_empty(),
+            "--cases",
+            "a general machine runs as its file says (its [[damper]] entries are the dampers)",
+        ),
+        (
+            a.bed_mass.is_some(),
+            "--bed-mass",
+            "md/mb belongs to the paper's machine; vary damper.NAME.mass",
+        ),
+        (
+            a.shard.is_some(),
+            "--shard",
+            "a general machine's sweep runs whole",
+        ),
+        (
+            a.resume || a.force,
+            "--resume/--force",
+            "a general machine's sweep keeps no journal",
+        ),
     ] {
         if given {
             bail!("{flag}: not for a general machine's sweep: {why}");
@@ -55,7 +71,11 @@ pub fn run(a: &SweepArgs) -> Result<()> {
     let result = pool.install(|| sweep.run(&|done| bar.set_position(done as u64)));
     bar.finish_and_clear();
     if result.points.iter().all(|p| p.error.is_some()) {
-        let e = result.points.first().and_then(|p| p.error.clone()).unwrap_or_default();
+        let e = result
+            .points
+            .first()
+            .and_then(|p| p.error.clone())
+            .unwrap_or_default();
         bail!("every point of the sweep failed; the first: {e}");
     }
     let col = result.column(metric)?;
@@ -138,7 +158,9 @@ fn picture(r: &NetSweepResult, col: usize, dir: &std::path::Path) -> Result<()> 
             line_plot(dir.join("sweep_curve"), &plot)?;
         }
         [v0, v1] => {
-            let (Some(x), Some(y)) = (numbers(v1), numbers(v0)) else { return Ok(()) };
+            let (Some(x), Some(y)) = (numbers(v1), numbers(v0)) else {
+                return Ok(());
+            };
             let increasing = |s: &[f64]| s.len() >= 2 && s.windows(2).all(|w| w[0] < w[1]);
             if !(increasing(&x) && increasing(&y)) {
                 return Ok(());

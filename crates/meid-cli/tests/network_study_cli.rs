@@ -57,7 +57,13 @@ fn a_general_sweep_equals_simulate_with_set_bit_for_bit() {
     let out = d.join("out");
     let sweep = ok_json(
         meid()
-            .args(["sweep", "--json", "--vary", "damper.d_left.mass=0.5..2:3", "-o"])
+            .args([
+                "sweep",
+                "--json",
+                "--vary",
+                "damper.d_left.mass=0.5..2:3",
+                "-o",
+            ])
             .arg(&out)
             .arg(&f)
             .output()
@@ -74,7 +80,12 @@ fn a_general_sweep_equals_simulate_with_set_bit_for_bit() {
     for (i, mass) in ["5e-1", "1.25e0", "2e0"].iter().enumerate() {
         let sim = ok_json(
             meid()
-                .args(["simulate", "--json", "--set", &format!("damper.d_left.mass={mass}")])
+                .args([
+                    "simulate",
+                    "--json",
+                    "--set",
+                    &format!("damper.d_left.mass={mass}"),
+                ])
                 .arg(&f)
                 .output()
                 .unwrap(),
@@ -89,14 +100,26 @@ fn a_general_sweep_equals_simulate_with_set_bit_for_bit() {
         for p in sim["points"].as_array().unwrap() {
             let name = format!("peak_acceleration_m_per_s2:{}", p["name"].as_str().unwrap());
             let a = p["acceleration_m_per_s2"]["peak"].as_f64().unwrap().abs();
-            assert_eq!(col(&name).as_f64().unwrap().to_bits(), a.to_bits(), "{name}");
+            assert_eq!(
+                col(&name).as_f64().unwrap().to_bits(),
+                a.to_bits(),
+                "{name}"
+            );
         }
     }
-    for name in ["sweep.csv", "sweep.json", "sweep_curve.png", "sweep_curve.svg"] {
+    for name in [
+        "sweep.csv",
+        "sweep.json",
+        "sweep_curve.png",
+        "sweep_curve.svg",
+    ] {
         assert!(out.join(name).exists(), "{name}");
     }
     let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
-    assert!(csv.starts_with("index,damper.d_left.mass,energy_ratio,"), "{csv}");
+    assert!(
+        csv.starts_with("index,damper.d_left.mass,energy_ratio,"),
+        "{csv}"
+    );
 }
 
 /// A placement study over the command line: the best placement, every simulation in the JSON.
@@ -105,7 +128,16 @@ fn optimize_place_reports_every_evaluation() {
     let (_d, f) = file("place");
     let rep = ok_json(
         meid()
-            .args(["optimize", "--json", "--place", "left,right", "--dampers", "1..2", "--total-mass", "1.75"])
+            .args([
+                "optimize",
+                "--json",
+                "--place",
+                "left,right",
+                "--dampers",
+                "1..2",
+                "--total-mass",
+                "1.75",
+            ])
             .arg(&f)
             .output()
             .unwrap(),
@@ -122,19 +154,68 @@ fn optimize_place_reports_every_evaluation() {
 fn bad_general_study_input_exits_2_naming_the_option() {
     let (_d, f) = file("bad");
     for (args, want) in [
-        (vec!["sweep", "--vary", "damper.d_lfet.mass=1,2"], "did you mean 'd_left'"),
-        (vec!["sweep", "--vary", "damper.d_left.point=[lfet]"], "did you mean 'left'"),
-        (vec!["sweep", "--vary", "damper.d_left.mass=1,2", "--metric", "energy"], "--metric"),
-        (vec!["sweep", "--vary", "damper.d_left.mass=1,2", "--cases", "none"], "--cases"),
-        (vec!["optimize", "--place", "left,rihgt"], "did you mean 'right'"),
-        (vec!["optimize", "--place", "left,right", "--dampers", "3"], "--dampers"),
-        (vec!["optimize", "--place", "left", "--total-mass", "0"], "--total-mass"),
-        (vec!["optimize", "--place", "left", "--total-mass=-1"], "--total-mass"),
         (
-            vec!["optimize", "--place", "left,right", "--dampers", "1..2", "--search", "exhaustive", "--max-combinations", "2"],
+            vec!["sweep", "--vary", "damper.d_lfet.mass=1,2"],
+            "did you mean 'd_left'",
+        ),
+        (
+            vec!["sweep", "--vary", "damper.d_left.point=[lfet]"],
+            "did you mean 'left'",
+        ),
+        (
+            vec![
+                "sweep",
+                "--vary",
+                "damper.d_left.mass=1,2",
+                "--metric",
+                "energy",
+            ],
+            "--metric",
+        ),
+        (
+            vec![
+                "sweep",
+                "--vary",
+                "damper.d_left.mass=1,2",
+                "--cases",
+                "none",
+            ],
+            "--cases",
+        ),
+        (
+            vec!["optimize", "--place", "left,rihgt"],
+            "did you mean 'right'",
+        ),
+        (
+            vec!["optimize", "--place", "left,right", "--dampers", "3"],
+            "--dampers",
+        ),
+        (
+            vec!["optimize", "--place", "left", "--total-mass", "0"],
+            "--total-mass",
+        ),
+        (
+            vec!["optimize", "--place", "left", "--total-mass=-1"],
+            "--total-mass",
+        ),
+        (
+            vec![
+                "optimize",
+                "--place",
+                "left,right",
+                "--dampers",
+                "1..2",
+                "--search",
+                "exhaustive",
+                "--max-combinations",
+                "2",
+            ],
             "--max-combinations",
         ),
-        (vec!["optimize", "--over", "damper.mass", "--place", "left"], "--over"),
+        (
+            vec!["optimize", "--over", "damper.mass", "--place", "left"],
+            "--over",
+        ),
     ] {
         let o = meid().args(&args).arg(&f).output().unwrap();
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));

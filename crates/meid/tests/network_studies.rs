@@ -27,7 +27,10 @@ fn energy(m: &NetworkModel) -> f64 {
 /// did-you-mean.
 #[test]
 fn named_paths_set_the_entry_so_named() {
-    let by_name = load(&lumped(), &["damper.d_left.mass=2.5", "contact.die_left.gap=1e-4"]);
+    let by_name = load(
+        &lumped(),
+        &["damper.d_left.mass=2.5", "contact.die_left.gap=1e-4"],
+    );
     let by_index = load(&lumped(), &["damper[0].mass=2.5", "contact[0].gap=1e-4"]);
     assert_eq!(by_name.spec, by_index.spec);
     assert_eq!(by_name.spec.damper[0].mass, 2.5);
@@ -78,14 +81,20 @@ fn a_sweep_over_a_damper_point_moves_it() {
     let r = NetSweep::new(base.clone(), vary).unwrap().run(&|_| {});
     let e = |i: usize| r.points[i].metrics[0].unwrap();
     assert_eq!(e(1), energy(&base));
-    assert_eq!(e(0), energy(&load(&lumped(), &["damper.d_left.point=\"right\""])));
+    assert_eq!(
+        e(0),
+        energy(&load(&lumped(), &["damper.d_left.point=\"right\""]))
+    );
     let bad = NetSweep::new(
         base,
         vec![NetVary::parse("damper.d_left.point=[rigth]").unwrap()],
     )
     .unwrap_err()
     .to_string();
-    assert!(bad.contains("--vary") && bad.contains("did you mean 'right'"), "{bad}");
+    assert!(
+        bad.contains("--vary") && bad.contains("did you mean 'right'"),
+        "{bad}"
+    );
 }
 
 fn place(model: NetworkModel, candidates: &[&str], counts: (usize, usize)) -> PlacementStudy {
@@ -117,7 +126,11 @@ fn n_dampers_at_one_point_with_the_total_mass_equal_one() {
     assert_eq!(one.objective.unwrap(), energy(&base));
     for p in &r.placements {
         let (a, b) = (p.objective.unwrap(), one.objective.unwrap());
-        assert!((a - b).abs() <= 1e-12 * b, "{} dampers: {a} vs {b}", p.dampers);
+        assert!(
+            (a - b).abs() <= 1e-12 * b,
+            "{} dampers: {a} vs {b}",
+            p.dampers
+        );
         assert_eq!(p.masses_kg, vec![1.75 / p.dampers as f64; p.dampers]);
     }
 }
@@ -138,7 +151,9 @@ fn modal() -> String {
 #[test]
 fn the_optimiser_places_the_damper_where_the_structure_moves() {
     let base = load(&modal(), &[]);
-    let r = place(base.clone(), &["far", "mid", "left"], (1, 1)).run().unwrap();
+    let r = place(base.clone(), &["far", "mid", "left"], (1, 1))
+        .run()
+        .unwrap();
     assert_eq!(r.search, "exhaustive");
     assert_eq!(r.best.points, ["left"]);
     assert_eq!(r.evaluations.len(), 3);
@@ -168,12 +183,29 @@ fn the_optimiser_places_the_damper_where_the_structure_moves() {
 #[test]
 fn bad_placement_input_names_the_option() {
     let base = load(&modal(), &[]);
-    let cases: Vec<(Box<dyn Fn(&mut PlacementStudy)>, &str, &str)> = vec![
-        (Box::new(|s| s.candidates = vec!["lfet".into()]), "--place", "did you mean 'left'"),
+    type Change = Box<dyn Fn(&mut PlacementStudy)>;
+    let cases: Vec<(Change, &str, &str)> = vec![
+        (
+            Box::new(|s| s.candidates = vec!["lfet".into()]),
+            "--place",
+            "did you mean 'left'",
+        ),
         (Box::new(|s| s.counts = (1, 4)), "--dampers", "3 candidate"),
-        (Box::new(|s| s.masses = MassRule::Total(0.0)), "--total-mass", "> 0"),
-        (Box::new(|s| s.masses = MassRule::Total(-1.0)), "--total-mass", "> 0"),
-        (Box::new(|s| s.template = "d_lef".into()), "--template", "did you mean 'd_left'"),
+        (
+            Box::new(|s| s.masses = MassRule::Total(0.0)),
+            "--total-mass",
+            "> 0",
+        ),
+        (
+            Box::new(|s| s.masses = MassRule::Total(-1.0)),
+            "--total-mass",
+            "> 0",
+        ),
+        (
+            Box::new(|s| s.template = "d_lef".into()),
+            "--template",
+            "did you mean 'd_left'",
+        ),
         (
             Box::new(|s| {
                 s.search = Search::Exhaustive;
@@ -182,8 +214,16 @@ fn bad_placement_input_names_the_option() {
             "--max-combinations",
             "3 placements",
         ),
-        (Box::new(|s| s.objective = NetObjective::Accel("fra".into())), "--objective", "did you mean 'far'"),
-        (Box::new(|s| s.objective = NetObjective::ContactForce("left_damper".into())), "--objective", "die_left"),
+        (
+            Box::new(|s| s.objective = NetObjective::Accel("fra".into())),
+            "--objective",
+            "did you mean 'far'",
+        ),
+        (
+            Box::new(|s| s.objective = NetObjective::ContactForce("left_damper".into())),
+            "--objective",
+            "die_left",
+        ),
     ];
     for (change, option, what) in cases {
         let mut s = place(base.clone(), &["far", "mid", "left"], (1, 1));
@@ -204,15 +244,40 @@ fn mirror_image_placements_keep_the_same_energy() {
     let text = std::fs::read_to_string(path)
         .unwrap()
         .replacen("S = [0.15, 0.0], ", "", 1)
-        .replacen("spring_inset = 0.03\n", "spring_inset = 0.03\nb_offset = [0.0, 0.0]\n", 1)
-        .replacen(r#"between = ["slider", "S"]"#, r#"between = ["slider", "O_b"]"#, 1)
+        .replacen(
+            "spring_inset = 0.03\n",
+            "spring_inset = 0.03\nb_offset = [0.0, 0.0]\n",
+            1,
+        )
+        .replacen(
+            r#"between = ["slider", "S"]"#,
+            r#"between = ["slider", "O_b"]"#,
+            1,
+        )
         .replacen("elements_per_side = 20", "elements_per_side = 8", 1)
         .replacen("duration = 0.5", "duration = 0.004", 1);
     let m = NetworkModel::from_text("sym.toml", text, &[]).unwrap();
-    let r = place(m, &["D1", "D2", "D3", "D4", "O_b"], (1, 1)).run().unwrap();
-    let e = |p: &str| r.placements.iter().find(|x| x.points == [p]).unwrap().objective.unwrap();
+    let r = place(m, &["D1", "D2", "D3", "D4", "O_b"], (1, 1))
+        .run()
+        .unwrap();
+    let e = |p: &str| {
+        r.placements
+            .iter()
+            .find(|x| x.points == [p])
+            .unwrap()
+            .objective
+            .unwrap()
+    };
     for p in ["D2", "D3", "D4"] {
-        assert!((e(p) - e("D1")).abs() <= 1e-9 * e("D1"), "{p}: {} vs {}", e(p), e("D1"));
+        assert!(
+            (e(p) - e("D1")).abs() <= 1e-9 * e("D1"),
+            "{p}: {} vs {}",
+            e(p),
+            e("D1")
+        );
     }
-    assert!((e("O_b") - e("D1")).abs() > 1e-4 * e("D1"), "the centre differs");
+    assert!(
+        (e("O_b") - e("D1")).abs() > 1e-4 * e("D1"),
+        "the centre differs"
+    );
 }

@@ -114,13 +114,19 @@ pub fn metrics(s: &NetSummary) -> Vec<(String, Option<f64>)> {
     let mut out = vec![
         ("energy_ratio".to_string(), s.energy_ratio),
         ("collision_end_s".to_string(), s.collision_end_s),
-        ("dissipated_energy_j".to_string(), Some(s.dissipated_energy_j)),
+        (
+            "dissipated_energy_j".to_string(),
+            Some(s.dissipated_energy_j),
+        ),
     ];
     if let Some(f) = &s.floor_force_n {
         out.push(("floor_force_n".into(), Some(f.peak.abs())));
     }
     for c in &s.contacts {
-        out.push((format!("peak_force_n:{}", c.name), Some(c.peak_force_n.peak)));
+        out.push((
+            format!("peak_force_n:{}", c.name),
+            Some(c.peak_force_n.peak),
+        ));
     }
     for p in &s.points {
         out.push((
@@ -168,7 +174,10 @@ impl NetSweep {
         if vary.is_empty() || vary.len() > 2 {
             return Err(Error::invalid(
                 "--vary",
-                format!("a general machine's sweep takes one or two --vary (got {})", vary.len()),
+                format!(
+                    "a general machine's sweep takes one or two --vary (got {})",
+                    vary.len()
+                ),
             ));
         }
         for (i, v) in vary.iter().enumerate() {
@@ -392,16 +401,19 @@ impl NetSweepResult {
 
     /// The index of column `metric`, or an error listing the valid ones.
     pub fn column(&self, metric: &str) -> Result<usize> {
-        self.columns.iter().position(|c| c == metric).ok_or_else(|| {
-            let known: Vec<&str> = self.columns.iter().map(|s| s.as_str()).collect();
-            Error::invalid(
-                "--metric",
-                format!(
-                    "unknown metric `{metric}` for this machine{} (valid: {})",
-                    crate::model::network_fields::did_you_mean(metric, &known),
-                    known.join(", ")
-                ),
-            )
-        })
+        self.columns
+            .iter()
+            .position(|c| c == metric)
+            .ok_or_else(|| {
+                let known: Vec<&str> = self.columns.iter().map(|s| s.as_str()).collect();
+                Error::invalid(
+                    "--metric",
+                    format!(
+                        "unknown metric `{metric}` for this machine{} (valid: {})",
+                        crate::model::network_fields::did_you_mean(metric, &known),
+                        known.join(", ")
+                    ),
+                )
+            })
     }
 }

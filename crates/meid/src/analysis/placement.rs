@@ -223,7 +223,14 @@ fn choose(n: usize, k: usize) -> usize {
 fn placements_of(c: usize, n: usize, repeat: bool) -> Vec<Vec<usize>> {
     let mut out = Vec::new();
     let mut cur = Vec::with_capacity(n);
-    fn rec(c: usize, n: usize, repeat: bool, start: usize, cur: &mut Vec<usize>, out: &mut Vec<Vec<usize>>) {
+    fn rec(
+        c: usize,
+        n: usize,
+        repeat: bool,
+        start: usize,
+        cur: &mut Vec<usize>,
+        out: &mut Vec<Vec<usize>>,
+    ) {
         if cur.len() == n {
             out.push(cur.clone());
             return;
@@ -262,16 +269,28 @@ impl PlacementStudy {
             if !m.structure.points.contains_key(p) {
                 return Err(Error::invalid(
                     "--place",
-                    format!("'{p}' is not a structure point{} (valid: {})", did_you_mean(p, &known), known.join(", ")),
+                    format!(
+                        "'{p}' is not a structure point{} (valid: {})",
+                        did_you_mean(p, &known),
+                        known.join(", ")
+                    ),
                 ));
             }
             if self.candidates[..i].contains(p) {
-                return Err(Error::invalid("--place", format!("'{p}' is listed twice (use --repeat for several dampers at one point)")));
+                return Err(Error::invalid(
+                    "--place",
+                    format!(
+                        "'{p}' is listed twice (use --repeat for several dampers at one point)"
+                    ),
+                ));
             }
         }
         let (lo, hi) = self.counts;
         if lo == 0 || hi < lo {
-            return Err(Error::invalid("--dampers", format!("give N or LO..HI with 1 ≤ LO ≤ HI (got {lo}..{hi})")));
+            return Err(Error::invalid(
+                "--dampers",
+                format!("give N or LO..HI with 1 ≤ LO ≤ HI (got {lo}..{hi})"),
+            ));
         }
         if !self.repeat && hi > self.candidates.len() {
             return Err(Error::invalid(
@@ -281,13 +300,28 @@ impl PlacementStudy {
         }
         match self.masses {
             MassRule::Total(t) if !(t.is_finite() && t > 0.0) => {
-                return Err(Error::invalid("--total-mass", format!("must be a finite number > 0 kg (got {})", crate::num(t))))
+                return Err(Error::invalid(
+                    "--total-mass",
+                    format!("must be a finite number > 0 kg (got {})", crate::num(t)),
+                ))
             }
-            MassRule::Free { lower, upper } if !(lower.is_finite() && upper.is_finite() && lower > 0.0 && upper >= lower) => {
-                return Err(Error::invalid("--mass-bounds", format!("give LO..HI with 0 < LO ≤ HI kg (got {}..{})", crate::num(lower), crate::num(upper))))
+            MassRule::Free { lower, upper }
+                if !(lower.is_finite() && upper.is_finite() && lower > 0.0 && upper >= lower) =>
+            {
+                return Err(Error::invalid(
+                    "--mass-bounds",
+                    format!(
+                        "give LO..HI with 0 < LO ≤ HI kg (got {}..{})",
+                        crate::num(lower),
+                        crate::num(upper)
+                    ),
+                ))
             }
             MassRule::Free { .. } if self.mass_evaluations < 2 => {
-                return Err(Error::invalid("--mass-evaluations", "at least 2 simulations per placement"))
+                return Err(Error::invalid(
+                    "--mass-evaluations",
+                    "at least 2 simulations per placement",
+                ))
             }
             _ => {}
         }
@@ -308,22 +342,38 @@ impl PlacementStudy {
     pub fn combinations(&self) -> usize {
         let c = self.candidates.len();
         (self.counts.0..=self.counts.1)
-            .map(|n| if self.repeat { choose(c + n - 1, n) } else { choose(c, n) })
+            .map(|n| {
+                if self.repeat {
+                    choose(c + n - 1, n)
+                } else {
+                    choose(c, n)
+                }
+            })
             .fold(0usize, usize::saturating_add)
     }
 
     /// The objective of one simulation of the dampers at `points` with `masses`.
     fn simulate(&self, points: &[String], masses: &[f64], cache: &NetCache) -> Result<f64> {
-        let placement = Placement { points: points.to_vec(), masses_kg: masses.to_vec() };
+        let placement = Placement {
+            points: points.to_vec(),
+            masses_kg: masses.to_vec(),
+        };
         let spec = placed_spec(&self.model.spec, &self.template, &placement)?;
-        let m = self.model.with_spec(spec, self.model.source.clone(), Some(cache))?;
+        let m = self
+            .model
+            .with_spec(spec, self.model.source.clone(), Some(cache))?;
         let sol = m.solve(&m.options()?)?;
         let col = self.objective.column();
         metrics(&summary(&m, &sol))
             .into_iter()
             .find(|(c, _)| *c == col)
             .and_then(|(_, v)| v)
-            .ok_or_else(|| Error::numerical("placement", format!("{col}: no value (the collision did not end within the run?)")))
+            .ok_or_else(|| {
+                Error::numerical(
+                    "placement",
+                    format!("{col}: no value (the collision did not end within the run?)"),
+                )
+            })
     }
 
     /// The best result of placement `idx` (candidate indices) and its simulations.
@@ -348,9 +398,18 @@ impl PlacementStudy {
                 (m, f)
             }
             MassRule::Free { lower, upper } => {
-                let opts = NelderMeadOptions { max_evaluations: self.mass_evaluations, ..Default::default() };
+                let opts = NelderMeadOptions {
+                    max_evaluations: self.mass_evaluations,
+                    ..Default::default()
+                };
                 let x0 = vec![0.5 * (lower + upper); n];
-                match minimize_box(|x: &[f64]| run(x), &x0, &vec![lower; n], &vec![upper; n], &opts) {
+                match minimize_box(
+                    |x: &[f64]| run(x),
+                    &x0,
+                    &vec![lower; n],
+                    &vec![upper; n],
+                    &opts,
+                ) {
                     Ok(r) if r.f.is_finite() => (r.x, Some(r.f)),
                     _ => (x0, None),
                 }
@@ -368,7 +427,12 @@ impl PlacementStudy {
     }
 
     /// Evaluates the placements of `list` not yet in `memo` (in parallel, kept in order).
-    fn evaluate_new(&self, list: &[Vec<usize>], memo: &mut Vec<(Vec<usize>, PlacedResult, Vec<Evaluation>)>, cache: &NetCache) {
+    fn evaluate_new(
+        &self,
+        list: &[Vec<usize>],
+        memo: &mut Vec<(Vec<usize>, PlacedResult, Vec<Evaluation>)>,
+        cache: &NetCache,
+    ) {
         let mut new: Vec<Vec<usize>> = Vec::new();
         for p in list {
             if !memo.iter().any(|(q, _, _)| q == p) && !new.contains(p) {
@@ -386,10 +450,16 @@ impl PlacementStudy {
     }
 
     /// The best of `list` in `memo` (lowest objective; ties: the first).
-    fn best_of(list: &[Vec<usize>], memo: &[(Vec<usize>, PlacedResult, Vec<Evaluation>)]) -> Option<(Vec<usize>, f64)> {
+    fn best_of(
+        list: &[Vec<usize>],
+        memo: &[(Vec<usize>, PlacedResult, Vec<Evaluation>)],
+    ) -> Option<(Vec<usize>, f64)> {
         let mut best: Option<(Vec<usize>, f64)> = None;
         for p in list {
-            let f = memo.iter().find(|(q, _, _)| q == p).and_then(|(_, r, _)| r.objective);
+            let f = memo
+                .iter()
+                .find(|(q, _, _)| q == p)
+                .and_then(|(_, r, _)| r.objective);
             if let Some(f) = f {
                 if best.as_ref().is_none_or(|(_, b)| f < *b) {
                     best = Some((p.clone(), f));
@@ -400,7 +470,11 @@ impl PlacementStudy {
     }
 
     /// The greedy search with swaps (module docs).
-    fn heuristic(&self, memo: &mut Vec<(Vec<usize>, PlacedResult, Vec<Evaluation>)>, cache: &NetCache) {
+    fn heuristic(
+        &self,
+        memo: &mut Vec<(Vec<usize>, PlacedResult, Vec<Evaluation>)>,
+        cache: &NetCache,
+    ) {
         let c = self.candidates.len();
         let allowed = |cur: &[usize], i: usize| self.repeat || !cur.contains(&i);
         let mut current: Vec<usize> = Vec::new();
@@ -425,7 +499,12 @@ impl PlacementStudy {
             loop {
                 let mut moves: Vec<Vec<usize>> = Vec::new();
                 for pos in 0..current.len() {
-                    let rest: Vec<usize> = current.iter().enumerate().filter(|(j, _)| *j != pos).map(|(_, &v)| v).collect();
+                    let rest: Vec<usize> = current
+                        .iter()
+                        .enumerate()
+                        .filter(|(j, _)| *j != pos)
+                        .map(|(_, &v)| v)
+                        .collect();
                     for i in (0..c).filter(|&i| i != current[pos] && allowed(&rest, i)) {
                         let mut p = rest.clone();
                         p.push(i);
@@ -481,7 +560,10 @@ fn report(
     structures_built: usize,
     notes: Vec<String>,
 ) -> Result<PlacementReport> {
-    let evaluations: Vec<Evaluation> = memo.iter().flat_map(|(_, _, l)| l.iter().cloned()).collect();
+    let evaluations: Vec<Evaluation> = memo
+        .iter()
+        .flat_map(|(_, _, l)| l.iter().cloned())
+        .collect();
     let mut placements: Vec<PlacedResult> = memo.into_iter().map(|(_, r, _)| r).collect();
     // Best first; failed placements last; ties keep the search's order.
     placements.sort_by(|a, b| match (a.objective, b.objective) {
@@ -495,16 +577,34 @@ fn report(
         .filter(|p| p.objective.is_some())
         .cloned()
         .ok_or_else(|| {
-            let why = evaluations.iter().find_map(|e| e.error.clone()).unwrap_or_default();
-            Error::numerical("placement", format!("no placement has a value of {}: {why}", s.objective.column()))
+            let why = evaluations
+                .iter()
+                .find_map(|e| e.error.clone())
+                .unwrap_or_default();
+            Error::numerical(
+                "placement",
+                format!(
+                    "no placement has a value of {}: {why}",
+                    s.objective.column()
+                ),
+            )
         })?;
     let best_per_count = (s.counts.0..=s.counts.1)
-        .filter_map(|n| placements.iter().find(|p| p.dampers == n && p.objective.is_some()).cloned())
+        .filter_map(|n| {
+            placements
+                .iter()
+                .find(|p| p.dampers == n && p.objective.is_some())
+                .cloned()
+        })
         .collect();
     Ok(PlacementReport {
         machine: "general",
         objective: s.objective.column(),
-        search: if exhaustive { "exhaustive".into() } else { "heuristic (greedy + swap)".into() },
+        search: if exhaustive {
+            "exhaustive".into()
+        } else {
+            "heuristic (greedy + swap)".into()
+        },
         combinations,
         max_combinations: s.max_combinations,
         candidates: s.candidates.clone(),

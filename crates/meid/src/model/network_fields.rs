@@ -42,14 +42,7 @@ const ARRAYS: [(&str, &[&str]); 3] = [
     ("impactor", &["mass", "velocity", "force"]),
     (
         "damper",
-        &[
-            "mass",
-            "stiffness",
-            "damping",
-            "dashpot",
-            "point",
-            "anchor",
-        ],
+        &["mass", "stiffness", "damping", "dashpot", "point", "anchor"],
     ),
     (
         "contact",
@@ -73,7 +66,13 @@ const ARRAYS: [(&str, &[&str]); 3] = [
 pub(crate) fn did_you_mean(name: &str, known: &[&str]) -> String {
     known
         .iter()
-        .map(|c| (strsim::jaro_winkler(name, c), strsim::osa_distance(name, c), *c))
+        .map(|c| {
+            (
+                strsim::jaro_winkler(name, c),
+                strsim::osa_distance(name, c),
+                *c,
+            )
+        })
         .filter(|(s, d, _)| *s > 0.8 || *d <= 1)
         .max_by(|a, b| a.0.total_cmp(&b.0))
         .map(|(_, _, c)| format!("; did you mean '{c}'?"))
@@ -295,7 +294,11 @@ pub struct Placement {
 /// stiffness `K` and damping `C` are multiplied by `s` (√(k/m), c/(2√(km)), √(K/m) unchanged;
 /// a contact given by `restitution` keeps it). `n` such dampers of `M/n` each at one point
 /// move as one damper of `M` there (issue 29's check).
-pub fn placed_spec(base: &NetworkSpec, template: &str, placement: &Placement) -> Result<NetworkSpec> {
+pub fn placed_spec(
+    base: &NetworkSpec,
+    template: &str,
+    placement: &Placement,
+) -> Result<NetworkSpec> {
     let names: Vec<&str> = base.damper.iter().map(|d| d.name.as_str()).collect();
     let t = base
         .damper
@@ -311,13 +314,12 @@ pub fn placed_spec(base: &NetworkSpec, template: &str, placement: &Placement) ->
                 ),
             )
         })?;
-    let touches = |c: &super::network::ContactEntrySpec, d: &DamperEntrySpec| {
-        c.between.iter().any(|e| *e == d.name)
-    };
+    let touches =
+        |c: &super::network::ContactEntrySpec, d: &DamperEntrySpec| c.between.contains(&d.name);
     let own: Vec<_> = base
         .contact
         .iter()
-        .filter(|c| touches(c, t) && c.between.iter().any(|e| *e == t.point))
+        .filter(|c| touches(c, t) && c.between.contains(&t.point))
         .cloned()
         .collect();
     let mut spec = base.clone();
