@@ -5,46 +5,19 @@ use crate::common;
 
 use common::{meid, ok_json, stderr, tmpdir};
 
-const LUMPED: &str = r#"name = "general"
-[structure.lumped]
-masses = [ { name = "left", mass = 10.0 }, { name = "right", mass = 10.0 } ]
-springs = [ { nodes = ["left", "right"], stiffness = 2.0e7 },
-            { nodes = ["left", "ground"], stiffness = 1.0e5 },
-            { nodes = ["right", "ground"], stiffness = 1.0e5 } ]
-damping_ratios = [0.01, 0.01]
-
-[[impactor]]
-name = "die"
-mass = 1.2
-velocity = 1.2
-
-[[damper]]
-name = "d_left"
-mass = 1.75
-stiffness = 900.0
-damping = 350.0
-point = "left"
-anchor = "ground"
-
-[[contact]]
-name = "die_left"
-between = ["die", "left"]
-stiffness = 4.3e7
-
-[[contact]]
-name = "left_damper"
-between = ["left", "d_left"]
-stiffness = 6.3e7
-damping = 40.0
-
-[simulation]
-duration = 0.02
-"#;
+/// The lumped two-mass machine of the library's tests, its damper's contact given by damping.
+fn lumped() -> String {
+    include_str!("../../meid/tests/data/general_two_mass.toml").replacen(
+        "restitution = 0.8",
+        "damping = 40.0",
+        1,
+    )
+}
 
 fn file(tag: &str) -> (std::path::PathBuf, std::path::PathBuf) {
     let d = tmpdir("netstudy", tag);
     let f = d.join("m.toml");
-    std::fs::write(&f, LUMPED).unwrap();
+    std::fs::write(&f, lumped()).unwrap();
     (d, f)
 }
 

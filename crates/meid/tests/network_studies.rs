@@ -239,21 +239,7 @@ fn bad_placement_input_names_the_option() {
 /// ratio leaves room for that, far below what moving a damper does (≈1e-2).
 #[test]
 fn mirror_image_placements_keep_the_same_energy() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples/press-off-centre-4-dampers.toml");
-    let text = std::fs::read_to_string(path)
-        .unwrap()
-        .replacen("S = [0.15, 0.0], ", "", 1)
-        .replacen(
-            "spring_inset = 0.03\n",
-            "spring_inset = 0.03\nb_offset = [0.0, 0.0]\n",
-            1,
-        )
-        .replacen(
-            r#"between = ["slider", "S"]"#,
-            r#"between = ["slider", "O_b"]"#,
-            1,
-        )
+    let text = crate::network_model::symmetric_press()
         .replacen("elements_per_side = 20", "elements_per_side = 8", 1)
         .replacen("duration = 0.5", "duration = 0.004", 1);
     let m = NetworkModel::from_text("sym.toml", text, &[]).unwrap();
