@@ -42,6 +42,7 @@ mod montecarlo;
 mod optimize;
 mod outputs;
 mod paper;
+mod placement;
 mod production;
 mod progress;
 mod report;
@@ -50,6 +51,7 @@ mod shard;
 mod shell;
 mod simulate;
 mod sweep;
+mod sweep_general;
 mod ui;
 mod validate;
 

@@ -19,14 +19,17 @@ pub struct OptimizeArgs {
     #[arg(
         long,
         value_name = "PATH[,PATH...]",
-        required = true,
+        required_unless_present = "place",
         value_delimiter = ','
     )]
     over: Vec<String>,
     /// energy (E_p+/E_s− at the end of the collision), bed-accel or floor-force (peaks over
-    /// the model's duration).
-    #[arg(long, value_parser = ["energy", "bed-accel", "floor-force"], default_value = "energy")]
+    /// the model's duration); for a general machine's --place also accel:POINT and
+    /// contact-force:CONTACT.
+    #[arg(long, value_name = "NAME", default_value = "energy")]
     objective: String,
+    #[command(flatten)]
+    place: crate::placement::PlaceArgs,
     /// Bounds of a variable, PATH=LO..HI (repeatable; PATH=LO:HI is accepted too). Positive
     /// bounds are searched in log scale; LO = HI holds the variable fixed.
     #[arg(long = "bounds", value_name = "PATH=LO..HI")]
@@ -65,6 +68,25 @@ pub struct OptimizeArgs {
 }
 
 pub fn run(a: OptimizeArgs) -> Result<()> {
+    let general = meid::model::network::is_general_file(&a.model);
+    if general || !a.place.place.is_empty() {
+        if !a.over.is_empty() {
+            bail!("--over: a general machine's optimisation chooses its dampers' places and masses (--place, --dampers, --total-mass or --mass-bounds); vary its fields with `meid sweep --vary`");
+        }
+        if !general {
+            bail!("--place: a placement study takes a general machine ([[impactor]], [[damper]], [[contact]]); {} is the paper's machine", a.model.display());
+        }
+        return crate::placement::run(
+            &a.model,
+            &a.set.set,
+            &a.objective,
+            &a.place,
+            a.rate_bpm,
+            a.output.as_deref(),
+            a.print,
+        );
+    }
+    Objective::parse(&a.objective)?;
     let model = load(&a.model, &a.set.set, None, None, None)?;
     crate::warn_model(&model, &a.print);
     let over: Vec<Quantity> = a

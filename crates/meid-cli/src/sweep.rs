@@ -18,50 +18,50 @@ use crate::load;
 #[derive(clap::Args)]
 pub struct SweepArgs {
     /// Model file (TOML).
-    model: PathBuf,
+    pub(crate) model: PathBuf,
     /// NAME=LIST, NAME=A..B:N or NAME=A..B:N:log; NAME is ws/w_ref, wd/w_ref, wd/ws, md/mb or a
     /// model field path (repeatable; the grid is their Cartesian product, last fastest).
     #[arg(long = "vary", value_name = "SPEC", required = true)]
-    vary: Vec<String>,
+    pub(crate) vary: Vec<String>,
     /// Output directory (sweep.csv, sweep.parquet, sweep.json, pictures, manifest.json, and the journal
     /// sweep.partial.csv). Without it, nothing is written: the summary and the table of every
     /// point (sweep.csv's content) go to stdout.
     #[arg(short, long, value_name = "DIR")]
-    output: Option<PathBuf>,
+    pub(crate) output: Option<PathBuf>,
     /// Reuse the finished points of an interrupted sweep (DIR/sweep.partial.csv).
     #[arg(long, conflicts_with = "force")]
-    resume: bool,
+    pub(crate) resume: bool,
     /// Discard the journal of an earlier sweep in DIR and start over.
     #[arg(long)]
-    force: bool,
+    pub(crate) force: bool,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
-    threads: Option<usize>,
+    pub(crate) threads: Option<usize>,
     #[command(flatten)]
-    set: SetArgs,
+    pub(crate) set: SetArgs,
     /// Metric drawn in the pictures and summarised (a sweep.csv column).
     #[arg(long, value_name = "NAME", default_value = "energy_ratio")]
-    metric: String,
+    pub(crate) metric: String,
     /// Run every point for S seconds instead of stopping at the end of the collision.
     #[arg(long, value_name = "S")]
-    duration: Option<f64>,
+    pub(crate) duration: Option<f64>,
     /// Compare cases in one run: every point is simulated once per case (none, damper,
     /// added-mass, as-specified) and the metric columns become METRIC:CASE; the pictures draw
     /// one curve (or map) per case.
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
-    cases: Vec<String>,
+    pub(crate) cases: Vec<String>,
     /// Compute only shard K of N (1 <= K <= N: grid points ⌊(K−1)T/N⌋..⌊KT/N⌋) into
     /// DIR/shard.csv (needs -o DIR); `meid merge` puts the shards together.
     #[arg(long, value_name = "K/N")]
-    shard: Option<crate::shard::Shard>,
+    pub(crate) shard: Option<crate::shard::Shard>,
     /// Bed mass m_b (kg) for md/mb (default: the lumped mass at the bed contact point, the
     /// FE machine's bed plate, or a general FE model's elements labelled part = "bed"; see
     /// docs/explanations/studies.md).
     #[arg(long, value_name = "KG")]
-    bed_mass: Option<f64>,
+    pub(crate) bed_mass: Option<f64>,
     // --json prints the result (sweep.json's content); -q: no progress bar or summary either.
     #[command(flatten)]
-    print: PrintArgs,
+    pub(crate) print: PrintArgs,
 }
 
 /// The sweep of the arguments (model loaded, grid checked), as `meid sweep` and `meid merge`
@@ -101,7 +101,7 @@ fn prepare(a: &SweepArgs) -> Result<Sweep> {
     Ok(sweep)
 }
 
-fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+pub(crate) fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
     let mut b = rayon::ThreadPoolBuilder::new();
     if let Some(n) = threads {
         if n == 0 {
@@ -113,6 +113,9 @@ fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
 }
 
 pub fn run(a: SweepArgs) -> Result<()> {
+    if meid::model::network::is_general_file(&a.model) {
+        return crate::sweep_general::run(&a);
+    }
     let sweep = prepare(&a)?;
     let total = sweep.len();
     if let Some(shard) = a.shard {

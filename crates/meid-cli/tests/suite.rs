@@ -24,6 +24,7 @@ mod model_cli;
 mod modes_cli;
 mod mutations;
 mod network_cli;
+mod network_study_cli;
 mod outputs_cli;
 mod paper_cli;
 mod pictures_cli;

@@ -5,41 +5,7 @@ use meid::model::network::NetworkModel;
 use meid::model::Model;
 
 /// A two-mass lumped structure, one impactor, one damper under "left".
-const BASE: &str = r#"name = "general"
-[structure.lumped]
-masses = [ { name = "left", mass = 10.0 }, { name = "right", mass = 10.0 } ]
-springs = [ { nodes = ["left", "right"], stiffness = 2.0e7 },
-            { nodes = ["left", "ground"], stiffness = 1.0e5 },
-            { nodes = ["right", "ground"], stiffness = 1.0e5 } ]
-damping_ratios = [0.01, 0.01]
-
-[[impactor]]
-name = "die"
-mass = 1.2
-velocity = 1.2
-
-[[damper]]
-name = "d_left"
-mass = 1.75
-stiffness = 900.0
-damping = 350.0
-point = "left"
-anchor = "ground"
-
-[[contact]]
-name = "die_left"
-between = ["die", "left"]
-stiffness = 4.3e7
-
-[[contact]]
-name = "left_damper"
-between = ["left", "d_left"]
-stiffness = 6.3e7
-restitution = 0.8
-
-[simulation]
-duration = 0.05
-"#;
+pub(crate) const BASE: &str = include_str!("data/general_two_mass.toml");
 
 fn load(text: &str) -> meid::Result<NetworkModel> {
     NetworkModel::from_text("m.toml", text.to_string(), &[])
@@ -222,20 +188,13 @@ fn preloads_need_an_equilibrium() {
     assert!(sol.residual_run_end <= 1e-9);
 }
 
-/// examples/press-off-centre-4-dampers.toml made mirror-symmetric about both bed axes (no
-/// off-centre strike point S, the accelerometer B at the centre, the slider striking O_b): the
-/// four identical dampers at (±0.16, ±0.08) m then see the same motion, so their contacts' impact
-/// rows are identical up to round-off. The mesh is the mirror image of itself to round-off (its
-/// grid lines are symmetric sets) and so are the modes, to the eigen-solver's accuracy
-/// (≈1e-12 of the mode shapes); switching times are located to 1e-13 of the fastest period.
-/// 1e-9 of each quantity's scale leaves room for that and is far below what any asymmetry does:
-/// B's grid lines at (0.08, 0.05) m alone make the rows differ by about 1e-3.
-#[test]
-fn four_dampers_at_symmetric_points_give_four_identical_impact_rows() {
+/// examples/press-off-centre-4-dampers.toml made mirror-symmetric about both bed axes: no
+/// off-centre strike point S, the accelerometer B at the centre, the slider striking O_b.
+pub(crate) fn symmetric_press() -> String {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../examples/press-off-centre-4-dampers.toml");
-    let text = std::fs::read_to_string(path).unwrap();
-    let symmetric = text
+    std::fs::read_to_string(path)
+        .unwrap()
         .replacen("S = [0.15, 0.0], ", "", 1)
         .replacen(
             "spring_inset = 0.03\n",
@@ -247,6 +206,19 @@ fn four_dampers_at_symmetric_points_give_four_identical_impact_rows() {
             r#"between = ["slider", "O_b"]"#,
             1,
         )
+}
+
+/// examples/press-off-centre-4-dampers.toml made mirror-symmetric about both bed axes (no
+/// off-centre strike point S, the accelerometer B at the centre, the slider striking O_b): the
+/// four identical dampers at (±0.16, ±0.08) m then see the same motion, so their contacts' impact
+/// rows are identical up to round-off. The mesh is the mirror image of itself to round-off (its
+/// grid lines are symmetric sets) and so are the modes, to the eigen-solver's accuracy
+/// (≈1e-12 of the mode shapes); switching times are located to 1e-13 of the fastest period.
+/// 1e-9 of each quantity's scale leaves room for that and is far below what any asymmetry does:
+/// B's grid lines at (0.08, 0.05) m alone make the rows differ by about 1e-3.
+#[test]
+fn four_dampers_at_symmetric_points_give_four_identical_impact_rows() {
+    let symmetric = symmetric_press()
         // The damper impacts of the blow fall within its first 4 ms; 5 ms of the symmetric
         // machine (whose four identical one-way dashpots switch at the same instants) keep the
         // test's cost in bounds.

@@ -60,6 +60,7 @@ mod modes_import;
 mod modes_truncation;
 mod network_engine;
 mod network_model;
+mod network_studies;
 mod optimize_checks;
 mod output_sets;
 mod paper_impacts;

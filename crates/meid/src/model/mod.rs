@@ -37,6 +37,7 @@ mod keyhash;
 mod lumped;
 pub mod material;
 pub mod network;
+pub mod network_fields;
 mod plausible;
 pub mod setter;
 pub mod source;
@@ -248,7 +249,7 @@ impl Model {
         if network::is_general(&table) {
             return Err(Error::Input {
                 location: name.to_string(),
-                message: "this is a general machine ([[impactor]], [[damper]] or [[contact]] arrays): `meid simulate` runs it; the other commands take the paper's machine ([slider], [damper], [contact.slider_bed]) for now".into(),
+                message: "this is a general machine ([[impactor]], [[damper]] or [[contact]] arrays): `meid simulate`, `meid sweep` and `meid optimize --place` run it; the other commands take the paper's machine ([slider], [damper], [contact.slider_bed]) for now".into(),
             });
         }
         refuse_rigid_paper_form(name, &text, &table)?;

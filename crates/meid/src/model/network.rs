@@ -174,63 +174,26 @@ impl NetworkModel {
         Self::from_text(&path.display().to_string(), text, overrides)
     }
 
-    /// Parses and validates a general machine's text; `name` is used in errors.
+    /// Parses and validates a general machine's text; `name` is used in errors. An override's
+    /// path may name an array entry by its name (`damper.damper1.mass`,
+    /// [`super::network_fields`]).
     pub fn from_text(name: &str, text: String, overrides: &[String]) -> Result<Self> {
-        let mut table: toml::Table =
-            toml::from_str(&text).map_err(|e| source::toml_error(name, &text, &e))?;
-        let mut src = Source {
-            name: name.to_string(),
-            text,
-            overrides: Vec::new(),
-        };
-        for o in overrides {
-            let applied = source::apply_override(&mut table, o)?;
-            src.overrides.push(applied);
-        }
-        for (key, instead) in PAPER_ONLY {
-            if table.contains_key(key) {
-                return Err(src.error(
-                    key,
-                    format!(
-                        "[{key}] is the paper machine's shorthand and cannot be mixed with [[impactor]], [[damper]] or [[contact]] arrays: use {instead}"
-                    ),
-                ));
-            }
-        }
-        if let Some(toml::Value::Table(_)) = table.get("damper") {
-            return Err(src.error(
-                "damper",
-                "a [damper] table is the paper machine's shorthand; in a general machine write [[damper]] (an array of tables, with name, point and anchor)",
-            ));
-        }
-        let spec: NetworkSpec = if src.overrides.is_empty() {
-            let de = toml::de::Deserializer::parse(&src.text)
-                .map_err(|e| source::toml_error(name, &src.text, &e))?;
-            strict::deserialize(de).map_err(|(e, track)| {
-                source::toml_error_message(
-                    name,
-                    &src.text,
-                    &e,
-                    strict::message(e.message(), &track),
-                )
-            })?
-        } else {
-            strict::deserialize(toml::Value::Table(table.clone())).map_err(|(e, track)| {
-                Error::Input {
-                    location: src
-                        .overrides
-                        .iter()
-                        .map(|(p, v)| format!("--set {p}={v}"))
-                        .collect::<Vec<_>>()
-                        .join(" "),
-                    message: strict::message(e.message(), &track),
-                }
-            })?
-        };
-        super::check_table_magnitudes(&table, &src)?;
+        let (spec, src) = read_spec(name, text, overrides)?;
+        Self::of_spec(spec, src, |spec, src, ctx| {
+            super::build_structure_of(&spec.structure, None, src, ctx)
+        })
+    }
+
+    /// The model of a read `spec` (values from `src`), its structure from `structure` (called
+    /// with the spec, source and reduction context): checked as a model file is.
+    pub(crate) fn of_spec(
+        spec: NetworkSpec,
+        src: Source,
+        structure: impl FnOnce(&NetworkSpec, &Source, &ReductionContext) -> Result<ModalModel>,
+    ) -> Result<Self> {
         check_fields(&spec, &src)?;
         let ctx = context(&spec);
-        let structure = super::build_structure_of(&spec.structure, None, &src, &ctx)?;
+        let structure = structure(&spec, &src, &ctx)?;
         let (network, notes) = assemble(&spec, &structure, &src)?;
         // An impossible preload is an input error, found before any run.
         engine::initial_state(&network).map_err(|e| locate(e, &spec, &src))?;
@@ -265,6 +228,65 @@ impl NetworkModel {
     pub fn solve(&self, opts: &Options) -> Result<engine::NetSolution> {
         engine::solve(&self.network, opts).map_err(|e| locate(e, &self.spec, &self.source))
     }
+}
+
+/// The spec of a general machine's text with `overrides` applied in order (named array
+/// paths translated, [`super::network_fields::translate`]), and its source.
+pub(crate) fn read_spec(
+    name: &str,
+    text: String,
+    overrides: &[String],
+) -> Result<(NetworkSpec, Source)> {
+    let mut table: toml::Table =
+        toml::from_str(&text).map_err(|e| source::toml_error(name, &text, &e))?;
+    let mut src = Source {
+        name: name.to_string(),
+        text,
+        overrides: Vec::new(),
+    };
+    for o in overrides {
+        for t in super::network_fields::translate(&table, o)? {
+            let applied = source::apply_override(&mut table, &t)?;
+            src.overrides.push(applied);
+        }
+    }
+    for (key, instead) in PAPER_ONLY {
+        if table.contains_key(key) {
+            return Err(src.error(
+                key,
+                format!(
+                    "[{key}] is the paper machine's shorthand and cannot be mixed with [[impactor]], [[damper]] or [[contact]] arrays: use {instead}"
+                ),
+            ));
+        }
+    }
+    if let Some(toml::Value::Table(_)) = table.get("damper") {
+        return Err(src.error(
+            "damper",
+            "a [damper] table is the paper machine's shorthand; in a general machine write [[damper]] (an array of tables, with name, point and anchor)",
+        ));
+    }
+    let spec: NetworkSpec = if src.overrides.is_empty() {
+        let de = toml::de::Deserializer::parse(&src.text)
+            .map_err(|e| source::toml_error(name, &src.text, &e))?;
+        strict::deserialize(de).map_err(|(e, track)| {
+            source::toml_error_message(name, &src.text, &e, strict::message(e.message(), &track))
+        })?
+    } else {
+        strict::deserialize(toml::Value::Table(table.clone())).map_err(|(e, track)| {
+            Error::Input {
+                location: src
+                    .overrides
+                    .iter()
+                    .map(|(p, v)| format!("--set {p}={v}"))
+                    .collect::<Vec<_>>()
+                    .join(" "),
+                message: strict::message(e.message(), &track),
+            }
+        })?
+    };
+    super::check_table_magnitudes(&table, &src)?;
+    Ok((spec, src))
 }
 
 /// An API error naming `<entity name>.<field>` turned into one located at the entity's model
@@ -543,7 +565,7 @@ fn check_rigid_entry(p: &str, c: &ContactEntrySpec) -> std::result::Result<(), (
 
 /// The reduction context of the structure: the named points the machine uses, and the fastest
 /// contact frequency `√(K/m)` against a body.
-fn context(spec: &NetworkSpec) -> ReductionContext {
+pub(crate) fn context(spec: &NetworkSpec) -> ReductionContext {
     let masses: Vec<(&str, f64)> = spec
         .impactor
         .iter()
