@@ -151,6 +151,9 @@ fn main() -> ExitCode {
         Command::Simulate(a) => simulate::run(a),
         Command::Modes(a) => modes::run(a),
         Command::Model(a) => model::run(a),
+        Command::Sweep(a) if meid::model::network::is_general_file(&a.model) => {
+            sweep_general::run(&a)
+        }
         Command::Sweep(a) => sweep::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Optimize(a) => optimize::run(a),

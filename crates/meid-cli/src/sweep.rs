@@ -112,10 +112,9 @@ pub(crate) fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
     b.build().context("cannot start the worker threads")
 }
 
+/// `meid sweep` of the paper's machine (a general machine's: [`crate::sweep_general::run`],
+/// chosen by `main`).
 pub fn run(a: SweepArgs) -> Result<()> {
-    if meid::model::network::is_general_file(&a.model) {
-        return crate::sweep_general::run(&a);
-    }
     let sweep = prepare(&a)?;
     let total = sweep.len();
     if let Some(shard) = a.shard {

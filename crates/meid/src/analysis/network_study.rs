@@ -344,7 +344,7 @@ fn check_values(model: &NetworkModel, v: &NetVary) -> Result<()> {
                         format!(
                             "`{}`: '{n}' is not a structure point{} (valid: {})",
                             v.spec,
-                            crate::model::network_fields::did_you_mean(n, &known),
+                            crate::model::network_paths::did_you_mean(n, &known),
                             known.join(", ")
                         ),
                     ));
@@ -410,7 +410,7 @@ impl NetSweepResult {
                     "--metric",
                     format!(
                         "unknown metric `{metric}` for this machine{} (valid: {})",
-                        crate::model::network_fields::did_you_mean(metric, &known),
+                        crate::model::network_paths::did_you_mean(metric, &known),
                         known.join(", ")
                     ),
                 )

@@ -33,7 +33,8 @@ use super::network::summary;
 use super::network_study::metrics;
 use super::optimize::{minimize_box, NelderMeadOptions};
 use crate::model::network::NetworkModel;
-use crate::model::network_fields::{did_you_mean, placed_spec, NetCache, Placement};
+use crate::model::network_fields::{placed_spec, NetCache, Placement};
+use crate::model::network_paths::did_you_mean;
 use crate::{Error, Result};
 
 /// What a placement study minimises (module docs).

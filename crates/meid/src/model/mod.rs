@@ -38,6 +38,7 @@ mod lumped;
 pub mod material;
 pub mod network;
 pub mod network_fields;
+pub mod network_paths;
 mod plausible;
 pub mod setter;
 pub mod source;

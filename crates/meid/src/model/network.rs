@@ -176,7 +176,7 @@ impl NetworkModel {
 
     /// Parses and validates a general machine's text; `name` is used in errors. An override's
     /// path may name an array entry by its name (`damper.damper1.mass`,
-    /// [`super::network_fields`]).
+    /// [`super::network_paths`]).
     pub fn from_text(name: &str, text: String, overrides: &[String]) -> Result<Self> {
         let (spec, src) = read_spec(name, text, overrides)?;
         Self::of_spec(spec, src, |spec, src, ctx| {
@@ -231,7 +231,7 @@ impl NetworkModel {
 }
 
 /// The spec of a general machine's text with `overrides` applied in order (named array
-/// paths translated, [`super::network_fields::translate`]), and its source.
+/// paths translated, [`super::network_paths::translate`]), and its source.
 pub(crate) fn read_spec(
     name: &str,
     text: String,
@@ -245,7 +245,7 @@ pub(crate) fn read_spec(
         overrides: Vec::new(),
     };
     for o in overrides {
-        for t in super::network_fields::translate(&table, o)? {
+        for t in super::network_paths::translate(&table, o)? {
             let applied = source::apply_override(&mut table, &t)?;
             src.overrides.push(applied);
         }
