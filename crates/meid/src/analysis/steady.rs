@@ -55,7 +55,10 @@
 //! is far below anything a reported level resolves.
 //!
 //! # Regimes and the fallback
-//! 1. Newton on `P` from the machine at rest. Converged to a stable fixed point: **period-1**.
+//! 1. Newton on `P` from the machine at rest, globalised: a step that does not lower the
+//!    residual is followed by one backtracking step along it (the quadratic model's minimiser,
+//!    Dennis & Schnabel 1983, A6.3.1), and if that fails too by a march step `y ← P(y)`.
+//!    Converged to a stable fixed point: **period-1**.
 //! 2. Otherwise (no convergence within its budget: the map is non-smooth where a contact just
 //!    grazes, or the fixed point is unstable) the train is **marched** blow by blow from where
 //!    Newton was best, and after each blow the smallest `k ≤ max_period` with
@@ -187,7 +190,8 @@ pub struct SteadyState {
     /// What the reader should know about how the result was obtained.
     pub notes: Vec<String>,
     /// The search's residuals in order, each marked: `s` the start of a Newton search, `N` an
-    /// accepted Newton step, `x` a rejected one, `m` a march step of the Newton search.
+    /// accepted Newton step, `b` an accepted backtracking step after a rejected Newton step, `x`
+    /// a rejected step (Newton or backtracking), `m` a march step of the Newton search.
     pub residual_history: Vec<(char, f64)>,
     /// The state `y` just before the first of [`Self::blows`] (the fixed point of `P^k`, or
     /// for an irregular train the marched state before its last blows): [`replay`] runs the
@@ -522,6 +526,25 @@ impl<'a> Map<'a> {
     }
 }
 
+/// The backtracked point after a Newton step `s = yt − y` was rejected (residual `rt ≥ r`):
+/// `y + α s` with `α` the minimiser of the quadratic model of `φ(α) = ‖F(y + α s)‖²` through
+/// `φ(0) = r²`, `φ'(0) = −2r²` (the Newton direction's own slope) and `φ(1) = rt²`,
+/// safeguarded to `[0.1, 0.5]`:
+///
+/// ```text
+/// α = clamp( r² / (rt² + r²), 0.1, 0.5 )
+/// ```
+///
+/// (Dennis & Schnabel, *Numerical Methods for Unconstrained Optimization and Nonlinear
+/// Equations*, 1983, §6.3.2, Algorithm A6.3.1). `None` when the budget has no room for it.
+fn backtrack(map: &Map, y: &[f64], yt: &[f64], r: f64, rt: f64, k: usize) -> Option<Vec<f64>> {
+    if map.left() < 2 * k || !(r > 0.0 && rt.is_finite()) {
+        return None;
+    }
+    let a = (r * r / (rt * rt + r * r)).clamp(0.1, 0.5);
+    Some(y.iter().zip(yt).map(|(p, q)| p + a * (q - p)).collect())
+}
+
 /// Solves `(J − I) Δ = −r`.
 fn newton_step(jac: &Mat<f64>, r: &[f64]) -> Option<Vec<f64>> {
     let d = r.len();
@@ -582,10 +605,11 @@ fn eval_k(map: &mut Map, y: &[f64], k: usize, peaks: bool, with_jac: bool) -> Re
     Ok((z, jac, reports, switches))
 }
 
-/// Newton on `P^k(y) − y = 0` from `y0`, globalised by marching: a Newton step whose residual
-/// is not smaller than the current one is rejected and replaced by the march step
+/// Newton on `P^k(y) − y = 0` from `y0`, globalised by backtracking and marching: a Newton
+/// step whose residual is not smaller than the current one is rejected and followed by one
+/// backtracking step along it ([`backtrack`]); if that is not smaller either, by the march step
 /// `y ← P^k(y)` (already evaluated), which contracts wherever the regime attracts. At most
-/// `iterations` evaluations of `P^k`.
+/// `iterations` steps (each one to three evaluations of `P^k`, within the map's budget).
 ///
 /// With `march_first` the first step is a march step: from rest a damper touches the bed with
 /// zero overlap and zero relative velocity (a grazing start), where the map is not
@@ -639,6 +663,20 @@ fn newton(
                     (y, z, jac, reports, switches, residual) = (yt, zt, jt, rt, st, res_t);
                     with_peaks = last;
                     true
+                } else if let Some(yw) = backtrack(map, &y, &yt, residual, res_t, k) {
+                    // One backtracking step along the rejected Newton step.
+                    let (zw, jw, rw, sw) = eval_k(map, &yw, k, false, true)?;
+                    let res_w = map.norm(&diff(&zw, &yw));
+                    map.record(if res_w < residual { 'b' } else { 'x' }, res_w);
+                    if res_w < residual {
+                        smooth = sw == switches;
+                        before = None;
+                        (y, z, jac, reports, switches, residual) = (yw, zw, jw, rw, sw, res_w);
+                        with_peaks = false;
+                        true
+                    } else {
+                        false
+                    }
                 } else {
                     false
                 }
@@ -922,8 +960,9 @@ fn finish(
     }
     if fixed.rejected > 0 {
         notes.push(format!(
-            "{} Newton step{} did not lower the residual and {} replaced by march steps (the \
-             map is not smooth there: a contact's closing changed between iterates)",
+            "{} Newton step{} did not lower the residual, nor did a backtracking step along it, \
+             and {} replaced by march steps (the map is not smooth there: a contact's closing \
+             changed between iterates)",
             fixed.rejected,
             if fixed.rejected == 1 { "" } else { "s" },
             if fixed.rejected == 1 { "was" } else { "were" }
