@@ -18,6 +18,8 @@ use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
+mod machine;
+
 use meid::analysis::montecarlo::{self, MonteCarlo, Uncertain};
 use meid::analysis::sweep::{self, Quantity, Sweep, Vary};
 use meid::model::{Case, StructureCache};
@@ -330,6 +332,13 @@ impl Model {
         overrides: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let ov = override_list(overrides)?;
+        if meid::model::network::is_general_file(&path) {
+            return Err(InputError::new_err(format!(
+                "{}: this is a general machine ([[impactor]], [[damper]] or [[contact]] arrays): \
+                 read it with meid.Machine.from_file (or meid.load, which reads either kind)",
+                path.display()
+            )));
+        }
         py.detach(|| meid::model::Model::from_file(&path, &ov))
             .map(|inner| Model { inner })
             .map_err(err)
@@ -584,6 +593,24 @@ const PY_HISTORY_SAMPLE_BYTES: f64 = meid::analysis::energy::HISTORY_SAMPLE_BYTE
 pub struct Run {
     summary_json: String,
     columns: Option<Vec<Vec<f64>>>,
+}
+
+impl Run {
+    /// A run without a sampled history (a general machine's, [`machine::Machine`]).
+    fn from_summary(summary_json: String) -> Self {
+        Run {
+            summary_json,
+            columns: None,
+        }
+    }
+}
+
+/// Whether the model file at `path` is a general machine (`[[impactor]]`, `[[damper]]` or
+/// `[[contact]]` arrays), which `meid.Machine` reads, rather than the paper's machine
+/// (`meid.Model`). A file that cannot be read or parsed is not one.
+#[pyfunction]
+fn is_general_file(path: std::path::PathBuf) -> bool {
+    meid::model::network::is_general_file(&path)
 }
 
 #[pymethods]
@@ -1111,6 +1138,9 @@ fn column_unit(name: &str) -> Option<&'static str> {
 fn _meid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Model>()?;
     m.add_class::<Run>()?;
+    m.add_class::<machine::Machine>()?;
+    m.add_function(wrap_pyfunction!(machine::machine_sweep_json, m)?)?;
+    m.add_function(wrap_pyfunction!(is_general_file, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_columns, m)?)?;
     m.add_function(wrap_pyfunction!(montecarlo_columns, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate, m)?)?;

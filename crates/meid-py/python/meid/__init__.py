@@ -10,6 +10,10 @@ Problem -> solve -> solution::
     run.history["bed_acceleration_m_per_s2"]   # numpy array
     df = run.to_pandas()                  # needs pandas
 
+    press = meid.load("examples/press-off-centre-4-dampers.toml")   # a general machine
+    press.simulate().summary["impacts"]   # one row per closing of a contact
+    meid.sweep(press, vary={"damper.damper1.point": ["D1", "D2"]})
+
     table = meid.sweep(model, vary={"wd/ws": "0.3..3:41:log"})             # pyarrow Table
     mc = meid.montecarlo(model, vary={"contact.slider_bed.stiffness": "lognormal(4.3e7,0.3)"},
                          samples=1000, seed=1, output="pandas")
@@ -36,6 +40,7 @@ from ._meid import (  # noqa: F401
     FileError,
     FileNotFound,
     InputError,
+    Machine,
     MeidError,
     MeidWarning,
     Model,
@@ -44,6 +49,8 @@ from ._meid import (  # noqa: F401
     blows_json,
     column_unit,
     evaluate as _evaluate,
+    is_general_file,
+    machine_sweep_json,
     max_memory,
     metric_names,
     montecarlo_columns,
@@ -53,6 +60,8 @@ from ._meid import (  # noqa: F401
 
 __all__ = [
     "Model",
+    "Machine",
+    "load",
     "Run",
     "MeidError",
     "InputError",
@@ -77,6 +86,16 @@ def units(column: str) -> Optional[str]:
     the field's last name for a field path (``...stiffness`` N/m, ``...mass`` kg, ``...damping``
     N·s/m, ``...velocity`` m/s); ``None`` for a field path of unknown unit."""
     return column_unit(column)
+
+
+def load(path: str, overrides: Optional[Sequence[str]] = None) -> Union[Model, Machine]:
+    """Reads a model file of either kind: the paper's machine (``[slider]``, ``[damper]``,
+    ``[contact.slider_bed]``) as a :class:`Model`, a general machine (``[[impactor]]``,
+    ``[[damper]]``, ``[[contact]]`` arrays) as a :class:`Machine`. ``overrides`` are
+    "PATH=VALUE" strings, as the CLI's ``--set``."""
+    if is_general_file(str(path)):
+        return Machine.from_file(path, overrides)
+    return Model.from_file(path, overrides)
 
 
 def _spec(name: str, values: Any) -> str:
@@ -117,6 +136,10 @@ def _table(names, columns, errors, output: str, index: str):
             # uint64, as in the Parquet files of `meid sweep`/`meid montecarlo -o`.
             arrays.append(pa.array(c.astype("uint64")))
             fields.append(pa.field(n, pa.uint64(), metadata={"unit": "1"}))
+        elif c.dtype == object:
+            # Names (a general machine's varied point), as text.
+            arrays.append(pa.array(list(c), type=pa.string()))
+            fields.append(pa.field(n, pa.string()))
         else:
             u = units(n)
             arrays.append(pa.array(c, type=pa.float64()))
@@ -166,8 +189,52 @@ def sweep(
     numpy arrays (``output="numpy"``), one row per point: ``index``, the varied values, K_s,
     K_d, m_d, m_s and every metric; ``error`` says why a point failed (NaN metrics).
     """
+    if isinstance(model, Machine):
+        if bed_mass_kg is not None or duration is not None:
+            raise ValueError(
+                "sweep of a Machine: bed_mass_kg and duration are for the paper's Model (set a "
+                "general machine's duration with machine.with_values({'simulation.duration': T}))"
+            )
+        return _machine_sweep(model, vary, threads, output)
     specs = [_spec(k, v) for k, v in vary.items()]
     names, columns, errors = sweep_columns(model, specs, bed_mass_kg, threads, duration)
+    return _table(names, columns, errors, output, "index")
+
+
+def _machine_spec(name: str, values: Any) -> str:
+    """A general machine's ``--vary``: a range text, or a list of numbers or point names."""
+    if isinstance(values, str):
+        return f"{name}={values}"
+    vals = list(np.asarray(values, dtype=object).ravel())
+    if vals and all(isinstance(v, str) for v in vals):
+        return f"{name}=[" + ",".join(vals) + "]"
+    return _spec(name, values)
+
+
+def _machine_sweep(machine: Machine, vary, threads, output: str):
+    """A general machine's sweep (``meid sweep GENERAL.toml --vary``) as a table: ``index``, the
+    varied fields (numbers, or point names as text), the metric columns, ``error``."""
+    import json
+
+    specs = [_machine_spec(k, v) for k, v in vary.items()]
+    r = json.loads(machine_sweep_json(machine, specs, threads))
+    points = r["points"]
+    index = np.array([p["index"] for p in points], dtype=np.float64)
+    names = ["index"]
+    columns: list = [index]
+    for k, v in enumerate(r["vary"]):
+        vals = [p["values"][k] for p in points]
+        names.append(v["path"])
+        if all(isinstance(x, (int, float)) for x in vals):
+            columns.append(np.array(vals, dtype=np.float64))
+        else:
+            columns.append(np.array([str(x) for x in vals], dtype=object))
+    for j, c in enumerate(r["columns"]):
+        names.append(c)
+        columns.append(
+            np.array([np.nan if p["metrics"][j] is None else p["metrics"][j] for p in points])
+        )
+    errors = [p["error"] for p in points]
     return _table(names, columns, errors, output, "index")
 
 

@@ -243,13 +243,32 @@ impl NetSweep {
     /// Runs every point (in parallel, collected in grid order); `progress` is called with the
     /// count of finished points. A point that fails keeps its error and no metrics.
     pub fn run(&self, progress: &(dyn Fn(usize) + Sync)) -> NetSweepResult {
+        self.run_unless(progress, &std::sync::atomic::AtomicBool::new(false))
+    }
+
+    /// [`Self::run`], except that once `cancel` is set the points not yet started are not run
+    /// (their rows carry the error "interrupted"); a point's result does not depend on it.
+    pub fn run_unless(
+        &self,
+        progress: &(dyn Fn(usize) + Sync),
+        cancel: &std::sync::atomic::AtomicBool,
+    ) -> NetSweepResult {
+        use std::sync::atomic::Ordering;
         let cache = NetCache::new();
         let done = std::sync::atomic::AtomicUsize::new(0);
         let points = (0..self.len())
             .into_par_iter()
             .map(|i| {
+                if cancel.load(Ordering::Relaxed) {
+                    return NetPoint {
+                        index: i,
+                        values: self.values_at(i),
+                        metrics: vec![None; self.columns.len()],
+                        error: Some("interrupted".into()),
+                    };
+                }
                 let r = self.point(i, &cache);
-                progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1);
                 r
             })
             .collect();
