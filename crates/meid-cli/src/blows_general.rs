@@ -53,7 +53,9 @@ pub fn verdict(s: &NetSteadyState) -> String {
         .map(|d| d.name.as_str())
         .collect();
     if s.dampers_touch.is_empty() {
-        format!("At {rate} blows/min the machine (no damper) settles into the steady blow: {levels}.")
+        format!(
+            "At {rate} blows/min the machine (no damper) settles into the steady blow: {levels}."
+        )
     } else if away.is_empty() {
         format!("At {rate} blows/min every damper returns between blows: each touches its point in every steady blow ({levels}).")
     } else {
@@ -175,10 +177,9 @@ fn print_steady(s: &NetSteadyState) {
     if let Some(m) = s.multipliers_abs.first() {
         println!(
             "  |μ|max {m:.6}{}",
-            s.periods_to_settle
-                .map_or(String::new(), |p| format!(
-                    " (a disturbance decays to 1e-3 in {p:.1} periods)"
-                ))
+            s.periods_to_settle.map_or(String::new(), |p| format!(
+                " (a disturbance decays to 1e-3 in {p:.1} periods)"
+            ))
         );
     }
     for d in &s.dampers_touch {

@@ -67,8 +67,7 @@ use serde::Serialize;
 
 use super::blows::{blow_interval_s, BlowOptions};
 use super::steady::{
-    check_options, fixed_notes, search, settle, BlowMap, Evaluation, Found, Regime,
-    SteadyOptions,
+    check_options, fixed_notes, search, settle, BlowMap, Evaluation, Found, Regime, SteadyOptions,
 };
 use crate::impact::network::{End, Network};
 use crate::integrate::network::{self as engine, ChannelKind, NetSolution};
@@ -316,12 +315,16 @@ impl<'a> NetMap<'a> {
         let bed_point = impactors
             .iter()
             .find_map(|&b| {
-                net.contacts.iter().find_map(|c| match (&c.ends[0], &c.ends[1]) {
-                    (End::Body(x), End::Point(p)) | (End::Point(p), End::Body(x)) if *x == b => {
-                        Some(p.clone())
-                    }
-                    _ => None,
-                })
+                net.contacts
+                    .iter()
+                    .find_map(|c| match (&c.ends[0], &c.ends[1]) {
+                        (End::Body(x), End::Point(p)) | (End::Point(p), End::Body(x))
+                            if *x == b =>
+                        {
+                            Some(p.clone())
+                        }
+                        _ => None,
+                    })
             })
             .or_else(|| net.structure.points.keys().next().cloned())
             .unwrap_or_default();
@@ -522,7 +525,10 @@ fn blow_report(map: &NetMap, sol: &NetSolution, k: usize) -> NetBlowReport {
 
 impl BlowMap for NetMap<'_> {
     type Report = NetBlowReport;
-    type Switches = Vec<(crate::impact::network::NetMode, crate::impact::network::NetMode)>;
+    type Switches = Vec<(
+        crate::impact::network::NetMode,
+        crate::impact::network::NetMode,
+    )>;
     fn dim(&self) -> usize {
         self.keep.len()
     }
@@ -651,7 +657,12 @@ fn settled(blows: &[NetBlowReport], tol: f64) -> Option<usize> {
 pub fn steady_state(model: &NetworkModel, so: &SteadyOptions) -> Result<NetSteadyState> {
     check_options(so).map_err(rate_error)?;
     let net = &model.network;
-    let mut map = NetMap::new(net, &model.options()?, so.rate_bpm, so.max_evaluations.max(2))?;
+    let mut map = NetMap::new(
+        net,
+        &model.options()?,
+        so.rate_bpm,
+        so.max_evaluations.max(2),
+    )?;
     let mut notes = Vec::new();
     let found = search(&mut map, so, !net.suspensions.is_empty(), &mut notes)?;
     let (blows, converged, residual, regime, method, mu, smooth, strike_state) = match found {
@@ -722,6 +733,28 @@ pub fn steady_state(model: &NetworkModel, so: &SteadyOptions) -> Result<NetStead
         strike_state,
     };
     levels(&mut s);
+    Ok(s)
+}
+
+/// The steady state of `model` at `rate_bpm` (default settings) for a study's point or design:
+/// an error, naming the regime and residual, when the train did not settle (the point has no
+/// value then).
+pub fn settled_steady_state(model: &NetworkModel, rate_bpm: f64) -> Result<NetSteadyState> {
+    let so = SteadyOptions {
+        rate_bpm,
+        ..SteadyOptions::default()
+    };
+    let s = steady_state(model, &so)?;
+    if !s.converged {
+        return Err(Error::numerical(
+            "steady state",
+            format!(
+                "the train at {rate_bpm} /min did not settle ({}, residual {:.2e})",
+                s.regime.name(),
+                s.residual
+            ),
+        ));
+    }
     Ok(s)
 }
 

@@ -29,8 +29,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::network::{summary, NetSummary};
-use super::network_blows::steady_state;
-use super::steady::SteadyOptions;
+use super::network_blows::settled_steady_state;
 use super::sweep::parse_values;
 use crate::model::network::NetworkModel;
 use crate::model::network_fields::NetCache;
@@ -303,21 +302,7 @@ impl NetSweep {
         rate_bpm: f64,
     ) -> Result<Vec<Option<f64>>> {
         let m = self.model_at(index, cache)?;
-        let so = SteadyOptions {
-            rate_bpm,
-            ..SteadyOptions::default()
-        };
-        let s = steady_state(&m, &so)?;
-        if !s.converged {
-            return Err(Error::numerical(
-                "steady state",
-                format!(
-                    "the train at {rate_bpm} /min did not settle ({}, residual {:.2e})",
-                    s.regime.name(),
-                    s.residual
-                ),
-            ));
-        }
+        let s = settled_steady_state(&m, rate_bpm)?;
         Ok(self
             .columns
             .iter()

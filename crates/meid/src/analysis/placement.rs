@@ -39,9 +39,9 @@ use serde::Serialize;
 
 use super::network::summary;
 use super::network_blows::steady_state;
-use super::steady::SteadyOptions;
 use super::network_study::metrics;
 use super::optimize::{minimize_box, NelderMeadOptions};
+use super::steady::SteadyOptions;
 use crate::model::network::NetworkModel;
 use crate::model::network_fields::{placed_spec, NetCache, Placement};
 use crate::model::network_paths::did_you_mean;
@@ -404,21 +404,7 @@ impl PlacementStudy {
             .with_spec(spec, self.model.source.clone(), Some(cache))?;
         let col = self.objective.column();
         if let Some(rate_bpm) = self.rate_bpm {
-            let so = SteadyOptions {
-                rate_bpm,
-                ..SteadyOptions::default()
-            };
-            let s = steady_state(&m, &so)?;
-            if !s.converged {
-                return Err(Error::numerical(
-                    "placement",
-                    format!(
-                        "{col}: the train at {rate_bpm} /min did not settle ({}, residual {:.2e})",
-                        s.regime.name(),
-                        s.residual
-                    ),
-                ));
-            }
+            let s = settled_steady_state(&m, rate_bpm)?;
             let v = s.metric(&col).ok_or_else(|| {
                 Error::numerical("placement", format!("{col}: no value in the steady blow"))
             })?;

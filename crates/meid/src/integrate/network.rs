@@ -666,7 +666,11 @@ pub fn solve_from(net: &Network, x0: Vec<f64>, opts: &Options) -> Result<NetSolu
                 "needs {} finite values [x; ẋ] (got {}{})",
                 2 * net.dofs(),
                 x0.len(),
-                if x0.iter().any(|v| !v.is_finite()) { ", not all finite" } else { "" }
+                if x0.iter().any(|v| !v.is_finite()) {
+                    ", not all finite"
+                } else {
+                    ""
+                }
             ),
         ));
     }
