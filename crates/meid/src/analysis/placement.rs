@@ -38,10 +38,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::network::summary;
-use super::network_blows::steady_state;
+use super::network_blows::settled_steady_state;
 use super::network_study::metrics;
 use super::optimize::{minimize_box, NelderMeadOptions};
-use super::steady::SteadyOptions;
 use crate::model::network::NetworkModel;
 use crate::model::network_fields::{placed_spec, NetCache, Placement};
 use crate::model::network_paths::did_you_mean;
