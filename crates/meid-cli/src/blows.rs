@@ -11,43 +11,43 @@ use crate::args::{CaseArg, PrintArgs, RunArgs};
 #[derive(clap::Args)]
 pub struct BlowsArgs {
     /// Model file (TOML).
-    model: PathBuf,
+    pub(crate) model: PathBuf,
     /// Number of blows.
     #[arg(long, value_name = "N", default_value_t = 10)]
-    blows: usize,
+    pub(crate) blows: usize,
     /// Stroke rate (blows per minute; default: the model's [production] rate_bpm, else 60).
     /// The interval 60/R must outlast each blow's collision (else exit 2, naming the largest
     /// valid rate); the machine need not be at rest.
     #[arg(long, value_name = "R")]
-    rate_bpm: Option<f64>,
+    pub(crate) rate_bpm: Option<f64>,
     /// Relative blow-to-blow change that counts as steady (the march's table).
     #[arg(long, value_name = "FRACTION", default_value_t = 0.01)]
-    tolerance: f64,
+    pub(crate) tolerance: f64,
     /// Only the direct periodic steady state of each case (no march): the fixed point of the
     /// blow-to-blow map, its regime and Floquet multipliers (docs/explanations/blows.md, "Production").
     #[arg(long)]
-    steady: bool,
+    pub(crate) steady: bool,
     /// A stroke-rate map instead: the steady state of every case at each rate of
     /// LO..HI:N (or LO..HI:N:log, or R1,R2,…) blows/min; with -o, rates.csv, rates.json and
     /// a picture of the dB changes against the rate.
     #[arg(long, value_name = "LO..HI:N", conflicts_with = "steady")]
-    rates: Option<String>,
+    pub(crate) rates: Option<String>,
     /// A damper-return map instead: over one or two quantities (repeat --vary, as in `meid
     /// sweep`: e.g. --vary damper.stiffness=1e3..1e5:9:log --vary damper.damping=50..1000:9:log),
     /// each design's steady state at --rate-bpm: whether the damper returns before every strike,
     /// and its steady floor force and bed acceleration against no damper; with -o,
     /// return-map.csv, return-map.json and a picture.
     #[arg(long, value_name = "SPEC", conflicts_with_all = ["steady", "rates"])]
-    vary: Vec<String>,
+    pub(crate) vary: Vec<String>,
     #[command(flatten)]
-    case: CaseArg,
+    pub(crate) case: CaseArg,
     /// Write blows.csv, blows.json, history.csv and pictures into DIR.
     #[arg(short, long, value_name = "DIR")]
-    output: Option<PathBuf>,
+    pub(crate) output: Option<PathBuf>,
     #[command(flatten)]
-    run: RunArgs,
+    pub(crate) run: RunArgs,
     #[command(flatten)]
-    print: PrintArgs,
+    pub(crate) print: PrintArgs,
 }
 
 pub fn run(a: BlowsArgs) -> Result<()> {

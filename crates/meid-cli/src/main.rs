@@ -30,6 +30,7 @@ macro_rules! eprintln {
 
 mod args;
 mod blows;
+mod blows_general;
 mod calibrate;
 mod compare;
 mod correlate;
@@ -157,6 +158,9 @@ fn main() -> ExitCode {
         Command::Sweep(a) => sweep::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Optimize(a) => optimize::run(a),
+        Command::Blows(a) if meid::model::network::is_general_file(&a.model) => {
+            blows_general::run(a)
+        }
         Command::Blows(a) => blows::run(a),
         Command::Montecarlo(a) => montecarlo::run(a),
         Command::Report(a) => report::run(a),

@@ -70,7 +70,12 @@ fn parse_counts(s: &str) -> Result<(usize, usize)> {
 }
 
 /// The study of the arguments.
-fn study(model: NetworkModel, objective: &str, p: &PlaceArgs) -> Result<PlacementStudy> {
+fn study(
+    model: NetworkModel,
+    objective: &str,
+    p: &PlaceArgs,
+    rate_bpm: Option<f64>,
+) -> Result<PlacementStudy> {
     let masses = match (&p.mass_bounds, p.total_mass) {
         (Some(b), _) => {
             let (lo, hi) = meid::analysis::study::parse_range(b).map_err(|_| {
@@ -103,6 +108,7 @@ fn study(model: NetworkModel, objective: &str, p: &PlaceArgs) -> Result<Placemen
         search: Search::parse(&p.search)?,
         max_combinations: p.max_combinations,
         mass_evaluations: p.mass_evaluations,
+        rate_bpm,
         model,
     };
     study.check()?;
@@ -118,11 +124,13 @@ pub fn run(
     output: Option<&Path>,
     print: PrintArgs,
 ) -> Result<()> {
-    if rate_bpm.is_some() {
-        bail!("--rate-bpm: a general machine's placement is judged on the first blow for now (the train of repeated blows is not built yet)");
-    }
     let model = NetworkModel::from_file(path, set)?;
-    let study = study(model, objective, p)?;
+    // The operating condition: --rate-bpm, else the file's [production] rate_bpm.
+    let rate_bpm = match rate_bpm {
+        Some(r) => Some(crate::blows_general::stroke_rate(&model, Some(r))?),
+        None => model.spec.production.as_ref().map(|p| p.rate_bpm),
+    };
+    let study = study(model, objective, p, rate_bpm)?;
     let out = output.map(crate::outputs::begin).transpose()?;
     let rep = study.run()?;
     if let Some(set) = out {
@@ -140,19 +148,27 @@ pub fn run(
 fn line(r: &PlacedResult) -> String {
     let masses: Vec<String> = r.masses_kg.iter().map(|m| format!("{m:.4}")).collect();
     format!(
-        "{} at [{}], masses [{}] kg: {}",
+        "{} at [{}], masses [{}] kg: {}{}",
         r.dampers,
         r.points.join(", "),
         masses.join(", "),
         r.objective
-            .map_or("failed".to_string(), |f| format!("{f:.6e}"))
+            .map_or("failed".to_string(), |f| format!("{f:.6e}")),
+        match r.dampers_return {
+            Some(true) => ", every damper returns",
+            Some(false) => ", a damper does NOT return between blows",
+            None => "",
+        }
     )
 }
 
 fn print_report(r: &PlacementReport, output: Option<&Path>) {
     println!(
-        "meid optimize — general machine: minimise {} over the places of {} among {} ({}: {} placements of {} evaluated, {} simulations)",
+        "meid optimize — general machine: minimise {}{} over the places of {} among {} ({}: {} placements of {} evaluated, {} simulations)",
         r.objective,
+        r.rate_bpm.map_or(" (first blow)".to_string(), |b| format!(
+            " of the steady blow at {b} /min"
+        )),
         r.template,
         r.candidates.join(", "),
         r.search,

@@ -45,6 +45,11 @@ pub struct SweepArgs {
     /// Run every point for S seconds instead of stopping at the end of the collision.
     #[arg(long, value_name = "S")]
     pub(crate) duration: Option<f64>,
+    /// General machine: judge every point on its steady blow at this stroke rate (blows per
+    /// minute; default: the file's [production] rate_bpm, else the first blow), with the
+    /// column dampers_return.
+    #[arg(long, value_name = "R")]
+    pub(crate) rate_bpm: Option<f64>,
     /// Compare cases in one run: every point is simulated once per case (none, damper,
     /// added-mass, as-specified) and the metric columns become METRIC:CASE; the pictures draw
     /// one curve (or map) per case.
@@ -115,6 +120,9 @@ pub(crate) fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
 /// `meid sweep` of the paper's machine (a general machine's: [`crate::sweep_general::run`],
 /// chosen by `main`).
 pub fn run(a: SweepArgs) -> Result<()> {
+    if a.rate_bpm.is_some() {
+        anyhow::bail!("--rate-bpm: the paper machine's sweep is of the first blow; its damper's return at a stroke rate is `meid blows MODEL --rate-bpm R --vary …`");
+    }
     let sweep = prepare(&a)?;
     let total = sweep.len();
     if let Some(shard) = a.shard {

@@ -53,7 +53,11 @@ pub fn run(a: &SweepArgs) -> Result<()> {
         .iter()
         .map(|s| NetVary::parse(s))
         .collect::<meid::Result<Vec<_>>>()?;
-    let sweep = NetSweep::new(model, vary)?;
+    let rate = match a.rate_bpm {
+        Some(r) => Some(crate::blows_general::stroke_rate(&model, Some(r))?),
+        None => model.spec.production.as_ref().map(|p| p.rate_bpm),
+    };
+    let sweep = NetSweep::new(model, vary)?.at_rate(rate)?;
     let metric = a.metric.as_str();
     if !sweep.columns().iter().any(|c| c == metric) {
         let probe = NetSweepResult {

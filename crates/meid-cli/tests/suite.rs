@@ -7,6 +7,7 @@
 mod common;
 
 mod audit_s11_cli;
+mod blows_general_cli;
 mod calibrate_cli;
 mod cli;
 mod commands_doc;

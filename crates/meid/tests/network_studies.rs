@@ -108,6 +108,7 @@ fn place(model: NetworkModel, candidates: &[&str], counts: (usize, usize)) -> Pl
         search: Search::Auto,
         max_combinations: 256,
         mass_evaluations: 20,
+        rate_bpm: None,
         model,
     }
 }

@@ -58,6 +58,7 @@ mod model_input;
 mod model_sketch;
 mod modes_import;
 mod modes_truncation;
+mod network_blows;
 mod network_engine;
 mod network_model;
 mod network_studies;

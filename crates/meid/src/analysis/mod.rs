@@ -7,6 +7,7 @@ pub mod esd;
 pub mod impacts;
 pub mod montecarlo;
 pub mod network;
+pub mod network_blows;
 pub mod network_study;
 pub mod octave;
 pub mod optimize;

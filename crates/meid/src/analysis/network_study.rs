@@ -17,11 +17,19 @@
 //! `dissipated_energy_j`, `floor_force_n` (the peak force to the floor, when something carries
 //! force to it), `peak_force_n:CONTACT` (each contact's largest compressive force) and
 //! `peak_acceleration_m_per_s2:POINT` (each named point's largest |acceleration|).
+//!
+//! With a stroke rate ([`NetSweep::at_rate`]: `--rate-bpm R`, or the file's `[production]
+//! rate_bpm`) every point is judged on its **steady blow** at that rate instead
+//! ([`super::network_blows::steady_state`]): the same columns from the steady blow
+//! (`collision_end_s` of its first blow; `dissipated_energy_j` has no value), and
+//! `dampers_return` (1 when the train settled and every damper touches its point before each
+//! strike, 0 otherwise).
 
 use rayon::prelude::*;
 use serde::Serialize;
 
 use super::network::{summary, NetSummary};
+use super::network_blows::settled_steady_state;
 use super::sweep::parse_values;
 use crate::model::network::NetworkModel;
 use crate::model::network_fields::NetCache;
@@ -165,6 +173,8 @@ pub struct NetSweep {
     pub model: NetworkModel,
     pub vary: Vec<NetVary>,
     columns: Vec<String>,
+    /// The stroke rate at which every point is judged on its steady blow (module docs).
+    rate_bpm: Option<f64>,
 }
 
 impl NetSweep {
@@ -197,7 +207,29 @@ impl NetSweep {
             model,
             vary,
             columns,
+            rate_bpm: None,
         })
+    }
+
+    /// Every point judged on its steady blow at `rate_bpm` (module docs); `None` keeps the
+    /// first blow. Adds the `dampers_return` column.
+    pub fn at_rate(mut self, rate_bpm: Option<f64>) -> Result<Self> {
+        if let Some(r) = rate_bpm {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(Error::invalid(
+                    "--rate-bpm",
+                    format!(
+                        "the stroke rate must be a finite number > 0 blows per minute (got {})",
+                        crate::num(r)
+                    ),
+                ));
+            }
+            if self.rate_bpm.is_none() {
+                self.columns.push("dampers_return".into());
+            }
+        }
+        self.rate_bpm = rate_bpm;
+        Ok(self)
     }
 
     /// The metric columns, in order.
@@ -281,8 +313,45 @@ impl NetSweep {
         }
     }
 
+    /// The metrics of grid point `index`'s steady blow at `rate_bpm` (module docs).
+    fn steady_point(
+        &self,
+        index: usize,
+        cache: &NetCache,
+        rate_bpm: f64,
+    ) -> Result<Vec<Option<f64>>> {
+        let m = self.model_at(index, cache)?;
+        let s = settled_steady_state(&m, rate_bpm)?;
+        Ok(self
+            .columns
+            .iter()
+            .map(|c| match c.as_str() {
+                "dampers_return" => Some(if s.dampers_return() { 1.0 } else { 0.0 }),
+                "collision_end_s" => s.blows.first().and_then(|b| b.collision_end_s),
+                "dissipated_energy_j" => None,
+                c => s.metric(c),
+            })
+            .collect())
+    }
+
     fn point(&self, index: usize, cache: &NetCache) -> NetPoint {
         let values = self.values_at(index);
+        if let Some(rate) = self.rate_bpm {
+            return match self.steady_point(index, cache, rate) {
+                Ok(metrics) => NetPoint {
+                    index,
+                    values,
+                    metrics,
+                    error: None,
+                },
+                Err(e) => NetPoint {
+                    index,
+                    values,
+                    metrics: vec![None; self.columns.len()],
+                    error: Some(e.to_string()),
+                },
+            };
+        }
         let run = || -> Result<NetSummary> {
             let m = self.model_at(index, cache)?;
             let sol = m.solve(&m.options()?)?;

@@ -25,11 +25,20 @@
 //! **Objectives** (minimised): `energy` (the energy ratio, the share of the blows' energy kept
 //! by the structure), `floor-force` (peak force to the floor), `accel:POINT` (peak |acceleration|
 //! of a named point), `contact-force:NAME` (peak force of a contact that is not a damper's).
+//!
+//! **Operating condition.** With a stroke rate (`--rate-bpm R`, or the file's `[production]
+//! rate_bpm`) each design is judged on its **steady blow** at that rate
+//! ([`super::network_blows::steady_state`]: the fixed point of the blow-to-blow map), not on
+//! the first blow: the objective is the steady level (for a period-k regime the mean energy
+//! ratio and the largest peaks over the period), and each design reports `dampers_return`,
+//! whether the train settled and every damper touches its point before each strike. A design
+//! whose train did not settle has no objective value (its error says so).
 
 use rayon::prelude::*;
 use serde::Serialize;
 
 use super::network::summary;
+use super::network_blows::settled_steady_state;
 use super::network_study::metrics;
 use super::optimize::{minimize_box, NelderMeadOptions};
 use crate::model::network::NetworkModel;
@@ -154,6 +163,9 @@ pub struct PlacementStudy {
     pub max_combinations: usize,
     /// Simulations per placement for free masses.
     pub mass_evaluations: usize,
+    /// The stroke rate (blows/min) at which each design is judged on its steady blow; `None`:
+    /// on the first blow (module docs).
+    pub rate_bpm: Option<f64>,
 }
 
 /// One simulation of the study.
@@ -164,6 +176,9 @@ pub struct Evaluation {
     /// `None`: the run failed or has no value (see `error`).
     pub objective: Option<f64>,
     pub error: Option<String>,
+    /// With a stroke rate: the train settled and every damper touches before each strike.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dampers_return: Option<bool>,
 }
 
 /// A placement's best result.
@@ -175,6 +190,9 @@ pub struct PlacedResult {
     pub total_mass_kg: f64,
     pub objective: Option<f64>,
     pub simulations: usize,
+    /// With a stroke rate: every damper returns in the steady regime of the chosen masses.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dampers_return: Option<bool>,
 }
 
 /// The study's report.
@@ -189,6 +207,9 @@ pub struct PlacementReport {
     pub candidates: Vec<String>,
     pub template: String,
     pub masses: MassRule,
+    /// The stroke rate the designs were judged at (their steady blow); `None`: the first blow.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rate_bpm: Option<f64>,
     pub best: PlacedResult,
     /// The best placement of each count of dampers.
     pub best_per_count: Vec<PlacedResult>,
@@ -327,6 +348,17 @@ impl PlacementStudy {
             _ => {}
         }
         self.objective.check(m)?;
+        if let Some(r) = self.rate_bpm {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(Error::invalid(
+                    "--rate-bpm",
+                    format!(
+                        "the stroke rate must be a finite number > 0 blows per minute (got {})",
+                        crate::num(r)
+                    ),
+                ));
+            }
+        }
         if self.search == Search::Exhaustive && self.combinations() > self.max_combinations {
             return Err(Error::invalid(
                 "--max-combinations",
@@ -353,8 +385,14 @@ impl PlacementStudy {
             .fold(0usize, usize::saturating_add)
     }
 
-    /// The objective of one simulation of the dampers at `points` with `masses`.
-    fn simulate(&self, points: &[String], masses: &[f64], cache: &NetCache) -> Result<f64> {
+    /// The objective of one simulation of the dampers at `points` with `masses` (with a stroke
+    /// rate: of its steady blow, and whether every damper returns).
+    fn simulate(
+        &self,
+        points: &[String],
+        masses: &[f64],
+        cache: &NetCache,
+    ) -> Result<(f64, Option<bool>)> {
         let placement = Placement {
             points: points.to_vec(),
             masses_kg: masses.to_vec(),
@@ -363,12 +401,20 @@ impl PlacementStudy {
         let m = self
             .model
             .with_spec(spec, self.model.source.clone(), Some(cache))?;
-        let sol = m.solve(&m.options()?)?;
         let col = self.objective.column();
+        if let Some(rate_bpm) = self.rate_bpm {
+            let s = settled_steady_state(&m, rate_bpm)?;
+            let v = s.metric(&col).ok_or_else(|| {
+                Error::numerical("placement", format!("{col}: no value in the steady blow"))
+            })?;
+            return Ok((v, Some(s.dampers_return())));
+        }
+        let sol = m.solve(&m.options()?)?;
         metrics(&summary(&m, &sol))
             .into_iter()
             .find(|(c, _)| *c == col)
             .and_then(|(_, v)| v)
+            .map(|v| (v, None))
             .ok_or_else(|| {
                 Error::numerical(
                     "placement",
@@ -387,10 +433,11 @@ impl PlacementStudy {
             log.push(Evaluation {
                 points: points.clone(),
                 masses_kg: masses.to_vec(),
-                objective: r.as_ref().ok().copied(),
+                objective: r.as_ref().ok().map(|v| v.0),
                 error: r.as_ref().err().map(|e| e.to_string()),
+                dampers_return: r.as_ref().ok().and_then(|v| v.1),
             });
-            r.ok()
+            r.ok().map(|v| v.0)
         };
         let (masses, objective) = match self.masses {
             MassRule::Total(t) => {
@@ -416,8 +463,15 @@ impl PlacementStudy {
                 }
             }
         };
+        // Whether the dampers return at the masses chosen (their evaluation's).
+        let dampers_return = log
+            .iter()
+            .rev()
+            .find(|e| e.masses_kg == masses)
+            .and_then(|e| e.dampers_return);
         let result = PlacedResult {
             dampers: n,
+            dampers_return,
             total_mass_kg: masses.iter().sum(),
             points,
             masses_kg: masses,
@@ -611,6 +665,7 @@ fn report(
         candidates: s.candidates.clone(),
         template: s.template.clone(),
         masses: s.masses,
+        rate_bpm: s.rate_bpm,
         best,
         best_per_count,
         runner_ups: placements.iter().skip(1).take(5).cloned().collect(),

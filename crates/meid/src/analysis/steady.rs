@@ -208,12 +208,68 @@ impl SteadyState {
     }
 }
 
-/// One evaluation of `P` (one blow) with its Jacobian.
-struct Evaluation {
-    p: Vec<f64>,
-    jac: Option<Mat<f64>>,
-    report: BlowReport,
-    switches: Vec<Mode>,
+/// One evaluation of a blow map `P` (one blow) with its Jacobian.
+pub(crate) struct Evaluation<R, S> {
+    /// `P(y)`.
+    pub p: Vec<f64>,
+    /// `∂P/∂y` when asked for.
+    pub jac: Option<Mat<f64>>,
+    /// The blow's levels.
+    pub report: R,
+    /// Its switching sequence (compared between iterates: a change means the map is not
+    /// smooth there).
+    pub switches: S,
+}
+
+/// A blow-to-blow map `P: y ↦ y'` (the state just before a strike to the state just before
+/// the next) as the direct steady state's search sees it: the engine-independent part of the
+/// method (Newton on `P^k`, the march and its period detection, the multipliers) is written
+/// over it, for the paper's machine here ([`Map`]) and for a general machine
+/// ([`super::network_blows`]).
+pub(crate) trait BlowMap {
+    /// The levels of one blow.
+    type Report: Clone;
+    /// A blow's switching sequence.
+    type Switches: PartialEq;
+    /// The dimension of `y`.
+    fn dim(&self) -> usize;
+    /// The energy-norm weights of the components of `y`, relative to the blow's energy
+    /// (`‖d‖² = Σ w_i d_i²`).
+    fn weight(&self) -> &[f64];
+    /// One blow from `y` (blow number `k` of a period, for its report), with `∂P/∂y` when
+    /// `with_jac`, and the blow's exact peaks only when `peaks`. Counts one evaluation (and
+    /// those of a Jacobian by differences).
+    fn eval(
+        &mut self,
+        y: &[f64],
+        k: usize,
+        with_jac: bool,
+        peaks: bool,
+    ) -> Result<Evaluation<Self::Report, Self::Switches>>;
+    /// Blow evaluations spent, and the most allowed.
+    fn evaluations(&self) -> usize;
+    fn budget(&self) -> usize;
+    /// The search's residual history ([`SteadyState::residual_history`]).
+    fn history(&mut self) -> &mut Vec<(char, f64)>;
+    /// The peak floor force of a blow (N), for the irregular regime's note.
+    fn floor_force(report: &Self::Report) -> f64;
+
+    /// The relative energy norm of a difference of two states `y` (module docs).
+    fn norm(&self, d: &[f64]) -> f64 {
+        d.iter()
+            .zip(self.weight())
+            .map(|(v, w)| w * v * v)
+            .sum::<f64>()
+            .sqrt()
+    }
+    /// Records a residual of the search ([`SteadyState::residual_history`]).
+    fn record(&mut self, what: char, residual: f64) {
+        self.history().push((what, residual));
+    }
+    /// Blow evaluations left in the budget.
+    fn left(&self) -> usize {
+        self.budget().saturating_sub(self.evaluations())
+    }
 }
 
 /// What stays fixed while the map is iterated.
@@ -291,19 +347,6 @@ impl<'a> Map<'a> {
         })
     }
 
-    fn dim(&self) -> usize {
-        self.keep.len()
-    }
-
-    /// The relative energy norm of a difference of two states `y` (module docs).
-    fn norm(&self, d: &[f64]) -> f64 {
-        d.iter()
-            .zip(&self.weight)
-            .map(|(v, w)| w * v * v)
-            .sum::<f64>()
-            .sqrt()
-    }
-
     fn embed(&self, y: &[f64]) -> Vec<f64> {
         let mut x = vec![0.0; 2 * self.sys.dofs()];
         for (&i, &v) in self.keep.iter().zip(y) {
@@ -323,20 +366,16 @@ impl<'a> Map<'a> {
         Ok(())
     }
 
-    /// Records a residual of the search ([`SteadyState::residual_history`]).
-    fn record(&mut self, what: char, residual: f64) {
-        self.history.push((what, residual));
-    }
-
-    /// Blow evaluations left in the budget.
-    fn left(&self) -> usize {
-        self.budget.saturating_sub(self.evaluations)
-    }
-
     /// One blow from `y` (blow number `k` for the report), with the Jacobian when `with_jac`,
     /// and the report's exact peaks and checked energy balance only when `peaks` (an iterate of
     /// the search needs the state at the next strike, not its levels: [`Options::levels`]).
-    fn eval(&mut self, y: &[f64], k: usize, with_jac: bool, peaks: bool) -> Result<Evaluation> {
+    fn eval_blow(
+        &mut self,
+        y: &[f64],
+        k: usize,
+        with_jac: bool,
+        peaks: bool,
+    ) -> Result<Evaluation<BlowReport, Vec<Mode>>> {
         self.spend()?;
         let x0 = self.embed(y);
         let t0 = k as f64 * self.opts.duration;
@@ -526,6 +565,38 @@ impl<'a> Map<'a> {
     }
 }
 
+impl BlowMap for Map<'_> {
+    type Report = BlowReport;
+    type Switches = Vec<Mode>;
+    fn dim(&self) -> usize {
+        self.keep.len()
+    }
+    fn weight(&self) -> &[f64] {
+        &self.weight
+    }
+    fn eval(
+        &mut self,
+        y: &[f64],
+        k: usize,
+        with_jac: bool,
+        peaks: bool,
+    ) -> Result<Evaluation<BlowReport, Vec<Mode>>> {
+        self.eval_blow(y, k, with_jac, peaks)
+    }
+    fn evaluations(&self) -> usize {
+        self.evaluations
+    }
+    fn budget(&self) -> usize {
+        self.budget
+    }
+    fn history(&mut self) -> &mut Vec<(char, f64)> {
+        &mut self.history
+    }
+    fn floor_force(report: &BlowReport) -> f64 {
+        report.peak_floor_force_n
+    }
+}
+
 /// The backtracked point after a Newton step `s = yt − y` was rejected (residual `rt ≥ r`):
 /// `y + α s` with `α` the minimiser of the quadratic model of `φ(α) = ‖F(y + α s)‖²` through
 /// `φ(0) = r²`, `φ'(0) = −2r²` (the Newton direction's own slope) and `φ(1) = rt²`,
@@ -537,7 +608,14 @@ impl<'a> Map<'a> {
 ///
 /// (Dennis & Schnabel, *Numerical Methods for Unconstrained Optimization and Nonlinear
 /// Equations*, 1983, §6.3.2, Algorithm A6.3.1). `None` when the budget has no room for it.
-fn backtrack(map: &Map, y: &[f64], yt: &[f64], r: f64, rt: f64, k: usize) -> Option<Vec<f64>> {
+fn backtrack<M: BlowMap>(
+    map: &M,
+    y: &[f64],
+    yt: &[f64],
+    r: f64,
+    rt: f64,
+    k: usize,
+) -> Option<Vec<f64>> {
     if map.left() < 2 * k || !(r > 0.0 && rt.is_finite()) {
         return None;
     }
@@ -556,7 +634,7 @@ fn newton_step(jac: &Mat<f64>, r: &[f64]) -> Option<Vec<f64>> {
 }
 
 /// `|eig(J)|`, descending.
-fn multipliers(jac: &Mat<f64>) -> Vec<f64> {
+pub(crate) fn multipliers(jac: &Mat<f64>) -> Vec<f64> {
     let mut m: Vec<f64> = jac
         .eigenvalues()
         .map(|v| v.iter().map(|z| z.norm()).collect())
@@ -566,25 +644,36 @@ fn multipliers(jac: &Mat<f64>) -> Vec<f64> {
 }
 
 /// The result of Newton's method on `P^k`.
-struct Fixed {
-    y: Vec<f64>,
-    residual: f64,
-    jac: Mat<f64>,
-    smooth: bool,
-    converged: bool,
+pub(crate) struct Fixed<R> {
+    pub y: Vec<f64>,
+    pub residual: f64,
+    pub jac: Mat<f64>,
+    pub smooth: bool,
+    pub converged: bool,
     /// The k blows evaluated from `y`.
-    reports: Vec<BlowReport>,
+    pub reports: Vec<R>,
     /// Evaluations of `P^k` spent, and of them Newton steps rejected for a march step.
-    rejected: usize,
+    pub rejected: usize,
 }
 
 /// `P^k(y)`, its Jacobian, the k blows' reports and their switching sequences.
-type PeriodEval = (Vec<f64>, Mat<f64>, Vec<BlowReport>, Vec<Vec<Mode>>);
+type PeriodEval<M> = (
+    Vec<f64>,
+    Mat<f64>,
+    Vec<<M as BlowMap>::Report>,
+    Vec<<M as BlowMap>::Switches>,
+);
 
 /// `P^k(y)`, its Jacobian (the identity when not `with_jac`: a start that is marched from is
 /// not differentiated), the blows' reports (with their exact peaks when `peaks`) and switching
 /// sequences.
-fn eval_k(map: &mut Map, y: &[f64], k: usize, peaks: bool, with_jac: bool) -> Result<PeriodEval> {
+fn eval_k<M: BlowMap>(
+    map: &mut M,
+    y: &[f64],
+    k: usize,
+    peaks: bool,
+    with_jac: bool,
+) -> Result<PeriodEval<M>> {
     let d = map.dim();
     let mut z = y.to_vec();
     let mut jac = Mat::<f64>::identity(d, d);
@@ -621,14 +710,14 @@ fn eval_k(map: &mut Map, y: &[f64], k: usize, peaks: bool, with_jac: bool) -> Re
 /// when that is within the tolerance the next evaluation tracks the peaks. The result's blows
 /// always carry them: a search that ends on an evaluation without them evaluates its last
 /// iterate once more (the same trajectory, bit for bit), with them.
-fn newton(
-    map: &mut Map,
+fn newton<M: BlowMap>(
+    map: &mut M,
     y0: Vec<f64>,
     k: usize,
     tol: f64,
     iterations: usize,
     march_first: bool,
-) -> Result<Fixed> {
+) -> Result<Fixed<M::Report>> {
     let mut y = y0;
     // From rest with a damper the first step is a march: the start is not differentiated.
     let (mut z, mut jac, mut reports, mut switches) = eval_k(map, &y, k, false, !march_first)?;
@@ -645,7 +734,7 @@ fn newton(
             break;
         }
         let r = diff(&z, &y);
-        let trial: Option<Vec<f64>> = if march_first && map.history.len() == 1 {
+        let trial: Option<Vec<f64>> = if march_first && map.history().len() == 1 {
             None
         } else {
             newton_step(&jac, &r).map(|s| y.iter().zip(&s).map(|(a, b)| a + b).collect())
@@ -721,7 +810,6 @@ fn newton(
 pub fn steady_state(sys: &ImpactSystem, opts: &Options, so: &SteadyOptions) -> Result<SteadyState> {
     check_options(so)?;
     let mut map = Map::new(sys, opts, so)?;
-    let d = map.dim();
     let mut notes = Vec::new();
     if opts.method == Method::Dopri5 && map.path_jacobian {
         notes.push(
@@ -730,19 +818,88 @@ pub fn steady_state(sys: &ImpactSystem, opts: &Options, so: &SteadyOptions) -> R
                 .to_string(),
         );
     }
+    let found = search(&mut map, so, sys.damper.is_some(), &mut notes)?;
+    match found {
+        Found::Periodic {
+            fixed,
+            k,
+            mu,
+            method,
+        } => finish(&mut map, so, fixed, k, mu, method, notes),
+        Found::Irregular {
+            tail,
+            strike_state,
+            residual,
+        } => Ok(levels(SteadyState {
+            rate_bpm: so.rate_bpm,
+            interval_s: map.opts.duration,
+            converged: false,
+            residual,
+            map_evaluations: map.evaluations,
+            regime: Regime::Irregular,
+            period_blows: None,
+            method: "marching",
+            jacobian: jacobian_kind(&map),
+            energy_ratio: 0.0,
+            peak_floor_force_n: 0.0,
+            peak_bed_acceleration_m_per_s2: 0.0,
+            peak_contact_force_slider_bed_n: 0.0,
+            damper_gap_at_strike_m: None,
+            damper_touches_bed: None,
+            multipliers_abs: Vec::new(),
+            stable: None,
+            periods_to_settle: None,
+            smooth: false,
+            blows: tail,
+            notes,
+            residual_history: std::mem::take(&mut map.history),
+            strike_state,
+        })),
+    }
+}
+
+/// What the search of a blow map found ([`search`]).
+pub(crate) enum Found<R> {
+    /// A fixed point of `P^k` (converged or Newton's best), its multipliers `|μ|` descending,
+    /// and how it was found.
+    Periodic {
+        fixed: Fixed<R>,
+        k: usize,
+        mu: Vec<f64>,
+        method: &'static str,
+    },
+    /// No period within the budget: the last marched blows (at most `max_period`), the state
+    /// before the first of them, and the last blow-to-blow change (energy norm).
+    Irregular {
+        tail: Vec<R>,
+        strike_state: Vec<f64>,
+        residual: f64,
+    },
+}
+
+/// The steady state's search on any blow map (module docs, "Regimes and the fallback"):
+/// Newton on `P` from rest (a first march step when `march_first`: a damper resting on its
+/// contact at rest is a grazing start); else a march from Newton's best iterate (off an
+/// unstable fixed point), seeking the smallest period `k ≤ max_period`, refined by Newton on
+/// `P^k`; else irregular. Adds its notes to `notes`.
+pub(crate) fn search<M: BlowMap>(
+    map: &mut M,
+    so: &SteadyOptions,
+    march_first: bool,
+    notes: &mut Vec<String>,
+) -> Result<Found<M::Report>> {
+    let d = map.dim();
     // 1. Newton on P from rest.
-    let fixed = newton(
-        &mut map,
-        vec![0.0; d],
-        1,
-        so.tolerance,
-        40,
-        sys.damper.is_some(),
-    )?;
+    let fixed = newton(map, vec![0.0; d], 1, so.tolerance, 40, march_first)?;
     let mu = multipliers(&fixed.jac);
     let stable = mu.first().is_none_or(|m| *m < 1.0);
     if fixed.converged && stable {
-        return finish(&mut map, so, fixed, 1, mu, "newton", notes);
+        return Ok(Found::Periodic {
+            fixed,
+            k: 1,
+            mu,
+            method: "newton",
+        });
     }
     if fixed.converged {
         notes.push(format!(
@@ -755,22 +912,25 @@ pub fn steady_state(sys: &ImpactSystem, opts: &Options, so: &SteadyOptions) -> R
             "Newton on the blow map (with march steps where it did not descend) did not \
              converge from rest in {} evaluations (residual {:.2e}): the train was marched on, \
              seeking a period",
-            map.evaluations, fixed.residual
+            map.evaluations(),
+            fixed.residual
         ));
     }
     // 2. March from the best iterate (perturbed off an unstable fixed point), seeking a period.
     let mut y = fixed.y.clone();
     if fixed.converged {
         // Off the unstable fixed point along everything (1e-6 of the blow's energy norm).
-        for (v, w) in y.iter_mut().zip(&map.weight) {
+        for (v, w) in y.iter_mut().zip(map.weight()) {
             *v += 1e-6 / w.sqrt() / (d as f64).sqrt();
         }
     }
     let mut states = vec![y.clone()];
-    let mut reports: Vec<BlowReport> = Vec::new();
+    let mut reports: Vec<M::Report> = Vec::new();
     let detect = 1e-6_f64.max(so.tolerance);
     let k_max = so.max_period.max(1);
-    let march_budget = map.budget.saturating_sub(map.evaluations + 4 * (k_max + 1));
+    let march_budget = map
+        .budget()
+        .saturating_sub(map.evaluations() + 4 * (k_max + 1));
     for j in 1..=march_budget {
         if map.left() == 0 {
             break;
@@ -784,75 +944,54 @@ pub fn steady_state(sys: &ImpactSystem, opts: &Options, so: &SteadyOptions) -> R
             map.norm(&diff) < detect
         });
         if let Some(k) = found {
-            let fixed = newton(&mut map, y.clone(), k, so.tolerance, 8, false)?;
+            let fixed = newton(map, y.clone(), k, so.tolerance, 8, false)?;
             let mu = multipliers(&fixed.jac);
             notes.push(format!(
                 "a period of {k} blow{} appeared after {j} marched blows and was refined by \
                  Newton on P^{k}",
                 if k == 1 { "" } else { "s" }
             ));
-            return finish(&mut map, so, fixed, k, mu, "newton after marching", notes);
+            return Ok(Found::Periodic {
+                fixed,
+                k,
+                mu,
+                method: "newton after marching",
+            });
         }
     }
     // 3. Irregular: the last blows' levels as an estimate.
-    let tail: Vec<BlowReport> = reports.iter().rev().take(k_max).rev().cloned().collect();
+    let tail: Vec<M::Report> = reports.iter().rev().take(k_max).rev().cloned().collect();
     // `states[j]` is the state before marched blow j + 1.
     let strike_state = states[reports.len() - tail.len()].clone();
-    let spread = |f: &dyn Fn(&BlowReport) -> f64| {
-        let v: Vec<f64> = tail.iter().map(f).collect();
-        let (lo, hi) = v
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-                (a.min(*x), b.max(*x))
-            });
-        (lo, hi)
-    };
-    let (flo, fhi) = spread(&|b| b.peak_floor_force_n);
+    let (flo, fhi) = tail
+        .iter()
+        .map(M::floor_force)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x), b.max(x))
+        });
     notes.push(format!(
         "no period of at most {k_max} blows within {} blows: irregular; the levels are the \
          largest of the last {} marched blows, an estimate (floor force {flo:.4}..{fhi:.4} N \
          over them)",
-        map.evaluations,
+        map.evaluations(),
         tail.len()
     ));
-    let last_res = {
-        let n = states.len();
-        if n >= 2 {
-            let diff: Vec<f64> = states[n - 1]
-                .iter()
-                .zip(&states[n - 2])
-                .map(|(a, b)| a - b)
-                .collect();
-            map.norm(&diff)
-        } else {
-            f64::NAN
-        }
+    let n = states.len();
+    let residual = if n >= 2 {
+        let diff: Vec<f64> = states[n - 1]
+            .iter()
+            .zip(&states[n - 2])
+            .map(|(a, b)| a - b)
+            .collect();
+        map.norm(&diff)
+    } else {
+        f64::NAN
     };
-    Ok(levels(SteadyState {
-        rate_bpm: so.rate_bpm,
-        interval_s: map.opts.duration,
-        converged: false,
-        residual: last_res,
-        map_evaluations: map.evaluations,
-        regime: Regime::Irregular,
-        period_blows: None,
-        method: "marching",
-        jacobian: jacobian_kind(&map),
-        energy_ratio: 0.0,
-        peak_floor_force_n: 0.0,
-        peak_bed_acceleration_m_per_s2: 0.0,
-        peak_contact_force_slider_bed_n: 0.0,
-        damper_gap_at_strike_m: None,
-        damper_touches_bed: None,
-        multipliers_abs: Vec::new(),
-        stable: None,
-        periods_to_settle: None,
-        smooth: false,
-        blows: tail,
-        notes,
-        residual_history: std::mem::take(&mut map.history),
+    Ok(Found::Irregular {
+        tail,
         strike_state,
-    }))
+        residual,
+    })
 }
 
 /// One steady blow run again by [`replay`]: its solution (exact peaks in `totals.peaks`, blow
@@ -913,7 +1052,7 @@ fn jacobian_kind(map: &Map) -> Jacobian {
     }
 }
 
-fn check_options(so: &SteadyOptions) -> Result<()> {
+pub(crate) fn check_options(so: &SteadyOptions) -> Result<()> {
     blow_interval_s(so.rate_bpm)?;
     if !(so.tolerance.is_finite() && so.tolerance > 0.0 && so.tolerance < 1.0) {
         return Err(Error::invalid(
@@ -934,7 +1073,7 @@ fn check_options(so: &SteadyOptions) -> Result<()> {
 fn finish(
     map: &mut Map,
     so: &SteadyOptions,
-    fixed: Fixed,
+    fixed: Fixed<BlowReport>,
     k: usize,
     mu: Vec<f64>,
     method: &'static str,
@@ -945,6 +1084,43 @@ fn finish(
     let mu_max = mu.first().copied().unwrap_or(0.0);
     let stable = mu_max < 1.0;
     let mut notes = notes;
+    fixed_notes(&fixed, so, &mut notes);
+    Ok(levels(SteadyState {
+        rate_bpm: so.rate_bpm,
+        interval_s: map.opts.duration,
+        converged: fixed.converged,
+        residual: fixed.residual,
+        map_evaluations: map.evaluations,
+        regime: Regime::Period(k),
+        period_blows: Some(k),
+        method,
+        jacobian: jacobian_kind(map),
+        energy_ratio: 0.0,
+        peak_floor_force_n: 0.0,
+        peak_bed_acceleration_m_per_s2: 0.0,
+        peak_contact_force_slider_bed_n: 0.0,
+        damper_gap_at_strike_m: None,
+        damper_touches_bed: None,
+        multipliers_abs: mu,
+        stable: Some(stable),
+        periods_to_settle: settle(mu_max),
+        smooth: fixed.smooth,
+        blows,
+        notes,
+        residual_history: std::mem::take(&mut map.history),
+        strike_state: fixed.y,
+    }))
+}
+
+/// Periods for a disturbance to decay to 1e-3 of itself, `ln 1e-3 / ln |μ|max`, for a stable
+/// regime (`0 < |μ|max < 1`).
+pub(crate) fn settle(mu_max: f64) -> Option<f64> {
+    (mu_max < 1.0 && mu_max > 0.0).then(|| 1e-3_f64.ln() / mu_max.ln())
+}
+
+/// The notes on how Newton's result was reached: a grazing contact, no convergence, rejected
+/// steps.
+pub(crate) fn fixed_notes<R>(fixed: &Fixed<R>, so: &SteadyOptions, notes: &mut Vec<String>) {
     if !fixed.smooth && fixed.converged {
         notes.push(
             "the switching sequence changed between the last two Newton evaluations: a \
@@ -968,31 +1144,6 @@ fn finish(
             if fixed.rejected == 1 { "was" } else { "were" }
         ));
     }
-    Ok(levels(SteadyState {
-        rate_bpm: so.rate_bpm,
-        interval_s: map.opts.duration,
-        converged: fixed.converged,
-        residual: fixed.residual,
-        map_evaluations: map.evaluations,
-        regime: Regime::Period(k),
-        period_blows: Some(k),
-        method,
-        jacobian: jacobian_kind(map),
-        energy_ratio: 0.0,
-        peak_floor_force_n: 0.0,
-        peak_bed_acceleration_m_per_s2: 0.0,
-        peak_contact_force_slider_bed_n: 0.0,
-        damper_gap_at_strike_m: None,
-        damper_touches_bed: None,
-        multipliers_abs: mu,
-        stable: Some(stable),
-        periods_to_settle: (stable && mu_max > 0.0).then(|| 1e-3_f64.ln() / mu_max.ln()),
-        smooth: fixed.smooth,
-        blows,
-        notes,
-        residual_history: std::mem::take(&mut map.history),
-        strike_state: fixed.y,
-    }))
 }
 
 /// Fills the levels of `s` from its blows: η the mean, peaks and gaps the largest,

@@ -639,15 +639,42 @@ struct OpenImpact {
 }
 
 /// Simulates the network for `opts.duration` (`opts.max_events` caps the switches; sample
-/// output is not produced). See the module documentation.
+/// output is not produced) from its initial state ([`initial_state`]): [`solve_from`] at it.
+/// See the module documentation.
 pub fn solve(net: &Network, opts: &Options) -> Result<NetSolution> {
+    solve_from(net, initial_state(net)?, opts)
+}
+
+/// Simulates the network for `opts.duration` from the state `x0 = [x; ẋ]` (`2·dofs` values,
+/// time restarting at 0): the mode at `x0` is decided by the same sign rules as at a switch
+/// (each indicator's side is the sign of its first non-vanishing derivative), contacts closed
+/// at `x0` open an impact row at t = 0 and a rigid contact closing there strikes, as at the
+/// start of [`solve`]. The energy ratio's input `KE_b(0)` is the impactors' kinetic energy at
+/// `x0` (the dampers' energy at `x0` is in `E_b(0)`): a blow of a train struck on a moving
+/// machine ([`crate::analysis::network_blows`]).
+pub fn solve_from(net: &Network, x0: Vec<f64>, opts: &Options) -> Result<NetSolution> {
     if !(opts.duration.is_finite() && opts.duration > 0.0) {
         return Err(Error::invalid(
             "simulation.duration",
             format!("must be > 0 s (got {})", opts.duration),
         ));
     }
-    let mut run = Run::new(net, opts)?;
+    if x0.len() != 2 * net.dofs() || x0.iter().any(|v| !v.is_finite()) {
+        return Err(Error::invalid(
+            "initial state",
+            format!(
+                "needs {} finite values [x; ẋ] (got {}{})",
+                2 * net.dofs(),
+                x0.len(),
+                if x0.iter().any(|v| !v.is_finite()) {
+                    ", not all finite"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    let mut run = Run::new(net, opts, x0)?;
     run.rigid_events()?;
     let ended_at_start = run.collision_ended() && opts.stop_at_collision_end;
     if !ended_at_start {
@@ -725,9 +752,8 @@ struct Run<'n, 'o> {
 }
 
 impl<'n, 'o> Run<'n, 'o> {
-    /// The initial state, its mode and energies, and the impacts of the contacts closed at t = 0.
-    fn new(net: &'n Network, opts: &'o Options) -> Result<Self> {
-        let x0 = initial_state(net)?;
+    /// The state `x0`, its mode and energies, and the impacts of the contacts closed at t = 0.
+    fn new(net: &'n Network, opts: &'o Options, x0: Vec<f64>) -> Result<Self> {
         let nd = net.dofs();
         let nc = net.contacts.len();
         let mut modes = Modes {
@@ -756,10 +782,15 @@ impl<'n, 'o> Run<'n, 'o> {
         let mut signs = vec![0.0; modes.inds.len()];
         let mode = modes.select(&x0, NetMode(0), &mut signs)?;
         let (ke0, pe0) = net.energies(mode, &x0);
+        // The impactors' kinetic energy at x0 (at the initial state the dampers are at rest
+        // and the impactors move with their configured velocities).
+        let nm = net.n_modes();
         let body_ke0: f64 = net
             .bodies
             .iter()
-            .map(|b| 0.5 * b.mass * b.velocity * b.velocity)
+            .enumerate()
+            .filter(|(b, _)| !net.suspensions.iter().any(|s| s.body == *b))
+            .map(|(b, body)| 0.5 * body.mass * x0[nd + nm + b] * x0[nd + nm + b])
             .sum();
         let body_e0 = net.body_energy(&x0);
         let preloaded: Vec<bool> = net.contacts.iter().map(|c| c.gap < 0.0).collect();

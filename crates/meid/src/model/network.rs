@@ -33,7 +33,8 @@ use serde::{Deserialize, Serialize};
 
 use super::fem::{self, ReductionContext};
 use super::spec::{
-    ContactSpec, DashpotKindSpec, LawSpec, ReleaseSpec, SimulationSpec, StructureSpec,
+    ContactSpec, DashpotKindSpec, LawSpec, ProductionSpec, ReleaseSpec, SimulationSpec,
+    StructureSpec,
 };
 use super::{source, strict, Source};
 use crate::impact::network::{Body, End, Link, Network, Suspension};
@@ -57,6 +58,11 @@ pub struct NetworkSpec {
     pub contact: Vec<ContactEntrySpec>,
     #[serde(default)]
     pub simulation: SimulationSpec,
+    /// `[production]`: the stroke rate at which `meid blows`, `optimize --place` and `sweep`
+    /// judge the machine on its steady blow ([`crate::analysis::network_blows`]); a command's
+    /// `--rate-bpm` overrides it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub production: Option<ProductionSpec>,
 }
 
 /// `[[impactor]]`: a rigid body that strikes.
@@ -328,6 +334,18 @@ fn locate(e: Error, spec: &NetworkSpec, src: &Source) -> Error {
 
 /// The checks that need no structure: names, numbers, ranges.
 fn check_fields(spec: &NetworkSpec, src: &Source) -> Result<()> {
+    if let Some(p) = &spec.production {
+        if !(p.rate_bpm.is_finite() && p.rate_bpm > 0.0) {
+            return Err(field_error(
+                src,
+                "production.rate_bpm".into(),
+                format!(
+                    "must be a finite number > 0 blows per minute (got {})",
+                    crate::num(p.rate_bpm)
+                ),
+            ));
+        }
+    }
     if spec.impactor.is_empty() {
         return Err(field_error(
             src,
