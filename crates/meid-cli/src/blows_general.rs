@@ -3,71 +3,14 @@
 
 use anyhow::{bail, Result};
 
+use meid::analysis::network_blows::{stroke_rate, verdict};
+
 use meid::analysis::blows::BlowOptions;
 use meid::analysis::network_blows::{self, NetBlowReport, NetSteadyState};
 use meid::analysis::steady::SteadyOptions;
 use meid::model::network::NetworkModel;
 
 use crate::blows::BlowsArgs;
-
-/// The stroke rate: `--rate-bpm`, else the file's `[production] rate_bpm`, else 60; checked
-/// (an error names `--rate-bpm`).
-pub fn stroke_rate(model: &NetworkModel, given: Option<f64>) -> Result<f64> {
-    let r = given
-        .or_else(|| model.spec.production.as_ref().map(|p| p.rate_bpm))
-        .unwrap_or(60.0);
-    if !(r.is_finite() && r > 0.0) {
-        bail!(meid::Error::invalid(
-            "--rate-bpm",
-            format!(
-                "the stroke rate must be a finite number > 0 blows per minute (got {})",
-                given.unwrap_or(f64::NAN)
-            ),
-        ));
-    }
-    Ok(r)
-}
-
-/// The sentence on top: whether every damper returns between blows in the steady regime.
-pub fn verdict(s: &NetSteadyState) -> String {
-    let rate = s.rate_bpm;
-    let levels = format!(
-        "{}, energy ratio {:.4}, peak acceleration at {} {:.4} m/s²{}",
-        s.regime.name(),
-        s.energy_ratio,
-        s.bed_point,
-        s.peak_bed_acceleration_m_per_s2,
-        s.peak_floor_force_n
-            .map_or(String::new(), |f| format!(", floor force {f:.4} N"))
-    );
-    if !s.converged {
-        return format!(
-            "At {rate} blows/min the train did not settle within {} blow evaluations ({levels}, an estimate).",
-            s.map_evaluations
-        );
-    }
-    let away: Vec<&str> = s
-        .dampers_touch
-        .iter()
-        .filter(|d| !d.touches)
-        .map(|d| d.name.as_str())
-        .collect();
-    if s.dampers_touch.is_empty() {
-        format!(
-            "At {rate} blows/min the machine (no damper) settles into the steady blow: {levels}."
-        )
-    } else if away.is_empty() {
-        format!("At {rate} blows/min every damper returns between blows: each touches its point in every steady blow ({levels}).")
-    } else {
-        format!(
-            "At {rate} blows/min {} of {} dampers do not return between blows ({}): in the steady blow they no longer touch their points (largest gap at the strike {:.4} mm; {levels}).",
-            away.len(),
-            s.dampers_touch.len(),
-            away.join(", "),
-            s.damper_gap_at_strike_m.unwrap_or(0.0) * 1e3
-        )
-    }
-}
 
 /// The options of the paper machine's `meid blows` that a general machine's does not take.
 fn refuse_paper_options(a: &BlowsArgs) -> Result<()> {

@@ -127,7 +127,7 @@ pub fn run(
     let model = NetworkModel::from_file(path, set)?;
     // The operating condition: --rate-bpm, else the file's [production] rate_bpm.
     let rate_bpm = match rate_bpm {
-        Some(r) => Some(crate::blows_general::stroke_rate(&model, Some(r))?),
+        Some(r) => Some(meid::analysis::network_blows::stroke_rate(&model, Some(r))?),
         None => model.spec.production.as_ref().map(|p| p.rate_bpm),
     };
     let study = study(model, objective, p, rate_bpm)?;

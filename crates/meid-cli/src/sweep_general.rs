@@ -54,7 +54,7 @@ pub fn run(a: &SweepArgs) -> Result<()> {
         .map(|s| NetVary::parse(s))
         .collect::<meid::Result<Vec<_>>>()?;
     let rate = match a.rate_bpm {
-        Some(r) => Some(crate::blows_general::stroke_rate(&model, Some(r))?),
+        Some(r) => Some(meid::analysis::network_blows::stroke_rate(&model, Some(r))?),
         None => model.spec.production.as_ref().map(|p| p.rate_bpm),
     };
     let sweep = NetSweep::new(model, vary)?.at_rate(rate)?;

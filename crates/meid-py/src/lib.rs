@@ -1140,6 +1140,7 @@ fn _meid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Run>()?;
     m.add_class::<machine::Machine>()?;
     m.add_function(wrap_pyfunction!(machine::machine_sweep_json, m)?)?;
+    m.add_function(wrap_pyfunction!(machine::machine_blows_json, m)?)?;
     m.add_function(wrap_pyfunction!(is_general_file, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_columns, m)?)?;
     m.add_function(wrap_pyfunction!(montecarlo_columns, m)?)?;

@@ -213,3 +213,59 @@ pub(crate) fn machine_sweep_json(
     }
     serde_json::to_string(&result).map_err(|e| MeidError::new_err(e.to_string()))
 }
+
+/// A general machine in production at `rate_bpm` blows/min (`None`: its `[production]
+/// rate_bpm`, else 60): `meid blows GENERAL.toml --json`'s object as JSON text. With `steady`,
+/// the verdict and the periodic steady state found directly (`--steady`); without, the march
+/// of `blows` blows from rest.
+#[pyfunction]
+#[pyo3(signature = (machine, rate_bpm=None, steady=true, blows=10))]
+pub(crate) fn machine_blows_json(
+    py: Python<'_>,
+    machine: &Machine,
+    rate_bpm: Option<f64>,
+    steady: bool,
+    blows: i64,
+) -> PyResult<String> {
+    use meid::analysis::blows::BlowOptions;
+    use meid::analysis::network_blows::{run_blows, steady_state, stroke_rate, verdict};
+    use meid::analysis::steady::SteadyOptions;
+    let blows = crate::count("blows", blows, 1)?;
+    let out = py
+        .detach(|| -> meid::Result<serde_json::Value> {
+            let m = &machine.inner;
+            let rate_bpm = stroke_rate(m, rate_bpm)?;
+            let je = |e: serde_json::Error| meid::Error::numerical("blows", e.to_string());
+            if steady {
+                let so = SteadyOptions {
+                    rate_bpm,
+                    ..SteadyOptions::default()
+                };
+                let s = steady_state(m, &so)?;
+                Ok(serde_json::json!({
+                    "machine": "general",
+                    "rate_bpm": rate_bpm,
+                    "interval_s": s.interval_s,
+                    "verdict": verdict(&s),
+                    "steady_state": s,
+                }))
+            } else {
+                let b = BlowOptions {
+                    blows,
+                    rate_bpm,
+                    ..BlowOptions::default()
+                };
+                serde_json::to_value(run_blows(m, &b)?).map_err(je)
+            }
+        })
+        .map_err(err)?;
+    // `warnings` and `notes` as every JSON object of the CLI carries them.
+    let mut out = out;
+    if let serde_json::Value::Object(o) = &mut out {
+        for key in ["warnings", "notes"] {
+            o.entry(key)
+                .or_insert_with(|| serde_json::Value::Array(Vec::new()));
+        }
+    }
+    serde_json::to_string(&out).map_err(|e| MeidError::new_err(e.to_string()))
+}

@@ -100,3 +100,21 @@ def test_a_machine_sweep_refuses_paper_only_options():
     m = meid.Machine.from_file(HAMMER)
     with pytest.raises(ValueError, match="bed_mass_kg and duration"):
         meid.sweep(m, vary={"simulation.duration": [0.1]}, duration=0.1)
+
+
+LUMPED_GENERAL = ROOT / "crates" / "meid" / "tests" / "data" / "paper_lumped_general.toml"
+
+
+def test_blows_of_a_machine_are_the_cli_blows():
+    m = meid.Machine.from_file(LUMPED_GENERAL)
+    march = meid.blows(m, 60.0, steady=False, blows=3)
+    assert march == cli("blows", LUMPED_GENERAL, "--rate-bpm", "60", "--blows", "3")
+    steady = meid.blows(m, 60.0)
+    assert steady == cli("blows", LUMPED_GENERAL, "--rate-bpm", "60", "--steady")
+    # The paper's damper at 60 /min does not come back to the bed (issue 28's finding).
+    assert steady["steady_state"]["dampers_touch"][0]["touches"] is False
+    assert "do not return" in steady["verdict"]
+    with pytest.raises(ValueError, match="case is for the paper's Model"):
+        meid.blows(m, 60.0, case="none")
+    with pytest.raises(meid.InputError, match="rate-bpm"):
+        meid.blows(m, 0.0)

@@ -50,6 +50,7 @@ from ._meid import (  # noqa: F401
     column_unit,
     evaluate as _evaluate,
     is_general_file,
+    machine_blows_json,
     machine_sweep_json,
     max_memory,
     metric_names,
@@ -150,7 +151,7 @@ def _table(names, columns, errors, output: str, index: str):
 
 
 def blows(
-    model: Model,
+    model: Union[Model, Machine],
     rate_bpm: Optional[float] = None,
     *,
     steady: bool = True,
@@ -163,9 +164,20 @@ def blows(
     ``energy_ratio``, ``peak_floor_force_n``, ``peak_bed_acceleration_m_per_s2``,
     ``damper_gap_at_strike_m``, ``damper_touches_bed``, ``multipliers_abs``, ...) and
     ``production`` (every case and the damper's return rate). With ``steady=False``, also the
-    march of ``blows`` blows from rest (``blows``, ``steady``)."""
+    march of ``blows`` blows from rest (``blows``, ``steady``).
+
+    A general machine (:class:`Machine`) gives ``meid blows GENERAL.toml --json``'s object: with
+    ``steady``, ``verdict`` and ``steady_state`` (the same fields, with ``dampers_touch`` per
+    damper); without, the march of ``blows`` blows from rest. Its ``case`` is as its file says."""
     import json
 
+    if isinstance(model, Machine):
+        if case != "as-specified":
+            raise ValueError(
+                "blows of a Machine: case is for the paper's Model (a general machine's "
+                "[[damper]] entries are its dampers)"
+            )
+        return json.loads(machine_blows_json(model, rate_bpm, steady, blows))
     return json.loads(blows_json(model, rate_bpm, steady, case, blows))
 
 
