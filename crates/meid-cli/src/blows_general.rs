@@ -46,13 +46,7 @@ pub fn run(a: BlowsArgs) -> Result<()> {
         if a.print.human() {
             print_steady(&s);
         }
-        serde_json::json!({
-            "machine": "general",
-            "rate_bpm": rate_bpm,
-            "interval_s": s.interval_s,
-            "verdict": verdict(&s),
-            "steady_state": s,
-        })
+        network_blows::steady_object(&s)
     } else {
         let b = BlowOptions {
             blows: a.blows,

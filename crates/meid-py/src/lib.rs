@@ -247,6 +247,23 @@ fn interruptible<R: Send>(
 /// one after the other; a point depends only on its index, so the rows are the same).
 const CANCEL_CHUNK: usize = 1024;
 
+/// `with_values`' dict as `PATH=VALUE` overrides; a key that is not a str is a TypeError
+/// naming `example`, a path of the model's kind.
+fn field_list(values: &Bound<'_, PyDict>, example: &str) -> PyResult<Vec<String>> {
+    let mut fields = Vec::new();
+    for (k, v) in values.iter() {
+        let k: String = k.extract().map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(format!(
+                "with_values: keys are field paths such as \"{example}\" (str); got {} {}",
+                type_name(&k),
+                k.repr().map(|r| r.to_string()).unwrap_or_default()
+            ))
+        })?;
+        fields.push(format!("{k}={}", literal(&k, &v)?));
+    }
+    Ok(fields)
+}
+
 /// The TOML literal of a Python value for a field (`with_values`): bool (numpy's too) →
 /// boolean, int (numpy integers too) → integer, float (numpy floats too) → shortest
 /// round-trip real (`nan`/`inf` as TOML spells them), str → TOML string.
@@ -377,17 +394,7 @@ impl Model {
     /// This model with fields set, as `--set PATH=VALUE` would: `{"contact.slider_bed.stiffness":
     /// 4.3e7}`. The structure's modes are reused unless a value changes the structure.
     fn with_values(&self, py: Python<'_>, values: &Bound<'_, PyDict>) -> PyResult<Self> {
-        let mut fields = Vec::new();
-        for (k, v) in values.iter() {
-            let k: String = k.extract().map_err(|_| {
-                pyo3::exceptions::PyTypeError::new_err(format!(
-                    "with_values: keys are field paths such as \"damper.mass\" (str); got {} {}",
-                    type_name(&k),
-                    k.repr().map(|r| r.to_string()).unwrap_or_default()
-                ))
-            })?;
-            fields.push(format!("{k}={}", literal(&k, &v)?));
-        }
+        let fields = field_list(values, "damper.mass")?;
         py.detach(|| self.inner.with_fields(&fields, None))
             .map(|inner| Model { inner })
             .map_err(err)

@@ -12,7 +12,7 @@ use meid::analysis::network::summary;
 use meid::analysis::network_study::{NetSweep, NetVary};
 use meid::model::network::NetworkModel;
 
-use crate::{err, interruptible, literal, override_list, pool, toml_real, type_name};
+use crate::{err, field_list, interruptible, override_list, pool, toml_real};
 use crate::{MeidError, MeidWarning, Run};
 
 /// A validated general impact machine: impactors, dampers and contacts on a structure reduced
@@ -59,17 +59,7 @@ impl Machine {
     /// This machine with fields set, as `--set PATH=VALUE` would:
     /// `{"damper.damper1.mass": 1.2, "damper.damper1.point": "D2"}`.
     fn with_values(&self, py: Python<'_>, values: &Bound<'_, PyDict>) -> PyResult<Self> {
-        let mut fields = Vec::new();
-        for (k, v) in values.iter() {
-            let k: String = k.extract().map_err(|_| {
-                pyo3::exceptions::PyTypeError::new_err(format!(
-                    "with_values: keys are field paths such as \"damper.damper1.mass\" (str); got {} {}",
-                    type_name(&k),
-                    k.repr().map(|r| r.to_string()).unwrap_or_default()
-                ))
-            })?;
-            fields.push(format!("{k}={}", literal(&k, &v)?));
-        }
+        let fields = field_list(values, "damper.damper1.mass")?;
         py.detach(|| self.inner.with_fields(&fields, None))
             .map(|inner| Machine { inner })
             .map_err(err)
@@ -228,7 +218,7 @@ pub(crate) fn machine_blows_json(
     blows: i64,
 ) -> PyResult<String> {
     use meid::analysis::blows::BlowOptions;
-    use meid::analysis::network_blows::{run_blows, steady_state, stroke_rate, verdict};
+    use meid::analysis::network_blows::{run_blows, steady_object, steady_state, stroke_rate};
     use meid::analysis::steady::SteadyOptions;
     let blows = crate::count("blows", blows, 1)?;
     let out = py
@@ -241,14 +231,7 @@ pub(crate) fn machine_blows_json(
                     rate_bpm,
                     ..SteadyOptions::default()
                 };
-                let s = steady_state(m, &so)?;
-                Ok(serde_json::json!({
-                    "machine": "general",
-                    "rate_bpm": rate_bpm,
-                    "interval_s": s.interval_s,
-                    "verdict": verdict(&s),
-                    "steady_state": s,
-                }))
+                Ok(steady_object(&steady_state(m, &so)?))
             } else {
                 let b = BlowOptions {
                     blows,

@@ -860,3 +860,15 @@ pub fn verdict(s: &NetSteadyState) -> String {
         )
     }
 }
+
+/// `meid blows GENERAL.toml --steady --json`'s object (also Python's `meid.blows` of a
+/// machine): the machine kind, the rate and interval, the [`verdict`] and the steady state.
+pub fn steady_object(s: &NetSteadyState) -> serde_json::Value {
+    serde_json::json!({
+        "machine": "general",
+        "rate_bpm": s.rate_bpm,
+        "interval_s": s.interval_s,
+        "verdict": verdict(s),
+        "steady_state": s,
+    })
+}
