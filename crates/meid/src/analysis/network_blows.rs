@@ -51,9 +51,10 @@
 //! The blow map `P: y ↦ y'` acts on the state just before a strike without the impactors,
 //! `y = [q; z_d; q̇; ż_d]` (dimension `2·(modes + dampers)`), and its fixed point (of `P^k` for
 //! a period-k regime) is found by [`super::steady`]'s search: Newton on `P − I` from rest,
-//! globalised by march steps, then a march seeking a period, then irregular; its multipliers
-//! `|eig ∂P^k/∂y|`, stability and blows to settle; the same energy norm (`ω̄_i² q_i² + q̇_i²`
-//! per mode, `max(k, m ω_T²) z² + m ż²` per damper, over `Σ m v²` of the impactors). The
+//! globalised by a backtracking step and march steps, then a march seeking a period, then
+//! irregular; its multipliers `|eig ∂P^k/∂y|`, stability and blows to settle; the same energy
+//! norm (`ω̄_i² q_i² + q̇_i²` per mode, `max(k, m ω_T²) z² + m ż²` per damper, over `Σ m v²` of
+//! the impactors). The
 //! Jacobian is taken by **forward differences**, `h_j = 1e-7/√w_j` (1e-7 of the blow's energy
 //! norm): the general engine has held contacts, rigid impulses and non-linear laws, for which
 //! no product of transition matrices holds. Cost: `1 + dim` blows per Newton step
