@@ -809,16 +809,22 @@ pub fn stroke_rate(model: &NetworkModel, given: Option<f64>) -> Result<f64> {
     let r = given
         .or_else(|| model.spec.production.as_ref().map(|p| p.rate_bpm))
         .unwrap_or(60.0);
+    check_rate(r)?;
+    Ok(r)
+}
+
+/// A stroke rate must be a finite number > 0 blows/min (an error names `--rate-bpm`).
+pub fn check_rate(r: f64) -> Result<()> {
     if !(r.is_finite() && r > 0.0) {
         return Err(Error::invalid(
             "--rate-bpm",
             format!(
                 "the stroke rate must be a finite number > 0 blows per minute (got {})",
-                given.unwrap_or(f64::NAN)
+                crate::num(r)
             ),
         ));
     }
-    Ok(r)
+    Ok(())
 }
 
 /// The sentence on top: whether every damper returns between blows in the steady regime.

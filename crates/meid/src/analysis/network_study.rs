@@ -215,15 +215,7 @@ impl NetSweep {
     /// first blow. Adds the `dampers_return` column.
     pub fn at_rate(mut self, rate_bpm: Option<f64>) -> Result<Self> {
         if let Some(r) = rate_bpm {
-            if !(r.is_finite() && r > 0.0) {
-                return Err(Error::invalid(
-                    "--rate-bpm",
-                    format!(
-                        "the stroke rate must be a finite number > 0 blows per minute (got {})",
-                        crate::num(r)
-                    ),
-                ));
-            }
+            super::network_blows::check_rate(r)?;
             if self.rate_bpm.is_none() {
                 self.columns.push("dampers_return".into());
             }
@@ -336,42 +328,17 @@ impl NetSweep {
 
     fn point(&self, index: usize, cache: &NetCache) -> NetPoint {
         let values = self.values_at(index);
-        if let Some(rate) = self.rate_bpm {
-            return match self.steady_point(index, cache, rate) {
-                Ok(metrics) => NetPoint {
-                    index,
-                    values,
-                    metrics,
-                    error: None,
-                },
-                Err(e) => NetPoint {
-                    index,
-                    values,
-                    metrics: vec![None; self.columns.len()],
-                    error: Some(e.to_string()),
-                },
-            };
-        }
-        let run = || -> Result<NetSummary> {
-            let m = self.model_at(index, cache)?;
-            let sol = m.solve(&m.options()?)?;
-            Ok(summary(&m, &sol))
+        let got = match self.rate_bpm {
+            Some(rate) => self.steady_point(index, cache, rate),
+            None => self.first_blow_point(index, cache),
         };
-        match run() {
-            Ok(s) => {
-                let got = metrics(&s);
-                let metrics = self
-                    .columns
-                    .iter()
-                    .map(|c| got.iter().find(|(n, _)| n == c).and_then(|(_, v)| *v))
-                    .collect();
-                NetPoint {
-                    index,
-                    values,
-                    metrics,
-                    error: None,
-                }
-            }
+        match got {
+            Ok(metrics) => NetPoint {
+                index,
+                values,
+                metrics,
+                error: None,
+            },
             Err(e) => NetPoint {
                 index,
                 values,
@@ -379,6 +346,18 @@ impl NetSweep {
                 error: Some(e.to_string()),
             },
         }
+    }
+
+    /// The metrics of grid point `index`'s first blow, in column order.
+    fn first_blow_point(&self, index: usize, cache: &NetCache) -> Result<Vec<Option<f64>>> {
+        let m = self.model_at(index, cache)?;
+        let sol = m.solve(&m.options()?)?;
+        let got = metrics(&summary(&m, &sol));
+        Ok(self
+            .columns
+            .iter()
+            .map(|c| got.iter().find(|(n, _)| n == c).and_then(|(_, v)| *v))
+            .collect())
     }
 }
 

@@ -349,15 +349,7 @@ impl PlacementStudy {
         }
         self.objective.check(m)?;
         if let Some(r) = self.rate_bpm {
-            if !(r.is_finite() && r > 0.0) {
-                return Err(Error::invalid(
-                    "--rate-bpm",
-                    format!(
-                        "the stroke rate must be a finite number > 0 blows per minute (got {})",
-                        crate::num(r)
-                    ),
-                ));
-            }
+            super::network_blows::check_rate(r)?;
         }
         if self.search == Search::Exhaustive && self.combinations() > self.max_combinations {
             return Err(Error::invalid(
