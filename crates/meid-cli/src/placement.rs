@@ -152,8 +152,11 @@ fn line(r: &PlacedResult) -> String {
         r.dampers,
         r.points.join(", "),
         masses.join(", "),
-        r.objective
-            .map_or("failed".to_string(), |f| format!("{f:.6e}")),
+        match (r.objective, r.dampers_return) {
+            (Some(f), _) => format!("{f:.6e}"),
+            (None, Some(false)) => "infeasible".to_string(),
+            (None, _) => "failed".to_string(),
+        },
         match r.dampers_return {
             Some(true) => ", every damper returns",
             Some(false) => ", a damper does NOT return between blows",
@@ -177,6 +180,12 @@ fn print_report(r: &PlacementReport, output: Option<&Path>) {
         r.simulations
     );
     println!("  best            {}", line(&r.best));
+    if let Some(n) = r.infeasible.filter(|n| *n > 0) {
+        println!(
+            "  refused         {n} of {} simulations: a damper does not return between blows",
+            r.simulations
+        );
+    }
     for b in &r.best_per_count {
         println!("  best of {:<7} {}", b.dampers, line(b));
     }

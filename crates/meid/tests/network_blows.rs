@@ -207,6 +207,59 @@ fn the_paper_machine_as_a_general_one_has_the_paper_engines_steady_state() {
     }
 }
 
+/// A search whose Newton phase cannot converge within its share of the budget still marches
+/// and finds the regime. With k_d = 2e3 N/m and c_d = 300 N·s/m at 60 /min the damper of the
+/// paper's lumped machine settles just off the bed (gap 0.44 mm at the strike): the general
+/// machine's forward-difference Newton does not descend near that grazing state (each step
+/// costs 7 blows), and before the search left room for marching it spent the whole budget and
+/// reported an "irregular" train with no blow. Now it hands over to the march, which settles on
+/// period-1 and is refined to the paper engine's steady state (exact path Jacobian): floor
+/// force and gap to 1e-9, within the budget.
+#[test]
+fn a_newton_search_that_stalls_hands_over_to_the_march() {
+    let sets = [
+        "damper.stiffness=2e3".to_string(),
+        "damper.damping=300".to_string(),
+    ];
+    let paper = Model::from_file(&example("paper-lumped.toml"), &sets).unwrap();
+    let sys = paper.impact_system(Case::Damper).unwrap();
+    let gen = NetworkModel::from_text(
+        "test.toml",
+        paper_lumped_general(),
+        &[
+            "damper.damper.stiffness=2e3".to_string(),
+            "damper.damper.damping=300".to_string(),
+        ],
+    )
+    .unwrap();
+    let so = SteadyOptions {
+        rate_bpm: 60.0,
+        tolerance: 1e-12,
+        ..SteadyOptions::default()
+    };
+    let p = steady::steady_state(&sys, &paper.options(), &so).unwrap();
+    let g = steady_state(&gen, &so).unwrap();
+    let what = format!("paper {p:?}\ngeneral {g:?}");
+    assert!(p.converged && g.converged, "{what}");
+    assert_eq!(
+        (p.regime, g.regime),
+        (Regime::Period(1), Regime::Period(1)),
+        "{what}"
+    );
+    assert!(g.map_evaluations <= so.max_evaluations, "{what}");
+    assert!(
+        rel(g.peak_floor_force_n.unwrap(), p.peak_floor_force_n) < 1e-9,
+        "{what}"
+    );
+    let (gg, pg) = (
+        g.damper_gap_at_strike_m.unwrap(),
+        p.damper_gap_at_strike_m.unwrap(),
+    );
+    assert!(pg > 1e-4 && rel(gg, pg) < 1e-9, "{what}");
+    assert_eq!(g.damper_touches_bed, Some(false), "{what}");
+    assert_eq!(p.damper_touches_bed, Some(false), "{what}");
+}
+
 /// A 60-blow march from rest and the direct steady state agree within 1e-6 (relative) in
 /// every reported level where the march has settled (within the geometric tail the slowest
 /// multiplier leaves), at 60 and 120 /min on the paper's machine as a general one; the first

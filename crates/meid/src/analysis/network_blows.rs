@@ -575,6 +575,9 @@ impl BlowMap for NetMap<'_> {
     fn evaluations(&self) -> usize {
         self.evaluations
     }
+    fn step_cost(&self) -> usize {
+        1 + self.dim()
+    }
     fn budget(&self) -> usize {
         self.budget
     }

@@ -31,14 +31,20 @@
 //! ([`super::network_blows::steady_state`]: the fixed point of the blow-to-blow map), not on
 //! the first blow: the objective is the steady level (for a period-k regime the mean energy
 //! ratio and the largest peaks over the period), and each design reports `dampers_return`,
-//! whether the train settled and every damper touches its point before each strike. A design
-//! whose train did not settle has no objective value (its error says so).
+//! whether the train settled and every damper touches its point before each strike. **Only
+//! designs whose dampers all return are feasible**: a damper that no longer touches its point
+//! at the strike cannot take the blow's momentum, and in the steady regime it is a tuned mass at
+//! best (the paper's damper at 60 /min makes the floor force worse than no damper). An infeasible
+//! design has no objective value; its error names the dampers that do not return, their largest
+//! gap at a strike and the value it would have had; the report counts them (`infeasible`). A
+//! design whose train did not settle has no objective value either (its error says so). With no
+//! feasible design the study ends with an error saying so.
 
 use rayon::prelude::*;
 use serde::Serialize;
 
 use super::network::summary;
-use super::network_blows::settled_steady_state;
+use super::network_blows::{settled_steady_state, DamperTouch, NetSteadyState};
 use super::network_study::metrics;
 use super::optimize::{minimize_box, NelderMeadOptions};
 use crate::model::network::NetworkModel;
@@ -181,6 +187,38 @@ pub struct Evaluation {
     pub dampers_return: Option<bool>,
 }
 
+/// Whether every damper of a design returns at the stroke rate; when not, why (the error of
+/// an infeasible design: module docs, "Operating condition").
+#[derive(Debug, Clone, PartialEq)]
+enum Returning {
+    Yes,
+    No(String),
+}
+
+impl Returning {
+    /// From a settled steady state whose objective `column` is `value`.
+    fn of(s: &NetSteadyState, column: &str, value: f64) -> Self {
+        if s.dampers_return() {
+            return Self::Yes;
+        }
+        let away: Vec<&DamperTouch> = s.dampers_touch.iter().filter(|d| !d.touches).collect();
+        let gap = away
+            .iter()
+            .map(|d| d.gap_at_strike_m)
+            .fold(0.0_f64, f64::max);
+        let names: Vec<&str> = away.iter().map(|d| d.name.as_str()).collect();
+        Self::No(format!(
+            "infeasible: at {} blows/min {} {} not return between blows (largest gap at a strike {:.4} mm in the {} steady state); its {column} would be {}",
+            crate::num(s.rate_bpm),
+            names.join(", "),
+            if names.len() == 1 { "does" } else { "do" },
+            gap * 1e3,
+            s.regime.name(),
+            crate::num(value),
+        ))
+    }
+}
+
 /// A placement's best result.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PlacedResult {
@@ -210,6 +248,10 @@ pub struct PlacementReport {
     /// The stroke rate the designs were judged at (their steady blow); `None`: the first blow.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rate_bpm: Option<f64>,
+    /// With a stroke rate: the simulations refused because a damper does not return (module
+    /// docs, "Operating condition").
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub infeasible: Option<usize>,
     pub best: PlacedResult,
     /// The best placement of each count of dampers.
     pub best_per_count: Vec<PlacedResult>,
@@ -378,13 +420,14 @@ impl PlacementStudy {
     }
 
     /// The objective of one simulation of the dampers at `points` with `masses` (with a stroke
-    /// rate: of its steady blow, and whether every damper returns).
+    /// rate: of its steady blow, and whether every damper returns, with the reason when not:
+    /// [`Returning`]).
     fn simulate(
         &self,
         points: &[String],
         masses: &[f64],
         cache: &NetCache,
-    ) -> Result<(f64, Option<bool>)> {
+    ) -> Result<(f64, Option<Returning>)> {
         let placement = Placement {
             points: points.to_vec(),
             masses_kg: masses.to_vec(),
@@ -399,7 +442,7 @@ impl PlacementStudy {
             let v = s.metric(&col).ok_or_else(|| {
                 Error::numerical("placement", format!("{col}: no value in the steady blow"))
             })?;
-            return Ok((v, Some(s.dampers_return())));
+            return Ok((v, Some(Returning::of(&s, &col, v))));
         }
         let sol = m.solve(&m.options()?)?;
         metrics(&summary(&m, &sol))
@@ -421,15 +464,21 @@ impl PlacementStudy {
         let n = points.len();
         let mut log = Vec::new();
         let mut run = |masses: &[f64]| -> Option<f64> {
-            let r = self.simulate(&points, masses, cache);
+            // An infeasible design (a damper that does not return) has no objective value.
+            let (objective, error, dampers_return) = match self.simulate(&points, masses, cache) {
+                Ok((v, None)) => (Some(v), None, None),
+                Ok((v, Some(Returning::Yes))) => (Some(v), None, Some(true)),
+                Ok((_, Some(Returning::No(why)))) => (None, Some(why), Some(false)),
+                Err(e) => (None, Some(e.to_string()), None),
+            };
             log.push(Evaluation {
                 points: points.clone(),
                 masses_kg: masses.to_vec(),
-                objective: r.as_ref().ok().map(|v| v.0),
-                error: r.as_ref().err().map(|e| e.to_string()),
-                dampers_return: r.as_ref().ok().and_then(|v| v.1),
+                objective,
+                error,
+                dampers_return,
             });
-            r.ok().map(|v| v.0)
+            objective
         };
         let (masses, objective) = match self.masses {
             MassRule::Total(t) => {
@@ -619,21 +668,35 @@ fn report(
         (None, Some(_)) => std::cmp::Ordering::Greater,
         (None, None) => std::cmp::Ordering::Equal,
     });
+    let infeasible = evaluations
+        .iter()
+        .filter(|e| e.dampers_return == Some(false))
+        .count();
     let best = placements
         .first()
         .filter(|p| p.objective.is_some())
         .cloned()
         .ok_or_else(|| {
+            // The first infeasible design's error, else the first failure's.
             let why = evaluations
                 .iter()
+                .filter(|e| infeasible == 0 || e.dampers_return == Some(false))
                 .find_map(|e| e.error.clone())
                 .unwrap_or_default();
+            let rate = s.rate_bpm.map(crate::num).unwrap_or_default();
             Error::numerical(
                 "placement",
-                format!(
-                    "no placement has a value of {}: {why}",
-                    s.objective.column()
-                ),
+                if infeasible > 0 {
+                    format!(
+                        "no placement is feasible at {rate} blows/min: in {infeasible} of {} simulations a damper does not return between blows (first: {why}); a damper creeps back with a time constant of about c/k (docs/explanations/blows.md, \"The damper that does not return\"): try a template with a stiffer spring or a weaker dashpot, or a lower stroke rate",
+                        evaluations.len()
+                    )
+                } else {
+                    format!(
+                        "no placement has a value of {}: {why}",
+                        s.objective.column()
+                    )
+                },
             )
         })?;
     let best_per_count = (s.counts.0..=s.counts.1)
@@ -658,6 +721,7 @@ fn report(
         template: s.template.clone(),
         masses: s.masses,
         rate_bpm: s.rate_bpm,
+        infeasible: s.rate_bpm.map(|_| infeasible),
         best,
         best_per_count,
         runner_ups: placements.iter().skip(1).take(5).cloned().collect(),

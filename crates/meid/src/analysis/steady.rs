@@ -83,6 +83,11 @@ use crate::impact::{ImpactSystem, Mode, Switch};
 use crate::integrate::{self, propagator::Propagator, Method, Options, Solution};
 use crate::{Error, Result};
 
+/// Blow evaluations the search from rest leaves for marching (step 2 of the module docs'
+/// "Regimes and the fallback"): a disturbance decaying by `|μ|max = 0.75` per blow falls below
+/// the period detection's `1e-6` within 48 blows.
+const MARCH_RESERVE: usize = 48;
+
 /// Settings of the direct steady state.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SteadyOptions {
@@ -253,6 +258,11 @@ pub(crate) trait BlowMap {
     fn history(&mut self) -> &mut Vec<(char, f64)>;
     /// The peak floor force of a blow (N), for the irregular regime's note.
     fn floor_force(report: &Self::Report) -> f64;
+    /// Blow evaluations one blow with its Jacobian costs (1 where the Jacobian comes from the
+    /// path; `1 + dim` by forward differences).
+    fn step_cost(&self) -> usize {
+        1
+    }
 
     /// The relative energy norm of a difference of two states `y` (module docs).
     fn norm(&self, d: &[f64]) -> f64 {
@@ -702,7 +712,8 @@ fn eval_k<M: BlowMap>(
 ///
 /// With `march_first` the first step is a march step: from rest a damper touches the bed with
 /// zero overlap and zero relative velocity (a grazing start), where the map is not
-/// differentiable and a Newton step from there is wasted.
+/// differentiable and a Newton step from there is wasted. No step is begun with fewer than
+/// `reserve` evaluations of the budget left (kept for the march that follows a failed search).
 ///
 /// The iterates are evaluated without the blows' exact peaks (they need only the state at the
 /// next strike and the Jacobian), except the one Newton is expected to end on: after an accepted
@@ -717,6 +728,7 @@ fn newton<M: BlowMap>(
     tol: f64,
     iterations: usize,
     march_first: bool,
+    reserve: usize,
 ) -> Result<Fixed<M::Report>> {
     let mut y = y0;
     // From rest with a damper the first step is a march: the start is not differentiated.
@@ -730,7 +742,7 @@ fn newton<M: BlowMap>(
     // The residual before the last accepted Newton step (`None` after a march step).
     let mut before: Option<f64> = None;
     for _ in 1..iterations {
-        if residual <= tol || map.left() < 2 * k {
+        if residual <= tol || map.left() < 2 * k * map.step_cost() + reserve {
             break;
         }
         let r = diff(&z, &y);
@@ -889,8 +901,14 @@ pub(crate) fn search<M: BlowMap>(
     notes: &mut Vec<String>,
 ) -> Result<Found<M::Report>> {
     let d = map.dim();
+    let k_max = so.max_period.max(1);
+    // What the march of step 2 needs: the refinement of a period-k (`4·(k_max + 1)`, as below)
+    // and enough blows to see a period settle (`MARCH_RESERVE`). A Newton search that has not
+    // converged by then (a costly finite-difference Jacobian near a grazing contact can spend
+    // the whole budget) hands over to the march.
+    let reserve = (4 * (k_max + 1) + MARCH_RESERVE).min(map.budget() / 2);
     // 1. Newton on P from rest.
-    let fixed = newton(map, vec![0.0; d], 1, so.tolerance, 40, march_first)?;
+    let fixed = newton(map, vec![0.0; d], 1, so.tolerance, 40, march_first, reserve)?;
     let mu = multipliers(&fixed.jac);
     let stable = mu.first().is_none_or(|m| *m < 1.0);
     if fixed.converged && stable {
@@ -927,7 +945,6 @@ pub(crate) fn search<M: BlowMap>(
     let mut states = vec![y.clone()];
     let mut reports: Vec<M::Report> = Vec::new();
     let detect = 1e-6_f64.max(so.tolerance);
-    let k_max = so.max_period.max(1);
     let march_budget = map
         .budget()
         .saturating_sub(map.evaluations() + 4 * (k_max + 1));
@@ -944,7 +961,7 @@ pub(crate) fn search<M: BlowMap>(
             map.norm(&diff) < detect
         });
         if let Some(k) = found {
-            let fixed = newton(map, y.clone(), k, so.tolerance, 8, false)?;
+            let fixed = newton(map, y.clone(), k, so.tolerance, 8, false, 0)?;
             let mu = multipliers(&fixed.jac);
             notes.push(format!(
                 "a period of {k} blow{} appeared after {j} marched blows and was refined by \
@@ -960,6 +977,16 @@ pub(crate) fn search<M: BlowMap>(
         }
     }
     // 3. Irregular: the last blows' levels as an estimate.
+    if reports.is_empty() {
+        return Err(Error::numerical(
+            "steady state",
+            format!(
+                "the budget of {} blow evaluations was spent before any blow could be marched (Newton's residual {:.2e}): raise it or lower the model's cost",
+                map.budget(),
+                fixed.residual
+            ),
+        ));
+    }
     let tail: Vec<M::Report> = reports.iter().rev().take(k_max).rev().cloned().collect();
     // `states[j]` is the state before marched blow j + 1.
     let strike_state = states[reports.len() - tail.len()].clone();
