@@ -73,6 +73,7 @@ mod report_measured;
 mod restitution_contacts;
 mod rigid_contacts;
 mod small_eig;
+mod steady_examples;
 mod spectrum_checks;
 mod stiff_inputs;
 mod structure_cache;

@@ -661,12 +661,11 @@ fn settled(blows: &[NetBlowReport], tol: f64) -> Option<usize> {
 pub fn steady_state(model: &NetworkModel, so: &SteadyOptions) -> Result<NetSteadyState> {
     check_options(so).map_err(rate_error)?;
     let net = &model.network;
-    let mut map = NetMap::new(
-        net,
-        &model.options()?,
-        so.rate_bpm,
-        so.max_evaluations.max(2),
-    )?;
+    let mut map = NetMap::new(net, &model.options()?, so.rate_bpm, 2)?;
+    // A Newton step costs `1 + d` blows here (forward differences): the budget holds at least
+    // eight of them besides the march's reserve, so a machine with many modes (the 40-mode press
+    // with four dampers: d = 90) is not cut off after three steps.
+    map.budget = so.max_evaluations.max(8 * map.step_cost() + 84).max(2);
     let mut notes = Vec::new();
     let found = search(&mut map, so, !net.suspensions.is_empty(), &mut notes)?;
     let (blows, converged, residual, regime, method, mu, smooth, strike_state) = match found {

@@ -64,6 +64,9 @@
 //!    Newton was best, and after each blow the smallest `k ≤ max_period` with
 //!    `‖y_j − y_{j−k}‖ < 1e-6` is sought; found, Newton on `P^k` refines it from `y_j`:
 //!    **period-k** (every k-th blow alike; k = 2 is a damper touching every other blow).
+//!    Where none appears to 1e-6 within the budget, the period with the smallest change over
+//!    the last blows (below 1e-2) is refined by Newton on `P^k` once, and taken when it
+//!    converges to a stable fixed point: the march was settling slowly onto it.
 //! 3. No period within the budget: **irregular**, with the last marched blows' levels as an
 //!    estimate, their spread beside them, and `converged = false`.
 //!
@@ -664,14 +667,18 @@ pub(crate) struct Fixed<R> {
     pub reports: Vec<R>,
     /// Evaluations of `P^k` spent, and of them Newton steps rejected for a march step.
     pub rejected: usize,
+    /// The states before each of the k blows from `y` (`y` first).
+    pub orbit: Vec<Vec<f64>>,
 }
 
-/// `P^k(y)`, its Jacobian, the k blows' reports and their switching sequences.
+/// `P^k(y)`, its Jacobian, the k blows' reports, their switching sequences and the states
+/// before each of them (`y` first).
 type PeriodEval<M> = (
     Vec<f64>,
     Mat<f64>,
     Vec<<M as BlowMap>::Report>,
     Vec<<M as BlowMap>::Switches>,
+    Vec<Vec<f64>>,
 );
 
 /// `P^k(y)`, its Jacobian (the identity when not `with_jac`: a start that is marched from is
@@ -689,7 +696,9 @@ fn eval_k<M: BlowMap>(
     let mut jac = Mat::<f64>::identity(d, d);
     let mut reports = Vec::with_capacity(k);
     let mut switches = Vec::with_capacity(k);
+    let mut orbit = Vec::with_capacity(k);
     for b in 0..k {
+        orbit.push(z.clone());
         let e = map.eval(&z, b, with_jac, peaks)?;
         if with_jac {
             let jb = e
@@ -701,7 +710,7 @@ fn eval_k<M: BlowMap>(
         reports.push(e.report);
         switches.push(e.switches);
     }
-    Ok((z, jac, reports, switches))
+    Ok((z, jac, reports, switches, orbit))
 }
 
 /// Newton on `P^k(y) − y = 0` from `y0`, globalised by backtracking and marching: a Newton
@@ -732,7 +741,8 @@ fn newton<M: BlowMap>(
 ) -> Result<Fixed<M::Report>> {
     let mut y = y0;
     // From rest with a damper the first step is a march: the start is not differentiated.
-    let (mut z, mut jac, mut reports, mut switches) = eval_k(map, &y, k, false, !march_first)?;
+    let (mut z, mut jac, mut reports, mut switches, mut orbit) =
+        eval_k(map, &y, k, false, !march_first)?;
     let mut with_peaks = false;
     let diff = |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(p, q)| p - q).collect() };
     let mut residual = map.norm(&diff(&z, &y));
@@ -755,24 +765,26 @@ fn newton<M: BlowMap>(
         let accepted = match trial {
             Some(yt) => {
                 let last = before.is_some_and(|r0| r0 > 0.0 && residual.powi(3) / (r0 * r0) <= tol);
-                let (zt, jt, rt, st) = eval_k(map, &yt, k, last, true)?;
+                let (zt, jt, rt, st, ot) = eval_k(map, &yt, k, last, true)?;
                 let res_t = map.norm(&diff(&zt, &yt));
                 map.record(if res_t < residual { 'N' } else { 'x' }, res_t);
                 if res_t < residual {
                     smooth = st == switches;
                     before = Some(residual);
                     (y, z, jac, reports, switches, residual) = (yt, zt, jt, rt, st, res_t);
+                    orbit = ot;
                     with_peaks = last;
                     true
                 } else if let Some(yw) = backtrack(map, &y, &yt, residual, res_t, k) {
                     // One backtracking step along the rejected Newton step.
-                    let (zw, jw, rw, sw) = eval_k(map, &yw, k, false, true)?;
+                    let (zw, jw, rw, sw, ow) = eval_k(map, &yw, k, false, true)?;
                     let res_w = map.norm(&diff(&zw, &yw));
                     map.record(if res_w < residual { 'b' } else { 'x' }, res_w);
                     if res_w < residual {
                         smooth = sw == switches;
                         before = None;
                         (y, z, jac, reports, switches, residual) = (yw, zw, jw, rw, sw, res_w);
+                        orbit = ow;
                         with_peaks = false;
                         true
                     } else {
@@ -791,18 +803,18 @@ fn newton<M: BlowMap>(
                 break;
             }
             y = z.clone();
-            let (zt, jt, rt, st) = eval_k(map, &y, k, false, true)?;
+            let (zt, jt, rt, st, ot) = eval_k(map, &y, k, false, true)?;
             smooth = st == switches;
             residual = map.norm(&diff(&zt, &y));
             map.record('m', residual);
-            (z, jac, reports, switches) = (zt, jt, rt, st);
+            (z, jac, reports, switches, orbit) = (zt, jt, rt, st, ot);
             (with_peaks, before) = (false, None);
         }
     }
     if !with_peaks {
         // The levels of the last iterate: the same blows again, with their exact peaks (and
         // the Jacobian, which a start that converged at once was not given).
-        let (_, jt, rt, _) = eval_k(map, &y, k, true, true)?;
+        let (_, jt, rt, _, _) = eval_k(map, &y, k, true, true)?;
         (jac, reports) = (jt, rt);
     }
     Ok(Fixed {
@@ -813,6 +825,7 @@ fn newton<M: BlowMap>(
         smooth,
         reports,
         rejected,
+        orbit,
     })
 }
 
@@ -976,6 +989,12 @@ pub(crate) fn search<M: BlowMap>(
             });
         }
     }
+    // 2b. No period to 1e-6 within the march: a regime that settles slowly (|μ| near 1 on
+    // P^k) still has its fixed point of P^k near the last state, which Newton finds where the
+    // march crawls. The closest period is refined once, and taken only converged and stable.
+    if let Some(found) = closest_period(map, so, &states, k_max, notes)? {
+        return Ok(found);
+    }
     // 3. Irregular: the last blows' levels as an estimate.
     if reports.is_empty() {
         return Err(Error::numerical(
@@ -1019,6 +1038,79 @@ pub(crate) fn search<M: BlowMap>(
         strike_state,
         residual,
     })
+}
+
+/// Step 2b of [`search`]: after a march of `states` (the states before each marched blow and
+/// after the last) in which no period appeared to the detection's 1e-6, the period `k ≤ k_max`
+/// with the smallest change `‖y_j − y_{j−k}‖` over the last `k` blows, when that change is below
+/// 1e-2 of the blow's energy norm, is refined by Newton on `P^k` from the last state; a converged
+/// fixed point whose multipliers are all inside the unit circle is the regime the march was
+/// approaching (it attracts, and the march was within its reach), so it is returned, with its
+/// least period (a divisor `d` of `k` with `‖P^d(y) − y‖ < 1e-6` is refined on `P^d`). Anything
+/// else: `None`, and the train is irregular.
+fn closest_period<M: BlowMap>(
+    map: &mut M,
+    so: &SteadyOptions,
+    states: &[Vec<f64>],
+    k_max: usize,
+    notes: &mut Vec<String>,
+) -> Result<Option<Found<M::Report>>> {
+    let j = states.len().saturating_sub(1);
+    let Some(y) = states.last() else {
+        return Ok(None);
+    };
+    let Some((k, change)) = (1..=k_max.min(j))
+        .map(|k| {
+            let diff: Vec<f64> = y.iter().zip(&states[j - k]).map(|(a, b)| a - b).collect();
+            (k, map.norm(&diff))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+    else {
+        return Ok(None);
+    };
+    if !(change < 1e-2) || map.left() < 2 * k * map.step_cost() {
+        return Ok(None);
+    }
+    let k0 = k;
+    let mut fixed = newton(map, y.clone(), k, so.tolerance, 8, false, 0)?;
+    if !fixed.converged {
+        return Ok(None);
+    }
+    // The least period of the orbit found: a slowly decaying disturbance of a period-d orbit
+    // (multiplier μ of P^d near −1) changes least over 2d blows, so the closest period can be
+    // a multiple of the orbit's own.
+    let mut k = k;
+    for d in (1..k).filter(|d| k % d == 0) {
+        let diff: Vec<f64> = fixed.orbit[d]
+            .iter()
+            .zip(&fixed.y)
+            .map(|(a, b)| a - b)
+            .collect();
+        if map.norm(&diff) < 1e-6 {
+            let f = newton(map, fixed.y.clone(), d, so.tolerance, 8, false, 0)?;
+            if f.converged {
+                (fixed, k) = (f, d);
+                break;
+            }
+        }
+    }
+    let mu = multipliers(&fixed.jac);
+    if mu.first().is_some_and(|m| *m >= 1.0) {
+        return Ok(None);
+    }
+    notes.push(format!(
+        "no period appeared to 1e-6 within {j} marched blows; the closest (a change of \
+         {change:.1e} over the last {k0} blows) was refined by Newton to a stable orbit of \
+         {k} blow{} (|μ|max = {:.4} on P^{k}): the march was settling slowly onto it",
+        if k == 1 { "" } else { "s" },
+        mu.first().copied().unwrap_or(0.0)
+    ));
+    Ok(Some(Found::Periodic {
+        fixed,
+        k,
+        mu,
+        method: "newton after marching",
+    }))
 }
 
 /// One steady blow run again by [`replay`]: its solution (exact peaks in `totals.peaks`, blow
