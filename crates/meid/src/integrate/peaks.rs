@@ -1025,7 +1025,9 @@ mod tests {
         assert_eq!(visits, 0);
         let mut e = Extremes::default();
         on_segment(&seg, &l, &la, 2.0, len, &mut e);
-        assert_eq!((e.max, e.t_max, e.min, e.t_min), (-0.417, 2.0, -0.417, 2.0));
+        // (−0.417 to the round-off of the mass-scaled rigid split, √1.2 and back.)
+        assert_eq!((e.max, e.t_max, e.t_min), (e.min, 2.0, 2.0), "{e:?}");
+        assert!((e.max + 0.417).abs() <= 2.0 * f64::EPSILON, "{e:?}");
         // Its displacement −0.417 s: the slope is not zero, the extremes are the ends.
         let (l, la) = (
             [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
