@@ -12,6 +12,19 @@
 //! far is not searched, nor is a window or cell of a closed-form segment whose range bound (a
 //! cubic Hermite interpolant plus its remainder, envelopes for the fast terms:
 //! `exp_extremes`) cannot: the result is the same, only cheaper.
+//!
+//! # A channel that cannot move
+//! The velocity of an impactor in free flight is constant: its slope `ℓ_σᵀA_σX(s)` has a zero
+//! row of `A_σ` behind it, so `p₀ = p₁ = p₂ = 0` and every `A_k = 0` exactly
+//! ([`Functional::is_zero`]). The search for sign changes of such a slope can find none (the
+//! lifted value `G = noise ≥ 0` is never negative, [`super::roots::Search::advance`]), but it
+//! proves that only by halving every cell down to `h/2¹⁰` and stepping across it at that size
+//! (about 14,000 evaluations of `g'` and of its curvature bound per cell, each one `exp` and
+//! `sincos` per term). Meanwhile the channel's bounds stay within their round-off allowance
+//! of its constant value, so every cell "could improve" it and is searched: on the FE press
+//! (`examples/press-off-centre-4-dampers.toml`, 46-49 terms) that was 99 % of the run
+//! (issue 29). Such a slope is not searched; the value at each such cell's start is still
+//! offered, so the extremes are the same bit for bit.
 
 use faer::c64;
 
@@ -415,9 +428,12 @@ fn exp_extremes(e: &ExpSum, dg: &Functional<'_>, t0: f64, len: f64, ext: &mut Ex
     let value = |s: f64| e.derivative(0, s);
     let period = e.fastest_period();
     if !(period.is_finite() && period > 0.0) || e.amp.is_empty() {
-        for_each_extremum(dg, 0.0, len, EXTREMUM_SEARCH, |s, _| {
-            ext.offer(value(s), t0 + s)
-        });
+        // A zero slope has no sign change to find (module docs, "A channel that cannot move").
+        if !dg.is_zero() {
+            for_each_extremum(dg, 0.0, len, EXTREMUM_SEARCH, |s, _| {
+                ext.offer(value(s), t0 + s)
+            });
+        }
         return;
     }
     let win = ExpWindows::new(e, len, period);
@@ -607,6 +623,8 @@ impl<'e> ExpWindows<'e> {
         let (e, w, hc, n_cell, n_win) = (self.e, self.w, self.hc, self.n_cell, self.n_win);
         let (k, mags, pad) = (e.amp.len(), &self.mags, self.pad);
         let value = |s: f64| e.derivative(0, s);
+        // No sign change of a zero slope to search for (module docs).
+        let slope_is_zero = dg.is_zero();
         let mut z = vec![c64::new(0.0, 0.0); k];
         let mut env = vec![0.0; k];
         let cell_step: Vec<c64> = e.lam.iter().map(|l| (l * hc).exp()).collect();
@@ -649,9 +667,11 @@ impl<'e> ExpWindows<'e> {
                 let rem = m4 * (cb - ca).powi(4) / 384.0 + pad;
                 if ext.could_improve_range(hlo - rem, hhi + rem) {
                     ext.offer(value(ca), t0 + ca);
-                    for_each_extremum(dg, ca, cb, EXTREMUM_SEARCH, |s, _| {
-                        ext.offer(value(s), t0 + s)
-                    });
+                    if !slope_is_zero {
+                        for_each_extremum(dg, ca, cb, EXTREMUM_SEARCH, |s, _| {
+                            ext.offer(value(s), t0 + s)
+                        });
+                    }
                 }
                 (g0, d0) = (g1, d1);
             }
@@ -969,6 +989,59 @@ mod tests {
             (pruned.t_min - all.t_min).abs() < 1e-9,
             "{pruned:?} {all:?}"
         );
+    }
+
+    /// A free body (no stiffness, no damping: an impactor in flight) beside two oscillators:
+    /// its velocity is constant, the slope functional is exactly zero
+    /// ([`Functional::is_zero`]) and the search it is spared finds nothing (the equivalence
+    /// the skip rests on); the extremes are the constant, first reached at the start, and the
+    /// body's displacement (slope = the constant velocity) still gets its exact ends.
+    #[test]
+    fn constant_channel_of_a_free_body() {
+        use super::super::propagator::Propagator;
+        use faer::Mat;
+        let (w1, w2) = (
+            2.0 * std::f64::consts::PI * 50.0,
+            2.0 * std::f64::consts::PI * 2900.0,
+        );
+        let diag = |v: [f64; 3]| Mat::from_fn(3, 3, |i, j| if i == j { v[i] } else { 0.0 });
+        let k = diag([0.0, w1 * w1, w2 * w2]);
+        let c = diag([0.0, 0.02 * w1, 0.02 * w2]);
+        let a = Mat::from_fn(6, 6, |i, j| match (i < 3, j < 3) {
+            (true, false) => f64::from(u8::from(j - 3 == i)),
+            (false, true) => -k[(i - 3, j)],
+            (false, false) => -c[(i - 3, j - 3)],
+            _ => 0.0,
+        });
+        let p = Propagator::new(&k, &c, &[1.2, 1.0, 1.0], a).unwrap();
+        let seg = p.segment(&[0.0, 1e-3, -2e-4, -0.417, 0.3, 2.0]);
+        let len = 0.05;
+        // Velocity of the free body: ℓ = e₄, ℓᵀA = 0.
+        let (l, la) = ([0.0, 0.0, 0.0, 1.0, 0.0, 0.0], [0.0; 6]);
+        let df = seg.functional(&la);
+        assert!(df.is_zero());
+        let mut visits = 0;
+        for_each_extremum(&df, 0.0, len, EXTREMUM_SEARCH, |_, _| visits += 1);
+        assert_eq!(visits, 0);
+        let mut e = Extremes::default();
+        on_segment(&seg, &l, &la, 2.0, len, &mut e);
+        // (−0.417 to the round-off of the mass-scaled rigid split, √1.2 and back.)
+        assert_eq!((e.max, e.t_max, e.t_min), (e.min, 2.0, 2.0), "{e:?}");
+        assert!((e.max + 0.417).abs() <= 2.0 * f64::EPSILON, "{e:?}");
+        // Its displacement −0.417 s: the slope is not zero, the extremes are the ends.
+        let (l, la) = (
+            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+        );
+        assert!(!seg.functional(&la).is_zero());
+        let mut e = Extremes::default();
+        on_segment(&seg, &l, &la, 2.0, len, &mut e);
+        assert_eq!((e.max, e.t_max, e.t_min), (0.0, 2.0, 2.0 + len));
+        assert!((e.min + 0.417 * len).abs() <= 1e-16, "{e:?}");
+        // An oscillator's velocity: its slope is not zero.
+        assert!(!seg
+            .functional(&[0.0, -w1 * w1, 0.0, 0.0, -0.02 * w1, 0.0])
+            .is_zero());
     }
 
     /// A slow mode peaking late (25 ms) under a fast one that starts almost as large and

@@ -597,6 +597,16 @@ pub enum Functional<'s> {
 }
 
 impl ExpSum {
+    /// Is this the zero function: `p₀ = p₁ = p₂ = 0` and every `A_k = 0` exactly? (The slope
+    /// of a channel that cannot move in its mode: the velocity of an impactor in free flight,
+    /// whose row of `A` is zero, so that every term of `ℓᵀA X(s)` is an exact `0`.)
+    pub fn is_zero(&self) -> bool {
+        self.p0 == 0.0
+            && self.p1 == 0.0
+            && self.p2 == 0.0
+            && self.amp.iter().all(|a| a.re == 0.0 && a.im == 0.0)
+    }
+
     /// `j`-th derivative at `s`.
     pub fn derivative(&self, j: u32, s: f64) -> f64 {
         let mut v = match j {
@@ -655,6 +665,17 @@ impl Scalar for ExpSum {
     }
     fn noise(&self) -> f64 {
         self.noise
+    }
+}
+
+impl Functional<'_> {
+    /// Is this functional the zero function ([`ExpSum::is_zero`]; never claimed of the
+    /// matrix-exponential fallback)?
+    pub fn is_zero(&self) -> bool {
+        match self {
+            Functional::Exp(e) => e.is_zero(),
+            Functional::Expm { .. } => false,
+        }
     }
 }
 
