@@ -72,7 +72,10 @@ fn check(name: &str, model: &Model, method: Method, rate: f64) -> String {
             (hi - lo) / hi.abs()
         };
         assert!(!s.converged, "{what}");
-        assert!((0..3).any(|i| spread(i) > 1e-6), "{what}: the march settled");
+        assert!(
+            (0..3).any(|i| spread(i) > 1e-6),
+            "{what}: the march settled"
+        );
         return format!("{what}: irregular, the march unsettled too");
     };
     assert!(s.converged, "{what}");
@@ -85,7 +88,11 @@ fn check(name: &str, model: &Model, method: Method, rate: f64) -> String {
     let mut worst = 0.0_f64;
     for i in 0..4 {
         let tail = (last[i] - prev[i]).abs() * mu / (1.0 - mu);
-        let scale = if i == 3 { last[i].abs().max(1e-6) } else { last[i].abs() };
+        let scale = if i == 3 {
+            last[i].abs().max(1e-6)
+        } else {
+            last[i].abs()
+        };
         let d = (st[i] - last[i]).abs();
         assert!(
             d <= (1e-6 * scale).max(2.0 * tail),
