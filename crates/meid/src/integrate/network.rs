@@ -408,13 +408,27 @@ fn channel_vector(net: &Network, md: &ModeData, mode: NetMode, kind: &ChannelKin
 /// above its round-off band, `1e-9` (value) or `1e-11` (derivatives) of the sizes of its terms
 /// (`T₀ = |X|`, `T₁ = |A|T₀ + |b|`, `T_{k+1} = |A|T_k`); 0 when none is, up to order 8.
 fn lex_signs(inds: &[NetIndicator], md: &ModeData, x: &[f64], out: &mut [f64]) {
+    lex_signs_of(inds, (&md.a, &md.b), x, VALUE_TOL, out);
+}
+
+/// [`lex_signs`] under `Ẋ = A X + b` given as `(A column-major, b)`, with a value band of
+/// `value_tol` of its terms (dopri5 on a network passes its Jacobian at `x`, `b = F(x) − A x`,
+/// and a band of its tolerance: exact for linear laws and for the first two derivatives with
+/// any law, [`super::network_dopri5`]).
+pub(super) fn lex_signs_of(
+    inds: &[NetIndicator],
+    (a, b): (&[f64], &[f64]),
+    x: &[f64],
+    value_tol: f64,
+    out: &mut [f64],
+) {
     let n = x.len();
     out.fill(0.0);
     let mut y = x.to_vec();
     let mut terms: Vec<f64> = x.iter().map(|v| v.abs()).collect();
     let mut open = inds.len();
     for k in 0..=K_MAX {
-        let tol = if k == 0 { VALUE_TOL } else { 1e-11 };
+        let tol = if k == 0 { value_tol } else { 1e-11 };
         for (ind, o) in inds.iter().zip(out.iter_mut()) {
             if *o != 0.0 {
                 continue;
@@ -433,7 +447,7 @@ fn lex_signs(inds: &[NetIndicator], md: &ModeData, x: &[f64], out: &mut [f64]) {
         let mut next = vec![0.0; n];
         let mut next_terms = vec![0.0; n];
         for j in 0..n {
-            let col = &md.a[j * n..(j + 1) * n];
+            let col = &a[j * n..(j + 1) * n];
             for i in 0..n {
                 next[i] += col[i] * y[j];
                 next_terms[i] += col[i].abs() * terms[j];
@@ -441,8 +455,8 @@ fn lex_signs(inds: &[NetIndicator], md: &ModeData, x: &[f64], out: &mut [f64]) {
         }
         if k == 0 {
             for i in 0..n {
-                next[i] += md.b[i];
-                next_terms[i] += md.b[i].abs();
+                next[i] += b[i];
+                next_terms[i] += b[i].abs();
             }
         }
         y = next;
