@@ -27,7 +27,12 @@
 //! ([`super::network`]'s rule, with the Jacobian of the right-hand side at the switch: exact for
 //! linear laws, and for the first two derivatives with any law), candidate modes iterated to a
 //! consistent one; an indicator the derivatives leave on the side it was searched from while
-//! the state is past its zero takes the state's side.
+//! the state is past its zero takes the state's side. An indicator still zero to all orders (a
+//! Hertz contact at zero overlap moves with fractional powers of time, so a structure struck
+//! through it starts moving with all derivatives zero at t = 0) is settled by the motion: when
+//! the next accepted step leaves it beyond its band on a side that implies another mode, it
+//! left zero at once, and the step is redone from its start in that mode (as the paper
+//! machine's engine does).
 //!
 //! **Outputs** are those of the exact engine ([`NetSolution`]): the same channels, with their
 //! extremes located on the dense output (values and slopes at the step ends, the slope's root
@@ -326,6 +331,8 @@ struct Run<'n, 'o> {
     /// The indicators' `ℓ` (sparse) and `ℓ₀`.
     ind_l: Vec<(SparseVec, f64)>,
     signs: Vec<f64>,
+    /// Indicators zero to all orders at the last selection (module documentation).
+    provisional: Vec<bool>,
     value_tol: f64,
     nd: usize,
     y: Vec<f64>,
@@ -366,6 +373,7 @@ impl<'n, 'o> Run<'n, 'o> {
             opts,
             rhs: Rhs::new(net),
             signs: vec![0.0; inds.len()],
+            provisional: vec![false; inds.len()],
             inds,
             ind_l,
             value_tol: (opts.rtol / 10.0).max(VALUE_TOL),
@@ -426,16 +434,83 @@ impl<'n, 'o> Run<'n, 'o> {
             self.signs_under(cand, x)?;
             let next = self.net.implied(&self.inds, &self.signs);
             if next == cand {
-                return Ok(cand);
+                break;
             }
             if seen.contains(&next) {
+                self.signs_under(cand, x)?;
                 break;
             }
             seen.push(next);
             cand = next;
         }
-        self.signs_under(cand, x)?;
+        for (p, s) in self.provisional.iter_mut().zip(&self.signs) {
+            *p = *s == 0.0;
+        }
         Ok(cand)
+    }
+
+    /// Indicators zero to all orders at the last selection (a Hertz contact at zero overlap
+    /// moves with fractional powers of time), settled by where the accepted step took them:
+    /// beyond their band, they take the side of the state; one whose side implies another
+    /// mode left zero at once, and the step is redone from its start in that mode (returns
+    /// true).
+    fn settle_provisional(&mut self) -> Result<bool> {
+        let n = 2 * self.nd;
+        let mut forced = false;
+        for (i, (l, l0)) in self.ind_l.iter().enumerate() {
+            if !self.provisional[i] {
+                continue;
+            }
+            let g = l.dot(&self.ynew[..n]) + l0;
+            if g.abs() <= self.value_tol * terms(l, *l0, &self.ynew[..n]) {
+                continue;
+            }
+            self.provisional[i] = false;
+            self.signs[i] = g.signum();
+            forced |= self.net.implied(&self.inds, &self.signs) != self.mode;
+        }
+        if !forced {
+            return Ok(false);
+        }
+        let new_mode = self.net.implied(&self.inds, &self.signs);
+        self.stalled_switches += 1;
+        if self.stalled_switches > MAX_STALLED {
+            return Err(self.stalled(&format!(
+                "{MAX_STALLED} switches in a row without time advancing"
+            )));
+        }
+        self.change_mode(new_mode)?;
+        self.need_k1 = true;
+        Ok(true)
+    }
+
+    /// The switch from the current mode to `new_mode` at `(t, y)`: the contacts' rows, the
+    /// energy jumps of force-release contacts (into `D`), the event (more than
+    /// `simulation.max_events` is an error).
+    fn change_mode(&mut self, new_mode: NetMode) -> Result<()> {
+        let n = 2 * self.nd;
+        let (jump, touched) = book_contacts(
+            self.net,
+            (self.mode, new_mode),
+            (self.t, &self.y[..n]),
+            &self.start.preloaded,
+            &mut self.start.impacts,
+            &mut self.start.open,
+        );
+        self.y[n] += jump;
+        self.start.touched |= touched;
+        self.events.push((self.t, self.mode, new_mode));
+        if self.events.len() > self.opts.max_events {
+            return Err(Error::numerical(
+                "dopri5",
+                format!(
+                    "more than {} switching events by t = {:.6e} s (simulation.max_events)",
+                    self.opts.max_events, self.t
+                ),
+            ));
+        }
+        self.mode = new_mode;
+        Ok(())
     }
 
     /// Steps to the end of the run (or of the collision, when asked).
@@ -469,6 +544,9 @@ impl<'n, 'o> Run<'n, 'o> {
             }
             self.stalled_rejects = 0;
             self.steps += 1;
+            if self.settle_provisional()? {
+                continue;
+            }
             self.dense.fill(self.h, &self.y, &self.ynew, &self.k);
             let (s_end, switched) = self.crossing();
             self.book_step(s_end);
@@ -481,6 +559,7 @@ impl<'n, 'o> Run<'n, 'o> {
             self.y.copy_from_slice(&self.ynew);
             self.k.swap(0, 6);
             self.t += self.h;
+            self.stalled_switches = 0;
             self.control(err, fac11);
         }
     }
@@ -697,30 +776,10 @@ impl<'n, 'o> Run<'n, 'o> {
         } else {
             self.stalled_switches = 0;
         }
-        if new_mode != self.mode {
-            let (jump, touched) = book_contacts(
-                self.net,
-                (self.mode, new_mode),
-                (self.t, &y[..n]),
-                &self.start.preloaded,
-                &mut self.start.impacts,
-                &mut self.start.open,
-            );
-            y[n] += jump;
-            self.start.touched |= touched;
-            self.events.push((self.t, self.mode, new_mode));
-            if self.events.len() > self.opts.max_events {
-                return Err(Error::numerical(
-                    "dopri5",
-                    format!(
-                        "more than {} switching events by t = {:.6e} s (simulation.max_events)",
-                        self.opts.max_events, self.t
-                    ),
-                ));
-            }
-            self.mode = new_mode;
-        }
         self.y = y;
+        if new_mode != self.mode {
+            self.change_mode(new_mode)?;
+        }
         self.need_k1 = true;
         Ok(self.collision_ended())
     }

@@ -562,7 +562,7 @@ fn check_nonlinear_entry(
             format!("law = \"{name}\" needs simulation.method = \"dopri5\" (the exact method takes piecewise-linear contacts: law = \"linear\" or \"rigid\"); add [simulation] method = \"dopri5\""),
         ));
     }
-    if let Some(d) = c.damping {
+    if let Some(d) = c.damping.filter(|d| *d != 0.0) {
         return Err((
             format!("{p}.damping"),
             format!("damping = {} is given with law = \"{name}\": only the linear law takes damping; hunt-crossley takes alpha (s/m) or restitution", crate::num(d)),
