@@ -49,7 +49,10 @@ fn same_rows(a: &[ImpactRow], b: &[ImpactRow], tol: f64) {
     for (x, y) in a.iter().zip(b) {
         assert_eq!(x.contact, y.contact);
         let dur = y.duration_s.max(1e-300);
-        assert!((x.start_s - y.start_s).abs() <= tol * dur.max(y.start_s), "{x:?} {y:?}");
+        assert!(
+            (x.start_s - y.start_s).abs() <= tol * dur.max(y.start_s),
+            "{x:?} {y:?}"
+        );
         assert!(rel(x.duration_s, y.duration_s) <= tol, "{x:?} {y:?}");
         let (px, py) = (x.peak_force_n.unwrap(), y.peak_force_n.unwrap());
         assert!(rel(px, py) <= tol, "{x:?} {y:?}");
@@ -97,8 +100,8 @@ fn linear_laws_match_the_exact_engine_on_the_paper_machine() {
 /// contact of restitution 0.5: dopri5 against the exact engine, as above.
 #[test]
 fn linear_laws_match_the_exact_engine_on_the_hammer_foundation() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples/hammer-rigid.toml");
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/hammer-rigid.toml");
     let sets = [
         "contact.tup_anvil.law=\"linear\"".to_string(),
         "contact.tup_anvil.stiffness=1e11".to_string(),
@@ -130,8 +133,8 @@ fn linear_laws_match_the_exact_engine_on_the_hammer_foundation() {
 /// the paper's form (the same physics): energy ratio and peak contact forces within 1e-6.
 #[test]
 fn hertz_paper_machine_matches_the_paper_engine() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples/paper-lumped.toml");
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-lumped.toml");
     let sets = [
         "contact.slider_bed.law=\"hertz\"".to_string(),
         "contact.slider_bed.stiffness=1e9".to_string(),
@@ -210,7 +213,11 @@ rtol = 1e-10
         let m_red = m1 * m2 / (m1 + m2);
         let lost = 0.5 * m_red * v * v * (1.0 - e * e);
         let e_in = 0.5 * m1 * v * v;
-        assert!((sol.dissipated_j - lost).abs() < 1e-6 * e_in, "{}", sol.dissipated_j);
+        assert!(
+            (sol.dissipated_j - lost).abs() < 1e-6 * e_in,
+            "{}",
+            sol.dissipated_j
+        );
         assert!((row.dissipated_j - lost).abs() < 1e-6 * e_in, "{row:?}");
         assert!(sol.residual_run_end < 1e-6);
     }
@@ -266,7 +273,11 @@ fn hertz_two_body_contact_time_is_johnsons() {
     let m_red = m1 * m2 / (m1 + m2);
     let d_max = (5.0 * m_red * v * v / (4.0 * k)).powf(0.4);
     let t_c = c * d_max / v;
-    assert!(rel(row.duration_s, t_c) < 1e-6, "{} vs {t_c}", row.duration_s);
+    assert!(
+        rel(row.duration_s, t_c) < 1e-6,
+        "{} vs {t_c}",
+        row.duration_s
+    );
     assert!(rel(row.start_s, 1e-3 / v) < 1e-6, "{}", row.start_s);
     let f_max = k * d_max.powf(1.5);
     assert!(rel(row.peak_force_n.unwrap(), f_max) < 1e-6, "{row:?}");
@@ -330,9 +341,7 @@ fn bad_laws_and_methods_are_refused_naming_the_field() {
         .map(|e| e.to_string())
         .unwrap_or_default();
     assert!(
-        e.contains("paper-general.toml")
-            && e.contains("contact[0].law")
-            && e.contains("dopri5"),
+        e.contains("paper-general.toml") && e.contains("contact[0].law") && e.contains("dopri5"),
         "{e}"
     );
     let e = general_error(&[
@@ -340,7 +349,10 @@ fn bad_laws_and_methods_are_refused_naming_the_field() {
         "simulation.method=\"dopri5\"",
         "contact.slider_bed.restitution=0.5",
     ]);
-    assert!(e.contains("contact[0].restitution") && e.contains("hunt-crossley"), "{e}");
+    assert!(
+        e.contains("contact[0].restitution") && e.contains("hunt-crossley"),
+        "{e}"
+    );
     let e = general_error(&[
         "contact.slider_bed.law=\"rigid\"",
         "contact.slider_bed.restitution=0.5",
@@ -353,7 +365,10 @@ fn bad_laws_and_methods_are_refused_naming_the_field() {
         "contact.bed_damper.restitution=0.5",
         "simulation.method=\"dopri5\"",
     ]);
-    assert!(e.contains("contact[1].restitution") && e.contains("alpha"), "{e}");
+    assert!(
+        e.contains("contact[1].restitution") && e.contains("alpha"),
+        "{e}"
+    );
     // Accepted with dopri5, and it runs.
     let sets: Vec<String> = [
         "contact.slider_bed.law=\"hertz\"",

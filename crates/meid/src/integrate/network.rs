@@ -319,7 +319,12 @@ pub fn channel_kinds(net: &Network) -> Vec<ChannelKind> {
 }
 
 /// The affine functional `[ℓ; ℓ₀]` (length `2·dofs + 1`) of channel `kind` in a mode.
-pub(super) fn channel_vector(net: &Network, md: &ModeData, mode: NetMode, kind: &ChannelKind) -> Vec<f64> {
+pub(super) fn channel_vector(
+    net: &Network,
+    md: &ModeData,
+    mode: NetMode,
+    kind: &ChannelKind,
+) -> Vec<f64> {
     let nd = net.dofs();
     let n = 2 * nd;
     let nm = net.n_modes();

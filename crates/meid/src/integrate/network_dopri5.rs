@@ -58,8 +58,7 @@ use std::collections::HashMap;
 use super::dopri5::{extremes_on_step, initial_step, scale, stages, Dense};
 use super::network::{
     book_contacts, channel_kinds, channel_vector, check_within, close_rows_and_ratio, lex_signs_of,
-    merge, ChannelKind, ModeData, NetChannel, NetCollisionEnd, NetSolution, Start,
-    VALUE_TOL,
+    merge, ChannelKind, ModeData, NetChannel, NetCollisionEnd, NetSolution, Start, VALUE_TOL,
 };
 use super::peaks::Extremes;
 use super::roots::{first_crossing, hermite_dip, Scalar, SearchOptions};
@@ -136,7 +135,10 @@ impl<'n> Rhs<'n> {
             .map(|k| {
                 let l = channel_vector(net, &md, mode, k);
                 let n = 2 * nd;
-                let lv = l[..n].iter().any(|v| *v != 0.0).then(|| SparseVec::new(&l[..n]));
+                let lv = l[..n]
+                    .iter()
+                    .any(|v| *v != 0.0)
+                    .then(|| SparseVec::new(&l[..n]));
                 ChanVec {
                     l: lv,
                     l0: l[n],
@@ -792,8 +794,8 @@ impl<'n, 'o> Run<'n, 'o> {
         }
         let net = self.net;
         let n = 2 * self.nd;
-        let all_open = (0..net.contacts.len())
-            .all(|c| self.start.preloaded[c] || !net.closed(self.mode, c));
+        let all_open =
+            (0..net.contacts.len()).all(|c| self.start.preloaded[c] || !net.closed(self.mode, c));
         if self.start.touched && all_open {
             let x = self.y[..n].to_vec();
             self.collision_end = Some(NetCollisionEnd {

@@ -569,7 +569,11 @@ fn check_nonlinear_entry(
         ));
     }
     if c.law == LawSpec::Hertz {
-        for (what, v) in [("exponent", c.exponent), ("alpha", c.alpha), ("restitution", c.restitution)] {
+        for (what, v) in [
+            ("exponent", c.exponent),
+            ("alpha", c.alpha),
+            ("restitution", c.restitution),
+        ] {
             if let Some(v) = v {
                 return Err((
                     format!("{p}.{what}"),
@@ -583,7 +587,10 @@ fn check_nonlinear_entry(
         if !(n.is_finite() && n > 0.0) {
             return Err((
                 format!("{p}.exponent"),
-                format!("must be a finite number > 0 (1.5 for Hertzian geometry; got {})", crate::num(n)),
+                format!(
+                    "must be a finite number > 0 (1.5 for Hertzian geometry; got {})",
+                    crate::num(n)
+                ),
             ));
         }
     }
@@ -599,7 +606,10 @@ fn check_nonlinear_entry(
         if !(e > 0.0 && e <= 1.0) {
             return Err((
                 format!("{p}.restitution"),
-                format!("the coefficient of restitution must be in (0, 1] (1: elastic; got {})", crate::num(e)),
+                format!(
+                    "the coefficient of restitution must be in (0, 1] (1: elastic; got {})",
+                    crate::num(e)
+                ),
             ));
         }
         if let Some(a) = c.alpha {
@@ -785,7 +795,9 @@ fn nonlinear_law(
                 return Err(src.error(&field, format!("{field}: a hunt-crossley contact's restitution depends on the approach velocity, and this contact does not close at t = 0 (closing speed {} m/s from the impactors' velocities): give alpha (s/m), or use law = \"linear\", whose restitution does not depend on the approach velocity", crate::num(v_in))));
             }
             let x = restitution::x_of_e(e).map_err(|err| match err {
-                Error::InvalidValue { message, .. } => src.error(&field, format!("{field}: {message}")),
+                Error::InvalidValue { message, .. } => {
+                    src.error(&field, format!("{field}: {message}"))
+                }
                 other => other,
             })?;
             let alpha = 2.0 * x / (3.0 * v_in);
