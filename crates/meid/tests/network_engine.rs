@@ -241,7 +241,7 @@ pub(crate) fn paper_model() -> Model {
     Model::from_file(&path, &[]).unwrap()
 }
 
-fn peak_of(sol: &NetSolution, kind: &ChannelKind) -> (f64, f64) {
+pub(crate) fn peak_of(sol: &NetSolution, kind: &ChannelKind) -> (f64, f64) {
     sol.channels
         .iter()
         .find(|c| &c.kind == kind)

@@ -512,15 +512,25 @@ fn check_contact_entry(
     if c.exponent.is_some() || c.alpha.is_some() {
         return Err((format!("{p}.alpha"), "exponent and alpha belong to law = \"hunt-crossley\"; the linear law takes damping or restitution".into()));
     }
-    if let Some(d) = c.damping {
+    check_damping_or_restitution(p, ("damping", c.damping, "N·s/m"), c.restitution)
+}
+
+/// A contact's damping coefficient `(name, value, unit)` (finite, ≥ 0) or its restitution
+/// (in (0, 1]), not both.
+fn check_damping_or_restitution(
+    p: &str,
+    (name, coefficient, unit): (&str, Option<f64>, &str),
+    restitution: Option<f64>,
+) -> std::result::Result<(), (String, String)> {
+    if let Some(d) = coefficient {
         if !(d.is_finite() && d >= 0.0) {
             return Err((
-                format!("{p}.damping"),
-                format!("must be a finite number ≥ 0 N·s/m (got {})", crate::num(d)),
+                format!("{p}.{name}"),
+                format!("must be a finite number ≥ 0 {unit} (got {})", crate::num(d)),
             ));
         }
     }
-    if let Some(e) = c.restitution {
+    if let Some(e) = restitution {
         if !(e > 0.0 && e <= 1.0) {
             return Err((
                 format!("{p}.restitution"),
@@ -530,11 +540,11 @@ fn check_contact_entry(
                 ),
             ));
         }
-        if let Some(d) = c.damping {
+        if let Some(d) = coefficient {
             return Err((
                 format!("{p}.restitution"),
                 format!(
-                    "given together with {p}.damping = {} N·s/m; give one of them",
+                    "given together with {p}.{name} = {} {unit}; give one of them (restitution sets {name})",
                     crate::num(d)
                 ),
             ));
@@ -594,32 +604,7 @@ fn check_nonlinear_entry(
             ));
         }
     }
-    if let Some(a) = c.alpha {
-        if !(a.is_finite() && a >= 0.0) {
-            return Err((
-                format!("{p}.alpha"),
-                format!("must be a finite number ≥ 0 s/m (got {})", crate::num(a)),
-            ));
-        }
-    }
-    if let Some(e) = c.restitution {
-        if !(e > 0.0 && e <= 1.0) {
-            return Err((
-                format!("{p}.restitution"),
-                format!(
-                    "the coefficient of restitution must be in (0, 1] (1: elastic; got {})",
-                    crate::num(e)
-                ),
-            ));
-        }
-        if let Some(a) = c.alpha {
-            return Err((
-                format!("{p}.restitution"),
-                format!("given together with {p}.alpha = {} s/m; give one of them (restitution sets alpha)", crate::num(a)),
-            ));
-        }
-    }
-    Ok(())
+    check_damping_or_restitution(p, ("alpha", c.alpha, "s/m"), c.restitution)
 }
 
 /// A `law = "rigid"` entry at model path `p`: a restitution in [0, 1], no stiffness, damping,
