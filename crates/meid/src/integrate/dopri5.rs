@@ -1060,13 +1060,19 @@ pub(crate) fn extremes_on_step(
     if len <= 0.0 {
         return;
     }
-    let mut extremum = |a: f64, b: f64, da: f64, db: f64, on: &mut dyn FnMut(f64) -> (f64, f64)| {
+    // The extremum where the slope changes sign between `a` and `b`.
+    fn extremum<F: FnMut(f64) -> (f64, f64)>(
+        on: &mut F,
+        (a, b, da, db): (f64, f64, f64, f64),
+        (t, len): (f64, f64),
+        ext: &mut Extremes,
+    ) {
         let s = slope_root(|s| on(s).1, a, b, da, db, 1e-12 * len);
         let (v, _) = on(s);
         ext.offer(v, t + s);
-    };
+    }
     if d0 * d1 < 0.0 {
-        extremum(0.0, len, d0, d1, &mut on);
+        extremum(&mut on, (0.0, len, d0, d1), (t, len), ext);
         return;
     }
     // Critical points of the Hermite cubic through the ends (u ∈ (0, 1)): the slope is
@@ -1087,14 +1093,14 @@ pub(crate) fn extremes_on_step(
         let sm = 0.5 * (knots[k] + knots[k + 1]) * len;
         let dm = on(sm).1;
         if da * dm < 0.0 {
-            extremum(sa, sm, da, dm, &mut on);
+            extremum(&mut on, (sa, sm, da, dm), (t, len), ext);
         }
         if dm != 0.0 {
             (sa, da) = (sm, dm);
         }
     }
     if da * d1 < 0.0 {
-        extremum(sa, len, da, d1, &mut on);
+        extremum(&mut on, (sa, len, da, d1), (t, len), ext);
     }
 }
 
