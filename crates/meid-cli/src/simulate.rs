@@ -365,9 +365,10 @@ fn print_general(model: &meid::model::network::NetworkModel, s: &analysis::netwo
     let name = model.spec.name.as_deref().unwrap_or("model");
     let bold = crate::ui::bold;
     println!(
-        "{} — {} (general machine, exact method)",
+        "{} — {} (general machine, {} method)",
         bold("meid simulate"),
-        name
+        name,
+        s.method
     );
     match s.energy_ratio {
         Some(r) => println!(

@@ -12,7 +12,7 @@ use meid::modal::ModalModel;
 use meid::model::{Case, Model};
 
 /// A structure that takes no part: one mode at 1 Hz with a point "s" nothing touches.
-fn bystander() -> ModalModel {
+pub(crate) fn bystander() -> ModalModel {
     let mut s = ModalModel::with_damping_ratios(vec![2.0 * PI], &[0.0]).unwrap();
     s.points.insert("s".into(), vec![1.0]);
     s
@@ -28,7 +28,7 @@ fn linear(k: f64, c: f64) -> Contact {
     }
 }
 
-fn body(name: &str, mass: f64, velocity: f64) -> Body {
+pub(crate) fn body(name: &str, mass: f64, velocity: f64) -> Body {
     Body {
         name: name.into(),
         mass,
@@ -182,7 +182,7 @@ fn two_contacts_closing_at_the_same_instant() {
 /// The paper's machine (examples/paper-lumped.toml) as a network with its damper split into
 /// `split` identical dampers at O_b, each with 1/split of m_d, k_d, c_d and K_d (the same
 /// contact frequency).
-fn paper_network(model: &Model, split: usize) -> Network {
+pub(crate) fn paper_network(model: &Model, split: usize) -> Network {
     let s = &model.spec;
     let d = s.damper.as_ref().unwrap();
     let cs = model.slider_bed_setting().unwrap().contact;
@@ -235,13 +235,13 @@ fn paper_network(model: &Model, split: usize) -> Network {
     Network::new(&model.structure, bodies, susp, links).unwrap()
 }
 
-fn paper_model() -> Model {
+pub(crate) fn paper_model() -> Model {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper-lumped.toml");
     Model::from_file(&path, &[]).unwrap()
 }
 
-fn peak_of(sol: &NetSolution, kind: &ChannelKind) -> (f64, f64) {
+pub(crate) fn peak_of(sol: &NetSolution, kind: &ChannelKind) -> (f64, f64) {
     sol.channels
         .iter()
         .find(|c| &c.kind == kind)

@@ -59,6 +59,7 @@ mod model_sketch;
 mod modes_import;
 mod modes_truncation;
 mod network_blows;
+mod network_dopri5;
 mod network_engine;
 mod network_model;
 mod network_studies;

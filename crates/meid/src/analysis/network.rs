@@ -197,9 +197,10 @@ pub fn summary(model: &NetworkModel, sol: &NetSolution) -> NetSummary {
         .iter()
         .map(|b| 0.5 * b.mass * b.velocity * b.velocity)
         .sum();
+    let dopri5 = model.spec.simulation.method == crate::model::MethodSpec::Dopri5;
     NetSummary {
         machine: "general",
-        method: "exact",
+        method: if dopri5 { "dopri5" } else { "exact" },
         energy_ratio: sol.energy_ratio,
         collision_end_s: sol.collision_end.as_ref().map(|c| c.t),
         energy_input_j: sol
@@ -211,7 +212,11 @@ pub fn summary(model: &NetworkModel, sol: &NetSolution) -> NetSummary {
         dissipated_energy_j: sol.dissipated_j,
         energy_balance_residual: sol.residual_collision_end,
         energy_balance_residual_run_end: sol.residual_run_end,
-        peak_accuracy: "exact, on the continuous solution",
+        peak_accuracy: if dopri5 {
+            "estimates on dopri5's dense output, as accurate as the integration (simulation.rtol, atol)"
+        } else {
+            "exact, on the continuous solution"
+        },
         contacts,
         dampers,
         impactors,

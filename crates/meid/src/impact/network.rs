@@ -35,7 +35,9 @@
 //! ```
 //!
 //! (`D` the structure's modal damping, `F_b` an impactor's constant force): affine, exact
-//! between switches ([`crate::integrate::network`]).
+//! between switches ([`crate::integrate::network`]). A closed contact with a non-linear law
+//! (Hertz `f = Kδ^{3/2}`, Hunt-Crossley `f = Kδⁿ(1 + 3/2 αδ̇)`) is left out of `K_σ`, `C_σ`,
+//! `f_σ`: dopri5 adds its force `−a_c f_c(δ, δ̇)` ([`crate::integrate::network_dopri5`]).
 //!
 //! # Switching rules
 //! As in the paper's system: a contact is closed while `δ > 0` and, with the force-release rule
@@ -145,7 +147,8 @@ pub struct NetIndicator {
 pub enum IndicatorKind {
     /// The overlap `δ` of contact `i`.
     Overlap(usize),
-    /// The force `K δ + C δ̇` of contact `i` (force-release rule, damped law).
+    /// The sign of the force of contact `i` (force-release rule, damped law): `K δ + C δ̇`
+    /// (linear), `1 + 3/2 α δ̇` (Hunt-Crossley).
     Force(usize),
     /// The relative velocity `δ̇_s` of suspension `j` (one-way dashpot).
     DashpotVelocity(usize),
@@ -372,6 +375,14 @@ impl Network {
         }
     }
 
+    /// The first contact with a non-linear law (Hertz or Hunt-Crossley), which only dopri5
+    /// runs.
+    pub fn first_nonlinear(&self) -> Option<usize> {
+        self.contacts.iter().position(|c| {
+            !c.contact.law.is_linear() && !matches!(c.contact.law, ContactLaw::Rigid { .. })
+        })
+    }
+
     /// The rigid contacts held (closed, as constraints `a_cᵀx = g_c`) in `mode`.
     pub fn held(&self, mode: NetMode) -> Vec<usize> {
         (0..self.contacts.len())
@@ -387,7 +398,7 @@ impl Network {
     }
 
     /// `(K, C)` of contact `c`'s linear law; an error for a non-linear law (a rigid law has
-    /// none: see [`Self::rigid`]).
+    /// none: see [`Self::rigid`]; Hertz and Hunt-Crossley are dopri5's).
     pub fn linear_law(&self, c: usize) -> Result<(f64, f64)> {
         match self.contacts[c].contact.law {
             ContactLaw::Linear { stiffness, damping } => Ok((stiffness, damping)),
@@ -397,7 +408,7 @@ impl Network {
             )),
             _ => Err(Error::invalid(
                 format!("{}.law", self.contacts[c].name),
-                "a general machine ([[contact]] arrays) takes linear contact laws (law = \"linear\", with damping or restitution); hertz and hunt-crossley need dopri5, which runs the paper's machine only for now",
+                "the exact method takes linear and rigid contact laws; hertz and hunt-crossley need simulation.method = \"dopri5\"",
             )),
         }
     }
@@ -415,7 +426,9 @@ impl Network {
     }
 
     /// `K_σ`, `C_σ`, `f_σ` of the elements of a mode, without the held rigid contacts'
-    /// constraints (a rigid contact adds no stiffness, damping or forcing).
+    /// constraints (a rigid contact adds no stiffness, damping or forcing) and without the
+    /// closed non-linear contacts (Hertz, Hunt-Crossley: their forces are added by dopri5,
+    /// [`crate::integrate::network_dopri5`]).
     fn free_matrices(&self, mode: NetMode) -> Result<(Mat<f64>, Mat<f64>, Vec<f64>)> {
         let nd = self.dofs();
         let n = self.n_modes();
@@ -453,7 +466,7 @@ impl Network {
             f[n + b] = body.force;
         }
         for ci in 0..self.contacts.len() {
-            if self.closed(mode, ci) && self.rigid(ci).is_none() {
+            if self.closed(mode, ci) && self.contacts[ci].contact.law.is_linear() {
                 let (kk, cc) = self.linear_law(ci)?;
                 add(&self.rel[ci], kk, cc);
                 let g = self.contacts[ci].gap;
@@ -484,19 +497,32 @@ impl Network {
                     if self.rigid(ci).is_some() {
                         continue;
                     }
-                    let (kk, cc) = self.linear_law(ci)?;
-                    if self.contacts[ci].contact.release == Release::Force && cc != 0.0 {
-                        let mut l = vec![0.0; 2 * nd + 1];
-                        for i in 0..nd {
-                            l[i] = kk * a[i];
-                            l[nd + i] = cc * a[i];
-                        }
-                        l[2 * nd] = -kk * g;
-                        out.push(NetIndicator {
-                            kind: IndicatorKind::Force(ci),
-                            l,
-                        });
+                    if self.contacts[ci].contact.release != Release::Force {
+                        continue;
                     }
+                    // The force's sign function, affine in the state:
+                    // K δ + C δ̇ (linear), 1 + 3/2 α δ̇ (Hunt-Crossley); Hertz never pulls.
+                    let mut l = vec![0.0; 2 * nd + 1];
+                    match self.contacts[ci].contact.law {
+                        ContactLaw::Linear { stiffness, damping } if damping != 0.0 => {
+                            for i in 0..nd {
+                                l[i] = stiffness * a[i];
+                                l[nd + i] = damping * a[i];
+                            }
+                            l[2 * nd] = -stiffness * g;
+                        }
+                        ContactLaw::HuntCrossley { alpha, .. } if alpha != 0.0 => {
+                            for i in 0..nd {
+                                l[nd + i] = 1.5 * alpha * a[i];
+                            }
+                            l[2 * nd] = 1.0;
+                        }
+                        _ => continue,
+                    }
+                    out.push(NetIndicator {
+                        kind: IndicatorKind::Force(ci),
+                        l,
+                    });
                 }
                 NetSwitch::Dashpot(j) => {
                     let mut l = vec![0.0; 2 * nd + 1];

@@ -54,7 +54,7 @@
 //! every half period of a contact for ever. The dashpot force is continuous at the switch
 //! (`c·v` with `v` in the band), so the band moves forces by at most `c` times its width.
 
-use super::peaks::Peaks;
+use super::peaks::{Extremes, Peaks};
 use super::roots::{first_crossing, hermite_dip, Scalar, SearchOptions};
 use super::switching::{implied_mode, ModeSelector};
 use super::{CollisionEnd, Event, Grid, Observer, Options, PathPoint, Solution, Totals};
@@ -411,13 +411,47 @@ fn elastic(law: &ContactLaw, d: f64) -> f64 {
 /// Dense output of one step: `y(θ) = r1 + θ(r2 + θ₁(r3 + θ(r4 + θ₁ r5)))`, θ = s/h, θ₁ = 1 − θ
 /// (Hairer, Nørsett & Wanner's `contd5`): a quartic in θ that matches `y`, `y_new` and the
 /// slopes `f(y)`, `f(y_new)` at the ends of the step.
-struct Dense {
+pub(crate) struct Dense {
     r: [Vec<f64>; 5],
     h: f64,
 }
 
 impl Dense {
-    fn eval(&self, s: f64, out: &mut [f64]) {
+    /// An empty dense output for states of `n` components.
+    pub(crate) fn new(n: usize) -> Self {
+        Self {
+            r: std::array::from_fn(|_| vec![0.0; n]),
+            h: 0.0,
+        }
+    }
+
+    /// The dense output of the accepted step of size `h` from `y` to `ynew` with the stages
+    /// `k` (Hairer, Nørsett & Wanner's `contd5`).
+    pub(crate) fn fill(&mut self, h: f64, y: &[f64], ynew: &[f64], k: &[Vec<f64>; 7]) {
+        for i in 0..y.len() {
+            let ydiff = ynew[i] - y[i];
+            let bspl = h * k[0][i] - ydiff;
+            self.r[0][i] = y[i];
+            self.r[1][i] = ydiff;
+            self.r[2][i] = bspl;
+            self.r[3][i] = ydiff - h * k[6][i] - bspl;
+            self.r[4][i] = h
+                * (D1 * k[0][i]
+                    + D3 * k[2][i]
+                    + D4 * k[3][i]
+                    + D5 * k[4][i]
+                    + D6 * k[5][i]
+                    + D7 * k[6][i]);
+        }
+        self.h = h;
+    }
+
+    /// The step's size.
+    pub(crate) fn h(&self) -> f64 {
+        self.h
+    }
+
+    pub(crate) fn eval(&self, s: f64, out: &mut [f64]) {
         let th = s / self.h;
         let th1 = 1.0 - th;
         for (i, o) in out.iter_mut().enumerate() {
@@ -428,7 +462,7 @@ impl Dense {
     }
 
     /// The state `y(s)` and its time derivative `ẏ(s)` (the derivative of the quartic).
-    fn eval_with_slope(&self, s: f64, out: &mut [f64], slope: &mut [f64]) {
+    pub(crate) fn eval_with_slope(&self, s: f64, out: &mut [f64], slope: &mut [f64]) {
         let th = s / self.h;
         let th1 = 1.0 - th;
         for (i, (o, d)) in out.iter_mut().zip(slope.iter_mut()).enumerate() {
@@ -457,7 +491,7 @@ impl Dense {
     }
 
     /// `ℓᵀy(s)` and its time derivative, `ℓ` given by its non-zeros.
-    fn functional(&self, l: &SparseVec, s: f64) -> (f64, f64) {
+    pub(crate) fn functional(&self, l: &SparseVec, s: f64) -> (f64, f64) {
         let th = s / self.h;
         let th1 = 1.0 - th;
         let (idx, val) = l.parts();
@@ -998,53 +1032,75 @@ fn step_extremes(
 ) {
     let (v0, d0, v1, d1) = ends;
     for c in 0..N_CHANNELS {
-        peaks.0[c].offer(v1[c], t + len);
-        if len <= 0.0 {
-            continue;
+        extremes_on_step(
+            |s| ch.on_dense(rhs, mode, c, dense, s, buf, bufd),
+            (v0[c], d0[c], v1[c], d1[c]),
+            t,
+            len,
+            &mut peaks.0[c],
+        );
+    }
+}
+
+/// The extremes of one channel `g` over a step of length `len` from `t` into `ext`: its end
+/// value, and each interior extremum where its slope changes sign. `ends = (g(0), g'(0),
+/// g(len), g'(len))`; `on(s) = (g(s), g'(s))` on the dense output. Only where the end slopes
+/// differ in sign, or the cubic Hermite interpolant of the ends has critical points inside
+/// (then the slope is sampled between them), is the slope's root located (Illinois regula
+/// falsi to `1e-12` of the step).
+pub(crate) fn extremes_on_step(
+    mut on: impl FnMut(f64) -> (f64, f64),
+    ends: (f64, f64, f64, f64),
+    t: f64,
+    len: f64,
+    ext: &mut Extremes,
+) {
+    let (v0, d0, v1, d1) = ends;
+    ext.offer(v1, t + len);
+    if len <= 0.0 {
+        return;
+    }
+    // The extremum where the slope changes sign between `a` and `b`.
+    fn extremum<F: FnMut(f64) -> (f64, f64)>(
+        on: &mut F,
+        (a, b, da, db): (f64, f64, f64, f64),
+        (t, len): (f64, f64),
+        ext: &mut Extremes,
+    ) {
+        let s = slope_root(|s| on(s).1, a, b, da, db, 1e-12 * len);
+        let (v, _) = on(s);
+        ext.offer(v, t + s);
+    }
+    if d0 * d1 < 0.0 {
+        extremum(&mut on, (0.0, len, d0, d1), (t, len), ext);
+        return;
+    }
+    // Critical points of the Hermite cubic through the ends (u ∈ (0, 1)): the slope is
+    // sampled between them, where the cubic's slope has the other sign.
+    let crit = hermite_critical_points(v0, d0, v1, d1, len);
+    if crit[0].is_nan() {
+        return;
+    }
+    let mut knots = [0.0; 4];
+    let mut nk = 1;
+    for u in crit.into_iter().filter(|u| !u.is_nan()) {
+        knots[nk] = u;
+        nk += 1;
+    }
+    knots[nk] = 1.0;
+    let (mut sa, mut da) = (0.0, d0);
+    for k in 0..nk {
+        let sm = 0.5 * (knots[k] + knots[k + 1]) * len;
+        let dm = on(sm).1;
+        if da * dm < 0.0 {
+            extremum(&mut on, (sa, sm, da, dm), (t, len), ext);
         }
-        let mut extremum = |a: f64, b: f64, da: f64, db: f64, buf: &mut [f64], bufd: &mut [f64]| {
-            let s = slope_root(
-                |s| ch.on_dense(rhs, mode, c, dense, s, buf, bufd).1,
-                a,
-                b,
-                da,
-                db,
-                1e-12 * len,
-            );
-            let (v, _) = ch.on_dense(rhs, mode, c, dense, s, buf, bufd);
-            peaks.0[c].offer(v, t + s);
-        };
-        if d0[c] * d1[c] < 0.0 {
-            extremum(0.0, len, d0[c], d1[c], buf, bufd);
-            continue;
+        if dm != 0.0 {
+            (sa, da) = (sm, dm);
         }
-        // Critical points of the Hermite cubic through the ends (u ∈ (0, 1)): the slope is
-        // sampled between them, where the cubic's slope has the other sign.
-        let crit = hermite_critical_points(v0[c], d0[c], v1[c], d1[c], len);
-        if crit[0].is_nan() {
-            continue;
-        }
-        let mut knots = [0.0; 4];
-        let mut nk = 1;
-        for u in crit.into_iter().filter(|u| !u.is_nan()) {
-            knots[nk] = u;
-            nk += 1;
-        }
-        knots[nk] = 1.0;
-        let (mut sa, mut da) = (0.0, d0[c]);
-        for k in 0..nk {
-            let sm = 0.5 * (knots[k] + knots[k + 1]) * len;
-            let dm = ch.on_dense(rhs, mode, c, dense, sm, buf, bufd).1;
-            if da * dm < 0.0 {
-                extremum(sa, sm, da, dm, buf, bufd);
-            }
-            if dm != 0.0 {
-                (sa, da) = (sm, dm);
-            }
-        }
-        if da * d1[c] < 0.0 {
-            extremum(sa, len, da, d1[c], buf, bufd);
-        }
+    }
+    if da * d1 < 0.0 {
+        extremum(&mut on, (sa, len, da, d1), (t, len), ext);
     }
 }
 
@@ -1422,7 +1478,7 @@ pub fn solve_from(
 
 /// The error scale `atol + rtol · max(|a|, |b|)` of a component with values `a`, `b` at the
 /// step's ends.
-fn scale(opts: &Options, a: f64, b: f64) -> f64 {
+pub(crate) fn scale(opts: &Options, a: f64, b: f64) -> f64 {
     opts.atol + opts.rtol * a.abs().max(b.abs())
 }
 
@@ -1621,9 +1677,10 @@ impl<'s, 'o> Run<'s, 'o> {
             let opts = self.opts;
             let sc = |a: f64, b: f64| scale(opts, a, b);
             let (k0, k1) = self.k.split_at_mut(1);
+            let rhs = &self.rhs;
             self.h = initial_step(
-                &self.rhs,
-                mode,
+                |y, dy| rhs.eval(mode, y, dy),
+                self.nx,
                 &self.y,
                 &k0[0],
                 self.t_end - self.t,
@@ -1663,57 +1720,15 @@ impl<'s, 'o> Run<'s, 'o> {
     /// error estimate `ytmp = h Σ e_j k_j`. Each stage state is `y + h Σ a_ij k_j`, one
     /// contiguous pass per term.
     fn stages(&mut self) {
-        let (h, mode, y, ytmp) = (self.h, self.mode, &self.y, &mut self.ytmp);
-        let rhs = &self.rhs;
-        let (k0, rest) = self.k.split_at_mut(1);
-        let k0 = &k0[0];
-        combo(ytmp, y, h, &[(A21, k0)]);
-        let (k1, rest) = rest.split_at_mut(1);
-        let k1 = &mut k1[0];
-        rhs.eval(mode, ytmp, k1);
-        combo(ytmp, y, h, &[(A31, k0), (A32, k1)]);
-        let (k2, rest) = rest.split_at_mut(1);
-        let k2 = &mut k2[0];
-        rhs.eval(mode, ytmp, k2);
-        combo(ytmp, y, h, &[(A41, k0), (A42, k1), (A43, k2)]);
-        let (k3, rest) = rest.split_at_mut(1);
-        let k3 = &mut k3[0];
-        rhs.eval(mode, ytmp, k3);
-        combo(ytmp, y, h, &[(A51, k0), (A52, k1), (A53, k2), (A54, k3)]);
-        let (k4, rest) = rest.split_at_mut(1);
-        let k4 = &mut k4[0];
-        rhs.eval(mode, ytmp, k4);
-        combo(
-            ytmp,
-            y,
-            h,
-            &[(A61, k0), (A62, k1), (A63, k2), (A64, k3), (A65, k4)],
-        );
-        let (k5, rest) = rest.split_at_mut(1);
-        let k5 = &mut k5[0];
-        rhs.eval(mode, ytmp, k5);
-        combo(
+        let (rhs, mode) = (&self.rhs, self.mode);
+        stages(
+            |y, dy| rhs.eval(mode, y, dy),
+            self.h,
+            &self.y,
+            &mut self.k,
+            &mut self.ytmp,
             &mut self.ynew,
-            y,
-            h,
-            &[(A71, k0), (A73, k2), (A74, k3), (A75, k4), (A76, k5)],
         );
-        let k6 = &mut rest[0];
-        rhs.eval(mode, &self.ynew, k6);
-        ytmp.iter_mut().for_each(|v| *v = 0.0);
-        for (c, kj) in [
-            (E1, k0),
-            (E3, &*k2),
-            (E4, &*k3),
-            (E5, &*k4),
-            (E6, &*k5),
-            (E7, &*k6),
-        ] {
-            let hc = h * c;
-            for (o, &v) in ytmp.iter_mut().zip(kj.iter()) {
-                *o += hc * v;
-            }
-        }
     }
 
     /// The step's error, the RMS over the state (not the dissipated energy) of the estimate
@@ -1799,23 +1814,7 @@ impl<'s, 'o> Run<'s, 'o> {
 
     /// The dense output of the accepted step (Hairer, Nørsett & Wanner's `contd5`).
     fn dense_output(&mut self) {
-        let (h, y, ynew, k, dense) = (self.h, &self.y, &self.ynew, &self.k, &mut self.dense);
-        for i in 0..y.len() {
-            let ydiff = ynew[i] - y[i];
-            let bspl = h * k[0][i] - ydiff;
-            dense.r[0][i] = y[i];
-            dense.r[1][i] = ydiff;
-            dense.r[2][i] = bspl;
-            dense.r[3][i] = ydiff - h * k[6][i] - bspl;
-            dense.r[4][i] = h
-                * (D1 * k[0][i]
-                    + D3 * k[2][i]
-                    + D4 * k[3][i]
-                    + D5 * k[4][i]
-                    + D6 * k[5][i]
-                    + D7 * k[6][i]);
-        }
-        dense.h = h;
+        self.dense.fill(self.h, &self.y, &self.ynew, &self.k);
     }
 
     /// The first crossing of an indicator on the step (not provisional, not of a held
@@ -2158,10 +2157,12 @@ pub(crate) fn contact_energy_jump(sys: &ImpactSystem, from: Mode, to: Mode, x: &
     jump
 }
 
+/// The first step size (Hairer, Nørsett & Wanner's `hinit`) for `ẏ = f(y)` from `y` with
+/// `f0 = f(y)`, over the first `nx` components (the error-controlled state).
 #[allow(clippy::too_many_arguments)]
-fn initial_step(
-    rhs: &Rhs<'_>,
-    mode: Mode,
+pub(crate) fn initial_step(
+    f: impl Fn(&[f64], &mut [f64]),
+    nx: usize,
     y: &[f64],
     f0: &[f64],
     span: f64,
@@ -2170,7 +2171,6 @@ fn initial_step(
     sc: &dyn Fn(f64, f64) -> f64,
 ) -> f64 {
     // Hairer, Nørsett & Wanner, Solving ODEs I, §II.4 ("starting step size").
-    let nx = y.len() - 1;
     let norm = |v: &[f64]| {
         (v[..nx]
             .iter()
@@ -2191,7 +2191,7 @@ fn initial_step(
     for i in 0..y.len() {
         ytmp[i] = y[i] + h0 * f0[i];
     }
-    rhs.eval(mode, ytmp, f1);
+    f(ytmp, f1);
     let mut d2 = 0.0;
     for i in 0..nx {
         d2 += ((f1[i] - f0[i]) / sc(y[i], y[i])).powi(2);
@@ -2211,6 +2211,69 @@ fn combo(out: &mut [f64], y: &[f64], h: f64, terms: &[(f64, &Vec<f64>)]) {
     for &(c, kj) in terms {
         let hc = h * c;
         for (o, &v) in out.iter_mut().zip(kj.iter()) {
+            *o += hc * v;
+        }
+    }
+}
+
+/// The stages of a Dormand-Prince 5(4) step of size `h` from `y` for `ẏ = f(y)` (`k[0] = f(y)`
+/// given): `ynew = y + h Σ a_7j k_j`, `k[6] = f(ynew)` (FSAL), and the error estimate
+/// `ytmp = h Σ e_j k_j` (Hairer, Nørsett & Wanner, *Solving ODEs I*, Table II.5.2). Each stage
+/// state is `y + h Σ a_ij k_j`, one contiguous pass per term.
+pub(crate) fn stages(
+    f: impl Fn(&[f64], &mut [f64]),
+    h: f64,
+    y: &[f64],
+    k: &mut [Vec<f64>; 7],
+    ytmp: &mut [f64],
+    ynew: &mut [f64],
+) {
+    let (k0, rest) = k.split_at_mut(1);
+    let k0 = &k0[0];
+    combo(ytmp, y, h, &[(A21, k0)]);
+    let (k1, rest) = rest.split_at_mut(1);
+    let k1 = &mut k1[0];
+    f(ytmp, k1);
+    combo(ytmp, y, h, &[(A31, k0), (A32, k1)]);
+    let (k2, rest) = rest.split_at_mut(1);
+    let k2 = &mut k2[0];
+    f(ytmp, k2);
+    combo(ytmp, y, h, &[(A41, k0), (A42, k1), (A43, k2)]);
+    let (k3, rest) = rest.split_at_mut(1);
+    let k3 = &mut k3[0];
+    f(ytmp, k3);
+    combo(ytmp, y, h, &[(A51, k0), (A52, k1), (A53, k2), (A54, k3)]);
+    let (k4, rest) = rest.split_at_mut(1);
+    let k4 = &mut k4[0];
+    f(ytmp, k4);
+    combo(
+        ytmp,
+        y,
+        h,
+        &[(A61, k0), (A62, k1), (A63, k2), (A64, k3), (A65, k4)],
+    );
+    let (k5, rest) = rest.split_at_mut(1);
+    let k5 = &mut k5[0];
+    f(ytmp, k5);
+    combo(
+        ynew,
+        y,
+        h,
+        &[(A71, k0), (A73, k2), (A74, k3), (A75, k4), (A76, k5)],
+    );
+    let k6 = &mut rest[0];
+    f(ynew, k6);
+    ytmp.iter_mut().for_each(|v| *v = 0.0);
+    for (c, kj) in [
+        (E1, k0),
+        (E3, &*k2),
+        (E4, &*k3),
+        (E5, &*k4),
+        (E6, &*k5),
+        (E7, &*k6),
+    ] {
+        let hc = h * c;
+        for (o, &v) in ytmp.iter_mut().zip(kj.iter()) {
             *o += hc * v;
         }
     }

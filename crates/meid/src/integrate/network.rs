@@ -125,7 +125,7 @@ use crate::impact::network::{
 use crate::{Error, Result};
 
 /// The band, relative to the size of its terms, within which [`lex_signs`] calls a value zero.
-const VALUE_TOL: f64 = 1e-9;
+pub(super) const VALUE_TOL: f64 = 1e-9;
 /// Highest derivative order consulted when deciding an indicator's side.
 const K_MAX: usize = 8;
 /// The energy-balance residual an exact run must stay within (relative).
@@ -222,13 +222,13 @@ pub struct NetSolution {
 type ChannelVectors = (Vec<f64>, Vec<f64>);
 
 /// The first-order data of one mode, and its closed form once built.
-struct ModeData {
+pub(super) struct ModeData {
     /// `A_σ` column-major (`n × n`, `n = 2·dofs`).
-    a: Vec<f64>,
+    pub(super) a: Vec<f64>,
     /// `b_σ = [0; M⁻¹f_σ]`.
-    b: Vec<f64>,
+    pub(super) b: Vec<f64>,
     k: Mat<f64>,
-    c: Mat<f64>,
+    pub(super) c: Mat<f64>,
     f: Vec<f64>,
     prop: Option<Rc<Propagator>>,
     /// The held rigid contacts' constraint forces `(contact, [ℓ; ℓ₀])`
@@ -239,7 +239,7 @@ struct ModeData {
 }
 
 impl ModeData {
-    fn new(net: &Network, mode: NetMode) -> Result<Self> {
+    pub(super) fn new(net: &Network, mode: NetMode) -> Result<Self> {
         let (k, c, f) = net.matrices(mode)?;
         let nd = net.dofs();
         let n = 2 * nd;
@@ -319,7 +319,12 @@ pub fn channel_kinds(net: &Network) -> Vec<ChannelKind> {
 }
 
 /// The affine functional `[ℓ; ℓ₀]` (length `2·dofs + 1`) of channel `kind` in a mode.
-fn channel_vector(net: &Network, md: &ModeData, mode: NetMode, kind: &ChannelKind) -> Vec<f64> {
+pub(super) fn channel_vector(
+    net: &Network,
+    md: &ModeData,
+    mode: NetMode,
+    kind: &ChannelKind,
+) -> Vec<f64> {
     let nd = net.dofs();
     let n = 2 * nd;
     let nm = net.n_modes();
@@ -408,13 +413,27 @@ fn channel_vector(net: &Network, md: &ModeData, mode: NetMode, kind: &ChannelKin
 /// above its round-off band, `1e-9` (value) or `1e-11` (derivatives) of the sizes of its terms
 /// (`T₀ = |X|`, `T₁ = |A|T₀ + |b|`, `T_{k+1} = |A|T_k`); 0 when none is, up to order 8.
 fn lex_signs(inds: &[NetIndicator], md: &ModeData, x: &[f64], out: &mut [f64]) {
+    lex_signs_of(inds, (&md.a, &md.b), x, VALUE_TOL, out);
+}
+
+/// [`lex_signs`] under `Ẋ = A X + b` given as `(A column-major, b)`, with a value band of
+/// `value_tol` of its terms (dopri5 on a network passes its Jacobian at `x`, `b = F(x) − A x`,
+/// and a band of its tolerance: exact for linear laws and for the first two derivatives with
+/// any law, [`super::network_dopri5`]).
+pub(super) fn lex_signs_of(
+    inds: &[NetIndicator],
+    (a, b): (&[f64], &[f64]),
+    x: &[f64],
+    value_tol: f64,
+    out: &mut [f64],
+) {
     let n = x.len();
     out.fill(0.0);
     let mut y = x.to_vec();
     let mut terms: Vec<f64> = x.iter().map(|v| v.abs()).collect();
     let mut open = inds.len();
     for k in 0..=K_MAX {
-        let tol = if k == 0 { VALUE_TOL } else { 1e-11 };
+        let tol = if k == 0 { value_tol } else { 1e-11 };
         for (ind, o) in inds.iter().zip(out.iter_mut()) {
             if *o != 0.0 {
                 continue;
@@ -433,7 +452,7 @@ fn lex_signs(inds: &[NetIndicator], md: &ModeData, x: &[f64], out: &mut [f64]) {
         let mut next = vec![0.0; n];
         let mut next_terms = vec![0.0; n];
         for j in 0..n {
-            let col = &md.a[j * n..(j + 1) * n];
+            let col = &a[j * n..(j + 1) * n];
             for i in 0..n {
                 next[i] += col[i] * y[j];
                 next_terms[i] += col[i].abs() * terms[j];
@@ -441,8 +460,8 @@ fn lex_signs(inds: &[NetIndicator], md: &ModeData, x: &[f64], out: &mut [f64]) {
         }
         if k == 0 {
             for i in 0..n {
-                next[i] += md.b[i];
-                next_terms[i] += md.b[i].abs();
+                next[i] += b[i];
+                next_terms[i] += b[i].abs();
             }
         }
         y = next;
@@ -632,10 +651,145 @@ pub fn initial_state(net: &Network) -> Result<Vec<f64>> {
     Ok(x)
 }
 
+/// A run's bookkeeping at its start `x0` in `mode` (either engine).
+pub(super) struct Start {
+    /// Initial total energy, the bodies' initial kinetic and total energies (J).
+    pub e0: f64,
+    pub body_ke0: f64,
+    pub body_e0: f64,
+    pub preloaded: Vec<bool>,
+    /// Has a contact that was not preloaded closed at the start?
+    pub touched: bool,
+    /// The rows of the contacts closed at the start, open.
+    pub impacts: Vec<ImpactRow>,
+    pub open: Vec<Option<OpenImpact>>,
+}
+
+impl Start {
+    pub(super) fn new(net: &Network, mode: NetMode, x0: &[f64]) -> Self {
+        let nd = net.dofs();
+        let nc = net.contacts.len();
+        let (ke0, pe0) = net.energies(mode, x0);
+        // The impactors' kinetic energy at x0 (at the initial state the dampers are at rest
+        // and the impactors move with their configured velocities).
+        let nm = net.n_modes();
+        let body_ke0: f64 = net
+            .bodies
+            .iter()
+            .enumerate()
+            .filter(|(b, _)| !net.suspensions.iter().any(|s| s.body == *b))
+            .map(|(b, body)| 0.5 * body.mass * x0[nd + nm + b] * x0[nd + nm + b])
+            .sum();
+        let preloaded: Vec<bool> = net.contacts.iter().map(|c| c.gap < 0.0).collect();
+        let touched = (0..nc).any(|c| !preloaded[c] && net.closed(mode, c));
+        let mut impacts: Vec<ImpactRow> = Vec::new();
+        let mut open: Vec<Option<OpenImpact>> = (0..nc).map(|_| None).collect();
+        for (c, o) in open.iter_mut().enumerate() {
+            if net.closed(mode, c) {
+                *o = Some(start_impact(net, c, x0, 0.0, &mut impacts));
+            }
+        }
+        Self {
+            e0: ke0 + pe0,
+            body_ke0,
+            body_e0: net.body_energy(x0),
+            preloaded,
+            touched,
+            impacts,
+            open,
+        }
+    }
+}
+
+/// The contacts' rows at a switch from `from` to `to` at `(t, x)`: those that open finish
+/// their rows (a force-release contact letting go at `δ > 0` dissipates its elastic energy),
+/// those that close start one (one closing again at `δ > 0` gets its elastic energy back:
+/// negative dissipation). Returns the energy dissipated by the jumps and whether a contact
+/// that was not preloaded closed.
+pub(super) fn book_contacts(
+    net: &Network,
+    (from, to): (NetMode, NetMode),
+    (t, x): (f64, &[f64]),
+    preloaded: &[bool],
+    impacts: &mut Vec<ImpactRow>,
+    open: &mut [Option<OpenImpact>],
+) -> (f64, bool) {
+    let mut dissipated = 0.0;
+    let mut touched = false;
+    for c in 0..net.contacts.len() {
+        let (was, now) = (net.closed(from, c), net.closed(to, c));
+        if was && !now {
+            let (delta, rate) = net.overlap(c, x);
+            let jump = net.contacts[c].contact.law.potential_energy(delta);
+            dissipated += jump;
+            if let Some(o) = open[c].take() {
+                finish_impact(&mut impacts[o.row], &o.ext, t, rate, jump);
+            }
+        } else if now && !was {
+            // A force-release contact may close again at δ > 0 (its force rising through
+            // zero before the overlap has): its elastic energy comes back with it.
+            let (delta, _) = net.overlap(c, x);
+            let back = net.contacts[c].contact.law.potential_energy(delta);
+            dissipated -= back;
+            let o = start_impact(net, c, x, t, impacts);
+            impacts[o.row].dissipated_j -= back;
+            open[c] = Some(o);
+            touched |= !preloaded[c];
+        }
+    }
+    (dissipated, touched)
+}
+
+/// The energy-balance residual `|E(0) + W − E − D| / (E(0) + |W|)` at `x` in mode `m`.
+pub(super) fn residual(net: &Network, e0: f64, x: &[f64], w: f64, d: f64, m: NetMode) -> f64 {
+    let (ke, pe) = net.energies(m, x);
+    let denom = e0 + w.abs();
+    let disc = e0 + w - ke - pe - d;
+    if disc == 0.0 {
+        0.0
+    } else {
+        disc.abs() / denom.max(f64::MIN_POSITIVE)
+    }
+}
+
+/// The rows still open closed at the end of the run `t`, then the residuals and the energy
+/// ratio (module documentation): `(residual_collision_end, energy_ratio)`.
+/// `energies0 = (E(0), KE_b(0), E_b(0))` of [`Start`].
+pub(super) fn close_rows_and_ratio(
+    net: &Network,
+    (energies0, preloaded): ((f64, f64, f64), &[bool]),
+    (t, open): (f64, &[Option<OpenImpact>]),
+    impacts: &mut [ImpactRow],
+    collision_end: Option<&NetCollisionEnd>,
+) -> (Option<f64>, Option<f64>) {
+    let (e0, body_ke0, body_e0) = energies0;
+    for o in open.iter().flatten() {
+        let row = &mut impacts[o.row];
+        row.duration_s = t - row.start_s;
+        let (v, tv) = o.ext.peak();
+        row.peak_force_n = Some(v);
+        row.peak_time_s = tv;
+    }
+    match collision_end {
+        Some(ce) => {
+            // The mode at the collision's end: every non-preloaded contact open, the
+            // preloaded ones as the state says.
+            let m = (0..net.contacts.len()).fold(NetMode(0), |m, c| {
+                m.with(c, preloaded[c] && net.overlap(c, &ce.x).0 > 0.0)
+            });
+            let r = residual(net, e0, &ce.x, ce.force_work_j, ce.dissipated_j, m);
+            let e_in = body_ke0 + ce.force_work_j;
+            let kept = body_e0 + ce.force_work_j - net.body_energy(&ce.x);
+            (Some(r), (e_in > 0.0).then(|| kept / e_in))
+        }
+        None => (None, None),
+    }
+}
+
 /// Per-contact bookkeeping of the impact now open on it.
-struct OpenImpact {
-    row: usize,
-    ext: Extremes,
+pub(super) struct OpenImpact {
+    pub row: usize,
+    pub ext: Extremes,
 }
 
 /// Simulates the network for `opts.duration` (`opts.max_events` caps the switches; sample
@@ -672,6 +826,15 @@ pub fn solve_from(net: &Network, x0: Vec<f64>, opts: &Options) -> Result<NetSolu
                     ""
                 }
             ),
+        ));
+    }
+    if opts.method == super::Method::Dopri5 {
+        return super::network_dopri5::solve_from(net, x0, opts);
+    }
+    if let Some(c) = net.first_nonlinear() {
+        return Err(Error::invalid(
+            format!("{}.law", net.contacts[c].name),
+            "hertz and hunt-crossley contacts run with simulation.method = \"dopri5\" (the exact method takes linear and rigid laws)",
         ));
     }
     let mut run = Run::new(net, opts, x0)?;
@@ -781,27 +944,15 @@ impl<'n, 'o> Run<'n, 'o> {
             .collect();
         let mut signs = vec![0.0; modes.inds.len()];
         let mode = modes.select(&x0, NetMode(0), &mut signs)?;
-        let (ke0, pe0) = net.energies(mode, &x0);
-        // The impactors' kinetic energy at x0 (at the initial state the dampers are at rest
-        // and the impactors move with their configured velocities).
-        let nm = net.n_modes();
-        let body_ke0: f64 = net
-            .bodies
-            .iter()
-            .enumerate()
-            .filter(|(b, _)| !net.suspensions.iter().any(|s| s.body == *b))
-            .map(|(b, body)| 0.5 * body.mass * x0[nd + nm + b] * x0[nd + nm + b])
-            .sum();
-        let body_e0 = net.body_energy(&x0);
-        let preloaded: Vec<bool> = net.contacts.iter().map(|c| c.gap < 0.0).collect();
-        let touched = (0..nc).any(|c| !preloaded[c] && net.closed(mode, c));
-        let mut impacts: Vec<ImpactRow> = Vec::new();
-        let mut open: Vec<Option<OpenImpact>> = (0..nc).map(|_| None).collect();
-        for (c, o) in open.iter_mut().enumerate() {
-            if net.closed(mode, c) {
-                *o = Some(start_impact(net, c, &x0, 0.0, &mut impacts));
-            }
-        }
+        let Start {
+            e0,
+            body_ke0,
+            body_e0,
+            preloaded,
+            touched,
+            impacts,
+            open,
+        } = Start::new(net, mode, &x0);
         Ok(Self {
             net,
             opts,
@@ -814,7 +965,7 @@ impl<'n, 'o> Run<'n, 'o> {
             x: x0.clone(),
             x0,
             t: 0.0,
-            e0: ke0 + pe0,
+            e0,
             body_ke0,
             body_e0,
             preloaded,
@@ -1015,29 +1166,17 @@ impl<'n, 'o> Run<'n, 'o> {
     /// start one (one closing again at `δ > 0` gets `K δ²/2` back: negative dissipation); the
     /// event is recorded, and more than `opts.max_events` is an error.
     fn switch_to(&mut self, new_mode: NetMode) -> Result<()> {
-        let net = self.net;
         let t = self.t;
-        for c in 0..net.contacts.len() {
-            let (was, now) = (net.closed(self.mode, c), net.closed(new_mode, c));
-            if was && !now {
-                let (delta, rate) = net.overlap(c, &self.x);
-                let jump = net.contacts[c].contact.law.potential_energy(delta);
-                self.dissipated_j += jump;
-                if let Some(o) = self.open[c].take() {
-                    finish_impact(&mut self.impacts[o.row], &o.ext, t, rate, jump);
-                }
-            } else if now && !was {
-                // A force-release contact may close again at δ > 0 (its force rising through
-                // zero before the overlap has): its elastic energy comes back with it.
-                let (delta, _) = net.overlap(c, &self.x);
-                let back = net.contacts[c].contact.law.potential_energy(delta);
-                self.dissipated_j -= back;
-                let o = start_impact(net, c, &self.x, t, &mut self.impacts);
-                self.impacts[o.row].dissipated_j -= back;
-                self.open[c] = Some(o);
-                self.touched |= !self.preloaded[c];
-            }
-        }
+        let (jump, touched) = book_contacts(
+            self.net,
+            (self.mode, new_mode),
+            (t, &self.x),
+            &self.preloaded,
+            &mut self.impacts,
+            &mut self.open,
+        );
+        self.dissipated_j += jump;
+        self.touched |= touched;
         self.events.push((t, self.mode, new_mode));
         if self.events.len() > self.opts.max_events {
             return Err(Error::numerical(
@@ -1348,14 +1487,7 @@ impl<'n, 'o> Run<'n, 'o> {
 
     /// The energy-balance residual `|E(0) + W − E − D| / (E(0) + |W|)` at `x` in mode `m`.
     fn residual(&self, x: &[f64], w: f64, d: f64, m: NetMode) -> f64 {
-        let (ke, pe) = self.net.energies(m, x);
-        let denom = self.e0 + w.abs();
-        let disc = self.e0 + w - ke - pe - d;
-        if disc == 0.0 {
-            0.0
-        } else {
-            disc.abs() / denom.max(f64::MIN_POSITIVE)
-        }
+        residual(self.net, self.e0, x, w, d, m)
     }
 
     /// The finished run: the impacts still open closed at the end of the run, the residuals
@@ -1363,31 +1495,15 @@ impl<'n, 'o> Run<'n, 'o> {
     fn finish(mut self) -> NetSolution {
         let net = self.net;
         let t = self.t;
-        for o in self.open.iter_mut() {
-            if let Some(o) = o.take() {
-                let row = &mut self.impacts[o.row];
-                row.duration_s = t - row.start_s;
-                let (v, tv) = o.ext.peak();
-                row.peak_force_n = Some(v);
-                row.peak_time_s = tv;
-            }
-        }
         let force_work_j = net.force_work(&self.x0, &self.x);
         let residual_run_end = self.residual(&self.x, force_work_j, self.dissipated_j, self.mode);
-        let (residual_collision_end, energy_ratio) = match &self.collision_end {
-            Some(ce) => {
-                // The mode at the collision's end: every non-preloaded contact open, the
-                // preloaded ones as the state says.
-                let m = (0..net.contacts.len()).fold(NetMode(0), |m, c| {
-                    m.with(c, self.preloaded[c] && net.overlap(c, &ce.x).0 > 0.0)
-                });
-                let r = self.residual(&ce.x, ce.force_work_j, ce.dissipated_j, m);
-                let e_in = self.body_ke0 + ce.force_work_j;
-                let kept = self.body_e0 + ce.force_work_j - net.body_energy(&ce.x);
-                (Some(r), (e_in > 0.0).then(|| kept / e_in))
-            }
-            None => (None, None),
-        };
+        let (residual_collision_end, energy_ratio) = close_rows_and_ratio(
+            net,
+            ((self.e0, self.body_ke0, self.body_e0), &self.preloaded),
+            (t, &self.open),
+            &mut self.impacts,
+            self.collision_end.as_ref(),
+        );
         NetSolution {
             x0: self.x0,
             mode0: self.mode0,
@@ -1411,6 +1527,16 @@ impl<'n, 'o> Run<'n, 'o> {
 /// A finished run's checks: finite state and extremes, and the energy balance within
 /// [`RESIDUAL_BOUND`] at the end of the collision and of the run.
 fn check(net: &Network, sol: &NetSolution) -> Result<()> {
+    check_within(net, sol, RESIDUAL_BOUND, "exact")
+}
+
+/// [`check`] with the residual bound `bound` of the method `method` (named in the error).
+pub(super) fn check_within(
+    net: &Network,
+    sol: &NetSolution,
+    bound: f64,
+    method: &str,
+) -> Result<()> {
     if sol.x_final.iter().any(|v| !v.is_finite())
         || sol.channels.iter().any(|c| !c.extremes.is_finite())
     {
@@ -1427,11 +1553,11 @@ fn check(net: &Network, sol: &NetSolution) -> Result<()> {
         ("end of the run", Some(sol.residual_run_end)),
     ] {
         if let Some(r) = r {
-            if r.is_nan() || r > RESIDUAL_BOUND {
+            if r.is_nan() || r > bound {
                 return Err(Error::numerical(
                     "simulation",
                     format!(
-                        "energy balance violated at the {what}: residual {r:.3e} of the energy put in > {RESIDUAL_BOUND:e} allowed (exact); {} contacts, {} bodies",
+                        "energy balance violated at the {what}: residual {r:.3e} of the energy put in > {bound:e} allowed ({method}); {} contacts, {} bodies",
                         net.contacts.len(),
                         net.bodies.len()
                     ),
@@ -1442,7 +1568,7 @@ fn check(net: &Network, sol: &NetSolution) -> Result<()> {
     Ok(())
 }
 
-fn merge(into: &mut Extremes, e: &Extremes) {
+pub(super) fn merge(into: &mut Extremes, e: &Extremes) {
     if e.is_set() {
         into.offer(e.max, e.t_max);
         into.offer(e.min, e.t_min);

@@ -33,7 +33,7 @@ use serde::{Deserialize, Serialize};
 
 use super::fem::{self, ReductionContext};
 use super::spec::{
-    ContactSpec, DashpotKindSpec, LawSpec, ProductionSpec, ReleaseSpec, SimulationSpec,
+    ContactSpec, DashpotKindSpec, LawSpec, MethodSpec, ProductionSpec, ReleaseSpec, SimulationSpec,
     StructureSpec,
 };
 use super::{source, strict, Source};
@@ -212,16 +212,17 @@ impl NetworkModel {
         })
     }
 
-    /// The run's settings (`[simulation]`): exact method only.
+    /// The run's settings (`[simulation]`): the method (exact, or dopri5 with its `rtol`,
+    /// `atol`), the duration and the event cap.
     pub fn options(&self) -> Result<Options> {
         let s = &self.spec.simulation;
-        if s.method != super::MethodSpec::Exact {
-            return Err(self.source.error(
-                "simulation.method",
-                "simulation.method: a general machine runs with the exact method for now (linear contacts); dopri5 runs the paper's machine only",
-            ));
-        }
         Ok(Options {
+            method: match s.method {
+                MethodSpec::Exact => crate::integrate::Method::Exact,
+                MethodSpec::Dopri5 => crate::integrate::Method::Dopri5,
+            },
+            rtol: s.rtol,
+            atol: s.atol,
             duration: s.duration,
             sample_rate: None,
             max_events: s.max_events as usize,
@@ -356,7 +357,7 @@ fn check_fields(spec: &NetworkSpec, src: &Source) -> Result<()> {
     check_bodies(spec, src)?;
     let mut contact_names: Vec<&str> = Vec::new();
     for (i, c) in spec.contact.iter().enumerate() {
-        check_contact_entry(&format!("contact[{i}]"), c)
+        check_contact_entry(&format!("contact[{i}]"), c, spec.simulation.method)
             .map_err(|(path, msg)| field_error(src, path, msg))?;
     }
     for (i, c) in spec.contact.iter().enumerate() {
@@ -452,7 +453,11 @@ fn check_bodies(spec: &NetworkSpec, src: &Source) -> Result<()> {
 /// One `[[contact]]` entry at model path `p` (`contact[i]`): two different ends, a finite
 /// gap, a positive stiffness, the linear law, damping ≥ 0 or a restitution in (0, 1] (not
 /// both). The error is `(field path, message)`.
-fn check_contact_entry(p: &str, c: &ContactEntrySpec) -> std::result::Result<(), (String, String)> {
+fn check_contact_entry(
+    p: &str,
+    c: &ContactEntrySpec,
+    method: MethodSpec,
+) -> std::result::Result<(), (String, String)> {
     if c.between.len() != 2 {
         return Err((
             format!("{p}.between"),
@@ -481,6 +486,9 @@ fn check_contact_entry(p: &str, c: &ContactEntrySpec) -> std::result::Result<(),
         ));
     }
     if c.law == LawSpec::Rigid {
+        if method == MethodSpec::Dopri5 {
+            return Err((format!("{p}.law"), "law = \"rigid\" runs with simulation.method = \"exact\" only (its impulses and resting constraint are the exact engine's); with dopri5 give the contact law = \"linear\" (a stiffness and a restitution), \"hertz\" or \"hunt-crossley\"".into()));
+        }
         return check_rigid_entry(p, c);
     }
     let stiffness = c.stiffness.ok_or_else(|| {
@@ -499,20 +507,30 @@ fn check_contact_entry(p: &str, c: &ContactEntrySpec) -> std::result::Result<(),
         ));
     }
     if c.law != LawSpec::Linear {
-        return Err((format!("{p}.law"), "a general machine takes law = \"linear\" (with damping or restitution) or law = \"rigid\" (with restitution) for now: its exact engine needs piecewise-linear contacts, and dopri5 runs the paper's machine only".into()));
+        return check_nonlinear_entry(p, c, method);
     }
     if c.exponent.is_some() || c.alpha.is_some() {
-        return Err((format!("{p}.alpha"), "exponent and alpha belong to law = \"hunt-crossley\", which a general machine does not take yet".into()));
+        return Err((format!("{p}.alpha"), "exponent and alpha belong to law = \"hunt-crossley\"; the linear law takes damping or restitution".into()));
     }
-    if let Some(d) = c.damping {
+    check_damping_or_restitution(p, ("damping", c.damping, "N·s/m"), c.restitution)
+}
+
+/// A contact's damping coefficient `(name, value, unit)` (finite, ≥ 0) or its restitution
+/// (in (0, 1]), not both.
+fn check_damping_or_restitution(
+    p: &str,
+    (name, coefficient, unit): (&str, Option<f64>, &str),
+    restitution: Option<f64>,
+) -> std::result::Result<(), (String, String)> {
+    if let Some(d) = coefficient {
         if !(d.is_finite() && d >= 0.0) {
             return Err((
-                format!("{p}.damping"),
-                format!("must be a finite number ≥ 0 N·s/m (got {})", crate::num(d)),
+                format!("{p}.{name}"),
+                format!("must be a finite number ≥ 0 {unit} (got {})", crate::num(d)),
             ));
         }
     }
-    if let Some(e) = c.restitution {
+    if let Some(e) = restitution {
         if !(e > 0.0 && e <= 1.0) {
             return Err((
                 format!("{p}.restitution"),
@@ -522,17 +540,71 @@ fn check_contact_entry(p: &str, c: &ContactEntrySpec) -> std::result::Result<(),
                 ),
             ));
         }
-        if let Some(d) = c.damping {
+        if let Some(d) = coefficient {
             return Err((
                 format!("{p}.restitution"),
                 format!(
-                    "given together with {p}.damping = {} N·s/m; give one of them",
+                    "given together with {p}.{name} = {} {unit}; give one of them (restitution sets {name})",
                     crate::num(d)
                 ),
             ));
         }
     }
     Ok(())
+}
+
+/// A `law = "hertz"` or `"hunt-crossley"` entry at model path `p` (its stiffness checked):
+/// dopri5 only; no damping; Hertz takes no restitution, exponent or alpha; Hunt-Crossley an
+/// exponent > 0, an alpha ≥ 0 or a restitution in (0, 1] (not both).
+fn check_nonlinear_entry(
+    p: &str,
+    c: &ContactEntrySpec,
+    method: MethodSpec,
+) -> std::result::Result<(), (String, String)> {
+    let name = if c.law == LawSpec::Hertz {
+        "hertz"
+    } else {
+        "hunt-crossley"
+    };
+    if method != MethodSpec::Dopri5 {
+        return Err((
+            format!("{p}.law"),
+            format!("law = \"{name}\" needs simulation.method = \"dopri5\" (the exact method takes piecewise-linear contacts: law = \"linear\" or \"rigid\"); add [simulation] method = \"dopri5\""),
+        ));
+    }
+    if let Some(d) = c.damping.filter(|d| *d != 0.0) {
+        return Err((
+            format!("{p}.damping"),
+            format!("damping = {} is given with law = \"{name}\": only the linear law takes damping; hunt-crossley takes alpha (s/m) or restitution", crate::num(d)),
+        ));
+    }
+    if c.law == LawSpec::Hertz {
+        for (what, v) in [
+            ("exponent", c.exponent),
+            ("alpha", c.alpha),
+            ("restitution", c.restitution),
+        ] {
+            if let Some(v) = v {
+                return Err((
+                    format!("{p}.{what}"),
+                    format!("{what} = {} is given with law = \"hertz\" (f = K δ^1.5, undamped): use law = \"hunt-crossley\" (f = K δ^n (1 + 3/2 α δ̇)) for exponent, alpha or restitution", crate::num(v)),
+                ));
+            }
+        }
+        return Ok(());
+    }
+    if let Some(n) = c.exponent {
+        if !(n.is_finite() && n > 0.0) {
+            return Err((
+                format!("{p}.exponent"),
+                format!(
+                    "must be a finite number > 0 (1.5 for Hertzian geometry; got {})",
+                    crate::num(n)
+                ),
+            ));
+        }
+    }
+    check_damping_or_restitution(p, ("alpha", c.alpha, "s/m"), c.restitution)
 }
 
 /// A `law = "rigid"` entry at model path `p`: a restitution in [0, 1], no stiffness, damping,
@@ -678,6 +750,58 @@ fn end_of(
     ))
 }
 
+/// The law of a checked Hertz or Hunt-Crossley entry at `path` with ends `ends`: with
+/// `restitution = e`, Hunt-Crossley's `α = 2 x(e)/(3 v_in)` ([`restitution::x_of_e`]) at the
+/// contact's closing speed at t = 0, `v_in = aᵀẋ(0)` (the impactors' velocities), as the
+/// paper's form sizes it at the slider's velocity; a contact that does not close at t = 0 has
+/// no approach velocity to size α from: refused (give alpha).
+fn nonlinear_law(
+    c: &ContactEntrySpec,
+    path: &str,
+    ends: [&End; 2],
+    bodies: &[Body],
+    src: &Source,
+    notes: &mut Vec<String>,
+) -> Result<ContactLaw> {
+    let stiffness = c.stiffness.unwrap_or(0.0);
+    if c.law == LawSpec::Hertz {
+        return Ok(ContactLaw::Hertz { stiffness });
+    }
+    let alpha = match c.restitution {
+        None => c.alpha.unwrap_or(0.0),
+        Some(e) => {
+            let speed = |end: &End| match end {
+                End::Body(k) => bodies[*k].velocity,
+                _ => 0.0,
+            };
+            let v_in = speed(ends[0]) - speed(ends[1]);
+            let field = format!("{path}.restitution");
+            if !(v_in.is_finite() && v_in > 0.0) {
+                return Err(src.error(&field, format!("{field}: a hunt-crossley contact's restitution depends on the approach velocity, and this contact does not close at t = 0 (closing speed {} m/s from the impactors' velocities): give alpha (s/m), or use law = \"linear\", whose restitution does not depend on the approach velocity", crate::num(v_in))));
+            }
+            let x = restitution::x_of_e(e).map_err(|err| match err {
+                Error::InvalidValue { message, .. } => {
+                    src.error(&field, format!("{field}: {message}"))
+                }
+                other => other,
+            })?;
+            let alpha = 2.0 * x / (3.0 * v_in);
+            notes.push(format!(
+                "{path} ({}): restitution e = {} → alpha = {alpha:.5e} s/m (x = 3/2 α v_in = {x:.5} at the closing speed v_in = {} m/s at t = 0; at another approach velocity this α gives another e)",
+                c.name,
+                crate::num(e),
+                crate::num(v_in)
+            ));
+            alpha
+        }
+    };
+    Ok(ContactLaw::HuntCrossley {
+        stiffness,
+        exponent: c.exponent.unwrap_or(1.5),
+        alpha,
+    })
+}
+
 /// The network of a checked spec, and the notes of the contacts whose damping `restitution` set.
 fn assemble(
     spec: &NetworkSpec,
@@ -782,6 +906,16 @@ fn assemble(
             continue;
         }
         let stiffness = c.stiffness.unwrap_or(0.0);
+        if matches!(c.law, LawSpec::Hertz | LawSpec::HuntCrossley) {
+            let law = nonlinear_law(c, &path, [&a, &b], &bodies, src, &mut notes)?;
+            links.push(Link {
+                name: c.name.clone(),
+                ends: [a, b],
+                gap: c.gap,
+                contact: Contact { law, release },
+            });
+            continue;
+        }
         let damping = match c.restitution {
             None => c.damping.unwrap_or(0.0),
             Some(e) => {
