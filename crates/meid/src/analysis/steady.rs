@@ -1068,7 +1068,7 @@ fn closest_period<M: BlowMap>(
     else {
         return Ok(None);
     };
-    if !(change < 1e-2) || map.left() < 2 * k * map.step_cost() {
+    if change.is_nan() || change >= 1e-2 || map.left() < 2 * k * map.step_cost() {
         return Ok(None);
     }
     let k0 = k;

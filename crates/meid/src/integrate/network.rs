@@ -74,8 +74,9 @@
 //!   with several held, the most negative goes first and the others' forces are those of the
 //!   smaller set.
 //!
-//! The dopri5 method runs the paper's machine only, so a rigid contact with a Hertz or
-//! Hunt-Crossley contact in one machine (which would need it) is not possible yet; the paper's
+//! The dopri5 method ([`super::network_dopri5`]) runs general machines with linear, Hertz and
+//! Hunt-Crossley laws but not rigid ones (an impulse is exact-only), so a rigid contact with a
+//! Hertz or Hunt-Crossley contact in one machine is not possible yet; the paper's
 //! form (`[contact.slider_bed]`) refuses the rigid law with a message that says how to write
 //! the machine as a general one: its engine has no impulses, and the general machine's exact
 //! engine already runs the same machine (`examples/hammer-rigid.toml`).

@@ -250,7 +250,7 @@ impl Model {
         if network::is_general(&table) {
             return Err(Error::Input {
                 location: name.to_string(),
-                message: "this is a general machine ([[impactor]], [[damper]] or [[contact]] arrays): `meid simulate`, `meid sweep` and `meid optimize --place` run it; the other commands take the paper's machine ([slider], [damper], [contact.slider_bed]) for now".into(),
+                message: "this is a general machine ([[impactor]], [[damper]] or [[contact]] arrays): `meid simulate`, `meid blows`, `meid sweep` and `meid optimize --place` run it; the other commands take the paper's machine ([slider], [damper], [contact.slider_bed]) for now".into(),
             });
         }
         refuse_rigid_paper_form(name, &text, &table)?;
