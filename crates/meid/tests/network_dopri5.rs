@@ -374,3 +374,59 @@ fn bad_laws_and_methods_are_refused_naming_the_field() {
     let sol = m.solve(&m.options().unwrap()).unwrap();
     assert!(sol.energy_ratio.is_some());
 }
+
+/// A preloaded linear contact next to a Hertz contact runs with dopri5: the static state under
+/// the preload is the linear equilibrium (the damper's contact closed, its force the preload's
+/// `K·|g|` less what the damper's spring and the bed's supports take), and the run keeps its
+/// energy balance. A preload on a Hertz contact is refused naming its gap: its static state is
+/// not linear.
+#[test]
+fn a_preload_next_to_a_hertz_contact_runs_and_a_hertz_preload_is_refused() {
+    let sets = |extra: &[&str]| -> Vec<String> {
+        [
+            "contact.slider_bed.law=\"hertz\"",
+            "contact.slider_bed.stiffness=1e9",
+            "simulation.method=\"dopri5\"",
+            "simulation.duration=0.02",
+        ]
+        .iter()
+        .chain(extra)
+        .map(|s| s.to_string())
+        .collect()
+    };
+    let text = include_str!("data/paper_lumped_general.toml").to_string();
+    let m = NetworkModel::from_text(
+        "paper-general.toml",
+        text.clone(),
+        &sets(&["contact.bed_damper.gap=-1e-5"]),
+    )
+    .unwrap();
+    let x0 = engine::initial_state(&m.network).unwrap();
+    let c = m
+        .network
+        .contacts
+        .iter()
+        .position(|l| l.name == "bed_damper")
+        .unwrap();
+    let (delta, _) = m.network.overlap(c, &x0);
+    assert!(delta > 0.0 && delta < 1e-5, "overlap at the start {delta}");
+    let sol = m.solve(&m.options().unwrap()).unwrap();
+    assert!(sol.energy_ratio.is_some_and(|r| r > 0.0 && r < 1.0));
+    let e = NetworkModel::from_text(
+        "paper-general.toml",
+        text,
+        &sets(&[
+            "contact.bed_damper.law=\"hertz\"",
+            "contact.bed_damper.stiffness=1e9",
+            "contact.bed_damper.gap=-1e-5",
+        ]),
+    )
+    .and_then(|m| engine::initial_state(&m.network))
+    .err()
+    .map(|e| e.to_string())
+    .unwrap_or_default();
+    assert!(
+        e.contains("bed_damper.gap") && e.contains("linear contact law"),
+        "{e}"
+    );
+}

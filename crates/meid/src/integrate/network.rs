@@ -626,7 +626,18 @@ pub fn initial_state(net: &Network) -> Result<Vec<f64>> {
             }
             continue;
         }
-        let (kk, _) = net.linear_law(c)?;
+        let kk = match net.linear_law(c) {
+            Ok((kk, _)) => kk,
+            // A non-linear (Hertz, Hunt-Crossley) contact: open at the start, or refused
+            // preloaded (its static state is not linear).
+            Err(_) if link.gap < 0.0 => {
+                return Err(Error::invalid(
+                    format!("{}.gap", link.name),
+                    "a preload (gap < 0) needs a linear contact law (the static state under the preloads is found as a linear equilibrium): give law = \"linear\" or a gap ≥ 0",
+                ))
+            }
+            Err(_) => 0.0,
+        };
         let force = kk * delta;
         if link.gap < 0.0 && (force.is_nan() || force <= 1e-9 * kk * link.gap.abs()) {
             return Err(Error::invalid(
