@@ -1,4 +1,4 @@
-//! dopri5 on general machines (`integrate::network_dopri5`): against the exact engine with
+//! dopri5 on general machines (`integrate::network::dopri5`): against the exact engine with
 //! linear laws, against the paper engine's dopri5 with a Hertz slider-bed contact, against
 //! the free impact's restitution of Hunt-Crossley contacts and Hertz's closed-form contact
 //! time (Johnson, *Contact Mechanics*, §11.4), and its refusals.
@@ -14,8 +14,8 @@
 use meid::analysis::energy;
 use meid::impact::network::{End, Network};
 use meid::impact::{restitution, Contact, ContactLaw, Release};
+use meid::integrate::network::dopri5::residual_bound;
 use meid::integrate::network::{self as engine, ChannelKind, ImpactRow, NetSolution};
-use meid::integrate::network_dopri5::residual_bound;
 use meid::integrate::{Method, Options};
 use meid::model::network::NetworkModel;
 use meid::model::{Case, Model};

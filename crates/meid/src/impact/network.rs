@@ -37,7 +37,7 @@
 //! (`D` the structure's modal damping, `F_b` an impactor's constant force): affine, exact
 //! between switches ([`crate::integrate::network`]). A closed contact with a non-linear law
 //! (Hertz `f = Kδ^{3/2}`, Hunt-Crossley `f = Kδⁿ(1 + 3/2 αδ̇)`) is left out of `K_σ`, `C_σ`,
-//! `f_σ`: dopri5 adds its force `−a_c f_c(δ, δ̇)` ([`crate::integrate::network_dopri5`]).
+//! `f_σ`: dopri5 adds its force `−a_c f_c(δ, δ̇)` ([`crate::integrate::network::dopri5`]).
 //!
 //! # Switching rules
 //! As in the paper's system: a contact is closed while `δ > 0` and, with the force-release rule
@@ -428,7 +428,7 @@ impl Network {
     /// `K_σ`, `C_σ`, `f_σ` of the elements of a mode, without the held rigid contacts'
     /// constraints (a rigid contact adds no stiffness, damping or forcing) and without the
     /// closed non-linear contacts (Hertz, Hunt-Crossley: their forces are added by dopri5,
-    /// [`crate::integrate::network_dopri5`]).
+    /// [`crate::integrate::network::dopri5`]).
     fn free_matrices(&self, mode: NetMode) -> Result<(Mat<f64>, Mat<f64>, Vec<f64>)> {
         let nd = self.dofs();
         let n = self.n_modes();

@@ -17,7 +17,6 @@ pub mod dopri5;
 pub mod exact;
 pub mod expm;
 pub mod network;
-pub mod network_dopri5;
 pub mod peaks;
 pub mod propagator;
 pub mod roots;

@@ -74,7 +74,7 @@
 //!   with several held, the most negative goes first and the others' forces are those of the
 //!   smaller set.
 //!
-//! The dopri5 method ([`super::network_dopri5`]) runs general machines with linear, Hertz and
+//! The dopri5 method ([`dopri5`]) runs general machines with linear, Hertz and
 //! Hunt-Crossley laws but not rigid ones (an impulse is exact-only), so a rigid contact with a
 //! Hertz or Hunt-Crossley contact in one machine is not possible yet; the paper's
 //! form (`[contact.slider_bed]`) refuses the rigid law with a message that says how to write
@@ -109,6 +109,8 @@
 //! with `E_b` the bodies' energy (kinetic energies and suspension spring energies: the paper's
 //! `E_s + E_d`), `KE_b(0)` their initial kinetic energy and `W+` the constant forces' work up
 //! to then: the share of the energy put in that the structure kept or dissipated.
+
+pub mod dopri5;
 
 use std::collections::HashMap;
 use std::rc::Rc;
@@ -420,7 +422,7 @@ fn lex_signs(inds: &[NetIndicator], md: &ModeData, x: &[f64], out: &mut [f64]) {
 /// [`lex_signs`] under `Ẋ = A X + b` given as `(A column-major, b)`, with a value band of
 /// `value_tol` of its terms (dopri5 on a network passes its Jacobian at `x`, `b = F(x) − A x`,
 /// and a band of its tolerance: exact for linear laws and for the first two derivatives with
-/// any law, [`super::network_dopri5`]).
+/// any law, [`dopri5`]).
 pub(super) fn lex_signs_of(
     inds: &[NetIndicator],
     (a, b): (&[f64], &[f64]),
@@ -841,7 +843,7 @@ pub fn solve_from(net: &Network, x0: Vec<f64>, opts: &Options) -> Result<NetSolu
         ));
     }
     if opts.method == super::Method::Dopri5 {
-        return super::network_dopri5::solve_from(net, x0, opts);
+        return dopri5::solve_from(net, x0, opts);
     }
     if let Some(c) = net.first_nonlinear() {
         return Err(Error::invalid(

@@ -11,7 +11,7 @@
 //! (`K_σ`, `C_σ`, `f_σ` of the linear elements, [`Network::matrices`]; `f_c` the Hertz law
 //! `K δ^{3/2}` or Hunt-Crossley's `K δⁿ (1 + 3/2 α δ̇)`, [`crate::impact::ContactLaw::force`]),
 //! integrated by the tableau, PI step control and 4th-order dense output of the paper
-//! machine's engine ([`super::dopri5`]: [`stages`], [`Dense`], [`initial_step`]). The state
+//! machine's engine ([`crate::integrate::dopri5`]: [`stages`], [`Dense`], [`initial_step`]). The state
 //! carries, beside `[x; ẋ]`, the dissipated energy `D` (`Ḋ = ẋᵀC_σẋ + Σ (f_c − f_c,el) δ̇_c`,
 //! `f_c,el = f_c(δ, 0)`), and per contact its impulse `∫f dt` and dissipation; they are not
 //! under error control.
@@ -20,11 +20,11 @@
 //! `a_cᵀx − g_c`, the force-release functions `K δ + C δ̇` (linear) and `1 + 3/2 α δ̇`
 //! (Hunt-Crossley; a Hertz contact never pulls, so it opens with its overlap), the relative
 //! velocities of one-way dashpots. After each accepted step they are searched on the dense
-//! output with the crossing search of the paper's engine ([`super::roots`]; values and slopes
+//! output with the crossing search of the paper's engine ([`crate::integrate::roots`]; values and slopes
 //! at the step ends with a Hermite dip test first, the search lifted by the indicator's zero
 //! band `max(rtol/10, 1e-9)` of its terms); the step is cut at the first crossing. The new mode
 //! is that of the signs of the indicators' first non-vanishing derivatives
-//! ([`super::network`]'s rule, with the Jacobian of the right-hand side at the switch: exact for
+//! ([`super`]'s rule, with the Jacobian of the right-hand side at the switch: exact for
 //! linear laws, and for the first two derivatives with any law), candidate modes iterated to a
 //! consistent one; an indicator the derivatives leave on the side it was searched from while
 //! the state is past its zero takes the state's side. An indicator still zero to all orders (a
@@ -39,8 +39,8 @@
 //! where it changes sign or where the Hermite cubic of the ends has critical points,
 //! [`extremes_on_step`]); a closed non-linear contact's force enters a channel as
 //! `f_c(δ, δ̇)`, its slope as `∂f/∂δ δ̇ + ∂f/∂δ̇ δ̈`. Impact rows, the end of the collision and
-//! the energy ratio are booked as by the exact engine ([`super::network::book_contacts`],
-//! [`super::network::close_rows_and_ratio`]).
+//! the energy ratio are booked as by the exact engine ([`super::book_contacts`],
+//! [`super::close_rows_and_ratio`]).
 //!
 //! **Energy balance**: `|E(0) + W − E − D| ≤ max(1e-6, 100·rtol) (E(0) + |W|)` at the end of
 //! the collision and of the run (the paper engine's dopri5 bound,
@@ -55,16 +55,16 @@
 
 use std::collections::HashMap;
 
-use super::dopri5::{extremes_on_step, initial_step, scale, stages, Dense};
-use super::network::{
+use super::{
     book_contacts, channel_kinds, channel_vector, check_within, close_rows_and_ratio, lex_signs_of,
     merge, ChannelKind, ModeData, NetChannel, NetCollisionEnd, NetSolution, Start, VALUE_TOL,
 };
-use super::peaks::Extremes;
-use super::roots::{first_crossing, hermite_dip, Scalar, SearchOptions};
-use super::Options;
 use crate::impact::network::{dot, End, NetIndicator, NetMode, Network};
 use crate::impact::SparseVec;
+use crate::integrate::dopri5::{extremes_on_step, initial_step, scale, stages, Dense};
+use crate::integrate::peaks::Extremes;
+use crate::integrate::roots::{first_crossing, hermite_dip, Scalar, SearchOptions};
+use crate::integrate::Options;
 use crate::{Error, Result};
 
 /// Consecutive rejected steps, or switches that do not advance time, before a run gives up.
@@ -300,7 +300,7 @@ impl Scalar for OnStep<'_> {
 }
 
 /// Runs dopri5 on `net` from `x0` (module documentation); called by
-/// [`super::network::solve_from`] for `Method::Dopri5`, which has checked `x0`.
+/// [`super::solve_from`] for `Method::Dopri5`, which has checked `x0`.
 pub fn solve_from(net: &Network, x0: Vec<f64>, opts: &Options) -> Result<NetSolution> {
     if !(opts.rtol > 0.0 && opts.rtol < 1.0 && opts.atol > 0.0) {
         return Err(Error::invalid(
@@ -823,8 +823,7 @@ impl<'n, 'o> Run<'n, 'o> {
             open,
             ..
         } = self.start;
-        let residual_run_end =
-            super::network::residual(net, e0, &x, force_work_j, dissipated_j, self.mode);
+        let residual_run_end = super::residual(net, e0, &x, force_work_j, dissipated_j, self.mode);
         let (residual_collision_end, energy_ratio) = close_rows_and_ratio(
             net,
             ((e0, body_ke0, body_e0), &preloaded),
