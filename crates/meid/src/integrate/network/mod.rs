@@ -1571,9 +1571,14 @@ pub(super) fn check_within(
                 return Err(Error::numerical(
                     "simulation",
                     format!(
-                        "energy balance violated at the {what}: residual {r:.3e} of the energy put in > {bound:e} allowed ({method}); {} contacts, {} bodies",
+                        "energy balance violated at the {what}: residual {r:.3e} of the energy put in > {bound:e} allowed ({method}); {} contacts, {} bodies{}",
                         net.contacts.len(),
-                        net.bodies.len()
+                        net.bodies.len(),
+                        if method == "dopri5" {
+                            "; dopri5's residual follows its tolerance: a smaller simulation.rtol (e.g. 1e-10) tightens it"
+                        } else {
+                            ""
+                        }
                     ),
                 ));
             }
