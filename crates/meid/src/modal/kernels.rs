@@ -19,7 +19,7 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::matmul::matmul;
-use faer::reborrow::ReborrowMut;
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
@@ -69,6 +69,21 @@ pub(crate) fn mul_rows_into(
             let rows = cq.nrows();
             let aq = a.get(start..start + rows, ..);
             matmul(cq.rb_mut(), accum, aq, b, alpha, Par::Seq);
+        });
+}
+
+/// `a[:, ..l] = a[:, ..k] b` in place (`b` is k × l, l ≤ k), by row chunks in parallel: each
+/// chunk's product goes through a chunk-sized buffer, so no n × l matrix is allocated. The
+/// same sequential product per chunk as [`mul_rows`], hence the same bits.
+pub(crate) fn mul_rows_leading_in_place(a: MatMut<'_, f64>, k: usize, b: MatRef<'_, f64>) {
+    let l = b.ncols();
+    assert!(b.nrows() == k && l <= k && k <= a.ncols());
+    row_chunks_mut(a)
+        .into_par_iter()
+        .for_each(|(_, aq)| {
+            let mut t = Mat::<f64>::zeros(aq.nrows(), l);
+            matmul(t.as_mut(), Accum::Replace, aq.rb().get(.., ..k), b, 1.0, Par::Seq);
+            aq.get_mut(.., ..l).copy_from(&t);
         });
 }
 
@@ -197,6 +212,24 @@ mod tests {
             };
             assert_eq!(bits(&ab), bits(&ab0), "A B, {t} threads");
             assert_eq!(bits(&atw), bits(&atw0), "Aᵀ W, {t} threads");
+        }
+    }
+
+    /// The in-place leading product is the chunked product's bits, written over the leading
+    /// columns, and leaves the other columns alone.
+    #[test]
+    fn leading_product_in_place_equals_the_chunked_product() {
+        let n = 3 * ROW_CHUNK + 11;
+        let a = pseudo(n, 14, 4);
+        let b = pseudo(10, 7, 5);
+        let expected = mul_rows(a.get(.., ..10), b.as_ref());
+        let mut c = a.clone();
+        mul_rows_leading_in_place(c.as_mut(), 10, b.as_ref());
+        for j in 0..14 {
+            for i in 0..n {
+                let want = if j < 7 { expected[(i, j)] } else { a[(i, j)] };
+                assert_eq!(c[(i, j)].to_bits(), want.to_bits(), "({i}, {j})");
+            }
         }
     }
 

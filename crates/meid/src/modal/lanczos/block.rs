@@ -16,38 +16,66 @@ use rayon::prelude::*;
 pub(crate) fn sym_matmul(
     a: SparseColMatRef<'_, usize, f64>,
     x: MatRef<'_, f64>,
-    mut y: MatMut<'_, f64>,
+    y: MatMut<'_, f64>,
+) {
+    sym_matmul_with(a, x, y, &mut Vec::new());
+}
+
+/// Rows of `y` per task of [`sym_matmul_with`] (fixed: each row's sum is the same whatever the
+/// thread count).
+const GATHER_ROWS: usize = 256;
+
+/// [`sym_matmul`] with a caller-owned buffer for the row-major copy of `x`, so that the
+/// Lanczos iteration, which multiplies by M at every block step, does not map and fault in
+/// fresh pages each time (at 10⁶ DOF a block is 48 MB, above glibc's largest mmap
+/// threshold: every allocation of that size is a new mapping). Each row `j` of `y` is
+/// `Σ_p a_pj x_{i_p}` summed from 0 in storage order, by one task.
+pub(crate) fn sym_matmul_with(
+    a: SparseColMatRef<'_, usize, f64>,
+    x: MatRef<'_, f64>,
+    y: MatMut<'_, f64>,
+    xr: &mut Vec<f64>,
 ) {
     let n = x.nrows();
     let b = x.ncols();
     if b == 0 || n == 0 {
         return;
     }
-    let mut xr = vec![0.0; n * b];
+    xr.clear();
+    xr.resize(n * b, 0.0);
     for c in 0..b {
         let col = x.col(c);
-        for i in 0..n {
-            xr[i * b + c] = col[i];
+        for (i, &v) in col.iter().enumerate() {
+            xr[i * b + c] = v;
         }
     }
-    let mut yr = vec![0.0; n * b];
-    yr.par_chunks_mut(b)
-        .with_min_len(256)
-        .enumerate()
-        .for_each(|(j, yrow)| {
+    let xr = &xr[..];
+    let mut chunks = Vec::with_capacity(n.div_ceil(GATHER_ROWS));
+    let mut rest = y;
+    let mut start = 0;
+    while rest.nrows() > 0 {
+        let rows = GATHER_ROWS.min(rest.nrows());
+        let (top, bottom) = rest.split_at_row_mut(rows);
+        chunks.push((start, top));
+        start += rows;
+        rest = bottom;
+    }
+    chunks.into_par_iter().for_each(|(start, mut yq)| {
+        let mut acc = vec![0.0; b];
+        for r in 0..yq.nrows() {
+            let j = start + r;
+            acc.fill(0.0);
             for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
                 let xrow = &xr[i * b..i * b + b];
-                for (yc, &xc) in yrow.iter_mut().zip(xrow) {
+                for (yc, &xc) in acc.iter_mut().zip(xrow) {
                     *yc += v * xc;
                 }
             }
-        });
-    for c in 0..b {
-        let mut col = y.rb_mut().col_mut(c);
-        for i in 0..n {
-            col[i] = yr[i * b + c];
+            for (c, &v) in acc.iter().enumerate() {
+                yq[(r, c)] = v;
+            }
         }
-    }
+    });
 }
 
 /// Orthogonalises column `w` (with `mw = M w`) against `v[:, ..cols]` in the M-inner product

@@ -96,14 +96,15 @@ use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
 use faer::sparse::SparseColMatRef;
-use faer::{Accum, Mat, Par};
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::{Accum, Mat, MatMut, Par};
 
 use std::time::Instant;
 
 use super::kernels::{self, mul, mul_rows, mul_rows_into, mul_tn};
 use crate::rng::SplitMix64;
 use crate::{Error, Result};
-use block::{fill_random, m_norm, norm2, project_column, sym_matmul};
+use block::{fill_random, m_norm, norm2, project_column, sym_matmul, sym_matmul_with};
 use shifted::ShiftedPencil;
 
 /// Automatic shift as a fraction of `s` (the mass-weighted median of `K_ii/M_ii`): `σ₀ = -AUTO_SHIFT_FRACTION · s`.
@@ -287,8 +288,8 @@ fn lowest_modes_scaled(
     let mut rng = SplitMix64::new(opts.seed);
     let mut st = Basis::new(n, basis, b);
     // Random start block.
-    let w = random_block(&mut rng, n, b);
-    st.append_block(w, m, &mut rng, &mut stats, false)?;
+    st.w.copy_from(random_block(&mut rng, n, b));
+    st.append_block(m, &mut rng, &mut stats, false)?;
 
     let mut tol_op = opts.tol;
     let mut best_converged = 0usize;
@@ -296,14 +297,14 @@ fn lowest_modes_scaled(
         // Fill the basis.
         while st.next < basis {
             let clock = Instant::now();
-            let mut w = st.mv.get(.., st.next..st.next + b).to_owned();
-            llt.solve_in_place(w.as_mut())?;
+            st.w.copy_from(st.mv.get(.., st.next..st.next + b));
+            llt.solve_in_place(st.w.as_mut())?;
             stats.block_solves += 1;
             stats.solved_columns += b;
             stats.block_steps += 1;
             stats.solve_s += clock.elapsed().as_secs_f64();
             let clock = Instant::now();
-            st.append_block(w, m, &mut rng, &mut stats, true)?;
+            st.append_block(m, &mut rng, &mut stats, true)?;
             stats.orthogonalise_s += clock.elapsed().as_secs_f64();
         }
         stats.cycles += 1;
@@ -369,7 +370,8 @@ fn lowest_modes_scaled(
             // New start block: the Ritz vectors folded into b columns.
             let w = folded_ritz_block(&st, &y, basis, basis.min(want + b), b);
             st.reset();
-            st.append_block(w, m, &mut rng, &mut stats, false)?;
+            st.w.copy_from(w);
+            st.append_block(m, &mut rng, &mut stats, false)?;
             continue;
         }
 
@@ -621,6 +623,15 @@ struct Basis {
     v: Mat<f64>,
     mv: Mat<f64>,
     h: Mat<f64>,
+    /// The block being appended (n × b): the operator's image, or a start block. Kept with
+    /// `mw` and `xr` across block steps: at 10⁶ DOF a block is 48 MB, and a fresh allocation
+    /// of that size is a new mapping whose pages fault in (and whose unmapping interrupts the
+    /// other threads) at every step.
+    w: Mat<f64>,
+    /// `M w` (n × b).
+    mw: Mat<f64>,
+    /// Row-major copy of a block for the sparse products ([`block::sym_matmul_with`]).
+    xr: Vec<f64>,
     /// Basis columns filled.
     nv: usize,
     /// First column whose operator image is not yet in the basis.
@@ -635,6 +646,9 @@ impl Basis {
             v: Mat::zeros(n, m + b),
             mv: Mat::zeros(n, m + b),
             h: Mat::zeros(m + b, m),
+            w: Mat::zeros(n, b),
+            mw: Mat::zeros(n, b),
+            xr: Vec::new(),
             nv: 0,
             next: 0,
             m,
@@ -648,8 +662,8 @@ impl Basis {
         self.next = 0;
     }
 
-    /// M-orthonormalises the block `w` against the basis and appends it. If `is_image`, `w`
-    /// is `Op V[:, next..next+b]` and the coefficients go into column block `next` of H.
+    /// M-orthonormalises the block `self.w` against the basis and appends it. If `is_image`,
+    /// `w` is `Op V[:, next..next+b]` and the coefficients go into column block `next` of H.
     ///
     /// Two block Gram-Schmidt passes against the basis (`W -= V (MVᵀ W)`, twice), then
     /// modified Gram-Schmidt inside the block (twice per column). A column that lost more
@@ -657,13 +671,29 @@ impl Basis {
     /// column that vanished is replaced by a random direction with zero coupling.
     fn append_block(
         &mut self,
-        mut w: Mat<f64>,
         m: SparseColMatRef<'_, usize, f64>,
         rng: &mut SplitMix64,
         stats: &mut LanczosStats,
         is_image: bool,
     ) -> Result<()> {
-        let n = w.nrows();
+        let mut w = std::mem::replace(&mut self.w, Mat::new());
+        let mut mw = std::mem::replace(&mut self.mw, Mat::new());
+        let done = self.orthonormalise_into_basis(w.as_mut(), mw.as_mut(), m, rng, stats, is_image);
+        self.w = w;
+        self.mw = mw;
+        done
+    }
+
+    /// The work of [`Basis::append_block`] on the block `w` with the buffer `mw`.
+    fn orthonormalise_into_basis(
+        &mut self,
+        mut w: MatMut<'_, f64>,
+        mut mw: MatMut<'_, f64>,
+        m: SparseColMatRef<'_, usize, f64>,
+        rng: &mut SplitMix64,
+        stats: &mut LanczosStats,
+        is_image: bool,
+    ) -> Result<()> {
         let b = self.b;
         let nv = self.nv;
         let mut coef_v = Mat::<f64>::zeros(nv, b);
@@ -671,22 +701,15 @@ impl Basis {
         if nv > 0 {
             for _pass in 0..2 {
                 // C = (M V)ᵀ W, W -= V C: row chunks of fixed size, thread-count independent.
-                let c = mul_tn(self.mv.get(.., ..nv), w.as_ref());
-                mul_rows_into(
-                    w.as_mut(),
-                    Accum::Add,
-                    self.v.get(.., ..nv),
-                    c.as_ref(),
-                    -1.0,
-                );
+                let c = mul_tn(self.mv.get(.., ..nv), w.rb());
+                mul_rows_into(w.rb_mut(), Accum::Add, self.v.get(.., ..nv), c.as_ref(), -1.0);
                 coef_v += &c;
             }
             for (cc, r) in norm2_removed.iter_mut().enumerate() {
                 *r = coef_v.col(cc).iter().map(|x| x * x).sum::<f64>();
             }
         }
-        let mut mw = Mat::<f64>::zeros(n, b);
-        sym_matmul(m, w.as_ref(), mw.as_mut());
+        sym_matmul_with(m, w.rb(), mw.rb_mut(), &mut self.xr);
         stats.matvec_columns += b;
 
         for (c, &removed) in norm2_removed.iter().enumerate() {
@@ -695,9 +718,9 @@ impl Basis {
             for (dst, src) in coef[..nv].iter_mut().zip(coef_v.col(c).iter()) {
                 *dst = *src;
             }
-            let mut wc = w.get(.., c..c + 1).to_owned();
-            let mut mwc = mw.get(.., c..c + 1).to_owned();
-            let own = m_norm(wc.as_ref(), mwc.as_ref());
+            let mut wc = w.rb_mut().get_mut(.., c..c + 1);
+            let mut mwc = mw.rb_mut().get_mut(.., c..c + 1);
+            let own = m_norm(wc.rb(), mwc.rb());
             let before = (removed + own * own).sqrt();
             // In-block MGS: against the block's previous columns only.
             let mut in_block = vec![0.0; c];
@@ -706,67 +729,39 @@ impl Basis {
                     self.v.get(.., nv..).as_ref(),
                     self.mv.get(.., nv..).as_ref(),
                     c,
-                    wc.as_mut(),
-                    mwc.as_mut(),
+                    wc.rb_mut(),
+                    mwc.rb_mut(),
                     &mut in_block,
                 );
             }
             for (dst, src) in coef[nv..col].iter_mut().zip(&in_block) {
                 *dst += *src;
             }
-            let mut eta = m_norm(wc.as_ref(), mwc.as_ref());
+            let mut eta = m_norm(wc.rb(), mwc.rb());
             if eta < 1e-3 * own && eta > DEFLATION_TOL * before {
                 // Heavy cancellation inside the block: restore orthogonality to the basis.
                 project_column(
                     self.v.as_ref(),
                     self.mv.as_ref(),
                     col,
-                    wc.as_mut(),
-                    mwc.as_mut(),
+                    wc.rb_mut(),
+                    mwc.rb_mut(),
                     &mut coef,
                 );
-                eta = m_norm(wc.as_ref(), mwc.as_ref());
+                eta = m_norm(wc.rb(), mwc.rb());
             }
             if eta <= DEFLATION_TOL * before || !eta.is_finite() {
                 // Numerically in the span of the basis: continue with a random direction.
                 coef[col] = 0.0;
-                let mut found = false;
-                for _attempt in 0..3 {
-                    let r = fill_random(rng, n);
-                    wc.col_mut(0).copy_from(&r);
-                    sym_matmul(m, wc.as_ref(), mwc.as_mut());
-                    stats.matvec_columns += 1;
-                    let r0 = m_norm(wc.as_ref(), mwc.as_ref());
-                    let mut dummy = vec![0.0; col];
-                    for _ in 0..2 {
-                        project_column(
-                            self.v.as_ref(),
-                            self.mv.as_ref(),
-                            col,
-                            wc.as_mut(),
-                            mwc.as_mut(),
-                            &mut dummy,
-                        );
-                    }
-                    eta = m_norm(wc.as_ref(), mwc.as_ref());
-                    if eta > 1e-8 * r0 {
-                        found = true;
-                        break;
-                    }
-                }
-                if !found {
-                    return Err(Error::numerical(
-                        "sparse eigen-solver",
-                        "could not extend the Krylov basis (the basis spans the whole space); use modal::dense",
-                    ));
-                }
+                eta = self.random_direction(m, rng, stats, col, wc.rb_mut(), mwc.rb_mut())?;
             } else {
                 coef[col] = eta;
             }
             let inv = 1.0 / eta;
-            for i in 0..n {
-                self.v[(i, col)] = wc[(i, 0)] * inv;
-                self.mv[(i, col)] = mwc[(i, 0)] * inv;
+            for (dst, src) in [(&mut self.v, wc.rb()), (&mut self.mv, mwc.rb())] {
+                for (d, s) in dst.col_mut(col).iter_mut().zip(src.col(0).iter()) {
+                    *d = *s * inv;
+                }
             }
             if is_image {
                 let hc = self.next + c;
@@ -780,6 +775,47 @@ impl Basis {
             self.next += b;
         }
         Ok(())
+    }
+
+    /// A random direction M-orthogonal to the basis' first `col` columns, in `wc` (with
+    /// `mwc = M wc`); returns its M-norm. Up to three tries; an error if every one lies in
+    /// the basis' span (the basis spans the whole space).
+    fn random_direction(
+        &self,
+        m: SparseColMatRef<'_, usize, f64>,
+        rng: &mut SplitMix64,
+        stats: &mut LanczosStats,
+        col: usize,
+        mut wc: MatMut<'_, f64>,
+        mut mwc: MatMut<'_, f64>,
+    ) -> Result<f64> {
+        let n = wc.nrows();
+        for _attempt in 0..3 {
+            let r = fill_random(rng, n);
+            wc.rb_mut().col_mut(0).copy_from(&r);
+            sym_matmul(m, wc.rb(), mwc.rb_mut());
+            stats.matvec_columns += 1;
+            let r0 = m_norm(wc.rb(), mwc.rb());
+            let mut dummy = vec![0.0; col];
+            for _ in 0..2 {
+                project_column(
+                    self.v.as_ref(),
+                    self.mv.as_ref(),
+                    col,
+                    wc.rb_mut(),
+                    mwc.rb_mut(),
+                    &mut dummy,
+                );
+            }
+            let eta = m_norm(wc.rb(), mwc.rb());
+            if eta > 1e-8 * r0 {
+                return Ok(eta);
+            }
+        }
+        Err(Error::numerical(
+            "sparse eigen-solver",
+            "could not extend the Krylov basis (the basis spans the whole space); use modal::dense",
+        ))
     }
 
     /// Eigen-decomposition of the symmetrised projected matrix, θ descending.
@@ -813,14 +849,13 @@ impl Basis {
         let q = ((m - want) / (2 * b)).max(1);
         let l = m - q * b;
         let yl = y.get(.., ..l);
-        let nv_new = mul_rows(self.v.get(.., ..m), yl);
-        let nmv_new = mul_rows(self.mv.get(.., ..m), yl);
-        self.v.get_mut(.., ..l).copy_from(&nv_new);
-        self.mv.get_mut(.., ..l).copy_from(&nmv_new);
-        let res_v = self.v.get(.., m..m + b).to_owned();
-        let res_mv = self.mv.get(.., m..m + b).to_owned();
-        self.v.get_mut(.., l..l + b).copy_from(&res_v);
-        self.mv.get_mut(.., l..l + b).copy_from(&res_mv);
+        kernels::mul_rows_leading_in_place(self.v.as_mut(), m, yl);
+        kernels::mul_rows_leading_in_place(self.mv.as_mut(), m, yl);
+        // The residual block moves from columns m..m+b to l..l+b (l + b ≤ m: no overlap).
+        for a in [&mut self.v, &mut self.mv] {
+            let (left, right) = a.as_mut().split_at_col_mut(m);
+            left.get_mut(.., l..l + b).copy_from(right.get(.., ..b));
+        }
         self.h.fill(0.0);
         for i in 0..l {
             self.h[(i, i)] = theta[i];
