@@ -36,6 +36,10 @@ pub(crate) struct ShiftedPencil {
     /// M values on the union pattern (lower triangle).
     m_val: Vec<f64>,
     symbolic: SymbolicCholesky<usize>,
+    /// The value array of the last factor dropped, for the next factorisation: the Sturm
+    /// check's L D Lᵀ follows the operator's L Lᵀ with the same pattern, and a fresh array
+    /// (1.2 GB at 10⁶ DOF) would fault in every page again.
+    spare: std::sync::Mutex<Vec<f64>>,
 }
 
 /// A numeric Cholesky factor of `K - σ M` (σ below the spectrum).
@@ -103,12 +107,32 @@ impl ShiftedPencil {
             k_val,
             m_val,
             symbolic,
+            spare: std::sync::Mutex::new(Vec::new()),
         })
     }
 
     /// Number of stored entries in the factor (a measure of memory and solve cost).
     pub(crate) fn factor_nnz(&self) -> usize {
         self.symbolic.len_val()
+    }
+
+    /// A zeroed value array of the factor's length, reusing the last dropped one.
+    fn factor_values(&self) -> Vec<f64> {
+        let len = self.symbolic.len_val();
+        let mut v = match self.spare.lock() {
+            Ok(mut g) => std::mem::take(&mut *g),
+            Err(_) => Vec::new(),
+        };
+        v.clear();
+        v.resize(len, 0.0);
+        v
+    }
+
+    /// Keeps `v` for the next factorisation.
+    fn keep_values(&self, v: Vec<f64>) {
+        if let Ok(mut g) = self.spare.lock() {
+            *g = v;
+        }
     }
 
     fn shifted_values(&self, sigma: f64) -> Vec<f64> {
@@ -126,7 +150,7 @@ impl ShiftedPencil {
     pub(crate) fn factor_llt(&self, sigma: f64, par: Par) -> Result<ShiftedLlt<'_>> {
         let values = self.shifted_values(sigma);
         let a = SparseColMatRef::new(self.pattern.as_ref(), &values);
-        let mut l_val = vec![0.0; self.symbolic.len_val()];
+        let mut l_val = self.factor_values();
         let mut mem = MemBuffer::try_new(
             self.symbolic
                 .factorize_numeric_llt_scratch::<f64>(par, Default::default()),
@@ -169,7 +193,7 @@ impl ShiftedPencil {
     pub(crate) fn negative_pivots(&self, sigma: f64, par: Par) -> Result<Option<usize>> {
         let values = self.shifted_values(sigma);
         let a = SparseColMatRef::new(self.pattern.as_ref(), &values);
-        let mut l_val = vec![0.0; self.symbolic.len_val()];
+        let mut l_val = self.factor_values();
         let mut mem = MemBuffer::try_new(
             self.symbolic
                 .factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),
@@ -224,7 +248,14 @@ impl ShiftedPencil {
                 }
             }
         }
+        self.keep_values(l_val);
         Ok(if bad { None } else { Some(negative) })
+    }
+}
+
+impl Drop for ShiftedLlt<'_> {
+    fn drop(&mut self) {
+        self.pencil.keep_values(std::mem::take(&mut self.l_val));
     }
 }
 
