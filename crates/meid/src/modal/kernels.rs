@@ -78,13 +78,18 @@ pub(crate) fn mul_rows_into(
 pub(crate) fn mul_rows_leading_in_place(a: MatMut<'_, f64>, k: usize, b: MatRef<'_, f64>) {
     let l = b.ncols();
     assert!(b.nrows() == k && l <= k && k <= a.ncols());
-    row_chunks_mut(a)
-        .into_par_iter()
-        .for_each(|(_, aq)| {
-            let mut t = Mat::<f64>::zeros(aq.nrows(), l);
-            matmul(t.as_mut(), Accum::Replace, aq.rb().get(.., ..k), b, 1.0, Par::Seq);
-            aq.get_mut(.., ..l).copy_from(&t);
-        });
+    row_chunks_mut(a).into_par_iter().for_each(|(_, aq)| {
+        let mut t = Mat::<f64>::zeros(aq.nrows(), l);
+        matmul(
+            t.as_mut(),
+            Accum::Replace,
+            aq.rb().get(.., ..k),
+            b,
+            1.0,
+            Par::Seq,
+        );
+        aq.get_mut(.., ..l).copy_from(&t);
+    });
 }
 
 /// `a b` by row chunks (see [`mul_rows_into`]).

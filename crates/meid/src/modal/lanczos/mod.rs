@@ -95,8 +95,8 @@ pub(crate) mod shifted;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
-use faer::sparse::SparseColMatRef;
 use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::sparse::SparseColMatRef;
 use faer::{Accum, Mat, MatMut, Par};
 
 use std::time::Instant;
@@ -751,7 +751,13 @@ impl Basis {
             for _pass in 0..2 {
                 // C = (M V)ᵀ W, W -= V C: row chunks of fixed size, thread-count independent.
                 let c = mul_tn(self.mv.get(.., ..nv), w.rb());
-                mul_rows_into(w.rb_mut(), Accum::Add, self.v.get(.., ..nv), c.as_ref(), -1.0);
+                mul_rows_into(
+                    w.rb_mut(),
+                    Accum::Add,
+                    self.v.get(.., ..nv),
+                    c.as_ref(),
+                    -1.0,
+                );
                 coef_v += &c;
             }
             for (cc, r) in norm2_removed.iter_mut().enumerate() {
@@ -1173,4 +1179,68 @@ fn sturm_and_assemble(
         "sparse eigen-solver (Sturm check)",
         "the LDLᵀ factorisation of K - σ_u M met a zero pivot at every trial shift",
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+
+    fn csc(n: usize, cols: &[&[(usize, f64)]], sorted: bool) -> SparseColMat<usize, f64> {
+        let mut col_ptr = vec![0];
+        let (mut rows, mut vals) = (Vec::new(), Vec::new());
+        for c in cols {
+            for &(i, v) in c.iter() {
+                rows.push(i);
+                vals.push(v);
+            }
+            col_ptr.push(rows.len());
+        }
+        let sym = if sorted {
+            SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows)
+        } else {
+            SymbolicSparseColMat::new_unsorted_checked(n, n, col_ptr, None, rows)
+        };
+        SparseColMat::new(sym, vals)
+    }
+
+    /// The binary-search check accepts a symmetric matrix, finds an entry whose mirror differs
+    /// or is missing, and leaves unsorted columns to the transpose-based check, which words
+    /// the error with the pair's indices.
+    #[test]
+    fn symmetry_check_by_binary_search_and_its_fall_back() {
+        let sym = csc(
+            3,
+            &[
+                &[(0, 2.0), (1, -1.0)],
+                &[(0, -1.0), (1, 2.0), (2, -1.0)],
+                &[(1, -1.0), (2, 1.0)],
+            ],
+            true,
+        );
+        assert_eq!(symmetric_sorted(sym.as_ref()), Some(true));
+        assert!(check_symmetric(sym.as_ref(), "K").is_ok());
+        let off = csc(
+            3,
+            &[
+                &[(0, 2.0), (1, -1.0)],
+                &[(0, -1.5), (1, 2.0), (2, -1.0)],
+                &[(1, -1.0), (2, 1.0)],
+            ],
+            true,
+        );
+        assert_eq!(symmetric_sorted(off.as_ref()), Some(false));
+        let e = check_symmetric(off.as_ref(), "K").unwrap_err().to_string();
+        assert!(e.contains("not symmetric") && e.contains("(1, 0)"), "{e}");
+        let missing = csc(3, &[&[(0, 2.0), (2, 0.5)], &[(1, 2.0)], &[(2, 1.0)]], true);
+        assert_eq!(symmetric_sorted(missing.as_ref()), Some(false));
+        assert!(check_symmetric(missing.as_ref(), "K").is_err());
+        let unsorted = csc(
+            3,
+            &[&[(1, -1.0), (0, 2.0)], &[(0, -1.0), (1, 2.0)], &[(2, 1.0)]],
+            false,
+        );
+        assert_eq!(symmetric_sorted(unsorted.as_ref()), None);
+        assert!(check_symmetric(unsorted.as_ref(), "K").is_ok());
+    }
 }
