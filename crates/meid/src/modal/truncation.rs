@@ -46,7 +46,7 @@ use faer::sparse::SparseColMatRef;
 use faer::{Mat, Par};
 use serde::Serialize;
 
-use super::lanczos::shifted::ShiftedPencil;
+use super::lanczos::ShiftedPencil;
 use super::ModalModel;
 use crate::{Error, Result};
 
@@ -395,6 +395,20 @@ pub fn static_deflections(
     rigid: &[Vec<f64>],
     lowest_elastic: Option<f64>,
 ) -> Result<Mat<f64>> {
+    static_deflections_sharing(k, m, functionals, rigid, lowest_elastic, &mut None)
+}
+
+/// [`static_deflections`] with the symbolic analysis of `K − σM` taken from `pencil` (the
+/// eigen-solver's, [`super::lanczos::lowest_modes_sharing`]) or built there when it is `None`.
+/// `pencil` must hold the analysis of this `k` and `m`.
+pub fn static_deflections_sharing(
+    k: SparseColMatRef<'_, usize, f64>,
+    m: SparseColMatRef<'_, usize, f64>,
+    functionals: &[Vec<f64>],
+    rigid: &[Vec<f64>],
+    lowest_elastic: Option<f64>,
+    pencil: &mut Option<ShiftedPencil>,
+) -> Result<Mat<f64>> {
     let n = k.nrows();
     let p = functionals.len();
     if p == 0 {
@@ -406,7 +420,12 @@ pub fn static_deflections(
             format!("point functionals and rigid-body modes need {n} entries"),
         ));
     }
-    let pencil = ShiftedPencil::new(k, m)?;
+    if pencil.is_none() {
+        *pencil = Some(ShiftedPencil::new(k, m)?);
+    }
+    let Some(pencil) = pencil.as_ref() else {
+        unreachable!("the pencil was just built")
+    };
     let mut rhs = Mat::<f64>::from_fn(n, p, |i, j| functionals[j][i]);
     if rigid.is_empty() {
         let mut llt = pencil.factor_llt(0.0, Par::Seq).map_err(|_| {

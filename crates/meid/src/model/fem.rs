@@ -751,6 +751,17 @@ pub fn solve_modes(
     solver: Option<SolverSpec>,
     count: usize,
 ) -> Result<(DenseModes, &'static str)> {
+    solve_modes_sharing(model, solver, count, &mut None)
+}
+
+/// [`solve_modes`], keeping the sparse solver's symbolic analysis of `K − σM` in `pencil` for
+/// the static deflections ([`full_static_flexibility`]).
+fn solve_modes_sharing(
+    model: &FeModel,
+    solver: Option<SolverSpec>,
+    count: usize,
+    pencil: &mut Option<lanczos::ShiftedPencil>,
+) -> Result<(DenseModes, &'static str)> {
     let n = model.n_dofs();
     if solver.is_none() && n < DENSE_LIMIT_DOFS {
         // The automatic choice: dense, and when its solution fails the check (the dense
@@ -759,7 +770,7 @@ pub fn solve_modes(
         let block = LanczosOptions::default().block_size;
         return match solve_modes(model, Some(SolverSpec::Dense), count) {
             Err(e) if lanczos_max_modes(n, block) >= count.min(n) => {
-                solve_modes(model, Some(SolverSpec::Lanczos), count).map_err(|e2| {
+                solve_modes_sharing(model, Some(SolverSpec::Lanczos), count, pencil).map_err(|e2| {
                     Error::numerical("eigen-solvers", format!("dense: {e}; lanczos: {e2}"))
                 })
             }
@@ -795,7 +806,8 @@ pub fn solve_modes(
                 count: count.min(n),
                 ..LanczosOptions::default()
             };
-            let s = lanczos::lowest_modes(model.stiffness.as_ref(), model.mass.as_ref(), &opts)
+            let (k, m) = (model.stiffness.as_ref(), model.mass.as_ref());
+            let s = lanczos::lowest_modes_sharing(k, m, &opts, pencil)
                 .map_err(|e| solver_hint(e, model, "lanczos"))?;
             Ok((checked(model, to_dense(s), "lanczos")?, "lanczos"))
         }
@@ -924,8 +936,10 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
     check_auto_max_hz(spec, src)?;
     let model = build_model(spec, src)?;
     let (wanted, solved) = mode_counts(spec, src, model.n_dofs())?;
+    let mut pencil = None;
     let (mut modes, solver) =
-        solve_modes(&model, spec.solver, solved.max(wanted)).map_err(|e| unsolvable(e, src))?;
+        solve_modes_sharing(&model, spec.solver, solved.max(wanted), &mut pencil)
+            .map_err(|e| unsolvable(e, src))?;
     let mut warnings = Vec::new();
     let extent = super::general::bounding_diagonal(model.mesh.nodes.iter().copied());
     warnings.extend(super::plausible::extent_slip(extent, base, src));
@@ -941,7 +955,8 @@ pub fn analyse(spec: &FemSpec, src: &Source, ctx: &ReductionContext) -> Result<F
             *s += v * v;
         }
     }
-    let statics = full_static_flexibility(&model, &modes, &functionals, &mut warnings);
+    let statics = full_static_flexibility(&model, &modes, &functionals, &mut pencil, &mut warnings);
+    drop(pencil);
     let (static_flexibility, static_cross) = (statics.diagonal.clone(), statics.cross.clone());
     let freq = &table.frequency_hz;
     let input = AutoInput {
@@ -1182,16 +1197,18 @@ fn full_static_flexibility(
     model: &FeModel,
     modes: &DenseModes,
     functionals: &[(String, Vec<f64>)],
+    pencil: &mut Option<lanczos::ShiftedPencil>,
     warnings: &mut Vec<String>,
 ) -> Statics {
     let (rigid, lowest_elastic) = rigid_and_lowest(modes);
     let fvecs: Vec<Vec<f64>> = functionals.iter().map(|(_, f)| f.clone()).collect();
-    match truncation::static_deflections(
+    match truncation::static_deflections_sharing(
         model.stiffness.as_ref(),
         model.mass.as_ref(),
         &fvecs,
         &rigid,
         lowest_elastic,
+        pencil,
     ) {
         Ok(u) => {
             let g = truncation::flexibility_of_deflections(&fvecs, u.as_ref());

@@ -28,8 +28,10 @@ use faer::{Conj, MatMut, Par, Side};
 
 use crate::{Error, Result};
 
-/// `K - σ M` on the union pattern of the lower triangles, with its symbolic factorisation.
-pub(crate) struct ShiftedPencil {
+/// `K - σ M` on the union pattern of the lower triangles, with its symbolic factorisation
+/// (built by the eigen-solver, [`super::lowest_modes_sharing`], and reused by the static
+/// deflections).
+pub struct ShiftedPencil {
     pattern: SymbolicSparseColMat<usize>,
     /// K values on the union pattern (lower triangle).
     k_val: Vec<f64>,
