@@ -420,12 +420,7 @@ pub fn static_deflections_sharing(
             format!("point functionals and rigid-body modes need {n} entries"),
         ));
     }
-    if pencil.is_none() {
-        *pencil = Some(ShiftedPencil::new(k, m)?);
-    }
-    let Some(pencil) = pencil.as_ref() else {
-        unreachable!("the pencil was just built")
-    };
+    let pencil = ShiftedPencil::in_slot(pencil, k, m)?;
     let mut rhs = Mat::<f64>::from_fn(n, p, |i, j| functionals[j][i]);
     if rigid.is_empty() {
         let mut llt = pencil.factor_llt(0.0, Par::Seq).map_err(|_| {

@@ -292,12 +292,7 @@ fn lowest_modes_scaled(
         ..Default::default()
     };
     let clock = Instant::now();
-    if pencil.is_none() {
-        *pencil = Some(ShiftedPencil::new(k, m)?);
-    }
-    let Some(pencil) = pencil.as_ref() else {
-        unreachable!("the pencil was just built")
-    };
+    let pencil = ShiftedPencil::in_slot(pencil, k, m)?;
     stats.factor_nnz = pencil.factor_nnz();
 
     let mut sigma = opts.shift.unwrap_or(-AUTO_SHIFT_FRACTION * s_ref);

@@ -113,6 +113,19 @@ impl ShiftedPencil {
         })
     }
 
+    /// The pencil held in `slot`, built from `k` and `m` when the slot is empty (a caller that
+    /// factors the same pencil again passes the same slot).
+    pub(crate) fn in_slot<'s>(
+        slot: &'s mut Option<Self>,
+        k: SparseColMatRef<'_, usize, f64>,
+        m: SparseColMatRef<'_, usize, f64>,
+    ) -> Result<&'s Self> {
+        match slot {
+            Some(p) => Ok(p),
+            None => Ok(slot.insert(Self::new(k, m)?)),
+        }
+    }
+
     /// Number of stored entries in the factor (a measure of memory and solve cost).
     pub(crate) fn factor_nnz(&self) -> usize {
         self.symbolic.len_val()
