@@ -172,18 +172,7 @@ pub fn blow_impacts(
 fn start(sys: &ImpactSystem, s: Switch, ci: usize, t: f64, x: &[f64]) -> Open {
     let (_, rate) = sys.relative_motion(s, x);
     Open {
-        row: ImpactRow {
-            contact: CONTACT_NAMES[ci].to_string(),
-            start_s: t,
-            approach_velocity_m_per_s: rate,
-            peak_force_n: Some(0.0),
-            peak_time_s: t,
-            duration_s: 0.0,
-            impulse_n_s: 0.0,
-            dissipated_j: 0.0,
-            exit_velocity_m_per_s: None,
-            restitution: None,
-        },
+        row: ImpactRow::opening(CONTACT_NAMES[ci].to_string(), t, rate),
         ext: Extremes::default(),
     }
 }

@@ -252,7 +252,18 @@ struct NetMap<'a> {
 }
 
 impl<'a> NetMap<'a> {
-    fn new(net: &'a Network, user: &Options, rate_bpm: f64, budget: usize) -> Result<Self> {
+    /// The steady search's budget of blow evaluations: `so.max_evaluations`, and at least
+    /// eight Newton steps (each `1 + d` blows here, forward differences) besides the march's
+    /// reserve of 84, so a machine with many modes (the 40-mode press with four dampers:
+    /// d = 90) is not cut off after three steps.
+    fn with_steady_budget(mut self, so: &SteadyOptions) -> Self {
+        self.budget = so.max_evaluations.max(8 * self.step_cost() + 84).max(2);
+        self
+    }
+
+    /// The map of `net`'s train at `rate_bpm`, with no limit on blow evaluations (a steady
+    /// search sets its own: [`NetMap::with_steady_budget`]).
+    fn new(net: &'a Network, user: &Options, rate_bpm: f64) -> Result<Self> {
         let interval = blow_interval_s(rate_bpm).map_err(rate_error)?;
         let nd = net.dofs();
         let n = net.n_modes();
@@ -345,7 +356,7 @@ impl<'a> NetMap<'a> {
             damper_contact,
             bed_point,
             evaluations: 0,
-            budget,
+            budget: usize::MAX,
             history: Vec::new(),
         })
     }
@@ -598,7 +609,7 @@ pub fn run_blows(model: &NetworkModel, b: &BlowOptions) -> Result<NetBlowsRun> {
         ));
     }
     let net = &model.network;
-    let map = NetMap::new(net, &model.options()?, b.rate_bpm, usize::MAX)?;
+    let map = NetMap::new(net, &model.options()?, b.rate_bpm)?;
     let mut x = engine::initial_state(net)?;
     let mut blows = Vec::with_capacity(b.blows);
     for k in 0..b.blows {
@@ -661,11 +672,7 @@ fn settled(blows: &[NetBlowReport], tol: f64) -> Option<usize> {
 pub fn steady_state(model: &NetworkModel, so: &SteadyOptions) -> Result<NetSteadyState> {
     check_options(so).map_err(rate_error)?;
     let net = &model.network;
-    let mut map = NetMap::new(net, &model.options()?, so.rate_bpm, 2)?;
-    // A Newton step costs `1 + d` blows here (forward differences): the budget holds at least
-    // eight of them besides the march's reserve, so a machine with many modes (the 40-mode press
-    // with four dampers: d = 90) is not cut off after three steps.
-    map.budget = so.max_evaluations.max(8 * map.step_cost() + 84).max(2);
+    let mut map = NetMap::new(net, &model.options()?, so.rate_bpm)?.with_steady_budget(so);
     let mut notes = Vec::new();
     let found = search(&mut map, so, !net.suspensions.is_empty(), &mut notes)?;
     let (blows, converged, residual, regime, method, mu, smooth, strike_state) = match found {

@@ -187,6 +187,25 @@ pub struct ImpactRow {
     pub restitution: Option<f64>,
 }
 
+impl ImpactRow {
+    /// The row of a contact that closed at `t` with closing speed `approach` (m/s): no force,
+    /// impulse or dissipation yet, still closed.
+    pub fn opening(contact: String, t: f64, approach: f64) -> Self {
+        Self {
+            contact,
+            start_s: t,
+            approach_velocity_m_per_s: approach,
+            peak_force_n: Some(0.0),
+            peak_time_s: t,
+            duration_s: 0.0,
+            impulse_n_s: 0.0,
+            dissipated_j: 0.0,
+            exit_velocity_m_per_s: None,
+            restitution: None,
+        }
+    }
+}
+
 /// The energies at the end of the collision.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NetCollisionEnd {
@@ -1602,18 +1621,7 @@ fn start_impact(
     impacts: &mut Vec<ImpactRow>,
 ) -> OpenImpact {
     let (_, rate) = net.overlap(c, x);
-    impacts.push(ImpactRow {
-        contact: net.contacts[c].name.clone(),
-        start_s: t,
-        approach_velocity_m_per_s: rate,
-        peak_force_n: Some(0.0),
-        peak_time_s: t,
-        duration_s: 0.0,
-        impulse_n_s: 0.0,
-        dissipated_j: 0.0,
-        exit_velocity_m_per_s: None,
-        restitution: None,
-    });
+    impacts.push(ImpactRow::opening(net.contacts[c].name.clone(), t, rate));
     OpenImpact {
         row: impacts.len() - 1,
         ext: Extremes::default(),
