@@ -456,3 +456,15 @@ proptest! {
         }
     }
 }
+
+/// An input the bounded fuzzing found (2026-11-29): a UFF file with nodes (2411) and two
+/// mode-shape datasets (55), one with a corrupted exponent. Every reader must refuse it or
+/// accept it whole, without a panic.
+#[test]
+fn fuzz_found_uff_with_two_mode_datasets_never_panics() {
+    let bytes = include_bytes!("data/fuzz/readers-crash-28d844b9.uff");
+    check_uff(bytes);
+    check_uff_import(bytes);
+    check_csv(bytes);
+    check_frd(bytes);
+}

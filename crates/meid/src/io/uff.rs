@@ -1656,6 +1656,19 @@ impl<R: BufRead> Parser<'_, R> {
         if usize::try_from(nrdv).ok() != Some(r8v.len()) {
             return Err(self.err(Some(ds), Some("record 8"), self.line_no, format!("record 7 declares {nrdv} real values (NRDV, field 2) but record 8 holds {}: '{}'", r8v.len(), clip(&r8))));
         }
+        // Read as fixed fields, record 8 may hold fewer numbers than its free-field reading did.
+        if r8v.len() < 3 {
+            return Err(self.err(
+                Some(ds),
+                Some("record 8"),
+                self.line_no,
+                format!(
+                    "expected frequency, modal mass and damping ratio (3 real values), got {}: '{}'",
+                    r8v.len(),
+                    clip(&r8)
+                ),
+            ));
+        }
         let mut shapes = Vec::new();
         loop {
             let l = self.dataset_line(ds)?;
