@@ -195,7 +195,9 @@ pub fn check_modes(
     let mdiag = diagonal(m);
     for (j, phi) in phis.iter().enumerate() {
         let (kphi, akphi) = products(k, phi);
-        let (mphi, _) = products(m, phi);
+        // `products` returns `M φ` and `|M||φ|`: the second is the mass term of the residual's
+        // round-off floor below (the same sums in the same order as a product with `|φ|`).
+        let (mphi, amphi) = products(m, phi);
         let q = dot(phi, &mphi);
         if !(q.is_finite() && q > 0.0) {
             return Err(Error::numerical(
@@ -222,8 +224,6 @@ pub fn check_modes(
             let d = norm(&akphi);
             (if d > 0.0 { norm(&kphi) / d } else { 0.0 }, 0.0)
         } else {
-            let abs_phi: Vec<f64> = phi.iter().map(|x| x.abs()).collect();
-            let (_, amphi) = products(m, &abs_phi);
             let (mut r2, mut k2, mut f2) = (0.0, 0.0, 0.0);
             for i in 0..n {
                 let w = kdiag[i] + lam.abs() * mdiag[i];
