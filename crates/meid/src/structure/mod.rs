@@ -24,6 +24,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod assembly;
+pub mod compress;
 pub mod discrete;
 pub mod frame;
 pub(crate) mod geom;
