@@ -534,7 +534,7 @@ impl FeModel {
         let grounded = !mesh.fixed.is_empty()
             || mesh.springs.iter().any(|s| s.other.is_none())
             || mesh.dashpots.iter().any(|s| s.other.is_none());
-        // Each triplet list is freed once compressed (at 10⁶ DOF K's is 2.4 GB).
+        // Each triplet list is freed once compressed (at 10⁶ DOF K's is ~1.4 GB).
         let stiffness = compress(n, &std::mem::take(&mut col.k), "stiffness")?;
         let mass = compress(n, &std::mem::take(&mut col.m), "mass")?;
         let damping = compress(n, &std::mem::take(&mut col.c), "damping")?;

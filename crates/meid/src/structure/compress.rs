@@ -4,8 +4,8 @@
 //! # Why hand-written
 //! faer 0.24 buckets the triplet indices by column, sorts each column's indices with a key that
 //! reads the row back from the triplet array, and gathers the values from it again: at 10⁶ DOF
-//! the stiffness has ~10⁸ triplets (2.4 GB), every key and every value is a cache miss, and the
-//! conversion was 6 % of a `meid modes` run (docs/performance.md). Here each column's entries
+//! the stiffness has ~6 × 10⁷ triplets (1.4 GB, estimated), every key and every value is a
+//! cache miss, and the conversion was 6 % of a `meid modes` run (docs/performance.md). Here each column's entries
 //! are first copied next to each other as `(row << 32 | position in the column)` keys with their
 //! values, and each column is sorted in place.
 //!
