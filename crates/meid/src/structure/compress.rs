@@ -5,9 +5,9 @@
 //! faer 0.24 buckets the triplet indices by column, sorts each column's indices with a key that
 //! reads the row back from the triplet array, and gathers the values from it again: at 10⁶ DOF
 //! the stiffness has ~6 × 10⁷ triplets (1.4 GB, estimated), every key and every value is a
-//! cache miss, and the conversion was 6 % of a `meid modes` run (docs/performance.md). Here each column's entries
-//! are first copied next to each other as `(row << 32 | position in the column)` keys with their
-//! values, and each column is sorted in place.
+//! cache miss, and the conversion was 6 % of a `meid modes` run (docs/performance.md). Here
+//! each column's entries are first copied next to each other as `(row << 32 | position in the
+//! column)` keys with their values, and each column is sorted in place.
 //!
 //! # Same bits as faer
 //! Within a column the entries stand in triplet order in both (a stable bucket pass), and both
@@ -70,10 +70,9 @@ pub fn compress(
         vals[s] = e.val;
         fill[e.col] += 1;
     }
-    drop(fill);
 
     // Each column sorted by row (module docs: the same comparisons as faer's), duplicates summed
-    // left to right; rows and values written over the front of the arrays.
+    // left to right into the compressed rows and values.
     let mut col_ptr = vec![0usize; n + 1];
     let mut row_idx = Vec::with_capacity(t.len());
     let mut values = Vec::with_capacity(t.len());
