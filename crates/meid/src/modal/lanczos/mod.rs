@@ -409,6 +409,8 @@ fn lowest_modes_scaled(
             stats.factor_s += fclock.elapsed().as_secs_f64();
             stats.factorizations += 1;
             stats.reshifts += 1;
+            // A new operator: its residuals start afresh, and so does the stall's reference.
+            (best_worst, since_halved) = (f64::INFINITY, 0);
             // New start block: the Ritz vectors folded into b columns.
             let w = folded_ritz_block(&st, &y, basis, basis.min(want + b), b);
             st.reset();
